@@ -1,0 +1,1 @@
+//! 10 s window averaging and temperature-rate estimation.

@@ -1,0 +1,1 @@
+//! Integer-only RBF evaluation for FPU-less parts.

@@ -1,0 +1,19 @@
+//! `fog-core`: the code that runs unchanged on the gyro's MCU and on the training PC.
+//!
+//! It turns high-rate fibre-optic-gyro samples into 10 s means, estimates the
+//! temperature rate, predicts the warm-up (Shupe) drift with a Gaussian RBF model,
+//! subtracts it, and runs the north-seeking routine on the compensated windows.
+//! `no_std`, no allocation, no `unsafe`; every fallible call returns a small `Copy`
+//! error enum instead of panicking on data.
+#![cfg_attr(not(any(test, feature = "std")), no_std)]
+#![forbid(unsafe_code)]
+
+pub mod compensator;
+pub mod consts;
+pub mod features;
+pub mod fixed;
+pub mod hal;
+pub mod model;
+pub mod northfinder;
+pub mod protocol;
+pub mod rbf;

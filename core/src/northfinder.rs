@@ -1,0 +1,1 @@
+//! Two- and four-position north seeking as a non-blocking state machine.

@@ -1,0 +1,1 @@
+//! Upload protocol messages shared by `fogsim upload` and the firmware.

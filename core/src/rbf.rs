@@ -1,0 +1,1 @@
+//! Gaussian RBF evaluation in f32 (`libm::expf`).

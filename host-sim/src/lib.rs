@@ -1,0 +1,1 @@
+//! `fog-sim`: the training PC's library behind the `fogsim` binary.

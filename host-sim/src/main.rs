@@ -1,0 +1,2 @@
+//! `fogsim`: command-line entry point.
+fn main() {}
