@@ -7,6 +7,8 @@
 //!
 //! drift_dph = bias_dph + sum_j linear[j] * xn_j + sum_i weights[i] * exp(-||xn - c_i||^2 / (2 widths[i]^2))
 //! with xn_j = (x_j - input_offset[j]) / input_scale[j] (normalised inputs).
+//! Only the first `n_rbf_inputs` inputs enter the Gaussian distance; inputs after
+//! them are linear-only terms (diagnose may add a cause that way).
 
 use heapless::{String, Vec};
 use serde::{Deserialize, Serialize};
@@ -67,6 +69,8 @@ pub struct TrainingMeta {
 /// A validated RBF drift model.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RbfModel {
+    /// How many of `inputs` (the leading ones) enter the RBF distance; the rest are linear-only.
+    pub n_rbf_inputs: u8,
     pub inputs: Vec<FeatureSpec, MAX_INPUTS>,
     pub input_offset: Vec<f32, MAX_INPUTS>,
     pub input_scale: Vec<f32, MAX_INPUTS>,
