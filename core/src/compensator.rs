@@ -1,1 +1,422 @@
-//! Per-window drift compensation.
+//! Per-window drift compensation: the 10 s pipeline the device runs after power-on.
+//!
+//! Samples go in as they arrive (gyro at its raw rate, temperature at ~1 Hz, optional
+//! aux channels); each time a window closes, the compensator produces one `WindowResult`:
+//! mean rate, mean temperature, the model's inputs (via `features::FeatureExtractor`, the
+//! same code the trainer uses on 10 s means), the RBF drift (f32 or fixed point) and the
+//! compensated rate, with a `WindowStatus` saying whether the window can be trusted.
+//! Inputs outside the model's trained range are flagged (and the drift is evaluated at
+//! the range edge, never extrapolated).
+
+use crate::features::{
+    FeatureError, FeatureExtractor, TempRateEstimator, WindowAverager, WindowMean,
+    DEFAULT_RATE_SPAN_S, EXTRACTOR_RATE_POINTS,
+};
+use crate::fixed::{FixedError, FixedModel};
+use crate::hal::{GyroSample, TempSample};
+use crate::model::{FeatureKind, FeatureSpec, ModelError, RbfModel, MAX_AUX, MAX_INPUTS};
+use crate::rbf::{predict_f32, RbfError};
+
+/// Which evaluator computes the drift.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Evaluator {
+    /// f32 with `libm::expf` (MCUs with an FPU, the host).
+    F32,
+    /// Integer-only (`fixed::FixedModel`) for FPU-less parts.
+    Fixed,
+}
+
+/// Compensator settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct CompensatorConfig {
+    /// Window length, s (10 s as in the paper).
+    pub window_s: f32,
+    /// Nominal gyro sample rate, Hz (1..10_000).
+    pub gyro_rate_hz: f32,
+    /// Nominal temperature (and aux) sample rate, Hz.
+    pub temp_rate_hz: f32,
+    /// Fraction of the expected gyro samples a valid window needs.
+    pub min_fill: f32,
+    /// Plausible sensor temperature range, degC; readings outside are a sensor fault.
+    pub temp_plausible_min_c: f32,
+    pub temp_plausible_max_c: f32,
+    /// Tolerance beyond the trained range, as a fraction of the range width.
+    pub range_margin_frac: f32,
+    /// Number of aux channels pushed with `push_aux` (0..=MAX_AUX).
+    pub n_aux: u8,
+    pub evaluator: Evaluator,
+}
+
+impl Default for CompensatorConfig {
+    fn default() -> Self {
+        CompensatorConfig {
+            window_s: crate::consts::WINDOW_S,
+            gyro_rate_hz: 100.0,
+            temp_rate_hz: 1.0,
+            min_fill: 0.9,
+            temp_plausible_min_c: -60.0,
+            temp_plausible_max_c: 125.0,
+            range_margin_frac: 0.05,
+            n_aux: 0,
+            evaluator: Evaluator::F32,
+        }
+    }
+}
+
+/// Why the compensator could not be set up.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum CompensatorError {
+    /// Invalid model.
+    Model(ModelError),
+    /// The model cannot be converted to fixed point.
+    Fixed(FixedError),
+    /// The model's features cannot be computed.
+    Feature(FeatureError),
+    /// A configuration value out of range (window, rates, fill, n_aux).
+    BadConfig,
+    /// The model reads an aux channel the configuration does not provide.
+    AuxNotConfigured { channel: u8 },
+}
+
+impl core::fmt::Display for CompensatorError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            CompensatorError::Model(e) => write!(f, "compensator: {e}"),
+            CompensatorError::Fixed(e) => write!(f, "compensator: {e}"),
+            CompensatorError::Feature(e) => write!(f, "compensator: {e}"),
+            CompensatorError::BadConfig => write!(
+                f,
+                "compensator: bad configuration (window > 0, rates 0..=10 kHz, 0 < min_fill <= 1, n_aux <= {MAX_AUX})"
+            ),
+            CompensatorError::AuxNotConfigured { channel } => write!(
+                f,
+                "compensator: model needs aux channel {channel}, not configured"
+            ),
+        }
+    }
+}
+
+impl core::error::Error for CompensatorError {}
+
+/// Whether a window's result can be used.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum WindowStatus {
+    /// Enough samples, temperature present and in range, model inputs in the trained range.
+    Valid,
+    /// A sensor fault was reported during the window, or a reading was implausible.
+    SensorFault,
+    /// Fewer gyro samples than `min_fill` of the expected count.
+    TooFewSamples,
+    /// No temperature reading in the window.
+    NoTemperature,
+    /// A rate/accel feature does not have enough history yet (first windows after power-on).
+    FeaturesWarmingUp,
+    /// Model input `input` lies outside its trained range (drift taken at the range edge).
+    InputOutOfRange { input: u8 },
+}
+
+impl WindowStatus {
+    pub fn is_valid(self) -> bool {
+        self == WindowStatus::Valid
+    }
+}
+
+/// One 10 s result.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct WindowResult {
+    /// Window start and end, s since power-on.
+    pub t_start_s: f64,
+    pub t_end_s: f64,
+    /// Mean gyro output over the window, deg/h.
+    pub mean_rate_dph: f32,
+    /// Mean gyro temperature, degC (NaN if none).
+    pub temp_c: f32,
+    /// dT/dt, degC/s (least-squares over `DEFAULT_RATE_SPAN_S` of window means; 0 until known).
+    pub temp_rate_cps: f32,
+    /// The model's inputs for this window (raw units), `n_inputs` used.
+    pub inputs: [f32; MAX_INPUTS],
+    pub n_inputs: u8,
+    /// Predicted drift, deg/h (0 without a model).
+    pub drift_dph: f32,
+    /// mean_rate_dph - drift_dph.
+    pub compensated_dph: f32,
+    /// Gyro samples averaged / expected; gaps seen.
+    pub n_samples: u32,
+    pub n_expected: u32,
+    pub n_gaps: u32,
+    /// True if a model was applied.
+    pub model_applied: bool,
+    pub status: WindowStatus,
+}
+
+/// The 10 s compensation pipeline.
+#[derive(Clone, Debug)]
+pub struct Compensator {
+    cfg: CompensatorConfig,
+    model: Option<RbfModel>,
+    fixed: Option<FixedModel>,
+    features: FeatureExtractor,
+    rate_report: TempRateEstimator<EXTRACTOR_RATE_POINTS>,
+    gyro: WindowAverager,
+    temp: WindowAverager,
+    temp_pending: Option<WindowMean>,
+    aux: [WindowAverager; MAX_AUX],
+    aux_pending: [Option<WindowMean>; MAX_AUX],
+    fault_window: Option<i64>,
+}
+
+const DEFAULT_SPECS: [FeatureSpec; 2] = [
+    FeatureSpec {
+        kind: FeatureKind::TempC,
+        tau_s: 0.0,
+    },
+    FeatureSpec {
+        kind: FeatureKind::TempRateCps,
+        tau_s: 0.0,
+    },
+];
+
+impl Compensator {
+    /// Pipeline with an optional model (None: windows are reported uncompensated).
+    pub fn new(cfg: CompensatorConfig, model: Option<RbfModel>) -> Result<Self, CompensatorError> {
+        let ok_rate = |r: f32| r.is_finite() && r > 0.0 && r <= 10_000.0;
+        if !(cfg.window_s.is_finite()
+            && cfg.window_s > 0.0
+            && ok_rate(cfg.gyro_rate_hz)
+            && ok_rate(cfg.temp_rate_hz)
+            && cfg.min_fill > 0.0
+            && cfg.min_fill <= 1.0
+            && cfg.range_margin_frac >= 0.0
+            && cfg.temp_plausible_min_c < cfg.temp_plausible_max_c
+            && cfg.n_aux as usize <= MAX_AUX)
+        {
+            return Err(CompensatorError::BadConfig);
+        }
+        let bad = |_| CompensatorError::BadConfig;
+        let temp = WindowAverager::new(cfg.window_s, cfg.temp_rate_hz).map_err(bad)?;
+        let mut c = Compensator {
+            cfg,
+            model: None,
+            fixed: None,
+            features: FeatureExtractor::new(&DEFAULT_SPECS).map_err(CompensatorError::Feature)?,
+            rate_report: TempRateEstimator::new(DEFAULT_RATE_SPAN_S).map_err(bad)?,
+            gyro: WindowAverager::new(cfg.window_s, cfg.gyro_rate_hz).map_err(bad)?,
+            temp: temp.clone(),
+            temp_pending: None,
+            aux: [temp.clone(), temp.clone(), temp.clone(), temp],
+            aux_pending: [None; MAX_AUX],
+            fault_window: None,
+        };
+        c.set_model(model)?;
+        Ok(c)
+    }
+
+    /// Replace the model (e.g. after an upload). Feature history restarts.
+    pub fn set_model(&mut self, model: Option<RbfModel>) -> Result<(), CompensatorError> {
+        let (features, fixed) = match &model {
+            Some(m) => {
+                m.validate().map_err(CompensatorError::Model)?;
+                for spec in m.inputs.iter() {
+                    if let Some(ch) = spec.kind.aux_channel() {
+                        if ch >= self.cfg.n_aux {
+                            return Err(CompensatorError::AuxNotConfigured { channel: ch });
+                        }
+                    }
+                }
+                let fixed = match self.cfg.evaluator {
+                    Evaluator::Fixed => {
+                        Some(FixedModel::from_model(m).map_err(CompensatorError::Fixed)?)
+                    }
+                    Evaluator::F32 => None,
+                };
+                (
+                    FeatureExtractor::new(&m.inputs).map_err(CompensatorError::Feature)?,
+                    fixed,
+                )
+            }
+            None => (
+                FeatureExtractor::new(&DEFAULT_SPECS).map_err(CompensatorError::Feature)?,
+                None,
+            ),
+        };
+        self.features = features;
+        self.fixed = fixed;
+        self.model = model;
+        Ok(())
+    }
+
+    /// The model in use.
+    pub fn model(&self) -> Option<&RbfModel> {
+        self.model.as_ref()
+    }
+
+    pub fn config(&self) -> &CompensatorConfig {
+        &self.cfg
+    }
+
+    /// Add a gyro sample; returns the result of the window it closed, if any.
+    pub fn push_gyro(&mut self, s: GyroSample) -> Option<WindowResult> {
+        if !s.rate_dph.is_finite() || !s.t_s.is_finite() {
+            return None;
+        }
+        let closed = self.gyro.push(s.t_s, s.rate_dph)?;
+        Some(self.finish(closed))
+    }
+
+    /// Add a temperature reading. Implausible values mark the window as faulty.
+    pub fn push_temp(&mut self, s: TempSample) {
+        if !s.temp_c.is_finite()
+            || s.temp_c < self.cfg.temp_plausible_min_c
+            || s.temp_c > self.cfg.temp_plausible_max_c
+        {
+            self.report_fault(s.t_s);
+            return;
+        }
+        if let Some(m) = self.temp.push(s.t_s, s.temp_c) {
+            self.temp_pending = Some(m);
+        }
+    }
+
+    /// Add a reading of aux channel `channel` (< `n_aux`; others are ignored).
+    pub fn push_aux(&mut self, channel: u8, t_s: f64, value: f32) {
+        let ch = channel as usize;
+        if channel >= self.cfg.n_aux {
+            return;
+        }
+        if let Some(m) = self.aux[ch].push(t_s, value) {
+            self.aux_pending[ch] = Some(m);
+        }
+    }
+
+    /// A sensor reported a fault at `t_s` (read error, timeout): that window is invalid.
+    pub fn report_fault(&mut self, t_s: f64) {
+        if t_s.is_finite() {
+            self.fault_window = Some(self.gyro.window_index(t_s));
+        }
+    }
+
+    /// Close the current window by time (no gyro sample needed), e.g. from a timer, so a
+    /// silent gyro still yields an (invalid) result.
+    pub fn poll(&mut self, t_now_s: f64) -> Option<WindowResult> {
+        let closed = self.gyro.poll(t_now_s)?;
+        Some(self.finish(closed))
+    }
+
+    fn take_mean(avg: &mut WindowAverager, pending: &mut Option<WindowMean>, t_end_s: f64) -> Option<f64> {
+        let same = |m: &WindowMean| libm::fabs(m.t_end_s - t_end_s) < 1e-6 && m.n_samples > 0;
+        if let Some(m) = pending.take() {
+            if same(&m) {
+                return Some(m.mean);
+            }
+        }
+        match avg.poll(t_end_s) {
+            Some(m) if same(&m) => Some(m.mean),
+            _ => None,
+        }
+    }
+
+    fn finish(&mut self, g: WindowMean) -> WindowResult {
+        let t_end = g.t_end_s;
+        let window_k = self.gyro.window_index(g.t_start_s + 0.5 * self.gyro.window_s());
+        let temp = Self::take_mean(&mut self.temp, &mut self.temp_pending, t_end);
+        let mut aux = [0.0f32; MAX_AUX];
+        let mut aux_ok = true;
+        for ch in 0..self.cfg.n_aux as usize {
+            match Self::take_mean(&mut self.aux[ch], &mut self.aux_pending[ch], t_end) {
+                Some(v) => aux[ch] = v as f32,
+                None => aux_ok = false,
+            }
+        }
+        let faulted = self.fault_window == Some(window_k);
+        let mean_rate = g.mean as f32;
+        let mut r = WindowResult {
+            t_start_s: g.t_start_s,
+            t_end_s: t_end,
+            mean_rate_dph: mean_rate,
+            temp_c: temp.map_or(f32::NAN, |t| t as f32),
+            temp_rate_cps: 0.0,
+            inputs: [0.0; MAX_INPUTS],
+            n_inputs: 0,
+            drift_dph: 0.0,
+            compensated_dph: mean_rate,
+            n_samples: g.n_samples,
+            n_expected: g.n_expected,
+            n_gaps: g.n_gaps,
+            model_applied: false,
+            status: WindowStatus::Valid,
+        };
+        let enough = g.n_samples > 0
+            && g.n_samples as f32 >= self.cfg.min_fill * g.n_expected as f32;
+        let mut status = if faulted || (self.cfg.n_aux > 0 && !aux_ok) {
+            WindowStatus::SensorFault
+        } else if !enough {
+            WindowStatus::TooFewSamples
+        } else if temp.is_none() {
+            WindowStatus::NoTemperature
+        } else {
+            WindowStatus::Valid
+        };
+        if let Some(t) = temp {
+            if let Some(e) = self.rate_report.push(t_end, t) {
+                r.temp_rate_cps = e.rate_per_s as f32;
+            }
+            // Feature history only advances on windows with a real temperature.
+            match self.features.push(t_end, t as f32, &aux[..self.cfg.n_aux as usize]) {
+                Ok(fv) => {
+                    r.inputs = fv.values;
+                    r.n_inputs = fv.len;
+                    if !fv.ready && status.is_valid() {
+                        status = WindowStatus::FeaturesWarmingUp;
+                    }
+                    if fv.ready {
+                        let (drift, range) = self.evaluate(&fv.values[..fv.len as usize]);
+                        if let Some(d) = drift {
+                            r.drift_dph = d;
+                            r.compensated_dph = mean_rate - d;
+                            r.model_applied = true;
+                        }
+                        if let (Some(i), true) = (range, status.is_valid()) {
+                            status = WindowStatus::InputOutOfRange { input: i };
+                        }
+                    }
+                }
+                Err(_) => status = WindowStatus::SensorFault,
+            }
+        }
+        if !mean_rate.is_finite() && status.is_valid() {
+            status = WindowStatus::TooFewSamples;
+        }
+        r.status = status;
+        r
+    }
+
+    /// Drift at the inputs clamped to the (margin-widened) trained range, and the first
+    /// input that was outside it.
+    fn evaluate(&self, x: &[f32]) -> (Option<f32>, Option<u8>) {
+        let Some(m) = &self.model else {
+            return (None, None);
+        };
+        let mut clamped = [0.0f32; MAX_INPUTS];
+        let mut outside = None;
+        for (j, &v) in x.iter().enumerate() {
+            let (lo, hi) = (m.input_min[j], m.input_max[j]);
+            let margin = self.cfg.range_margin_frac * (hi - lo);
+            let (lo, hi) = (lo - margin, hi + margin);
+            if v < lo || v > hi {
+                outside.get_or_insert(j as u8);
+            }
+            clamped[j] = v.clamp(lo, hi);
+        }
+        let xs = &clamped[..x.len()];
+        let drift: Result<f32, RbfError> = match &self.fixed {
+            Some(f) => f.predict(xs),
+            None => predict_f32(m, xs),
+        };
+        (drift.ok(), outside)
+    }
+}

@@ -1,1 +1,585 @@
-//! 10 s window averaging and temperature-rate estimation.
+//! Model inputs computed from sensor streams, identically on the device and on the host.
+//!
+//! - `WindowAverager`: plain mean of samples over fixed windows aligned to power-on
+//!   (window k covers [k w, (k+1) w), labelled by its end), any rate 1 Hz..10 kHz, with
+//!   sample count, expected count and gaps tracked.
+//! - `TempRateEstimator`: least-squares slope (and optionally the quadratic term, i.e. the
+//!   second derivative) over a sliding *time* span. It accepts any sample spacing: 1 Hz raw
+//!   temperatures on the device or 10 s means on the host. With a span S, a ramp's slope is
+//!   exact; for a changing slope the estimate is the slope at the middle of the span, i.e.
+//!   it is causal with a delay of S/2 (30 s for the default 60 s span). A sensor quantised
+//!   in steps q moves the slope by at most 3 q / S (0.0031 degC/s for q = 0.0625 degC,
+//!   S = 60 s) instead of the q / dt spikes of a finite difference.
+//! - `FirstOrderLag`, `power_on_decay`: the remaining `FeatureKind`s.
+//! - `FeatureExtractor` / `features_for_series`: a list of `FeatureSpec` -> input vectors.
+//!   The device feeds it its 10 s window means as they close; the trainer feeds it the
+//!   10 s rows of a fog-runs file. Same code, same inputs, so trained and deployed features
+//!   are identical. Every feature is causal: row k only uses rows 0..=k.
+
+use crate::model::{FeatureKind, FeatureSpec, MAX_AUX, MAX_INPUTS};
+use heapless::{Deque, Vec};
+
+/// Default least-squares span of `TempRateCps` / `AuxRate` when `tau_s` is 0, s.
+pub const DEFAULT_RATE_SPAN_S: f64 = 60.0;
+/// Default least-squares span of `TempAccelCps2` when `tau_s` is 0, s.
+pub const DEFAULT_ACCEL_SPAN_S: f64 = 180.0;
+/// Points kept by the estimators inside `FeatureExtractor` (10 s rows: spans up to 310 s).
+pub const EXTRACTOR_RATE_POINTS: usize = 32;
+
+/// Why a feature could not be computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FeatureError {
+    /// A NaN or infinite temperature, aux value or time.
+    NonFinite { row: u32 },
+    /// Time did not increase from one row to the next.
+    TimeNotIncreasing { row: u32 },
+    /// A feature needs aux channel `channel`, which was not supplied.
+    MissingAux { channel: u8 },
+    /// Input series (or output slice) of different lengths.
+    LengthMismatch { expected: u32, found: u32 },
+    /// More feature specs than `MAX_INPUTS`.
+    TooManyFeatures,
+    /// A span or time constant that is not a positive finite number.
+    BadTimeConstant,
+}
+
+impl core::fmt::Display for FeatureError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            FeatureError::NonFinite { row } => {
+                write!(f, "features: row {row} has a NaN or infinite value")
+            }
+            FeatureError::TimeNotIncreasing { row } => {
+                write!(f, "features: time at row {row} does not increase")
+            }
+            FeatureError::MissingAux { channel } => {
+                write!(f, "features: aux channel {channel} is needed but not supplied")
+            }
+            FeatureError::LengthMismatch { expected, found } => {
+                write!(f, "features: series of length {found}, expected {expected}")
+            }
+            FeatureError::TooManyFeatures => {
+                write!(f, "features: more than {MAX_INPUTS} features requested")
+            }
+            FeatureError::BadTimeConstant => {
+                write!(f, "features: span / time constant must be positive and finite")
+            }
+        }
+    }
+}
+
+impl core::error::Error for FeatureError {}
+
+/// One closed averaging window.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct WindowMean {
+    /// Window start, s since power-on.
+    pub t_start_s: f64,
+    /// Window end (its label, as in fog-runs), s since power-on.
+    pub t_end_s: f64,
+    /// Mean of the samples (NaN if there were none).
+    pub mean: f64,
+    /// Samples averaged.
+    pub n_samples: u32,
+    /// Samples expected at the nominal rate.
+    pub n_expected: u32,
+    /// Intervals between consecutive samples longer than 1.5 nominal periods
+    /// (including a late first sample or a missing tail).
+    pub n_gaps: u32,
+    /// Longest time without a sample inside the window, s.
+    pub max_gap_s: f32,
+}
+
+/// Mean of samples over windows of `window_s` aligned to power-on.
+#[derive(Clone, Debug)]
+pub struct WindowAverager {
+    window_s: f64,
+    period_s: f64,
+    index: i64,
+    sum: f64,
+    n: u32,
+    n_gaps: u32,
+    max_gap_s: f64,
+    last_t_s: Option<f64>,
+}
+
+impl WindowAverager {
+    /// Windows of `window_s` (> 0) for samples arriving at `nominal_rate_hz` (> 0).
+    pub fn new(window_s: f32, nominal_rate_hz: f32) -> Result<Self, FeatureError> {
+        if !(window_s.is_finite() && window_s > 0.0 && nominal_rate_hz.is_finite())
+            || nominal_rate_hz <= 0.0
+        {
+            return Err(FeatureError::BadTimeConstant);
+        }
+        Ok(WindowAverager {
+            window_s: window_s as f64,
+            period_s: 1.0 / nominal_rate_hz as f64,
+            index: 0,
+            sum: 0.0,
+            n: 0,
+            n_gaps: 0,
+            max_gap_s: 0.0,
+            last_t_s: None,
+        })
+    }
+
+    /// Window length, s.
+    pub fn window_s(&self) -> f64 {
+        self.window_s
+    }
+
+    /// Index of the window containing time `t_s`.
+    pub fn window_index(&self, t_s: f64) -> i64 {
+        libm::floor(t_s / self.window_s) as i64
+    }
+
+    /// End of the window currently being filled, s.
+    pub fn current_end_s(&self) -> f64 {
+        (self.index + 1) as f64 * self.window_s
+    }
+
+    fn close(&mut self) -> WindowMean {
+        let t_start_s = self.index as f64 * self.window_s;
+        let t_end_s = t_start_s + self.window_s;
+        let since_last = match self.last_t_s {
+            Some(t) if t >= t_start_s => t_end_s - t,
+            _ => self.window_s,
+        };
+        let mut n_gaps = self.n_gaps;
+        let mut max_gap = self.max_gap_s;
+        if since_last > 1.5 * self.period_s {
+            n_gaps += 1;
+        }
+        if since_last > max_gap {
+            max_gap = since_last;
+        }
+        let out = WindowMean {
+            t_start_s,
+            t_end_s,
+            mean: if self.n > 0 {
+                self.sum / self.n as f64
+            } else {
+                f64::NAN
+            },
+            n_samples: self.n,
+            n_expected: libm::round(self.window_s / self.period_s) as u32,
+            n_gaps,
+            max_gap_s: max_gap as f32,
+        };
+        self.index += 1;
+        self.sum = 0.0;
+        self.n = 0;
+        self.n_gaps = 0;
+        self.max_gap_s = 0.0;
+        out
+    }
+
+    /// Add a sample. If it belongs to a later window, the current window is closed and
+    /// returned first (windows in between with no samples at all are skipped; their
+    /// absence shows as a jump in `t_end_s`). Samples older than the current window and
+    /// non-finite values are ignored (counted as a gap by the missing sample).
+    pub fn push(&mut self, t_s: f64, value: f32) -> Option<WindowMean> {
+        if !t_s.is_finite() || !value.is_finite() {
+            return None;
+        }
+        let k = self.window_index(t_s);
+        if k < self.index {
+            return None;
+        }
+        let mut closed = None;
+        if k > self.index {
+            if self.n > 0 || self.last_t_s.is_some_and(|t| t >= self.window_start()) {
+                closed = Some(self.close());
+            }
+            self.index = k;
+        }
+        let start = self.window_start();
+        let gap = match self.last_t_s {
+            Some(t) if t >= start => t_s - t,
+            _ => t_s - start,
+        };
+        if gap > 1.5 * self.period_s {
+            self.n_gaps += 1;
+        }
+        if gap > self.max_gap_s {
+            self.max_gap_s = gap;
+        }
+        self.sum += value as f64;
+        self.n += 1;
+        self.last_t_s = Some(t_s);
+        closed
+    }
+
+    fn window_start(&self) -> f64 {
+        self.index as f64 * self.window_s
+    }
+
+    /// Close the current window if `t_now_s` is at or past its end, even with no samples
+    /// (so a silent sensor still yields a window, with `n_samples` = 0).
+    pub fn poll(&mut self, t_now_s: f64) -> Option<WindowMean> {
+        if t_now_s >= self.current_end_s() {
+            let out = self.close();
+            let k = self.window_index(t_now_s);
+            if k > self.index {
+                self.index = k;
+            }
+            Some(out)
+        } else {
+            None
+        }
+    }
+}
+
+/// Result of a least-squares fit over the sliding span.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct RateEstimate {
+    /// Slope, units per second (degC/s for temperatures).
+    pub rate_per_s: f64,
+    /// Second derivative from a quadratic fit, units per s^2 (`None` with fewer than 3 points).
+    pub accel_per_s2: Option<f64>,
+    /// Points used.
+    pub n_points: u32,
+    /// Time covered by the points, s.
+    pub covered_s: f64,
+    /// True once the points cover at least 90 % of the span.
+    pub full: bool,
+}
+
+/// Least-squares slope (and second derivative) over a sliding time span.
+/// `N` bounds the points kept: if more than `N` fall inside the span, the oldest go first.
+#[derive(Clone, Debug)]
+pub struct TempRateEstimator<const N: usize = 128> {
+    span_s: f64,
+    points: Deque<(f64, f64), N>,
+}
+
+impl<const N: usize> TempRateEstimator<N> {
+    /// Estimator over the last `span_s` seconds (> 0).
+    pub fn new(span_s: f64) -> Result<Self, FeatureError> {
+        if !(span_s.is_finite() && span_s > 0.0) {
+            return Err(FeatureError::BadTimeConstant);
+        }
+        Ok(TempRateEstimator {
+            span_s,
+            points: Deque::new(),
+        })
+    }
+
+    /// Span, s.
+    pub fn span_s(&self) -> f64 {
+        self.span_s
+    }
+
+    /// Forget all points.
+    pub fn reset(&mut self) {
+        self.points.clear();
+    }
+
+    /// Add a point; returns the estimate over the span ending at `t_s` (None with fewer than
+    /// two points). Points with non-finite values or non-increasing time are ignored.
+    pub fn push(&mut self, t_s: f64, value: f64) -> Option<RateEstimate> {
+        if !t_s.is_finite() || !value.is_finite() {
+            return self.estimate();
+        }
+        if let Some(&(t_last, _)) = self.points.back() {
+            if t_s <= t_last {
+                return self.estimate();
+            }
+        }
+        if self.points.is_full() {
+            self.points.pop_front();
+        }
+        // Cannot fail: a slot was freed above.
+        let _ = self.points.push_back((t_s, value));
+        let oldest_allowed = t_s - self.span_s * (1.0 + 1e-9);
+        while self.points.front().is_some_and(|&(t, _)| t < oldest_allowed) {
+            self.points.pop_front();
+        }
+        self.estimate()
+    }
+
+    /// The current estimate without adding a point.
+    pub fn estimate(&self) -> Option<RateEstimate> {
+        let n = self.points.len();
+        if n < 2 {
+            return None;
+        }
+        let (t0, y0) = *self.points.front()?;
+        let (t1, _) = *self.points.back()?;
+        let nf = n as f64;
+        let (mut st, mut sy) = (0.0, 0.0);
+        for &(t, y) in self.points.iter() {
+            st += t - t0;
+            sy += y - y0;
+        }
+        let (tm, ym) = (st / nf, sy / nf);
+        let (mut s2, mut s3, mut s4, mut sty, mut st2y) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        for &(t, y) in self.points.iter() {
+            let tc = t - t0 - tm;
+            let yc = y - y0 - ym;
+            let tc2 = tc * tc;
+            s2 += tc2;
+            s3 += tc2 * tc;
+            s4 += tc2 * tc2;
+            sty += tc * yc;
+            st2y += tc2 * yc;
+        }
+        if s2 <= 0.0 {
+            return None;
+        }
+        let rate = sty / s2;
+        // Quadratic fit y = a + b tc + c tc^2 in centred time (sum tc = 0, sum yc = 0):
+        // [s2 s3; s3 s4 - s2^2/n] [b; c] = [sty; st2y].
+        let accel = if n >= 3 {
+            let d = s4 - s2 * s2 / nf;
+            let det = s2 * d - s3 * s3;
+            if det > 1e-12 * s2 * d.abs().max(1e-300) {
+                Some(2.0 * (s2 * st2y - s3 * sty) / det)
+            } else {
+                None
+            }
+        } else {
+            None
+        };
+        let covered = t1 - t0;
+        Some(RateEstimate {
+            rate_per_s: rate,
+            accel_per_s2: accel,
+            n_points: n as u32,
+            covered_s: covered,
+            full: covered >= 0.9 * self.span_s,
+        })
+    }
+}
+
+/// First-order lag (low-pass) y' = (x - y) / tau, exact for inputs held between samples.
+/// Starts at the first input.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FirstOrderLag {
+    tau_s: f64,
+    state: Option<(f64, f64)>,
+}
+
+impl FirstOrderLag {
+    /// Lag with time constant `tau_s` (> 0).
+    pub fn new(tau_s: f64) -> Result<Self, FeatureError> {
+        if !(tau_s.is_finite() && tau_s > 0.0) {
+            return Err(FeatureError::BadTimeConstant);
+        }
+        Ok(FirstOrderLag { tau_s, state: None })
+    }
+
+    /// Feed the input at `t_s`; returns the lagged value.
+    pub fn push(&mut self, t_s: f64, x: f64) -> f64 {
+        let y = match self.state {
+            None => x,
+            Some((t_last, y)) => {
+                let dt = t_s - t_last;
+                if dt > 0.0 {
+                    y + (x - y) * (1.0 - libm::exp(-dt / self.tau_s))
+                } else {
+                    y
+                }
+            }
+        };
+        self.state = Some((t_s, y));
+        y
+    }
+}
+
+/// Power-on transient shape exp(-t / tau).
+pub fn power_on_decay(t_s: f64, tau_s: f64) -> f64 {
+    libm::exp(-t_s / tau_s)
+}
+
+/// Model input vector for one row.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FeatureVector {
+    /// Values in the order of the specs; entries past `len` are 0.
+    pub values: [f32; MAX_INPUTS],
+    pub len: u8,
+    /// False while a rate/accel estimator has too few points (first row for rates,
+    /// first two rows for accelerations); such rows hold 0 there and should not be used.
+    pub ready: bool,
+}
+
+impl FeatureVector {
+    /// The used values.
+    pub fn as_slice(&self) -> &[f32] {
+        &self.values[..self.len as usize]
+    }
+}
+
+#[derive(Clone, Debug)]
+enum FeatureState {
+    Plain,
+    Rate(TempRateEstimator<EXTRACTOR_RATE_POINTS>),
+    Lag(FirstOrderLag),
+}
+
+/// Stateful computation of a list of `FeatureSpec`s, one row (window) at a time.
+#[derive(Clone, Debug)]
+pub struct FeatureExtractor {
+    specs: Vec<FeatureSpec, MAX_INPUTS>,
+    states: Vec<FeatureState, MAX_INPUTS>,
+    last_t_s: Option<f64>,
+    row: u32,
+}
+
+/// Span used for a rate or accel spec (its `tau_s`, or the default when 0).
+pub fn span_for(spec: &FeatureSpec) -> f64 {
+    let default = match spec.kind {
+        FeatureKind::TempAccelCps2 => DEFAULT_ACCEL_SPAN_S,
+        _ => DEFAULT_RATE_SPAN_S,
+    };
+    if spec.tau_s > 0.0 {
+        spec.tau_s as f64
+    } else {
+        default
+    }
+}
+
+impl FeatureExtractor {
+    /// Extractor for `specs` (at most `MAX_INPUTS`).
+    pub fn new(specs: &[FeatureSpec]) -> Result<Self, FeatureError> {
+        let mut v = Vec::new();
+        let mut states = Vec::new();
+        for spec in specs {
+            let state = match spec.kind {
+                FeatureKind::TempRateCps | FeatureKind::TempAccelCps2 | FeatureKind::AuxRate(_) => {
+                    FeatureState::Rate(TempRateEstimator::new(span_for(spec))?)
+                }
+                FeatureKind::TempLagC => FeatureState::Lag(FirstOrderLag::new(spec.tau_s as f64)?),
+                FeatureKind::PowerOnDecay => {
+                    if !(spec.tau_s.is_finite() && spec.tau_s > 0.0) {
+                        return Err(FeatureError::BadTimeConstant);
+                    }
+                    FeatureState::Plain
+                }
+                _ => FeatureState::Plain,
+            };
+            if let Some(ch) = spec.kind.aux_channel() {
+                if ch as usize >= MAX_AUX {
+                    return Err(FeatureError::MissingAux { channel: ch });
+                }
+            }
+            v.push(*spec).map_err(|_| FeatureError::TooManyFeatures)?;
+            states
+                .push(state)
+                .map_err(|_| FeatureError::TooManyFeatures)?;
+        }
+        Ok(FeatureExtractor {
+            specs: v,
+            states,
+            last_t_s: None,
+            row: 0,
+        })
+    }
+
+    /// The specs, in order.
+    pub fn specs(&self) -> &[FeatureSpec] {
+        &self.specs
+    }
+
+    /// Process one row: time since power-on (s), temperature (degC) and aux channel values.
+    /// On error the extractor state is unchanged.
+    pub fn push(&mut self, t_s: f64, temp_c: f32, aux: &[f32]) -> Result<FeatureVector, FeatureError> {
+        let row = self.row;
+        if !t_s.is_finite() || !temp_c.is_finite() {
+            return Err(FeatureError::NonFinite { row });
+        }
+        if self.last_t_s.is_some_and(|t| t_s <= t) {
+            return Err(FeatureError::TimeNotIncreasing { row });
+        }
+        for spec in self.specs.iter() {
+            if let Some(ch) = spec.kind.aux_channel() {
+                match aux.get(ch as usize) {
+                    None => return Err(FeatureError::MissingAux { channel: ch }),
+                    Some(v) if !v.is_finite() => return Err(FeatureError::NonFinite { row }),
+                    Some(_) => {}
+                }
+            }
+        }
+        let mut out = FeatureVector {
+            values: [0.0; MAX_INPUTS],
+            len: self.specs.len() as u8,
+            ready: true,
+        };
+        let temp = temp_c as f64;
+        for (i, (spec, state)) in self.specs.iter().zip(self.states.iter_mut()).enumerate() {
+            let aux_v = spec.kind.aux_channel().map(|ch| aux[ch as usize] as f64);
+            let value = match (spec.kind, state) {
+                (FeatureKind::TempC, _) => Some(temp),
+                (FeatureKind::TempRateCps, FeatureState::Rate(e)) => {
+                    e.push(t_s, temp).map(|r| r.rate_per_s)
+                }
+                (FeatureKind::TempAccelCps2, FeatureState::Rate(e)) => {
+                    e.push(t_s, temp).and_then(|r| r.accel_per_s2)
+                }
+                (FeatureKind::TempLagC, FeatureState::Lag(l)) => Some(l.push(t_s, temp)),
+                (FeatureKind::PowerOnDecay, _) => Some(power_on_decay(t_s, spec.tau_s as f64)),
+                (FeatureKind::AuxValue(_), _) => aux_v,
+                (FeatureKind::AuxRate(_), FeatureState::Rate(e)) => {
+                    e.push(t_s, aux_v.unwrap_or(0.0)).map(|r| r.rate_per_s)
+                }
+                (FeatureKind::AuxCos(_), _) => aux_v.map(|d| libm::cos(d.to_radians())),
+                (FeatureKind::AuxSin(_), _) => aux_v.map(|d| libm::sin(d.to_radians())),
+                _ => None,
+            };
+            match value {
+                Some(v) => out.values[i] = v as f32,
+                None => out.ready = false,
+            }
+        }
+        self.last_t_s = Some(t_s);
+        self.row += 1;
+        Ok(out)
+    }
+}
+
+/// Host-side helper for the trainer: the input vectors of every row of a series of 10 s
+/// means, computed by the same `FeatureExtractor` the device runs.
+///
+/// `aux[ch][row]` is aux channel `ch`; `out` must have one entry per row. Causal: row k uses
+/// rows 0..=k only; rows whose `ready` is false (estimator warm-up) should be left out of
+/// training, exactly as the device marks those windows invalid.
+pub fn features_for_series(
+    specs: &[FeatureSpec],
+    t_s: &[f64],
+    temp_c: &[f32],
+    aux: &[&[f32]],
+    out: &mut [FeatureVector],
+) -> Result<(), FeatureError> {
+    let n = t_s.len();
+    let mismatch = |found: usize| FeatureError::LengthMismatch {
+        expected: n as u32,
+        found: found as u32,
+    };
+    if temp_c.len() != n {
+        return Err(mismatch(temp_c.len()));
+    }
+    if out.len() != n {
+        return Err(mismatch(out.len()));
+    }
+    if let Some(a) = aux.iter().find(|a| a.len() != n) {
+        return Err(mismatch(a.len()));
+    }
+    if aux.len() > MAX_AUX {
+        return Err(FeatureError::MissingAux {
+            channel: MAX_AUX as u8,
+        });
+    }
+    let mut fx = FeatureExtractor::new(specs)?;
+    let mut row_aux = [0.0f32; MAX_AUX];
+    for k in 0..n {
+        for (ch, col) in aux.iter().enumerate() {
+            row_aux[ch] = col[k];
+        }
+        out[k] = fx.push(t_s[k], temp_c[k], &row_aux[..aux.len()])?;
+    }
+    Ok(())
+}

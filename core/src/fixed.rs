@@ -1,1 +1,381 @@
-//! Integer-only RBF evaluation for FPU-less parts.
+//! Integer-only RBF evaluation for FPU-less parts (Cortex-M0, fixed-point DSPs).
+//!
+//! `FixedModel::from_model` converts a validated `RbfModel` once (this step may use
+//! floats: it runs at model load). `FixedModel::predict` then uses integers only:
+//! inputs are taken apart from their IEEE-754 bits, the distance, the exponential and the
+//! weighted sum are integer arithmetic, and the result is assembled back into f32 bits.
+//!
+//! Number formats:
+//! - raw input j: i64 with `F_j` fraction bits chosen from its trained range (|x| < 2^(40-F_j)
+//!   gets full precision, larger values saturate; such inputs are out of range anyway);
+//! - normalised inputs and centres: Q.24 (`XN_FRAC`) in i64;
+//! - per-centre gain g_i = 1/(sqrt(2) s_i): Q.24, so ||xn - c||^2/(2 s^2) = sum (g (xn - c))^2
+//!   is a sum of squares in Q.48;
+//! - exp(-u): range-reduced as 2^-(u log2 e) = 2^-n * 2^-(k/32) * 2^-r with r < 1/32, a
+//!   32-entry Q.30 table and a 4th-order polynomial (truncation error < 5e-11); Q.30 result;
+//! - weights, bias, linear terms: Q.`w_frac`, scaled per model so the largest fits in 31 bits;
+//!   the weighted sum accumulates in i64.
+//!
+//! Worst error against the f64 reference: see `docs/core.md` (measured by the
+//! `fixed_worst_error_*` tests and `cargo run -p fog-core --example fixed_error --release`).
+
+use crate::model::{ModelError, RbfModel, MAX_CENTERS, MAX_INPUTS};
+use crate::rbf::RbfError;
+
+/// Fraction bits of normalised inputs and centres.
+pub const XN_FRAC: u32 = 24;
+/// Fraction bits of the exponential's result.
+pub const EXP_FRAC: u32 = 30;
+/// exp(-u) is taken as 0 for u >= this (exp(-23) = 1e-10 < 2^-30).
+pub const EXP_CUTOFF: u64 = 23;
+/// Bits of precision kept for raw inputs inside their trained range.
+const RAW_BITS: i32 = 40;
+/// Largest |normalised input| representable, Q.24 (about 120).
+const XN_LIMIT: i64 = 120 << XN_FRAC;
+
+/// 2^(-k/32) in Q.30 for k = 0..32.
+const EXP2_TABLE_Q30: [u32; 32] = [
+    1073741824, 1050733751, 1028218693, 1006186087, 984625594, 963527098, 942880699, 922676710,
+    902905651, 883558244, 864625413, 846098274, 827968132, 810226483, 792865000, 775875538,
+    759250125, 742980960, 727060411, 711481005, 696235434, 681316545, 666717336, 652430958,
+    638450708, 624770026, 611382493, 598281827, 585461881, 572916640, 560640218, 548626854,
+];
+/// log2(e) in Q.30.
+const LOG2E_Q30: u64 = 1_549_082_005;
+/// ln(2) in Q.30.
+const LN2_Q30: u64 = 744_261_118;
+/// 1/3 in Q.30.
+const INV3_Q30: u64 = 357_913_941;
+const ONE_Q30: u64 = 1 << 30;
+
+/// Why a model cannot be converted to fixed point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FixedError {
+    /// The model itself is invalid.
+    Model(ModelError),
+    /// Width too small for Q.24 gains (needs s >= 0.0056 in normalised units).
+    WidthTooSmall { center: u8 },
+    /// A centre coordinate beyond +-100 normalised units.
+    CenterOutOfRange { center: u8 },
+    /// An input's range, offset or scale cannot be represented.
+    InputRange { input: u8 },
+    /// A weight, bias or linear term beyond 2^30 deg/h.
+    WeightTooLarge,
+}
+
+impl core::fmt::Display for FixedError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            FixedError::Model(e) => write!(f, "fixed: {e}"),
+            FixedError::WidthTooSmall { center } => write!(
+                f,
+                "fixed: width of centre {center} is below 0.0056 normalised units (Q.24 limit)"
+            ),
+            FixedError::CenterOutOfRange { center } => {
+                write!(f, "fixed: centre {center} lies beyond +-100 normalised units")
+            }
+            FixedError::InputRange { input } => write!(
+                f,
+                "fixed: input {input}'s range/offset/scale cannot be represented in fixed point"
+            ),
+            FixedError::WeightTooLarge => write!(f, "fixed: a weight exceeds 2^30 deg/h"),
+        }
+    }
+}
+
+impl core::error::Error for FixedError {}
+
+/// A model prepared for integer-only evaluation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FixedModel {
+    n_inputs: u8,
+    n_rbf: u8,
+    n_centers: u8,
+    /// Fraction bits of raw input j.
+    in_frac: [u8; MAX_INPUTS],
+    /// Offset of input j in Q.in_frac.
+    in_offset_q: [i64; MAX_INPUTS],
+    /// 1/scale of input j, Q.in_gain_frac (about 2^40).
+    in_gain_q: [i64; MAX_INPUTS],
+    /// Right shift that brings (x - offset) * gain to Q.24.
+    in_shift: [u8; MAX_INPUTS],
+    centers_q: [[i32; MAX_INPUTS]; MAX_CENTERS],
+    gain_q: [i32; MAX_CENTERS],
+    weights_q: [i32; MAX_CENTERS],
+    linear_q: [i32; MAX_INPUTS],
+    bias_q: i64,
+    w_frac: u8,
+}
+
+/// Smallest e with v <= 2^e, for v > 0.
+fn ceil_log2(v: f64) -> i32 {
+    let (m, e) = libm::frexp(v);
+    if m == 0.5 {
+        e - 1
+    } else {
+        e
+    }
+}
+
+fn to_q(v: f64, frac: i32) -> i64 {
+    libm::round(libm::ldexp(v, frac)) as i64
+}
+
+impl FixedModel {
+    /// Convert a model (validated here) for integer-only evaluation.
+    pub fn from_model(model: &RbfModel) -> Result<FixedModel, FixedError> {
+        model.validate().map_err(FixedError::Model)?;
+        let n = model.inputs.len();
+        let mut fm = FixedModel {
+            n_inputs: n as u8,
+            n_rbf: model.n_rbf_inputs,
+            n_centers: model.centers.len() as u8,
+            in_frac: [0; MAX_INPUTS],
+            in_offset_q: [0; MAX_INPUTS],
+            in_gain_q: [0; MAX_INPUTS],
+            in_shift: [0; MAX_INPUTS],
+            centers_q: [[0; MAX_INPUTS]; MAX_CENTERS],
+            gain_q: [0; MAX_CENTERS],
+            weights_q: [0; MAX_CENTERS],
+            linear_q: [0; MAX_INPUTS],
+            bias_q: 0,
+            w_frac: 0,
+        };
+        for j in 0..n {
+            let off = model.input_offset[j] as f64;
+            let bound = (model.input_min[j] as f64)
+                .abs()
+                .max((model.input_max[j] as f64).abs())
+                .max(off.abs())
+                .max(1e-30);
+            let frac = RAW_BITS - ceil_log2(bound);
+            let gain = 1.0 / model.input_scale[j] as f64;
+            let gain_frac = RAW_BITS - ceil_log2(gain);
+            let shift = frac + gain_frac - XN_FRAC as i32;
+            if !(0..=126).contains(&frac) || !(0..=120).contains(&shift) {
+                return Err(FixedError::InputRange { input: j as u8 });
+            }
+            fm.in_frac[j] = frac as u8;
+            fm.in_offset_q[j] = to_q(off, frac);
+            fm.in_gain_q[j] = to_q(gain, gain_frac);
+            fm.in_shift[j] = shift as u8;
+        }
+        for (i, c) in model.centers.iter().enumerate() {
+            for j in 0..n {
+                if c[j].abs() >= 100.0 {
+                    return Err(FixedError::CenterOutOfRange { center: i as u8 });
+                }
+                fm.centers_q[i][j] = to_q(c[j] as f64, XN_FRAC as i32) as i32;
+            }
+            let g = 1.0 / (core::f64::consts::SQRT_2 * model.widths[i] as f64);
+            if g >= 127.0 {
+                return Err(FixedError::WidthTooSmall { center: i as u8 });
+            }
+            fm.gain_q[i] = to_q(g, XN_FRAC as i32) as i32;
+        }
+        let max_abs = model
+            .weights
+            .iter()
+            .chain(model.linear.iter())
+            .chain(core::iter::once(&model.bias_dph))
+            .fold(0.0f64, |m, &w| m.max((w as f64).abs()));
+        if max_abs >= (1u64 << 30) as f64 {
+            return Err(FixedError::WeightTooLarge);
+        }
+        let w_frac = if max_abs > 0.0 {
+            (30 - ceil_log2(max_abs)).clamp(0, 60)
+        } else {
+            30
+        };
+        fm.w_frac = w_frac as u8;
+        for (q, &w) in fm.weights_q.iter_mut().zip(model.weights.iter()) {
+            *q = to_q(w as f64, w_frac) as i32;
+        }
+        for (q, &w) in fm.linear_q.iter_mut().zip(model.linear.iter()) {
+            *q = to_q(w as f64, w_frac) as i32;
+        }
+        fm.bias_q = to_q(model.bias_dph as f64, w_frac);
+        Ok(fm)
+    }
+
+    /// Number of inputs the model expects.
+    pub fn n_inputs(&self) -> usize {
+        self.n_inputs as usize
+    }
+
+    /// Fraction bits of the internal drift accumulator.
+    pub fn weight_frac_bits(&self) -> u32 {
+        self.w_frac as u32
+    }
+
+    /// Raw inputs -> normalised Q.24, integer-only.
+    pub fn normalise_q24(&self, x_raw: &[f32]) -> Result<[i64; MAX_INPUTS], RbfError> {
+        let n = self.n_inputs as usize;
+        if x_raw.len() != n {
+            return Err(RbfError::WrongInputCount {
+                expected: n as u8,
+                got: x_raw.len().min(u8::MAX as usize) as u8,
+            });
+        }
+        let mut xn = [0i64; MAX_INPUTS];
+        for j in 0..n {
+            let x_q = f32_to_fixed(x_raw[j], self.in_frac[j] as i32)
+                .ok_or(RbfError::NonFiniteInput { index: j as u8 })?;
+            let diff = x_q.saturating_sub(self.in_offset_q[j]) as i128;
+            let prod = (diff * self.in_gain_q[j] as i128) >> self.in_shift[j];
+            xn[j] = prod.clamp(-XN_LIMIT as i128, XN_LIMIT as i128) as i64;
+        }
+        Ok(xn)
+    }
+
+    /// Drift in Q.`weight_frac_bits()` deg/h from normalised Q.24 inputs (integer-only core).
+    pub fn predict_from_normalised(&self, xn: &[i64; MAX_INPUTS]) -> i64 {
+        let n = self.n_inputs as usize;
+        let nr = self.n_rbf as usize;
+        let mut acc = self.bias_q;
+        for j in 0..n {
+            acc += (self.linear_q[j] as i64 * xn[j]) >> XN_FRAC;
+        }
+        let z_limit: i64 = 5 << XN_FRAC; // z^2 >= 25 > EXP_CUTOFF
+        let u_limit: i64 = (EXP_CUTOFF as i64) << (2 * XN_FRAC);
+        'centres: for i in 0..self.n_centers as usize {
+            let g = self.gain_q[i] as i64;
+            let c = &self.centers_q[i];
+            let mut u: i64 = 0;
+            for j in 0..nr {
+                let z = ((xn[j] - c[j] as i64) * g) >> XN_FRAC;
+                if z.abs() >= z_limit {
+                    continue 'centres;
+                }
+                u += z * z;
+            }
+            if u >= u_limit {
+                continue;
+            }
+            let e = exp_neg_q30((u >> (2 * XN_FRAC - 28)) as u64);
+            acc += (self.weights_q[i] as i64 * e as i64) >> EXP_FRAC;
+        }
+        acc
+    }
+
+    /// Predicted drift, deg/h (integer-only; f32 only at the boundary, by bit manipulation).
+    pub fn predict(&self, x_raw: &[f32]) -> Result<f32, RbfError> {
+        let xn = self.normalise_q24(x_raw)?;
+        Ok(fixed_to_f32(self.predict_from_normalised(&xn), self.w_frac as u32))
+    }
+
+    /// Predicted drift as Q16.16 deg/h (saturating), integer-only end to end.
+    pub fn predict_q16(&self, x_raw: &[f32]) -> Result<i32, RbfError> {
+        let xn = self.normalise_q24(x_raw)?;
+        let acc = self.predict_from_normalised(&xn);
+        let wf = self.w_frac as i32;
+        let q16 = if wf >= 16 {
+            acc >> (wf - 16)
+        } else {
+            acc.saturating_mul(1 << (16 - wf))
+        };
+        Ok(q16.clamp(i32::MIN as i64, i32::MAX as i64) as i32)
+    }
+}
+
+/// exp(-u) in Q.30 for u in Q.28, 0 <= u < 23 * 2^28. Integer-only.
+pub fn exp_neg_q30(u_q28: u64) -> u32 {
+    if u_q28 >= EXP_CUTOFF << 28 {
+        return 0;
+    }
+    // t = u * log2(e) in Q.58: < 23 * 1.443 * 2^58 < 2^64.
+    let t = u_q28 * LOG2E_Q30;
+    let n = (t >> 58) as u32;
+    let f = t & ((1u64 << 58) - 1);
+    let k = (f >> 53) as usize;
+    let r_q30 = (f & ((1u64 << 53) - 1)) >> 28; // r < 1/32
+    let y = (r_q30 * LN2_Q30) >> 30; // y = r ln 2 < 0.0217, Q.30
+    // exp(-y) = 1 - y (1 - y/2 (1 - y/3 (1 - y/4))), Horner in Q.30.
+    let mut p = ONE_Q30 - (y >> 2);
+    p = ONE_Q30 - ((((y * p) >> 30) * INV3_Q30) >> 30);
+    p = ONE_Q30 - (((y * p) >> 30) >> 1);
+    p = ONE_Q30 - ((y * p) >> 30);
+    let e = (EXP2_TABLE_Q30[k] as u64 * p) >> 30;
+    if n >= 32 {
+        0
+    } else {
+        (e >> n) as u32
+    }
+}
+
+/// f32 -> fixed with `frac` fraction bits, truncating toward zero and saturating at
+/// +-2^(RAW_BITS+1); `None` for NaN or infinity. Integer-only (IEEE-754 bit fields).
+pub fn f32_to_fixed(x: f32, frac: i32) -> Option<i64> {
+    let bits = x.to_bits();
+    let neg = bits >> 31 != 0;
+    let exp = ((bits >> 23) & 0xff) as i32;
+    if exp == 0xff {
+        return None;
+    }
+    let (mant, exp) = if exp == 0 {
+        ((bits & 0x7f_ffff) as i64, 1)
+    } else {
+        (((bits & 0x7f_ffff) | 0x80_0000) as i64, exp)
+    };
+    let limit = 1i64 << (RAW_BITS + 1);
+    let shift = exp - 150 + frac;
+    let mag = if mant == 0 {
+        0
+    } else if shift >= 0 {
+        if shift > 40 || (mant << shift) > limit {
+            limit
+        } else {
+            mant << shift
+        }
+    } else if shift <= -25 {
+        0
+    } else {
+        mant >> (-shift)
+    };
+    Some(if neg { -mag } else { mag })
+}
+
+/// Fixed (`frac` fraction bits) -> f32, round to nearest even. Integer-only.
+pub fn fixed_to_f32(v: i64, frac: u32) -> f32 {
+    if v == 0 {
+        return 0.0;
+    }
+    let neg = v < 0;
+    let mag = v.unsigned_abs();
+    let top = 63 - mag.leading_zeros() as i32; // index of the leading one
+    // Keep 24 significant bits, rounding the rest to nearest even.
+    let (mut mant, mut top) = if top > 23 {
+        let drop = (top - 23) as u32;
+        let m = mag >> drop;
+        let rest = mag & ((1u64 << drop) - 1);
+        let half = 1u64 << (drop - 1);
+        let m = if rest > half || (rest == half && m & 1 == 1) {
+            m + 1
+        } else {
+            m
+        };
+        (m, top)
+    } else {
+        (mag << (23 - top) as u32, top)
+    };
+    if mant >= 1 << 24 {
+        mant >>= 1;
+        top += 1;
+    }
+    let exp = top - frac as i32 + 127;
+    let bits = if exp >= 255 {
+        0x7f80_0000 // overflow: infinity (cannot happen for drift values)
+    } else if exp <= 0 {
+        // Subnormal or zero; such tiny drifts are below any resolution that matters.
+        let shift = (1 - exp) as u32;
+        if shift >= 24 {
+            0
+        } else {
+            (mant >> shift) as u32
+        }
+    } else {
+        ((exp as u32) << 23) | (mant as u32 & 0x7f_ffff)
+    };
+    f32::from_bits(bits | if neg { 0x8000_0000 } else { 0 })
+}

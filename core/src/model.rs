@@ -88,3 +88,413 @@ pub struct RbfModel {
     pub bias_dph: f32,
     pub meta: TrainingMeta,
 }
+
+/// Most auxiliary (extra sensor) channels a model may refer to.
+pub const MAX_AUX: usize = 4;
+/// Bytes reserved in front of the body while encoding (varint magic + version + length).
+const HEADER_RESERVE: usize = 5 + 3 + 3;
+
+/// Which part of a model a validation error is about.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ModelField {
+    Inputs,
+    InputOffset,
+    InputScale,
+    InputMin,
+    InputMax,
+    Linear,
+    Centers,
+    Widths,
+    Weights,
+    Bias,
+    HeldoutRms,
+    TimeConstant,
+}
+
+impl ModelField {
+    /// Field name as written in `RbfModel`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            ModelField::Inputs => "inputs",
+            ModelField::InputOffset => "input_offset",
+            ModelField::InputScale => "input_scale",
+            ModelField::InputMin => "input_min",
+            ModelField::InputMax => "input_max",
+            ModelField::Linear => "linear",
+            ModelField::Centers => "centers",
+            ModelField::Widths => "widths",
+            ModelField::Weights => "weights",
+            ModelField::Bias => "bias_dph",
+            ModelField::HeldoutRms => "meta.heldout_rms_dph",
+            ModelField::TimeConstant => "inputs[].tau_s",
+        }
+    }
+}
+
+/// Why a model could not be encoded, decoded or accepted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ModelError {
+    /// The output buffer cannot hold the encoded model.
+    BufferTooSmall { needed_at_least: u16 },
+    /// The encoded model is larger than `MAX_ENCODED_LEN`.
+    TooLarge { len: u32 },
+    /// The bytes end before the model does.
+    Truncated,
+    /// The first field is not `MODEL_MAGIC`.
+    BadMagic { found: u32 },
+    /// A format version this code does not understand.
+    UnsupportedVersion { found: u16 },
+    /// CRC-32 of the body does not match the stored one.
+    CrcMismatch { stored: u32, computed: u32 },
+    /// Bytes left over after the CRC.
+    TrailingBytes { count: u16 },
+    /// The body is not a well-formed postcard `RbfModel`.
+    Malformed,
+    /// Zero inputs.
+    NoInputs,
+    /// More inputs than `MAX_INPUTS`.
+    TooManyInputs { count: u16 },
+    /// More centres than `MAX_CENTERS`.
+    TooManyCenters { count: u16 },
+    /// `n_rbf_inputs` is larger than the number of inputs, or 0 with centres present.
+    BadRbfInputCount { n_rbf_inputs: u8, n_inputs: u8 },
+    /// A per-input or per-centre vector has the wrong length.
+    LengthMismatch { field: ModelField, expected: u16, found: u16 },
+    /// A NaN or infinite number.
+    NonFinite { field: ModelField, index: u16 },
+    /// An input scale that is not > 0.
+    NonPositiveScale { input: u8 },
+    /// A Gaussian width that is not > 0.
+    NonPositiveWidth { center: u16 },
+    /// Trained range with min > max.
+    BadRange { input: u8 },
+    /// A lag/decay input without a positive time constant, or a negative one elsewhere.
+    BadTimeConstant { input: u8 },
+    /// An auxiliary channel index >= `MAX_AUX`.
+    BadAuxChannel { input: u8, channel: u8 },
+}
+
+impl core::fmt::Display for ModelError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            ModelError::BufferTooSmall { needed_at_least } => {
+                write!(f, "model: output buffer too small (need at least {needed_at_least} bytes)")
+            }
+            ModelError::TooLarge { len } => {
+                write!(f, "model: encoded size {len} bytes exceeds the {MAX_ENCODED_LEN}-byte limit")
+            }
+            ModelError::Truncated => write!(f, "model: data ends before the model does (truncated)"),
+            ModelError::BadMagic { found } => write!(
+                f,
+                "model: bad magic 0x{found:08X} (expected 0x{MODEL_MAGIC:08X}, not a fog model)"
+            ),
+            ModelError::UnsupportedVersion { found } => write!(
+                f,
+                "model: format version {found} is not supported (this build reads version {MODEL_VERSION})"
+            ),
+            ModelError::CrcMismatch { stored, computed } => write!(
+                f,
+                "model: CRC-32 mismatch (stored 0x{stored:08X}, computed 0x{computed:08X}): corrupted"
+            ),
+            ModelError::TrailingBytes { count } => {
+                write!(f, "model: {count} unexpected bytes after the CRC")
+            }
+            ModelError::Malformed => write!(f, "model: body is not a well-formed model encoding"),
+            ModelError::NoInputs => write!(f, "model: has no inputs"),
+            ModelError::TooManyInputs { count } => {
+                write!(f, "model: {count} inputs, at most {MAX_INPUTS} are supported")
+            }
+            ModelError::TooManyCenters { count } => {
+                write!(f, "model: {count} centres, at most {MAX_CENTERS} are supported")
+            }
+            ModelError::BadRbfInputCount { n_rbf_inputs, n_inputs } => write!(
+                f,
+                "model: n_rbf_inputs = {n_rbf_inputs} is invalid for {n_inputs} inputs"
+            ),
+            ModelError::LengthMismatch { field, expected, found } => write!(
+                f,
+                "model: field `{}` has {found} entries, expected {expected}",
+                field.name()
+            ),
+            ModelError::NonFinite { field, index } => {
+                write!(f, "model: field `{}`[{index}] is NaN or infinite", field.name())
+            }
+            ModelError::NonPositiveScale { input } => {
+                write!(f, "model: input_scale[{input}] must be > 0")
+            }
+            ModelError::NonPositiveWidth { center } => {
+                write!(f, "model: widths[{center}] must be > 0")
+            }
+            ModelError::BadRange { input } => {
+                write!(f, "model: trained range of input {input} has min > max")
+            }
+            ModelError::BadTimeConstant { input } => write!(
+                f,
+                "model: input {input} has an invalid tau_s (lags/decays need tau_s > 0, others >= 0)"
+            ),
+            ModelError::BadAuxChannel { input, channel } => write!(
+                f,
+                "model: input {input} uses aux channel {channel}, at most {MAX_AUX} channels exist"
+            ),
+        }
+    }
+}
+
+impl core::error::Error for ModelError {}
+
+/// Counts written before the body so that oversize models get a precise error.
+#[derive(Serialize, Deserialize)]
+struct BodyCounts {
+    n_inputs: u16,
+    n_centers: u16,
+}
+
+/// The outer envelope: postcard of (magic, version, body bytes, CRC-32 of the body bytes).
+#[derive(Serialize, Deserialize)]
+struct WireModel<'a> {
+    magic: u32,
+    version: u16,
+    #[serde(borrow)]
+    body: &'a [u8],
+    crc32: u32,
+}
+
+/// CRC-32 (IEEE 802.3, as zlib/PNG) used for the model body.
+pub fn crc32(bytes: &[u8]) -> u32 {
+    crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC).checksum(bytes)
+}
+
+fn check_finite(field: ModelField, values: &[f32]) -> Result<(), ModelError> {
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(i) => Err(ModelError::NonFinite { field, index: i as u16 }),
+        None => Ok(()),
+    }
+}
+
+fn check_len(field: ModelField, expected: usize, found: usize) -> Result<(), ModelError> {
+    if expected == found {
+        Ok(())
+    } else {
+        Err(ModelError::LengthMismatch {
+            field,
+            expected: expected as u16,
+            found: found as u16,
+        })
+    }
+}
+
+impl FeatureKind {
+    /// The auxiliary channel this feature reads, if any.
+    pub const fn aux_channel(self) -> Option<u8> {
+        match self {
+            FeatureKind::AuxValue(n)
+            | FeatureKind::AuxRate(n)
+            | FeatureKind::AuxCos(n)
+            | FeatureKind::AuxSin(n) => Some(n),
+            _ => None,
+        }
+    }
+
+    /// True for kinds whose `tau_s` must be > 0 (lags and decays).
+    pub const fn needs_time_constant(self) -> bool {
+        matches!(self, FeatureKind::TempLagC | FeatureKind::PowerOnDecay)
+    }
+}
+
+impl RbfModel {
+    /// Number of inputs.
+    pub fn n_inputs(&self) -> usize {
+        self.inputs.len()
+    }
+
+    /// Number of RBF centres.
+    pub fn n_centers(&self) -> usize {
+        self.centers.len()
+    }
+
+    /// Check every invariant the evaluators rely on.
+    pub fn validate(&self) -> Result<(), ModelError> {
+        let n = self.inputs.len();
+        if n == 0 {
+            return Err(ModelError::NoInputs);
+        }
+        let nr = self.n_rbf_inputs as usize;
+        if nr > n || (nr == 0 && !self.centers.is_empty()) {
+            return Err(ModelError::BadRbfInputCount {
+                n_rbf_inputs: self.n_rbf_inputs,
+                n_inputs: n as u8,
+            });
+        }
+        check_len(ModelField::InputOffset, n, self.input_offset.len())?;
+        check_len(ModelField::InputScale, n, self.input_scale.len())?;
+        check_len(ModelField::InputMin, n, self.input_min.len())?;
+        check_len(ModelField::InputMax, n, self.input_max.len())?;
+        check_len(ModelField::Linear, n, self.linear.len())?;
+        let m = self.centers.len();
+        check_len(ModelField::Widths, m, self.widths.len())?;
+        check_len(ModelField::Weights, m, self.weights.len())?;
+        for (i, spec) in self.inputs.iter().enumerate() {
+            let tau_ok = spec.tau_s.is_finite()
+                && if spec.kind.needs_time_constant() {
+                    spec.tau_s > 0.0
+                } else {
+                    spec.tau_s >= 0.0
+                };
+            if !tau_ok {
+                return Err(ModelError::BadTimeConstant { input: i as u8 });
+            }
+            if let Some(ch) = spec.kind.aux_channel() {
+                if ch as usize >= MAX_AUX {
+                    return Err(ModelError::BadAuxChannel { input: i as u8, channel: ch });
+                }
+            }
+        }
+        check_finite(ModelField::InputOffset, &self.input_offset)?;
+        check_finite(ModelField::InputScale, &self.input_scale)?;
+        check_finite(ModelField::InputMin, &self.input_min)?;
+        check_finite(ModelField::InputMax, &self.input_max)?;
+        check_finite(ModelField::Linear, &self.linear)?;
+        if let Some(i) = self.input_scale.iter().position(|&s| s <= 0.0) {
+            return Err(ModelError::NonPositiveScale { input: i as u8 });
+        }
+        if let Some(i) = (0..n).find(|&i| self.input_min[i] > self.input_max[i]) {
+            return Err(ModelError::BadRange { input: i as u8 });
+        }
+        for (i, c) in self.centers.iter().enumerate() {
+            if c.iter().any(|v| !v.is_finite()) {
+                return Err(ModelError::NonFinite {
+                    field: ModelField::Centers,
+                    index: i as u16,
+                });
+            }
+        }
+        check_finite(ModelField::Widths, &self.widths)?;
+        if let Some(i) = self.widths.iter().position(|&w| w <= 0.0) {
+            return Err(ModelError::NonPositiveWidth { center: i as u16 });
+        }
+        check_finite(ModelField::Weights, &self.weights)?;
+        check_finite(ModelField::Bias, &[self.bias_dph])?;
+        check_finite(ModelField::HeldoutRms, &[self.meta.heldout_rms_dph])?;
+        Ok(())
+    }
+
+    /// Validate and encode into `buf`; returns the number of bytes written.
+    ///
+    /// Layout: postcard of `(magic: u32, version: u16, body: bytes, crc32: u32)` where body is
+    /// postcard of `(n_inputs: u16, n_centers: u16, RbfModel)` and the CRC covers the body bytes.
+    pub fn encode(&self, buf: &mut [u8]) -> Result<usize, ModelError> {
+        self.validate()?;
+        let too_small = ModelError::BufferTooSmall {
+            needed_at_least: (buf.len() + 1).min(u16::MAX as usize) as u16,
+        };
+        if buf.len() <= HEADER_RESERVE + 5 {
+            return Err(too_small);
+        }
+        let buf_len = buf.len();
+        let limit = buf_len.min(MAX_ENCODED_LEN + HEADER_RESERVE);
+        let counts = BodyCounts {
+            n_inputs: self.inputs.len() as u16,
+            n_centers: self.centers.len() as u16,
+        };
+        let body_area = &mut buf[HEADER_RESERVE..limit];
+        let counts_len = postcard::to_slice(&counts, body_area)
+            .map_err(|_| too_small)?
+            .len();
+        let model_len = postcard::to_slice(self, &mut body_area[counts_len..])
+            .map_err(|_| {
+                if limit < buf_len {
+                    ModelError::TooLarge { len: limit as u32 }
+                } else {
+                    too_small
+                }
+            })?
+            .len();
+        let body_len = counts_len + model_len;
+        let crc = crc32(&buf[HEADER_RESERVE..HEADER_RESERVE + body_len]);
+        // Header = postcard(magic, version, body length varint); serialise it with an empty
+        // body slice and drop the trailing zero length byte, then write the real length.
+        let mut head = [0u8; HEADER_RESERVE + 8];
+        let head_len = {
+            let fixed = postcard::to_slice(&(MODEL_MAGIC, MODEL_VERSION), &mut head)
+                .map_err(|_| ModelError::Malformed)?
+                .len();
+            let len_varint = postcard::to_slice(&(body_len as u32), &mut head[fixed..])
+                .map_err(|_| ModelError::Malformed)?
+                .len();
+            fixed + len_varint
+        };
+        buf.copy_within(HEADER_RESERVE..HEADER_RESERVE + body_len, head_len);
+        buf[..head_len].copy_from_slice(&head[..head_len]);
+        let crc_at = head_len + body_len;
+        let crc_len = postcard::to_slice(&crc, &mut buf[crc_at..])
+            .map_err(|_| too_small)?
+            .len();
+        let total = crc_at + crc_len;
+        if total > MAX_ENCODED_LEN {
+            return Err(ModelError::TooLarge { len: total as u32 });
+        }
+        Ok(total)
+    }
+
+    /// Decode and fully validate an encoded model.
+    pub fn decode(bytes: &[u8]) -> Result<RbfModel, ModelError> {
+        if bytes.len() > MAX_ENCODED_LEN {
+            return Err(ModelError::TooLarge { len: bytes.len() as u32 });
+        }
+        // Magic and version first, so a foreign or newer file gets the precise error.
+        let (magic, rest) = postcard::take_from_bytes::<u32>(bytes).map_err(map_postcard)?;
+        if magic != MODEL_MAGIC {
+            return Err(ModelError::BadMagic { found: magic });
+        }
+        let (version, _) = postcard::take_from_bytes::<u16>(rest).map_err(map_postcard)?;
+        if version != MODEL_VERSION {
+            return Err(ModelError::UnsupportedVersion { found: version });
+        }
+        let (wire, trailing) =
+            postcard::take_from_bytes::<WireModel<'_>>(bytes).map_err(map_postcard)?;
+        if !trailing.is_empty() {
+            return Err(ModelError::TrailingBytes {
+                count: trailing.len() as u16,
+            });
+        }
+        let computed = crc32(wire.body);
+        if computed != wire.crc32 {
+            return Err(ModelError::CrcMismatch {
+                stored: wire.crc32,
+                computed,
+            });
+        }
+        let (counts, model_bytes) =
+            postcard::take_from_bytes::<BodyCounts>(wire.body).map_err(|_| ModelError::Malformed)?;
+        if counts.n_inputs as usize > MAX_INPUTS {
+            return Err(ModelError::TooManyInputs {
+                count: counts.n_inputs,
+            });
+        }
+        if counts.n_centers as usize > MAX_CENTERS {
+            return Err(ModelError::TooManyCenters {
+                count: counts.n_centers,
+            });
+        }
+        let (model, left) = postcard::take_from_bytes::<RbfModel>(model_bytes)
+            .map_err(|_| ModelError::Malformed)?;
+        if !left.is_empty() {
+            return Err(ModelError::TrailingBytes {
+                count: left.len() as u16,
+            });
+        }
+        check_len(ModelField::Inputs, counts.n_inputs as usize, model.inputs.len())?;
+        check_len(ModelField::Centers, counts.n_centers as usize, model.centers.len())?;
+        model.validate()?;
+        Ok(model)
+    }
+}
+
+fn map_postcard(e: postcard::Error) -> ModelError {
+    match e {
+        postcard::Error::DeserializeUnexpectedEnd => ModelError::Truncated,
+        _ => ModelError::Malformed,
+    }
+}

@@ -1,1 +1,457 @@
 //! Two- and four-position north seeking as a non-blocking state machine.
+//!
+//! The gyro's input axis is horizontal on an indexing turntable. With the table at heading h
+//! (degrees, clockwise seen from above, like azimuth) the axis points at azimuth A + h, where A
+//! is the azimuth of table heading 0 (what we look for), and the gyro reads
+//! w(h) = Omega_H cos(A + h) + bias.
+//!
+//! - Two positions: dwell at h0, turn 180 deg, dwell at h0+180: cos(psi) = (w1 - w2) / (2 Omega_H)
+//!   with psi = A + h0 (the bias cancels if it is the same in both dwells). acos leaves the
+//!   sign of psi open; a short dwell at h0+90 reads -Omega_H sin(psi) + bias, and with the bias
+//!   from the two main dwells ((w1 + w2) / 2) its sign picks the half circle.
+//! - Four positions (h0 + 0/90/180/270): psi = atan2(w4 - w2, w1 - w3); bias and scale factor cancel.
+//!
+//! It is driven by the 10 s `WindowResult`s (compensated rates) and polls a `hal::Turntable`;
+//! it never blocks. Windows that overlap a move or the settle time are not used; invalid
+//! windows are skipped (too many abort the seek). The 1-sigma uncertainty comes from the
+//! scatter of the window means observed in each dwell.
+
+use crate::compensator::WindowResult;
+use crate::consts::earth_rate_horizontal_dph;
+use crate::hal::{TableState, Turntable};
+
+/// Most table positions in one seek.
+pub const MAX_POSITIONS: usize = 4;
+
+/// Two or four positions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum SeekMode {
+    /// h0, h0+180, then a short dwell at h0+90 to resolve the acos ambiguity.
+    TwoPosition,
+    /// h0, h0+90, h0+180, h0+270 with atan2 (cancels bias and scale factor).
+    FourPosition,
+}
+
+/// Seek settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct SeekConfig {
+    pub mode: SeekMode,
+    /// Site latitude, deg (|lat| < 85 so that Omega_H is usable).
+    pub latitude_deg: f64,
+    /// Table heading of the first position, deg.
+    pub start_heading_deg: f32,
+    /// Measuring time per main position, s (rounded up to whole windows).
+    pub dwell_s: f32,
+    /// Measuring time at h0+90 for the two-position ambiguity, s (> 0).
+    pub ambiguity_dwell_s: f32,
+    /// Extra wait after the table reports `Settled`, s.
+    pub settle_s: f32,
+    /// Longest a move may take, s.
+    pub move_timeout_s: f32,
+    /// Invalid windows tolerated per position before the seek fails.
+    pub max_invalid_windows: u16,
+}
+
+impl Default for SeekConfig {
+    /// Two positions, 120 s dwells and a 30 s ambiguity dwell: with 10 s windows and
+    /// ~10 s per move this takes about 290 s, within the paper's 4 min 56 s.
+    fn default() -> Self {
+        SeekConfig {
+            mode: SeekMode::TwoPosition,
+            latitude_deg: 39.9,
+            start_heading_deg: 0.0,
+            dwell_s: 120.0,
+            ambiguity_dwell_s: 30.0,
+            settle_s: 0.0,
+            move_timeout_s: 60.0,
+            max_invalid_windows: 3,
+        }
+    }
+}
+
+/// Why a seek could not run or finish.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum SeekError {
+    /// A configuration value out of range.
+    BadConfig,
+    /// `start` while a seek is running.
+    Busy,
+    /// The turntable driver returned an error.
+    Turntable,
+    /// The table did not settle within `move_timeout_s` at position `position`.
+    TableTimeout { position: u8 },
+    /// Too many invalid windows at position `position`.
+    TooManyInvalidWindows { position: u8 },
+    /// |w1 - w2| is well above 2 Omega_H: wrong latitude, gyro fault or uncompensated drift.
+    InconsistentRates,
+}
+
+impl core::fmt::Display for SeekError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            SeekError::BadConfig => write!(
+                f,
+                "north finder: bad configuration (|latitude| < 85 deg, dwells > 0, finite headings)"
+            ),
+            SeekError::Busy => write!(f, "north finder: a seek is already running"),
+            SeekError::Turntable => write!(f, "north finder: turntable driver error"),
+            SeekError::TableTimeout { position } => write!(
+                f,
+                "north finder: turntable did not settle in time at position {position}"
+            ),
+            SeekError::TooManyInvalidWindows { position } => write!(
+                f,
+                "north finder: too many invalid 10 s windows at position {position}"
+            ),
+            SeekError::InconsistentRates => write!(
+                f,
+                "north finder: rate difference exceeds 2 Omega_H (wrong latitude or gyro fault)"
+            ),
+        }
+    }
+}
+
+impl core::error::Error for SeekError {}
+
+/// What one position measured.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PositionMean {
+    /// Table heading, deg.
+    pub heading_deg: f32,
+    /// Mean of the compensated window rates, deg/h.
+    pub mean_rate_dph: f64,
+    /// Standard deviation of the mean (window scatter / sqrt(n)), deg/h; 0 with one window.
+    pub sigma_dph: f64,
+    /// Windows used.
+    pub n_windows: u16,
+}
+
+/// A finished seek.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct SeekResult {
+    /// Azimuth of table heading 0 w.r.t. true north, deg in [0, 360).
+    pub azimuth_deg: f64,
+    /// 1-sigma uncertainty from the observed window noise, deg.
+    pub sigma_deg: f64,
+    /// From `start` to the end of the last window used, s.
+    pub duration_s: f64,
+    pub t_start_s: f64,
+    pub t_end_s: f64,
+    /// Bias estimated from the dwells, deg/h.
+    pub bias_dph: f64,
+    pub mode: SeekMode,
+    /// Per-position means, in the order measured; `n_positions` used.
+    pub positions: [PositionMean; MAX_POSITIONS],
+    pub n_positions: u8,
+}
+
+/// Where the seek is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum SeekStatus {
+    Idle,
+    Moving { position: u8 },
+    Dwelling { position: u8, windows: u16 },
+    Done(SeekResult),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Phase {
+    Idle,
+    Moving { since_s: f64 },
+    Dwelling { accept_from_s: f64 },
+    Done,
+}
+
+#[derive(Clone, Copy, Debug, Default)]
+struct Accumulator {
+    sum: f64,
+    sum_sq: f64,
+    n: u16,
+    invalid: u16,
+    duration_s: f64,
+}
+
+/// The north-seeking state machine.
+#[derive(Clone, Debug)]
+pub struct NorthFinder {
+    cfg: SeekConfig,
+    omega_h_dph: f64,
+    phase: Phase,
+    position: u8,
+    acc: [Accumulator; MAX_POSITIONS],
+    t_start_s: f64,
+    last: Option<SeekResult>,
+}
+
+fn wrap_360(deg: f64) -> f64 {
+    let r = deg - 360.0 * libm::floor(deg / 360.0);
+    if r >= 360.0 {
+        0.0
+    } else {
+        r
+    }
+}
+
+impl NorthFinder {
+    pub fn new(cfg: SeekConfig) -> Result<Self, SeekError> {
+        let pos = |v: f32| v.is_finite() && v > 0.0;
+        let ok = cfg.latitude_deg.is_finite()
+            && libm::fabs(cfg.latitude_deg) < 85.0
+            && cfg.start_heading_deg.is_finite()
+            && pos(cfg.dwell_s)
+            && pos(cfg.move_timeout_s)
+            && cfg.settle_s.is_finite()
+            && cfg.settle_s >= 0.0
+            && (cfg.mode == SeekMode::FourPosition || pos(cfg.ambiguity_dwell_s));
+        if !ok {
+            return Err(SeekError::BadConfig);
+        }
+        Ok(NorthFinder {
+            cfg,
+            omega_h_dph: earth_rate_horizontal_dph(cfg.latitude_deg),
+            phase: Phase::Idle,
+            position: 0,
+            acc: [Accumulator::default(); MAX_POSITIONS],
+            t_start_s: 0.0,
+            last: None,
+        })
+    }
+
+    pub fn config(&self) -> &SeekConfig {
+        &self.cfg
+    }
+
+    /// Horizontal Earth rate used, deg/h.
+    pub fn omega_h_dph(&self) -> f64 {
+        self.omega_h_dph
+    }
+
+    /// Number of positions of the configured mode.
+    pub fn n_positions(&self) -> usize {
+        match self.cfg.mode {
+            SeekMode::TwoPosition => 3,
+            SeekMode::FourPosition => 4,
+        }
+    }
+
+    /// Table heading of position `k`, deg in [0, 360).
+    pub fn heading_of(&self, k: usize) -> f32 {
+        let offset = match (self.cfg.mode, k) {
+            (SeekMode::TwoPosition, 0) => 0.0,
+            (SeekMode::TwoPosition, 1) => 180.0,
+            (SeekMode::TwoPosition, _) => 90.0,
+            (SeekMode::FourPosition, k) => 90.0 * k as f64,
+        };
+        wrap_360(self.cfg.start_heading_deg as f64 + offset) as f32
+    }
+
+    fn dwell_of(&self, k: usize) -> f64 {
+        match (self.cfg.mode, k) {
+            (SeekMode::TwoPosition, 2) => self.cfg.ambiguity_dwell_s as f64,
+            _ => self.cfg.dwell_s as f64,
+        }
+    }
+
+    /// The last finished seek.
+    pub fn last_result(&self) -> Option<&SeekResult> {
+        self.last.as_ref()
+    }
+
+    /// Current status.
+    pub fn status(&self) -> SeekStatus {
+        match self.phase {
+            Phase::Idle => SeekStatus::Idle,
+            Phase::Moving { .. } => SeekStatus::Moving {
+                position: self.position,
+            },
+            Phase::Dwelling { .. } => SeekStatus::Dwelling {
+                position: self.position,
+                windows: self.acc[self.position as usize].n,
+            },
+            Phase::Done => match self.last {
+                Some(r) => SeekStatus::Done(r),
+                None => SeekStatus::Idle,
+            },
+        }
+    }
+
+    /// True while a seek is running.
+    pub fn is_busy(&self) -> bool {
+        matches!(self.phase, Phase::Moving { .. } | Phase::Dwelling { .. })
+    }
+
+    /// Abandon the running seek (the table is left where it is).
+    pub fn abort(&mut self) {
+        self.phase = Phase::Idle;
+    }
+
+    /// Begin a seek at `t_now_s`: commands the first heading.
+    pub fn start<T: Turntable>(&mut self, table: &mut T, t_now_s: f64) -> Result<(), SeekError> {
+        if self.is_busy() {
+            return Err(SeekError::Busy);
+        }
+        if !t_now_s.is_finite() {
+            return Err(SeekError::BadConfig);
+        }
+        self.acc = [Accumulator::default(); MAX_POSITIONS];
+        self.t_start_s = t_now_s;
+        self.go_to(table, 0, t_now_s)
+    }
+
+    fn go_to<T: Turntable>(&mut self, table: &mut T, k: usize, t_now_s: f64) -> Result<(), SeekError> {
+        self.position = k as u8;
+        if let Err(_e) = table.command_heading(self.heading_of(k)) {
+            self.phase = Phase::Idle;
+            return Err(SeekError::Turntable);
+        }
+        self.phase = Phase::Moving { since_s: t_now_s };
+        Ok(())
+    }
+
+    /// Poll the turntable (call often while moving; `on_window` also calls it).
+    pub fn poll<T: Turntable>(&mut self, table: &mut T, t_now_s: f64) -> Result<SeekStatus, SeekError> {
+        if let Phase::Moving { since_s } = self.phase {
+            match table.poll() {
+                Err(_) => {
+                    self.phase = Phase::Idle;
+                    return Err(SeekError::Turntable);
+                }
+                Ok(TableState::Settled { .. }) => {
+                    self.phase = Phase::Dwelling {
+                        accept_from_s: t_now_s + self.cfg.settle_s as f64,
+                    };
+                }
+                Ok(TableState::Moving) => {
+                    if t_now_s - since_s > self.cfg.move_timeout_s as f64 {
+                        self.phase = Phase::Idle;
+                        return Err(SeekError::TableTimeout {
+                            position: self.position,
+                        });
+                    }
+                }
+            }
+        }
+        Ok(self.status())
+    }
+
+    /// Feed one 10 s result. Windows that started before the table settled are ignored.
+    pub fn on_window<T: Turntable>(
+        &mut self,
+        w: &WindowResult,
+        table: &mut T,
+    ) -> Result<SeekStatus, SeekError> {
+        self.poll(table, w.t_end_s)?;
+        let Phase::Dwelling { accept_from_s } = self.phase else {
+            return Ok(self.status());
+        };
+        if w.t_start_s < accept_from_s - 1e-6 {
+            return Ok(self.status());
+        }
+        let k = self.position as usize;
+        let a = &mut self.acc[k];
+        if w.status.is_valid() && w.compensated_dph.is_finite() {
+            let v = w.compensated_dph as f64;
+            a.sum += v;
+            a.sum_sq += v * v;
+            a.n += 1;
+            a.duration_s += w.t_end_s - w.t_start_s;
+        } else {
+            a.invalid += 1;
+            if a.invalid > self.cfg.max_invalid_windows {
+                self.phase = Phase::Idle;
+                return Err(SeekError::TooManyInvalidWindows {
+                    position: self.position,
+                });
+            }
+        }
+        if a.duration_s + 1e-6 >= self.dwell_of(k) {
+            if k + 1 < self.n_positions() {
+                self.go_to(table, k + 1, w.t_end_s)?;
+            } else {
+                let r = self.solve(w.t_end_s);
+                self.phase = if r.is_ok() { Phase::Done } else { Phase::Idle };
+                self.last = Some(r?);
+            }
+        }
+        Ok(self.status())
+    }
+
+    fn position_mean(&self, k: usize) -> PositionMean {
+        let a = &self.acc[k];
+        let n = a.n.max(1) as f64;
+        let mean = a.sum / n;
+        let sigma = if a.n >= 2 {
+            let var = ((a.sum_sq - n * mean * mean) / (n - 1.0)).max(0.0);
+            libm::sqrt(var / n)
+        } else {
+            0.0
+        };
+        PositionMean {
+            heading_deg: self.heading_of(k),
+            mean_rate_dph: mean,
+            sigma_dph: sigma,
+            n_windows: a.n,
+        }
+    }
+
+    fn solve(&self, t_end_s: f64) -> Result<SeekResult, SeekError> {
+        let np = self.n_positions();
+        let mut positions = [PositionMean::default(); MAX_POSITIONS];
+        for (k, p) in positions.iter_mut().enumerate().take(np) {
+            *p = self.position_mean(k);
+        }
+        let oh = self.omega_h_dph;
+        let (psi, sigma_rad, bias) = match self.cfg.mode {
+            SeekMode::TwoPosition => {
+                let (p1, p2, p3) = (positions[0], positions[1], positions[2]);
+                let c = (p1.mean_rate_dph - p2.mean_rate_dph) / (2.0 * oh);
+                if libm::fabs(c) > 1.1 {
+                    return Err(SeekError::InconsistentRates);
+                }
+                let psi0 = libm::acos(c.clamp(-1.0, 1.0));
+                let bias = 0.5 * (p1.mean_rate_dph + p2.mean_rate_dph);
+                // w3 = -Omega_H sin(psi) + bias.
+                let sin_sign = bias - p3.mean_rate_dph;
+                let psi = if sin_sign >= 0.0 { psi0 } else { -psi0 };
+                let sigma_c = libm::sqrt(p1.sigma_dph * p1.sigma_dph + p2.sigma_dph * p2.sigma_dph)
+                    / (2.0 * oh);
+                // d(acos c) = dc / |sin psi|; near psi = 0/180 acos behaves like sqrt(2 dc).
+                let s = libm::fabs(libm::sin(psi0)).max(libm::sqrt(2.0 * sigma_c));
+                let sigma = if sigma_c > 0.0 { sigma_c / s } else { 0.0 };
+                (psi, sigma, bias)
+            }
+            SeekMode::FourPosition => {
+                let m: [f64; 4] = core::array::from_fn(|k| positions[k].mean_rate_dph);
+                let v: [f64; 4] = core::array::from_fn(|k| positions[k].sigma_dph * positions[k].sigma_dph);
+                // w_k = Omega_H cos(psi + 90 k) + b.
+                let dc = m[0] - m[2]; // 2 Omega_H cos psi
+                let ds = m[3] - m[1]; // 2 Omega_H sin psi
+                let r2 = dc * dc + ds * ds;
+                if r2 <= 0.0 {
+                    return Err(SeekError::InconsistentRates);
+                }
+                let psi = libm::atan2(ds, dc);
+                let var = (dc * dc * (v[1] + v[3]) + ds * ds * (v[0] + v[2])) / (r2 * r2);
+                (psi, libm::sqrt(var), 0.25 * (m[0] + m[1] + m[2] + m[3]))
+            }
+        };
+        let azimuth = wrap_360(psi.to_degrees() - self.cfg.start_heading_deg as f64);
+        Ok(SeekResult {
+            azimuth_deg: azimuth,
+            sigma_deg: sigma_rad.to_degrees(),
+            duration_s: t_end_s - self.t_start_s,
+            t_start_s: self.t_start_s,
+            t_end_s,
+            bias_dph: bias,
+            mode: self.cfg.mode,
+            positions,
+            n_positions: np as u8,
+        })
+    }
+}

@@ -1,3 +1,15 @@
 //! `fog-firmware`: the portable part of the gyro MCU application.
+//!
+//! Everything here builds and is tested on the host; the target-only glue (runtime,
+//! UART registers, semihosting, SysTick) lives in `src/bin/`. Modules:
+//! `clock` (time for drivers), `drivers` (gyro frames, TMP117, turntable),
+//! `app` (samples -> 10 s windows -> compensation -> north seek), `replay` (the QEMU
+//! replay scenario's file formats, shared with the host test).
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
+
+pub mod clock;
+pub mod drivers;
+pub mod signature;
+pub mod store;
+pub mod upload;

@@ -11,6 +11,7 @@ pub mod import;
 pub mod metrics;
 pub mod northseek;
 pub mod plots;
+pub mod report;
 pub mod runs;
 pub mod sim;
 pub mod train;

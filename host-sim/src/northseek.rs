@@ -1,1 +1,387 @@
-//! (to be written)
+//! Cold-start north-seek Monte Carlo: the paper's north-finder experiment, repeated.
+//!
+//! Each start powers a simulated gyro on cold (soaked at the ambient), mounted with its input
+//! axis horizontal on the simulated indexing turntable, and runs `seeks_per_start` seeks back
+//! to back with fog-core's `NorthFinder` fed by fog-core's `Compensator` -- the device's
+//! code path, while the gyro keeps warming up and the table turns. Every start is run twice
+//! with the same seed (same gyro, same noise, same table errors): once without a model
+//! (uncompensated) and once with the drift model (compensated), so the two arms differ only
+//! by the compensation. Starts are spread over threads with `std::thread::scope`; each has
+//! its own seed derived from the campaign seed and its index, so the result does not depend
+//! on the thread count or scheduling.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+use anyhow::{anyhow, bail, Context, Result};
+use fog_core::compensator::{Compensator, CompensatorConfig};
+use fog_core::consts::earth_rate_horizontal_dph;
+use fog_core::hal::{GyroSample, TempSample};
+use fog_core::model::RbfModel;
+use fog_core::northfinder::{NorthFinder, SeekConfig, SeekMode, SeekStatus};
+
+use crate::report::SeekStats;
+use crate::sim::{rig, GyroParams, RunSpec, StartState, TurntableParams};
+
+/// The paper's seek time, 4 min 56 s.
+pub const PAPER_SEEK_DURATION_S: f64 = 296.0;
+/// The paper's site azimuth of the north finder's reference (mean of its table), deg.
+pub const PAPER_AZIMUTH_DEG: f64 = 108.4;
+/// The paper's "fast initialisation under 3 s" before the first seek.
+pub const INIT_S: f64 = 3.0;
+
+/// Settings of one Monte Carlo.
+#[derive(Clone, Debug)]
+pub struct MonteCarloConfig {
+    /// Cold starts (power-ons).
+    pub starts: usize,
+    /// Seeks after each power-on, back to back.
+    pub seeks_per_start: usize,
+    pub mode: SeekMode,
+    pub latitude_deg: f64,
+    /// Chamber / room temperature, degC.
+    pub ambient_c: f64,
+    /// Azimuth of the table's zero w.r.t. true north: what the seeks must find, deg.
+    pub true_azimuth_deg: f64,
+    /// Measuring time per main position, s.
+    pub dwell_s: f32,
+    /// Two-position only: dwell at +90 deg that resolves the acos ambiguity, s.
+    pub ambiguity_dwell_s: f32,
+    /// Raw gyro rate, Hz.
+    pub raw_rate_hz: f64,
+    pub turntable: TurntableParams,
+    pub seed: u64,
+    /// Worker threads (>= 1).
+    pub threads: usize,
+}
+
+impl MonteCarloConfig {
+    /// The paper's experiment: 30 starts x 6 seeks, two positions, 20 degC, 108.4 deg, seeks
+    /// that fit the paper's 4 min 56 s (120 s dwells, 10 s ambiguity dwell, 2 s settling).
+    pub fn paper(seed: u64) -> Self {
+        Self {
+            starts: 30,
+            seeks_per_start: 6,
+            mode: SeekMode::TwoPosition,
+            latitude_deg: crate::sim::DEFAULT_LATITUDE_DEG,
+            ambient_c: 20.0,
+            true_azimuth_deg: PAPER_AZIMUTH_DEG,
+            dwell_s: 120.0,
+            ambiguity_dwell_s: 10.0,
+            raw_rate_hz: 100.0,
+            turntable: TurntableParams::default(),
+            seed,
+            threads: default_threads(),
+        }
+    }
+
+    /// Checks the options, naming the offending one.
+    pub fn validate(&self) -> Result<()> {
+        if self.starts == 0 {
+            bail!("--starts: must be at least 1");
+        }
+        if self.seeks_per_start == 0 {
+            bail!("--seeks: must be at least 1");
+        }
+        if !self.latitude_deg.is_finite() || self.latitude_deg.abs() > 90.0 {
+            bail!("--latitude {}: must be within -90..=90 deg", self.latitude_deg);
+        }
+        if self.latitude_deg.abs() >= 85.0 {
+            bail!("--latitude {}: north seeking needs |latitude| < 85 deg (horizontal Earth rate too small)", self.latitude_deg);
+        }
+        if !self.true_azimuth_deg.is_finite() {
+            bail!("--azimuth: must be a finite angle in degrees");
+        }
+        if !(self.dwell_s.is_finite() && self.dwell_s >= 10.0) {
+            bail!("--dwell {}: must be at least one 10 s window", self.dwell_s);
+        }
+        if self.threads == 0 {
+            bail!("--threads: must be at least 1");
+        }
+        Ok(())
+    }
+
+    fn seek_config(&self) -> SeekConfig {
+        SeekConfig {
+            mode: self.mode,
+            latitude_deg: self.latitude_deg,
+            start_heading_deg: 0.0,
+            dwell_s: self.dwell_s,
+            ambiguity_dwell_s: self.ambiguity_dwell_s,
+            settle_s: 0.0,
+            move_timeout_s: 60.0,
+            max_invalid_windows: 3,
+        }
+    }
+
+    /// Seed of start `index`: a SplitMix64 mix of the campaign seed and the index.
+    pub fn start_seed(&self, index: usize) -> u64 {
+        let mut z = self.seed ^ (index as u64).wrapping_add(1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+}
+
+/// Both cores by default, as the machine the demo targets has two.
+pub fn default_threads() -> usize {
+    std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1).min(8)
+}
+
+/// One finished seek.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SeekOutcome {
+    pub azimuth_deg: f64,
+    /// The north finder's own 1-sigma estimate, deg.
+    pub sigma_deg: f64,
+    pub t_start_s: f64,
+    pub duration_s: f64,
+    /// Dwell actually used per main position, s (windows x 10 s).
+    pub main_dwell_s: f64,
+}
+
+/// Both arms of one cold start.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StartOutcome {
+    pub seed: u64,
+    pub uncompensated: Vec<SeekOutcome>,
+    pub compensated: Vec<SeekOutcome>,
+}
+
+/// Runs `cfg.seeks_per_start` seeks after one cold start with the given seed, with
+/// `model` applied by the compensator (None: uncompensated).
+pub fn run_seeks(
+    params: &GyroParams,
+    cfg: &MonteCarloConfig,
+    model: Option<&RbfModel>,
+    seed: u64,
+) -> Result<Vec<SeekOutcome>> {
+    let spec = RunSpec {
+        ambient_c: cfg.ambient_c,
+        minutes: cfg.seeks_per_start as f64 * 10.0,
+        latitude_deg: cfg.latitude_deg,
+        heading_deg: cfg.true_azimuth_deg,
+        input_axis_vertical: false,
+        raw_rate_hz: cfg.raw_rate_hz,
+        seed,
+        start: StartState::Soaked,
+    };
+    let (mut gyro, mut table) = rig(params, &spec, cfg.turntable.clone()).map_err(|e| anyhow!("simulator: {e}"))?;
+    let dt_s = gyro.sample_period_s();
+    let temp_period_s = params.sensor.sample_period_s;
+    let comp_cfg = CompensatorConfig {
+        gyro_rate_hz: cfg.raw_rate_hz as f32,
+        temp_rate_hz: (1.0 / temp_period_s) as f32,
+        ..CompensatorConfig::default()
+    };
+    let mut comp = Compensator::new(comp_cfg, model.cloned()).map_err(|e| anyhow!("{e}"))?;
+    let mut finder = NorthFinder::new(cfg.seek_config()).map_err(|e| anyhow!("{e}"))?;
+    let temp_every = ((temp_period_s / dt_s).round() as u64).max(1);
+    let poll_every = ((1.0 / dt_s).round() as u64).max(1);
+    // Generous bound: a seek that has not finished in 4x its nominal time never will.
+    let t_limit_s = INIT_S + cfg.seeks_per_start as f64 * 4.0 * (3.0 * cfg.dwell_s as f64 + 120.0);
+    let mut out = Vec::with_capacity(cfg.seeks_per_start);
+    let mut started = false;
+    let mut step: u64 = 0;
+    while out.len() < cfg.seeks_per_start {
+        let s = gyro.next_sample();
+        step += 1;
+        if s.t_s > t_limit_s {
+            bail!("seek {} did not finish within {t_limit_s:.0} s of power-on", out.len() + 1);
+        }
+        if !started && s.t_s >= INIT_S {
+            finder.start(&mut table, s.t_s).map_err(|e| anyhow!("seek 1: {e}"))?;
+            started = true;
+        }
+        if step % temp_every == 0 {
+            comp.push_temp(TempSample { t_s: s.t_s, temp_c: gyro.read_sensor_c() as f32 });
+        }
+        if started && step % poll_every == 0 {
+            finder.poll(&mut table, s.t_s).map_err(|e| anyhow!("seek {}: {e}", out.len() + 1))?;
+        }
+        // A raw sample is the mean over (t - dt, t]: time-stamp it at the interval's middle.
+        let sample = GyroSample { t_s: s.t_s - 0.5 * dt_s, rate_dph: s.rate_dph as f32 };
+        let Some(w) = comp.push_gyro(sample) else { continue };
+        if !started {
+            continue;
+        }
+        let status = finder.on_window(&w, &mut table).map_err(|e| anyhow!("seek {}: {e}", out.len() + 1))?;
+        if let SeekStatus::Done(r) = status {
+            let n_main = r.positions[0].n_windows as f64;
+            out.push(SeekOutcome {
+                azimuth_deg: r.azimuth_deg,
+                sigma_deg: r.sigma_deg,
+                t_start_s: r.t_start_s,
+                duration_s: r.duration_s,
+                main_dwell_s: n_main * fog_core::consts::WINDOW_S as f64,
+            });
+            if out.len() < cfg.seeks_per_start {
+                finder.start(&mut table, w.t_end_s).map_err(|e| anyhow!("seek {}: {e}", out.len() + 1))?;
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Runs every start (both arms) over `cfg.threads` threads; `on_start_done` is called after
+/// each finished start (for progress bars). Results are in start order.
+pub fn run_monte_carlo(
+    params: &GyroParams,
+    cfg: &MonteCarloConfig,
+    model: &RbfModel,
+    on_start_done: &(dyn Fn() + Sync),
+) -> Result<Vec<StartOutcome>> {
+    cfg.validate()?;
+    let next = AtomicUsize::new(0);
+    let results: Mutex<Vec<Option<Result<StartOutcome>>>> = Mutex::new((0..cfg.starts).map(|_| None).collect());
+    std::thread::scope(|scope| {
+        for _ in 0..cfg.threads.min(cfg.starts) {
+            scope.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                if i >= cfg.starts {
+                    break;
+                }
+                let seed = cfg.start_seed(i);
+                let r = run_seeks(params, cfg, None, seed)
+                    .with_context(|| format!("start {} (seed {seed}), uncompensated", i + 1))
+                    .and_then(|unc| {
+                        let comp = run_seeks(params, cfg, Some(model), seed)
+                            .with_context(|| format!("start {} (seed {seed}), compensated", i + 1))?;
+                        Ok(StartOutcome { seed, uncompensated: unc, compensated: comp })
+                    });
+                let failed = r.is_err();
+                results.lock().expect("no panics while holding the lock")[i] = Some(r);
+                on_start_done();
+                if failed {
+                    // Stop handing out work: the first error is reported.
+                    next.store(cfg.starts, Ordering::Relaxed);
+                    break;
+                }
+            });
+        }
+    });
+    let results = results.into_inner().expect("no panics while holding the lock");
+    let mut out = Vec::with_capacity(cfg.starts);
+    for r in results {
+        match r {
+            Some(r) => out.push(r?),
+            None => bail!("north-seek Monte Carlo stopped early"),
+        }
+    }
+    Ok(out)
+}
+
+/// Signed azimuth difference a - b wrapped to [-180, 180), deg.
+pub fn azimuth_error_deg(a: f64, b: f64) -> f64 {
+    (a - b + 180.0).rem_euclid(360.0) - 180.0
+}
+
+/// White-noise floor of the azimuth, deg, for angle random walk `arw_dpsh` (deg/sqrt(h)):
+/// two positions N / (sqrt(2 tau) Omega_H |sin psi|) with tau the dwell per position;
+/// four positions sqrt(2) N / (Omega_H sqrt(T_total)), T_total = 4 tau.
+pub fn noise_floor_deg(arw_dpsh: f64, mode: SeekMode, latitude_deg: f64, psi_deg: f64, dwell_s: f64) -> f64 {
+    let omega_h = earth_rate_horizontal_dph(latitude_deg);
+    let tau_h = dwell_s / 3600.0;
+    let rad = match mode {
+        SeekMode::TwoPosition => arw_dpsh / ((2.0 * tau_h).sqrt() * omega_h * psi_deg.to_radians().sin().abs()),
+        SeekMode::FourPosition => std::f64::consts::SQRT_2 * arw_dpsh / (omega_h * (4.0 * tau_h).sqrt()),
+    };
+    rad.to_degrees()
+}
+
+fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len().max(1) as f64
+}
+
+/// Sample standard deviation (n - 1), 0 for fewer than two values.
+fn std_dev(v: &[f64]) -> f64 {
+    if v.len() < 2 {
+        return 0.0;
+    }
+    let m = mean(v);
+    (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64).sqrt()
+}
+
+fn rms(v: &[f64]) -> f64 {
+    (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt()
+}
+
+/// Statistics of one arm: `seeks[start][seek]` against the true azimuth.
+pub fn seek_stats(seeks: &[Vec<SeekOutcome>], true_azimuth_deg: f64) -> SeekStats {
+    let err = |s: &SeekOutcome| azimuth_error_deg(s.azimuth_deg, true_azimuth_deg);
+    let all: Vec<f64> = seeks.iter().flatten().map(err).collect();
+    let n_seek = seeks.iter().map(Vec::len).max().unwrap_or(0);
+    let column = |k: usize| -> Vec<f64> { seeks.iter().filter_map(|s| s.get(k)).map(err).collect() };
+    let per_start = |f: fn(&[f64]) -> f64| -> f64 {
+        let v: Vec<f64> = seeks.iter().map(|s| f(&s.iter().map(err).collect::<Vec<_>>())).collect();
+        mean(&v)
+    };
+    let range = |v: &[f64]| -> f64 {
+        let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| (l.min(*x), h.max(*x)));
+        if v.is_empty() {
+            0.0
+        } else {
+            hi - lo
+        }
+    };
+    SeekStats {
+        std_deg: std_dev(&all),
+        max_dev_deg: all.iter().fold(0.0f64, |m, e| m.max(e.abs())),
+        mean_error_deg: mean(&all),
+        rms_error_deg: rms(&all),
+        per_seek_std_deg: (0..n_seek).map(|k| rms(&column(k))).collect(),
+        per_seek_mean_error_deg: (0..n_seek).map(|k| mean(&column(k))).collect(),
+        mean_range_deg: per_start(range),
+        mean_within_start_std_deg: per_start(std_dev),
+        mean_reported_sigma_deg: mean(&seeks.iter().flatten().map(|s| s.sigma_deg).collect::<Vec<_>>()),
+        azimuths_deg: seeks.iter().map(|s| s.iter().map(|o| o.azimuth_deg).collect()).collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn azimuth_error_wraps() {
+        assert!((azimuth_error_deg(359.9, 0.1) + 0.2).abs() < 1e-9);
+        assert!((azimuth_error_deg(0.1, 359.9) - 0.2).abs() < 1e-9);
+        assert!((azimuth_error_deg(108.5, 108.4) - 0.1).abs() < 1e-9);
+    }
+
+    #[test]
+    fn noise_floor_matches_the_formula() {
+        // 0.0011 deg/sqrt(h), 120 s dwell, equator, psi = 90 deg:
+        // N / (sqrt(2 tau) Omega) = 0.0011 / (sqrt(2/30) * 15.041067) rad.
+        let f = noise_floor_deg(0.0011, SeekMode::TwoPosition, 0.0, 90.0, 120.0);
+        let expect = (0.0011 / ((2.0f64 / 30.0).sqrt() * 15.041067)).to_degrees();
+        assert!((f - expect).abs() < 1e-12, "{f} vs {expect}");
+        // Four positions (4 tau in total) do not depend on psi and equal two positions at psi = 90 deg.
+        let f4 = noise_floor_deg(0.0011, SeekMode::FourPosition, 0.0, 10.0, 120.0);
+        assert!((f4 - f).abs() < 1e-12);
+    }
+
+    #[test]
+    fn start_seeds_differ_and_repeat() {
+        let cfg = MonteCarloConfig::paper(7);
+        let seeds: Vec<u64> = (0..100).map(|i| cfg.start_seed(i)).collect();
+        let mut sorted = seeds.clone();
+        sorted.sort_unstable();
+        sorted.dedup();
+        assert_eq!(sorted.len(), 100);
+        assert_eq!(seeds[5], MonteCarloConfig::paper(7).start_seed(5));
+        assert_ne!(seeds[5], MonteCarloConfig::paper(8).start_seed(5));
+    }
+
+    #[test]
+    fn stats_of_known_seeks() {
+        let s = |a: f64| SeekOutcome { azimuth_deg: a, sigma_deg: 0.01, t_start_s: 0.0, duration_s: 290.0, main_dwell_s: 120.0 };
+        let seeks = vec![vec![s(108.5), s(108.4)], vec![s(108.3), s(108.4)]];
+        let st = seek_stats(&seeks, 108.4);
+        assert!((st.mean_error_deg).abs() < 1e-9);
+        assert!((st.max_dev_deg - 0.1).abs() < 1e-9);
+        assert!((st.per_seek_std_deg[0] - 0.1).abs() < 1e-9);
+        assert!(st.per_seek_std_deg[1].abs() < 1e-9);
+        assert!((st.mean_range_deg - 0.1).abs() < 1e-9);
+    }
+}

@@ -1,10 +1,45 @@
-//! `fogsim diagnose` (to be written).
+//! `fogsim diagnose RUNS... [--json FILE] [--plots DIR]`: what the simulation and the
+//! paper's model get wrong on a measured campaign, the cause, the extension and its gain.
+
+use crate::diagnose::{diagnose, plots, report};
+use anyhow::Context;
+use std::path::PathBuf;
 
 /// Options of `fogsim diagnose`.
 #[derive(clap::Args, Debug)]
-pub struct Args {}
+pub struct Args {
+    /// fog-runs v1 files or directories (read in name order).
+    #[arg(required = true)]
+    pub runs: Vec<PathBuf>,
+    /// Write the diagnosis as JSON here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Write SVG plots into this directory.
+    #[arg(long)]
+    pub plots: Option<PathBuf>,
+}
 
 /// Runs the subcommand.
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("fogsim diagnose: not implemented yet")
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let runs = crate::runs::read_runs(&args.runs)?;
+    let d = diagnose(&runs).context("diagnose")?;
+    print!("{}", report::render_text(&d.report));
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&d.report)?;
+        write_atomic(path, text.as_bytes()).with_context(|| format!("writing {}", path.display()))?;
+        println!("JSON written to {}", path.display());
+    }
+    if let Some(dir) = &args.plots {
+        for p in plots::write_plots(dir, &d).with_context(|| format!("plots in {}", dir.display()))? {
+            println!("plot: {}", p.display());
+        }
+    }
+    Ok(())
+}
+
+/// Writes a file via a temporary sibling and a rename, so no partial file is left.
+pub fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
+    let tmp = path.with_extension("tmp-fogsim");
+    std::fs::write(&tmp, bytes)?;
+    std::fs::rename(&tmp, path)
 }

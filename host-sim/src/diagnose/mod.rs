@@ -1,1 +1,157 @@
-//! (to be written)
+//! `diagnose`: from a measured campaign to what the simulation and the paper's model get
+//! wrong, the cause, the extended model and its held-out gain (issue 4).
+//!
+//! Pipeline: [`input`] checks and averages the runs; [`models`] fits the paper's RBF on
+//! (T, dT/dt) with run offsets and validates it on held-out runs ([`cv`]); [`simfit`]
+//! calibrates the simulator's physics; [`residuals`] describes what is left; [`transforms`]
+//! builds every candidate feature; [`screen`] ranks them by held-out gain with the
+//! family-wise sign-flip test of [`signflip`]; [`report`] states the result, [`plots`]
+//! draws it, [`azimuth`] translates it into north-seeking error.
+
+pub mod azimuth;
+pub mod basis;
+pub mod cv;
+pub mod error;
+pub mod input;
+pub mod linalg;
+pub mod models;
+pub mod plots;
+pub mod report;
+pub mod residuals;
+pub mod screen;
+pub mod signflip;
+pub mod simfit;
+pub mod transforms;
+
+pub use error::DiagnoseError;
+pub use report::{Cause, Report};
+
+use crate::runs::Run;
+use cv::Folds;
+use input::Exclusion;
+use models::Stacked;
+use report::{Azimuth, CampaignSummary, CandidateRow, Competitor, DriftStd, Extended, ModelSummary, Simulation};
+
+/// Everything the diagnosis computed: the report plus the series the plots need.
+#[derive(Clone, Debug)]
+pub struct Diagnosis {
+    pub report: Report,
+    pub run_names: Vec<String>,
+    pub run_rows: Vec<std::ops::Range<usize>>,
+    pub t_s: Vec<f64>,
+    /// Drift with run offsets removed as the fits see it, deg/h.
+    pub drift_dph: Vec<f64>,
+    pub baseline_residual: Vec<f64>,
+    pub extended_residual: Vec<f64>,
+    /// The named cause's first feature column (stacked), if any.
+    pub cause_feature: Option<Vec<f64>>,
+}
+
+fn pooled_within_std(rows: &[std::ops::Range<usize>], v: &[f64]) -> f64 {
+    let mut ss = 0.0;
+    for r in rows {
+        let m = v[r.clone()].iter().sum::<f64>() / r.len() as f64;
+        ss += v[r.clone()].iter().map(|x| (x - m) * (x - m)).sum::<f64>();
+    }
+    (ss / v.len().max(1) as f64).sqrt()
+}
+
+/// Runs the whole diagnosis on a campaign.
+pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
+    let campaign = input::prepare(runs)?;
+    let st = Stacked::new(&campaign);
+    let folds = Folds::new(&st.run_lengths)?;
+    let base = models::fit_baseline(&folds, &st)?;
+    let base_rms = base.cv.rms();
+    let structure = residuals::structure(&campaign, &folds, &st, &base.cv.residual);
+    let screening = screen::screen(&campaign, &folds, &st, &base, transforms::enumerate(&campaign))?;
+
+    let named = screening.named.map(|i| &screening.scored[i]);
+    let cause = named.map(|s| Cause { column: s.cand.column.clone(), transform: s.cand.transform, tau_s: s.cand.tau_s });
+    let sim = simfit::calibrate(&campaign, &folds.run_rows, &st.y, named.map(|s| s.cols.as_slice()))?;
+    let base_inputs = vec!["temp_c:value".to_owned(), "temp_c:rate".to_owned()];
+    let (extended, ext_resid) = match named {
+        Some(s) => {
+            let mut inputs = base_inputs.clone();
+            inputs.push(cause.as_ref().map(Cause::label).unwrap_or_default());
+            (
+                Extended { inputs, mode: Some(s.mode), heldout_rms_dph: s.heldout_rms_dph, gain_pct: s.gain_pct },
+                s.cv.residual.clone(),
+            )
+        }
+        None => (
+            Extended { inputs: base_inputs.clone(), mode: None, heldout_rms_dph: base_rms, gain_pct: 0.0 },
+            base.cv.residual.clone(),
+        ),
+    };
+    let has_heading = campaign.extra_names.iter().any(|n| n.contains("heading"));
+    let latitude = campaign.runs.iter().find_map(|s| s.latitude_deg).unwrap_or(azimuth::DEFAULT_LATITUDE_DEG);
+    let azimuth = has_heading.then(|| Azimuth {
+        baseline: azimuth::azimuth_effect(&folds, &st.t_s, &base.cv.residual, latitude),
+        extended: azimuth::azimuth_effect(&folds, &st.t_s, &ext_resid, latitude),
+    });
+    let words = report::cause_in_words(cause.as_ref(), &sim.effect_coef);
+    let to_excl = |(c, r): &(String, String)| Exclusion { column: c.clone(), reason: r.clone() };
+    let report = Report {
+        campaign: CampaignSummary {
+            runs: campaign.runs.len(),
+            points: campaign.points(),
+            validation: folds.describe(),
+            excluded_columns: campaign.exclusions.clone(),
+            skipped_candidates: screening.skipped.iter().map(to_excl).collect(),
+        },
+        baseline: ModelSummary {
+            inputs: base_inputs,
+            heldout_rms_dph: base_rms,
+            centres: base.centres,
+            width_factor: base.width_factor,
+            ridge: base.ridge,
+        },
+        residual_structure: structure,
+        candidates: screening
+            .scored
+            .iter()
+            .map(|s| CandidateRow {
+                column: s.cand.column.clone(),
+                transform: s.cand.transform,
+                tau_s: s.cand.tau_s,
+                mode: s.mode,
+                heldout_rms_dph: s.heldout_rms_dph,
+                gain_pct: s.gain_pct,
+                p_value: s.p_value,
+                significant: s.significant,
+                units_improved: s.units_improved,
+            })
+            .collect(),
+        named_cause: cause,
+        cause_in_words: words,
+        competing: screening
+            .competing
+            .iter()
+            .map(|(c, g)| Competitor { candidate: c.clone(), conditional_gain_pct: *g })
+            .collect(),
+        parsimony_note: screening.parsimony_note.clone(),
+        drift_std: DriftStd {
+            uncompensated_dph: pooled_within_std(&folds.run_rows, &st.y),
+            baseline_heldout_dph: pooled_within_std(&folds.run_rows, &base.cv.residual),
+            extended_heldout_dph: pooled_within_std(&folds.run_rows, &ext_resid),
+        },
+        extended,
+        azimuth,
+        simulation: Simulation {
+            before_rms_dph: sim.before_rms_dph,
+            after_rms_dph: sim.after_rms_dph.unwrap_or(sim.before_rms_dph),
+            calibration: sim,
+        },
+    };
+    Ok(Diagnosis {
+        report,
+        run_names: campaign.runs.iter().map(|s| s.name.clone()).collect(),
+        run_rows: folds.run_rows.clone(),
+        t_s: st.t_s.clone(),
+        drift_dph: base.prepared.target().to_vec(),
+        baseline_residual: base.cv.residual.clone(),
+        extended_residual: ext_resid,
+        cause_feature: named.and_then(|s| s.cols.first().cloned()),
+    })
+}

@@ -1,0 +1,148 @@
+//! The FOG's RS-422 output as a `fog_core::hal::Gyro`: reads bytes from a non-blocking
+//! UART (`embedded_hal_nb::serial::Read`), decodes frames (`gyro_frame`), converts the
+//! angle increment to deg/h and time-stamps each sample from the frame counter.
+//!
+//! Faults never stop the stream and never produce a sample: frames with a bad CRC or a
+//! gyro fault flag are counted and skipped, lost frames (counter jumps) are counted and
+//! leave a gap in time that the 10 s averager sees. Time is sample index x period since
+//! the first frame (the gyro's crystal is the time base of the whole measurement).
+
+use embedded_hal_nb::nb;
+use embedded_hal_nb::serial::{Error as _, ErrorKind, Read};
+use fog_core::hal::{Gyro, GyroSample, TempSample};
+
+use super::gyro_frame::{FrameDecoder, FrameStats, GyroFrame, ANGLE_LSB_DEG};
+
+/// Sample-level counters on top of the frame decoder's.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct GyroStats {
+    pub frames: FrameStats,
+    /// Good frames the gyro flagged invalid (light-source fault, not valid).
+    pub flagged_invalid: u32,
+    /// Frames missing according to the sequence counter.
+    pub frames_lost: u32,
+    /// UART errors (overrun, framing, parity, noise).
+    pub uart_errors: u32,
+}
+
+/// A UART error seen while reading; the byte stream continues after it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct UartError(pub ErrorKind);
+
+impl core::fmt::Display for UartError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "gyro UART error: {:?}", self.0)
+    }
+}
+
+impl core::error::Error for UartError {}
+
+/// Driver for a FOG with framed serial output.
+pub struct FogSerialGyro<S> {
+    uart: S,
+    decoder: FrameDecoder,
+    period_s: f64,
+    dtheta_to_dph: f32,
+    /// Index of the next expected sample (frames since the first one, lost ones included).
+    next_index: u64,
+    last_seq: Option<u8>,
+    last_temp: Option<TempSample>,
+    stats: GyroStats,
+}
+
+impl<S: Read<u8>> FogSerialGyro<S> {
+    /// `sample_rate_hz`: the gyro's configured output rate (1..=10,000 Hz).
+    pub fn new(uart: S, sample_rate_hz: u32) -> Self {
+        let period_s = 1.0 / f64::from(sample_rate_hz.clamp(1, 10_000));
+        Self {
+            uart,
+            decoder: FrameDecoder::new(),
+            period_s,
+            dtheta_to_dph: (ANGLE_LSB_DEG * 3600.0 / period_s) as f32,
+            next_index: 0,
+            last_seq: None,
+            last_temp: None,
+            stats: GyroStats::default(),
+        }
+    }
+
+    pub fn stats(&self) -> GyroStats {
+        GyroStats {
+            frames: self.decoder.stats(),
+            ..self.stats
+        }
+    }
+
+    /// The internal temperature carried by the latest valid frame, if any.
+    pub fn latest_temp(&self) -> Option<TempSample> {
+        self.last_temp
+    }
+
+    /// Sample period, s.
+    pub fn period_s(&self) -> f64 {
+        self.period_s
+    }
+
+    /// Give the UART back (e.g. to reconfigure it).
+    pub fn release(self) -> S {
+        self.uart
+    }
+
+    /// Turn a decoded frame into a sample (None if the gyro flags it invalid).
+    pub fn accept_frame(&mut self, frame: GyroFrame) -> Option<GyroSample> {
+        let index = match self.last_seq {
+            None => 0,
+            Some(prev) => {
+                // The counter never repeats in a healthy stream, so an unchanged
+                // counter means exactly 256 frames were lost.
+                let step = match frame.seq.wrapping_sub(prev) {
+                    0 => 256,
+                    s => u32::from(s),
+                };
+                self.stats.frames_lost += step - 1;
+                self.next_index + u64::from(step) - 1
+            }
+        };
+        self.last_seq = Some(frame.seq);
+        self.next_index = index + 1;
+        // End of this sample's integration interval.
+        let t_s = (index + 1) as f64 * self.period_s;
+        if !frame.rate_ok() {
+            self.stats.flagged_invalid += 1;
+            self.last_temp = None;
+            return None;
+        }
+        self.last_temp = frame.temp_ok().then(|| TempSample {
+            t_s,
+            temp_c: frame.temp_c(),
+        });
+        Some(GyroSample {
+            t_s,
+            rate_dph: frame.dtheta_lsb as f32 * self.dtheta_to_dph,
+        })
+    }
+}
+
+impl<S: Read<u8>> Gyro for FogSerialGyro<S> {
+    type Error = UartError;
+
+    fn read(&mut self) -> Result<Option<GyroSample>, UartError> {
+        // Bounded by the UART: bytes arrive far slower than this loop drains them.
+        loop {
+            let byte = match self.uart.read() {
+                Ok(b) => b,
+                Err(nb::Error::WouldBlock) => return Ok(None),
+                Err(nb::Error::Other(e)) => {
+                    self.stats.uart_errors += 1;
+                    return Err(UartError(e.kind()));
+                }
+            };
+            if let Some(frame) = self.decoder.push(byte) {
+                if let Some(sample) = self.accept_frame(frame) {
+                    return Ok(Some(sample));
+                }
+            }
+        }
+    }
+}

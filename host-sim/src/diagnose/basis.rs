@@ -1,0 +1,120 @@
+//! Gaussian RBF basis on normalised inputs (the paper's model family) for the
+//! fixed-effects fits of `diagnose`: k-means centres, one shared width, plus the
+//! inputs themselves as linear terms so the model extrapolates gently.
+
+/// A fixed Gaussian basis: normalisation, centres and width in normalised space.
+#[derive(Clone, Debug)]
+pub struct RbfBasis {
+    pub mean: Vec<f64>,
+    pub scale: Vec<f64>,
+    pub centres: Vec<Vec<f64>>,
+    pub width: f64,
+}
+
+impl RbfBasis {
+    /// Builds the basis for `inputs` (one Vec per input, equal lengths): z-score
+    /// normalisation, `k` k-means centres (deterministic farthest-point start), and
+    /// width = `width_factor` x the mean distance from a centre to its nearest other centre.
+    pub fn fit(inputs: &[Vec<f64>], k: usize, width_factor: f64) -> Self {
+        let d = inputs.len();
+        let n = inputs.first().map_or(0, Vec::len);
+        let mut mean = vec![0.0; d];
+        let mut scale = vec![1.0; d];
+        for j in 0..d {
+            let m = inputs[j].iter().sum::<f64>() / n.max(1) as f64;
+            let v = inputs[j].iter().map(|x| (x - m) * (x - m)).sum::<f64>() / n.max(1) as f64;
+            mean[j] = m;
+            scale[j] = if v.sqrt() > 1e-300 { v.sqrt() } else { 1.0 };
+        }
+        let pts: Vec<Vec<f64>> = (0..n).map(|i| (0..d).map(|j| (inputs[j][i] - mean[j]) / scale[j]).collect()).collect();
+        let centres = kmeans(&pts, k.min(n).max(1));
+        let spacing = mean_nearest_distance(&centres).max(1e-3);
+        Self { mean, scale, centres, width: width_factor * spacing }
+    }
+
+    /// The design columns: one Gaussian per centre, then the normalised inputs.
+    pub fn columns(&self, inputs: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        let d = inputs.len();
+        let n = inputs.first().map_or(0, Vec::len);
+        let inv = 1.0 / (2.0 * self.width * self.width);
+        let mut cols: Vec<Vec<f64>> = vec![Vec::with_capacity(n); self.centres.len() + d];
+        let mut x = vec![0.0; d];
+        for i in 0..n {
+            for j in 0..d {
+                x[j] = (inputs[j][i] - self.mean[j]) / self.scale[j];
+            }
+            for (c, col) in self.centres.iter().zip(cols.iter_mut()) {
+                let r2: f64 = c.iter().zip(&x).map(|(a, b)| (a - b) * (a - b)).sum();
+                col.push((-r2 * inv).exp());
+            }
+            for j in 0..d {
+                cols[self.centres.len() + j].push(x[j]);
+            }
+        }
+        cols
+    }
+}
+
+fn dist2(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
+}
+
+fn mean_nearest_distance(c: &[Vec<f64>]) -> f64 {
+    if c.len() < 2 {
+        return 1.0;
+    }
+    let total: f64 = c
+        .iter()
+        .enumerate()
+        .map(|(i, a)| {
+            c.iter().enumerate().filter(|(j, _)| *j != i).map(|(_, b)| dist2(a, b)).fold(f64::INFINITY, f64::min).sqrt()
+        })
+        .sum();
+    total / c.len() as f64
+}
+
+/// Lloyd's k-means from a farthest-point start (deterministic).
+fn kmeans(pts: &[Vec<f64>], k: usize) -> Vec<Vec<f64>> {
+    if pts.is_empty() {
+        return vec![vec![]];
+    }
+    let d = pts[0].len();
+    let mut centres = vec![pts[0].clone()];
+    let mut near: Vec<f64> = pts.iter().map(|p| dist2(p, &pts[0])).collect();
+    while centres.len() < k {
+        let (far, &dmax) = near.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1)).unwrap_or((0, &0.0));
+        if dmax <= 1e-18 {
+            break;
+        }
+        centres.push(pts[far].clone());
+        for (i, p) in pts.iter().enumerate() {
+            near[i] = near[i].min(dist2(p, &pts[far]));
+        }
+    }
+    let mut assign = vec![0usize; pts.len()];
+    for _ in 0..20 {
+        let mut changed = false;
+        for (i, p) in pts.iter().enumerate() {
+            let best = (0..centres.len()).min_by(|&a, &b| dist2(p, &centres[a]).total_cmp(&dist2(p, &centres[b]))).unwrap_or(0);
+            changed |= best != assign[i];
+            assign[i] = best;
+        }
+        let mut sum = vec![vec![0.0; d]; centres.len()];
+        let mut cnt = vec![0usize; centres.len()];
+        for (p, &a) in pts.iter().zip(&assign) {
+            cnt[a] += 1;
+            for j in 0..d {
+                sum[a][j] += p[j];
+            }
+        }
+        for (c, (s, n)) in centres.iter_mut().zip(sum.iter().zip(&cnt)) {
+            if *n > 0 {
+                *c = s.iter().map(|v| v / *n as f64).collect();
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    centres
+}

@@ -1,0 +1,86 @@
+//! The models `diagnose` compares, all with one free offset per run: the paper's RBF on
+//! (T, dT/dt) as the baseline, and that model extended by one candidate feature either
+//! as a linear term or as a further RBF input. Width and ridge are chosen on held-out
+//! data from a small grid, the same way for every model, so comparisons are fair.
+
+use super::basis::RbfBasis;
+use super::cv::{CvResult, Folds, Prepared};
+use super::error::DiagnoseError;
+use super::input::Campaign;
+use super::transforms::{local_derivative, RATE_HALF_S};
+
+/// Width factors tried (x mean centre spacing).
+pub const WIDTH_FACTORS: [f64; 3] = [0.5, 1.0, 2.0];
+/// Relative ridge values tried.
+pub const RIDGES: [f64; 2] = [1e-6, 1e-3];
+
+/// The campaign stacked run after run.
+#[derive(Clone, Debug)]
+pub struct Stacked {
+    pub y: Vec<f64>,
+    pub t_s: Vec<f64>,
+    pub temp_c: Vec<f64>,
+    pub temp_rate_cps: Vec<f64>,
+    pub run_lengths: Vec<usize>,
+}
+
+impl Stacked {
+    /// Stacks drift, time, temperature and dT/dt (centred least-squares slope).
+    pub fn new(c: &Campaign) -> Self {
+        let cat = |f: &dyn Fn(&super::input::Series) -> Vec<f64>| c.runs.iter().flat_map(f).collect::<Vec<f64>>();
+        Self {
+            y: cat(&|s| s.drift_dph.clone()),
+            t_s: cat(&|s| s.t_s.clone()),
+            temp_c: cat(&|s| s.temp_c.clone()),
+            temp_rate_cps: cat(&|s| local_derivative(&s.t_s, &s.temp_c, 1, RATE_HALF_S)),
+            run_lengths: c.runs.iter().map(|s| s.t_s.len()).collect(),
+        }
+    }
+}
+
+/// A fitted and validated RBF model.
+#[derive(Clone, Debug)]
+pub struct RbfFit {
+    pub basis: RbfBasis,
+    pub prepared: Prepared,
+    pub cv: CvResult,
+    pub centres: usize,
+    pub width_factor: f64,
+    pub ridge: f64,
+}
+
+/// Centres for `n` points (more data, more centres; at most 30).
+pub fn centre_count(n: usize, inputs: usize) -> usize {
+    (n / 25).clamp(3, 18 + 4 * inputs)
+}
+
+/// Fits an RBF on `inputs` (plus `linear` columns) choosing width and ridge on held-out data.
+pub fn fit_rbf(folds: &Folds, inputs: &[Vec<f64>], linear: &[Vec<f64>], y: &[f64]) -> Result<RbfFit, DiagnoseError> {
+    let k = centre_count(y.len(), inputs.len());
+    let mut best: Option<RbfFit> = None;
+    for wf in WIDTH_FACTORS {
+        let basis = RbfBasis::fit(inputs, k, wf);
+        let mut cols = basis.columns(inputs);
+        cols.extend(linear.iter().cloned());
+        for ridge in RIDGES {
+            let prepared = Prepared::new(folds, &cols, y, ridge);
+            let Ok(cv) = prepared.validate(folds) else { continue };
+            if best.as_ref().is_none_or(|b| cv.rms() < b.cv.rms()) {
+                best = Some(RbfFit { basis: basis.clone(), prepared, cv, centres: k, width_factor: wf, ridge });
+            }
+        }
+    }
+    best.ok_or(DiagnoseError::Singular { what: "RBF fit" })
+}
+
+/// The paper's model: RBF on (T, dT/dt).
+pub fn fit_baseline(folds: &Folds, st: &Stacked) -> Result<RbfFit, DiagnoseError> {
+    fit_rbf(folds, &[st.temp_c.clone(), st.temp_rate_cps.clone()], &[], &st.y)
+}
+
+/// The candidate as a further RBF input (its columns also kept as linear terms).
+pub fn fit_rbf_input(folds: &Folds, st: &Stacked, cand: &[Vec<f64>]) -> Result<RbfFit, DiagnoseError> {
+    let mut inputs = vec![st.temp_c.clone(), st.temp_rate_cps.clone()];
+    inputs.extend(cand.iter().cloned());
+    fit_rbf(folds, &inputs, &[], &st.y)
+}

@@ -1,0 +1,264 @@
+//! The diagnosis as data (JSON, the issue's schema and more) and as words (stdout).
+
+use super::azimuth::AzimuthEffect;
+use super::input::Exclusion;
+use super::residuals::Structure;
+use super::screen::Mode;
+use super::simfit::SimCalibration;
+use super::transforms::Transform;
+use serde::Serialize;
+use std::fmt::Write as _;
+
+/// A model's held-out performance.
+#[derive(Clone, Debug, Serialize)]
+pub struct ModelSummary {
+    pub inputs: Vec<String>,
+    pub heldout_rms_dph: f64,
+    pub centres: usize,
+    pub width_factor: f64,
+    pub ridge: f64,
+}
+
+/// One ranked candidate.
+#[derive(Clone, Debug, Serialize)]
+pub struct CandidateRow {
+    pub column: String,
+    pub transform: Transform,
+    pub tau_s: Option<f64>,
+    pub mode: Mode,
+    pub heldout_rms_dph: f64,
+    pub gain_pct: f64,
+    pub p_value: f64,
+    pub significant: bool,
+    pub units_improved: f64,
+}
+
+/// The named cause.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct Cause {
+    pub column: String,
+    pub transform: Transform,
+    pub tau_s: Option<f64>,
+}
+
+impl Cause {
+    /// `column:transform[(tau)]`.
+    pub fn label(&self) -> String {
+        match self.tau_s {
+            Some(t) => format!("{}:{}({t:.0}s)", self.column, self.transform.name()),
+            None => format!("{}:{}", self.column, self.transform.name()),
+        }
+    }
+}
+
+/// A candidate that explains the same thing as the named cause.
+#[derive(Clone, Debug, Serialize)]
+pub struct Competitor {
+    pub candidate: String,
+    /// Its held-out gain once the named cause is in the model, %.
+    pub conditional_gain_pct: f64,
+}
+
+/// The extended model.
+#[derive(Clone, Debug, Serialize)]
+pub struct Extended {
+    pub inputs: Vec<String>,
+    pub mode: Option<Mode>,
+    pub heldout_rms_dph: f64,
+    pub gain_pct: f64,
+}
+
+/// Drift std (pooled within-run 1 sigma of 10 s means), deg/h.
+#[derive(Clone, Debug, Serialize)]
+pub struct DriftStd {
+    pub uncompensated_dph: f64,
+    pub baseline_heldout_dph: f64,
+    pub extended_heldout_dph: f64,
+}
+
+/// Azimuth effect before/after the extension.
+#[derive(Clone, Debug, Serialize)]
+pub struct Azimuth {
+    pub baseline: AzimuthEffect,
+    pub extended: AzimuthEffect,
+}
+
+/// Simulator vs measurement.
+#[derive(Clone, Debug, Serialize)]
+pub struct Simulation {
+    pub before_rms_dph: f64,
+    pub after_rms_dph: f64,
+    pub calibration: SimCalibration,
+}
+
+/// Campaign facts.
+#[derive(Clone, Debug, Serialize)]
+pub struct CampaignSummary {
+    pub runs: usize,
+    pub points: usize,
+    pub validation: String,
+    pub excluded_columns: Vec<Exclusion>,
+    pub skipped_candidates: Vec<Exclusion>,
+}
+
+/// The whole diagnosis.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    pub campaign: CampaignSummary,
+    pub baseline: ModelSummary,
+    pub residual_structure: Structure,
+    pub candidates: Vec<CandidateRow>,
+    pub named_cause: Option<Cause>,
+    pub cause_in_words: String,
+    pub competing: Vec<Competitor>,
+    pub parsimony_note: Option<String>,
+    pub extended: Extended,
+    pub drift_std: DriftStd,
+    pub azimuth: Option<Azimuth>,
+    pub simulation: Simulation,
+}
+
+/// The cause in words (physics reading of a column and transform).
+pub fn cause_in_words(c: Option<&Cause>, coef: &[f64]) -> String {
+    let Some(c) = c else {
+        return "no significant cause: the residual of the paper's T, dT/dt model shows no structure that any \
+                candidate explains better than chance on held-out data"
+            .into();
+    };
+    let tau = c.tau_s.unwrap_or(0.0);
+    let k = coef.first().copied().unwrap_or(0.0);
+    match (c.column.as_str(), c.transform) {
+        ("temp_c", Transform::Accel) => format!(
+            "drift follows d2T/dt2 ({k:.3e} deg/h per degC/s^2): the Shupe gradient term (the rate of the temperature \
+             gradient along the coil), which the T, dT/dt model cannot express"
+        ),
+        ("temp_c", Transform::Lag) => format!(
+            "drift follows the temperature through a {tau:.0} s lag: the sensor does not sit where the drift is \
+             generated (sensor lag / placement), which T, dT/dt of the sensor cannot express"
+        ),
+        ("t_s", Transform::Decay) => format!(
+            "a power-on transient exp(-t/{tau:.0} s) independent of temperature (start-up amplitude {k:.4} deg/h): \
+             e.g. light-source or electronics settling, which no function of T, dT/dt can express in warm restarts"
+        ),
+        ("earth_dph", Transform::Value) => format!(
+            "drift proportional to the Earth-rate input ({:.1} ppm): a scale-factor error",
+            k * 1e6
+        ),
+        (col, Transform::Harmonic) => {
+            let a = coef.first().copied().unwrap_or(0.0);
+            let b = coef.get(1).copied().unwrap_or(0.0);
+            format!(
+                "drift depends on {col} as a sinusoid (amplitude {:.4} deg/h, maximum at {:.0} deg): a heading-dependent \
+                 bias such as magnetic (Faraday) sensitivity; it flips with the 180 deg turn and does not cancel in a seek",
+                a.hypot(b),
+                b.atan2(a).to_degrees().rem_euclid(360.0)
+            )
+        }
+        (col, Transform::Value) => format!("drift follows `{col}` itself ({k:.4e} deg/h per unit)"),
+        (col, Transform::Rate) => format!("drift follows the rate of change of `{col}` ({k:.4e} deg/h per unit/s)"),
+        (col, Transform::Accel) => format!("drift follows the second derivative of `{col}` ({k:.4e} deg/h per unit/s^2)"),
+        (col, Transform::Lag) => format!("drift follows `{col}` through a first-order lag of {tau:.0} s ({k:.4e} deg/h per unit)"),
+        (col, Transform::Decay) => format!("drift decays as exp(-{col}/{tau:.0} s)"),
+    }
+}
+
+/// Human-readable report.
+pub fn render_text(r: &Report) -> String {
+    let mut s = String::new();
+    let c = &r.campaign;
+    let _ = writeln!(s, "fogsim diagnose: {} runs, {} points (10 s means); validation: {}", c.runs, c.points, c.validation);
+    for e in &c.excluded_columns {
+        let _ = writeln!(s, "  excluded column `{}`: {}", e.column, e.reason);
+    }
+    if !c.skipped_candidates.is_empty() {
+        let _ = writeln!(s, "  {} candidate(s) skipped (e.g. {}: {})", c.skipped_candidates.len(), c.skipped_candidates[0].column, c.skipped_candidates[0].reason);
+    }
+    let sim = &r.simulation.calibration;
+    let _ = writeln!(s, "\n1. Baseline");
+    let _ = writeln!(
+        s,
+        "  simulator calibrated by least squares: thermal tau {:.0} s / {:.0} s (temp rms {:.3} degC), bias {:.4} deg/h/degC, \
+         Shupe {:.3} deg/h per degC/s, white noise {:.4} deg/h (10 s)",
+        sim.tau_fast_s, sim.tau_slow_s, sim.temp_rms_c, sim.bias_dph_per_c, sim.shupe_dph_per_cps, sim.noise_10s_dph
+    );
+    let _ = writeln!(s, "  simulation vs measured drift: rms {:.4} deg/h (run offsets removed)", r.simulation.before_rms_dph);
+    let _ = writeln!(
+        s,
+        "  paper's model RBF({}): held-out rms {:.4} deg/h ({} centres); uncompensated drift std {:.4} deg/h",
+        r.baseline.inputs.join(", "),
+        r.baseline.heldout_rms_dph,
+        r.baseline.centres,
+        r.drift_std.uncompensated_dph
+    );
+    let _ = writeln!(s, "\n2. What the model gets wrong (held-out residual)");
+    for b in &r.residual_structure.by_time {
+        let _ = writeln!(s, "  {:>12}: rms {:.4}  mean {:+.4} deg/h  (n={})", b.label, b.rms_dph, b.mean_dph, b.n);
+    }
+    for b in &r.residual_structure.by_ambient {
+        let _ = writeln!(s, "  ambient {:>10}: rms {:.4} deg/h (n={})", b.label, b.rms_dph, b.n);
+    }
+    let mut links = r.residual_structure.by_signal.clone();
+    links.sort_by(|a, b| b.correlation.abs().total_cmp(&a.correlation.abs()));
+    let top: Vec<String> = links.iter().take(5).map(|l| format!("{} {:+.2}", l.signal, l.correlation)).collect();
+    let _ = writeln!(s, "  within-run correlation with signals: {}", top.join(", "));
+    let _ = writeln!(s, "\n3. Candidate causes (ranked by held-out rms; p = family-wise sign-flip test over whole validation units)");
+    for row in r.candidates.iter().take(8) {
+        let label = Cause { column: row.column.clone(), transform: row.transform, tau_s: row.tau_s }.label();
+        let _ = writeln!(
+            s,
+            "  {:<28} {:>9} rms {:.4}  gain {:+6.2}%  p {:.4}  units improved {:>3.0}%{}",
+            label,
+            format!("{:?}", row.mode),
+            row.heldout_rms_dph,
+            row.gain_pct,
+            row.p_value,
+            100.0 * row.units_improved,
+            if row.significant { "  *" } else { "" }
+        );
+    }
+    let _ = writeln!(s, "\n4. Cause");
+    match &r.named_cause {
+        Some(cause) => {
+            let _ = writeln!(s, "  named: {}", cause.label());
+        }
+        None => {
+            let _ = writeln!(s, "  named: none");
+        }
+    }
+    let _ = writeln!(s, "  {}", r.cause_in_words);
+    if let Some(n) = &r.parsimony_note {
+        let _ = writeln!(s, "  {n}");
+    }
+    for comp in &r.competing {
+        let _ = writeln!(
+            s,
+            "  competes: {} explains the same thing (its gain drops to {:+.2}% once the named cause is in)",
+            comp.candidate, comp.conditional_gain_pct
+        );
+    }
+    let e = &r.extended;
+    let _ = writeln!(
+        s,
+        "  extended model RBF({}): held-out rms {:.4} deg/h, gain {:+.2}% ; drift std {:.4} -> {:.4} -> {:.4} deg/h (raw -> paper -> extended)",
+        e.inputs.join(", "),
+        e.heldout_rms_dph,
+        e.gain_pct,
+        r.drift_std.uncompensated_dph,
+        r.drift_std.baseline_heldout_dph,
+        r.drift_std.extended_heldout_dph
+    );
+    if let Some(a) = &r.azimuth {
+        let _ = writeln!(
+            s,
+            "  azimuth (two-position seek, {:.0} s dwells, lat {:.1}, psi 90 deg): 1 sigma {:.4} deg -> {:.4} deg",
+            a.baseline.dwell_s, a.baseline.latitude_deg, a.baseline.azimuth_sigma_deg, a.extended.azimuth_sigma_deg
+        );
+    }
+    let _ = writeln!(s, "\n5. Simulator extended with the named effect");
+    let _ = writeln!(
+        s,
+        "  sim vs measured rms: {:.4} -> {:.4} deg/h (effect coefficient(s) {:?})",
+        r.simulation.before_rms_dph, r.simulation.after_rms_dph, sim.effect_coef
+    );
+    s
+}

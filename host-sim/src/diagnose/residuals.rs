@@ -1,0 +1,105 @@
+//! Where the baseline's held-out residual has structure: by time since power-on, per
+//! ambient temperature, and against each signal (within-run correlation).
+
+use super::cv::Folds;
+use super::input::Campaign;
+use super::models::Stacked;
+use serde::Serialize;
+
+/// Time-since-power-on bins, s.
+pub const TIME_BINS_S: [f64; 7] = [0.0, 120.0, 300.0, 600.0, 1200.0, 2700.0, f64::INFINITY];
+
+/// Residual statistics over one slice of the data.
+#[derive(Clone, Debug, Serialize)]
+pub struct Slice {
+    pub label: String,
+    pub n: usize,
+    pub mean_dph: f64,
+    pub rms_dph: f64,
+}
+
+/// Residual against one signal.
+#[derive(Clone, Debug, Serialize)]
+pub struct SignalLink {
+    pub signal: String,
+    /// Pearson correlation of within-run deviations.
+    pub correlation: f64,
+}
+
+/// The residual's structure.
+#[derive(Clone, Debug, Serialize)]
+pub struct Structure {
+    pub by_time: Vec<Slice>,
+    pub by_ambient: Vec<Slice>,
+    pub by_signal: Vec<SignalLink>,
+}
+
+fn slice(label: String, r: impl Iterator<Item = f64>) -> Slice {
+    let v: Vec<f64> = r.collect();
+    let n = v.len();
+    let mean = v.iter().sum::<f64>() / n.max(1) as f64;
+    let rms = (v.iter().map(|x| x * x).sum::<f64>() / n.max(1) as f64).sqrt();
+    Slice { label, n, mean_dph: mean, rms_dph: rms }
+}
+
+fn demeaned_by_run(folds: &Folds, v: &[f64]) -> Vec<f64> {
+    let mut out = v.to_vec();
+    for r in &folds.run_rows {
+        let m = v[r.clone()].iter().sum::<f64>() / r.len() as f64;
+        out[r.clone()].iter_mut().for_each(|x| *x -= m);
+    }
+    out
+}
+
+/// Within-run Pearson correlation.
+pub fn within_run_correlation(folds: &Folds, a: &[f64], b: &[f64]) -> f64 {
+    let a = demeaned_by_run(folds, a);
+    let b = demeaned_by_run(folds, b);
+    let ab: f64 = a.iter().zip(&b).map(|(x, y)| x * y).sum();
+    let aa: f64 = a.iter().map(|x| x * x).sum();
+    let bb: f64 = b.iter().map(|x| x * x).sum();
+    if aa <= 0.0 || bb <= 0.0 {
+        0.0
+    } else {
+        ab / (aa * bb).sqrt()
+    }
+}
+
+/// Builds the structure tables for `residual` (stacked, one per row).
+pub fn structure(c: &Campaign, folds: &Folds, st: &Stacked, residual: &[f64]) -> Structure {
+    let by_time = TIME_BINS_S
+        .windows(2)
+        .filter_map(|w| {
+            let s = slice(
+                if w[1].is_finite() { format!("{:.0}-{:.0} min", w[0] / 60.0, w[1] / 60.0) } else { format!(">{:.0} min", w[0] / 60.0) },
+                st.t_s.iter().zip(residual).filter(|(t, _)| **t >= w[0] && **t < w[1]).map(|(_, r)| *r),
+            );
+            (s.n > 0).then_some(s)
+        })
+        .collect();
+    let mut ambients: Vec<f64> = c.runs.iter().filter_map(|s| s.ambient_c.map(|a| (a * 10.0).round() / 10.0)).collect();
+    ambients.sort_by(f64::total_cmp);
+    ambients.dedup();
+    let by_ambient = ambients
+        .iter()
+        .map(|&a| {
+            let rows = c
+                .runs
+                .iter()
+                .zip(&folds.run_rows)
+                .filter(|(s, _)| s.ambient_c.is_some_and(|x| (x - a).abs() < 0.05))
+                .flat_map(|(_, r)| r.clone());
+            slice(format!("{a:.1} degC"), rows.map(|i| residual[i]))
+        })
+        .collect();
+    let mut by_signal = vec![
+        SignalLink { signal: "t_s".into(), correlation: within_run_correlation(folds, &st.t_s, residual) },
+        SignalLink { signal: "temp_c".into(), correlation: within_run_correlation(folds, &st.temp_c, residual) },
+        SignalLink { signal: "temp_c:rate".into(), correlation: within_run_correlation(folds, &st.temp_rate_cps, residual) },
+    ];
+    for (i, name) in c.extra_names.iter().enumerate() {
+        let v: Vec<f64> = c.runs.iter().flat_map(|s| s.extras[i].iter().copied()).collect();
+        by_signal.push(SignalLink { signal: name.clone(), correlation: within_run_correlation(folds, &v, residual) });
+    }
+    Structure { by_time, by_ambient, by_signal }
+}

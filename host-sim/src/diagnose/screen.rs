@@ -1,0 +1,206 @@
+//! Ranking candidate causes by held-out gain, cheaply first, properly for the few best.
+//!
+//! 1. Screen: every candidate is added to the baseline as a linear term and validated
+//!    (one small solve per fold); its per-unit gains feed the family-wise sign-flip test.
+//! 2. Refit: the best few are also tried as a further RBF input; each keeps whichever
+//!    form is better on held-out data.
+//! 3. Name: among significant candidates the largest held-out gain wins; within one
+//!    column, a simpler transform (value before lag, accel before lag, ...) is preferred
+//!    unless the more complex one is significantly better (a lag with a free tau can
+//!    imitate its column's value or derivatives). Significant candidates that lose their
+//!    gain once the named one is in the model are reported as competing with it.
+
+use super::cv::{CvResult, Folds};
+use super::error::DiagnoseError;
+use super::input::Campaign;
+use super::models::{fit_rbf_input, RbfFit, Stacked};
+use super::signflip::{max_t_pvalues, paired_pvalue};
+use super::transforms::Candidate;
+
+/// Family-wise significance level.
+pub const ALPHA: f64 = 0.01;
+/// Smallest held-out gain worth naming, % of rms.
+pub const MIN_GAIN_PCT: f64 = 0.2;
+/// Candidates refitted as RBF inputs.
+pub const REFIT_TOP: usize = 6;
+/// Seed of the sign-flip patterns (results are deterministic).
+pub const FLIP_SEED: u64 = 0x00D1_A6_05E;
+
+/// How a candidate enters the extended model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Mode {
+    Linear,
+    RbfInput,
+}
+
+/// One scored candidate.
+#[derive(Clone, Debug)]
+pub struct Scored {
+    pub cand: Candidate,
+    /// The feature's stacked columns.
+    pub cols: Vec<Vec<f64>>,
+    pub mode: Mode,
+    pub cv: CvResult,
+    pub heldout_rms_dph: f64,
+    pub gain_pct: f64,
+    pub p_value: f64,
+    pub significant: bool,
+    /// Share of validation units whose held-out error dropped.
+    pub units_improved: f64,
+}
+
+/// The outcome of screening.
+#[derive(Clone, Debug)]
+pub struct Screening {
+    /// Sorted by held-out rms, best first.
+    pub scored: Vec<Scored>,
+    /// Candidates skipped and why.
+    pub skipped: Vec<(String, String)>,
+    /// Index into `scored` of the named cause.
+    pub named: Option<usize>,
+    /// Labels of candidates competing with the named cause, with their conditional gain %.
+    pub competing: Vec<(String, f64)>,
+    /// When the named cause displaced a higher-gain candidate of the same column.
+    pub parsimony_note: Option<String>,
+}
+
+fn has_within_unit_variation(folds: &Folds, col: &[f64]) -> bool {
+    let total: f64 = col.iter().map(|v| v * v).sum::<f64>().max(1e-300);
+    let within: f64 = folds
+        .unit_rows
+        .iter()
+        .map(|r| {
+            let m = col[r.clone()].iter().sum::<f64>() / r.len() as f64;
+            col[r.clone()].iter().map(|v| (v - m) * (v - m)).sum::<f64>()
+        })
+        .sum();
+    within > 1e-10 * total && within > 1e-200
+}
+
+fn gain_pct(base: f64, ext: f64) -> f64 {
+    100.0 * (1.0 - ext / base)
+}
+
+/// Screens, refits and names (see the module header).
+pub fn screen(
+    campaign: &Campaign,
+    folds: &Folds,
+    st: &Stacked,
+    base: &RbfFit,
+    cands: Vec<Candidate>,
+) -> Result<Screening, DiagnoseError> {
+    let base_rms = base.cv.rms();
+    let mut skipped = Vec::new();
+    let mut scored = Vec::new();
+    for cand in cands {
+        let cols: Vec<Vec<f64>> = {
+            let per_run: Vec<Vec<Vec<f64>>> = campaign.runs.iter().map(|s| cand.compute(s)).collect();
+            let m = per_run.first().map_or(0, Vec::len);
+            (0..m).map(|j| per_run.iter().flat_map(|r| r[j].iter().copied()).collect()).collect()
+        };
+        if cols.iter().any(|c| c.iter().any(|v| !v.is_finite())) {
+            skipped.push((cand.label(), "not finite".to_owned()));
+            continue;
+        }
+        if folds.offsets == super::cv::Offsets::PerUnit && !cols.iter().any(|c| has_within_unit_variation(folds, c)) {
+            skipped.push((cand.label(), "no variation within runs: cannot be told from run offsets".to_owned()));
+            continue;
+        }
+        let cv = base.prepared.validate_with(folds, &cols)?;
+        let rms = cv.rms();
+        scored.push(Scored {
+            cand,
+            cols,
+            mode: Mode::Linear,
+            heldout_rms_dph: rms,
+            gain_pct: gain_pct(base_rms, rms),
+            cv,
+            p_value: 1.0,
+            significant: false,
+            units_improved: 0.0,
+        });
+    }
+    let gains: Vec<Vec<f64>> = scored.iter().map(|s| unit_gains(&base.cv, &s.cv)).collect();
+    let pv = max_t_pvalues(&gains, FLIP_SEED);
+    for (s, p) in scored.iter_mut().zip(pv) {
+        s.p_value = p;
+    }
+    scored.sort_by(|a, b| a.heldout_rms_dph.total_cmp(&b.heldout_rms_dph));
+    for s in scored.iter_mut().take(REFIT_TOP).filter(|s| s.gain_pct > 0.0) {
+        if let Ok(fit) = fit_rbf_input(folds, st, &s.cols) {
+            if fit.cv.rms() < s.heldout_rms_dph {
+                s.mode = Mode::RbfInput;
+                s.heldout_rms_dph = fit.cv.rms();
+                s.gain_pct = gain_pct(base_rms, s.heldout_rms_dph);
+                s.cv = fit.cv;
+            }
+        }
+    }
+    for s in scored.iter_mut() {
+        let g = unit_gains(&base.cv, &s.cv);
+        s.units_improved = g.iter().filter(|v| **v > 0.0).count() as f64 / g.len().max(1) as f64;
+        s.significant = s.p_value < ALPHA && s.gain_pct > MIN_GAIN_PCT;
+    }
+    scored.sort_by(|a, b| a.heldout_rms_dph.total_cmp(&b.heldout_rms_dph));
+    let mut named = scored.iter().position(|s| s.significant);
+    let mut parsimony_note = None;
+    if let Some(top) = named {
+        let simpler = scored
+            .iter()
+            .enumerate()
+            .filter(|(i, s)| {
+                *i != top
+                    && s.significant
+                    && s.cand.column == scored[top].cand.column
+                    && s.cand.transform.complexity() < scored[top].cand.transform.complexity()
+            })
+            .filter(|(_, s)| paired_pvalue(&unit_gains(&s.cv, &scored[top].cv), FLIP_SEED) >= 0.05)
+            .min_by(|a, b| {
+                (a.1.cand.transform.complexity(), a.1.heldout_rms_dph)
+                    .partial_cmp(&(b.1.cand.transform.complexity(), b.1.heldout_rms_dph))
+                    .unwrap_or(std::cmp::Ordering::Equal)
+            })
+            .map(|(i, _)| i);
+        if let Some(i) = simpler {
+            parsimony_note = Some(format!(
+                "{} chosen over {} (same column, simpler, not significantly worse on held-out data)",
+                scored[i].cand.label(),
+                scored[top].cand.label()
+            ));
+            named = Some(i);
+        }
+    }
+    let competing = match named {
+        Some(i) => competitors(folds, base, &scored, i)?,
+        None => vec![],
+    };
+    Ok(Screening { scored, skipped, named, competing, parsimony_note })
+}
+
+/// Per-unit drop in held-out squared error from `from` to `to`.
+pub fn unit_gains(from: &CvResult, to: &CvResult) -> Vec<f64> {
+    from.unit_sse.iter().zip(&to.unit_sse).map(|(a, b)| a - b).collect()
+}
+
+/// Significant candidates of other columns whose held-out gain (as linear terms) mostly
+/// vanishes once the named cause is in the model: they explain the same thing.
+fn competitors(folds: &Folds, base: &RbfFit, scored: &[Scored], named: usize) -> Result<Vec<(String, f64)>, DiagnoseError> {
+    let with_named = base.prepared.validate_with(folds, &scored[named].cols)?;
+    let mut out = Vec::new();
+    let mut seen_columns: Vec<String> = vec![scored[named].cand.column.clone()];
+    for s in scored.iter().filter(|s| s.significant) {
+        if seen_columns.contains(&s.cand.column) {
+            continue;
+        }
+        let mut both = scored[named].cols.clone();
+        both.extend(s.cols.iter().cloned());
+        let cv = base.prepared.validate_with(folds, &both)?;
+        let cond = gain_pct(with_named.rms(), cv.rms());
+        if cond < 0.5 * s.gain_pct {
+            out.push((s.cand.label(), cond));
+            seen_columns.push(s.cand.column.clone());
+        }
+    }
+    Ok(out)
+}

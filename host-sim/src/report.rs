@@ -1,0 +1,247 @@
+//! Report plumbing shared by `compensate`, `north-seek`, `reproduce` and `demo`:
+//! the JSON report structures (their shape is the contract of issue 3), atomic file output
+//! (nothing half-written on error) and a plain-text table for the terminal.
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::Path;
+
+use serde::Serialize;
+
+/// Writes `bytes` to `path` via a temporary file in the same directory and a rename, so
+/// readers never see a partial file and a failure leaves no file behind.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "out".into());
+    let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// Serialises `value` as pretty JSON and writes it atomically to `path`.
+pub fn write_json<T: Serialize>(path: &Path, value: &T) -> anyhow::Result<()> {
+    let mut text = serde_json::to_string_pretty(value)?;
+    text.push('\n');
+    write_atomic(path, text.as_bytes()).map_err(|e| anyhow::anyhow!("{}: cannot write JSON report: {e}", path.display()))
+}
+
+/// Fails early (before any long computation) if `path` cannot be created: its directory must exist.
+pub fn check_output_path(path: &Path, option: &str) -> anyhow::Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        anyhow::bail!("{option} {}: directory {} does not exist", path.display(), dir.display());
+    }
+    if path.is_dir() {
+        anyhow::bail!("{option} {}: is a directory, expected a file name", path.display());
+    }
+    Ok(())
+}
+
+/// Creates a plot directory (and parents) up front, with the option name in the error.
+pub fn ensure_dir(dir: &Path, option: &str) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{option} {}: cannot create directory: {e}", dir.display()))
+}
+
+// ---------------------------------------------------------------------------------------------
+// compensate
+
+/// Drift figures of one record (or the pool of records), all from 10 s means with Earth rate removed.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct DriftStats {
+    /// 1 sigma of the 10 s means (pooled over runs for `overall`), deg/h.
+    pub std_dph: f64,
+    /// Largest |10 s mean - settled mean| (largest over runs for `overall`), deg/h.
+    pub max_dev_dph: f64,
+    /// Time since power-on after which the 5-min moving std stays under the spec, s;
+    /// `null` if it never does (for `overall`: the worst run, `null` if any run never does).
+    pub time_to_spec_s: Option<f64>,
+}
+
+/// One record's before/after figures.
+#[derive(Clone, Debug, Serialize)]
+pub struct CompensatedRun {
+    pub file: String,
+    pub ambient_c: Option<f64>,
+    pub before: DriftStats,
+    pub after: DriftStats,
+    /// 10 s windows whose inputs lay outside the model's trained range (compensated anyway,
+    /// flagged by fog-core's compensator).
+    pub out_of_range_windows: usize,
+}
+
+/// Pooled before/after figures.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct BeforeAfter {
+    pub before: DriftStats,
+    pub after: DriftStats,
+}
+
+/// `fogsim compensate --json` output.
+#[derive(Clone, Debug, Serialize)]
+pub struct CompensateReport {
+    pub runs: Vec<CompensatedRun>,
+    pub overall: BeforeAfter,
+    /// The spec the time-to-spec figures refer to, deg/h (1 sigma of 10 s means).
+    pub spec_dph: f64,
+}
+
+// ---------------------------------------------------------------------------------------------
+// north-seek
+
+/// Azimuth statistics of all seeks of one arm (with or without compensation).
+#[derive(Clone, Debug, Serialize)]
+pub struct SeekStats {
+    /// 1 sigma of all azimuth errors (about their mean), deg.
+    pub std_deg: f64,
+    /// Largest |azimuth - true azimuth| over all seeks, deg.
+    pub max_dev_deg: f64,
+    /// Mean azimuth error (azimuth - true), deg.
+    pub mean_error_deg: f64,
+    /// Root mean square azimuth error against the truth, deg.
+    pub rms_error_deg: f64,
+    /// 1 sigma (about the true azimuth, i.e. rms error) of each seek index over the starts, deg.
+    pub per_seek_std_deg: Vec<f64>,
+    /// Mean error of each seek index over the starts, deg.
+    pub per_seek_mean_error_deg: Vec<f64>,
+    /// Mean over starts of (max - min) of the seeks of one start: the paper's "max deviation", deg.
+    pub mean_range_deg: f64,
+    /// Mean over starts of the 1 sigma of the seeks of one start (the paper's std), deg.
+    pub mean_within_start_std_deg: f64,
+    /// Mean 1-sigma uncertainty the north finder reported, deg.
+    pub mean_reported_sigma_deg: f64,
+    /// Every azimuth, `[start][seek]`, deg (0..360).
+    pub azimuths_deg: Vec<Vec<f64>>,
+}
+
+/// `fogsim north-seek --json` output.
+#[derive(Clone, Debug, Serialize)]
+pub struct NorthSeekReport {
+    pub starts: usize,
+    pub seeks_per_start: usize,
+    pub positions: u8,
+    pub latitude_deg: f64,
+    pub ambient_c: f64,
+    pub true_azimuth_deg: f64,
+    /// Duration of one seek from its start to its result, s (mean over all seeks).
+    pub seek_duration_s: f64,
+    /// The paper's seek time, s (4 min 56 s), for comparison.
+    pub paper_seek_duration_s: f64,
+    /// White-noise floor of the azimuth for the simulated ARW and this seek plan, deg.
+    pub noise_floor_deg: f64,
+    pub arw_dpsh: f64,
+    pub seed: u64,
+    pub uncompensated: SeekStats,
+    pub compensated: SeekStats,
+    /// Where the model came from (file or "trained on a default simulated campaign").
+    pub model_source: String,
+}
+
+// ---------------------------------------------------------------------------------------------
+// text tables
+
+/// A plain-text table with right-aligned columns (first column left-aligned).
+#[derive(Clone, Debug, Default)]
+pub struct Table {
+    header: Vec<String>,
+    rows: Vec<Vec<String>>,
+}
+
+impl Table {
+    /// A table with these column headings.
+    pub fn new<S: ToString>(header: &[S]) -> Self {
+        Self { header: header.iter().map(|h| h.to_string()).collect(), rows: Vec::new() }
+    }
+
+    /// Appends one row (cells beyond the header are kept, missing ones are blank).
+    pub fn row<S: ToString>(&mut self, cells: &[S]) {
+        self.rows.push(cells.iter().map(|c| c.to_string()).collect());
+    }
+
+    /// Renders the table with a rule under the header.
+    pub fn render(&self) -> String {
+        let ncol = self.rows.iter().map(Vec::len).chain([self.header.len()]).max().unwrap_or(0);
+        let width = |c: usize| {
+            self.rows
+                .iter()
+                .chain([&self.header])
+                .filter_map(|r| r.get(c))
+                .map(|s| s.chars().count())
+                .max()
+                .unwrap_or(0)
+        };
+        let widths: Vec<usize> = (0..ncol).map(width).collect();
+        let mut out = String::new();
+        let line = |out: &mut String, cells: &[String]| {
+            let mut text = String::new();
+            for (c, w) in widths.iter().enumerate() {
+                let cell = cells.get(c).map(String::as_str).unwrap_or("");
+                if c == 0 {
+                    let _ = write!(text, "{cell:<w$}");
+                } else {
+                    let _ = write!(text, "  {cell:>w$}");
+                }
+            }
+            out.push_str(text.trim_end());
+            out.push('\n');
+        };
+        line(&mut out, &self.header);
+        let total: usize = widths.iter().sum::<usize>() + 2 * widths.len().saturating_sub(1);
+        out.push_str(&"-".repeat(total));
+        out.push('\n');
+        for r in &self.rows {
+            line(&mut out, r);
+        }
+        out
+    }
+}
+
+/// Formats an optional time in seconds as minutes ("12.5 min"), "never" when absent.
+pub fn fmt_minutes(t_s: Option<f64>) -> String {
+    match t_s {
+        Some(t) => format!("{:.1} min", t / 60.0),
+        None => "never".into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn table_aligns_columns() {
+        let mut t = Table::new(&["quantity", "paper", "us"]);
+        t.row(&["std", "0.034", "0.1"]);
+        t.row(&["x", "1", "22.25"]);
+        let s = t.render();
+        let lines: Vec<&str> = s.lines().collect();
+        assert_eq!(lines.len(), 4);
+        assert_eq!(lines[2], "std       0.034    0.1");
+        assert_eq!(lines[3], "x             1  22.25");
+    }
+
+    #[test]
+    fn atomic_write_replaces_whole_file() {
+        let dir = std::env::temp_dir().join(format!("fogsim-report-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("a.json");
+        write_atomic(&p, b"first").unwrap();
+        write_atomic(&p, b"second").unwrap();
+        assert_eq!(std::fs::read(&p).unwrap(), b"second");
+        assert!(write_atomic(&dir.join("missing/x.json"), b"x").is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,95 @@
+//! Training options (`TrainConfig`) with the defaults `fogsim train` uses, and their checks.
+
+use super::error::{Result, TrainError};
+use fog_core::model::MAX_CENTERS;
+use serde::Serialize;
+
+/// Which forward-selection algorithm picks the centres.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// Chen-Cowan-Grant orthogonal least squares, stop at 1 - sum(err) < rho or `max_centers`.
+    Ols,
+    /// Orr (1995) regularised forward selection, ridge and stop chosen by GCV.
+    OrrGcv,
+}
+
+/// Everything `train_model` needs besides the data.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TrainConfig {
+    pub method: Method,
+    /// OLS stop: selection ends when 1 - sum(err) < rho (0 < rho < 1).
+    pub rho: f64,
+    /// Most RBF centres (1..=64, fog-core's MAX_CENTERS).
+    pub max_centers: usize,
+    /// Gaussian widths (sigma, in normalised input units) tried by grouped validation.
+    pub width_candidates: Vec<f64>,
+    /// Folds of the grouped (by run) cross-validation that picks the width.
+    pub folds: usize,
+    /// The last `linear_only_inputs` dataset inputs enter the model only as linear terms.
+    pub linear_only_inputs: usize,
+    /// Also fit linear terms on the RBF inputs (jointly with the centres).
+    pub linear_on_rbf_inputs: bool,
+    /// A candidate is dropped once less than this fraction of its energy is new
+    /// (orthogonal to the selection): guards the triangular solve's conditioning.
+    pub collinearity_tol: f64,
+    /// Gyro id written into the model's metadata (at most 16 bytes).
+    pub gyro_id: String,
+    /// Worker threads for the design matrix (None: all cores).
+    pub threads: Option<usize>,
+}
+
+impl Default for TrainConfig {
+    fn default() -> Self {
+        Self {
+            method: Method::Ols,
+            rho: 0.01,
+            max_centers: MAX_CENTERS,
+            width_candidates: vec![0.1, 0.2, 0.35, 0.6, 1.0],
+            folds: 3,
+            linear_only_inputs: 0,
+            linear_on_rbf_inputs: false,
+            collinearity_tol: 1e-6,
+            gyro_id: String::from("sim"),
+            threads: None,
+        }
+    }
+}
+
+impl TrainConfig {
+    /// Checks every option against its allowed range and against the input count.
+    pub fn check(&self, n_inputs: usize) -> Result<()> {
+        let bad = |option, why: String| Err(TrainError::BadConfig { option, why });
+        if !(self.rho > 0.0 && self.rho < 1.0) {
+            return bad("rho", format!("{} is outside 0 < rho < 1", self.rho));
+        }
+        if self.max_centers == 0 || self.max_centers > MAX_CENTERS {
+            return bad("max-centers", format!("{} is outside 1..={MAX_CENTERS}", self.max_centers));
+        }
+        if self.width_candidates.is_empty() {
+            return bad("widths", "no Gaussian width candidates given".into());
+        }
+        if let Some(w) = self.width_candidates.iter().find(|w| !(w.is_finite() && **w > 0.0)) {
+            return bad("widths", format!("width {w} is not a positive number"));
+        }
+        if self.folds < 2 {
+            return bad("folds", format!("{} folds: grouped validation needs at least 2", self.folds));
+        }
+        if self.linear_only_inputs >= n_inputs {
+            return bad(
+                "linear-only inputs",
+                format!("{} of {n_inputs} inputs: at least one RBF input is needed", self.linear_only_inputs),
+            );
+        }
+        if !(self.collinearity_tol > 0.0 && self.collinearity_tol < 1.0) {
+            return bad("collinearity tolerance", format!("{} is outside (0, 1)", self.collinearity_tol));
+        }
+        if self.gyro_id.len() > 16 {
+            return bad("gyro id", format!("`{}` is longer than 16 bytes", self.gyro_id));
+        }
+        if self.threads == Some(0) {
+            return bad("threads", "0 threads".into());
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,74 @@
+//! The trainer's error type: every way a dataset, a configuration or a fit can be
+//! rejected, each saying what was wrong and where, so `fogsim train` can print one line.
+
+use std::fmt;
+
+/// Why the trainer refused a dataset or configuration, or could not fit.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TrainError {
+    /// The dataset has no rows.
+    EmptyDataset,
+    /// A row or a spec list does not have the dataset's number of inputs.
+    InputCount { expected: usize, found: usize, row: usize },
+    /// The dataset has more inputs than a model can hold.
+    TooManyInputs { found: usize, max: usize },
+    /// Rows, targets and group ids have different lengths.
+    LengthMismatch { rows: usize, targets: usize, groups: usize },
+    /// A NaN or infinite input or target.
+    NonFinite { what: &'static str, row: usize, input: usize },
+    /// An input has (numerically) no spread, so it cannot be normalised.
+    ConstantInput { input: usize },
+    /// Grouped validation needs more distinct groups (runs) than the data holds.
+    TooFewGroups { found: usize, needed: usize },
+    /// An option is out of its allowed range.
+    BadConfig { option: &'static str, why: String },
+    /// Computing model inputs from a run failed.
+    Features { run: String, why: String },
+    /// A run lacks a column the requested features need.
+    MissingColumn { run: String, column: String },
+    /// The assembled model was rejected by fog-core's validation.
+    Model { why: String },
+    /// fog-core's RBF evaluation rejected an input row.
+    Predict { row: usize, why: String },
+}
+
+impl fmt::Display for TrainError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::EmptyDataset => write!(f, "training data is empty (no usable 10 s points)"),
+            Self::InputCount { expected, found, row } => {
+                write!(f, "row {row} has {found} inputs, expected {expected}")
+            }
+            Self::TooManyInputs { found, max } => {
+                write!(f, "{found} model inputs requested, a model holds at most {max}")
+            }
+            Self::LengthMismatch { rows, targets, groups } => write!(
+                f,
+                "dataset lengths differ: {rows} input rows, {targets} targets, {groups} group ids"
+            ),
+            Self::NonFinite { what, row, input } => {
+                write!(f, "{what} is not finite at row {row} (input {input})")
+            }
+            Self::ConstantInput { input } => write!(
+                f,
+                "model input {input} is constant over the training data, it cannot be normalised"
+            ),
+            Self::TooFewGroups { found, needed } => write!(
+                f,
+                "grouped validation needs at least {needed} runs, the data holds {found}"
+            ),
+            Self::BadConfig { option, why } => write!(f, "option {option}: {why}"),
+            Self::Features { run, why } => write!(f, "{run}: computing model inputs: {why}"),
+            Self::MissingColumn { run, column } => {
+                write!(f, "{run}: column `{column}` needed by a model input is missing")
+            }
+            Self::Model { why } => write!(f, "trained model rejected by fog-core: {why}"),
+            Self::Predict { row, why } => write!(f, "RBF evaluation failed at row {row}: {why}"),
+        }
+    }
+}
+
+impl std::error::Error for TrainError {}
+
+/// The trainer's result type.
+pub type Result<T> = std::result::Result<T, TrainError>;

@@ -1,0 +1,38 @@
+//! Chen-Cowan-Grant OLS forward selection: pick the candidate with the largest
+//! error-reduction ratio err_k = (u_k'y)^2 / (u_k'u_k * y'y) until 1 - sum(err) < rho
+//! or `max_centers` centres are in.
+
+use super::path::{PathSummary, StopReason};
+use super::select::{Added, Selection};
+
+/// Runs OLS selection on a state that already holds the forced terms.
+pub fn select_ols(sel: &mut Selection<'_>, rho: f64, max_centers: usize) -> PathSummary {
+    let yy = sel.y_energy();
+    let mut center_err = Vec::new();
+    let stop = loop {
+        // NaN (y'y = 0: nothing to fit) also stops here.
+        if !(sel.residual_energy() / yy >= rho) {
+            break StopReason::Rho;
+        }
+        if sel.selected().len() >= max_centers {
+            break StopReason::MaxCenters;
+        }
+        let Some((k, _)) = sel.best_candidate(|p, s| p * p / s) else {
+            break StopReason::NoCandidate;
+        };
+        if sel.add_candidate(k) == Added::Yes {
+            let z = sel.projections().last().copied().unwrap_or(0.0);
+            center_err.push(z * z / yy);
+        }
+    };
+    let terms = sel.n_forced() + sel.selected().len();
+    PathSummary {
+        terms,
+        shrink: vec![1.0; terms],
+        stop,
+        lambda: None,
+        gcv: None,
+        center_err,
+        err_sum: if yy > 0.0 { 1.0 - sel.residual_energy() / yy } else { 1.0 },
+    }
+}

@@ -1,0 +1,31 @@
+//! Batch prediction with fog-core's deployed RBF maths, so every rms the trainer reports
+//! is the rms the device would achieve on the same inputs.
+
+use super::error::{Result, TrainError};
+use fog_core::model::RbfModel;
+
+/// Predicted drift (deg/h) for each row of raw inputs (in `model.inputs` order).
+pub fn predict_batch<'r>(
+    model: &RbfModel,
+    rows: impl IntoIterator<Item = &'r [f64]>,
+) -> Result<Vec<f64>> {
+    let mut x = [0.0f32; fog_core::model::MAX_INPUTS];
+    rows.into_iter()
+        .enumerate()
+        .map(|(i, row)| {
+            if row.len() != model.inputs.len() {
+                return Err(TrainError::InputCount {
+                    expected: model.inputs.len(),
+                    found: row.len(),
+                    row: i,
+                });
+            }
+            for (xj, &v) in x.iter_mut().zip(row) {
+                *xj = v as f32;
+            }
+            fog_core::rbf::predict_f32(model, &x[..row.len()])
+                .map(f64::from)
+                .map_err(|e| TrainError::Predict { row: i, why: e.to_string() })
+        })
+        .collect()
+}
