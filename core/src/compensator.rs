@@ -307,7 +307,11 @@ impl Compensator {
         Some(self.finish(closed))
     }
 
-    fn take_mean(avg: &mut WindowAverager, pending: &mut Option<WindowMean>, t_end_s: f64) -> Option<f64> {
+    fn take_mean(
+        avg: &mut WindowAverager,
+        pending: &mut Option<WindowMean>,
+        t_end_s: f64,
+    ) -> Option<f64> {
         let same = |m: &WindowMean| libm::fabs(m.t_end_s - t_end_s) < 1e-6 && m.n_samples > 0;
         if let Some(m) = pending.take() {
             if same(&m) {
@@ -322,13 +326,22 @@ impl Compensator {
 
     fn finish(&mut self, g: WindowMean) -> WindowResult {
         let t_end = g.t_end_s;
-        let window_k = self.gyro.window_index(g.t_start_s + 0.5 * self.gyro.window_s());
+        let window_k = self
+            .gyro
+            .window_index(g.t_start_s + 0.5 * self.gyro.window_s());
         let temp = Self::take_mean(&mut self.temp, &mut self.temp_pending, t_end);
         let mut aux = [0.0f32; MAX_AUX];
         let mut aux_ok = true;
-        for ch in 0..self.cfg.n_aux as usize {
-            match Self::take_mean(&mut self.aux[ch], &mut self.aux_pending[ch], t_end) {
-                Some(v) => aux[ch] = v as f32,
+        let n_aux = self.cfg.n_aux as usize;
+        for ((avg, pending), slot) in self
+            .aux
+            .iter_mut()
+            .zip(self.aux_pending.iter_mut())
+            .zip(aux.iter_mut())
+            .take(n_aux)
+        {
+            match Self::take_mean(avg, pending, t_end) {
+                Some(v) => *slot = v as f32,
                 None => aux_ok = false,
             }
         }
@@ -350,8 +363,8 @@ impl Compensator {
             model_applied: false,
             status: WindowStatus::Valid,
         };
-        let enough = g.n_samples > 0
-            && g.n_samples as f32 >= self.cfg.min_fill * g.n_expected as f32;
+        let enough =
+            g.n_samples > 0 && g.n_samples as f32 >= self.cfg.min_fill * g.n_expected as f32;
         let mut status = if faulted || (self.cfg.n_aux > 0 && !aux_ok) {
             WindowStatus::SensorFault
         } else if !enough {
@@ -366,7 +379,10 @@ impl Compensator {
                 r.temp_rate_cps = e.rate_per_s as f32;
             }
             // Feature history only advances on windows with a real temperature.
-            match self.features.push(t_end, t as f32, &aux[..self.cfg.n_aux as usize]) {
+            match self
+                .features
+                .push(t_end, t as f32, &aux[..self.cfg.n_aux as usize])
+            {
                 Ok(fv) => {
                     r.inputs = fv.values;
                     r.n_inputs = fv.len;

@@ -54,7 +54,10 @@ impl core::fmt::Display for FeatureError {
                 write!(f, "features: time at row {row} does not increase")
             }
             FeatureError::MissingAux { channel } => {
-                write!(f, "features: aux channel {channel} is needed but not supplied")
+                write!(
+                    f,
+                    "features: aux channel {channel} is needed but not supplied"
+                )
             }
             FeatureError::LengthMismatch { expected, found } => {
                 write!(f, "features: series of length {found}, expected {expected}")
@@ -63,7 +66,10 @@ impl core::fmt::Display for FeatureError {
                 write!(f, "features: more than {MAX_INPUTS} features requested")
             }
             FeatureError::BadTimeConstant => {
-                write!(f, "features: span / time constant must be positive and finite")
+                write!(
+                    f,
+                    "features: span / time constant must be positive and finite"
+                )
             }
         }
     }
@@ -295,7 +301,11 @@ impl<const N: usize> TempRateEstimator<N> {
         // Cannot fail: a slot was freed above.
         let _ = self.points.push_back((t_s, value));
         let oldest_allowed = t_s - self.span_s * (1.0 + 1e-9);
-        while self.points.front().is_some_and(|&(t, _)| t < oldest_allowed) {
+        while self
+            .points
+            .front()
+            .is_some_and(|&(t, _)| t < oldest_allowed)
+        {
             self.points.pop_front();
         }
         self.estimate()
@@ -414,6 +424,8 @@ impl FeatureVector {
     }
 }
 
+// No allocator: the estimator lives inline; unused variants cost at most MAX_INPUTS x 544 B.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug)]
 enum FeatureState {
     Plain,
@@ -487,7 +499,12 @@ impl FeatureExtractor {
 
     /// Process one row: time since power-on (s), temperature (degC) and aux channel values.
     /// On error the extractor state is unchanged.
-    pub fn push(&mut self, t_s: f64, temp_c: f32, aux: &[f32]) -> Result<FeatureVector, FeatureError> {
+    pub fn push(
+        &mut self,
+        t_s: f64,
+        temp_c: f32,
+        aux: &[f32],
+    ) -> Result<FeatureVector, FeatureError> {
         let row = self.row;
         if !t_s.is_finite() || !temp_c.is_finite() {
             return Err(FeatureError::NonFinite { row });

@@ -73,7 +73,10 @@ impl core::fmt::Display for FixedError {
                 "fixed: width of centre {center} is below 0.0056 normalised units (Q.24 limit)"
             ),
             FixedError::CenterOutOfRange { center } => {
-                write!(f, "fixed: centre {center} lies beyond +-100 normalised units")
+                write!(
+                    f,
+                    "fixed: centre {center} lies beyond +-100 normalised units"
+                )
             }
             FixedError::InputRange { input } => write!(
                 f,
@@ -162,11 +165,11 @@ impl FixedModel {
             fm.in_shift[j] = shift as u8;
         }
         for (i, c) in model.centers.iter().enumerate() {
-            for j in 0..n {
-                if c[j].abs() >= 100.0 {
+            for (q, &v) in fm.centers_q[i].iter_mut().zip(c.iter()).take(n) {
+                if v.abs() >= 100.0 {
                     return Err(FixedError::CenterOutOfRange { center: i as u8 });
                 }
-                fm.centers_q[i][j] = to_q(c[j] as f64, XN_FRAC as i32) as i32;
+                *q = to_q(v as f64, XN_FRAC as i32) as i32;
             }
             let g = 1.0 / (core::f64::consts::SQRT_2 * model.widths[i] as f64);
             if g >= 127.0 {
@@ -219,12 +222,12 @@ impl FixedModel {
             });
         }
         let mut xn = [0i64; MAX_INPUTS];
-        for j in 0..n {
-            let x_q = f32_to_fixed(x_raw[j], self.in_frac[j] as i32)
+        for (j, (out, &x)) in xn.iter_mut().zip(x_raw.iter()).enumerate() {
+            let x_q = f32_to_fixed(x, self.in_frac[j] as i32)
                 .ok_or(RbfError::NonFiniteInput { index: j as u8 })?;
             let diff = x_q.saturating_sub(self.in_offset_q[j]) as i128;
             let prod = (diff * self.in_gain_q[j] as i128) >> self.in_shift[j];
-            xn[j] = prod.clamp(-XN_LIMIT as i128, XN_LIMIT as i128) as i64;
+            *out = prod.clamp(-XN_LIMIT as i128, XN_LIMIT as i128) as i64;
         }
         Ok(xn)
     }
@@ -234,8 +237,8 @@ impl FixedModel {
         let n = self.n_inputs as usize;
         let nr = self.n_rbf as usize;
         let mut acc = self.bias_q;
-        for j in 0..n {
-            acc += (self.linear_q[j] as i64 * xn[j]) >> XN_FRAC;
+        for (&l, &x) in self.linear_q.iter().zip(xn.iter()).take(n) {
+            acc += (l as i64 * x) >> XN_FRAC;
         }
         let z_limit: i64 = 5 << XN_FRAC; // z^2 >= 25 > EXP_CUTOFF
         let u_limit: i64 = (EXP_CUTOFF as i64) << (2 * XN_FRAC);
@@ -262,7 +265,10 @@ impl FixedModel {
     /// Predicted drift, deg/h (integer-only; f32 only at the boundary, by bit manipulation).
     pub fn predict(&self, x_raw: &[f32]) -> Result<f32, RbfError> {
         let xn = self.normalise_q24(x_raw)?;
-        Ok(fixed_to_f32(self.predict_from_normalised(&xn), self.w_frac as u32))
+        Ok(fixed_to_f32(
+            self.predict_from_normalised(&xn),
+            self.w_frac as u32,
+        ))
     }
 
     /// Predicted drift as Q16.16 deg/h (saturating), integer-only end to end.
@@ -291,7 +297,7 @@ pub fn exp_neg_q30(u_q28: u64) -> u32 {
     let k = (f >> 53) as usize;
     let r_q30 = (f & ((1u64 << 53) - 1)) >> 28; // r < 1/32
     let y = (r_q30 * LN2_Q30) >> 30; // y = r ln 2 < 0.0217, Q.30
-    // exp(-y) = 1 - y (1 - y/2 (1 - y/3 (1 - y/4))), Horner in Q.30.
+                                     // exp(-y) = 1 - y (1 - y/2 (1 - y/3 (1 - y/4))), Horner in Q.30.
     let mut p = ONE_Q30 - (y >> 2);
     p = ONE_Q30 - ((((y * p) >> 30) * INV3_Q30) >> 30);
     p = ONE_Q30 - (((y * p) >> 30) >> 1);
@@ -344,7 +350,7 @@ pub fn fixed_to_f32(v: i64, frac: u32) -> f32 {
     let neg = v < 0;
     let mag = v.unsigned_abs();
     let top = 63 - mag.leading_zeros() as i32; // index of the leading one
-    // Keep 24 significant bits, rounding the rest to nearest even.
+                                               // Keep 24 significant bits, rounding the rest to nearest even.
     let (mut mant, mut top) = if top > 23 {
         let drop = (top - 23) as u32;
         let m = mag >> drop;

@@ -17,3 +17,4 @@ pub mod model;
 pub mod northfinder;
 pub mod protocol;
 pub mod rbf;
+pub mod synthetic;

@@ -161,7 +161,11 @@ pub enum ModelError {
     /// `n_rbf_inputs` is larger than the number of inputs, or 0 with centres present.
     BadRbfInputCount { n_rbf_inputs: u8, n_inputs: u8 },
     /// A per-input or per-centre vector has the wrong length.
-    LengthMismatch { field: ModelField, expected: u16, found: u16 },
+    LengthMismatch {
+        field: ModelField,
+        expected: u16,
+        found: u16,
+    },
     /// A NaN or infinite number.
     NonFinite { field: ModelField, index: u16 },
     /// An input scale that is not > 0.
@@ -268,7 +272,10 @@ pub fn crc32(bytes: &[u8]) -> u32 {
 
 fn check_finite(field: ModelField, values: &[f32]) -> Result<(), ModelError> {
     match values.iter().position(|v| !v.is_finite()) {
-        Some(i) => Err(ModelError::NonFinite { field, index: i as u16 }),
+        Some(i) => Err(ModelError::NonFinite {
+            field,
+            index: i as u16,
+        }),
         None => Ok(()),
     }
 }
@@ -347,7 +354,10 @@ impl RbfModel {
             }
             if let Some(ch) = spec.kind.aux_channel() {
                 if ch as usize >= MAX_AUX {
-                    return Err(ModelError::BadAuxChannel { input: i as u8, channel: ch });
+                    return Err(ModelError::BadAuxChannel {
+                        input: i as u8,
+                        channel: ch,
+                    });
                 }
             }
         }
@@ -441,7 +451,9 @@ impl RbfModel {
     /// Decode and fully validate an encoded model.
     pub fn decode(bytes: &[u8]) -> Result<RbfModel, ModelError> {
         if bytes.len() > MAX_ENCODED_LEN {
-            return Err(ModelError::TooLarge { len: bytes.len() as u32 });
+            return Err(ModelError::TooLarge {
+                len: bytes.len() as u32,
+            });
         }
         // Magic and version first, so a foreign or newer file gets the precise error.
         let (magic, rest) = postcard::take_from_bytes::<u32>(bytes).map_err(map_postcard)?;
@@ -466,8 +478,8 @@ impl RbfModel {
                 computed,
             });
         }
-        let (counts, model_bytes) =
-            postcard::take_from_bytes::<BodyCounts>(wire.body).map_err(|_| ModelError::Malformed)?;
+        let (counts, model_bytes) = postcard::take_from_bytes::<BodyCounts>(wire.body)
+            .map_err(|_| ModelError::Malformed)?;
         if counts.n_inputs as usize > MAX_INPUTS {
             return Err(ModelError::TooManyInputs {
                 count: counts.n_inputs,
@@ -485,8 +497,16 @@ impl RbfModel {
                 count: left.len() as u16,
             });
         }
-        check_len(ModelField::Inputs, counts.n_inputs as usize, model.inputs.len())?;
-        check_len(ModelField::Centers, counts.n_centers as usize, model.centers.len())?;
+        check_len(
+            ModelField::Inputs,
+            counts.n_inputs as usize,
+            model.inputs.len(),
+        )?;
+        check_len(
+            ModelField::Centers,
+            counts.n_centers as usize,
+            model.centers.len(),
+        )?;
         model.validate()?;
         Ok(model)
     }

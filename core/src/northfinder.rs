@@ -304,7 +304,12 @@ impl NorthFinder {
         self.go_to(table, 0, t_now_s)
     }
 
-    fn go_to<T: Turntable>(&mut self, table: &mut T, k: usize, t_now_s: f64) -> Result<(), SeekError> {
+    fn go_to<T: Turntable>(
+        &mut self,
+        table: &mut T,
+        k: usize,
+        t_now_s: f64,
+    ) -> Result<(), SeekError> {
         self.position = k as u8;
         if let Err(_e) = table.command_heading(self.heading_of(k)) {
             self.phase = Phase::Idle;
@@ -315,7 +320,11 @@ impl NorthFinder {
     }
 
     /// Poll the turntable (call often while moving; `on_window` also calls it).
-    pub fn poll<T: Turntable>(&mut self, table: &mut T, t_now_s: f64) -> Result<SeekStatus, SeekError> {
+    pub fn poll<T: Turntable>(
+        &mut self,
+        table: &mut T,
+        t_now_s: f64,
+    ) -> Result<SeekStatus, SeekError> {
         if let Phase::Moving { since_s } = self.phase {
             match table.poll() {
                 Err(_) => {
@@ -428,7 +437,8 @@ impl NorthFinder {
             }
             SeekMode::FourPosition => {
                 let m: [f64; 4] = core::array::from_fn(|k| positions[k].mean_rate_dph);
-                let v: [f64; 4] = core::array::from_fn(|k| positions[k].sigma_dph * positions[k].sigma_dph);
+                let v: [f64; 4] =
+                    core::array::from_fn(|k| positions[k].sigma_dph * positions[k].sigma_dph);
                 // w_k = Omega_H cos(psi + 90 k) + b.
                 let dc = m[0] - m[2]; // 2 Omega_H cos psi
                 let ds = m[3] - m[1]; // 2 Omega_H sin psi

@@ -197,7 +197,10 @@ impl core::fmt::Display for UploadError {
             Self::FrameTooLong => write!(f, "frame longer than {MAX_WIRE_FRAME_LEN} bytes"),
             Self::MessageMalformed => write!(f, "message is not a valid request"),
             Self::ProtocolVersion { supported } => {
-                write!(f, "protocol version not supported (device speaks {supported})")
+                write!(
+                    f,
+                    "protocol version not supported (device speaks {supported})"
+                )
             }
             Self::NoUploadInProgress => write!(f, "no upload in progress (send Begin first)"),
             Self::ModelTooLarge { max_len } => {
@@ -327,7 +330,11 @@ impl Default for FrameReceiver {
 
 impl FrameReceiver {
     pub const fn new() -> Self {
-        Self { buf: [0; MAX_WIRE_FRAME_LEN], len: 0, overflowed: false }
+        Self {
+            buf: [0; MAX_WIRE_FRAME_LEN],
+            len: 0,
+            overflowed: false,
+        }
     }
 
     /// Feeds one byte. `None` while a frame is incomplete (or for an empty frame);
@@ -381,10 +388,18 @@ mod tests {
     fn every_request_roundtrips() {
         let data = [0u8; MAX_CHUNK_LEN];
         let sig = [0xA5u8; SIGNATURE_LEN];
-        roundtrip(&Request::Hello { protocol_version: PROTOCOL_VERSION });
+        roundtrip(&Request::Hello {
+            protocol_version: PROTOCOL_VERSION,
+        });
         roundtrip(&Request::Status);
-        roundtrip(&Request::Begin { model_len: 1234, model_crc32: 0xDEAD_BEEF });
-        roundtrip(&Request::Chunk { offset: 1792, data: &data });
+        roundtrip(&Request::Begin {
+            model_len: 1234,
+            model_crc32: 0xDEAD_BEEF,
+        });
+        roundtrip(&Request::Chunk {
+            offset: 1792,
+            data: &data,
+        });
         roundtrip(&Request::Commit { signature: &sig });
         roundtrip(&Request::Abort);
     }
@@ -392,7 +407,14 @@ mod tests {
     #[test]
     fn flipped_bit_is_a_crc_or_cobs_error() {
         let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
-        let n = encode_frame(&Request::Begin { model_len: 77, model_crc32: 5 }, &mut wire).unwrap();
+        let n = encode_frame(
+            &Request::Begin {
+                model_len: 77,
+                model_crc32: 5,
+            },
+            &mut wire,
+        )
+        .unwrap();
         for bit in 0..(n - 1) * 8 {
             let mut copy = wire;
             copy[bit / 8] ^= 1 << (bit % 8);
@@ -419,6 +441,9 @@ mod tests {
             last = rx.push(b).map(|r| r.map(|p| p.to_vec()));
         }
         let payload = last.unwrap().unwrap();
-        assert_eq!(decode_message::<Request<'_>>(&payload).unwrap(), Request::Status);
+        assert_eq!(
+            decode_message::<Request<'_>>(&payload).unwrap(),
+            Request::Status
+        );
     }
 }

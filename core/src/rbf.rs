@@ -73,8 +73,8 @@ pub(crate) fn check_inputs<T: Copy>(
 pub fn normalise_f32(model: &RbfModel, x_raw: &[f32]) -> Result<[f32; MAX_INPUTS], RbfError> {
     let n = check_inputs(model, x_raw, f32::is_finite)?;
     let mut xn = [0.0f32; MAX_INPUTS];
-    for j in 0..n {
-        xn[j] = (x_raw[j] - model.input_offset[j]) / model.input_scale[j];
+    for (j, (out, &x)) in xn.iter_mut().zip(x_raw.iter()).enumerate().take(n) {
+        *out = (x - model.input_offset[j]) / model.input_scale[j];
     }
     Ok(xn)
 }
@@ -85,8 +85,8 @@ pub fn predict_f32(model: &RbfModel, x_raw: &[f32]) -> Result<f32, RbfError> {
     let n = model.inputs.len();
     let nr = model.n_rbf_inputs as usize;
     let mut acc = model.bias_dph;
-    for j in 0..n {
-        acc += model.linear[j] * xn[j];
+    for (&l, &x) in model.linear.iter().zip(xn.iter()).take(n) {
+        acc += l * x;
     }
     for ((c, &s), &w) in model
         .centers
@@ -110,12 +110,12 @@ pub fn predict_f64(model: &RbfModel, x_raw: &[f64]) -> Result<f64, RbfError> {
     let n = check_inputs(model, x_raw, f64::is_finite)?;
     let nr = model.n_rbf_inputs as usize;
     let mut xn = [0.0f64; MAX_INPUTS];
-    for j in 0..n {
-        xn[j] = (x_raw[j] - model.input_offset[j] as f64) / model.input_scale[j] as f64;
+    for (j, (out, &x)) in xn.iter_mut().zip(x_raw.iter()).enumerate().take(n) {
+        *out = (x - model.input_offset[j] as f64) / model.input_scale[j] as f64;
     }
     let mut acc = model.bias_dph as f64;
-    for j in 0..n {
-        acc += model.linear[j] as f64 * xn[j];
+    for (&l, &x) in model.linear.iter().zip(xn.iter()).take(n) {
+        acc += l as f64 * x;
     }
     for ((c, &s), &w) in model
         .centers

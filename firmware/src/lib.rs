@@ -8,8 +8,10 @@
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
 
+pub mod app;
 pub mod clock;
 pub mod drivers;
+pub mod replay;
 pub mod signature;
 pub mod store;
 pub mod upload;

@@ -1,1 +1,156 @@
-//! (to be written)
+//! The paper's test campaign in simulation: at each chamber temperature, several cold
+//! power-ons of 45 min, input axis vertical, one fog-runs CSV per power-on. Runs are
+//! simulated in parallel (each from its own derived seed, so the bytes never depend
+//! on the thread schedule) and written only when all succeeded.
+
+use crate::runs::{write_run, Run, RunError};
+use crate::sim::{simulate_run, GyroParams, RunSpec, SimError, DEFAULT_LATITUDE_DEG};
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// The paper's chamber temperatures, degC.
+pub const PAPER_AMBIENTS_C: [f64; 11] = [-40.0, -30.0, -20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0];
+/// Power-ons per temperature in the paper (3 train, 2 validate).
+pub const PAPER_RUNS: usize = 5;
+/// Record length in the paper, min.
+pub const PAPER_MINUTES: f64 = 45.0;
+
+/// What to simulate.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CampaignSpec {
+    pub ambients_c: Vec<f64>,
+    pub runs_per_ambient: usize,
+    pub minutes: f64,
+    pub seed: u64,
+    pub latitude_deg: f64,
+    pub raw_rate_hz: f64,
+}
+
+impl CampaignSpec {
+    /// The paper's protocol: -40..+60 degC every 10, 5 runs of 45 min each.
+    pub fn paper(seed: u64) -> Self {
+        Self {
+            ambients_c: PAPER_AMBIENTS_C.to_vec(),
+            runs_per_ambient: PAPER_RUNS,
+            minutes: PAPER_MINUTES,
+            seed,
+            latitude_deg: DEFAULT_LATITUDE_DEG,
+            raw_rate_hz: 100.0,
+        }
+    }
+
+    /// The run spec of power-on `run` (0-based) at ambient index `amb`.
+    pub fn run_spec(&self, amb: usize, run: usize) -> RunSpec {
+        RunSpec {
+            minutes: self.minutes,
+            latitude_deg: self.latitude_deg,
+            raw_rate_hz: self.raw_rate_hz,
+            ..RunSpec::paper(self.ambients_c[amb], derive_seed(self.seed, amb as u64, run as u64))
+        }
+    }
+
+    /// File name of a run; sorts by ambient (in list order), then by run number.
+    pub fn file_name(&self, amb: usize, run: usize) -> String {
+        let a = self.ambients_c[amb];
+        let sign = if a < 0.0 { 'm' } else { 'p' };
+        format!("amb{amb:02}_{sign}{:03}c_run{}.csv", a.abs().round() as i64, run + 1)
+    }
+}
+
+/// A per-run seed from the campaign seed (SplitMix64 finaliser over the indices).
+pub fn derive_seed(seed: u64, a: u64, b: u64) -> u64 {
+    let mut z = seed ^ a.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ b.wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// Why a campaign failed.
+#[derive(Debug)]
+pub enum CampaignError {
+    Spec(String),
+    Sim(SimError),
+    Write(RunError),
+}
+
+impl fmt::Display for CampaignError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CampaignError::Spec(s) => write!(f, "{s}"),
+            CampaignError::Sim(e) => write!(f, "{e}"),
+            CampaignError::Write(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl std::error::Error for CampaignError {}
+
+/// Simulates every run (in parallel over the available cores); the result is in file
+/// order: (file name, run).
+pub fn simulate_campaign(params: &GyroParams, spec: &CampaignSpec) -> Result<Vec<(String, Run)>, CampaignError> {
+    if spec.ambients_c.is_empty() {
+        return Err(CampaignError::Spec("campaign: no ambient temperatures".into()));
+    }
+    if spec.runs_per_ambient == 0 {
+        return Err(CampaignError::Spec("campaign: runs per ambient must be >= 1".into()));
+    }
+    let jobs: Vec<(usize, usize)> =
+        (0..spec.ambients_c.len()).flat_map(|a| (0..spec.runs_per_ambient).map(move |r| (a, r))).collect();
+    // Fail fast on a bad spec before spawning anything.
+    spec.run_spec(0, 0).validate().map_err(CampaignError::Sim)?;
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(jobs.len());
+    let mut results: Vec<Option<Result<Run, SimError>>> = (0..jobs.len()).map(|_| None).collect();
+    std::thread::scope(|s| {
+        let chunks: Vec<_> = results.chunks_mut(jobs.len().div_ceil(threads)).enumerate().collect();
+        let size = jobs.len().div_ceil(threads);
+        for (c, chunk) in chunks {
+            let jobs = &jobs;
+            s.spawn(move || {
+                for (k, slot) in chunk.iter_mut().enumerate() {
+                    let (a, r) = jobs[c * size + k];
+                    *slot = Some(simulate_run(params, &spec.run_spec(a, r)));
+                }
+            });
+        }
+    });
+    jobs.iter()
+        .zip(results)
+        .map(|(&(a, r), res)| {
+            let mut run = res.expect("every slot is filled by its thread").map_err(CampaignError::Sim)?;
+            let name = spec.file_name(a, r);
+            run.path = PathBuf::from(&name);
+            run.set_meta("run", r + 1);
+            Ok((name, run))
+        })
+        .collect()
+}
+
+/// Writes a simulated campaign into `dir` (created if missing). If any file fails, the
+/// files written by this call are removed again: no partial campaign is left.
+pub fn write_campaign(dir: &Path, runs: &[(String, Run)]) -> Result<Vec<PathBuf>, CampaignError> {
+    let io = |e: std::io::Error| {
+        CampaignError::Write(RunError {
+            path: dir.to_path_buf(),
+            line: None,
+            column: None,
+            kind: crate::runs::RunErrorKind::Io(e.to_string()),
+        })
+    };
+    let created_dir = !dir.exists();
+    std::fs::create_dir_all(dir).map_err(io)?;
+    let mut written = Vec::new();
+    for (name, run) in runs {
+        let path = dir.join(name);
+        if let Err(e) = write_run(&path, run) {
+            for p in &written {
+                let _ = std::fs::remove_file(p);
+            }
+            if created_dir {
+                let _ = std::fs::remove_dir(dir);
+            }
+            return Err(CampaignError::Write(e));
+        }
+        written.push(path);
+    }
+    Ok(written)
+}

@@ -20,7 +20,7 @@ use fog_core::hal::{GyroSample, TempSample};
 use fog_core::model::RbfModel;
 use fog_core::northfinder::{NorthFinder, SeekConfig, SeekMode, SeekStatus};
 
-use crate::report::SeekStats;
+use crate::report::{NorthSeekReport, SeekStats, Table};
 use crate::sim::{rig, GyroParams, RunSpec, StartState, TurntableParams};
 
 /// The paper's seek time, 4 min 56 s.
@@ -336,6 +336,77 @@ pub fn seek_stats(seeks: &[Vec<SeekOutcome>], true_azimuth_deg: f64) -> SeekStat
         mean_reported_sigma_deg: mean(&seeks.iter().flatten().map(|s| s.sigma_deg).collect::<Vec<_>>()),
         azimuths_deg: seeks.iter().map(|s| s.iter().map(|o| o.azimuth_deg).collect()).collect(),
     }
+}
+
+/// The `north-seek` JSON report of a finished Monte Carlo.
+pub fn build_report(
+    params: &GyroParams,
+    cfg: &MonteCarloConfig,
+    outcomes: &[StartOutcome],
+    model_source: &str,
+) -> NorthSeekReport {
+    let unc: Vec<Vec<SeekOutcome>> = outcomes.iter().map(|o| o.uncompensated.clone()).collect();
+    let comp: Vec<Vec<SeekOutcome>> = outcomes.iter().map(|o| o.compensated.clone()).collect();
+    let all = || unc.iter().chain(&comp).flatten();
+    let n = all().count().max(1) as f64;
+    let seek_duration_s = all().map(|s| s.duration_s).sum::<f64>() / n;
+    let max_seek_duration_s = all().map(|s| s.duration_s).fold(0.0, f64::max);
+    let dwell_s = all().map(|s| s.main_dwell_s).sum::<f64>() / n;
+    let arw = params.noise.arw_dpsh;
+    NorthSeekReport {
+        starts: cfg.starts,
+        seeks_per_start: cfg.seeks_per_start,
+        positions: match cfg.mode {
+            SeekMode::TwoPosition => 2,
+            SeekMode::FourPosition => 4,
+        },
+        latitude_deg: cfg.latitude_deg,
+        ambient_c: cfg.ambient_c,
+        true_azimuth_deg: cfg.true_azimuth_deg,
+        seek_duration_s,
+        max_seek_duration_s,
+        paper_seek_duration_s: PAPER_SEEK_DURATION_S,
+        main_dwell_s: dwell_s,
+        noise_floor_deg: noise_floor_deg(arw, cfg.mode, cfg.latitude_deg, cfg.true_azimuth_deg, dwell_s),
+        arw_dpsh: arw,
+        seed: cfg.seed,
+        uncompensated: seek_stats(&unc, cfg.true_azimuth_deg),
+        compensated: seek_stats(&comp, cfg.true_azimuth_deg),
+        model_source: model_source.to_string(),
+    }
+}
+
+/// The per-seek table printed by `north-seek`, `reproduce` and `demo`.
+pub fn seek_table(r: &NorthSeekReport) -> String {
+    let mut t = Table::new(&["seek", "uncomp. 1 sigma (deg)", "uncomp. mean err (deg)", "comp. 1 sigma (deg)", "comp. mean err (deg)"]);
+    for k in 0..r.uncompensated.per_seek_std_deg.len() {
+        t.row(&[
+            format!("{}", k + 1),
+            format!("{:.4}", r.uncompensated.per_seek_std_deg[k]),
+            format!("{:+.4}", r.uncompensated.per_seek_mean_error_deg[k]),
+            format!("{:.4}", r.compensated.per_seek_std_deg.get(k).copied().unwrap_or(f64::NAN)),
+            format!("{:+.4}", r.compensated.per_seek_mean_error_deg.get(k).copied().unwrap_or(f64::NAN)),
+        ]);
+    }
+    t.row(&[
+        "all".to_string(),
+        format!("{:.4}", r.uncompensated.std_deg),
+        format!("{:+.4}", r.uncompensated.mean_error_deg),
+        format!("{:.4}", r.compensated.std_deg),
+        format!("{:+.4}", r.compensated.mean_error_deg),
+    ]);
+    format!(
+        "{}noise floor (ARW {:.4} deg/sqrt(h), {:.0} s per position): {:.4} deg; compensated/floor = {:.2}\n\
+         seek duration: mean {:.0} s, max {:.0} s (paper: {:.0} s)\n",
+        t.render(),
+        r.arw_dpsh,
+        r.main_dwell_s,
+        r.noise_floor_deg,
+        r.compensated.std_deg / r.noise_floor_deg,
+        r.seek_duration_s,
+        r.max_seek_duration_s,
+        r.paper_seek_duration_s
+    )
 }
 
 #[cfg(test)]

@@ -138,6 +138,10 @@ pub struct NorthSeekReport {
     pub true_azimuth_deg: f64,
     /// Duration of one seek from its start to its result, s (mean over all seeks).
     pub seek_duration_s: f64,
+    /// Longest single seek, s.
+    pub max_seek_duration_s: f64,
+    /// Measuring time actually used per main position, s (whole 10 s windows).
+    pub main_dwell_s: f64,
     /// The paper's seek time, s (4 min 56 s), for comparison.
     pub paper_seek_duration_s: f64,
     /// White-noise floor of the azimuth for the simulated ARW and this seek plan, deg.
@@ -207,6 +211,16 @@ impl Table {
         }
         out
     }
+}
+
+/// A progress bar on stderr for `len` steps (hidden automatically when stderr is not a terminal).
+pub fn progress_bar(len: usize, message: &str) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(len as u64);
+    if let Ok(style) = indicatif::ProgressStyle::with_template("{msg:<28} [{bar:40}] {pos}/{len} {elapsed_precise}") {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.set_message(message.to_string());
+    bar
 }
 
 /// Formats an optional time in seconds as minutes ("12.5 min"), "never" when absent.

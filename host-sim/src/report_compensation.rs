@@ -87,7 +87,7 @@ pub fn compensate_run(run: &Run, model: Option<&RbfModel>) -> Result<Compensated
     let mut comp = Compensator::new(cfg, model.cloned()).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
     let drift = run.drift_dph();
     let mut out = CompensatedSeries::default();
-    let mut take = |w: fog_core::compensator::WindowResult, out: &mut CompensatedSeries| {
+    let take = |w: fog_core::compensator::WindowResult, out: &mut CompensatedSeries| {
         if w.n_samples == 0 || !w.mean_rate_dph.is_finite() {
             return;
         }

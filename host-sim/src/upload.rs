@@ -1,1 +1,235 @@
-//! (to be written)
+//! The training PC's side of the model upload: sign a model and send it to the device.
+//!
+//! Speaks `fog_core::protocol` over any byte link (`Read + Write`): a serial port
+//! (`serialport` crate) for real hardware, or TCP for QEMU's `-serial tcp:...`.
+//! Every wait is bounded by a deadline; every refusal comes back as the device's typed
+//! `UploadError`, so callers and tests can tell a bad signature from a bad CRC.
+
+use std::io::{ErrorKind, Read, Write};
+use std::net::TcpStream;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use ed25519_compact::{KeyPair, Seed};
+use fog_core::protocol::{
+    crc32, decode_message, encode_frame, DeviceStatus, FrameError, FrameReceiver, ModelInfo,
+    Request, Response, UploadError, MAX_CHUNK_LEN, MAX_WIRE_FRAME_LEN, PROTOCOL_VERSION,
+    SIGNATURE_LEN,
+};
+
+/// The repository's TEST signing seed (public! see keys/README.md).
+pub fn test_key_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../keys/TEST-ONLY-signing-key.seed.hex")
+}
+
+/// Loads an Ed25519 key pair from a file holding the 32-byte seed as 64 hex digits.
+pub fn load_signing_key(path: &Path) -> anyhow::Result<KeyPair> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("reading signing key {}", path.display()))?;
+    let hex = text.trim();
+    let seed = decode_hex::<32>(hex).with_context(|| {
+        format!("{}: expected 64 hex digits (an Ed25519 seed), found {:?}", path.display(), hex)
+    })?;
+    Ok(KeyPair::from_seed(Seed::new(seed)))
+}
+
+fn decode_hex<const N: usize>(hex: &str) -> anyhow::Result<[u8; N]> {
+    anyhow::ensure!(hex.len() == 2 * N, "length {} instead of {}", hex.len(), 2 * N);
+    let mut out = [0u8; N];
+    for (i, byte) in out.iter_mut().enumerate() {
+        *byte = u8::from_str_radix(&hex[2 * i..2 * i + 2], 16)
+            .with_context(|| format!("not hex at character {}", 2 * i))?;
+    }
+    Ok(out)
+}
+
+/// Deterministic Ed25519 signature of the model bytes (what `Commit` carries).
+pub fn sign_model(key: &KeyPair, model_bytes: &[u8]) -> [u8; SIGNATURE_LEN] {
+    *key.sk.sign(model_bytes, None)
+}
+
+/// Why an exchange with the device failed.
+#[derive(Debug)]
+pub enum ClientError {
+    /// The device refused the request.
+    Rejected(UploadError),
+    /// The device answered something that does not fit the request.
+    Unexpected(Response),
+    /// A response frame was corrupt.
+    Frame(FrameError),
+    /// No complete response within the deadline.
+    Timeout(Duration),
+    Io(std::io::Error),
+}
+
+impl std::fmt::Display for ClientError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Rejected(e) => write!(f, "device rejected the request: {e}"),
+            Self::Unexpected(r) => write!(f, "unexpected response from device: {r:?}"),
+            Self::Frame(e) => write!(f, "bad response frame: {e}"),
+            Self::Timeout(d) => write!(f, "no response within {:.1} s", d.as_secs_f64()),
+            Self::Io(e) => write!(f, "link I/O error: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for ClientError {}
+
+impl From<std::io::Error> for ClientError {
+    fn from(e: std::io::Error) -> Self {
+        Self::Io(e)
+    }
+}
+
+/// A request/response client over a byte link whose reads time out (so deadlines hold).
+pub struct UploadClient<L> {
+    link: L,
+    rx: FrameReceiver,
+    timeout: Duration,
+}
+
+/// Opens `tcp:HOST:PORT` (QEMU) or a serial device path at `baud`, with a short read
+/// timeout so the client's deadlines can be enforced.
+pub fn open_link(port: &str, baud: u32) -> anyhow::Result<Box<dyn Link>> {
+    let poll = Duration::from_millis(50);
+    if let Some(addr) = port.strip_prefix("tcp:") {
+        let stream = TcpStream::connect(addr).with_context(|| format!("connecting to {addr}"))?;
+        stream.set_read_timeout(Some(poll))?;
+        stream.set_nodelay(true)?;
+        Ok(Box::new(stream))
+    } else {
+        let serial = serialport::new(port, baud)
+            .timeout(poll)
+            .open()
+            .with_context(|| format!("opening serial port {port} at {baud} Bd"))?;
+        Ok(Box::new(serial))
+    }
+}
+
+/// A byte link: what `open_link` returns.
+pub trait Link: Read + Write + Send {}
+impl<T: Read + Write + Send> Link for T {}
+
+impl<L: Read + Write> UploadClient<L> {
+    /// Wraps a link; `timeout` bounds each request/response exchange.
+    pub fn new(link: L, timeout: Duration) -> Self {
+        Self { link, rx: FrameReceiver::new(), timeout }
+    }
+
+    /// Sends raw bytes (tests use this for garbage and hand-made frames).
+    pub fn send_raw(&mut self, bytes: &[u8]) -> Result<(), ClientError> {
+        self.link.write_all(bytes)?;
+        self.link.flush()?;
+        Ok(())
+    }
+
+    /// Sends one request and returns the device's response (including `Rejected`).
+    pub fn request(&mut self, request: &Request<'_>) -> Result<Response, ClientError> {
+        let mut wire = [0u8; MAX_WIRE_FRAME_LEN + 1];
+        // A leading delimiter flushes any partial frame left in the device's buffer.
+        let n = encode_frame(request, &mut wire[1..]).map_err(ClientError::Frame)?;
+        self.send_raw(&wire[..n + 1])?;
+        self.read_response()
+    }
+
+    /// Waits for the next response frame.
+    pub fn read_response(&mut self) -> Result<Response, ClientError> {
+        let deadline = Instant::now() + self.timeout;
+        let mut byte = [0u8; 1];
+        loop {
+            if Instant::now() >= deadline {
+                return Err(ClientError::Timeout(self.timeout));
+            }
+            match self.link.read(&mut byte) {
+                Ok(0) => {
+                    return Err(ClientError::Io(std::io::Error::new(
+                        ErrorKind::UnexpectedEof,
+                        "link closed by the device",
+                    )))
+                }
+                Ok(_) => {
+                    if let Some(frame) = self.rx.push(byte[0]) {
+                        let payload = frame.map_err(ClientError::Frame)?;
+                        return decode_message::<Response>(payload).map_err(ClientError::Frame);
+                    }
+                }
+                Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
+                Err(e) if e.kind() == ErrorKind::Interrupted => {}
+                Err(e) => return Err(e.into()),
+            }
+        }
+    }
+
+    /// `Hello`: checks the protocol version and returns the device status.
+    pub fn hello(&mut self) -> Result<DeviceStatus, ClientError> {
+        expect_status(self.request(&Request::Hello { protocol_version: PROTOCOL_VERSION })?)
+    }
+
+    /// `Status`: what the device runs now.
+    pub fn status(&mut self) -> Result<DeviceStatus, ClientError> {
+        expect_status(self.request(&Request::Status)?)
+    }
+
+    /// Uploads `model_bytes` with `signature`: Begin, in-order chunks, Commit.
+    /// Returns the committed model's identity as the device reports it.
+    pub fn upload(
+        &mut self,
+        model_bytes: &[u8],
+        signature: &[u8],
+        mut progress: impl FnMut(usize, usize),
+    ) -> Result<ModelInfo, ClientError> {
+        let begin = Request::Begin {
+            model_len: model_bytes.len() as u32,
+            model_crc32: crc32(model_bytes),
+        };
+        let max_chunk = match self.request(&begin)? {
+            Response::Ready { max_chunk_len } => usize::from(max_chunk_len).clamp(1, MAX_CHUNK_LEN),
+            other => return Err(unexpected(other)),
+        };
+        let mut offset = 0usize;
+        for data in model_bytes.chunks(max_chunk) {
+            let chunk = Request::Chunk { offset: offset as u32, data };
+            match self.request(&chunk)? {
+                Response::ChunkAccepted { received } if received as usize == offset + data.len() => {}
+                other => return Err(unexpected(other)),
+            }
+            offset += data.len();
+            progress(offset, model_bytes.len());
+        }
+        match self.request(&Request::Commit { signature })? {
+            Response::Committed(info) => Ok(info),
+            other => Err(unexpected(other)),
+        }
+    }
+}
+
+fn expect_status(response: Response) -> Result<DeviceStatus, ClientError> {
+    match response {
+        Response::Status(status) => Ok(status),
+        other => Err(unexpected(other)),
+    }
+}
+
+fn unexpected(response: Response) -> ClientError {
+    match response {
+        Response::Rejected(e) => ClientError::Rejected(e),
+        other => ClientError::Unexpected(other),
+    }
+}
+
+/// One line describing a stored model, as `fogsim upload` prints it.
+pub fn describe_model(info: &ModelInfo) -> String {
+    format!(
+        "slot {} seq {} | {} bytes, CRC-32 0x{:08X} | gyro {} | {} centres, {} inputs | held-out rms {:.4} deg/h",
+        if info.slot == 0 { 'A' } else { 'B' },
+        info.sequence,
+        info.model_len,
+        info.model_crc32,
+        info.gyro_id,
+        info.n_centers,
+        info.n_inputs,
+        info.heldout_rms_dph
+    )
+}

@@ -17,11 +17,16 @@ fn reply(line: &str) -> [Transaction<u8>; 2] {
     [Transaction::read_many(line.as_bytes().to_vec()), idle()]
 }
 
+/// A reply that ends the poll with an error: the driver stops reading at it.
+fn fatal(line: &str) -> Transaction<u8> {
+    Transaction::read_many(line.as_bytes().to_vec())
+}
+
 fn sends(line: &str) -> Transaction<u8> {
     Transaction::write_many(line.as_bytes().to_vec())
 }
 
-fn table(tx: &[Transaction<u8>], clock: &Cell<f64>) -> SerialTurntable<Mock<u8>, &Cell<f64>> {
+fn table<'c>(tx: &[Transaction<u8>], clock: &'c Cell<f64>) -> SerialTurntable<Mock<u8>, &'c Cell<f64>> {
     SerialTurntable::new(Mock::new(tx), clock, TurntableConfig::default())
 }
 
@@ -94,11 +99,11 @@ fn missing_position_reply_times_out() {
 #[test]
 fn nak_and_controller_faults_are_reported() {
     let mut tx = vec![sends("MOV 10.000\r")];
-    tx.extend(reply("NAK\r"));
+    tx.push(fatal("NAK\r"));
     tx.push(sends("MOV 10.000\r"));
     tx.extend(reply("ACK\r"));
     tx.extend([idle(), sends("POS?\r")]);
-    tx.extend(reply("POS 3.500 F7\r"));
+    tx.push(fatal("POS 3.500 F7\r"));
     let clock = Cell::new(0.0);
     let mut t = table(&tx, &clock);
     t.command_heading(10.0).unwrap();
@@ -116,7 +121,7 @@ fn settling_off_target_is_a_position_fault() {
     let mut tx = vec![sends("MOV 0.000\r")];
     tx.extend(reply("ACK\r"));
     tx.extend([idle(), sends("POS?\r")]);
-    tx.extend(reply("POS 359.950 S\r"));
+    tx.push(fatal("POS 359.950 S\r"));
     let clock = Cell::new(0.0);
     let mut t = table(&tx, &clock);
     t.command_heading(0.0).unwrap();
@@ -163,7 +168,7 @@ fn garbled_replies_are_errors() {
     let mut tx = vec![sends("MOV 1.000\r")];
     tx.extend(reply("ACK\r"));
     tx.extend([idle(), sends("POS?\r")]);
-    tx.extend(reply("POS 1.0x0 S\r"));
+    tx.push(fatal("POS 1.0x0 S\r"));
     let clock = Cell::new(0.0);
     let mut t = table(&tx, &clock);
     t.command_heading(1.0).unwrap();

@@ -1,10 +1,122 @@
-//! `fogsim north_seek` (to be written).
+//! `fogsim north-seek`: the cold-start north-seek Monte Carlo (N power-ons x 6 seeks, with and
+//! without compensation) against the simulated gyro and turntable, with fog-core's north
+//! finder. Without `--model` it first trains the default model on a simulated campaign.
 
-/// Options of `fogsim north_seek`.
+use std::path::PathBuf;
+
+use anyhow::{bail, Result};
+use fog_core::northfinder::SeekMode;
+
+use crate::northseek::{build_report, default_threads, run_monte_carlo, seek_table, MonteCarloConfig};
+use crate::report::{check_output_path, progress_bar, write_json};
+use crate::report_pipeline::{read_model, simulate_campaign, train_default, CampaignSpec};
+use crate::sim::GyroParams;
+
+/// Options of `fogsim north-seek`.
 #[derive(clap::Args, Debug)]
-pub struct Args {}
+pub struct Args {
+    /// Drift model (fog-core postcard, from `fogsim train`); default: train one on a simulated campaign.
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+    /// Cold starts (power-ons).
+    #[arg(long, default_value_t = 30)]
+    pub starts: usize,
+    /// Seeks after each power-on, back to back.
+    #[arg(long, default_value_t = 6)]
+    pub seeks: usize,
+    /// Table positions per seek: 2 (paper) or 4.
+    #[arg(long, default_value_t = 2)]
+    pub positions: u8,
+    /// Site latitude, deg (north positive).
+    #[arg(long, default_value_t = crate::sim::DEFAULT_LATITUDE_DEG, allow_negative_numbers = true)]
+    pub latitude: f64,
+    /// Ambient (room) temperature, degC.
+    #[arg(long, default_value_t = 20.0, allow_negative_numbers = true)]
+    pub ambient: f64,
+    /// True azimuth of the table's zero, deg (the paper's was about 108.4).
+    #[arg(long, default_value_t = crate::northseek::PAPER_AZIMUTH_DEG, allow_negative_numbers = true)]
+    pub azimuth: f64,
+    /// Measuring time per main position, s.
+    #[arg(long, default_value_t = 120.0, allow_negative_numbers = true)]
+    pub dwell: f32,
+    /// Seed of the whole Monte Carlo (and of the default training campaign).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Worker threads (default: available cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Write the JSON report here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+}
+
+/// Turns the options into a Monte Carlo configuration, rejecting impossible values.
+pub fn config_from_args(a: &Args) -> Result<MonteCarloConfig> {
+    let mode = match a.positions {
+        2 => SeekMode::TwoPosition,
+        4 => SeekMode::FourPosition,
+        p => bail!("--positions {p}: must be 2 or 4"),
+    };
+    if !(a.ambient.is_finite() && (-60.0..=100.0).contains(&a.ambient)) {
+        bail!("--ambient {}: must be within -60..=100 degC", a.ambient);
+    }
+    let cfg = MonteCarloConfig {
+        starts: a.starts,
+        seeks_per_start: a.seeks,
+        mode,
+        latitude_deg: a.latitude,
+        ambient_c: a.ambient,
+        true_azimuth_deg: a.azimuth,
+        dwell_s: a.dwell,
+        seed: a.seed,
+        threads: a.threads.unwrap_or_else(default_threads),
+        ..MonteCarloConfig::paper(a.seed)
+    };
+    cfg.validate()?;
+    Ok(cfg)
+}
 
 /// Runs the subcommand.
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("fogsim north_seek: not implemented yet")
+pub fn run(args: Args) -> Result<()> {
+    let cfg = config_from_args(&args)?;
+    if let Some(p) = &args.json {
+        check_output_path(p, "--json")?;
+    }
+    let params = GyroParams::paper_default();
+    let (model, source) = match &args.model {
+        Some(p) => (read_model(p)?, p.display().to_string()),
+        None => {
+            let plan = CampaignSpec {
+                ambients_c: vec![cfg.ambient_c],
+                runs_per_ambient: 3,
+                latitude_deg: cfg.latitude_deg,
+                ..CampaignSpec::paper(cfg.seed)
+            };
+            let campaign = simulate_campaign(&params, &plan)?;
+            let runs: Vec<_> = campaign.iter().map(|c| &c.run).collect();
+            let trained = train_default(&runs, "sim")?;
+            eprintln!(
+                "trained the default model on {} simulated {} degC runs (seed {}): {} centres, held-out rms {:.4} deg/h",
+                runs.len(),
+                cfg.ambient_c,
+                cfg.seed,
+                trained.report.n_centers,
+                trained.report.heldout_rms_dph
+            );
+            (trained.model, format!("trained on {} simulated runs at {} degC, seed {}", runs.len(), cfg.ambient_c, cfg.seed))
+        }
+    };
+    let bar = progress_bar(cfg.starts, "north-seek cold starts");
+    let outcomes = run_monte_carlo(&params, &cfg, &model, &|| bar.inc(1))?;
+    bar.finish_and_clear();
+    let report = build_report(&params, &cfg, &outcomes, &source);
+    println!(
+        "north-seek Monte Carlo: {} cold starts x {} seeks, {} positions, {} degC, latitude {} deg, true azimuth {} deg",
+        report.starts, report.seeks_per_start, report.positions, report.ambient_c, report.latitude_deg, report.true_azimuth_deg
+    );
+    print!("{}", seek_table(&report));
+    if let Some(p) = &args.json {
+        write_json(p, &report)?;
+    }
+    Ok(())
 }

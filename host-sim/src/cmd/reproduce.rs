@@ -1,10 +1,86 @@
-//! `fogsim reproduce` (to be written).
+//! `fogsim reproduce`: the whole paper end to end (campaign -40..+60 degC, train on runs 1-3
+//! of each temperature, validate on runs 4-5, cold-start north-seek Monte Carlo at 20 degC)
+//! and a side-by-side table: paper vs this project.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Result};
+
+use crate::northseek::{default_threads, MonteCarloConfig};
+use crate::report::{check_output_path, write_json};
+use crate::report_pipeline::{validate_plan, CampaignSpec};
+use crate::report_reproduce::{reproduce, summary, validation_table, ReproduceOptions};
+use crate::sim::GyroParams;
+
+/// Training runs per temperature (the paper's protocol).
+pub const TRAIN_RUNS: usize = 3;
 
 /// Options of `fogsim reproduce`.
 #[derive(clap::Args, Debug)]
-pub struct Args {}
+pub struct Args {
+    /// Write the JSON report here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Write the SVG plots into this directory.
+    #[arg(long)]
+    pub plots: Option<PathBuf>,
+    /// Seed of the campaign and of the Monte Carlo.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Ambient temperatures, degC (comma separated).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true,
+          default_values_t = crate::campaign::PAPER_AMBIENTS_C.to_vec())]
+    pub ambient: Vec<f64>,
+    /// Runs per temperature (runs 1-3 train, the rest validate).
+    #[arg(long, default_value_t = 5)]
+    pub runs: usize,
+    /// Record length from power-on, min.
+    #[arg(long, default_value_t = 45.0, allow_negative_numbers = true)]
+    pub minutes: f64,
+    /// Cold starts of the north-seek Monte Carlo (6 seeks each).
+    #[arg(long, default_value_t = 30)]
+    pub starts: usize,
+    /// Worker threads (default: available cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+}
+
+/// Checks the options and builds the pipeline's settings.
+pub fn options(campaign: CampaignSpec, starts: usize, threads: Option<usize>, plots: Option<PathBuf>) -> Result<ReproduceOptions> {
+    validate_plan(&campaign)?;
+    if campaign.runs_per_ambient <= TRAIN_RUNS {
+        bail!(
+            "--runs {}: runs 1-{TRAIN_RUNS} of each temperature train, so at least {} are needed to hold some out",
+            campaign.runs_per_ambient,
+            TRAIN_RUNS + 1
+        );
+    }
+    if campaign.minutes < 30.0 {
+        bail!("--minutes {}: a record must reach the settled state (>= 30 min; the paper records 45)", campaign.minutes);
+    }
+    let room_c = if campaign.ambients_c.contains(&20.0) { 20.0 } else { campaign.ambients_c[campaign.ambients_c.len() / 2] };
+    let north_seek = MonteCarloConfig {
+        starts,
+        ambient_c: room_c,
+        latitude_deg: campaign.latitude_deg,
+        threads: threads.unwrap_or_else(default_threads),
+        ..MonteCarloConfig::paper(campaign.seed)
+    };
+    north_seek.validate()?;
+    Ok(ReproduceOptions { campaign, n_train: TRAIN_RUNS, north_seek, plots })
+}
 
 /// Runs the subcommand.
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("fogsim reproduce: not implemented yet")
+pub fn run(args: Args) -> Result<()> {
+    if let Some(p) = &args.json {
+        check_output_path(p, "--json")?;
+    }
+    let campaign = CampaignSpec { ambients_c: args.ambient.clone(), runs_per_ambient: args.runs, minutes: args.minutes, ..CampaignSpec::paper(args.seed) };
+    let opts = options(campaign, args.starts, args.threads, args.plots.clone())?;
+    let report = reproduce(&GyroParams::paper_default(), &opts)?;
+    print!("held-out runs:\n{}\n{}", validation_table(&report), summary(&report));
+    if let Some(p) = &args.json {
+        write_json(p, &report)?;
+    }
+    Ok(())
 }

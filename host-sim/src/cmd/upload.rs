@@ -1,10 +1,85 @@
-//! `fogsim upload` (to be written).
+//! `fogsim upload`: sign a trained model and install it on the gyro over its UART.
+//!
+//! Checks the model file locally first (a bad file never goes out), signs it with the
+//! training PC's Ed25519 key, uploads it in chunks, commits, then asks the device for
+//! its status and confirms that the new model (sequence, CRC) is the one in use.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use anyhow::{bail, Context};
+use fog_core::model::RbfModel;
+
+use crate::upload::{
+    describe_model, load_signing_key, open_link, sign_model, test_key_path, UploadClient,
+};
 
 /// Options of `fogsim upload`.
 #[derive(clap::Args, Debug)]
-pub struct Args {}
+pub struct Args {
+    /// Link to the device: a serial port (`/dev/ttyUSB0`, `COM3`) or `tcp:127.0.0.1:PORT`
+    /// (QEMU started with `-serial tcp:127.0.0.1:PORT,server`).
+    #[arg(long)]
+    pub port: String,
+    /// Serial baud rate (ignored for tcp:).
+    #[arg(long, default_value_t = 115_200)]
+    pub baud: u32,
+    /// Ed25519 signing seed (64 hex digits). Default: the repository's public TEST key.
+    #[arg(long)]
+    pub key: Option<PathBuf>,
+    /// Seconds to wait for each response.
+    #[arg(long, default_value_t = 5.0)]
+    pub timeout_s: f64,
+    /// Only query and print the device status; no upload.
+    #[arg(long)]
+    pub status_only: bool,
+    /// The model file written by `fogsim train --out` (`RbfModel::encode` bytes).
+    #[arg(required_unless_present = "status_only")]
+    pub model: Option<PathBuf>,
+}
 
 /// Runs the subcommand.
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("fogsim upload: not implemented yet")
+pub fn run(args: Args) -> anyhow::Result<()> {
+    if !(args.timeout_s.is_finite() && args.timeout_s > 0.0) {
+        bail!("--timeout-s must be a positive number of seconds, got {}", args.timeout_s);
+    }
+    let link = open_link(&args.port, args.baud)?;
+    let mut client = UploadClient::new(link, Duration::from_secs_f64(args.timeout_s));
+    let before = client.hello().context("handshake (Hello)")?;
+    match &before.active {
+        Some(info) => println!("device model before: {}", describe_model(info)),
+        None => println!("device model before: none"),
+    }
+    let Some(model_path) = args.model else {
+        return Ok(());
+    };
+    let bytes = std::fs::read(&model_path)
+        .with_context(|| format!("reading model {}", model_path.display()))?;
+    let model = RbfModel::decode(&bytes)
+        .map_err(|e| anyhow::anyhow!("{}: not a valid model file: {e}", model_path.display()))?;
+    let key_path = args.key.unwrap_or_else(test_key_path);
+    if key_path == test_key_path() {
+        eprintln!("fogsim upload: WARNING signing with the public TEST key (keys/README.md)");
+    }
+    let key = load_signing_key(&key_path)?;
+    let signature = sign_model(&key, &bytes);
+    println!(
+        "uploading {} ({} bytes, gyro {}, {} centres)",
+        model_path.display(),
+        bytes.len(),
+        model.meta.gyro_id,
+        model.centers.len()
+    );
+    let committed = client
+        .upload(&bytes, &signature, |done, total| eprint!("\r  sent {done}/{total} bytes"))
+        .context("upload")?;
+    eprintln!();
+    let after = client.status().context("status after commit")?;
+    match after.active {
+        Some(active) if active == committed => {
+            println!("device model now:    {}", describe_model(&active));
+            Ok(())
+        }
+        other => bail!("device committed {committed:?} but reports {other:?} as active"),
+    }
 }

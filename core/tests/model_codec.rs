@@ -1,0 +1,286 @@
+//! Model format: round trip, size budget, and rejection of every kind of corrupted model
+//! with the matching typed error.
+
+use fog_core::model::{
+    crc32, FeatureKind, ModelError, ModelField, RbfModel, MAX_CENTERS, MAX_ENCODED_LEN,
+    MODEL_MAGIC, MODEL_VERSION,
+};
+use fog_core::synthetic::warmup_model;
+use serde::Serialize;
+
+fn encode(m: &RbfModel) -> Vec<u8> {
+    let mut buf = [0u8; 4096];
+    let n = m.encode(&mut buf).expect("encode");
+    buf[..n].to_vec()
+}
+
+/// Same layout as `RbfModel::encode`, but without validation: lets the tests build
+/// encodings of invalid models (std `Vec`s allow more than 64 centres).
+#[derive(Serialize)]
+struct LooseModel {
+    n_rbf_inputs: u8,
+    inputs: Vec<fog_core::model::FeatureSpec>,
+    input_offset: Vec<f32>,
+    input_scale: Vec<f32>,
+    input_min: Vec<f32>,
+    input_max: Vec<f32>,
+    linear: Vec<f32>,
+    centers: Vec<[f32; 4]>,
+    widths: Vec<f32>,
+    weights: Vec<f32>,
+    bias_dph: f32,
+    meta: fog_core::model::TrainingMeta,
+}
+
+impl From<&RbfModel> for LooseModel {
+    fn from(m: &RbfModel) -> Self {
+        LooseModel {
+            n_rbf_inputs: m.n_rbf_inputs,
+            inputs: m.inputs.to_vec(),
+            input_offset: m.input_offset.to_vec(),
+            input_scale: m.input_scale.to_vec(),
+            input_min: m.input_min.to_vec(),
+            input_max: m.input_max.to_vec(),
+            linear: m.linear.to_vec(),
+            centers: m.centers.to_vec(),
+            widths: m.widths.to_vec(),
+            weights: m.weights.to_vec(),
+            bias_dph: m.bias_dph,
+            meta: m.meta.clone(),
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct Wire<'a> {
+    magic: u32,
+    version: u16,
+    body: &'a [u8],
+    crc32: u32,
+}
+
+fn encode_loose(m: &LooseModel, version: u16) -> Vec<u8> {
+    let body =
+        postcard::to_allocvec(&(m.inputs.len() as u16, m.centers.len() as u16, m)).unwrap();
+    postcard::to_allocvec(&Wire {
+        magic: MODEL_MAGIC,
+        version,
+        body: &body,
+        crc32: crc32(&body),
+    })
+    .unwrap()
+}
+
+#[test]
+fn round_trip_is_exact() {
+    for (centers, inputs) in [(1, 1), (35, 2), (64, 4), (0, 2)] {
+        let m = warmup_model(centers, inputs, 2.0, 7);
+        let bytes = encode(&m);
+        assert_eq!(RbfModel::decode(&bytes).unwrap(), m);
+    }
+}
+
+#[test]
+fn layout_is_postcard_of_the_wire_envelope() {
+    let m = warmup_model(35, 2, 2.0, 3);
+    assert_eq!(encode(&m), encode_loose(&LooseModel::from(&m), MODEL_VERSION));
+}
+
+#[test]
+fn full_model_fits_in_2_kib() {
+    let mut m = warmup_model(MAX_CENTERS, 4, 2.0, 11);
+    m.meta.gyro_id.clear();
+    m.meta.gyro_id.push_str("0123456789ABCDEF").unwrap();
+    let bytes = encode(&m);
+    println!("64 centres x 4 inputs: {} bytes", bytes.len());
+    assert!(bytes.len() <= MAX_ENCODED_LEN, "{} bytes", bytes.len());
+    assert!(bytes.len() <= 2048);
+}
+
+#[test]
+fn small_buffer_is_an_error_not_a_panic() {
+    let m = warmup_model(35, 2, 2.0, 3);
+    let full = encode(&m).len();
+    for len in 0..full {
+        let mut buf = vec![0u8; len];
+        assert!(
+            matches!(m.encode(&mut buf), Err(ModelError::BufferTooSmall { .. })),
+            "len {len}"
+        );
+    }
+}
+
+#[test]
+fn every_truncation_is_rejected_as_truncated() {
+    let bytes = encode(&warmup_model(35, 2, 2.0, 5));
+    for len in 0..bytes.len() {
+        assert_eq!(
+            RbfModel::decode(&bytes[..len]),
+            Err(ModelError::Truncated),
+            "prefix of {len} bytes"
+        );
+    }
+}
+
+#[test]
+fn every_flipped_byte_is_rejected() {
+    let bytes = encode(&warmup_model(35, 2, 2.0, 5));
+    // Envelope: magic varint (5 bytes), version (1), body length varint (2), body, crc varint.
+    let body_len = bytes.len() - 8 - 5;
+    let body = 8..8 + body_len;
+    for i in 0..bytes.len() {
+        let mut b = bytes.clone();
+        b[i] ^= 0xFF;
+        let err = RbfModel::decode(&b).expect_err("flipped byte accepted");
+        let ok = match i {
+            0..=4 => matches!(err, ModelError::BadMagic { .. } | ModelError::Malformed),
+            5 => matches!(err, ModelError::UnsupportedVersion { .. } | ModelError::Malformed),
+            6 | 7 => matches!(
+                err,
+                ModelError::Truncated
+                    | ModelError::CrcMismatch { .. }
+                    | ModelError::TrailingBytes { .. }
+                    | ModelError::Malformed
+                    | ModelError::TooLarge { .. }
+            ),
+            i if body.contains(&i) => matches!(err, ModelError::CrcMismatch { .. }),
+            _ => matches!(
+                err,
+                ModelError::CrcMismatch { .. }
+                    | ModelError::Malformed
+                    | ModelError::Truncated
+                    | ModelError::TrailingBytes { .. }
+            ),
+        };
+        assert!(ok, "byte {i}: unexpected {err:?}");
+    }
+}
+
+#[test]
+fn wrong_version_and_magic_are_named() {
+    let m = LooseModel::from(&warmup_model(35, 2, 2.0, 5));
+    assert_eq!(
+        RbfModel::decode(&encode_loose(&m, 2)),
+        Err(ModelError::UnsupportedVersion { found: 2 })
+    );
+    let mut bytes = encode_loose(&m, MODEL_VERSION);
+    bytes[0] = 0x01; // still a valid varint, different value
+    assert!(matches!(RbfModel::decode(&bytes), Err(ModelError::BadMagic { .. })));
+    let mut long = encode_loose(&m, MODEL_VERSION);
+    long.push(0);
+    assert_eq!(
+        RbfModel::decode(&long),
+        Err(ModelError::TrailingBytes { count: 1 })
+    );
+}
+
+#[test]
+fn invalid_contents_get_their_typed_error() {
+    let good = warmup_model(35, 2, 2.0, 5);
+    let cases: Vec<(Box<dyn Fn(&mut LooseModel)>, ModelError)> = vec![
+        (
+            Box::new(|m| m.weights[3] = f32::NAN),
+            ModelError::NonFinite { field: ModelField::Weights, index: 3 },
+        ),
+        (
+            Box::new(|m| m.widths[7] = 0.0),
+            ModelError::NonPositiveWidth { center: 7 },
+        ),
+        (
+            Box::new(|m| m.widths[2] = -1.0),
+            ModelError::NonPositiveWidth { center: 2 },
+        ),
+        (
+            Box::new(|m| {
+                while m.centers.len() < 65 {
+                    m.centers.push([0.1; 4]);
+                    m.widths.push(0.3);
+                    m.weights.push(0.1);
+                }
+            }),
+            ModelError::TooManyCenters { count: 65 },
+        ),
+        (
+            Box::new(|m| m.centers[4][1] = f32::INFINITY),
+            ModelError::NonFinite { field: ModelField::Centers, index: 4 },
+        ),
+        (
+            Box::new(|m| m.input_scale[1] = 0.0),
+            ModelError::NonPositiveScale { input: 1 },
+        ),
+        (
+            Box::new(|m| {
+                m.input_min[0] = 50.0;
+                m.input_max[0] = 10.0;
+            }),
+            ModelError::BadRange { input: 0 },
+        ),
+        (
+            Box::new(|m| {
+                m.weights.pop();
+            }),
+            ModelError::LengthMismatch { field: ModelField::Weights, expected: 35, found: 34 },
+        ),
+        (
+            Box::new(|m| m.bias_dph = f32::NAN),
+            ModelError::NonFinite { field: ModelField::Bias, index: 0 },
+        ),
+        (Box::new(|m| m.n_rbf_inputs = 3), ModelError::BadRbfInputCount { n_rbf_inputs: 3, n_inputs: 2 }),
+        (
+            Box::new(|m| {
+                m.inputs[1].kind = FeatureKind::TempLagC;
+                m.inputs[1].tau_s = 0.0;
+            }),
+            ModelError::BadTimeConstant { input: 1 },
+        ),
+        (
+            Box::new(|m| m.inputs[1].kind = FeatureKind::AuxValue(9)),
+            ModelError::BadAuxChannel { input: 1, channel: 9 },
+        ),
+        (
+            Box::new(|m| {
+                m.inputs.clear();
+                m.input_offset.clear();
+                m.input_scale.clear();
+                m.input_min.clear();
+                m.input_max.clear();
+                m.linear.clear();
+                m.n_rbf_inputs = 0;
+                m.centers.clear();
+                m.widths.clear();
+                m.weights.clear();
+            }),
+            ModelError::NoInputs,
+        ),
+    ];
+    for (i, (corrupt, expected)) in cases.iter().enumerate() {
+        let mut m = LooseModel::from(&good);
+        corrupt(&mut m);
+        let got = RbfModel::decode(&encode_loose(&m, MODEL_VERSION));
+        assert_eq!(got, Err(*expected), "case {i}");
+        // Display names the problem.
+        assert!(!format!("{expected}").is_empty());
+    }
+}
+
+#[test]
+fn encode_refuses_invalid_models() {
+    let mut m = warmup_model(35, 2, 2.0, 5);
+    m.widths[0] = 0.0;
+    let mut buf = [0u8; 4096];
+    assert_eq!(m.encode(&mut buf), Err(ModelError::NonPositiveWidth { center: 0 }));
+}
+
+#[test]
+fn random_bytes_never_panic() {
+    let mut rng = fog_core::synthetic::SplitMix64::new(99);
+    let good = encode(&warmup_model(35, 2, 2.0, 5));
+    for _ in 0..20_000 {
+        let len = (rng.next_u64() % 2100) as usize;
+        let mut b: Vec<u8> = (0..len).map(|_| rng.next_u64() as u8).collect();
+        if rng.unit() < 0.5 && len > 8 {
+            b[..8].copy_from_slice(&good[..8]); // valid envelope start
+        }
+        assert!(RbfModel::decode(&b).is_err());
+    }
+}

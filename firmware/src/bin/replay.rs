@@ -1,0 +1,84 @@
+//! QEMU scenario 1 (replay): reads a recorded cold start through semihosting files,
+//! runs the application logic exactly as the firmware does (`fog_firmware::replay::run`:
+//! gyro driver -> compensator -> north finder), and writes every 10 s window and seek
+//! to an output file for `tests/tests/qemu_replay.rs` to compare with the host.
+//!
+//! Arguments: `MODEL GYRO_STREAM TABLE_LOG OUT RATE_HZ SEEKS [f32|fixed]`.
+//! It also paints the stack and appends the high-water mark to OUT.
+#![no_std]
+#![no_main]
+
+#[path = "target/panic.rs"]
+mod panic;
+#[path = "target/semi.rs"]
+mod semi;
+#[path = "target/stack.rs"]
+mod stack;
+
+use core::fmt::Write as _;
+
+use cortex_m_rt::entry;
+use fog_core::compensator::Evaluator;
+use fog_core::model::{RbfModel, MAX_ENCODED_LEN};
+use fog_firmware::app::AppConfig;
+use fog_firmware::replay;
+
+#[entry]
+fn main() -> ! {
+    stack::paint();
+    let code = match run() {
+        Ok(()) => 0,
+        Err(msg) => {
+            semihosting::eprintln!("replay: {}", msg);
+            1
+        }
+    };
+    semihosting::process::exit(code)
+}
+
+fn run() -> Result<(), &'static str> {
+    let args = semi::Args::get()?;
+    if args.len() < 6 {
+        return Err("usage: replay MODEL GYRO_STREAM TABLE_LOG OUT RATE_HZ SEEKS [f32|fixed]");
+    }
+    let mut model_buf = [0u8; MAX_ENCODED_LEN];
+    let model_bytes = semi::read_file(args.path(0)?, &mut model_buf)?;
+    let model = RbfModel::decode(model_bytes).map_err(|_| "model file fails validation")?;
+    let rate_hz: f32 = args.str(4)?.parse().map_err(|_| "RATE_HZ is not a number")?;
+    let seeks: u16 = args.str(5)?.parse().map_err(|_| "SEEKS is not a number")?;
+    let mut cfg = AppConfig::for_rate(rate_hz);
+    cfg.seeks = seeks;
+    cfg.compensator.evaluator = match args.str(6).unwrap_or("f32") {
+        "fixed" => Evaluator::Fixed,
+        _ => Evaluator::F32,
+    };
+    let gyro = semi::HostReader::open(args.path(1)?)?;
+    let table = semi::HostReader::open(args.path(2)?)?;
+    let mut out = semi::HostWriter::create(args.path(3)?)?;
+    let sum = replay::run(cfg, Some(model), gyro, table, &mut out).map_err(|e| match e {
+        replay::ReplayError::App(_) => "application rejected the configuration",
+        replay::ReplayError::Output => "cannot write the output file",
+    })?;
+    let g = sum.gyro;
+    let _ = writeln!(
+        out,
+        "# samples {} windows {} valid {} seeks_done {} seeks_failed {} frames_ok {} crc_errors {} bytes_skipped {} frames_lost {} flagged {}",
+        sum.samples,
+        sum.windows,
+        sum.valid_windows,
+        sum.seeks_done,
+        sum.seeks_failed,
+        g.frames.frames_ok,
+        g.frames.crc_errors,
+        g.frames.bytes_skipped,
+        g.frames_lost,
+        g.flagged_invalid
+    );
+    let _ = writeln!(
+        out,
+        "# stack_high_water_bytes {} of {}",
+        stack::high_water_bytes(),
+        stack::size_bytes()
+    );
+    out.flush()
+}
