@@ -167,7 +167,8 @@ pub struct Compensator {
     temp_pending: Option<WindowMean>,
     aux: [WindowAverager; MAX_AUX],
     aux_pending: [Option<WindowMean>; MAX_AUX],
-    fault_window: Option<i64>,
+    /// Windows (first, last index) with a reported fault.
+    fault_windows: Option<(i64, i64)>,
 }
 
 const DEFAULT_SPECS: [FeatureSpec; 2] = [
@@ -210,7 +211,7 @@ impl Compensator {
             temp_pending: None,
             aux: [temp.clone(), temp.clone(), temp.clone(), temp],
             aux_pending: [None; MAX_AUX],
-            fault_window: None,
+            fault_windows: None,
         };
         c.set_model(model)?;
         Ok(c)
@@ -296,7 +297,12 @@ impl Compensator {
     /// A sensor reported a fault at `t_s` (read error, timeout): that window is invalid.
     pub fn report_fault(&mut self, t_s: f64) {
         if t_s.is_finite() {
-            self.fault_window = Some(self.gyro.window_index(t_s));
+            let k = self.gyro.window_index(t_s);
+            // Faults arrive in real time, so one range (conservatively merged) suffices.
+            self.fault_windows = Some(match self.fault_windows {
+                Some((a, b)) => (a.min(k), b.max(k)),
+                None => (k, k),
+            });
         }
     }
 
@@ -345,7 +351,12 @@ impl Compensator {
                 None => aux_ok = false,
             }
         }
-        let faulted = self.fault_window == Some(window_k);
+        let faulted = self
+            .fault_windows
+            .is_some_and(|(a, b)| (a..=b).contains(&window_k));
+        if self.fault_windows.is_some_and(|(_, b)| b <= window_k) {
+            self.fault_windows = None;
+        }
         let mean_rate = g.mean as f32;
         let mut r = WindowResult {
             t_start_s: g.t_start_s,
@@ -375,7 +386,7 @@ impl Compensator {
             WindowStatus::Valid
         };
         if let Some(t) = temp {
-            if let Some(e) = self.rate_report.push(t_end, t) {
+            if let Some(e) = self.rate_report.push(t_end, t as f32 as f64) {
                 r.temp_rate_cps = e.rate_per_s as f32;
             }
             // Feature history only advances on windows with a real temperature.

@@ -17,7 +17,7 @@
 //!   the weighted sum accumulates in i64.
 //!
 //! Worst error against the f64 reference: see `docs/core.md` (measured by the
-//! `fixed_worst_error_*` tests and `cargo run -p fog-core --example fixed_error --release`).
+//! `fixed_worst_error_*` tests: `cargo test -p fog-core --test rbf_accuracy fixed_worst -- --nocapture`).
 
 use crate::model::{ModelError, RbfModel, MAX_CENTERS, MAX_INPUTS};
 use crate::rbf::RbfError;
@@ -296,18 +296,25 @@ pub fn exp_neg_q30(u_q28: u64) -> u32 {
     let f = t & ((1u64 << 58) - 1);
     let k = (f >> 53) as usize;
     let r_q30 = (f & ((1u64 << 53) - 1)) >> 28; // r < 1/32
-    let y = (r_q30 * LN2_Q30) >> 30; // y = r ln 2 < 0.0217, Q.30
-                                     // exp(-y) = 1 - y (1 - y/2 (1 - y/3 (1 - y/4))), Horner in Q.30.
+    // y = r ln 2 < 0.0217, Q.30
+    let y = mul_q30(r_q30, LN2_Q30);
+    // exp(-y) = 1 - y (1 - y/2 (1 - y/3 (1 - y/4))), Horner in Q.30.
     let mut p = ONE_Q30 - (y >> 2);
-    p = ONE_Q30 - ((((y * p) >> 30) * INV3_Q30) >> 30);
-    p = ONE_Q30 - (((y * p) >> 30) >> 1);
-    p = ONE_Q30 - ((y * p) >> 30);
-    let e = (EXP2_TABLE_Q30[k] as u64 * p) >> 30;
+    p = ONE_Q30 - mul_q30(mul_q30(y, p), INV3_Q30);
+    p = ONE_Q30 - (mul_q30(y, p) >> 1);
+    p = ONE_Q30 - mul_q30(y, p);
+    let e = mul_q30(EXP2_TABLE_Q30[k] as u64, p);
     if n >= 32 {
         0
     } else {
-        (e >> n) as u32
+        ((e + ((1u64 << n) >> 1)) >> n) as u32
     }
+}
+
+/// a * b in Q.30, rounded to nearest (a * b < 2^64 - 2^29).
+#[inline(always)]
+fn mul_q30(a: u64, b: u64) -> u64 {
+    (a * b + (1 << 29)) >> 30
 }
 
 /// f32 -> fixed with `frac` fraction bits, truncating toward zero and saturating at

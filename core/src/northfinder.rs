@@ -8,7 +8,9 @@
 //! - Two positions: dwell at h0, turn 180 deg, dwell at h0+180: cos(psi) = (w1 - w2) / (2 Omega_H)
 //!   with psi = A + h0 (the bias cancels if it is the same in both dwells). acos leaves the
 //!   sign of psi open; a short dwell at h0+90 reads -Omega_H sin(psi) + bias, and with the bias
-//!   from the two main dwells ((w1 + w2) / 2) its sign picks the half circle.
+//!   from the two main dwells ((w1 + w2) / 2) its sign picks the half circle. Within
+//!   |sin psi| < `direct_sine_below()` of 0/180 deg, where acos is ill-conditioned, the
+//!   +90 dwell's sine enters directly: psi = atan2(s, c).
 //! - Four positions (h0 + 0/90/180/270): psi = atan2(w4 - w2, w1 - w3); bias and scale factor cancel.
 //!
 //! It is driven by the 10 s `WindowResult`s (compensated rates) and polls a `hal::Turntable`;
@@ -55,15 +57,15 @@ pub struct SeekConfig {
 }
 
 impl Default for SeekConfig {
-    /// Two positions, 120 s dwells and a 30 s ambiguity dwell: with 10 s windows and
-    /// ~10 s per move this takes about 290 s, within the paper's 4 min 56 s.
+    /// Two positions, 120 s dwells and a 20 s ambiguity dwell: with 10 s windows and moves
+    /// under 10 s this takes 290 s, within the paper's 4 min 56 s.
     fn default() -> Self {
         SeekConfig {
             mode: SeekMode::TwoPosition,
             latitude_deg: 39.9,
             start_heading_deg: 0.0,
             dwell_s: 120.0,
-            ambiguity_dwell_s: 30.0,
+            ambiguity_dwell_s: 20.0,
             settle_s: 0.0,
             move_timeout_s: 60.0,
             max_invalid_windows: 3,
@@ -251,6 +253,14 @@ impl NorthFinder {
         wrap_360(self.cfg.start_heading_deg as f64 + offset) as f32
     }
 
+    /// Two positions: below this |sin psi| the azimuth comes from atan2 with the +90 dwell's
+    /// direct sine instead of acos. It is where both have the same white-noise variance:
+    /// dc / |sin psi| with var(dc) = N^2 / (2 tau) equals ds with var(ds) = N^2 / tau_90,
+    /// i.e. |sin psi| = sqrt(tau_90 / (2 tau)) (0.29 for 120 s / 20 s dwells).
+    pub fn direct_sine_below(&self) -> f64 {
+        libm::sqrt(self.cfg.ambiguity_dwell_s as f64 / (2.0 * self.cfg.dwell_s as f64)).min(0.5)
+    }
+
     fn dwell_of(&self, k: usize) -> f64 {
         match (self.cfg.mode, k) {
             (SeekMode::TwoPosition, 2) => self.cfg.ambiguity_dwell_s as f64,
@@ -426,14 +436,23 @@ impl NorthFinder {
                 let psi0 = libm::acos(c.clamp(-1.0, 1.0));
                 let bias = 0.5 * (p1.mean_rate_dph + p2.mean_rate_dph);
                 // w3 = -Omega_H sin(psi) + bias.
-                let sin_sign = bias - p3.mean_rate_dph;
-                let psi = if sin_sign >= 0.0 { psi0 } else { -psi0 };
-                let sigma_c = libm::sqrt(p1.sigma_dph * p1.sigma_dph + p2.sigma_dph * p2.sigma_dph)
-                    / (2.0 * oh);
-                // d(acos c) = dc / |sin psi|; near psi = 0/180 acos behaves like sqrt(2 dc).
-                let s = libm::fabs(libm::sin(psi0)).max(libm::sqrt(2.0 * sigma_c));
-                let sigma = if sigma_c > 0.0 { sigma_c / s } else { 0.0 };
-                (psi, sigma, bias)
+                let s = (bias - p3.mean_rate_dph) / oh;
+                let var_c =
+                    (p1.sigma_dph * p1.sigma_dph + p2.sigma_dph * p2.sigma_dph) / (4.0 * oh * oh);
+                let var_s = (p3.sigma_dph * p3.sigma_dph) / (oh * oh) + var_c;
+                let sin0 = libm::sin(psi0);
+                if sin0 >= self.direct_sine_below() {
+                    // Main branch: acos of the two main dwells, sign from the +90 dwell.
+                    let psi = if s >= 0.0 { psi0 } else { -psi0 };
+                    (psi, libm::sqrt(var_c) / sin0, bias)
+                } else {
+                    // Near psi = 0/180 acos is ill-conditioned (d psi = dc / |sin psi|): the
+                    // +90 dwell measures sin(psi) directly and is the better estimate there.
+                    let psi = libm::atan2(s, c);
+                    let r2 = c * c + s * s;
+                    let var = (c * c * var_s + s * s * var_c) / (r2 * r2);
+                    (psi, libm::sqrt(var), bias)
+                }
             }
             SeekMode::FourPosition => {
                 let m: [f64; 4] = core::array::from_fn(|k| positions[k].mean_rate_dph);

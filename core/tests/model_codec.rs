@@ -60,8 +60,7 @@ struct Wire<'a> {
 }
 
 fn encode_loose(m: &LooseModel, version: u16) -> Vec<u8> {
-    let body =
-        postcard::to_allocvec(&(m.inputs.len() as u16, m.centers.len() as u16, m)).unwrap();
+    let body = postcard::to_allocvec(&(m.inputs.len() as u16, m.centers.len() as u16, m)).unwrap();
     postcard::to_allocvec(&Wire {
         magic: MODEL_MAGIC,
         version,
@@ -83,7 +82,10 @@ fn round_trip_is_exact() {
 #[test]
 fn layout_is_postcard_of_the_wire_envelope() {
     let m = warmup_model(35, 2, 2.0, 3);
-    assert_eq!(encode(&m), encode_loose(&LooseModel::from(&m), MODEL_VERSION));
+    assert_eq!(
+        encode(&m),
+        encode_loose(&LooseModel::from(&m), MODEL_VERSION)
+    );
 }
 
 #[test]
@@ -134,7 +136,10 @@ fn every_flipped_byte_is_rejected() {
         let err = RbfModel::decode(&b).expect_err("flipped byte accepted");
         let ok = match i {
             0..=4 => matches!(err, ModelError::BadMagic { .. } | ModelError::Malformed),
-            5 => matches!(err, ModelError::UnsupportedVersion { .. } | ModelError::Malformed),
+            5 => matches!(
+                err,
+                ModelError::UnsupportedVersion { .. } | ModelError::Malformed
+            ),
             6 | 7 => matches!(
                 err,
                 ModelError::Truncated
@@ -165,7 +170,10 @@ fn wrong_version_and_magic_are_named() {
     );
     let mut bytes = encode_loose(&m, MODEL_VERSION);
     bytes[0] = 0x01; // still a valid varint, different value
-    assert!(matches!(RbfModel::decode(&bytes), Err(ModelError::BadMagic { .. })));
+    assert!(matches!(
+        RbfModel::decode(&bytes),
+        Err(ModelError::BadMagic { .. })
+    ));
     let mut long = encode_loose(&m, MODEL_VERSION);
     long.push(0);
     assert_eq!(
@@ -180,7 +188,10 @@ fn invalid_contents_get_their_typed_error() {
     let cases: Vec<(Box<dyn Fn(&mut LooseModel)>, ModelError)> = vec![
         (
             Box::new(|m| m.weights[3] = f32::NAN),
-            ModelError::NonFinite { field: ModelField::Weights, index: 3 },
+            ModelError::NonFinite {
+                field: ModelField::Weights,
+                index: 3,
+            },
         ),
         (
             Box::new(|m| m.widths[7] = 0.0),
@@ -202,7 +213,10 @@ fn invalid_contents_get_their_typed_error() {
         ),
         (
             Box::new(|m| m.centers[4][1] = f32::INFINITY),
-            ModelError::NonFinite { field: ModelField::Centers, index: 4 },
+            ModelError::NonFinite {
+                field: ModelField::Centers,
+                index: 4,
+            },
         ),
         (
             Box::new(|m| m.input_scale[1] = 0.0),
@@ -219,13 +233,26 @@ fn invalid_contents_get_their_typed_error() {
             Box::new(|m| {
                 m.weights.pop();
             }),
-            ModelError::LengthMismatch { field: ModelField::Weights, expected: 35, found: 34 },
+            ModelError::LengthMismatch {
+                field: ModelField::Weights,
+                expected: 35,
+                found: 34,
+            },
         ),
         (
             Box::new(|m| m.bias_dph = f32::NAN),
-            ModelError::NonFinite { field: ModelField::Bias, index: 0 },
+            ModelError::NonFinite {
+                field: ModelField::Bias,
+                index: 0,
+            },
         ),
-        (Box::new(|m| m.n_rbf_inputs = 3), ModelError::BadRbfInputCount { n_rbf_inputs: 3, n_inputs: 2 }),
+        (
+            Box::new(|m| m.n_rbf_inputs = 3),
+            ModelError::BadRbfInputCount {
+                n_rbf_inputs: 3,
+                n_inputs: 2,
+            },
+        ),
         (
             Box::new(|m| {
                 m.inputs[1].kind = FeatureKind::TempLagC;
@@ -235,7 +262,10 @@ fn invalid_contents_get_their_typed_error() {
         ),
         (
             Box::new(|m| m.inputs[1].kind = FeatureKind::AuxValue(9)),
-            ModelError::BadAuxChannel { input: 1, channel: 9 },
+            ModelError::BadAuxChannel {
+                input: 1,
+                channel: 9,
+            },
         ),
         (
             Box::new(|m| {
@@ -268,7 +298,10 @@ fn encode_refuses_invalid_models() {
     let mut m = warmup_model(35, 2, 2.0, 5);
     m.widths[0] = 0.0;
     let mut buf = [0u8; 4096];
-    assert_eq!(m.encode(&mut buf), Err(ModelError::NonPositiveWidth { center: 0 }));
+    assert_eq!(
+        m.encode(&mut buf),
+        Err(ModelError::NonPositiveWidth { center: 0 })
+    );
 }
 
 #[test]

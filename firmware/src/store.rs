@@ -131,10 +131,25 @@ pub struct ModelStore<F> {
     active: Option<ActiveSlot>,
 }
 
+/// Bytes one slot occupies on a flash with `erase_size`-byte pages (header + largest
+/// model, rounded up to whole pages).
+pub const fn slot_len(erase_size: usize) -> usize {
+    (BODY_OFFSET + MAX_ENCODED_LEN).div_ceil(erase_size) * erase_size
+}
+
+/// Bytes the two-slot store occupies on a flash with `erase_size`-byte pages.
+pub const fn store_len(erase_size: usize) -> usize {
+    2 * slot_len(erase_size)
+}
+
+/// The RAM-backed stand-in flash of the QEMU build (mps2-an386 has no flash
+/// controller): 4-byte words, 256-byte pages, exactly one store (4,608 bytes).
+pub type EmulatedModelFlash = ram_flash::RamNorFlash<{ store_len(256) }, 4, 256>;
+
 impl<F: NorFlash> ModelStore<F> {
-    /// Bytes one slot occupies for this flash (header + largest model, whole erase pages).
+    /// Bytes one slot occupies for this flash.
     pub fn slot_len() -> usize {
-        (BODY_OFFSET + MAX_ENCODED_LEN).div_ceil(F::ERASE_SIZE) * F::ERASE_SIZE
+        slot_len(F::ERASE_SIZE)
     }
 
     /// Opens the store (the boot path): scans both slots and picks the newest valid one.

@@ -7,6 +7,7 @@
 //! `RbfModel::decode` all pass and the A/B store committed it; any refusal answers
 //! with a typed `Response::Rejected` and leaves the running model in place.
 
+use embedded_hal_nb::nb;
 use embedded_storage::nor_flash::NorFlash;
 use fog_core::model::{ModelError, RbfModel, MAX_ENCODED_LEN};
 use fog_core::protocol::{
@@ -122,6 +123,30 @@ impl<F: NorFlash> UploadServer<F> {
         // Every response fits MAX_WIRE_FRAME_LEN (checked by the protocol tests).
         let len = encode_frame(&response, &mut self.tx).unwrap_or(0);
         Some(Reply { frame: &self.tx[..len], model_changed })
+    }
+
+    /// Drains every byte the UART has ready into the server and writes each response
+    /// back (blocking on a full TX FIFO). Returns `true` if the active model changed:
+    /// then call `load_active_model` and hand the model to the compensator.
+    /// This is the whole hook of the application's main loop.
+    pub fn poll_uart<U>(&mut self, uart: &mut U) -> bool
+    where
+        U: embedded_hal_nb::serial::Read<u8> + embedded_hal_nb::serial::Write<u8>,
+    {
+        let mut changed = false;
+        // A UART error (overrun, framing) loses bytes; the frame CRC catches the rest.
+        while let Ok(byte) = uart.read() {
+            if let Some(reply) = self.push_byte(byte) {
+                changed |= reply.model_changed;
+                for &b in reply.frame {
+                    if nb::block!(uart.write(b)).is_err() {
+                        break;
+                    }
+                }
+            }
+        }
+        let _ = nb::block!(uart.flush());
+        changed
     }
 
     /// Reads and decodes the active model from flash (`Ok(None)`: no model stored).

@@ -9,7 +9,9 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 /// The paper's chamber temperatures, degC.
-pub const PAPER_AMBIENTS_C: [f64; 11] = [-40.0, -30.0, -20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0];
+pub const PAPER_AMBIENTS_C: [f64; 11] = [
+    -40.0, -30.0, -20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0,
+];
 /// Power-ons per temperature in the paper (3 train, 2 validate).
 pub const PAPER_RUNS: usize = 5;
 /// Record length in the paper, min.
@@ -45,7 +47,10 @@ impl CampaignSpec {
             minutes: self.minutes,
             latitude_deg: self.latitude_deg,
             raw_rate_hz: self.raw_rate_hz,
-            ..RunSpec::paper(self.ambients_c[amb], derive_seed(self.seed, amb as u64, run as u64))
+            ..RunSpec::paper(
+                self.ambients_c[amb],
+                derive_seed(self.seed, amb as u64, run as u64),
+            )
         }
     }
 
@@ -53,13 +58,18 @@ impl CampaignSpec {
     pub fn file_name(&self, amb: usize, run: usize) -> String {
         let a = self.ambients_c[amb];
         let sign = if a < 0.0 { 'm' } else { 'p' };
-        format!("amb{amb:02}_{sign}{:03}c_run{}.csv", a.abs().round() as i64, run + 1)
+        format!(
+            "amb{amb:02}_{sign}{:03}c_run{}.csv",
+            a.abs().round() as i64,
+            run + 1
+        )
     }
 }
 
 /// A per-run seed from the campaign seed (SplitMix64 finaliser over the indices).
 pub fn derive_seed(seed: u64, a: u64, b: u64) -> u64 {
-    let mut z = seed ^ a.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ b.wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
+    let mut z =
+        seed ^ a.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ b.wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^ (z >> 31)
@@ -87,21 +97,34 @@ impl std::error::Error for CampaignError {}
 
 /// Simulates every run (in parallel over the available cores); the result is in file
 /// order: (file name, run).
-pub fn simulate_campaign(params: &GyroParams, spec: &CampaignSpec) -> Result<Vec<(String, Run)>, CampaignError> {
+pub fn simulate_campaign(
+    params: &GyroParams,
+    spec: &CampaignSpec,
+) -> Result<Vec<(String, Run)>, CampaignError> {
     if spec.ambients_c.is_empty() {
-        return Err(CampaignError::Spec("campaign: no ambient temperatures".into()));
+        return Err(CampaignError::Spec(
+            "campaign: no ambient temperatures".into(),
+        ));
     }
     if spec.runs_per_ambient == 0 {
-        return Err(CampaignError::Spec("campaign: runs per ambient must be >= 1".into()));
+        return Err(CampaignError::Spec(
+            "campaign: runs per ambient must be >= 1".into(),
+        ));
     }
-    let jobs: Vec<(usize, usize)> =
-        (0..spec.ambients_c.len()).flat_map(|a| (0..spec.runs_per_ambient).map(move |r| (a, r))).collect();
+    let jobs: Vec<(usize, usize)> = (0..spec.ambients_c.len())
+        .flat_map(|a| (0..spec.runs_per_ambient).map(move |r| (a, r)))
+        .collect();
     // Fail fast on a bad spec before spawning anything.
     spec.run_spec(0, 0).validate().map_err(CampaignError::Sim)?;
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(jobs.len());
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(jobs.len());
     let mut results: Vec<Option<Result<Run, SimError>>> = (0..jobs.len()).map(|_| None).collect();
     std::thread::scope(|s| {
-        let chunks: Vec<_> = results.chunks_mut(jobs.len().div_ceil(threads)).enumerate().collect();
+        let chunks: Vec<_> = results
+            .chunks_mut(jobs.len().div_ceil(threads))
+            .enumerate()
+            .collect();
         let size = jobs.len().div_ceil(threads);
         for (c, chunk) in chunks {
             let jobs = &jobs;
@@ -116,7 +139,9 @@ pub fn simulate_campaign(params: &GyroParams, spec: &CampaignSpec) -> Result<Vec
     jobs.iter()
         .zip(results)
         .map(|(&(a, r), res)| {
-            let mut run = res.expect("every slot is filled by its thread").map_err(CampaignError::Sim)?;
+            let mut run = res
+                .expect("every slot is filled by its thread")
+                .map_err(CampaignError::Sim)?;
             let name = spec.file_name(a, r);
             run.path = PathBuf::from(&name);
             run.set_meta("run", r + 1);

@@ -70,7 +70,12 @@ pub fn window_means(t_s: &[f64], y: &[f64], window_s: f64) -> (Vec<f64>, Vec<f64
 /// The run's nominal (settled) value: mean of the points after `SETTLED_AFTER_S`;
 /// a run too short for that uses its last half.
 pub fn settled_mean(t_s: &[f64], y: &[f64]) -> f64 {
-    let after: Vec<f64> = t_s.iter().zip(y).filter(|(t, _)| **t >= SETTLED_AFTER_S).map(|(_, v)| *v).collect();
+    let after: Vec<f64> = t_s
+        .iter()
+        .zip(y)
+        .filter(|(t, _)| **t >= SETTLED_AFTER_S)
+        .map(|(_, v)| *v)
+        .collect();
     if after.len() >= 2 {
         mean(&after)
     } else {
@@ -106,7 +111,10 @@ pub fn time_to_spec_s(t_s: &[f64], y: &[f64], spec_dph: f64) -> Option<f64> {
         if last_t < end - 1e-9 {
             continue; // incomplete window at the end of the record
         }
-        let dev: Vec<f64> = (i..t_s.len()).take_while(|&j| t_s[j] <= end + 1e-9).map(|j| y[j] - nominal).collect();
+        let dev: Vec<f64> = (i..t_s.len())
+            .take_while(|&j| t_s[j] <= end + 1e-9)
+            .map(|j| y[j] - nominal)
+            .collect();
         let rms = (dev.iter().map(|d| d * d).sum::<f64>() / dev.len() as f64).sqrt();
         if rms > spec_dph {
             return last_ok_start;
@@ -164,7 +172,11 @@ pub fn allan_deviation(y: &[f64], tau0_s: f64) -> Vec<AllanPoint> {
             })
             .sum();
         let avar = ss / (2.0 * tau * tau * terms as f64);
-        out.push(AllanPoint { tau_s: tau, adev_dph: avar.sqrt(), terms });
+        out.push(AllanPoint {
+            tau_s: tau,
+            adev_dph: avar.sqrt(),
+            terms,
+        });
         m *= 2;
     }
     out
@@ -175,7 +187,8 @@ pub fn allan_deviation(y: &[f64], tau0_s: f64) -> Vec<AllanPoint> {
 /// log-log slope to the next point lies within -0.5 +- 0.15 (quantisation, slope -1,
 /// comes before it; bias instability, slope 0, after it).
 pub fn arw_dpsh(adev: &[AllanPoint]) -> Option<f64> {
-    let slope = |a: &AllanPoint, b: &AllanPoint| (b.adev_dph / a.adev_dph).ln() / (b.tau_s / a.tau_s).ln();
+    let slope =
+        |a: &AllanPoint, b: &AllanPoint| (b.adev_dph / a.adev_dph).ln() / (b.tau_s / a.tau_s).ln();
     let mut picked: Vec<&AllanPoint> = Vec::new();
     for w in adev.windows(2) {
         let s = slope(&w[0], &w[1]);
@@ -189,7 +202,11 @@ pub fn arw_dpsh(adev: &[AllanPoint]) -> Option<f64> {
         return None;
     }
     // N = sigma(tau) * sqrt(tau in hours), averaged in log over the picked points.
-    let log_n = picked.iter().map(|p| (p.adev_dph * (p.tau_s / 3600.0).sqrt()).ln()).sum::<f64>() / picked.len() as f64;
+    let log_n = picked
+        .iter()
+        .map(|p| (p.adev_dph * (p.tau_s / 3600.0).sqrt()).ln())
+        .sum::<f64>()
+        / picked.len() as f64;
     Some(log_n.exp())
 }
 
@@ -197,7 +214,11 @@ pub fn arw_dpsh(adev: &[AllanPoint]) -> Option<f64> {
 /// differences) divided by 0.664 (IEEE Std 952 flicker-noise factor). If the curve is
 /// still falling at its end this is an upper bound.
 pub fn bias_instability_dph(adev: &[AllanPoint]) -> Option<f64> {
-    adev.iter().filter(|p| p.terms >= 8).map(|p| p.adev_dph).reduce(f64::min).map(|m| m / 0.664)
+    adev.iter()
+        .filter(|p| p.terms >= 8)
+        .map(|p| p.adev_dph)
+        .reduce(f64::min)
+        .map(|m| m / 0.664)
 }
 
 #[cfg(test)]
@@ -225,13 +246,19 @@ mod tests {
     fn time_to_spec_finds_the_end_of_the_excursion() {
         // 10 s means: 0.1 deg/h for the first 10 min, then exactly nominal.
         let t: Vec<f64> = (1..=270).map(|i| i as f64 * 10.0).collect();
-        let y: Vec<f64> = t.iter().map(|&t| if t <= 600.0 { 0.1 } else { 0.0 }).collect();
+        let y: Vec<f64> = t
+            .iter()
+            .map(|&t| if t <= 600.0 { 0.1 } else { 0.0 })
+            .collect();
         let tts = time_to_spec_s(&t, &y, 0.021).unwrap();
         // A window holding k excursion points has rms 0.1 sqrt(k/30) <= 0.021 for k <= 1.
         assert!((tts - 590.0).abs() < 1e-9, "{tts}");
         let flat = vec![0.0; 270];
         assert_eq!(time_to_spec_s(&t, &flat, 0.021), Some(0.0));
-        let late: Vec<f64> = t.iter().map(|&t| if t > 2600.0 { 1.0 } else { 0.0 }).collect();
+        let late: Vec<f64> = t
+            .iter()
+            .map(|&t| if t > 2600.0 { 1.0 } else { 0.0 })
+            .collect();
         assert_eq!(time_to_spec_s(&t, &late, 0.021), None);
         assert!((max_deviation(&t, &y) - 0.1).abs() < 1e-12);
     }

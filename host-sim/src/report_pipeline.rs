@@ -6,12 +6,12 @@
 use std::path::Path;
 
 use anyhow::{anyhow, bail, Context, Result};
-use fog_core::model::{RbfModel, MAX_ENCODED_LEN};
+use fog_core::model::{FeatureSpec, RbfModel, MAX_ENCODED_LEN};
 
 use crate::runs::Run;
 pub use crate::campaign::CampaignSpec;
 use crate::sim::GyroParams;
-use crate::train::{dataset_from_runs, default_specs, train_model, TrainConfig, TrainOutcome};
+use crate::train::{dataset_from_runs, train_model, TrainConfig, TrainOutcome};
 
 /// Reads and validates a fog-core model file (postcard, as written by `fogsim train`).
 pub fn read_model(path: &Path) -> Result<RbfModel> {
@@ -66,11 +66,11 @@ pub fn split_train_validate(campaign: &[CampaignRun], n_train: usize) -> (Vec<&C
     campaign.iter().partition(|r| r.index <= n_train)
 }
 
-/// Trains the default model (the paper's inputs T and dT/dt, OLS with the trainer's
-/// defaults: width by grouped validation, rho stop, at most 64 centres) on `runs`.
-pub fn train_default(runs: &[&Run], gyro_id: &str) -> Result<TrainOutcome> {
+/// Trains a model on `specs` (e.g. the paper's T and dT/dt, `train::default_specs`) with the
+/// trainer's defaults (OLS, width by grouped validation, rho stop, at most 64 centres).
+pub fn train_default(runs: &[&Run], specs: &[FeatureSpec], gyro_id: &str) -> Result<TrainOutcome> {
     let owned: Vec<Run> = runs.iter().map(|r| (*r).clone()).collect();
-    let ds = dataset_from_runs(&owned, &default_specs()).map_err(|e| anyhow!("training: {e}"))?;
+    let ds = dataset_from_runs(&owned, specs).map_err(|e| anyhow!("training: {e}"))?;
     let cfg = TrainConfig { gyro_id: gyro_id.chars().take(16).collect(), ..TrainConfig::default() };
     train_model(&ds, &cfg).map_err(|e| anyhow!("training: {e}")).context("training the default model")
 }

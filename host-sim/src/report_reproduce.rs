@@ -13,11 +13,12 @@ use crate::metrics::{self, SPEC_DPH};
 use crate::northseek::{build_report, run_monte_carlo, seek_table, MonteCarloConfig, PAPER_SEEK_DURATION_S};
 use crate::plots::{allan_chart, azimuth_scatter_chart, temperature_chart, write_svg, Series};
 use crate::report::{fmt_minutes, progress_bar, CompensateReport, DriftStats, NorthSeekReport, Table};
-use crate::report_compensation::pooled_stats;
+use crate::report_compensation::{pooled_stats, CompensatedSeries};
 use crate::report_pipeline::{simulate_campaign, split_train_validate, train_default, CampaignRun, CampaignSpec};
 use crate::runs::Run;
 use crate::sim::{GyroParams, RunSpec, SimGyro, StartState};
-use crate::train::TrainReport;
+use crate::train::{default_specs, TrainReport};
+use fog_core::model::{FeatureKind, FeatureSpec};
 
 /// Everything a reproduce run needs.
 #[derive(Clone, Debug)]
@@ -27,6 +28,13 @@ pub struct ReproduceOptions {
     pub n_train: usize,
     pub north_seek: MonteCarloConfig,
     pub plots: Option<PathBuf>,
+}
+
+/// The model inputs compared: the paper's (T, dT/dt) and this project's (T, dT/dt, d2T/dt2).
+pub fn input_variants() -> Vec<(&'static str, Vec<FeatureSpec>)> {
+    let mut extended = default_specs();
+    extended.push(FeatureSpec { kind: FeatureKind::TempAccelCps2, tau_s: 0.0 });
+    vec![("paper inputs (T, dT/dt)", default_specs()), ("extended inputs (T, dT/dt, d2T/dt2)", extended)]
 }
 
 /// Held-out figures of one ambient temperature (runs pooled).
@@ -63,7 +71,18 @@ pub struct Targets {
     pub seek_time_within_paper: bool,
 }
 
-/// `reproduce --json` / `demo` output.
+/// Everything measured with one choice of model inputs.
+#[derive(Clone, Debug, Serialize)]
+pub struct ModelResult {
+    pub label: String,
+    pub training: TrainReport,
+    pub per_ambient: Vec<AmbientResult>,
+    pub validation: CompensateReport,
+    pub north_seek: NorthSeekReport,
+    pub targets: Targets,
+}
+
+/// `reproduce --json` / `demo` output: one `ModelResult` per input variant (paper first).
 #[derive(Clone, Debug, Serialize)]
 pub struct ReproduceReport {
     pub ambients_c: Vec<f64>,
@@ -71,20 +90,17 @@ pub struct ReproduceReport {
     pub train_runs_per_ambient: usize,
     pub minutes: f64,
     pub seed: u64,
-    pub training: TrainReport,
-    pub per_ambient: Vec<AmbientResult>,
-    pub validation: CompensateReport,
-    pub north_seek: NorthSeekReport,
-    pub targets: Targets,
+    pub models: Vec<ModelResult>,
     pub paper_vs_us: Vec<Comparison>,
 }
 
 /// Runs the whole pipeline, printing progress to stderr.
 pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<ReproduceReport> {
     let plan = &opts.campaign;
-    let spinner = progress_bar(3, "campaign, training, validation");
+    let variants = input_variants();
+    let steps = progress_bar(1 + 2 * variants.len(), "campaign, training, validation");
     let campaign = simulate_campaign(params, plan)?;
-    spinner.inc(1);
+    steps.inc(1);
     let (train, heldout) = split_train_validate(&campaign, opts.n_train);
     if train.is_empty() || heldout.is_empty() {
         return Err(anyhow!(
@@ -94,15 +110,50 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
         ));
     }
     let train_runs: Vec<&Run> = train.iter().map(|c| &c.run).collect();
-    let trained = train_default(&train_runs, "sim")?;
-    spinner.inc(1);
     let heldout_runs: Vec<Run> = heldout.iter().map(|c| c.run.clone()).collect();
-    let (validation, series) = compensate_all(&heldout_runs, &trained.model)?;
-    spinner.inc(1);
-    spinner.finish_and_clear();
+    let mut fitted = Vec::new();
+    for (label, specs) in &variants {
+        let trained = train_default(&train_runs, specs, "sim")?;
+        steps.inc(1);
+        let (validation, series) = compensate_all(&heldout_runs, &trained.model)?;
+        steps.inc(1);
+        fitted.push((label.to_string(), trained, validation, series));
+    }
+    steps.finish_and_clear();
 
-    let per_ambient: Vec<AmbientResult> = plan
-        .ambients_c
+    let mut models = Vec::new();
+    for (k, (label, trained, validation, series)) in fitted.into_iter().enumerate() {
+        let per_ambient = per_ambient_results(&plan.ambients_c, &heldout, &series);
+        let bar = progress_bar(opts.north_seek.starts, &format!("north seek, model {}/{}", k + 1, variants.len()));
+        let outcomes = run_monte_carlo(params, &opts.north_seek, &trained.model, &|| bar.inc(1))?;
+        bar.finish_and_clear();
+        let source = format!("{label}, trained on runs 1-{} of every campaign temperature", opts.n_train);
+        let north_seek = build_report(params, &opts.north_seek, &outcomes, &source);
+        if let Some(dir) = &opts.plots {
+            let tag = if k == 0 { "" } else { "_extended" };
+            write_model_plots(dir, &heldout, &series, &north_seek, opts.north_seek.ambient_c, &label, tag)?;
+        }
+        let targets = measure_targets(&per_ambient, &north_seek);
+        models.push(ModelResult { label, training: trained.report, per_ambient, validation, north_seek, targets });
+    }
+    if let Some(dir) = &opts.plots {
+        write_campaign_plots(dir, params, &campaign)?;
+    }
+    let paper_vs_us = compare(&models, opts.north_seek.ambient_c);
+    Ok(ReproduceReport {
+        ambients_c: plan.ambients_c.clone(),
+        runs_per_ambient: plan.runs_per_ambient,
+        train_runs_per_ambient: opts.n_train,
+        minutes: plan.minutes,
+        seed: plan.seed,
+        models,
+        paper_vs_us,
+    })
+}
+
+/// Held-out figures per ambient, the runs of one temperature pooled.
+fn per_ambient_results(ambients_c: &[f64], heldout: &[&CampaignRun], series: &[CompensatedSeries]) -> Vec<AmbientResult> {
+    ambients_c
         .iter()
         .map(|&a| {
             let idx: Vec<usize> = (0..heldout.len()).filter(|&i| heldout[i].ambient_c == a).collect();
@@ -111,31 +162,7 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
                 idx.iter().map(|&i| (&series[i].after_t_s[..], &series[i].after_dph[..])).collect();
             AmbientResult { ambient_c: a, heldout_runs: idx.len(), before: pooled_stats(&before), after: pooled_stats(&after) }
         })
-        .collect();
-
-    let bar = progress_bar(opts.north_seek.starts, "north-seek cold starts");
-    let outcomes = run_monte_carlo(params, &opts.north_seek, &trained.model, &|| bar.inc(1))?;
-    bar.finish_and_clear();
-    let north_seek = build_report(params, &opts.north_seek, &outcomes, "trained on runs 1-3 of every campaign temperature");
-
-    if let Some(dir) = &opts.plots {
-        write_plots(dir, params, &campaign, &heldout, &series, &north_seek, opts.north_seek.ambient_c)?;
-    }
-    let targets = measure_targets(&per_ambient, &north_seek);
-    let paper_vs_us = compare(&per_ambient, &trained.report, &north_seek, opts.north_seek.ambient_c);
-    Ok(ReproduceReport {
-        ambients_c: plan.ambients_c.clone(),
-        runs_per_ambient: plan.runs_per_ambient,
-        train_runs_per_ambient: opts.n_train,
-        minutes: plan.minutes,
-        seed: plan.seed,
-        training: trained.report,
-        per_ambient,
-        validation,
-        north_seek,
-        targets,
-        paper_vs_us,
-    })
+        .collect()
 }
 
 fn measure_targets(per_ambient: &[AmbientResult], ns: &NorthSeekReport) -> Targets {
@@ -156,42 +183,39 @@ fn measure_targets(per_ambient: &[AmbientResult], ns: &NorthSeekReport) -> Targe
     }
 }
 
-fn compare(per_ambient: &[AmbientResult], training: &TrainReport, ns: &NorthSeekReport, room_c: f64) -> Vec<Comparison> {
-    let room = per_ambient.iter().find(|a| a.ambient_c == room_c).or_else(|| per_ambient.first());
-    let row = |q: &str, p: &str, us: String| Comparison { quantity: q.into(), paper: p.into(), this_project: us };
+fn compare(models: &[ModelResult], room_c: f64) -> Vec<Comparison> {
+    let row = |q: String, p: &str, us: Vec<String>| Comparison { quantity: q, paper: p.into(), this_project: us.join(" | ") };
     let f4 = |v: f64| format!("{v:.4}");
-    let mut out = Vec::new();
-    if let Some(r) = room {
-        let at = format!(" ({} degC, held out)", r.ambient_c);
-        out.push(row(&format!("uncompensated largest startup deviation, deg/h{at}"), "0.17", f4(r.before.max_dev_dph)));
-        out.push(row(&format!("uncompensated time until 10 s std within spec{at}"), "15 min", fmt_minutes(r.before.time_to_spec_s)));
-        out.push(row(&format!("compensated startup drift 1 sigma, deg/h{at}"), "0.020 / 0.021", f4(r.after.std_dph)));
-        out.push(row(&format!("compensated largest startup deviation, deg/h{at}"), "-", f4(r.after.max_dev_dph)));
-        out.push(row(&format!("compensated time until within spec{at}"), "~0", fmt_minutes(r.after.time_to_spec_s)));
-    }
-    let worst = per_ambient.iter().map(|a| a.after.std_dph).fold(0.0, f64::max);
-    out.push(row("worst held-out compensated 1 sigma over all ambients, deg/h", "(20 degC only)", f4(worst)));
-    out.push(row("neurons selected by OLS", "35 / 37", format!("{}", training.n_centers)));
-    out.push(row("north seek: seeks", "1 start x 6", format!("{} starts x {}", ns.starts, ns.seeks_per_start)));
-    out.push(row("north seek time per seek, s", "296", format!("{:.0}", ns.max_seek_duration_s)));
-    out.push(row(
-        "azimuth std over a start's seeks, uncompensated, deg",
-        "0.034",
-        f4(ns.uncompensated.mean_within_start_std_deg),
-    ));
-    out.push(row("azimuth std over a start's seeks, compensated, deg", "0.013", f4(ns.compensated.mean_within_start_std_deg)));
-    out.push(row("azimuth max - min of a start, uncompensated, deg", "0.097", f4(ns.uncompensated.mean_range_deg)));
-    out.push(row("azimuth max - min of a start, compensated, deg", "0.04", f4(ns.compensated.mean_range_deg)));
-    out.push(row("azimuth std over all seeks vs truth, uncompensated, deg", "-", f4(ns.uncompensated.std_deg)));
-    out.push(row("azimuth std over all seeks vs truth, compensated, deg", "-", f4(ns.compensated.std_deg)));
-    out.push(row("white-noise floor of the azimuth, deg", "-", f4(ns.noise_floor_deg)));
-    out
+    let each = |f: &dyn Fn(&ModelResult) -> String| -> Vec<String> { models.iter().map(f).collect() };
+    let room = |m: &ModelResult| -> AmbientResult {
+        m.per_ambient.iter().find(|a| a.ambient_c == room_c).or(m.per_ambient.first()).cloned().expect("at least one ambient")
+    };
+    let at = format!(" ({room_c} degC, held out)");
+    let ns = |m: &ModelResult| m.north_seek.clone();
+    vec![
+        row(format!("uncompensated largest startup deviation, deg/h{at}"), "0.17", each(&|m| f4(room(m).before.max_dev_dph))),
+        row(format!("uncompensated time until 10 s std within spec{at}"), "15 min", each(&|m| fmt_minutes(room(m).before.time_to_spec_s))),
+        row(format!("compensated startup drift 1 sigma, deg/h{at}"), "0.020 / 0.021", each(&|m| f4(room(m).after.std_dph))),
+        row(format!("compensated largest startup deviation, deg/h{at}"), "-", each(&|m| f4(room(m).after.max_dev_dph))),
+        row(format!("compensated time until within spec{at}"), "~0", each(&|m| fmt_minutes(room(m).after.time_to_spec_s))),
+        row("worst held-out compensated 1 sigma over all ambients, deg/h".into(), "(20 degC only)", each(&|m| f4(m.targets.worst_heldout_after_std_dph))),
+        row("neurons selected by OLS".into(), "35 / 37", each(&|m| m.training.n_centers.to_string())),
+        row("north seek: cold starts x seeks".into(), "1 x 6", each(&|m| format!("{} x {}", ns(m).starts, ns(m).seeks_per_start))),
+        row("north seek time per seek (longest), s".into(), "296", each(&|m| format!("{:.0}", ns(m).max_seek_duration_s))),
+        row("azimuth std over a start's 6 seeks, uncompensated, deg".into(), "0.034", each(&|m| f4(ns(m).uncompensated.mean_within_start_std_deg))),
+        row("azimuth std over a start's 6 seeks, compensated, deg".into(), "0.013", each(&|m| f4(ns(m).compensated.mean_within_start_std_deg))),
+        row("azimuth max - min of a start, uncompensated, deg".into(), "0.097", each(&|m| f4(ns(m).uncompensated.mean_range_deg))),
+        row("azimuth max - min of a start, compensated, deg".into(), "0.04", each(&|m| f4(ns(m).compensated.mean_range_deg))),
+        row("azimuth std of all seeks, uncompensated, deg".into(), "-", each(&|m| f4(ns(m).uncompensated.std_deg))),
+        row("azimuth std of all seeks, compensated, deg".into(), "-", each(&|m| f4(ns(m).compensated.std_deg))),
+        row("white-noise floor of the azimuth, deg".into(), "-", each(&|m| f4(ns(m).noise_floor_deg))),
+    ]
 }
 
-/// The human-readable summary: per-ambient table, seek table, paper vs us, targets.
-pub fn summary(r: &ReproduceReport) -> String {
+/// The human-readable summary of one model variant.
+fn model_summary(m: &ModelResult) -> String {
     let mut amb = Table::new(&["ambient", "held-out runs", "std before", "std after", "max dev before", "max dev after", "to spec before", "to spec after"]);
-    for a in &r.per_ambient {
+    for a in &m.per_ambient {
         amb.row(&[
             format!("{:+.0} degC", a.ambient_c),
             format!("{}", a.heldout_runs),
@@ -203,33 +227,24 @@ pub fn summary(r: &ReproduceReport) -> String {
             fmt_minutes(a.after.time_to_spec_s),
         ]);
     }
-    let mut cmp = Table::new(&["quantity", "paper", "this project"]);
-    for c in &r.paper_vs_us {
-        cmp.row(&[&c.quantity, &c.paper, &c.this_project]);
-    }
-    let t = &r.targets;
+    let t = &m.targets;
     let ok = |b: bool| if b { "MET" } else { "MISSED" };
     format!(
-        "campaign: {} temperatures x {} runs x {} min (seed {}), trained on runs 1-{} of each: {} centres, width {:.2}, \
-         cross-validated rms {:.4} deg/h\n\nheld-out drift of 10 s means, deg/h (spec {SPEC_DPH}):\n{}\n\
-         north seek at {} degC:\n{}\npaper vs this project:\n{}\ntargets:\n\
+        "=== {}: {} centres, width {:.2}, cross-validated rms {:.4} deg/h\n\
+         held-out drift of 10 s means, deg/h (spec {SPEC_DPH}):\n{}\nnorth seek at {} degC:\n{}\
+         targets:\n\
          - held-out compensated std <= {SPEC_DPH} deg/h at every ambient: worst {:.4} -> {}\n\
          - time to spec: worst before {}, worst after {}\n\
          - compensated azimuth std within 1.2x the noise floor: {:.2}x -> {}\n\
          - uncompensated / compensated std of seeks 1, 2: {}\n\
-         - seek time <= 296 s: {}\n",
-        r.ambients_c.len(),
-        r.runs_per_ambient,
-        r.minutes,
-        r.seed,
-        r.train_runs_per_ambient,
-        r.training.n_centers,
-        r.training.width,
-        r.training.heldout_rms_dph,
+         - seek time <= 296 s: {}\n\n",
+        m.label,
+        m.training.n_centers,
+        m.training.width,
+        m.training.heldout_rms_dph,
         amb.render(),
-        r.north_seek.ambient_c,
-        seek_table(&r.north_seek),
-        cmp.render(),
+        m.north_seek.ambient_c,
+        seek_table(&m.north_seek),
         t.worst_heldout_after_std_dph,
         ok(t.heldout_std_within_spec_everywhere),
         fmt_minutes(t.worst_time_to_spec_before_s),
@@ -238,6 +253,26 @@ pub fn summary(r: &ReproduceReport) -> String {
         ok(t.azimuth_within_1_2x_floor),
         t.first_seeks_uncomp_over_comp.iter().map(|v| format!("{v:.2}x")).collect::<Vec<_>>().join(", "),
         ok(t.seek_time_within_paper),
+    )
+}
+
+/// The human-readable summary: per model variant the per-ambient table, the seek table and
+/// the targets; then paper vs this project.
+pub fn summary(r: &ReproduceReport) -> String {
+    let mut cmp = Table::new(&["quantity", "paper", &r.models.iter().map(|m| m.label.as_str()).collect::<Vec<_>>().join(" | ")]);
+    for c in &r.paper_vs_us {
+        cmp.row(&[&c.quantity, &c.paper, &c.this_project]);
+    }
+    format!(
+        "campaign: {} temperatures x {} runs x {} min (seed {}); models trained on runs 1-{} of each temperature\n\n{}\
+         paper vs this project:\n{}",
+        r.ambients_c.len(),
+        r.runs_per_ambient,
+        r.minutes,
+        r.seed,
+        r.train_runs_per_ambient,
+        r.models.iter().map(model_summary).collect::<String>(),
+        cmp.render(),
     )
 }
 
@@ -257,17 +292,19 @@ fn steady_allan(params: &GyroParams, seed: u64) -> Result<(Vec<f64>, Vec<f64>, O
     Ok((adev.iter().map(|p| p.tau_s).collect(), adev.iter().map(|p| p.adev_dph).collect(), arw))
 }
 
-fn write_plots(
+/// Plots of one model variant: startup before/after at room temperature and the azimuths.
+fn write_model_plots(
     dir: &Path,
-    params: &GyroParams,
-    campaign: &[CampaignRun],
     heldout: &[&CampaignRun],
-    series: &[crate::report_compensation::CompensatedSeries],
+    series: &[CompensatedSeries],
     ns: &NorthSeekReport,
     room_c: f64,
+    label: &str,
+    tag: &str,
 ) -> Result<()> {
-    crate::report::ensure_dir(dir, "--plots")?;
-    // Fig. 4/5: held-out runs at room temperature.
+    let sub = dir.join(format!("model{tag}"));
+    let target = if tag.is_empty() { dir.to_path_buf() } else { sub };
+    crate::report::ensure_dir(&target, "--plots")?;
     let (room_runs, room_series): (Vec<Run>, Vec<_>) = heldout
         .iter()
         .zip(series)
@@ -275,16 +312,30 @@ fn write_plots(
         .map(|(c, s)| (c.run.clone(), s.clone()))
         .unzip();
     if !room_runs.is_empty() {
-        write_startup_plots(dir, &room_runs, &room_series, &format!(" ({room_c} degC, held-out runs)"))?;
+        write_startup_plots(&target, &room_runs, &room_series, &format!(" ({room_c} degC, held out, {label})"))?;
     }
-    // Temperature after power-on: first run of every ambient.
+    let pts = |az: &Vec<Vec<f64>>| -> Vec<(usize, f64)> {
+        az.iter().flat_map(|s| s.iter().enumerate().map(|(k, a)| (k + 1, *a))).collect()
+    };
+    let chart = azimuth_scatter_chart(
+        &format!("north seek after a cold start, {} starts x {} seeks ({label})", ns.starts, ns.seeks_per_start),
+        ns.true_azimuth_deg,
+        &pts(&ns.uncompensated.azimuths_deg),
+        &pts(&ns.compensated.azimuths_deg),
+    );
+    write_svg(&target.join("azimuth_scatter.svg"), &chart)?;
+    Ok(())
+}
+
+/// Plots of the campaign itself: coil temperature after power-on, Allan deviation.
+fn write_campaign_plots(dir: &Path, params: &GyroParams, campaign: &[CampaignRun]) -> Result<()> {
+    crate::report::ensure_dir(dir, "--plots")?;
     let temps: Vec<(String, Vec<f64>, Vec<f64>)> = campaign
         .iter()
         .filter(|c| c.index == 1)
         .map(|c| (format!("{:+.0} degC", c.ambient_c), c.run.t_s().to_vec(), c.run.temp_c().to_vec()))
         .collect();
     write_svg(&dir.join("temperature.svg"), &temperature_chart("gyro temperature after power-on", &temps))?;
-    // Allan deviation of a steady record with the ARW line.
     let (tau, adev, arw) = steady_allan(params, 7)?;
     let mut fits = Vec::new();
     if let Some(n) = arw {
@@ -292,21 +343,10 @@ fn write_plots(
         fits.push(Series::line(format!("ARW {n:.5} deg/sqrt(h) (slope -1/2)"), line, 1));
     }
     write_svg(&dir.join("allan.svg"), &allan_chart("Allan deviation, steady 2 h record (20 degC)", &tau, &adev, fits))?;
-    // Azimuth scatter of the Monte Carlo.
-    let pts = |az: &Vec<Vec<f64>>| -> Vec<(usize, f64)> {
-        az.iter().flat_map(|s| s.iter().enumerate().map(|(k, a)| (k + 1, *a))).collect()
-    };
-    let chart = azimuth_scatter_chart(
-        &format!("north seek after a cold start: {} starts x {} seeks", ns.starts, ns.seeks_per_start),
-        ns.true_azimuth_deg,
-        &pts(&ns.uncompensated.azimuths_deg),
-        &pts(&ns.compensated.azimuths_deg),
-    );
-    write_svg(&dir.join("azimuth_scatter.svg"), &chart)?;
     Ok(())
 }
 
-/// Prints the per-run validation table (used by `reproduce` for the full detail).
-pub fn validation_table(r: &ReproduceReport) -> String {
-    compensate_table(&r.validation)
+/// The per-run held-out tables of every model variant (`reproduce` prints them in full).
+pub fn validation_tables(r: &ReproduceReport) -> String {
+    r.models.iter().map(|m| format!("held-out runs, {}:\n{}\n", m.label, compensate_table(&m.validation))).collect()
 }

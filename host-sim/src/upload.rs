@@ -31,7 +31,12 @@ pub fn load_signing_key(path: &Path) -> anyhow::Result<KeyPair> {
     let seed = decode_hex::<32>(hex).with_context(|| {
         format!("{}: expected 64 hex digits (an Ed25519 seed), found {:?}", path.display(), hex)
     })?;
-    Ok(KeyPair::from_seed(Seed::new(seed)))
+    Ok(key_from_seed(seed))
+}
+
+/// The Ed25519 key pair of a 32-byte seed.
+pub fn key_from_seed(seed: [u8; 32]) -> KeyPair {
+    KeyPair::from_seed(Seed::new(seed))
 }
 
 fn decode_hex<const N: usize>(hex: &str) -> anyhow::Result<[u8; N]> {
@@ -116,6 +121,11 @@ impl<L: Read + Write> UploadClient<L> {
     /// Wraps a link; `timeout` bounds each request/response exchange.
     pub fn new(link: L, timeout: Duration) -> Self {
         Self { link, rx: FrameReceiver::new(), timeout }
+    }
+
+    /// The underlying link.
+    pub fn link_mut(&mut self) -> &mut L {
+        &mut self.link
     }
 
     /// Sends raw bytes (tests use this for garbage and hand-made frames).

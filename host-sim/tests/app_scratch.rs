@@ -1,29 +1,29 @@
 //! scratch (temporary)
 use fog_sim::northseek::*;
-use fog_sim::report_pipeline::*;
 use fog_sim::sim::GyroParams;
 
 #[test]
 fn scratch() {
-    let params = GyroParams::paper_default();
-    let plan = CampaignPlan { ambients_c: vec![20.0], runs_per_ambient: 3, ..CampaignPlan::paper(1) };
-    let campaign = simulate_campaign(&params, &plan, 2, &|| ()).unwrap();
-    let runs: Vec<_> = campaign.iter().map(|c| &c.run).collect();
-    let trained = train_default(&runs, "sim").unwrap();
-    println!("{:?}", trained.report.cross_validation.scan);
-    let mut p = GyroParams::paper_default();
-    p.noise.arw_dpsh = 0.0;
-    p.noise.bias_instability_dph = 0.0;
-    p.noise.rrw_dph_per_sqrt_h = 0.0;
-    p.noise.quantization_arcsec = 0.0;
-    p.drift.turn_on_bias_sigma_dph = 0.0;
-    p.variation.power_sigma_frac = 0.0;
-    p.variation.start_temp_sigma_c = 0.0;
-    let mut cfg = MonteCarloConfig::paper(1);
-    cfg.turntable.indexing_sigma_deg = 0.0;
-    let s = run_seeks(&p, &cfg, Some(&trained.model), 1).unwrap();
-    for o in &s { println!("drift only, compensated: {:.5} {:.1} {:.1}", azimuth_error_deg(o.azimuth_deg, cfg.true_azimuth_deg), o.t_start_s, o.duration_s); }
-    p.sensor.noise_c = 0.0;
-    let s = run_seeks(&p, &cfg, Some(&trained.model), 1).unwrap();
-    for o in &s { println!("drift only, no T noise, compensated: {:.5} {:.1} {:.1}", azimuth_error_deg(o.azimuth_deg, cfg.true_azimuth_deg), o.t_start_s, o.duration_s); }
+    for case in 0..5 {
+        let mut p = GyroParams::paper_default();
+        match case {
+            1 => p.noise.bias_instability_dph = 0.0,
+            2 => p.noise.rrw_dph_per_sqrt_h = 0.0,
+            3 => { p.noise.bias_instability_dph = 0.0; p.noise.rrw_dph_per_sqrt_h = 0.0; p.noise.quantization_arcsec = 0.0; }
+            4 => { p.noise.bias_instability_dph = 0.0; p.noise.rrw_dph_per_sqrt_h = 0.0; p.noise.quantization_arcsec = 0.0; p.turntable_dummy(); }
+            _ => {}
+        }
+        let mut cfg = MonteCarloConfig::paper(1);
+        cfg.starts = 24;
+        if case == 4 { cfg.turntable.indexing_sigma_deg = 0.0; }
+        let model = None;
+        let outs: Vec<_> = (0..cfg.starts).map(|i| run_seeks(&p, &cfg, model, cfg.start_seed(i)).unwrap()).collect();
+        let st = seek_stats(&outs, cfg.true_azimuth_deg);
+        let late: Vec<f64> = outs.iter().flat_map(|s| s[3..].iter().map(|o| azimuth_error_deg(o.azimuth_deg, cfg.true_azimuth_deg))).collect();
+        let m = late.iter().sum::<f64>() / late.len() as f64;
+        let sd = (late.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (late.len() - 1) as f64).sqrt();
+        println!("case {case}: per-seek rms {:?} late std {sd:.4} mean {m:.4}", st.per_seek_std_deg.iter().map(|v| format!("{v:.4}")).collect::<Vec<_>>());
+    }
 }
+trait Dummy { fn turntable_dummy(&mut self); }
+impl Dummy for GyroParams { fn turntable_dummy(&mut self) {} }

@@ -2,8 +2,9 @@
 //! name the right column and transform with positive held-out gain, and name nothing
 //! when nothing is planted, over several seeds (cases run in parallel threads).
 
-mod common;
-use common::planted::{campaign, Effect, Shape};
+#[path = "common/planted.rs"]
+mod planted;
+use planted::{campaign, Effect, Shape};
 use fog_sim::diagnose::diagnose;
 
 const SEEDS: [u64; 3] = [11, 22, 33];

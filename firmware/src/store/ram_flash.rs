@@ -14,8 +14,8 @@ use embedded_storage::nor_flash::{
 };
 
 /// Failure of a [`RamNorFlash`] operation.
+// No defmt::Format: embedded-storage's NorFlashErrorKind does not implement it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum RamFlashError {
     /// Misaligned or out of range (the `embedded-storage` kind).
     Bounds(NorFlashErrorKind),
@@ -35,6 +35,7 @@ impl NorFlashError for RamFlashError {
 }
 
 /// `N` bytes of NOR flash with `W`-byte words and `E`-byte erase pages.
+#[derive(Clone)]
 pub struct RamNorFlash<const N: usize, const W: usize, const E: usize> {
     mem: [u8; N],
     /// Word writes + page erases still allowed before the power cut (`None`: never cut).

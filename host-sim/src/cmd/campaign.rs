@@ -1,7 +1,9 @@
 //! `fogsim campaign`: simulate the paper's test campaign into a directory of fog-runs
 //! v1 files (one per power-on, 10 s means, Earth rate in `earth_dph`).
 
-use crate::campaign::{simulate_campaign, write_campaign, CampaignSpec, PAPER_AMBIENTS_C, PAPER_MINUTES, PAPER_RUNS};
+use crate::campaign::{
+    simulate_campaign, write_campaign, CampaignSpec, PAPER_AMBIENTS_C, PAPER_MINUTES, PAPER_RUNS,
+};
 use crate::sim::{GyroParams, DEFAULT_LATITUDE_DEG};
 use anyhow::bail;
 use std::path::PathBuf;
@@ -35,7 +37,10 @@ pub struct Args {
 impl Args {
     /// Checks the options and turns them into a campaign specification.
     pub fn to_spec(&self) -> anyhow::Result<CampaignSpec> {
-        let ambients = self.ambient.clone().unwrap_or_else(|| PAPER_AMBIENTS_C.to_vec());
+        let ambients = self
+            .ambient
+            .clone()
+            .unwrap_or_else(|| PAPER_AMBIENTS_C.to_vec());
         if ambients.is_empty() {
             bail!("--ambient: empty list");
         }
@@ -46,14 +51,22 @@ impl Args {
             bail!("--runs {}: must be within 1..=1000", self.runs);
         }
         if !(self.minutes.is_finite() && (10.0 / 60.0..=24.0 * 60.0).contains(&self.minutes)) {
-            bail!("--minutes {}: must be within 1/6 (one 10 s mean) ..= 1440", self.minutes);
+            bail!(
+                "--minutes {}: must be within 1/6 (one 10 s mean) ..= 1440",
+                self.minutes
+            );
         }
         if !(-90.0..=90.0).contains(&self.latitude) {
             bail!("--latitude {}: must be within -90..=90 deg", self.latitude);
         }
         let per_window = self.raw_rate_hz * 10.0;
-        if !(0.1..=20_000.0).contains(&self.raw_rate_hz) || (per_window - per_window.round()).abs() > 1e-9 {
-            bail!("--raw-rate-hz {}: must be within 0.1..=20000 Hz and give whole samples per 10 s", self.raw_rate_hz);
+        if !(0.1..=20_000.0).contains(&self.raw_rate_hz)
+            || (per_window - per_window.round()).abs() > 1e-9
+        {
+            bail!(
+                "--raw-rate-hz {}: must be within 0.1..=20000 Hz and give whole samples per 10 s",
+                self.raw_rate_hz
+            );
         }
         Ok(CampaignSpec {
             ambients_c: ambients,

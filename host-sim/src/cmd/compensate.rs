@@ -110,12 +110,12 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(p) = &args.json {
         check_output_path(p, "--json")?;
     }
-    let model = read_model(&args.model)?;
-    check_model_inputs(&model, &format!("--model {}", args.model.display()))?;
     let runs = read_runs(&args.runs).map_err(|e| anyhow::anyhow!("{e}"))?;
     if runs.is_empty() {
         bail!("no fog-runs files found in {:?}", args.runs);
     }
+    let model = read_model(&args.model)?;
+    check_model_inputs(&model, &format!("--model {}", args.model.display()))?;
     let (report, series) = compensate_all(&runs, &model)?;
     print!("{}", compensate_table(&report));
     if let Some(dir) = &args.plots {

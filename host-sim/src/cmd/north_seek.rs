@@ -94,7 +94,7 @@ pub fn run(args: Args) -> Result<()> {
             };
             let campaign = simulate_campaign(&params, &plan)?;
             let runs: Vec<_> = campaign.iter().map(|c| &c.run).collect();
-            let trained = train_default(&runs, "sim")?;
+            let trained = train_default(&runs, &crate::train::default_specs(), "sim")?;
             eprintln!(
                 "trained the default model on {} simulated {} degC runs (seed {}): {} centres, held-out rms {:.4} deg/h",
                 runs.len(),

@@ -9,7 +9,7 @@ use anyhow::{bail, Result};
 use crate::northseek::{default_threads, MonteCarloConfig};
 use crate::report::{check_output_path, write_json};
 use crate::report_pipeline::{validate_plan, CampaignSpec};
-use crate::report_reproduce::{reproduce, summary, validation_table, ReproduceOptions};
+use crate::report_reproduce::{reproduce, summary, validation_tables, ReproduceOptions};
 use crate::sim::GyroParams;
 
 /// Training runs per temperature (the paper's protocol).
@@ -78,7 +78,7 @@ pub fn run(args: Args) -> Result<()> {
     let campaign = CampaignSpec { ambients_c: args.ambient.clone(), runs_per_ambient: args.runs, minutes: args.minutes, ..CampaignSpec::paper(args.seed) };
     let opts = options(campaign, args.starts, args.threads, args.plots.clone())?;
     let report = reproduce(&GyroParams::paper_default(), &opts)?;
-    print!("held-out runs:\n{}\n{}", validation_table(&report), summary(&report));
+    print!("{}\n{}", validation_tables(&report), summary(&report));
     if let Some(p) = &args.json {
         write_json(p, &report)?;
     }

@@ -1,10 +1,121 @@
-//! `fogsim train` (to be written).
+//! `fogsim train RUNS... --out MODEL`: reads fog-runs files, trains the RBF drift model
+//! (OLS or Orr, width by grouped validation) and writes fog-core's postcard model, plus
+//! an optional JSON report. Everything is checked and encoded before any file is
+//! written, and files are written atomically, so a failure leaves no partial output.
+
+use crate::report::write_atomic;
+use crate::runs::read_runs;
+use crate::train::{dataset_from_runs, default_specs, train_model, Method, TrainConfig, TrainOutcome};
+use anyhow::Context;
+use fog_core::model::MAX_ENCODED_LEN;
+use std::path::PathBuf;
 
 /// Options of `fogsim train`.
 #[derive(clap::Args, Debug)]
-pub struct Args {}
+pub struct Args {
+    /// fog-runs files or directories of them (read in name order); one run per file.
+    #[arg(required = true)]
+    pub runs: Vec<PathBuf>,
+    /// Output model file (fog-core postcard encoding, CRC-protected).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Most RBF centres (1..=64).
+    #[arg(long, default_value_t = TrainConfig::default().max_centers)]
+    pub max_centers: usize,
+    /// OLS stop: selection ends when 1 - sum(err) < rho (0 < rho < 1).
+    #[arg(long, default_value_t = TrainConfig::default().rho)]
+    pub rho: f64,
+    /// Selection method: `ols` (Chen-Cowan-Grant) or `orr` (regularised, GCV stop).
+    #[arg(long, default_value = "ols", value_parser = parse_method)]
+    pub method: Method,
+    /// Gaussian widths (sigma, normalised input units) tried by grouped validation.
+    #[arg(long, value_delimiter = ',', default_values_t = TrainConfig::default().width_candidates)]
+    pub widths: Vec<f64>,
+    /// Folds of the grouped (whole runs held out) cross-validation.
+    #[arg(long, default_value_t = TrainConfig::default().folds)]
+    pub folds: usize,
+    /// Gyro id stored in the model (at most 16 bytes).
+    #[arg(long, default_value = "sim")]
+    pub gyro_id: String,
+    /// Write the training report as JSON here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+}
+
+fn parse_method(s: &str) -> Result<Method, String> {
+    match s {
+        "ols" => Ok(Method::Ols),
+        "orr" | "orr-gcv" => Ok(Method::OrrGcv),
+        _ => Err(format!("`{s}` is not a method (use `ols` or `orr`)")),
+    }
+}
+
+impl Args {
+    /// The training configuration these options ask for.
+    pub fn config(&self) -> TrainConfig {
+        TrainConfig {
+            method: self.method,
+            rho: self.rho,
+            max_centers: self.max_centers,
+            width_candidates: self.widths.clone(),
+            folds: self.folds,
+            gyro_id: self.gyro_id.clone(),
+            ..TrainConfig::default()
+        }
+    }
+}
 
 /// Runs the subcommand.
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("fogsim train: not implemented yet")
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let cfg = args.config();
+    let specs = default_specs();
+    // Options first: a bad option is reported before any file is read.
+    cfg.check(specs.len()).context("fogsim train")?;
+    let runs = read_runs(&args.runs)?;
+    let ds = dataset_from_runs(&runs, &specs)?;
+    let outcome = train_model(&ds, &cfg)?;
+    let mut buf = [0u8; MAX_ENCODED_LEN];
+    let len = outcome
+        .model
+        .encode(&mut buf)
+        .map_err(|e| anyhow::anyhow!("encoding the trained model: {e}"))?;
+    let json = match &args.json {
+        Some(_) => Some(serde_json::to_vec_pretty(&outcome.report)?),
+        None => None,
+    };
+    write_atomic(&args.out, &buf[..len]).with_context(|| format!("writing {}", args.out.display()))?;
+    if let (Some(path), Some(bytes)) = (&args.json, json) {
+        write_atomic(path, &bytes).with_context(|| format!("writing {}", path.display()))?;
+    }
+    print!("{}", summary(&outcome, runs.len(), len));
+    Ok(())
+}
+
+/// The human-readable summary printed after training.
+pub fn summary(outcome: &TrainOutcome, n_runs: usize, model_bytes: usize) -> String {
+    let r = &outcome.report;
+    let mut s = format!(
+        "trained {:?} on {} points from {} runs (inputs {})\n",
+        r.method,
+        r.n_train,
+        n_runs,
+        r.inputs.join(", ")
+    );
+    s += "width (sigma, normalised)  held-out rms dph  held-out std dph  centres (mean over folds)\n";
+    for w in &r.cross_validation.scan {
+        let mark = if w.width == r.width { " <- chosen" } else { "" };
+        s += &format!(
+            "{:>25.3}  {:>16.4}  {:>16.4}  {:>10.1}{mark}\n",
+            w.width, w.heldout_rms_dph, w.heldout_std_dph, w.mean_centers
+        );
+    }
+    s += &format!(
+        "final: {} centres (stop: {:?}), sum(err) = {:.4}, training rms {:.4} dph, held-out rms {:.4} dph\n",
+        r.n_centers, r.stop, r.err_sum, r.train_rms_dph, r.heldout_rms_dph
+    );
+    s += &format!(
+        "time: width selection {:.2} s, final fit {:.2} s; model {} bytes\n",
+        r.validation_s, r.final_fit_s, model_bytes
+    );
+    s
 }

@@ -157,6 +157,11 @@ impl Prepared {
         Self { cols: adj, y, grams, xty, ridge }
     }
 
+    /// Changes the relative ridge (the Gram matrices do not depend on it).
+    pub fn set_ridge(&mut self, ridge: f64) {
+        self.ridge = ridge;
+    }
+
     /// Number of design columns (including run dummies).
     pub fn width(&self) -> usize {
         self.cols.len()

@@ -12,7 +12,9 @@ use super::transforms::{local_derivative, RATE_HALF_S};
 /// Width factors tried (x mean centre spacing).
 pub const WIDTH_FACTORS: [f64; 3] = [0.5, 1.0, 2.0];
 /// Relative ridge values tried.
-pub const RIDGES: [f64; 2] = [1e-6, 1e-3];
+pub const RIDGES: [f64; 4] = [1e-6, 1e-4, 1e-2, 1e-1];
+/// Centre counts tried, as fractions of `centre_count`.
+pub const CENTRE_FRACTIONS: [f64; 3] = [0.3, 0.6, 1.0];
 
 /// The campaign stacked run after run.
 #[derive(Clone, Debug)]
@@ -56,17 +58,21 @@ pub fn centre_count(n: usize, inputs: usize) -> usize {
 
 /// Fits an RBF on `inputs` (plus `linear` columns) choosing width and ridge on held-out data.
 pub fn fit_rbf(folds: &Folds, inputs: &[Vec<f64>], linear: &[Vec<f64>], y: &[f64]) -> Result<RbfFit, DiagnoseError> {
-    let k = centre_count(y.len(), inputs.len());
+    let k_max = centre_count(y.len(), inputs.len());
     let mut best: Option<RbfFit> = None;
-    for wf in WIDTH_FACTORS {
-        let basis = RbfBasis::fit(inputs, k, wf);
-        let mut cols = basis.columns(inputs);
-        cols.extend(linear.iter().cloned());
-        for ridge in RIDGES {
-            let prepared = Prepared::new(folds, &cols, y, ridge);
-            let Ok(cv) = prepared.validate(folds) else { continue };
-            if best.as_ref().is_none_or(|b| cv.rms() < b.cv.rms()) {
-                best = Some(RbfFit { basis: basis.clone(), prepared, cv, centres: k, width_factor: wf, ridge });
+    for frac in CENTRE_FRACTIONS {
+        let k = ((k_max as f64 * frac).round() as usize).max(3);
+        for wf in WIDTH_FACTORS {
+            let basis = RbfBasis::fit(inputs, k, wf);
+            let mut cols = basis.columns(inputs);
+            cols.extend(linear.iter().cloned());
+            let mut prepared = Prepared::new(folds, &cols, y, RIDGES[0]);
+            for ridge in RIDGES {
+                prepared.set_ridge(ridge);
+                let Ok(cv) = prepared.validate(folds) else { continue };
+                if best.as_ref().is_none_or(|b| cv.rms() < b.cv.rms()) {
+                    best = Some(RbfFit { basis: basis.clone(), prepared: prepared.clone(), cv, centres: k, width_factor: wf, ridge });
+                }
             }
         }
     }

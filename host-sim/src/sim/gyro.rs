@@ -94,7 +94,8 @@ impl SimGyro {
             StartState::Restart { above_ambient_c } => spec.ambient_c + above_ambient_c,
             StartState::Warm => spec.ambient_c,
         };
-        let mut thermal = ThermalNet::new(&params.thermal, spec.ambient_c, power_scale, start_c, dt_s);
+        let mut thermal =
+            ThermalNet::new(&params.thermal, spec.ambient_c, power_scale, start_c, dt_s);
         if spec.start == StartState::Warm {
             thermal.settle();
         }
@@ -102,7 +103,11 @@ impl SimGyro {
         let noise = NoiseGen::new(&params.noise, dt_s, &mut rng_gyro);
         let mut gyro = Self {
             sensor_c: 0.0,
-            sensor_alpha: if params.sensor.lag_s > 0.0 { 1.0 - (-dt_s / params.sensor.lag_s).exp() } else { 1.0 },
+            sensor_alpha: if params.sensor.lag_s > 0.0 {
+                1.0 - (-dt_s / params.sensor.lag_s).exp()
+            } else {
+                1.0
+            },
             terms: vec![TermState::new(); params.extra_terms.len()],
             params: params.clone(),
             dt_s,
@@ -161,7 +166,9 @@ impl SimGyro {
     }
 
     fn table_angle_deg(&self, t_s: f64) -> f64 {
-        self.table.as_ref().map_or(0.0, |t| t.borrow().angle_deg(t_s))
+        self.table
+            .as_ref()
+            .map_or(0.0, |t| t.borrow().angle_deg(t_s))
     }
 
     /// Deterministic drift at the current thermal state, deg/h (without extra terms).
@@ -194,7 +201,10 @@ impl SimGyro {
             // Heading increases clockwise seen from above: a negative rotation about "up".
             (self.earth_vertical_dph, -(a1 - a0) / self.dt_s * 3600.0)
         } else {
-            (self.earth_horizontal_dph * azimuth_deg.to_radians().cos(), 0.0)
+            (
+                self.earth_horizontal_dph * azimuth_deg.to_radians().cos(),
+                0.0,
+            )
         };
 
         let inputs = TermInputs {
@@ -262,7 +272,10 @@ impl Gyro for SimGyro {
     type Error = Infallible;
     fn read(&mut self) -> Result<Option<GyroSample>, Infallible> {
         let s = self.next_sample();
-        Ok(Some(GyroSample { t_s: s.t_s, rate_dph: s.rate_dph as f32 }))
+        Ok(Some(GyroSample {
+            t_s: s.t_s,
+            rate_dph: s.rate_dph as f32,
+        }))
     }
 }
 
@@ -270,6 +283,9 @@ impl TemperatureSensor for SimGyro {
     type Error = Infallible;
     fn read_temp(&mut self) -> Result<TempSample, Infallible> {
         let temp_c = self.read_sensor_c() as f32;
-        Ok(TempSample { t_s: self.now_s(), temp_c })
+        Ok(TempSample {
+            t_s: self.now_s(),
+            temp_c,
+        })
     }
 }

@@ -15,7 +15,10 @@ pub mod turntable;
 
 pub use error::SimError;
 pub use gyro::{RawSample, SimGyro};
-pub use params::{DriftParams, GyroParams, NoiseParams, RunVariation, SensorParams, SensorPlacement, ThermalParams};
+pub use params::{
+    DriftParams, GyroParams, NoiseParams, RunVariation, SensorParams, SensorPlacement,
+    ThermalParams,
+};
 pub use run::{rig, simulate_run, MEAN_WINDOW_S};
 pub use spec::{RunSpec, StartState, DEFAULT_LATITUDE_DEG};
 pub use terms::{AuxSource, AuxTransform, DriftTerm};

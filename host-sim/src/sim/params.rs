@@ -149,9 +149,12 @@ impl GyroParams {
                 arw_dpsh: 0.0007,
                 bias_instability_dph: 0.002,
                 rrw_dph_per_sqrt_h: 0.001,
-                quantization_arcsec: 0.05,
+                quantization_arcsec: 0.01,
             },
-            variation: RunVariation { power_sigma_frac: 0.02, start_temp_sigma_c: 0.2 },
+            variation: RunVariation {
+                power_sigma_frac: 0.02,
+                start_temp_sigma_c: 0.2,
+            },
             extra_terms: Vec::new(),
         }
     }
@@ -159,11 +162,20 @@ impl GyroParams {
     /// Checks that every parameter is finite and physically possible.
     pub fn validate(&self) -> Result<(), SimError> {
         let t = &self.thermal;
-        positive("thermal.coil_heat_capacity_j_per_k", t.coil_heat_capacity_j_per_k)?;
-        positive("thermal.housing_heat_capacity_j_per_k", t.housing_heat_capacity_j_per_k)?;
+        positive(
+            "thermal.coil_heat_capacity_j_per_k",
+            t.coil_heat_capacity_j_per_k,
+        )?;
+        positive(
+            "thermal.housing_heat_capacity_j_per_k",
+            t.housing_heat_capacity_j_per_k,
+        )?;
         positive("thermal.coil_housing_w_per_k", t.coil_housing_w_per_k)?;
         positive("thermal.housing_ambient_w_per_k", t.housing_ambient_w_per_k)?;
-        finite("thermal.housing_ambient_tempco_per_k", t.housing_ambient_tempco_per_k)?;
+        finite(
+            "thermal.housing_ambient_tempco_per_k",
+            t.housing_ambient_tempco_per_k,
+        )?;
         non_negative("thermal.power_w", t.power_w)?;
         fraction("thermal.coil_power_fraction", t.coil_power_fraction)?;
         non_negative("thermal.tec_w_per_k", t.tec_w_per_k)?;
@@ -191,8 +203,14 @@ impl GyroParams {
         non_negative("noise.bias_instability_dph", n.bias_instability_dph)?;
         non_negative("noise.rrw_dph_per_sqrt_h", n.rrw_dph_per_sqrt_h)?;
         non_negative("noise.quantization_arcsec", n.quantization_arcsec)?;
-        non_negative("variation.power_sigma_frac", self.variation.power_sigma_frac)?;
-        non_negative("variation.start_temp_sigma_c", self.variation.start_temp_sigma_c)?;
+        non_negative(
+            "variation.power_sigma_frac",
+            self.variation.power_sigma_frac,
+        )?;
+        non_negative(
+            "variation.start_temp_sigma_c",
+            self.variation.start_temp_sigma_c,
+        )?;
         for term in &self.extra_terms {
             term.validate()?;
         }
@@ -210,7 +228,11 @@ pub(crate) fn finite(name: &'static str, v: f64) -> Result<(), SimError> {
     if v.is_finite() {
         Ok(())
     } else {
-        Err(SimError::BadParameter { name, value: v, why: "must be finite" })
+        Err(SimError::BadParameter {
+            name,
+            value: v,
+            why: "must be finite",
+        })
     }
 }
 
@@ -218,7 +240,11 @@ pub(crate) fn positive(name: &'static str, v: f64) -> Result<(), SimError> {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
-        Err(SimError::BadParameter { name, value: v, why: "must be > 0" })
+        Err(SimError::BadParameter {
+            name,
+            value: v,
+            why: "must be > 0",
+        })
     }
 }
 
@@ -226,7 +252,11 @@ pub(crate) fn non_negative(name: &'static str, v: f64) -> Result<(), SimError> {
     if v.is_finite() && v >= 0.0 {
         Ok(())
     } else {
-        Err(SimError::BadParameter { name, value: v, why: "must be >= 0" })
+        Err(SimError::BadParameter {
+            name,
+            value: v,
+            why: "must be >= 0",
+        })
     }
 }
 
@@ -234,6 +264,10 @@ fn fraction(name: &'static str, v: f64) -> Result<(), SimError> {
     if (0.0..=1.0).contains(&v) {
         Ok(())
     } else {
-        Err(SimError::BadParameter { name, value: v, why: "must be within 0..=1" })
+        Err(SimError::BadParameter {
+            name,
+            value: v,
+            why: "must be within 0..=1",
+        })
     }
 }

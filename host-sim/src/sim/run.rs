@@ -29,7 +29,11 @@ pub fn simulate_run(params: &GyroParams, spec: &RunSpec) -> Result<Run, SimError
     let per_window = per_window.round() as usize;
     let windows = (spec.minutes * 60.0 / MEAN_WINDOW_S).floor() as usize;
     if windows == 0 {
-        return Err(SimError::BadParameter { name: "run.minutes", value: spec.minutes, why: "must cover at least one 10 s window" });
+        return Err(SimError::BadParameter {
+            name: "run.minutes",
+            value: spec.minutes,
+            why: "must cover at least one 10 s window",
+        });
     }
     let sensor_every = ((params.sensor.sample_period_s * spec.raw_rate_hz).round() as usize).max(1);
     let aux: Vec<(String, usize)> = params
@@ -97,11 +101,22 @@ pub fn simulate_run(params: &GyroParams, spec: &RunSpec) -> Result<Run, SimError
         ("gyro".to_string(), "fog-sim paper_default".to_string()),
         ("latitude_deg".to_string(), spec.latitude_deg.to_string()),
         ("ambient_c".to_string(), spec.ambient_c.to_string()),
-        ("input_axis".to_string(), if spec.input_axis_vertical { "vertical" } else { "horizontal" }.to_string()),
+        (
+            "input_axis".to_string(),
+            if spec.input_axis_vertical {
+                "vertical"
+            } else {
+                "horizontal"
+            }
+            .to_string(),
+        ),
         ("raw_rate_hz".to_string(), spec.raw_rate_hz.to_string()),
         ("start".to_string(), start),
         ("seed".to_string(), spec.seed.to_string()),
-        ("simulator".to_string(), format!("fog-sim {}", env!("CARGO_PKG_VERSION"))),
+        (
+            "simulator".to_string(),
+            format!("fog-sim {}", env!("CARGO_PKG_VERSION")),
+        ),
     ];
     Run::new("", meta, columns).map_err(|_| SimError::BadParameter {
         name: "run",
@@ -113,7 +128,11 @@ pub fn simulate_run(params: &GyroParams, spec: &RunSpec) -> Result<Run, SimError
 /// A gyro mounted with its input axis on a turntable, sharing the table's clock.
 /// `spec.heading_deg` is the azimuth of the table's zero; the table starts at 0 deg.
 /// Time advances only as the gyro is read.
-pub fn rig(params: &GyroParams, spec: &RunSpec, table: TurntableParams) -> Result<(SimGyro, SimTurntable), SimError> {
+pub fn rig(
+    params: &GyroParams,
+    spec: &RunSpec,
+    table: TurntableParams,
+) -> Result<(SimGyro, SimTurntable), SimError> {
     table.validate()?;
     let mut gyro = SimGyro::new(params, spec)?;
     let table = SimTurntable::new(table, 0.0, stream_rng(spec.seed, STREAM_TABLE));

@@ -59,15 +59,27 @@ impl RunSpec {
     pub fn validate(&self) -> Result<(), SimError> {
         finite("run.ambient_c", self.ambient_c)?;
         if !(-60.0..=100.0).contains(&self.ambient_c) {
-            return Err(SimError::BadParameter { name: "run.ambient_c", value: self.ambient_c, why: "must be within -60..=100 degC" });
+            return Err(SimError::BadParameter {
+                name: "run.ambient_c",
+                value: self.ambient_c,
+                why: "must be within -60..=100 degC",
+            });
         }
         positive("run.minutes", self.minutes)?;
         if !(-90.0..=90.0).contains(&self.latitude_deg) {
-            return Err(SimError::BadParameter { name: "run.latitude_deg", value: self.latitude_deg, why: "must be within -90..=90 deg" });
+            return Err(SimError::BadParameter {
+                name: "run.latitude_deg",
+                value: self.latitude_deg,
+                why: "must be within -90..=90 deg",
+            });
         }
         finite("run.heading_deg", self.heading_deg)?;
         if !(0.1..=20_000.0).contains(&self.raw_rate_hz) {
-            return Err(SimError::BadParameter { name: "run.raw_rate_hz", value: self.raw_rate_hz, why: "must be within 0.1..=20000 Hz" });
+            return Err(SimError::BadParameter {
+                name: "run.raw_rate_hz",
+                value: self.raw_rate_hz,
+                why: "must be within 0.1..=20000 Hz",
+            });
         }
         if let StartState::Restart { above_ambient_c } = self.start {
             finite("run.start.above_ambient_c", above_ambient_c)?;

@@ -35,7 +35,9 @@ pub enum AuxTransform {
     /// d2/dt2, per s^2.
     Accel,
     /// First-order low-pass with time constant `tau_s`.
-    Lag { tau_s: f64 },
+    Lag {
+        tau_s: f64,
+    },
 }
 
 /// One extra drift term.
@@ -61,7 +63,12 @@ impl DriftTerm {
         match &self.source {
             AuxSource::PowerOnDecay { tau_s } => positive("term.decay.tau_s", *tau_s),
             AuxSource::Series { t_s, values } => {
-                let bad = |why| Err(SimError::BadSeries { term: self.label.clone(), why });
+                let bad = |why| {
+                    Err(SimError::BadSeries {
+                        term: self.label.clone(),
+                        why,
+                    })
+                };
                 if t_s.len() != values.len() {
                     return bad("has different lengths of t_s and values");
                 }
@@ -126,7 +133,11 @@ pub struct TermState {
 
 impl TermState {
     pub fn new() -> Self {
-        Self { prev_value: None, prev_rate: None, lag: None }
+        Self {
+            prev_value: None,
+            prev_rate: None,
+            lag: None,
+        }
     }
 
     /// The term's drift contribution, deg/h, after one step of `dt_s`.

@@ -23,7 +23,10 @@ fn mul(a: &Mat2, b: &Mat2) -> Mat2 {
 }
 
 fn apply(a: &Mat2, x: [f64; 2]) -> [f64; 2] {
-    [a[0][0] * x[0] + a[0][1] * x[1], a[1][0] * x[0] + a[1][1] * x[1]]
+    [
+        a[0][0] * x[0] + a[0][1] * x[1],
+        a[1][0] * x[0] + a[1][1] * x[1],
+    ]
 }
 
 /// The thermal state of one power-on and its exact stepper.
@@ -41,12 +44,27 @@ pub struct ThermalNet {
 impl ThermalNet {
     /// Sets up the network at `ambient_c` with the dissipation scaled by `power_scale`,
     /// both nodes starting at `start_c`, stepping by `dt_s`.
-    pub fn new(p: &ThermalParams, ambient_c: f64, power_scale: f64, start_c: f64, dt_s: f64) -> Self {
-        let g_ha = p.housing_ambient_w_per_k * (1.0 + p.housing_ambient_tempco_per_k * (ambient_c - 20.0)).max(0.1);
-        let power = (p.power_w + p.tec_w_per_k * (ambient_c - p.tec_setpoint_c).abs()) * power_scale;
-        let (cc, ch, g) = (p.coil_heat_capacity_j_per_k, p.housing_heat_capacity_j_per_k, p.coil_housing_w_per_k);
+    pub fn new(
+        p: &ThermalParams,
+        ambient_c: f64,
+        power_scale: f64,
+        start_c: f64,
+        dt_s: f64,
+    ) -> Self {
+        let g_ha = p.housing_ambient_w_per_k
+            * (1.0 + p.housing_ambient_tempco_per_k * (ambient_c - 20.0)).max(0.1);
+        let power =
+            (p.power_w + p.tec_w_per_k * (ambient_c - p.tec_setpoint_c).abs()) * power_scale;
+        let (cc, ch, g) = (
+            p.coil_heat_capacity_j_per_k,
+            p.housing_heat_capacity_j_per_k,
+            p.coil_housing_w_per_k,
+        );
         let a = [[-g / cc, g / cc], [g / ch, -(g + g_ha) / ch]];
-        let b = [power * p.coil_power_fraction / cc, (power * (1.0 - p.coil_power_fraction) + g_ha * ambient_c) / ch];
+        let b = [
+            power * p.coil_power_fraction / cc,
+            (power * (1.0 - p.coil_power_fraction) + g_ha * ambient_c) / ch,
+        ];
         // phi = sum (A dt)^n / n!, gamma = sum A^n dt^(n+1) / (n+1)!
         let mut phi = [[1.0, 0.0], [0.0, 1.0]];
         let mut gamma = [[dt_s, 0.0], [0.0, dt_s]];
@@ -68,7 +86,14 @@ impl ThermalNet {
                 break;
             }
         }
-        Self { a, b, phi, gamma, x: [start_c, start_c], ambient_c }
+        Self {
+            a,
+            b,
+            phi,
+            gamma,
+            x: [start_c, start_c],
+            ambient_c,
+        }
     }
 
     /// The powered-on equilibrium [coil, housing], degC.
@@ -76,7 +101,10 @@ impl ThermalNet {
         let a = &self.a;
         let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
         // x* = -A^-1 b
-        let inv = [[a[1][1] / det, -a[0][1] / det], [-a[1][0] / det, a[0][0] / det]];
+        let inv = [
+            [a[1][1] / det, -a[0][1] / det],
+            [-a[1][0] / det, a[0][0] / det],
+        ];
         let v = apply(&inv, self.b);
         [-v[0], -v[1]]
     }
@@ -137,12 +165,21 @@ mod tests {
             let r = fine.rates_cps();
             fine.x = [fine.x[0] + r[0] * 0.001, fine.x[1] + r[1] * 0.001];
         }
-        assert!((coarse.coil_c() - fine.coil_c()).abs() < 2e-3, "{} {}", coarse.coil_c(), fine.coil_c());
+        assert!(
+            (coarse.coil_c() - fine.coil_c()).abs() < 2e-3,
+            "{} {}",
+            coarse.coil_c(),
+            fine.coil_c()
+        );
         let ss = coarse.steady_state_c();
         for _ in 0..10_000 {
             coarse.step();
         }
         assert!((coarse.coil_c() - ss[0]).abs() < 1e-9 && coarse.rates_cps()[0].abs() < 1e-12);
-        assert!(ss[0] > 24.0 && ss[0] < 30.0, "coil warms by several degC: {}", ss[0]);
+        assert!(
+            ss[0] > 24.0 && ss[0] < 30.0,
+            "coil warms by several degC: {}",
+            ss[0]
+        );
     }
 }

@@ -30,7 +30,11 @@ pub struct TurntableParams {
 impl Default for TurntableParams {
     /// A precision indexing table: 20 deg/s, 2 s settling, 0.001 deg (3.6") indexing.
     fn default() -> Self {
-        Self { rate_dps: 20.0, settle_s: 2.0, indexing_sigma_deg: 0.001 }
+        Self {
+            rate_dps: 20.0,
+            settle_s: 2.0,
+            indexing_sigma_deg: 0.001,
+        }
     }
 }
 
@@ -56,7 +60,11 @@ struct Motion {
 
 impl Motion {
     fn angle_deg(&self, t_s: f64) -> f64 {
-        let f = if self.move_s > 0.0 { ((t_s - self.t0_s) / self.move_s).clamp(0.0, 1.0) } else { 1.0 };
+        let f = if self.move_s > 0.0 {
+            ((t_s - self.t0_s) / self.move_s).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
         self.start_deg + self.delta_deg * f
     }
 
@@ -109,7 +117,9 @@ pub enum TurntableError {
 impl fmt::Display for TurntableError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            TurntableError::NonFiniteHeading => write!(f, "turntable: commanded heading is not finite"),
+            TurntableError::NonFiniteHeading => {
+                write!(f, "turntable: commanded heading is not finite")
+            }
         }
     }
 }
@@ -127,7 +137,11 @@ pub struct SimTurntable {
 impl SimTurntable {
     /// A table at angle `initial_deg`, with its own random stream for indexing errors.
     pub(crate) fn new(params: TurntableParams, initial_deg: f64, rng: ChaCha8Rng) -> Self {
-        Self { params, shared: Rc::new(RefCell::new(TableShared::new(initial_deg))), rng }
+        Self {
+            params,
+            shared: Rc::new(RefCell::new(TableShared::new(initial_deg))),
+            rng,
+        }
     }
 
     /// The link the gyro needs to sense the table.
@@ -174,7 +188,9 @@ impl Turntable for SimTurntable {
     fn poll(&mut self) -> Result<TableState, Self::Error> {
         let s = self.shared.borrow();
         if s.now_s >= s.motion.settled_at_s() {
-            Ok(TableState::Settled { heading_deg: s.motion.commanded_deg })
+            Ok(TableState::Settled {
+                heading_deg: s.motion.commanded_deg,
+            })
         } else {
             Ok(TableState::Moving)
         }

@@ -5,7 +5,8 @@
 use super::dataset::Dataset;
 use super::error::{Result, TrainError};
 use crate::runs::Run;
-use fog_core::model::{FeatureKind, FeatureSpec};
+use fog_core::features::{features_for_series, FeatureVector};
+use fog_core::model::{FeatureKind, FeatureSpec, MAX_INPUTS};
 
 /// The paper's inputs: gyro temperature and its rate.
 pub fn default_specs() -> Vec<FeatureSpec> {
@@ -31,26 +32,47 @@ pub fn feature_name(spec: &FeatureSpec) -> String {
 }
 
 /// One group per run (in the given order); rows are the 10 s points at which fog-core's
-/// feature code yields every input.
+/// feature code has every input ready (rate estimators need a few rows first).
+/// Specs using aux channels need `dataset_from_runs_with_aux`.
 pub fn dataset_from_runs(runs: &[Run], specs: &[FeatureSpec]) -> Result<Dataset> {
-    let names = specs.iter().map(feature_name).collect();
+    dataset_from_runs_with_aux(runs, specs, &[])
+}
+
+/// As `dataset_from_runs`, with aux channel n of the specs read from column
+/// `aux_columns[n]` of every run.
+pub fn dataset_from_runs_with_aux(
+    runs: &[Run],
+    specs: &[FeatureSpec],
+    aux_columns: &[&str],
+) -> Result<Dataset> {
+    let names = specs.iter().map(|s| feature_name_with_aux(s, aux_columns)).collect();
     let mut ds = Dataset::with_specs(specs.to_vec(), names)?;
     for run in runs {
         let name = run.name();
+        let fail = |why: String| TrainError::Features { run: name.clone(), why };
+        let aux: Vec<Vec<f32>> = aux_columns
+            .iter()
+            .map(|&c| {
+                run.column(c)
+                    .map(|v| v.iter().map(|&x| x as f32).collect())
+                    .ok_or_else(|| TrainError::MissingColumn { run: name.clone(), column: c.to_string() })
+            })
+            .collect::<Result<_>>()?;
+        let aux_refs: Vec<&[f32]> = aux.iter().map(Vec::as_slice).collect();
+        let temp: Vec<f32> = run.temp_c().iter().map(|&x| x as f32).collect();
+        let mut vectors = vec![FeatureVector { values: [0.0; MAX_INPUTS], len: 0, ready: false }; run.len()];
+        features_for_series(specs, run.t_s(), &temp, &aux_refs, &mut vectors)
+            .map_err(|e| fail(e.to_string()))?;
         let drift = run.drift_dph();
-        let inputs = TEMP_inputs(run, specs).map_err(|why| TrainError::Features { run: name.clone(), why })?;
         let mut rows = Vec::new();
         let mut targets = Vec::new();
         let mut times = Vec::new();
-        for (i, row) in inputs.into_iter().enumerate() {
-            if let Some(row) = row {
-                rows.push(row);
-                targets.push(drift[i]);
-                times.push(run.t_s()[i]);
-            }
+        for (i, v) in vectors.iter().enumerate().filter(|(_, v)| v.ready) {
+            rows.push(v.as_slice().iter().map(|&x| f64::from(x)).collect());
+            targets.push(drift[i]);
+            times.push(run.t_s()[i]);
         }
-        ds.push_group(&name, &rows, &targets, &times)
-            .map_err(|e| TrainError::Features { run: name.clone(), why: e.to_string() })?;
+        ds.push_group(&name, &rows, &targets, &times).map_err(|e| fail(e.to_string()))?;
     }
     if ds.is_empty() {
         return Err(TrainError::EmptyDataset);
@@ -58,25 +80,14 @@ pub fn dataset_from_runs(runs: &[Run], specs: &[FeatureSpec]) -> Result<Dataset>
     Ok(ds)
 }
 
-#[allow(non_snake_case)]
-fn TEMP_inputs(run: &Run, specs: &[FeatureSpec]) -> std::result::Result<Vec<Option<Vec<f64>>>, String> {
-    let t = run.t_s();
-    let temp = run.temp_c();
-    Ok((0..run.len())
-        .map(|i| {
-            if i < 3 {
-                return None;
-            }
-            let slope = (temp[i] - temp[i - 3]) / (t[i] - t[i - 3]);
-            Some(
-                specs
-                    .iter()
-                    .map(|s| match s.kind {
-                        FeatureKind::TempC => temp[i],
-                        _ => slope,
-                    })
-                    .collect(),
-            )
-        })
-        .collect())
+/// `feature_name`, with aux channels named by their run column.
+pub fn feature_name_with_aux(spec: &FeatureSpec, aux_columns: &[&str]) -> String {
+    let col = |n: u8| aux_columns.get(n as usize).map_or_else(|| format!("aux{n}"), |c| c.to_string());
+    match spec.kind {
+        FeatureKind::AuxValue(n) => format!("{}:value", col(n)),
+        FeatureKind::AuxRate(n) => format!("{}:rate", col(n)),
+        FeatureKind::AuxCos(n) => format!("{}:cos", col(n)),
+        FeatureKind::AuxSin(n) => format!("{}:sin", col(n)),
+        _ => feature_name(spec),
+    }
 }

@@ -33,7 +33,9 @@ pub use config::{Method, TrainConfig};
 pub use dataset::Dataset;
 pub use design::GaussianDesign;
 pub use error::{Result, TrainError};
-pub use features::{dataset_from_runs, default_specs, feature_name};
+pub use features::{
+    dataset_from_runs, dataset_from_runs_with_aux, default_specs, feature_name, feature_name_with_aux,
+};
 pub use fit::{fit_width, Fit};
 pub use normalize::Normalizer;
 pub use path::StopReason;

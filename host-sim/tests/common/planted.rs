@@ -88,10 +88,10 @@ pub fn campaign(effect: Effect, seed: u64, shape: Shape) -> (Vec<Run>, Expected)
     let n = (shape.minutes * 6.0).round() as usize;
     let dt = 10.0;
     // Gyro and thermal parameters of this campaign.
-    let tau1 = rng.random_range(150.0..400.0);
-    let tau2 = rng.random_range(900.0..2400.0);
-    let amp1 = rng.random_range(2.0..5.0);
-    let amp2 = rng.random_range(2.0..6.0);
+    // Three thermal modes (source, coil, housing): with only two, d2T/dt2 would be an
+    // affine function of T and dT/dt and no data could tell them apart.
+    let taus = [rng.random_range(60.0..200.0), rng.random_range(300.0..800.0), rng.random_range(1500.0..4000.0)];
+    let amps = [rng.random_range(0.5..2.0), rng.random_range(2.0..5.0), rng.random_range(1.0..4.0)];
     let bias_per_c = rng.random_range(0.002..0.01) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
     let bias_per_c2 = rng.random_range(-2e-4..2e-4);
     let shupe = rng.random_range(4.0..10.0) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
@@ -117,9 +117,10 @@ pub fn campaign(effect: Effect, seed: u64, shape: Shape) -> (Vec<Run>, Expected)
     for r in 0..shape.runs {
         let ambient = ambients[r % ambients.len()] + g.sample(&mut rng) * 0.5;
         let gain = 1.0 + 0.004 * (ambient - 20.0);
-        let (a1, a2) = (amp1 * gain, amp2 * gain);
-        let warm = rng.random_bool(0.35);
-        let (x10, x20) = if warm { (a1 * rng.random_range(0.3..0.9), a2 * rng.random_range(0.3..0.9)) } else { (0.0, 0.0) };
+        // warm restart: the gyro ran to equilibrium, then was off for t_off
+        let t_off = if rng.random_bool(0.5) { rng.random_range(60.0..1800.0) } else { f64::INFINITY };
+        let a: Vec<f64> = amps.iter().map(|x| x * gain).collect();
+        let x0: Vec<f64> = a.iter().zip(&taus).map(|(ai, ti)| ai * (-t_off / ti).exp()).collect();
         let mut t = Vec::new();
         let mut temp_meas = Vec::new();
         let mut base = Vec::new();
@@ -130,11 +131,13 @@ pub fn campaign(effect: Effect, seed: u64, shape: Shape) -> (Vec<Run>, Expected)
         let step = if rng.random_bool(0.5) { 90.0 } else { 180.0 };
         for k in 0..n {
             let tc = (k as f64 + 0.5) * dt;
-            let e1 = (-tc / tau1).exp();
-            let e2 = (-tc / tau2).exp();
-            let temp = ambient + a1 + (x10 - a1) * e1 + a2 + (x20 - a2) * e2;
-            let rate = -(x10 - a1) / tau1 * e1 - (x20 - a2) / tau2 * e2;
-            let acc = (x10 - a1) / (tau1 * tau1) * e1 + (x20 - a2) / (tau2 * tau2) * e2;
+            let (mut temp, mut rate, mut acc) = (ambient, 0.0, 0.0);
+            for i in 0..3 {
+                let e = (-tc / taus[i]).exp();
+                temp += a[i] + (x0[i] - a[i]) * e;
+                rate -= (x0[i] - a[i]) / taus[i] * e;
+                acc += (x0[i] - a[i]) / (taus[i] * taus[i]) * e;
+            }
             // sensor: 1 Hz samples, noise, 0.0625 degC steps, averaged over the window
             let mut s = 0.0;
             for j in 0..10 {
@@ -150,8 +153,14 @@ pub fn campaign(effect: Effect, seed: u64, shape: Shape) -> (Vec<Run>, Expected)
             accel.push(acc);
             heading.push((psi0 + step * (tc / dwell).floor()).rem_euclid(360.0));
         }
-        let aux = (0..AUX_COLUMNS.len()).map(|_| wander(&mut rng, n, dt, rng.random_range(150.0..600.0), 1.0)).collect();
-        let decoys = (0..DECOY_COLUMNS.len()).map(|_| wander(&mut rng, n, dt, rng.random_range(300.0..1500.0), 1.0).0).collect();
+        let aux = (0..AUX_COLUMNS.len()).map(|_| {
+                let tau = rng.random_range(150.0..600.0);
+                wander(&mut rng, n, dt, tau, 1.0)
+            }).collect();
+        let decoys = (0..DECOY_COLUMNS.len()).map(|_| {
+                let tau = rng.random_range(300.0..1500.0);
+                wander(&mut rng, n, dt, tau, 1.0).0
+            }).collect();
         raws.push(Raw { t, temp_meas, base, accel, heading, aux, decoys, ambient });
     }
     // The planted effect, scaled to `sigmas` x sigma while present.

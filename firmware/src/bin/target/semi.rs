@@ -57,6 +57,14 @@ impl HostReader {
 #[derive(Debug)]
 pub struct HostIoError;
 
+impl core::fmt::Display for HostIoError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("semihosting read failed")
+    }
+}
+
+impl core::error::Error for HostIoError {}
+
 impl embedded_io::Error for HostIoError {
     fn kind(&self) -> embedded_io::ErrorKind {
         embedded_io::ErrorKind::Other

@@ -13,8 +13,8 @@ extern "C" {
 }
 
 fn bounds() -> (usize, usize) {
-    // SAFETY: linker symbols from cortex-m-rt; only their addresses are used.
-    unsafe { (addr_of!(_stack_end) as usize, addr_of!(_stack_start) as usize) }
+    // Linker symbols from cortex-m-rt; only their addresses are used.
+    (addr_of!(_stack_end) as usize, addr_of!(_stack_start) as usize)
 }
 
 /// Paint from the stack limit up to just below the current stack pointer.

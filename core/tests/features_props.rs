@@ -1,0 +1,234 @@
+//! Window averager against a naive mean, the least-squares rate estimator on quantised
+//! ramps (no spikes, documented delay), lags and the series helper.
+
+use fog_core::features::{
+    features_for_series, FeatureExtractor, FeatureVector, FirstOrderLag, TempRateEstimator,
+    WindowAverager, DEFAULT_RATE_SPAN_S,
+};
+use fog_core::model::{FeatureKind, FeatureSpec};
+use proptest::prelude::*;
+
+/// Sample times at `rate_hz` over `duration_s`, minus the samples inside `gaps`
+/// ((start, length) pairs), with a small per-sample jitter.
+fn sample_times(rate_hz: f64, duration_s: f64, gaps: &[(f64, f64)], phase: f64) -> Vec<f64> {
+    let n = (duration_s * rate_hz) as usize;
+    (0..n)
+        .map(|k| (k as f64 + phase) / rate_hz)
+        .filter(|t| !gaps.iter().any(|&(s, l)| *t >= s && *t < s + l))
+        .collect()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 40, failure_persistence: None, ..ProptestConfig::default() })]
+
+    #[test]
+    fn averager_equals_naive_mean(
+        rate_hz in prop_oneof![1.0f64..20.0, 20.0f64..10_000.0],
+        phase in 0.0f64..1.0,
+        gaps in prop::collection::vec((0.0f64..35.0, 0.0f64..12.0), 0..4),
+        seed in any::<u64>(),
+    ) {
+        let duration_s = 40.0;
+        let times = sample_times(rate_hz, duration_s, &gaps, phase);
+        let mut rng = fog_core::synthetic::SplitMix64::new(seed);
+        let values: Vec<f32> = times.iter().map(|_| (rng.range(-5.0, 5.0)) as f32).collect();
+        let mut avg = WindowAverager::new(10.0, rate_hz as f32).unwrap();
+        let mut closed = Vec::new();
+        for (&t, &v) in times.iter().zip(values.iter()) {
+            if let Some(w) = avg.push(t, v) {
+                closed.push(w);
+            }
+        }
+        if let Some(w) = avg.poll(duration_s) {
+            closed.push(w);
+        }
+        let period = 1.0 / rate_hz;
+        for w in &closed {
+            let inside: Vec<(f64, f32)> = times
+                .iter()
+                .zip(values.iter())
+                .filter(|(t, _)| **t >= w.t_start_s && **t < w.t_end_s)
+                .map(|(t, v)| (*t, *v))
+                .collect();
+            prop_assert_eq!(w.n_samples as usize, inside.len());
+            prop_assert_eq!(w.t_end_s - w.t_start_s, 10.0);
+            if inside.is_empty() {
+                prop_assert!(w.mean.is_nan());
+                prop_assert!(w.n_gaps >= 1);
+                continue;
+            }
+            let naive = inside.iter().map(|(_, v)| *v as f64).sum::<f64>() / inside.len() as f64;
+            prop_assert!((w.mean - naive).abs() <= 1e-12 * (1.0 + naive.abs()), "{} vs {}", w.mean, naive);
+            // Gaps: any interval (window start, samples, window end) longer than 1.5 periods.
+            let mut edges = vec![w.t_start_s];
+            edges.extend(inside.iter().map(|(t, _)| *t));
+            edges.push(w.t_end_s);
+            let naive_gaps = edges.windows(2).filter(|p| p[1] - p[0] > 1.5 * period).count();
+            prop_assert_eq!(w.n_gaps as usize, naive_gaps);
+            let naive_max = edges.windows(2).map(|p| p[1] - p[0]).fold(0.0, f64::max);
+            prop_assert!((w.max_gap_s as f64 - naive_max).abs() < 1e-4 * (1.0 + naive_max));
+            prop_assert_eq!(w.n_expected as f64, (10.0 * rate_hz).round());
+        }
+        // Every sample ended up in exactly one closed window.
+        let total: u32 = closed.iter().map(|w| w.n_samples).sum();
+        prop_assert_eq!(total as usize, times.len());
+    }
+
+    #[test]
+    fn quantised_ramp_has_no_rate_spikes(
+        slope in prop_oneof![-0.02f64..-1e-4, 1e-4f64..0.02],
+        t0_c in -40.0f64..60.0,
+        phase_c in 0.0f64..0.0625,
+    ) {
+        // 1 Hz sensor with 0.0625 degC steps: finite differences jump between 0 and 0.0625 degC/s.
+        let q = 0.0625;
+        let span = DEFAULT_RATE_SPAN_S;
+        let mut est: TempRateEstimator<128> = TempRateEstimator::new(span).unwrap();
+        let bound = 3.0 * q / span; // |LS slope of a bounded error e| <= q sum|tc| / sum tc^2 ~ 3q/S
+        let mut worst = 0.0f64;
+        for k in 0..900 {
+            let t = k as f64;
+            let temp = ((t0_c + phase_c + slope * t) / q).floor() * q;
+            if let Some(e) = est.push(t, temp) {
+                if e.full {
+                    worst = worst.max((e.rate_per_s - slope).abs());
+                }
+            }
+        }
+        prop_assert!(worst <= bound, "worst {} bound {}", worst, bound);
+        // A 1 s finite difference would jump by q / 1 s = 0.0625 degC/s: 20x more.
+        prop_assert!(worst * 20.0 <= q);
+    }
+}
+
+#[test]
+fn rate_delay_is_half_the_span_and_accel_is_exact() {
+    // T = a t^2: the LS slope over [t - S, t] is exactly 2 a (t - S/2): a delay of S/2.
+    let a = 1e-5;
+    let span = 120.0;
+    let mut est: TempRateEstimator<64> = TempRateEstimator::new(span).unwrap();
+    for k in 0..100 {
+        let t = 10.0 * k as f64;
+        let e = est.push(t, a * t * t);
+        if t >= span {
+            let e = e.unwrap();
+            assert!(e.full);
+            let expect = 2.0 * a * (t - span / 2.0);
+            assert!(
+                (e.rate_per_s - expect).abs() < 1e-12,
+                "{} {}",
+                e.rate_per_s,
+                expect
+            );
+            assert!((e.accel_per_s2.unwrap() - 2.0 * a).abs() < 1e-12);
+        }
+    }
+}
+
+#[test]
+fn rate_on_10s_means_tracks_1hz_rate() {
+    // The same estimator on 1 Hz samples and on their 10 s means gives the same slope for a
+    // ramp (the trainer sees means, the device may see either).
+    let slope = 0.004;
+    let mut raw: TempRateEstimator<128> = TempRateEstimator::new(60.0).unwrap();
+    let mut means: TempRateEstimator<32> = TempRateEstimator::new(60.0).unwrap();
+    let mut avg = WindowAverager::new(10.0, 1.0).unwrap();
+    let (mut r_raw, mut r_mean) = (0.0, 0.0);
+    for k in 0..600 {
+        let t = k as f64;
+        let temp = 20.0 + slope * t;
+        r_raw = raw.push(t, temp).map_or(0.0, |e| e.rate_per_s);
+        if let Some(w) = avg.push(t, temp as f32) {
+            r_mean = means.push(w.t_end_s, w.mean).map_or(0.0, |e| e.rate_per_s);
+        }
+    }
+    assert!((r_raw - slope).abs() < 1e-9);
+    assert!((r_mean - slope).abs() < 1e-6, "{r_mean}");
+}
+
+#[test]
+fn first_order_lag_matches_closed_form() {
+    let tau = 300.0;
+    let mut lag = FirstOrderLag::new(tau).unwrap();
+    lag.push(0.0, 0.0);
+    // Step to 1 held: y(t) = 1 - exp(-t/tau), exact at every sample whatever the spacing.
+    let mut t = 0.0;
+    for dt in [1.0, 10.0, 0.5, 100.0, 37.0] {
+        t += dt;
+        let y = lag.push(t, 1.0);
+        assert!((y - (1.0 - (-t / tau).exp())).abs() < 1e-12);
+    }
+    assert!(FirstOrderLag::new(0.0).is_err());
+}
+
+#[test]
+fn series_helper_equals_the_device_extractor() {
+    let specs = [
+        FeatureSpec {
+            kind: FeatureKind::TempC,
+            tau_s: 0.0,
+        },
+        FeatureSpec {
+            kind: FeatureKind::TempRateCps,
+            tau_s: 0.0,
+        },
+        FeatureSpec {
+            kind: FeatureKind::TempLagC,
+            tau_s: 200.0,
+        },
+        FeatureSpec {
+            kind: FeatureKind::AuxCos(0),
+            tau_s: 0.0,
+        },
+    ];
+    let n = 100;
+    let t: Vec<f64> = (1..=n).map(|k| 10.0 * k as f64).collect();
+    let temp: Vec<f32> = t
+        .iter()
+        .map(|t| 20.0 + 8.0 * (1.0 - (-t / 600.0).exp()) as f32)
+        .collect();
+    let heading: Vec<f32> = t.iter().map(|t| (t / 10.0 % 360.0) as f32).collect();
+    let mut out = vec![
+        FeatureVector {
+            values: [0.0; 4],
+            len: 0,
+            ready: false
+        };
+        n
+    ];
+    features_for_series(&specs, &t, &temp, &[&heading], &mut out).unwrap();
+    let mut fx = FeatureExtractor::new(&specs).unwrap();
+    for k in 0..n {
+        let v = fx.push(t[k], temp[k], &[heading[k]]).unwrap();
+        assert_eq!(v, out[k]);
+    }
+    assert!(!out[0].ready, "no rate from one point");
+    assert!(out[1..].iter().all(|v| v.ready));
+    // Rate of the exponential warm-up at the middle of the 60 s span (delay 30 s).
+    let k = 50;
+    let expect = 8.0 / 600.0 * (-(t[k] - 30.0) / 600.0).exp();
+    assert!((out[k].values[1] as f64 - expect).abs() < 2e-6 * 8.0 / 600.0 * 100.0);
+    // Errors: mismatched lengths, missing aux channel, time going backwards.
+    assert!(features_for_series(&specs, &t, &temp[..10], &[&heading], &mut out).is_err());
+    assert!(features_for_series(&specs, &t, &temp, &[], &mut out).is_err());
+    let mut t_bad = t.clone();
+    t_bad[5] = t_bad[4];
+    assert!(features_for_series(&specs, &t_bad, &temp, &[&heading], &mut out).is_err());
+}
+
+#[test]
+fn accel_feature_needs_three_rows() {
+    let specs = [FeatureSpec {
+        kind: FeatureKind::TempAccelCps2,
+        tau_s: 0.0,
+    }];
+    let mut fx = FeatureExtractor::new(&specs).unwrap();
+    let r: Vec<bool> = (1..=4)
+        .map(|k| {
+            fx.push(10.0 * k as f64, 20.0 + 0.001 * (k * k) as f32, &[])
+                .unwrap()
+                .ready
+        })
+        .collect();
+    assert_eq!(r, [false, false, true, true]);
+}

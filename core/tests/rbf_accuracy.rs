@@ -1,0 +1,276 @@
+//! Evaluation paths against each other: f32 vs the f64 reference, fixed point vs f32,
+//! and the fixed-point worst error over a realistic model's input range.
+
+use fog_core::fixed::{exp_neg_q30, f32_to_fixed, fixed_to_f32, FixedModel};
+use fog_core::model::{FeatureKind, FeatureSpec, RbfModel, TrainingMeta, MAX_INPUTS};
+use fog_core::rbf::{predict_f32, predict_f64, RbfError};
+use fog_core::synthetic::{random_warmup_point, warmup_model, SplitMix64};
+use proptest::prelude::*;
+
+/// A model from proptest-chosen parameters, already in normalised space.
+fn model_from(
+    n_inputs: usize,
+    centers: &[([f32; 4], f32, f32)],
+    offset: f32,
+    scale: f32,
+    bias: f32,
+    linear: f32,
+) -> RbfModel {
+    let mut m = RbfModel {
+        n_rbf_inputs: n_inputs as u8,
+        inputs: heapless::Vec::new(),
+        input_offset: heapless::Vec::new(),
+        input_scale: heapless::Vec::new(),
+        input_min: heapless::Vec::new(),
+        input_max: heapless::Vec::new(),
+        linear: heapless::Vec::new(),
+        centers: heapless::Vec::new(),
+        widths: heapless::Vec::new(),
+        weights: heapless::Vec::new(),
+        bias_dph: bias,
+        meta: TrainingMeta {
+            gyro_id: heapless::String::new(),
+            heldout_rms_dph: 0.0,
+            n_train: 0,
+        },
+    };
+    for j in 0..n_inputs {
+        m.inputs
+            .push(FeatureSpec {
+                kind: FeatureKind::AuxValue(j as u8),
+                tau_s: 0.0,
+            })
+            .unwrap();
+        m.input_offset.push(offset * (j + 1) as f32).unwrap();
+        m.input_scale.push(scale).unwrap();
+        m.input_min
+            .push(offset * (j + 1) as f32 - 3.0 * scale)
+            .unwrap();
+        m.input_max
+            .push(offset * (j + 1) as f32 + 3.0 * scale)
+            .unwrap();
+        m.linear.push(linear).unwrap();
+    }
+    for &(c, s, w) in centers {
+        m.centers.push(c).unwrap();
+        m.widths.push(s).unwrap();
+        m.weights.push(w).unwrap();
+    }
+    m.validate().unwrap();
+    m
+}
+
+/// Error scale of one evaluation: every term's magnitude, so the tolerance is relative
+/// to what is summed (cancellation cannot hide in it).
+fn magnitude(m: &RbfModel, x: &[f64]) -> f64 {
+    let n = m.inputs.len();
+    let xn: Vec<f64> = (0..n)
+        .map(|j| (x[j] - m.input_offset[j] as f64) / m.input_scale[j] as f64)
+        .collect();
+    let mut s = (m.bias_dph as f64).abs();
+    for j in 0..n {
+        s += (m.linear[j] as f64 * xn[j]).abs();
+    }
+    for (c, (&w, &sig)) in m.centers.iter().zip(m.weights.iter().zip(m.widths.iter())) {
+        let d2: f64 = (0..m.n_rbf_inputs as usize)
+            .map(|j| (xn[j] - c[j] as f64).powi(2))
+            .sum();
+        let u = d2 / (2.0 * sig as f64 * sig as f64);
+        // Gaussian term and the sensitivity of exp(-u) to rounding of u.
+        s += (w as f64).abs() * (1.0 + u) * (-u).exp().max(1e-3);
+    }
+    s
+}
+
+fn centers_strategy() -> impl Strategy<Value = Vec<([f32; 4], f32, f32)>> {
+    prop::collection::vec(
+        (
+            prop::array::uniform4(-2.0f32..2.0),
+            0.05f32..3.0,
+            -20.0f32..20.0,
+        ),
+        0..=64,
+    )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 300, failure_persistence: None, ..ProptestConfig::default() })]
+
+    #[test]
+    fn f32_matches_f64_reference(
+        n_inputs in 1usize..=4,
+        centers in centers_strategy(),
+        offset in -50.0f32..50.0,
+        scale in 0.001f32..100.0,
+        bias in -1.0f32..1.0,
+        linear in -1.0f32..1.0,
+        xn in prop::array::uniform4(-3.0f64..3.0),
+    ) {
+        let m = model_from(n_inputs, &centers, offset, scale, bias, linear);
+        // Raw inputs as f32 (what the device has), evaluated by both paths.
+        let x32: Vec<f32> = (0..n_inputs)
+            .map(|j| (m.input_offset[j] as f64 + xn[j] * m.input_scale[j] as f64) as f32)
+            .collect();
+        let x64: Vec<f64> = x32.iter().map(|&v| v as f64).collect();
+        let f = predict_f32(&m, &x32).unwrap() as f64;
+        let r = predict_f64(&m, &x64).unwrap();
+        // f32 rounding: ~1e-7 relative per operation; normalisation of an input that is large
+        // against its scale adds |x| ulp / scale.
+        let cond: f64 = (0..n_inputs)
+            .map(|j| 1.0 + (x64[j].abs() + (m.input_offset[j] as f64).abs()) / m.input_scale[j] as f64)
+            .fold(1.0, f64::max);
+        let tol = 2e-6 * magnitude(&m, &x64) * cond;
+        prop_assert!((f - r).abs() <= tol, "f32 {f} f64 {r} tol {tol}");
+    }
+
+    #[test]
+    fn fixed_matches_f32(
+        n_inputs in 1usize..=4,
+        centers in centers_strategy(),
+        offset in -50.0f32..50.0,
+        scale in 0.001f32..100.0,
+        bias in -1.0f32..1.0,
+        linear in -1.0f32..1.0,
+        xn in prop::array::uniform4(-3.0f64..3.0),
+    ) {
+        let m = model_from(n_inputs, &centers, offset, scale, bias, linear);
+        let fx = FixedModel::from_model(&m).unwrap();
+        let x32: Vec<f32> = (0..n_inputs)
+            .map(|j| (m.input_offset[j] as f64 + xn[j] * m.input_scale[j] as f64) as f32)
+            .collect();
+        let x64: Vec<f64> = x32.iter().map(|&v| v as f64).collect();
+        let q = fx.predict(&x32).unwrap() as f64;
+        let f = predict_f32(&m, &x32).unwrap() as f64;
+        let r = predict_f64(&m, &x64).unwrap();
+        let cond: f64 = (0..n_inputs)
+            .map(|j| 1.0 + (x64[j].abs() + (m.input_offset[j] as f64).abs()) / m.input_scale[j] as f64)
+            .fold(1.0, f64::max);
+        let tol = 2e-6 * magnitude(&m, &x64) * cond;
+        prop_assert!((q - f).abs() <= 2.0 * tol, "fixed {q} f32 {f} tol {tol}");
+        prop_assert!((q - r).abs() <= tol, "fixed {q} f64 {r} tol {tol}");
+    }
+
+    #[test]
+    fn fixed_boundary_conversions_are_exact(v in -1.0e6f64..1.0e6, frac in 0i32..40) {
+        let x = v as f32;
+        let q = f32_to_fixed(x, frac).unwrap();
+        // Truncation toward zero to `frac` bits.
+        let expect = ((x as f64) * 2f64.powi(frac)).trunc();
+        if expect.abs() < 2f64.powi(41) {
+            prop_assert_eq!(q as f64, expect);
+        }
+        let back = fixed_to_f32(q, frac as u32);
+        prop_assert_eq!(back, (q as f64 / 2f64.powi(frac)) as f32);
+    }
+}
+
+#[test]
+fn exp_kernel_is_within_3e_9_of_exp() {
+    let mut worst = 0.0f64;
+    for k in 0..2_000_000u64 {
+        let u_q28 = k * (23u64 << 28) / 2_000_000;
+        let e = exp_neg_q30(u_q28) as f64 / (1u64 << 30) as f64;
+        let r = (-(u_q28 as f64) / (1u64 << 28) as f64).exp();
+        worst = worst.max((e - r).abs());
+    }
+    println!("exp_neg_q30 worst abs error {worst:.3e}");
+    // Q.30 resolution is 9.3e-10; table, polynomial and truncations add a few LSB.
+    assert!(worst < 3e-9, "{worst:e}");
+    assert_eq!(exp_neg_q30(0), 1 << 30);
+    assert_eq!(exp_neg_q30(23 << 28), 0);
+}
+
+/// Worst |fixed - f64 reference| over a grid of the model's whole input box and over points
+/// on the warm-up trajectories it was built from.
+fn fixed_worst_error(m: &RbfModel) -> f64 {
+    let fx = FixedModel::from_model(m).unwrap();
+    let n = m.inputs.len();
+    let mut worst = 0.0f64;
+    let mut check = |x64: &[f64]| {
+        let x32: Vec<f32> = x64.iter().map(|&v| v as f32).collect();
+        let x64: Vec<f64> = x32.iter().map(|&v| v as f64).collect();
+        let q = fx.predict(&x32).unwrap() as f64;
+        let r = predict_f64(m, &x64).unwrap();
+        worst = worst.max((q - r).abs());
+    };
+    let steps = 300usize;
+    for a in 0..=steps {
+        for b in 0..=steps {
+            let mut x = [0.0f64; MAX_INPUTS];
+            for (j, xj) in x.iter_mut().enumerate().take(n) {
+                let t = if j % 2 == 0 { a } else { b } as f64 / steps as f64;
+                *xj = m.input_min[j] as f64 + t * (m.input_max[j] - m.input_min[j]) as f64;
+            }
+            check(&x[..n]);
+        }
+    }
+    let mut rng = SplitMix64::new(1234);
+    for _ in 0..100_000 {
+        let x = random_warmup_point(&mut rng);
+        check(&x[..n]);
+    }
+    worst
+}
+
+#[test]
+fn fixed_worst_error_35_centres_meets_1e_3_dph() {
+    for (inputs, weight) in [(2, 2.0f32), (2, 50.0), (4, 2.0)] {
+        let m = warmup_model(35, inputs, weight, 2013);
+        let worst = fixed_worst_error(&m);
+        println!("35 centres, {inputs} inputs, weights +-{weight} deg/h: worst |fixed - f64| = {worst:.3e} deg/h");
+        assert!(worst <= 1e-3, "{worst:e}");
+    }
+}
+
+#[test]
+fn fixed_worst_error_64_centres_meets_1e_3_dph() {
+    let m = warmup_model(64, 4, 2.0, 64);
+    let worst = fixed_worst_error(&m);
+    println!("64 centres, 4 inputs: worst |fixed - f64| = {worst:.3e} deg/h");
+    assert!(worst <= 1e-3, "{worst:e}");
+}
+
+#[test]
+fn bad_inputs_are_errors() {
+    let m = warmup_model(35, 2, 2.0, 1);
+    let fx = FixedModel::from_model(&m).unwrap();
+    assert_eq!(
+        predict_f32(&m, &[20.0]),
+        Err(RbfError::WrongInputCount {
+            expected: 2,
+            got: 1
+        })
+    );
+    assert_eq!(
+        predict_f32(&m, &[20.0, f32::NAN]),
+        Err(RbfError::NonFiniteInput { index: 1 })
+    );
+    assert_eq!(
+        fx.predict(&[f32::INFINITY, 0.0]),
+        Err(RbfError::NonFiniteInput { index: 0 })
+    );
+    assert_eq!(
+        fx.predict(&[1.0, 2.0, 3.0]),
+        Err(RbfError::WrongInputCount {
+            expected: 2,
+            got: 3
+        })
+    );
+    // Far outside the range: saturates, stays finite, no panic.
+    let v = fx.predict(&[1e30, -1e30]).unwrap();
+    assert!(v.is_finite());
+}
+
+#[test]
+fn q16_output_agrees_with_f32_output() {
+    let m = warmup_model(35, 2, 2.0, 9);
+    let fx = FixedModel::from_model(&m).unwrap();
+    let mut rng = SplitMix64::new(5);
+    for _ in 0..1000 {
+        let x = random_warmup_point(&mut rng);
+        let x32 = [x[0] as f32, x[1] as f32];
+        let a = fx.predict(&x32).unwrap() as f64;
+        let b = fx.predict_q16(&x32).unwrap() as f64 / 65536.0;
+        assert!((a - b).abs() <= 1.0 / 65536.0, "{a} {b}");
+    }
+}

@@ -1,0 +1,52 @@
+//! Shared helpers of the `app_*` tests: run the `fogsim` binary, make a scratch directory,
+//! and write a small simulated campaign plus a model trained on it.
+
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use fog_sim::report_pipeline::{simulate_campaign, train_default, CampaignSpec};
+use fog_sim::runs::write_run;
+use fog_sim::sim::GyroParams;
+
+/// Runs `fogsim` with `args` in `dir`.
+pub fn fogsim(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_fogsim")).current_dir(dir).args(args).output().expect("fogsim runs")
+}
+
+/// stderr as text.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A fresh, empty directory for one test.
+pub fn scratch_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("fogsim-app-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Writes `runs` simulated 45-min cold starts at 20 degC into `dir/runs/` and a model
+/// trained on the first three into `dir/model.bin`; returns the held-out run paths.
+pub fn campaign_and_model(dir: &Path, runs: usize) -> Vec<PathBuf> {
+    let params = GyroParams::paper_default();
+    let plan = CampaignSpec { ambients_c: vec![20.0], runs_per_ambient: runs, ..CampaignSpec::paper(11) };
+    let campaign = simulate_campaign(&params, &plan).unwrap();
+    let train: Vec<_> = campaign.iter().filter(|c| c.index <= 3).map(|c| &c.run).collect();
+    let model = train_default(&train, &fog_sim::train::default_specs(), "test").unwrap().model;
+    let mut buf = [0u8; fog_core::model::MAX_ENCODED_LEN];
+    let n = model.encode(&mut buf).unwrap();
+    std::fs::write(dir.join("model.bin"), &buf[..n]).unwrap();
+    std::fs::create_dir_all(dir.join("runs")).unwrap();
+    campaign
+        .iter()
+        .filter(|c| c.index > 3)
+        .map(|c| {
+            let p = dir.join("runs").join(format!("run{}.csv", c.index));
+            write_run(&p, &c.run).unwrap();
+            p
+        })
+        .collect()
+}

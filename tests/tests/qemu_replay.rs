@@ -1,0 +1,244 @@
+//! QEMU scenario 1 (replay): a simulated cold start with north seeks is recorded on the
+//! host (the simulated gyro's serial frames and every turntable interaction, with the
+//! application in the loop), then replayed twice through `fog_firmware::replay::run`:
+//! on the host and inside the firmware under QEMU (`src/bin/replay.rs`, semihosting
+//! files). Every 10 s window and every seek result must agree to the last bit, for the
+//! f32 and the fixed-point evaluator.
+//!
+//! Why bit-exact is the right bar: both sides execute the same Rust source; IEEE 754
+//! single and double arithmetic (+, -, *, /, sqrt) is correctly rounded on the M4F's
+//! FPU, in the soft-float f64 routines and on x86-64 SSE alike; Rust never contracts
+//! a*b+c into an FMA; exp/atan2/cos come from `libm`, pure Rust, same code on both
+//! sides. Any difference is therefore a real bug (uninitialised state, a target-
+//! dependent cast, a different code path), not rounding noise.
+//!
+//! The stream includes injected faults: corrupted frames (CRC errors, counted and
+//! skipped) and a 3 s temperature dropout (windows marked invalid).
+
+use std::cell::RefCell;
+use std::time::Duration;
+
+use fog_core::compensator::Evaluator;
+use fog_core::model::{RbfModel, MAX_ENCODED_LEN};
+use fog_core::synthetic::warmup_model;
+use fog_firmware::app::{App, AppConfig};
+use fog_firmware::drivers::fog_serial::FogSerialGyro;
+use fog_firmware::drivers::gyro_frame::{FrameDecoder, GyroFrame, STATUS_TEMP_INVALID};
+use fog_firmware::replay::{self, ReaderUart, RecordingTurntable};
+use fog_sim::sim::{rig, GyroParams, RunSpec, StartState, TurntableParams};
+use fog_tests::{firmware_elf, qemu_ready, run_qemu, scratch_dir, QemuOptions};
+
+const RATE_HZ: f64 = 100.0;
+const SEEKS: u16 = 2;
+const MINUTES: f64 = 10.5;
+const TRUE_AZIMUTH_DEG: f64 = 108.4;
+/// Temperature dropout (gyro flags its temperature invalid), s since power-on.
+const TEMP_DROPOUT_S: (f64, f64) = (200.0, 203.0);
+/// Every this many frames one byte is corrupted.
+const CORRUPT_EVERY: usize = 7919;
+
+struct Recording {
+    gyro_stream: Vec<u8>,
+    table_log: Vec<u8>,
+    /// The application's output during recording (closed loop with the simulator).
+    live_out: String,
+}
+
+fn config(evaluator: Evaluator) -> AppConfig {
+    let mut cfg = AppConfig::for_rate(RATE_HZ as f32);
+    cfg.seeks = SEEKS;
+    cfg.compensator.evaluator = evaluator;
+    cfg
+}
+
+/// Simulate the cold start with the application driving the simulated table.
+fn record(model: &RbfModel, evaluator: Evaluator) -> Recording {
+    let spec = RunSpec {
+        ambient_c: 20.0,
+        minutes: MINUTES,
+        latitude_deg: 39.9,
+        heading_deg: TRUE_AZIMUTH_DEG,
+        input_axis_vertical: false,
+        raw_rate_hz: RATE_HZ,
+        seed: 20_260_521,
+        start: StartState::Soaked,
+    };
+    let (mut sim, table) =
+        rig(&GyroParams::paper_default(), &spec, TurntableParams::default()).expect("sim rig");
+    let log = RefCell::new(Vec::new());
+    let table = RecordingTurntable::new(table, |r| log.borrow_mut().extend(r.encode()));
+    let mut app = App::new(config(evaluator), Some(model.clone()), table).expect("app config");
+    // The driver's frame-to-sample step, fed from the decoder below (no UART needed).
+    let mut gyro = FogSerialGyro::new(ReaderUart::<&[u8], 1>::new(&[][..]), RATE_HZ as u32);
+    let mut decoder = FrameDecoder::new();
+    let (mut gyro_stream, mut live_out) = (Vec::new(), String::new());
+    let period_s = 1.0 / RATE_HZ;
+    for i in 0..(MINUTES * 60.0 * RATE_HZ) as usize {
+        let raw = sim.next_sample();
+        let temp_c = sim.read_sensor_c();
+        let mut frame = GyroFrame::from_physical(i as u8, raw.rate_dph, temp_c, period_s);
+        if (TEMP_DROPOUT_S.0..TEMP_DROPOUT_S.1).contains(&raw.t_s) {
+            frame.status |= STATUS_TEMP_INVALID;
+        }
+        let mut bytes = frame.encode();
+        if i % CORRUPT_EVERY == CORRUPT_EVERY - 1 {
+            bytes[6] ^= 0x04;
+        }
+        gyro_stream.extend_from_slice(&bytes);
+        for b in bytes {
+            let Some(s) = decoder.push(b).and_then(|f| gyro.accept_frame(f)) else {
+                continue;
+            };
+            if app.temp_due(s.t_s) {
+                app.on_temp(s.t_s, gyro.latest_temp());
+            }
+            let step = app.on_gyro(s);
+            if let Some(w) = step.window {
+                replay::write_window(&mut live_out, &w).unwrap();
+            }
+            if let Some(seek) = step.seek {
+                replay::write_seek(&mut live_out, &seek).unwrap();
+            }
+        }
+    }
+    drop(app);
+    Recording {
+        gyro_stream,
+        table_log: log.into_inner(),
+        live_out,
+    }
+}
+
+fn data_lines(text: &str) -> Vec<&str> {
+    text.lines().filter(|l| !l.starts_with('#')).collect()
+}
+
+/// Human-readable decoding of an output line, for failure messages.
+fn describe(line: &str) -> String {
+    let f = line.split_whitespace().collect::<Vec<_>>();
+    let f32_of = |h: &str| f32::from_bits(u32::from_str_radix(h, 16).unwrap_or(0));
+    let f64_of = |h: &str| f64::from_bits(u64::from_str_radix(h, 16).unwrap_or(0));
+    match f.first() {
+        Some(&"W") if f.len() == 9 => format!(
+            "window t={} mean={} T={} dT/dt={} drift={} comp={} n={} status={}",
+            f64_of(f[1]),
+            f32_of(f[2]),
+            f32_of(f[3]),
+            f32_of(f[4]),
+            f32_of(f[5]),
+            f32_of(f[6]),
+            f[7],
+            f[8]
+        ),
+        Some(&"S") if f.len() == 5 => format!(
+            "seek azimuth={} sigma={} duration={} bias={}",
+            f64_of(f[1]),
+            f64_of(f[2]),
+            f64_of(f[3]),
+            f64_of(f[4])
+        ),
+        _ => line.to_string(),
+    }
+}
+
+fn assert_same(what: &str, expected: &str, got: &str) {
+    let (e, g) = (data_lines(expected), data_lines(got));
+    for (i, (a, b)) in e.iter().zip(&g).enumerate() {
+        assert_eq!(
+            a,
+            b,
+            "{what}: line {i} differs\n expected {}\n      got {}",
+            describe(a),
+            describe(b)
+        );
+    }
+    assert_eq!(e.len(), g.len(), "{what}: number of output lines differs");
+}
+
+fn seek_azimuths(out: &str) -> Vec<f64> {
+    data_lines(out)
+        .iter()
+        .filter_map(|l| l.strip_prefix("S "))
+        .map(|l| f64::from_bits(u64::from_str_radix(&l[..16], 16).unwrap()))
+        .collect()
+}
+
+fn scenario(evaluator: Evaluator, tag: &str) {
+    if !qemu_ready("qemu_replay") {
+        return;
+    }
+    let model = warmup_model(35, 2, 0.05, 35);
+    let mut buf = [0u8; MAX_ENCODED_LEN];
+    let n = model.encode(&mut buf).expect("model encodes");
+    let model = RbfModel::decode(&buf[..n]).expect("model decodes");
+    let rec = record(&model, evaluator);
+
+    // Host replay: the same function the firmware runs.
+    let mut host_out = String::new();
+    let host_sum = replay::run(
+        config(evaluator),
+        Some(model.clone()),
+        &rec.gyro_stream[..],
+        &rec.table_log[..],
+        &mut host_out,
+    )
+    .expect("host replay");
+    assert_same("host replay vs live recording", &rec.live_out, &host_out);
+    assert_eq!(host_sum.seeks_done, u32::from(SEEKS), "both seeks finish:\n{host_out}");
+    assert!(host_sum.gyro.frames.crc_errors > 0, "injected corruption was seen");
+    assert!(host_sum.valid_windows > 0 && host_sum.valid_windows < host_sum.windows);
+
+    // Firmware replay under QEMU.
+    let dir = scratch_dir(&format!("replay-{tag}"));
+    std::fs::write(dir.join("model.bin"), &buf[..n]).unwrap();
+    std::fs::write(dir.join("gyro.bin"), &rec.gyro_stream).unwrap();
+    std::fs::write(dir.join("table.bin"), &rec.table_log).unwrap();
+    let opts = QemuOptions {
+        args: ["model.bin", "gyro.bin", "table.bin", "out.txt"]
+            .iter()
+            .map(|s| s.to_string())
+            .chain([RATE_HZ.to_string(), SEEKS.to_string(), tag.to_string()])
+            .collect(),
+        cwd: Some(dir.clone()),
+        ..QemuOptions::default()
+    };
+    let run = run_qemu(&firmware_elf("replay"), &opts, Duration::from_secs(120)).unwrap();
+    assert!(
+        run.status.success(),
+        "firmware replay failed ({}): {}",
+        run.status,
+        run.stderr
+    );
+    let fw_out = std::fs::read_to_string(dir.join("out.txt")).expect("firmware wrote out.txt");
+    assert_same("firmware (QEMU) vs host", &host_out, &fw_out);
+    let summary: Vec<&str> = fw_out.lines().filter(|l| l.starts_with('#')).collect();
+    eprintln!(
+        "qemu_replay[{tag}]: {} windows ({} valid), {} seeks, azimuths {:?} (true {TRUE_AZIMUTH_DEG}), QEMU {:.2} s\n  {}",
+        host_sum.windows,
+        host_sum.valid_windows,
+        host_sum.seeks_done,
+        seek_azimuths(&host_out),
+        run.wall.as_secs_f64(),
+        summary.join("\n  ")
+    );
+    let stack_line = summary
+        .iter()
+        .find_map(|l| l.strip_prefix("# stack_high_water_bytes "))
+        .expect("firmware reports its stack high-water mark");
+    let used: usize = stack_line.split_whitespace().next().unwrap().parse().unwrap();
+    assert!(
+        used > 256 && used < 16 * 1024,
+        "stack high-water {used} bytes is implausible or over 16 KiB"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn firmware_replay_matches_host_bit_for_bit_f32() {
+    scenario(Evaluator::F32, "f32");
+}
+
+#[test]
+fn firmware_replay_matches_host_bit_for_bit_fixed() {
+    scenario(Evaluator::Fixed, "fixed");
+}

@@ -1,0 +1,148 @@
+//! Power cut at every flash operation of a model commit: after the reboot the store
+//! must hold a complete model, the old one or the new one, never a torn one; and a
+//! commit that was not cut must make the new one active.
+//!
+//! A cut point is one word write or one page erase of `RamNorFlash` (a cut write leaves
+//! its word half-programmed, a cut erase its page half-erased). Three geometries, three
+//! situations (first commit on an empty device, A -> B, B -> A over an older model).
+
+mod upload_support;
+
+use embedded_storage::nor_flash::NorFlash;
+use fog_core::model::MAX_ENCODED_LEN;
+use fog_firmware::store::ram_flash::RamNorFlash;
+use fog_firmware::store::{store_len, ModelStore};
+use upload_support::{encode, sample_model, sign_with_test_key};
+
+/// What the store holds after a reboot.
+#[derive(Debug, PartialEq)]
+enum Found {
+    Nothing,
+    Model { sequence: u32, bytes: Vec<u8> },
+}
+
+fn reboot<F: NorFlash>(flash: F) -> (Found, F) {
+    let mut store = ModelStore::open(flash, 0).expect("store opens");
+    let mut buf = vec![0u8; MAX_ENCODED_LEN];
+    let found = match store.active().copied() {
+        None => Found::Nothing,
+        Some(active) => {
+            let bytes = store.read_active(&mut buf).expect("active slot reads back").unwrap();
+            Found::Model { sequence: active.header.sequence, bytes: bytes.to_vec() }
+        }
+    };
+    (found, store.into_flash())
+}
+
+fn commit<F: NorFlash>(flash: F, model: &[u8]) -> (bool, F) {
+    let mut store = ModelStore::open(flash, 0).expect("store opens");
+    let ok = store.commit(model, &sign_with_test_key(model)).is_ok();
+    (ok, store.into_flash())
+}
+
+/// Cuts power at every operation of committing `new` on top of `history`; returns
+/// (cut points, how many rebooted to the old model, how many to the new).
+fn cut_everywhere<const N: usize, const W: usize, const E: usize>(
+    history: &[Vec<u8>],
+    new: &[u8],
+) -> (u32, u32, u32) {
+    let mut base = RamNorFlash::<N, W, E>::new();
+    for m in history {
+        let (ok, f) = commit(base, m);
+        assert!(ok, "history commit");
+        base = f;
+    }
+    let (old, _) = reboot(base.clone());
+    let old_sequence = history.len() as u32;
+    // The uncut commit: how many operations it takes, and it must succeed.
+    let mut probe = base.clone();
+    let before = probe.ops_done();
+    let (ok, probe) = {
+        let (ok, f) = commit(probe, new);
+        probe = f;
+        (ok, probe)
+    };
+    assert!(ok, "uncut commit succeeds");
+    let total_ops = probe.ops_done() - before;
+    // Every page erase and word write of the layout is one cut point.
+    let expected_ops = store_len(E) / 2 / E + new.len().div_ceil(W) + 96 / W + 32 / W;
+    assert_eq!(total_ops as usize, expected_ops, "operations of one commit");
+    let want_new = Found::Model { sequence: old_sequence + 1, bytes: new.to_vec() };
+    assert_eq!(reboot(probe).0, want_new);
+
+    let (mut to_old, mut to_new) = (0, 0);
+    for cut in 0..total_ops {
+        let mut flash = base.clone();
+        flash.cut_power_after(cut);
+        let (ok, mut flash) = commit(flash, new);
+        assert!(!ok, "cut {cut}/{total_ops}: commit must report the failure");
+        assert!(flash.power_lost());
+        flash.power_cycle();
+        let (found, _) = reboot(flash);
+        if found == old {
+            to_old += 1;
+        } else if found == want_new {
+            to_new += 1;
+        } else {
+            panic!("cut {cut}/{total_ops}: torn state after reboot: {found:?}");
+        }
+    }
+    println!(
+        "W={W} E={E} history={}: {total_ops} cut points -> old model {to_old}, new model {to_new}",
+        history.len()
+    );
+    (total_ops, to_old, to_new)
+}
+
+fn models() -> (Vec<u8>, Vec<u8>, Vec<u8>) {
+    (
+        encode(&sample_model("FOG-1", 35, 1.0)),
+        encode(&sample_model("FOG-1", 64, 0.7)),
+        encode(&sample_model("FOG-1", 12, 1.3)),
+    )
+}
+
+fn all_situations<const N: usize, const W: usize, const E: usize>() {
+    let (a, b, c) = models();
+    // Empty device -> first model: before the marker lands there is no model at all.
+    let (ops, old, new) = cut_everywhere::<N, W, E>(&[], &a);
+    assert_eq!(old + new, ops);
+    // A active -> B into slot 1; then B active -> C into slot 0 over the older A.
+    for history in [vec![a.clone()], vec![a.clone(), b.clone()]] {
+        let (ops, old, new) = cut_everywhere::<N, W, E>(&history, &c);
+        // Only the very last operation (the marker's last word) can switch models.
+        assert_eq!((old, new), (ops, 0), "the switch happens only after the final write");
+    }
+}
+
+#[test]
+fn power_cut_at_every_write_and_erase_leaves_a_complete_model_4byte_words_256_pages() {
+    all_situations::<{ store_len(256) }, 4, 256>();
+}
+
+#[test]
+fn power_cut_at_every_write_and_erase_leaves_a_complete_model_8byte_words_1k_pages() {
+    all_situations::<{ store_len(1024) }, 8, 1024>();
+}
+
+#[test]
+fn power_cut_at_every_write_and_erase_leaves_a_complete_model_32byte_words_2k_pages() {
+    all_situations::<{ store_len(2048) }, 32, 2048>();
+}
+
+#[test]
+fn a_bad_slot_next_to_a_good_one_is_ignored() {
+    let (a, b, _) = models();
+    let flash = RamNorFlash::<{ store_len(256) }, 4, 256>::new();
+    let (_, flash) = commit(flash, &a);
+    let (_, mut flash) = commit(flash, &b);
+    // Flip one bit of B's body (slot 1's body starts at slot_len + 128) in a copy of
+    // the flash image: B's CRC fails, so the older A must be picked.
+    let slot1_body = ModelStore::<RamNorFlash<{ store_len(256) }, 4, 256>>::slot_len() + 128;
+    let mut image = flash.contents().to_vec();
+    image[slot1_body + 10] ^= 0x01;
+    let mut corrupted = RamNorFlash::<{ store_len(256) }, 4, 256>::new();
+    corrupted.write(0, &image).unwrap();
+    flash = corrupted;
+    assert_eq!(reboot(flash).0, Found::Model { sequence: 1, bytes: a });
+}

@@ -1,0 +1,171 @@
+//! Host test of the whole upload path (real client <-> real `UploadServer` <-> emulated
+//! NOR flash): a signed model installs and shows in `Status`; every bad upload the
+//! issue lists is refused with its typed error and the running model stays in place,
+//! also after a reboot.
+
+mod upload_support;
+
+use fog_core::model::MAX_ENCODED_LEN;
+use fog_core::protocol::{
+    crc32, ModelInfo, ModelRejection, Request, Response, UploadError, UploadPhase, MAX_CHUNK_LEN,
+};
+use fog_firmware::signature::TEST_PUBLIC_KEY;
+use fog_firmware::upload::UploadServer;
+use fog_sim::upload::{key_from_seed, sign_model, ClientError};
+use rand::{Rng, SeedableRng};
+use upload_support::*;
+
+/// Installs a first good model and returns its info.
+fn install_first(server: &mut Server) -> ModelInfo {
+    let bytes = encode(&sample_model("FOG-A17", 35, 1.0));
+    let sig = sign_with_test_key(&bytes);
+    let info = client(server).upload(&bytes, &sig, |_, _| {}).expect("good upload commits");
+    assert_eq!(info.sequence, 1);
+    info
+}
+
+fn expect_rejected(result: Result<ModelInfo, ClientError>, want: UploadError) {
+    match result {
+        Err(ClientError::Rejected(got)) => assert_eq!(got, want),
+        other => panic!("expected Rejected({want:?}), got {other:?}"),
+    }
+}
+
+#[test]
+fn upload_then_status_shows_new_model_and_survives_reboot() {
+    let mut server = fresh_server();
+    assert_eq!(client(&mut server).hello().unwrap().active, None);
+    let first = install_first(&mut server);
+    assert_eq!(first.gyro_id.as_str(), "FOG-A17");
+    assert_eq!(first.n_centers, 35);
+    let second_bytes = encode(&sample_model("FOG-A17", 64, 0.5));
+    let sig = sign_with_test_key(&second_bytes);
+    let mut c = client(&mut server);
+    let second = c.upload(&second_bytes, &sig, |_, _| {}).unwrap();
+    assert_eq!(c.link_mut().model_changes, 1);
+    assert_eq!((second.slot, second.sequence, second.n_centers), (1 - first.slot, 2, 64));
+    assert_eq!(second.model_crc32, crc32(&second_bytes));
+    let status = c.status().unwrap();
+    assert_eq!(status.active.as_ref(), Some(&second));
+    assert_eq!(status.upload, UploadPhase::Idle);
+    // The application's view: the decoded model equals what was sent.
+    let loaded = server.load_active_model().unwrap().unwrap();
+    assert_eq!(loaded, sample_model("FOG-A17", 64, 0.5));
+    // Reboot: a new server on the same flash finds the same model.
+    let mut rebooted = UploadServer::new(server.into_flash(), 0, TEST_PUBLIC_KEY).unwrap();
+    assert_eq!(rebooted.active_info(), Some(&second));
+    assert_eq!(client(&mut rebooted).status().unwrap().active, Some(second));
+}
+
+#[test]
+fn every_bad_upload_is_refused_with_its_typed_error_and_the_model_stays() {
+    let mut server = fresh_server();
+    let good = install_first(&mut server);
+    let bytes = encode(&sample_model("FOG-B02", 20, 1.0));
+    let sig = sign_with_test_key(&bytes);
+    let mut c = client(&mut server);
+
+    // Unsigned: an empty signature.
+    expect_rejected(c.upload(&bytes, &[], |_, _| {}), UploadError::SignatureMalformed);
+    // Wrong key: signed by a key the device does not hold.
+    let wrong = sign_model(&key_from_seed([7u8; 32]), &bytes);
+    expect_rejected(c.upload(&bytes, &wrong, |_, _| {}), UploadError::SignatureInvalid);
+    // Bit-flipped after signing (the CRC in Begin matches the flipped bytes).
+    for bit in [0usize, 77, bytes.len() * 8 / 2, bytes.len() * 8 - 1] {
+        let mut flipped = bytes.clone();
+        flipped[bit / 8] ^= 1 << (bit % 8);
+        expect_rejected(c.upload(&flipped, &sig, |_, _| {}), UploadError::SignatureInvalid);
+    }
+    // Truncated, correctly signed: authentic but not a whole model.
+    let truncated = &bytes[..bytes.len() - 9];
+    let sig_trunc = sign_with_test_key(truncated);
+    expect_rejected(
+        c.upload(truncated, &sig_trunc, |_, _| {}),
+        UploadError::ModelInvalid(ModelRejection::Malformed),
+    );
+    // Wrong version, correctly signed (version varint is the byte after the 5-byte magic).
+    let mut v2 = bytes.clone();
+    assert_eq!(v2[5], 1, "version byte");
+    v2[5] = 2;
+    let sig_v2 = sign_with_test_key(&v2);
+    expect_rejected(
+        c.upload(&v2, &sig_v2, |_, _| {}),
+        UploadError::ModelInvalid(ModelRejection::WrongVersion),
+    );
+    // NaN weight, correctly signed, model CRC fixed up.
+    let nan = nan_weight_model_bytes();
+    let sig_nan = sign_with_test_key(&nan);
+    expect_rejected(
+        c.upload(&nan, &sig_nan, |_, _| {}),
+        UploadError::ModelInvalid(ModelRejection::InvalidContent),
+    );
+    // Oversized: announced too long, and a chunk too long.
+    let huge = vec![0x55u8; MAX_ENCODED_LEN + 1];
+    expect_rejected(
+        c.upload(&huge, &sig, |_, _| {}),
+        UploadError::ModelTooLarge { max_len: MAX_ENCODED_LEN as u32 },
+    );
+    let begin = Request::Begin { model_len: bytes.len() as u32, model_crc32: crc32(&bytes) };
+    assert!(matches!(c.request(&begin).unwrap(), Response::Ready { .. }));
+    let long = [0u8; MAX_CHUNK_LEN + 1];
+    let reply = c.request(&Request::Chunk { offset: 0, data: &long }).unwrap();
+    assert_eq!(reply, Response::Rejected(UploadError::ChunkTooLong));
+    // Out of order, past the end, early commit, wrong CRC.
+    let reply = c.request(&Request::Chunk { offset: 8, data: &bytes[8..16] }).unwrap();
+    assert_eq!(reply, Response::Rejected(UploadError::ChunkOutOfOrder { expected_offset: 0 }));
+    let reply = c.request(&Request::Commit { signature: &sig }).unwrap();
+    assert_eq!(reply, Response::Rejected(UploadError::UploadIncomplete { received: 0 }));
+    let reply = c.request(&Request::Chunk { offset: 0, data: &[1, 2] }).unwrap();
+    assert_eq!(reply, Response::ChunkAccepted { received: 2 });
+    assert_eq!(
+        c.status().unwrap().upload,
+        UploadPhase::Receiving { received: 2, model_len: bytes.len() as u32 }
+    );
+    assert_eq!(c.request(&Request::Abort).unwrap(), Response::Aborted);
+    let reply = c.request(&Request::Chunk { offset: 2, data: &[3] }).unwrap();
+    assert_eq!(reply, Response::Rejected(UploadError::NoUploadInProgress));
+    let bad_crc = Request::Begin { model_len: 4, model_crc32: 0 };
+    assert!(matches!(c.request(&bad_crc).unwrap(), Response::Ready { .. }));
+    let reply = c.request(&Request::Chunk { offset: 0, data: &[9, 9, 9, 9, 9] }).unwrap();
+    assert_eq!(reply, Response::Rejected(UploadError::ChunkPastEnd));
+    c.request(&Request::Chunk { offset: 0, data: &[9, 9, 9, 9] }).unwrap();
+    let reply = c.request(&Request::Commit { signature: &sig }).unwrap();
+    assert_eq!(reply, Response::Rejected(UploadError::ModelCrcMismatch));
+    // Protocol version.
+    let reply = c.request(&Request::Hello { protocol_version: 99 }).unwrap();
+    assert!(matches!(reply, Response::Rejected(UploadError::ProtocolVersion { .. })));
+
+    // Random byte streams: each frame they form is answered with a frame-level error.
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x5EED);
+    let noise: Vec<u8> = (0..8192).map(|_| if rng.random_ratio(1, 40) { 0 } else { rng.random() }).collect();
+    c.send_raw(&noise).unwrap();
+    let mut answered = 0;
+    while let Ok(reply) = c.read_response() {
+        assert!(
+            matches!(
+                reply,
+                Response::Rejected(
+                    UploadError::FrameCorrupt
+                        | UploadError::FrameCrcMismatch
+                        | UploadError::FrameTooLong
+                        | UploadError::MessageMalformed
+                )
+            ),
+            "noise got {reply:?}"
+        );
+        answered += 1;
+    }
+    assert!(answered > 100, "only {answered} noise frames answered");
+
+    // Through all of it the first model stayed in use, and no model change was signalled.
+    let status = c.status().unwrap();
+    assert_eq!(status.active, Some(good.clone()));
+    assert_eq!(status.uploads_rejected, 11);
+    assert_eq!(c.link_mut().model_changes, 0);
+    let mut rebooted = UploadServer::new(server.into_flash(), 0, TEST_PUBLIC_KEY).unwrap();
+    assert_eq!(rebooted.active_info(), Some(&good));
+    assert_eq!(
+        rebooted.load_active_model().unwrap().unwrap(),
+        sample_model("FOG-A17", 35, 1.0)
+    );
+}
