@@ -296,7 +296,7 @@ pub fn exp_neg_q30(u_q28: u64) -> u32 {
     let f = t & ((1u64 << 58) - 1);
     let k = (f >> 53) as usize;
     let r_q30 = (f & ((1u64 << 53) - 1)) >> 28; // r < 1/32
-    // y = r ln 2 < 0.0217, Q.30
+                                                // y = r ln 2 < 0.0217, Q.30
     let y = mul_q30(r_q30, LN2_Q30);
     // exp(-y) = 1 - y (1 - y/2 (1 - y/3 (1 - y/4))), Horner in Q.30.
     let mut p = ONE_Q30 - (y >> 2);

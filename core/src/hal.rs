@@ -46,6 +46,9 @@ pub enum TableState {
 }
 
 /// A single-axis indexing turntable.
+///
+/// Headings are clockwise seen from above, like azimuth: at table heading h the gyro's input
+/// axis points at azimuth A + h, so it reads Omega_H cos(A + h) + bias (see `northfinder`).
 pub trait Turntable {
     type Error: core::fmt::Debug;
     /// Command a rotation to `heading_deg` (table frame, 0..360). Non-blocking.

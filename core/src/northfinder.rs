@@ -157,8 +157,14 @@ pub struct SeekResult {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum SeekStatus {
     Idle,
-    Moving { position: u8 },
-    Dwelling { position: u8, windows: u16 },
+    Moving {
+        position: u8,
+    },
+    Dwelling {
+        position: u8,
+        windows: u16,
+    },
+    /// Returned once, by the `on_window` call whose window completed the seek.
     Done(SeekResult),
 }
 
@@ -167,7 +173,6 @@ enum Phase {
     Idle,
     Moving { since_s: f64 },
     Dwelling { accept_from_s: f64 },
-    Done,
 }
 
 #[derive(Clone, Copy, Debug, Default)]
@@ -273,7 +278,7 @@ impl NorthFinder {
         self.last.as_ref()
     }
 
-    /// Current status.
+    /// Current status (`Done` is only ever returned by the `on_window` call that finishes).
     pub fn status(&self) -> SeekStatus {
         match self.phase {
             Phase::Idle => SeekStatus::Idle,
@@ -283,10 +288,6 @@ impl NorthFinder {
             Phase::Dwelling { .. } => SeekStatus::Dwelling {
                 position: self.position,
                 windows: self.acc[self.position as usize].n,
-            },
-            Phase::Done => match self.last {
-                Some(r) => SeekStatus::Done(r),
-                None => SeekStatus::Idle,
             },
         }
     }
@@ -393,9 +394,12 @@ impl NorthFinder {
             if k + 1 < self.n_positions() {
                 self.go_to(table, k + 1, w.t_end_s)?;
             } else {
-                let r = self.solve(w.t_end_s);
-                self.phase = if r.is_ok() { Phase::Done } else { Phase::Idle };
-                self.last = Some(r?);
+                // Done is reported exactly once, by the window that completes the seek;
+                // afterwards the finder is idle (the result stays in `last_result`).
+                self.phase = Phase::Idle;
+                let r = self.solve(w.t_end_s)?;
+                self.last = Some(r);
+                return Ok(SeekStatus::Done(r));
             }
         }
         Ok(self.status())

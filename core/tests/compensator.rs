@@ -272,3 +272,13 @@ fn bad_setup_is_rejected() {
         Err(CompensatorError::Model(_))
     ));
 }
+
+#[test]
+fn pipeline_state_fits_a_small_mcu() {
+    // Everything the device keeps for compensation and seeking (model, fixed copy, averagers,
+    // estimators): must stay well inside the firmware's 16 KiB static RAM budget.
+    let comp = std::mem::size_of::<Compensator>();
+    let nf = std::mem::size_of::<fog_core::northfinder::NorthFinder>();
+    println!("Compensator {comp} B, NorthFinder {nf} B");
+    assert!(comp + nf <= 10 * 1024, "{comp} + {nf}");
+}

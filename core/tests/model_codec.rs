@@ -185,7 +185,8 @@ fn wrong_version_and_magic_are_named() {
 #[test]
 fn invalid_contents_get_their_typed_error() {
     let good = warmup_model(35, 2, 2.0, 5);
-    let cases: Vec<(Box<dyn Fn(&mut LooseModel)>, ModelError)> = vec![
+    type Corruption = Box<dyn Fn(&mut LooseModel)>;
+    let cases: Vec<(Corruption, ModelError)> = vec![
         (
             Box::new(|m| m.weights[3] = f32::NAN),
             ModelError::NonFinite {

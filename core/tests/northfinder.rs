@@ -341,3 +341,24 @@ fn back_to_back_seeks_reuse_the_finder() {
         assert!(r.duration_s <= 296.0);
     }
 }
+
+#[test]
+fn done_is_reported_once_then_idle() {
+    let mut nf = NorthFinder::new(cfg(SeekMode::FourPosition, 0.0)).unwrap();
+    let mut table = MockTable::new(7.0);
+    nf.start(&mut table, 0.0).unwrap();
+    let mut t = 0.0;
+    let mut done = 0;
+    for _ in 0..80 {
+        let heading = table.heading_deg;
+        t += 10.0;
+        table.now_s = t;
+        let w = window(t, earth(10.0, heading), WindowStatus::Valid);
+        if let SeekStatus::Done(_) = nf.on_window(&w, &mut table).unwrap() {
+            done += 1;
+        }
+    }
+    assert_eq!(done, 1);
+    assert_eq!(nf.status(), SeekStatus::Idle);
+    assert!(ang_err(nf.last_result().unwrap().azimuth_deg, 10.0).abs() < 1e-4);
+}

@@ -227,6 +227,7 @@ where
 
 /// Why the application could not start.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum AppError {
     Compensator(CompensatorError),
     Seek(SeekError),

@@ -312,11 +312,49 @@ pub fn run<G: embedded_io::Read, L: embedded_io::Read, W: Write>(
     table_log: L,
     out: &mut W,
 ) -> Result<ReplaySummary, ReplayError> {
-    let mut app = App::new(cfg, model, ReplayTurntable::new(table_log)).map_err(ReplayError::App)?;
+    run_with_hook(cfg, model, gyro_stream, table_log, out, || ())
+}
+
+/// `run`, calling `on_ready` once the application is built and before the first sample
+/// (the firmware measures the boot stack peak there and re-paints the stack, so the
+/// steady-state high-water is measured separately).
+pub fn run_with_hook<G: embedded_io::Read, L: embedded_io::Read, W: Write>(
+    cfg: AppConfig,
+    model: Option<RbfModel>,
+    gyro_stream: G,
+    table_log: L,
+    out: &mut W,
+    on_ready: impl FnOnce(),
+) -> Result<ReplaySummary, ReplayError> {
+    // Construction and the sample loop are separate frames: the construction temporaries
+    // (model validation, fixed-point conversion) are not kept on the stack while running.
+    let mut app = build(cfg, model, table_log)?;
     let mut gyro = FogSerialGyro::new(
         ReaderUart::<G, 512>::new(gyro_stream),
         libm::roundf(cfg.compensator.gyro_rate_hz) as u32,
     );
+    on_ready();
+    process(&mut app, &mut gyro, out)
+}
+
+#[inline(never)]
+fn build<L: embedded_io::Read>(
+    cfg: AppConfig,
+    model: Option<RbfModel>,
+    table_log: L,
+) -> Result<App<ReplayTurntable<L>>, ReplayError> {
+    App::new(cfg, model, ReplayTurntable::new(table_log)).map_err(ReplayError::App)
+}
+
+#[inline(never)]
+fn process<T: Turntable, U: SerialRead<u8>, W: Write>(
+    app: &mut App<T>,
+    gyro: &mut FogSerialGyro<U>,
+    out: &mut W,
+) -> Result<ReplaySummary, ReplayError>
+where
+    T::Error: Copy,
+{
     let mut sum = ReplaySummary::default();
     let mut last_t_s = 0.0;
     loop {

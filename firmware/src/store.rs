@@ -111,7 +111,12 @@ impl SlotHeader {
         }
         let mut signature = [0u8; SIGNATURE_LEN];
         signature.copy_from_slice(&b[20..84]);
-        Some(Self { sequence: word(8), model_len, model_crc32: word(16), signature })
+        Some(Self {
+            sequence: word(8),
+            model_len,
+            model_crc32: word(16),
+            signature,
+        })
     }
 }
 
@@ -165,7 +170,12 @@ impl<F: NorFlash> ModelStore<F> {
         {
             return Err(StoreError::Geometry);
         }
-        let mut store = Self { flash, base, slot_len: slot_len as u32, active: None };
+        let mut store = Self {
+            flash,
+            base,
+            slot_len: slot_len as u32,
+            active: None,
+        };
         store.active = store.scan();
         Ok(store)
     }
@@ -218,10 +228,16 @@ impl<F: NorFlash> ModelStore<F> {
         };
         let base = self.slot_base(slot);
         let flash_err = |_| StoreError::Flash;
-        self.flash.erase(base, base + self.slot_len).map_err(flash_err)?;
+        self.flash
+            .erase(base, base + self.slot_len)
+            .map_err(flash_err)?;
         self.write_body(base + BODY_OFFSET as u32, model)?;
-        self.flash.write(base, &header.to_bytes()).map_err(flash_err)?;
-        self.flash.write(base + MARKER_OFFSET as u32, &COMMIT_MARKER).map_err(flash_err)?;
+        self.flash
+            .write(base, &header.to_bytes())
+            .map_err(flash_err)?;
+        self.flash
+            .write(base + MARKER_OFFSET as u32, &COMMIT_MARKER)
+            .map_err(flash_err)?;
         match self.read_slot(slot) {
             Some(h) if h == header => {
                 let active = ActiveSlot { slot, header };
@@ -235,13 +251,17 @@ impl<F: NorFlash> ModelStore<F> {
     /// Writes the body: whole words directly, the tail word padded with 0xFF.
     fn write_body(&mut self, at: u32, model: &[u8]) -> Result<(), StoreError> {
         let whole = model.len() / F::WRITE_SIZE * F::WRITE_SIZE;
-        self.flash.write(at, &model[..whole]).map_err(|_| StoreError::Flash)?;
+        self.flash
+            .write(at, &model[..whole])
+            .map_err(|_| StoreError::Flash)?;
         let tail = &model[whole..];
         if !tail.is_empty() {
             let mut word = [0xFFu8; MAX_WRITE_SIZE];
             word[..tail.len()].copy_from_slice(tail);
             let word = &word[..F::WRITE_SIZE];
-            self.flash.write(at + whole as u32, word).map_err(|_| StoreError::Flash)?;
+            self.flash
+                .write(at + whole as u32, word)
+                .map_err(|_| StoreError::Flash)?;
         }
         Ok(())
     }
@@ -252,10 +272,18 @@ impl<F: NorFlash> ModelStore<F> {
 
     /// Newest valid slot; on a (never written) equal sequence slot A wins.
     fn scan(&mut self) -> Option<ActiveSlot> {
-        let a = self.read_slot(0).map(|header| ActiveSlot { slot: 0, header });
-        let b = self.read_slot(1).map(|header| ActiveSlot { slot: 1, header });
+        let a = self
+            .read_slot(0)
+            .map(|header| ActiveSlot { slot: 0, header });
+        let b = self
+            .read_slot(1)
+            .map(|header| ActiveSlot { slot: 1, header });
         match (a, b) {
-            (Some(a), Some(b)) => Some(if b.header.sequence > a.header.sequence { b } else { a }),
+            (Some(a), Some(b)) => Some(if b.header.sequence > a.header.sequence {
+                b
+            } else {
+                a
+            }),
             (a, b) => a.or(b),
         }
     }
@@ -264,7 +292,9 @@ impl<F: NorFlash> ModelStore<F> {
     fn read_slot(&mut self, slot: u8) -> Option<SlotHeader> {
         let base = self.slot_base(slot);
         let mut marker = [0u8; MARKER_LEN];
-        self.flash.read(base + MARKER_OFFSET as u32, &mut marker).ok()?;
+        self.flash
+            .read(base + MARKER_OFFSET as u32, &mut marker)
+            .ok()?;
         if marker != COMMIT_MARKER {
             return None;
         }

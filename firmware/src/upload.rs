@@ -11,9 +11,9 @@ use embedded_hal_nb::nb;
 use embedded_storage::nor_flash::NorFlash;
 use fog_core::model::{ModelError, RbfModel, MAX_ENCODED_LEN};
 use fog_core::protocol::{
-    decode_message, encode_frame, DeviceStatus, FrameReceiver, ModelInfo, ModelRejection,
-    Request, Response, UploadError, UploadPhase, MAX_CHUNK_LEN, MAX_WIRE_FRAME_LEN,
-    PROTOCOL_VERSION, SIGNATURE_LEN,
+    decode_message, encode_frame, DeviceStatus, FrameReceiver, ModelInfo, ModelRejection, Request,
+    Response, UploadError, UploadPhase, MAX_CHUNK_LEN, MAX_WIRE_FRAME_LEN, PROTOCOL_VERSION,
+    SIGNATURE_LEN,
 };
 
 use crate::signature::verify_model;
@@ -51,7 +51,11 @@ impl core::fmt::Display for LoadError {
 #[derive(Clone, Copy)]
 enum Session {
     Idle,
-    Receiving { model_len: u32, model_crc32: u32, received: u32 },
+    Receiving {
+        model_len: u32,
+        model_crc32: u32,
+        received: u32,
+    },
 }
 
 /// Upload protocol server holding the model store.
@@ -122,7 +126,10 @@ impl<F: NorFlash> UploadServer<F> {
         };
         // Every response fits MAX_WIRE_FRAME_LEN (checked by the protocol tests).
         let len = encode_frame(&response, &mut self.tx).unwrap_or(0);
-        Some(Reply { frame: &self.tx[..len], model_changed })
+        Some(Reply {
+            frame: &self.tx[..len],
+            model_changed,
+        })
     }
 
     /// Drains every byte the UART has ready into the server and writes each response
@@ -154,7 +161,11 @@ impl<F: NorFlash> UploadServer<F> {
         if matches!(self.session, Session::Receiving { .. }) {
             return Err(LoadError::UploadInProgress);
         }
-        match self.store.read_active(&mut self.model_buf).map_err(LoadError::Store)? {
+        match self
+            .store
+            .read_active(&mut self.model_buf)
+            .map_err(LoadError::Store)?
+        {
             None => Ok(None),
             Some(bytes) => RbfModel::decode(bytes).map(Some).map_err(LoadError::Model),
         }
@@ -167,7 +178,12 @@ impl<F: NorFlash> UploadServer<F> {
 
     /// The status a `Status` request would return.
     pub fn status(&self) -> DeviceStatus {
-        device_status(&self.session, &self.active_info, self.frames_rejected, self.uploads_rejected)
+        device_status(
+            &self.session,
+            &self.active_info,
+            self.frames_rejected,
+            self.uploads_rejected,
+        )
     }
 
     /// Gives the flash back (tests reboot by building a new server on it).
@@ -198,15 +214,28 @@ fn handle<F: NorFlash>(request: Request<'_>, s: &mut Fields<'_, F>) -> (Response
     };
     let response = match request {
         Request::Hello { protocol_version } if protocol_version != PROTOCOL_VERSION => {
-            Response::Rejected(UploadError::ProtocolVersion { supported: PROTOCOL_VERSION })
+            Response::Rejected(UploadError::ProtocolVersion {
+                supported: PROTOCOL_VERSION,
+            })
         }
         Request::Hello { .. } | Request::Status => status(s),
-        Request::Begin { model_len, model_crc32 } => {
+        Request::Begin {
+            model_len,
+            model_crc32,
+        } => {
             if model_len == 0 || model_len as usize > MAX_ENCODED_LEN {
-                Response::Rejected(UploadError::ModelTooLarge { max_len: MAX_ENCODED_LEN as u32 })
+                Response::Rejected(UploadError::ModelTooLarge {
+                    max_len: MAX_ENCODED_LEN as u32,
+                })
             } else {
-                *s.session = Session::Receiving { model_len, model_crc32, received: 0 };
-                Response::Ready { max_chunk_len: MAX_CHUNK_LEN as u16 }
+                *s.session = Session::Receiving {
+                    model_len,
+                    model_crc32,
+                    received: 0,
+                };
+                Response::Ready {
+                    max_chunk_len: MAX_CHUNK_LEN as u16,
+                }
             }
         }
         Request::Chunk { offset, data } => match accept_chunk(s, offset, data) {
@@ -234,14 +263,21 @@ fn handle<F: NorFlash>(request: Request<'_>, s: &mut Fields<'_, F>) -> (Response
 /// Stores one in-order chunk; returns the bytes received so far. A refused chunk keeps
 /// the session, so the client can resend from the expected offset.
 fn accept_chunk<F>(s: &mut Fields<'_, F>, offset: u32, data: &[u8]) -> Result<u32, UploadError> {
-    let Session::Receiving { model_len, received, .. } = s.session else {
+    let Session::Receiving {
+        model_len,
+        received,
+        ..
+    } = s.session
+    else {
         return Err(UploadError::NoUploadInProgress);
     };
     if data.len() > MAX_CHUNK_LEN {
         return Err(UploadError::ChunkTooLong);
     }
     if offset != *received {
-        return Err(UploadError::ChunkOutOfOrder { expected_offset: *received });
+        return Err(UploadError::ChunkOutOfOrder {
+            expected_offset: *received,
+        });
     }
     let end = *received + data.len() as u32;
     if end > *model_len {
@@ -254,7 +290,12 @@ fn accept_chunk<F>(s: &mut Fields<'_, F>, offset: u32, data: &[u8]) -> Result<u3
 
 /// Verifies and commits the received model. The session ends whatever the outcome.
 fn commit<F: NorFlash>(s: &mut Fields<'_, F>, signature: &[u8]) -> Result<ModelInfo, UploadError> {
-    let Session::Receiving { model_len, model_crc32, received } = *s.session else {
+    let Session::Receiving {
+        model_len,
+        model_crc32,
+        received,
+    } = *s.session
+    else {
         return Err(UploadError::NoUploadInProgress);
     };
     if received < model_len {
@@ -265,8 +306,9 @@ fn commit<F: NorFlash>(s: &mut Fields<'_, F>, signature: &[u8]) -> Result<ModelI
     if fog_core::protocol::crc32(bytes) != model_crc32 {
         return Err(UploadError::ModelCrcMismatch);
     }
-    let signature: &[u8; SIGNATURE_LEN] =
-        signature.try_into().map_err(|_| UploadError::SignatureMalformed)?;
+    let signature: &[u8; SIGNATURE_LEN] = signature
+        .try_into()
+        .map_err(|_| UploadError::SignatureMalformed)?;
     verify_model(s.public_key, bytes, signature).map_err(|_| UploadError::SignatureInvalid)?;
     let model =
         RbfModel::decode(bytes).map_err(|e| UploadError::ModelInvalid(ModelRejection::from(e)))?;
@@ -290,9 +332,14 @@ fn device_status(
         active: active_info.clone(),
         upload: match *session {
             Session::Idle => UploadPhase::Idle,
-            Session::Receiving { model_len, received, .. } => {
-                UploadPhase::Receiving { received, model_len }
-            }
+            Session::Receiving {
+                model_len,
+                received,
+                ..
+            } => UploadPhase::Receiving {
+                received,
+                model_len,
+            },
         },
         frames_rejected,
         uploads_rejected,

@@ -161,6 +161,24 @@ pub fn write_campaign(dir: &Path, runs: &[(String, Run)]) -> Result<Vec<PathBuf>
             kind: crate::runs::RunErrorKind::Io(e.to_string()),
         })
     };
+    if dir.is_dir() {
+        // Stale runs of another campaign would silently join this one when the directory
+        // is read back (e.g. by `fogsim train DIR`): refuse before writing anything.
+        let ours: Vec<&str> = runs.iter().map(|(n, _)| n.as_str()).collect();
+        for entry in std::fs::read_dir(dir).map_err(io)? {
+            let name = entry
+                .map_err(io)?
+                .file_name()
+                .to_string_lossy()
+                .into_owned();
+            if name.to_ascii_lowercase().ends_with(".csv") && !ours.contains(&name.as_str()) {
+                return Err(CampaignError::Spec(format!(
+                    "--out {}: holds {name}, which is not part of this campaign and would mix with it; use an empty directory",
+                    dir.display()
+                )));
+            }
+        }
+    }
     let created_dir = !dir.exists();
     std::fs::create_dir_all(dir).map_err(io)?;
     let mut written = Vec::new();

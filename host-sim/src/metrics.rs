@@ -262,4 +262,19 @@ mod tests {
         assert_eq!(time_to_spec_s(&t, &late, 0.021), None);
         assert!((max_deviation(&t, &y) - 0.1).abs() < 1e-12);
     }
+
+    #[test]
+    fn allan_of_white_noise_recovers_the_arw_and_has_slope_minus_half() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+        let arw = 0.001; // deg/sqrt(h); per-sample sigma at 1 s is N / sqrt(1/3600 h)
+        let y: Vec<f64> = (0..100_000)
+            .map(|_| 60.0 * arw * rng.sample::<f64, _>(rand_distr::StandardNormal))
+            .collect();
+        let adev = allan_deviation(&y, 1.0);
+        let n = arw_dpsh(&adev).unwrap();
+        assert!((n / arw - 1.0).abs() < 0.05, "{n}");
+        let ratio = adev[4].adev_dph / adev[0].adev_dph; // tau 16 s vs 1 s
+        assert!((ratio - 0.25).abs() < 0.02, "{ratio}");
+    }
 }

@@ -57,7 +57,8 @@ pub struct MonteCarloConfig {
 
 impl MonteCarloConfig {
     /// The paper's experiment: 30 starts x 6 seeks, two positions, 20 degC, 108.4 deg, seeks
-    /// that fit the paper's 4 min 56 s (120 s dwells, 10 s ambiguity dwell, 2 s settling).
+    /// that fit the paper's 4 min 56 s: 110 s dwells and a 10 s ambiguity dwell take 270 s
+    /// with the table's moves, leaving room for two rejected 10 s windows.
     pub fn paper(seed: u64) -> Self {
         Self {
             starts: 30,
@@ -66,7 +67,7 @@ impl MonteCarloConfig {
             latitude_deg: crate::sim::DEFAULT_LATITUDE_DEG,
             ambient_c: 20.0,
             true_azimuth_deg: PAPER_AZIMUTH_DEG,
-            dwell_s: 120.0,
+            dwell_s: 110.0,
             ambiguity_dwell_s: 10.0,
             raw_rate_hz: 100.0,
             turntable: TurntableParams::default(),
@@ -84,7 +85,10 @@ impl MonteCarloConfig {
             bail!("--seeks: must be at least 1");
         }
         if !self.latitude_deg.is_finite() || self.latitude_deg.abs() > 90.0 {
-            bail!("--latitude {}: must be within -90..=90 deg", self.latitude_deg);
+            bail!(
+                "--latitude {}: must be within -90..=90 deg",
+                self.latitude_deg
+            );
         }
         if self.latitude_deg.abs() >= 85.0 {
             bail!("--latitude {}: north seeking needs |latitude| < 85 deg (horizontal Earth rate too small)", self.latitude_deg);
@@ -116,7 +120,10 @@ impl MonteCarloConfig {
 
     /// Seed of start `index`: a SplitMix64 mix of the campaign seed and the index.
     pub fn start_seed(&self, index: usize) -> u64 {
-        let mut z = self.seed ^ (index as u64).wrapping_add(1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.seed
+            ^ (index as u64)
+                .wrapping_add(1)
+                .wrapping_mul(0x9E37_79B9_7F4A_7C15);
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         z ^ (z >> 31)
@@ -125,7 +132,10 @@ impl MonteCarloConfig {
 
 /// Both cores by default, as the machine the demo targets has two.
 pub fn default_threads() -> usize {
-    std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1).min(8)
+    std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1)
+        .min(8)
 }
 
 /// One finished seek.
@@ -166,7 +176,8 @@ pub fn run_seeks(
         seed,
         start: StartState::Soaked,
     };
-    let (mut gyro, mut table) = rig(params, &spec, cfg.turntable.clone()).map_err(|e| anyhow!("simulator: {e}"))?;
+    let (mut gyro, mut table) =
+        rig(params, &spec, cfg.turntable.clone()).map_err(|e| anyhow!("simulator: {e}"))?;
     let dt_s = gyro.sample_period_s();
     let temp_period_s = params.sensor.sample_period_s;
     let comp_cfg = CompensatorConfig {
@@ -187,25 +198,42 @@ pub fn run_seeks(
         let s = gyro.next_sample();
         step += 1;
         if s.t_s > t_limit_s {
-            bail!("seek {} did not finish within {t_limit_s:.0} s of power-on", out.len() + 1);
+            bail!(
+                "seek {} did not finish within {t_limit_s:.0} s of power-on",
+                out.len() + 1
+            );
         }
         if !started && s.t_s >= INIT_S {
-            finder.start(&mut table, s.t_s).map_err(|e| anyhow!("seek 1: {e}"))?;
+            finder
+                .start(&mut table, s.t_s)
+                .map_err(|e| anyhow!("seek 1: {e}"))?;
             started = true;
         }
-        if step % temp_every == 0 {
-            comp.push_temp(TempSample { t_s: s.t_s, temp_c: gyro.read_sensor_c() as f32 });
+        if step.is_multiple_of(temp_every) {
+            comp.push_temp(TempSample {
+                t_s: s.t_s,
+                temp_c: gyro.read_sensor_c() as f32,
+            });
         }
-        if started && step % poll_every == 0 {
-            finder.poll(&mut table, s.t_s).map_err(|e| anyhow!("seek {}: {e}", out.len() + 1))?;
+        if started && step.is_multiple_of(poll_every) {
+            finder
+                .poll(&mut table, s.t_s)
+                .map_err(|e| anyhow!("seek {}: {e}", out.len() + 1))?;
         }
         // A raw sample is the mean over (t - dt, t]: time-stamp it at the interval's middle.
-        let sample = GyroSample { t_s: s.t_s - 0.5 * dt_s, rate_dph: s.rate_dph as f32 };
-        let Some(w) = comp.push_gyro(sample) else { continue };
+        let sample = GyroSample {
+            t_s: s.t_s - 0.5 * dt_s,
+            rate_dph: s.rate_dph as f32,
+        };
+        let Some(w) = comp.push_gyro(sample) else {
+            continue;
+        };
         if !started {
             continue;
         }
-        let status = finder.on_window(&w, &mut table).map_err(|e| anyhow!("seek {}: {e}", out.len() + 1))?;
+        let status = finder
+            .on_window(&w, &mut table)
+            .map_err(|e| anyhow!("seek {}: {e}", out.len() + 1))?;
         if let SeekStatus::Done(r) = status {
             let n_main = r.positions[0].n_windows as f64;
             out.push(SeekOutcome {
@@ -216,7 +244,9 @@ pub fn run_seeks(
                 main_dwell_s: n_main * fog_core::consts::WINDOW_S as f64,
             });
             if out.len() < cfg.seeks_per_start {
-                finder.start(&mut table, w.t_end_s).map_err(|e| anyhow!("seek {}: {e}", out.len() + 1))?;
+                finder
+                    .start(&mut table, w.t_end_s)
+                    .map_err(|e| anyhow!("seek {}: {e}", out.len() + 1))?;
             }
         }
     }
@@ -233,7 +263,8 @@ pub fn run_monte_carlo(
 ) -> Result<Vec<StartOutcome>> {
     cfg.validate()?;
     let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<Result<StartOutcome>>>> = Mutex::new((0..cfg.starts).map(|_| None).collect());
+    let results: Mutex<Vec<Option<Result<StartOutcome>>>> =
+        Mutex::new((0..cfg.starts).map(|_| None).collect());
     std::thread::scope(|scope| {
         for _ in 0..cfg.threads.min(cfg.starts) {
             scope.spawn(|| loop {
@@ -245,9 +276,15 @@ pub fn run_monte_carlo(
                 let r = run_seeks(params, cfg, None, seed)
                     .with_context(|| format!("start {} (seed {seed}), uncompensated", i + 1))
                     .and_then(|unc| {
-                        let comp = run_seeks(params, cfg, Some(model), seed)
-                            .with_context(|| format!("start {} (seed {seed}), compensated", i + 1))?;
-                        Ok(StartOutcome { seed, uncompensated: unc, compensated: comp })
+                        let comp =
+                            run_seeks(params, cfg, Some(model), seed).with_context(|| {
+                                format!("start {} (seed {seed}), compensated", i + 1)
+                            })?;
+                        Ok(StartOutcome {
+                            seed,
+                            uncompensated: unc,
+                            compensated: comp,
+                        })
                     });
                 let failed = r.is_err();
                 results.lock().expect("no panics while holding the lock")[i] = Some(r);
@@ -260,7 +297,9 @@ pub fn run_monte_carlo(
             });
         }
     });
-    let results = results.into_inner().expect("no panics while holding the lock");
+    let results = results
+        .into_inner()
+        .expect("no panics while holding the lock");
     let mut out = Vec::with_capacity(cfg.starts);
     for r in results {
         match r {
@@ -279,12 +318,22 @@ pub fn azimuth_error_deg(a: f64, b: f64) -> f64 {
 /// White-noise floor of the azimuth, deg, for angle random walk `arw_dpsh` (deg/sqrt(h)):
 /// two positions N / (sqrt(2 tau) Omega_H |sin psi|) with tau the dwell per position;
 /// four positions sqrt(2) N / (Omega_H sqrt(T_total)), T_total = 4 tau.
-pub fn noise_floor_deg(arw_dpsh: f64, mode: SeekMode, latitude_deg: f64, psi_deg: f64, dwell_s: f64) -> f64 {
+pub fn noise_floor_deg(
+    arw_dpsh: f64,
+    mode: SeekMode,
+    latitude_deg: f64,
+    psi_deg: f64,
+    dwell_s: f64,
+) -> f64 {
     let omega_h = earth_rate_horizontal_dph(latitude_deg);
     let tau_h = dwell_s / 3600.0;
     let rad = match mode {
-        SeekMode::TwoPosition => arw_dpsh / ((2.0 * tau_h).sqrt() * omega_h * psi_deg.to_radians().sin().abs()),
-        SeekMode::FourPosition => std::f64::consts::SQRT_2 * arw_dpsh / (omega_h * (4.0 * tau_h).sqrt()),
+        SeekMode::TwoPosition => {
+            arw_dpsh / ((2.0 * tau_h).sqrt() * omega_h * psi_deg.to_radians().sin().abs())
+        }
+        SeekMode::FourPosition => {
+            std::f64::consts::SQRT_2 * arw_dpsh / (omega_h * (4.0 * tau_h).sqrt())
+        }
     };
     rad.to_degrees()
 }
@@ -311,13 +360,21 @@ pub fn seek_stats(seeks: &[Vec<SeekOutcome>], true_azimuth_deg: f64) -> SeekStat
     let err = |s: &SeekOutcome| azimuth_error_deg(s.azimuth_deg, true_azimuth_deg);
     let all: Vec<f64> = seeks.iter().flatten().map(err).collect();
     let n_seek = seeks.iter().map(Vec::len).max().unwrap_or(0);
-    let column = |k: usize| -> Vec<f64> { seeks.iter().filter_map(|s| s.get(k)).map(err).collect() };
+    let column =
+        |k: usize| -> Vec<f64> { seeks.iter().filter_map(|s| s.get(k)).map(err).collect() };
     let per_start = |f: fn(&[f64]) -> f64| -> f64 {
-        let v: Vec<f64> = seeks.iter().map(|s| f(&s.iter().map(err).collect::<Vec<_>>())).collect();
+        let v: Vec<f64> = seeks
+            .iter()
+            .map(|s| f(&s.iter().map(err).collect::<Vec<_>>()))
+            .collect();
         mean(&v)
     };
     let range = |v: &[f64]| -> f64 {
-        let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| (l.min(*x), h.max(*x)));
+        let (lo, hi) = v
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
+                (l.min(*x), h.max(*x))
+            });
         if v.is_empty() {
             0.0
         } else {
@@ -333,8 +390,17 @@ pub fn seek_stats(seeks: &[Vec<SeekOutcome>], true_azimuth_deg: f64) -> SeekStat
         per_seek_mean_error_deg: (0..n_seek).map(|k| mean(&column(k))).collect(),
         mean_range_deg: per_start(range),
         mean_within_start_std_deg: per_start(std_dev),
-        mean_reported_sigma_deg: mean(&seeks.iter().flatten().map(|s| s.sigma_deg).collect::<Vec<_>>()),
-        azimuths_deg: seeks.iter().map(|s| s.iter().map(|o| o.azimuth_deg).collect()).collect(),
+        mean_reported_sigma_deg: mean(
+            &seeks
+                .iter()
+                .flatten()
+                .map(|s| s.sigma_deg)
+                .collect::<Vec<_>>(),
+        ),
+        azimuths_deg: seeks
+            .iter()
+            .map(|s| s.iter().map(|o| o.azimuth_deg).collect())
+            .collect(),
     }
 }
 
@@ -367,7 +433,13 @@ pub fn build_report(
         max_seek_duration_s,
         paper_seek_duration_s: PAPER_SEEK_DURATION_S,
         main_dwell_s: dwell_s,
-        noise_floor_deg: noise_floor_deg(arw, cfg.mode, cfg.latitude_deg, cfg.true_azimuth_deg, dwell_s),
+        noise_floor_deg: noise_floor_deg(
+            arw,
+            cfg.mode,
+            cfg.latitude_deg,
+            cfg.true_azimuth_deg,
+            dwell_s,
+        ),
         arw_dpsh: arw,
         seed: cfg.seed,
         uncompensated: seek_stats(&unc, cfg.true_azimuth_deg),
@@ -378,14 +450,34 @@ pub fn build_report(
 
 /// The per-seek table printed by `north-seek`, `reproduce` and `demo`.
 pub fn seek_table(r: &NorthSeekReport) -> String {
-    let mut t = Table::new(&["seek", "uncomp. 1 sigma (deg)", "uncomp. mean err (deg)", "comp. 1 sigma (deg)", "comp. mean err (deg)"]);
+    let mut t = Table::new(&[
+        "seek",
+        "uncomp. 1 sigma (deg)",
+        "uncomp. mean err (deg)",
+        "comp. 1 sigma (deg)",
+        "comp. mean err (deg)",
+    ]);
     for k in 0..r.uncompensated.per_seek_std_deg.len() {
         t.row(&[
             format!("{}", k + 1),
             format!("{:.4}", r.uncompensated.per_seek_std_deg[k]),
             format!("{:+.4}", r.uncompensated.per_seek_mean_error_deg[k]),
-            format!("{:.4}", r.compensated.per_seek_std_deg.get(k).copied().unwrap_or(f64::NAN)),
-            format!("{:+.4}", r.compensated.per_seek_mean_error_deg.get(k).copied().unwrap_or(f64::NAN)),
+            format!(
+                "{:.4}",
+                r.compensated
+                    .per_seek_std_deg
+                    .get(k)
+                    .copied()
+                    .unwrap_or(f64::NAN)
+            ),
+            format!(
+                "{:+.4}",
+                r.compensated
+                    .per_seek_mean_error_deg
+                    .get(k)
+                    .copied()
+                    .unwrap_or(f64::NAN)
+            ),
         ]);
     }
     t.row(&[
@@ -446,7 +538,13 @@ mod tests {
 
     #[test]
     fn stats_of_known_seeks() {
-        let s = |a: f64| SeekOutcome { azimuth_deg: a, sigma_deg: 0.01, t_start_s: 0.0, duration_s: 290.0, main_dwell_s: 120.0 };
+        let s = |a: f64| SeekOutcome {
+            azimuth_deg: a,
+            sigma_deg: 0.01,
+            t_start_s: 0.0,
+            duration_s: 290.0,
+            main_dwell_s: 120.0,
+        };
         let seeks = vec![vec![s(108.5), s(108.4)], vec![s(108.3), s(108.4)]];
         let st = seek_stats(&seeks, 108.4);
         assert!((st.mean_error_deg).abs() < 1e-9);

@@ -44,11 +44,21 @@ pub struct Series {
 impl Series {
     /// A line series.
     pub fn line(label: impl Into<String>, points: Vec<(f64, f64)>, color: usize) -> Self {
-        Self { label: label.into(), points, mark: Mark::Line, color }
+        Self {
+            label: label.into(),
+            points,
+            mark: Mark::Line,
+            color,
+        }
     }
     /// A point (scatter) series.
     pub fn points(label: impl Into<String>, points: Vec<(f64, f64)>, color: usize) -> Self {
-        Self { label: label.into(), points, mark: Mark::Points, color }
+        Self {
+            label: label.into(),
+            points,
+            mark: Mark::Points,
+            color,
+        }
     }
 }
 
@@ -79,15 +89,22 @@ pub enum PlotError {
     /// plotters failed while drawing.
     Draw { title: String, message: String },
     /// Writing the SVG file failed.
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
 }
 
 impl fmt::Display for PlotError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             PlotError::NoData { title } => write!(f, "chart '{title}': no plottable data"),
-            PlotError::Draw { title, message } => write!(f, "chart '{title}': drawing failed: {message}"),
-            PlotError::Io { path, source } => write!(f, "{}: cannot write chart: {source}", path.display()),
+            PlotError::Draw { title, message } => {
+                write!(f, "chart '{title}': drawing failed: {message}")
+            }
+            PlotError::Io { path, source } => {
+                write!(f, "{}: cannot write chart: {source}", path.display())
+            }
         }
     }
 }
@@ -127,7 +144,11 @@ fn axis_range(values: impl Iterator<Item = f64>, log: bool) -> Option<(f64, f64)
         return Some((lo / pad, hi * pad));
     }
     let span = hi - lo;
-    let pad = if span > 0.0 { 0.05 * span } else { lo.abs().max(1.0) * 0.05 };
+    let pad = if span > 0.0 {
+        0.05 * span
+    } else {
+        lo.abs().max(1.0) * 0.05
+    };
     Some((lo - pad, hi + pad))
 }
 
@@ -136,16 +157,32 @@ fn plottable(chart: &Chart, (x, y): (f64, f64)) -> bool {
 }
 
 fn draw_err(chart: &Chart, e: impl fmt::Display) -> PlotError {
-    PlotError::Draw { title: chart.title.clone(), message: e.to_string() }
+    PlotError::Draw {
+        title: chart.title.clone(),
+        message: e.to_string(),
+    }
 }
 
 /// Renders `chart` to an SVG document.
 pub fn render_svg(chart: &Chart) -> Result<String, PlotError> {
-    let pts = || chart.series.iter().flat_map(|s| s.points.iter().copied()).filter(|p| plottable(chart, *p));
-    let no_data = || PlotError::NoData { title: chart.title.clone() };
+    let pts = || {
+        chart
+            .series
+            .iter()
+            .flat_map(|s| s.points.iter().copied())
+            .filter(|p| plottable(chart, *p))
+    };
+    let no_data = || PlotError::NoData {
+        title: chart.title.clone(),
+    };
     let x = axis_range(pts().map(|p| p.0), chart.x_log).ok_or_else(no_data)?;
-    let y = axis_range(pts().map(|p| p.1).chain(chart.ref_lines.iter().map(|r| r.y)), chart.y_log)
-        .ok_or_else(no_data)?;
+    let y = axis_range(
+        pts()
+            .map(|p| p.1)
+            .chain(chart.ref_lines.iter().map(|r| r.y)),
+        chart.y_log,
+    )
+    .ok_or_else(no_data)?;
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, CHART_SIZE_PX).into_drawing_area();
@@ -187,33 +224,54 @@ where
         .draw()
         .map_err(|e| draw_err(chart, e))?;
     let x_span = || {
-        let xs = chart.series.iter().flat_map(|s| s.points.iter()).filter(|p| plottable(chart, **p));
-        xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.0), hi.max(p.0)))
+        let xs = chart
+            .series
+            .iter()
+            .flat_map(|s| s.points.iter())
+            .filter(|p| plottable(chart, **p));
+        xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p.0), hi.max(p.0))
+        })
     };
     let mut has_legend = false;
     for r in &chart.ref_lines {
         let (x0, x1) = x_span();
         let style = BLACK.mix(0.6).stroke_width(1);
-        let anno = ctx.draw_series(LineSeries::new([(x0, r.y), (x1, r.y)], style)).map_err(|e| draw_err(chart, e))?;
+        let anno = ctx
+            .draw_series(LineSeries::new([(x0, r.y), (x1, r.y)], style))
+            .map_err(|e| draw_err(chart, e))?;
         if !r.label.is_empty() {
             has_legend = true;
-            anno.label(r.label.as_str())
-                .legend(move |(lx, ly)| PathElement::new([(lx, ly), (lx + 20, ly)], BLACK.mix(0.6)));
+            anno.label(r.label.as_str()).legend(move |(lx, ly)| {
+                PathElement::new([(lx, ly), (lx + 20, ly)], BLACK.mix(0.6))
+            });
         }
     }
     for s in &chart.series {
         let color = palette(s.color);
-        let points: Vec<(f64, f64)> = s.points.iter().copied().filter(|p| plottable(chart, *p)).collect();
+        let points: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .copied()
+            .filter(|p| plottable(chart, *p))
+            .collect();
         let anno = match s.mark {
             Mark::Line => ctx.draw_series(LineSeries::new(points, color.stroke_width(2))),
-            Mark::ThinLine => ctx.draw_series(LineSeries::new(points, color.mix(0.5).stroke_width(1))),
-            Mark::Points => ctx.draw_series(points.into_iter().map(|p| Circle::new(p, 3, color.filled()))),
+            Mark::ThinLine => {
+                ctx.draw_series(LineSeries::new(points, color.mix(0.5).stroke_width(1)))
+            }
+            Mark::Points => ctx.draw_series(
+                points
+                    .into_iter()
+                    .map(|p| Circle::new(p, 3, color.filled())),
+            ),
         }
         .map_err(|e| draw_err(chart, e))?;
         if !s.label.is_empty() {
             has_legend = true;
-            anno.label(s.label.as_str())
-                .legend(move |(lx, ly)| PathElement::new([(lx, ly), (lx + 20, ly)], color.stroke_width(2)));
+            anno.label(s.label.as_str()).legend(move |(lx, ly)| {
+                PathElement::new([(lx, ly), (lx + 20, ly)], color.stroke_width(2))
+            });
         }
     }
     if has_legend {
@@ -230,7 +288,10 @@ where
 /// Renders `chart` and writes it to `path` atomically (temp file in the same directory, then rename).
 pub fn write_svg(path: &Path, chart: &Chart) -> Result<(), PlotError> {
     let svg = render_svg(chart)?;
-    crate::report::write_atomic(path, svg.as_bytes()).map_err(|source| PlotError::Io { path: path.to_path_buf(), source })
+    crate::report::write_atomic(path, svg.as_bytes()).map_err(|source| PlotError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -258,8 +319,14 @@ pub fn startup_chart(title: &str, curves: &[StartupCurve], spec_dph: Option<f64>
     let ref_lines = spec_dph
         .map(|s| {
             vec![
-                RefLine { label: format!("+/- spec {s} deg/h"), y: s },
-                RefLine { label: String::new(), y: -s },
+                RefLine {
+                    label: format!("+/- spec {s} deg/h"),
+                    y: s,
+                },
+                RefLine {
+                    label: String::new(),
+                    y: -s,
+                },
             ]
         })
         .unwrap_or_default();
@@ -293,7 +360,11 @@ pub fn temperature_chart(title: &str, runs: &[(String, Vec<f64>, Vec<f64>)]) -> 
 pub fn allan_chart(title: &str, tau_s: &[f64], adev_dph: &[f64], fits: Vec<Series>) -> Chart {
     let mut series = vec![Series {
         label: "overlapping Allan deviation".into(),
-        points: tau_s.iter().copied().zip(adev_dph.iter().copied()).collect(),
+        points: tau_s
+            .iter()
+            .copied()
+            .zip(adev_dph.iter().copied())
+            .collect(),
         mark: Mark::Points,
         color: 0,
     }];
@@ -331,7 +402,10 @@ pub fn azimuth_scatter_chart(
             Series::points("uncompensated", shift(uncompensated, -0.12), 1),
             Series::points("compensated", shift(compensated, 0.12), 0),
         ],
-        ref_lines: vec![RefLine { label: format!("true azimuth {true_azimuth_deg:.3} deg"), y: true_azimuth_deg }],
+        ref_lines: vec![RefLine {
+            label: format!("true azimuth {true_azimuth_deg:.3} deg"),
+            y: true_azimuth_deg,
+        }],
         ..Chart::default()
     }
 }
@@ -344,7 +418,11 @@ mod tests {
     fn renders_linear_and_log_charts() {
         let mut chart = Chart {
             title: "t".into(),
-            series: vec![Series::line("a", vec![(1.0, 2.0), (10.0, 3.0), (100.0, 0.5)], 0)],
+            series: vec![Series::line(
+                "a",
+                vec![(1.0, 2.0), (10.0, 3.0), (100.0, 0.5)],
+                0,
+            )],
             ..Chart::default()
         };
         let lin = render_svg(&chart).unwrap();

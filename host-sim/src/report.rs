@@ -15,7 +15,10 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "out".into());
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
     let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
@@ -33,7 +36,8 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 pub fn write_json<T: Serialize>(path: &Path, value: &T) -> anyhow::Result<()> {
     let mut text = serde_json::to_string_pretty(value)?;
     text.push('\n');
-    write_atomic(path, text.as_bytes()).map_err(|e| anyhow::anyhow!("{}: cannot write JSON report: {e}", path.display()))
+    write_atomic(path, text.as_bytes())
+        .map_err(|e| anyhow::anyhow!("{}: cannot write JSON report: {e}", path.display()))
 }
 
 /// Fails early (before any long computation) if `path` cannot be created: its directory must exist.
@@ -43,17 +47,25 @@ pub fn check_output_path(path: &Path, option: &str) -> anyhow::Result<()> {
         _ => Path::new("."),
     };
     if !dir.is_dir() {
-        anyhow::bail!("{option} {}: directory {} does not exist", path.display(), dir.display());
+        anyhow::bail!(
+            "{option} {}: directory {} does not exist",
+            path.display(),
+            dir.display()
+        );
     }
     if path.is_dir() {
-        anyhow::bail!("{option} {}: is a directory, expected a file name", path.display());
+        anyhow::bail!(
+            "{option} {}: is a directory, expected a file name",
+            path.display()
+        );
     }
     Ok(())
 }
 
 /// Creates a plot directory (and parents) up front, with the option name in the error.
 pub fn ensure_dir(dir: &Path, option: &str) -> anyhow::Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{option} {}: cannot create directory: {e}", dir.display()))
+    std::fs::create_dir_all(dir)
+        .map_err(|e| anyhow::anyhow!("{option} {}: cannot create directory: {e}", dir.display()))
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -167,17 +179,27 @@ pub struct Table {
 impl Table {
     /// A table with these column headings.
     pub fn new<S: ToString>(header: &[S]) -> Self {
-        Self { header: header.iter().map(|h| h.to_string()).collect(), rows: Vec::new() }
+        Self {
+            header: header.iter().map(|h| h.to_string()).collect(),
+            rows: Vec::new(),
+        }
     }
 
     /// Appends one row (cells beyond the header are kept, missing ones are blank).
     pub fn row<S: ToString>(&mut self, cells: &[S]) {
-        self.rows.push(cells.iter().map(|c| c.to_string()).collect());
+        self.rows
+            .push(cells.iter().map(|c| c.to_string()).collect());
     }
 
     /// Renders the table with a rule under the header.
     pub fn render(&self) -> String {
-        let ncol = self.rows.iter().map(Vec::len).chain([self.header.len()]).max().unwrap_or(0);
+        let ncol = self
+            .rows
+            .iter()
+            .map(Vec::len)
+            .chain([self.header.len()])
+            .max()
+            .unwrap_or(0);
         let width = |c: usize| {
             self.rows
                 .iter()
@@ -216,7 +238,9 @@ impl Table {
 /// A progress bar on stderr for `len` steps (hidden automatically when stderr is not a terminal).
 pub fn progress_bar(len: usize, message: &str) -> indicatif::ProgressBar {
     let bar = indicatif::ProgressBar::new(len as u64);
-    if let Ok(style) = indicatif::ProgressStyle::with_template("{msg:<28} [{bar:40}] {pos}/{len} {elapsed_precise}") {
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "{msg:<28} [{bar:40}] {pos}/{len} {elapsed_precise}",
+    ) {
         bar.set_style(style.progress_chars("=> "));
     }
     bar.set_message(message.to_string());

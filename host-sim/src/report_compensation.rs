@@ -43,7 +43,11 @@ pub struct CompensatedSeries {
 pub fn drift_stats(t_s: &[f64], drift_dph: &[f64]) -> DriftStats {
     DriftStats {
         std_dph: metrics::std_dev(drift_dph),
-        max_dev_dph: if drift_dph.is_empty() { 0.0 } else { metrics::max_deviation(t_s, drift_dph) },
+        max_dev_dph: if drift_dph.is_empty() {
+            0.0
+        } else {
+            metrics::max_deviation(t_s, drift_dph)
+        },
         time_to_spec_s: metrics::time_to_spec_s(t_s, drift_dph, metrics::SPEC_DPH),
     }
 }
@@ -53,7 +57,9 @@ pub fn drift_stats(t_s: &[f64], drift_dph: &[f64]) -> DriftStats {
 pub fn pooled_stats(series: &[(&[f64], &[f64])]) -> DriftStats {
     let groups: Vec<&[f64]> = series.iter().map(|(_, y)| *y).collect();
     let each: Vec<DriftStats> = series.iter().map(|(t, y)| drift_stats(t, y)).collect();
-    let worst_time = each.iter().try_fold(0.0f64, |acc, s| s.time_to_spec_s.map(|t| acc.max(t)));
+    let worst_time = each
+        .iter()
+        .try_fold(0.0f64, |acc, s| s.time_to_spec_s.map(|t| acc.max(t)));
     DriftStats {
         std_dph: metrics::pooled_std(&groups),
         max_dev_dph: each.iter().map(|s| s.max_dev_dph).fold(0.0, f64::max),
@@ -76,15 +82,20 @@ pub fn check_model_inputs(model: &RbfModel, model_name: &str) -> Result<()> {
 pub fn compensate_run(run: &Run, model: Option<&RbfModel>) -> Result<CompensatedSeries> {
     let name = run.path.display();
     let period_s = run.sample_period_s();
-    if run.len() < 2 || !(period_s > 0.0) {
+    if run.len() < 2 || period_s.is_nan() || period_s <= 0.0 {
         bail!("{name}: needs at least two rows to compensate");
     }
     if period_s > WINDOW_S as f64 * 1.01 {
         bail!("{name}: sample period {period_s} s is longer than the {WINDOW_S} s window; 10 s means cannot be formed");
     }
     let rate_hz = (1.0 / period_s) as f32;
-    let cfg = CompensatorConfig { gyro_rate_hz: rate_hz, temp_rate_hz: rate_hz, ..CompensatorConfig::default() };
-    let mut comp = Compensator::new(cfg, model.cloned()).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+    let cfg = CompensatorConfig {
+        gyro_rate_hz: rate_hz,
+        temp_rate_hz: rate_hz,
+        ..CompensatorConfig::default()
+    };
+    let mut comp =
+        Compensator::new(cfg, model.cloned()).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
     let drift = run.drift_dph();
     let mut out = CompensatedSeries::default();
     let take = |w: fog_core::compensator::WindowResult, out: &mut CompensatedSeries| {
@@ -98,7 +109,10 @@ pub fn compensate_run(run: &Run, model: Option<&RbfModel>) -> Result<Compensated
             out.after_t_s.push(w.t_end_s);
             out.after_dph.push(w.compensated_dph as f64);
             out.predicted_dph.push(w.drift_dph as f64);
-            if matches!(w.status, fog_core::compensator::WindowStatus::InputOutOfRange { .. }) {
+            if matches!(
+                w.status,
+                fog_core::compensator::WindowStatus::InputOutOfRange { .. }
+            ) {
                 out.out_of_range_windows += 1;
             }
         } else {
@@ -107,8 +121,14 @@ pub fn compensate_run(run: &Run, model: Option<&RbfModel>) -> Result<Compensated
     };
     for ((&t, &temp), &d) in run.t_s().iter().zip(run.temp_c()).zip(&drift) {
         let t_mid = t - 0.5 * period_s;
-        comp.push_temp(TempSample { t_s: t_mid, temp_c: temp as f32 });
-        if let Some(w) = comp.push_gyro(GyroSample { t_s: t_mid, rate_dph: d as f32 }) {
+        comp.push_temp(TempSample {
+            t_s: t_mid,
+            temp_c: temp as f32,
+        });
+        if let Some(w) = comp.push_gyro(GyroSample {
+            t_s: t_mid,
+            rate_dph: d as f32,
+        }) {
             take(w, &mut out);
         }
     }
@@ -130,7 +150,11 @@ mod tests {
         Run::new(
             "mem.csv",
             vec![("ambient_c".into(), "20".into())],
-            vec![("t_s".into(), t.to_vec()), ("rate_dph".into(), rate.to_vec()), ("temp_c".into(), temp.to_vec())],
+            vec![
+                ("t_s".into(), t.to_vec()),
+                ("rate_dph".into(), rate.to_vec()),
+                ("temp_c".into(), temp.to_vec()),
+            ],
         )
         .unwrap()
     }
@@ -163,7 +187,10 @@ mod tests {
     fn pooled_stats_take_the_worst_run() {
         let t: Vec<f64> = (1..=270).map(|i| i as f64 * 10.0).collect();
         let flat = vec![0.0; 270];
-        let late: Vec<f64> = t.iter().map(|&t| if t <= 600.0 { 0.1 } else { 0.0 }).collect();
+        let late: Vec<f64> = t
+            .iter()
+            .map(|&t| if t <= 600.0 { 0.1 } else { 0.0 })
+            .collect();
         let p = pooled_stats(&[(&t, &flat), (&t, &late)]);
         assert!((p.time_to_spec_s.unwrap() - 590.0).abs() < 1e-9);
         assert!((p.max_dev_dph - 0.1).abs() < 1e-12);

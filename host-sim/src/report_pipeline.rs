@@ -8,16 +8,21 @@ use std::path::Path;
 use anyhow::{anyhow, bail, Context, Result};
 use fog_core::model::{FeatureSpec, RbfModel, MAX_ENCODED_LEN};
 
-use crate::runs::Run;
 pub use crate::campaign::CampaignSpec;
+use crate::runs::Run;
 use crate::sim::GyroParams;
 use crate::train::{dataset_from_runs, train_model, TrainConfig, TrainOutcome};
 
 /// Reads and validates a fog-core model file (postcard, as written by `fogsim train`).
 pub fn read_model(path: &Path) -> Result<RbfModel> {
-    let bytes = std::fs::read(path).map_err(|e| anyhow!("--model {}: cannot read: {e}", path.display()))?;
+    let bytes =
+        std::fs::read(path).map_err(|e| anyhow!("--model {}: cannot read: {e}", path.display()))?;
     if bytes.len() > MAX_ENCODED_LEN {
-        bail!("--model {}: {} bytes, a model is at most {MAX_ENCODED_LEN} bytes", path.display(), bytes.len());
+        bail!(
+            "--model {}: {} bytes, a model is at most {MAX_ENCODED_LEN} bytes",
+            path.display(),
+            bytes.len()
+        );
     }
     RbfModel::decode(&bytes).map_err(|e| anyhow!("--model {}: {e}", path.display()))
 }
@@ -36,11 +41,18 @@ pub fn validate_plan(plan: &CampaignSpec) -> Result<()> {
     if plan.ambients_c.is_empty() {
         bail!("--ambient: at least one temperature is needed");
     }
-    if let Some(a) = plan.ambients_c.iter().find(|a| !(a.is_finite() && (-60.0..=100.0).contains(*a))) {
+    if let Some(a) = plan
+        .ambients_c
+        .iter()
+        .find(|a| !(a.is_finite() && (-60.0..=100.0).contains(*a)))
+    {
         bail!("--ambient {a}: must be within -60..=100 degC");
     }
     if !(plan.minutes.is_finite() && plan.minutes > 0.0) {
-        bail!("--minutes {}: must be a positive number of minutes", plan.minutes);
+        bail!(
+            "--minutes {}: must be a positive number of minutes",
+            plan.minutes
+        );
     }
     if plan.runs_per_ambient == 0 {
         bail!("--runs: must be at least 1");
@@ -52,17 +64,25 @@ pub fn validate_plan(plan: &CampaignSpec) -> Result<()> {
 /// `fogsim campaign --seed`), tagging each run with its ambient and 1-based index.
 pub fn simulate_campaign(params: &GyroParams, plan: &CampaignSpec) -> Result<Vec<CampaignRun>> {
     validate_plan(plan)?;
-    let runs = crate::campaign::simulate_campaign(params, plan).map_err(|e| anyhow!("campaign: {e}"))?;
+    let runs =
+        crate::campaign::simulate_campaign(params, plan).map_err(|e| anyhow!("campaign: {e}"))?;
     let per = plan.runs_per_ambient;
     Ok(runs
         .into_iter()
         .enumerate()
-        .map(|(k, (_, run))| CampaignRun { ambient_c: plan.ambients_c[k / per], index: k % per + 1, run })
+        .map(|(k, (_, run))| CampaignRun {
+            ambient_c: plan.ambients_c[k / per],
+            index: k % per + 1,
+            run,
+        })
         .collect())
 }
 
 /// Splits a campaign: runs 1..=`n_train` of each temperature train, the others validate.
-pub fn split_train_validate(campaign: &[CampaignRun], n_train: usize) -> (Vec<&CampaignRun>, Vec<&CampaignRun>) {
+pub fn split_train_validate(
+    campaign: &[CampaignRun],
+    n_train: usize,
+) -> (Vec<&CampaignRun>, Vec<&CampaignRun>) {
     campaign.iter().partition(|r| r.index <= n_train)
 }
 
@@ -71,6 +91,11 @@ pub fn split_train_validate(campaign: &[CampaignRun], n_train: usize) -> (Vec<&C
 pub fn train_default(runs: &[&Run], specs: &[FeatureSpec], gyro_id: &str) -> Result<TrainOutcome> {
     let owned: Vec<Run> = runs.iter().map(|r| (*r).clone()).collect();
     let ds = dataset_from_runs(&owned, specs).map_err(|e| anyhow!("training: {e}"))?;
-    let cfg = TrainConfig { gyro_id: gyro_id.chars().take(16).collect(), ..TrainConfig::default() };
-    train_model(&ds, &cfg).map_err(|e| anyhow!("training: {e}")).context("training the default model")
+    let cfg = TrainConfig {
+        gyro_id: gyro_id.chars().take(16).collect(),
+        ..TrainConfig::default()
+    };
+    train_model(&ds, &cfg)
+        .map_err(|e| anyhow!("training: {e}"))
+        .context("training the default model")
 }

@@ -10,11 +10,17 @@ use serde::Serialize;
 
 use crate::cmd::compensate::{compensate_all, compensate_table, write_startup_plots};
 use crate::metrics::{self, SPEC_DPH};
-use crate::northseek::{build_report, run_monte_carlo, seek_table, MonteCarloConfig, PAPER_SEEK_DURATION_S};
+use crate::northseek::{
+    build_report, run_monte_carlo, seek_table, MonteCarloConfig, PAPER_SEEK_DURATION_S,
+};
 use crate::plots::{allan_chart, azimuth_scatter_chart, temperature_chart, write_svg, Series};
-use crate::report::{fmt_minutes, progress_bar, CompensateReport, DriftStats, NorthSeekReport, Table};
+use crate::report::{
+    fmt_minutes, progress_bar, CompensateReport, DriftStats, NorthSeekReport, Table,
+};
 use crate::report_compensation::{pooled_stats, CompensatedSeries};
-use crate::report_pipeline::{simulate_campaign, split_train_validate, train_default, CampaignRun, CampaignSpec};
+use crate::report_pipeline::{
+    simulate_campaign, split_train_validate, train_default, CampaignRun, CampaignSpec,
+};
 use crate::runs::Run;
 use crate::sim::{GyroParams, RunSpec, SimGyro, StartState};
 use crate::train::{default_specs, TrainReport};
@@ -33,8 +39,14 @@ pub struct ReproduceOptions {
 /// The model inputs compared: the paper's (T, dT/dt) and this project's (T, dT/dt, d2T/dt2).
 pub fn input_variants() -> Vec<(&'static str, Vec<FeatureSpec>)> {
     let mut extended = default_specs();
-    extended.push(FeatureSpec { kind: FeatureKind::TempAccelCps2, tau_s: 0.0 });
-    vec![("paper inputs (T, dT/dt)", default_specs()), ("extended inputs (T, dT/dt, d2T/dt2)", extended)]
+    extended.push(FeatureSpec {
+        kind: FeatureKind::TempAccelCps2,
+        tau_s: 0.0,
+    });
+    vec![
+        ("paper inputs (T, dT/dt)", default_specs()),
+        ("extended inputs (T, dT/dt, d2T/dt2)", extended),
+    ]
 }
 
 /// Held-out figures of one ambient temperature (runs pooled).
@@ -124,17 +136,38 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
     let mut models = Vec::new();
     for (k, (label, trained, validation, series)) in fitted.into_iter().enumerate() {
         let per_ambient = per_ambient_results(&plan.ambients_c, &heldout, &series);
-        let bar = progress_bar(opts.north_seek.starts, &format!("north seek, model {}/{}", k + 1, variants.len()));
+        let bar = progress_bar(
+            opts.north_seek.starts,
+            &format!("north seek, model {}/{}", k + 1, variants.len()),
+        );
         let outcomes = run_monte_carlo(params, &opts.north_seek, &trained.model, &|| bar.inc(1))?;
         bar.finish_and_clear();
-        let source = format!("{label}, trained on runs 1-{} of every campaign temperature", opts.n_train);
+        let source = format!(
+            "{label}, trained on runs 1-{} of every campaign temperature",
+            opts.n_train
+        );
         let north_seek = build_report(params, &opts.north_seek, &outcomes, &source);
         if let Some(dir) = &opts.plots {
             let tag = if k == 0 { "" } else { "_extended" };
-            write_model_plots(dir, &heldout, &series, &north_seek, opts.north_seek.ambient_c, &label, tag)?;
+            write_model_plots(
+                dir,
+                &heldout,
+                &series,
+                &north_seek,
+                opts.north_seek.ambient_c,
+                &label,
+                tag,
+            )?;
         }
         let targets = measure_targets(&per_ambient, &north_seek);
-        models.push(ModelResult { label, training: trained.report, per_ambient, validation, north_seek, targets });
+        models.push(ModelResult {
+            label,
+            training: trained.report,
+            per_ambient,
+            validation,
+            north_seek,
+            targets,
+        });
     }
     if let Some(dir) = &opts.plots {
         write_campaign_plots(dir, params, &campaign)?;
@@ -152,22 +185,45 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
 }
 
 /// Held-out figures per ambient, the runs of one temperature pooled.
-fn per_ambient_results(ambients_c: &[f64], heldout: &[&CampaignRun], series: &[CompensatedSeries]) -> Vec<AmbientResult> {
+fn per_ambient_results(
+    ambients_c: &[f64],
+    heldout: &[&CampaignRun],
+    series: &[CompensatedSeries],
+) -> Vec<AmbientResult> {
     ambients_c
         .iter()
         .map(|&a| {
-            let idx: Vec<usize> = (0..heldout.len()).filter(|&i| heldout[i].ambient_c == a).collect();
-            let before: Vec<(&[f64], &[f64])> = idx.iter().map(|&i| (&series[i].t_s[..], &series[i].before_dph[..])).collect();
-            let after: Vec<(&[f64], &[f64])> =
-                idx.iter().map(|&i| (&series[i].after_t_s[..], &series[i].after_dph[..])).collect();
-            AmbientResult { ambient_c: a, heldout_runs: idx.len(), before: pooled_stats(&before), after: pooled_stats(&after) }
+            let idx: Vec<usize> = (0..heldout.len())
+                .filter(|&i| heldout[i].ambient_c == a)
+                .collect();
+            let before: Vec<(&[f64], &[f64])> = idx
+                .iter()
+                .map(|&i| (&series[i].t_s[..], &series[i].before_dph[..]))
+                .collect();
+            let after: Vec<(&[f64], &[f64])> = idx
+                .iter()
+                .map(|&i| (&series[i].after_t_s[..], &series[i].after_dph[..]))
+                .collect();
+            AmbientResult {
+                ambient_c: a,
+                heldout_runs: idx.len(),
+                before: pooled_stats(&before),
+                after: pooled_stats(&after),
+            }
         })
         .collect()
 }
 
 fn measure_targets(per_ambient: &[AmbientResult], ns: &NorthSeekReport) -> Targets {
-    let worst_after = per_ambient.iter().map(|a| a.after.std_dph).fold(0.0, f64::max);
-    let worst_time = |f: fn(&AmbientResult) -> Option<f64>| per_ambient.iter().try_fold(0.0f64, |m, a| f(a).map(|t| m.max(t)));
+    let worst_after = per_ambient
+        .iter()
+        .map(|a| a.after.std_dph)
+        .fold(0.0, f64::max);
+    let worst_time = |f: fn(&AmbientResult) -> Option<f64>| {
+        per_ambient
+            .iter()
+            .try_fold(0.0f64, |m, a| f(a).map(|t| m.max(t)))
+    };
     let ratio = ns.compensated.std_deg / ns.noise_floor_deg;
     Targets {
         worst_heldout_after_std_dph: worst_after,
@@ -184,37 +240,120 @@ fn measure_targets(per_ambient: &[AmbientResult], ns: &NorthSeekReport) -> Targe
 }
 
 fn compare(models: &[ModelResult], room_c: f64) -> Vec<Comparison> {
-    let row = |q: String, p: &str, us: Vec<String>| Comparison { quantity: q, paper: p.into(), this_project: us.join(" | ") };
+    let row = |q: String, p: &str, us: Vec<String>| Comparison {
+        quantity: q,
+        paper: p.into(),
+        this_project: us.join(" | "),
+    };
     let f4 = |v: f64| format!("{v:.4}");
-    let each = |f: &dyn Fn(&ModelResult) -> String| -> Vec<String> { models.iter().map(f).collect() };
+    let each =
+        |f: &dyn Fn(&ModelResult) -> String| -> Vec<String> { models.iter().map(f).collect() };
     let room = |m: &ModelResult| -> AmbientResult {
-        m.per_ambient.iter().find(|a| a.ambient_c == room_c).or(m.per_ambient.first()).cloned().expect("at least one ambient")
+        m.per_ambient
+            .iter()
+            .find(|a| a.ambient_c == room_c)
+            .or(m.per_ambient.first())
+            .cloned()
+            .expect("at least one ambient")
     };
     let at = format!(" ({room_c} degC, held out)");
     let ns = |m: &ModelResult| m.north_seek.clone();
     vec![
-        row(format!("uncompensated largest startup deviation, deg/h{at}"), "0.17", each(&|m| f4(room(m).before.max_dev_dph))),
-        row(format!("uncompensated time until 10 s std within spec{at}"), "15 min", each(&|m| fmt_minutes(room(m).before.time_to_spec_s))),
-        row(format!("compensated startup drift 1 sigma, deg/h{at}"), "0.020 / 0.021", each(&|m| f4(room(m).after.std_dph))),
-        row(format!("compensated largest startup deviation, deg/h{at}"), "-", each(&|m| f4(room(m).after.max_dev_dph))),
-        row(format!("compensated time until within spec{at}"), "~0", each(&|m| fmt_minutes(room(m).after.time_to_spec_s))),
-        row("worst held-out compensated 1 sigma over all ambients, deg/h".into(), "(20 degC only)", each(&|m| f4(m.targets.worst_heldout_after_std_dph))),
-        row("neurons selected by OLS".into(), "35 / 37", each(&|m| m.training.n_centers.to_string())),
-        row("north seek: cold starts x seeks".into(), "1 x 6", each(&|m| format!("{} x {}", ns(m).starts, ns(m).seeks_per_start))),
-        row("north seek time per seek (longest), s".into(), "296", each(&|m| format!("{:.0}", ns(m).max_seek_duration_s))),
-        row("azimuth std over a start's 6 seeks, uncompensated, deg".into(), "0.034", each(&|m| f4(ns(m).uncompensated.mean_within_start_std_deg))),
-        row("azimuth std over a start's 6 seeks, compensated, deg".into(), "0.013", each(&|m| f4(ns(m).compensated.mean_within_start_std_deg))),
-        row("azimuth max - min of a start, uncompensated, deg".into(), "0.097", each(&|m| f4(ns(m).uncompensated.mean_range_deg))),
-        row("azimuth max - min of a start, compensated, deg".into(), "0.04", each(&|m| f4(ns(m).compensated.mean_range_deg))),
-        row("azimuth std of all seeks, uncompensated, deg".into(), "-", each(&|m| f4(ns(m).uncompensated.std_deg))),
-        row("azimuth std of all seeks, compensated, deg".into(), "-", each(&|m| f4(ns(m).compensated.std_deg))),
-        row("white-noise floor of the azimuth, deg".into(), "-", each(&|m| f4(ns(m).noise_floor_deg))),
+        row(
+            format!("uncompensated largest startup deviation, deg/h{at}"),
+            "0.17",
+            each(&|m| f4(room(m).before.max_dev_dph)),
+        ),
+        row(
+            format!("uncompensated time until 10 s std within spec{at}"),
+            "15 min",
+            each(&|m| fmt_minutes(room(m).before.time_to_spec_s)),
+        ),
+        row(
+            format!("compensated startup drift 1 sigma, deg/h{at}"),
+            "0.020 / 0.021",
+            each(&|m| f4(room(m).after.std_dph)),
+        ),
+        row(
+            format!("compensated largest startup deviation, deg/h{at}"),
+            "-",
+            each(&|m| f4(room(m).after.max_dev_dph)),
+        ),
+        row(
+            format!("compensated time until within spec{at}"),
+            "~0",
+            each(&|m| fmt_minutes(room(m).after.time_to_spec_s)),
+        ),
+        row(
+            "worst held-out compensated 1 sigma over all ambients, deg/h".into(),
+            "(20 degC only)",
+            each(&|m| f4(m.targets.worst_heldout_after_std_dph)),
+        ),
+        row(
+            "neurons selected by OLS".into(),
+            "35 / 37",
+            each(&|m| m.training.n_centers.to_string()),
+        ),
+        row(
+            "north seek: cold starts x seeks".into(),
+            "1 x 6",
+            each(&|m| format!("{} x {}", ns(m).starts, ns(m).seeks_per_start)),
+        ),
+        row(
+            "north seek time per seek (longest), s".into(),
+            "296",
+            each(&|m| format!("{:.0}", ns(m).max_seek_duration_s)),
+        ),
+        row(
+            "azimuth std over a start's 6 seeks, uncompensated, deg".into(),
+            "0.034",
+            each(&|m| f4(ns(m).uncompensated.mean_within_start_std_deg)),
+        ),
+        row(
+            "azimuth std over a start's 6 seeks, compensated, deg".into(),
+            "0.013",
+            each(&|m| f4(ns(m).compensated.mean_within_start_std_deg)),
+        ),
+        row(
+            "azimuth max - min of a start, uncompensated, deg".into(),
+            "0.097",
+            each(&|m| f4(ns(m).uncompensated.mean_range_deg)),
+        ),
+        row(
+            "azimuth max - min of a start, compensated, deg".into(),
+            "0.04",
+            each(&|m| f4(ns(m).compensated.mean_range_deg)),
+        ),
+        row(
+            "azimuth std of all seeks, uncompensated, deg".into(),
+            "-",
+            each(&|m| f4(ns(m).uncompensated.std_deg)),
+        ),
+        row(
+            "azimuth std of all seeks, compensated, deg".into(),
+            "-",
+            each(&|m| f4(ns(m).compensated.std_deg)),
+        ),
+        row(
+            "white-noise floor of the azimuth, deg".into(),
+            "-",
+            each(&|m| f4(ns(m).noise_floor_deg)),
+        ),
     ]
 }
 
 /// The human-readable summary of one model variant.
 fn model_summary(m: &ModelResult) -> String {
-    let mut amb = Table::new(&["ambient", "held-out runs", "std before", "std after", "max dev before", "max dev after", "to spec before", "to spec after"]);
+    let mut amb = Table::new(&[
+        "ambient",
+        "held-out runs",
+        "std before",
+        "std after",
+        "max dev before",
+        "max dev after",
+        "to spec before",
+        "to spec after",
+    ]);
     for a in &m.per_ambient {
         amb.row(&[
             format!("{:+.0} degC", a.ambient_c),
@@ -251,7 +390,11 @@ fn model_summary(m: &ModelResult) -> String {
         fmt_minutes(t.worst_time_to_spec_after_s),
         t.azimuth_std_over_floor,
         ok(t.azimuth_within_1_2x_floor),
-        t.first_seeks_uncomp_over_comp.iter().map(|v| format!("{v:.2}x")).collect::<Vec<_>>().join(", "),
+        t.first_seeks_uncomp_over_comp
+            .iter()
+            .map(|v| format!("{v:.2}x"))
+            .collect::<Vec<_>>()
+            .join(", "),
         ok(t.seek_time_within_paper),
     )
 }
@@ -259,7 +402,15 @@ fn model_summary(m: &ModelResult) -> String {
 /// The human-readable summary: per model variant the per-ambient table, the seek table and
 /// the targets; then paper vs this project.
 pub fn summary(r: &ReproduceReport) -> String {
-    let mut cmp = Table::new(&["quantity", "paper", &r.models.iter().map(|m| m.label.as_str()).collect::<Vec<_>>().join(" | ")]);
+    let mut cmp = Table::new(&[
+        "quantity",
+        "paper",
+        &r.models
+            .iter()
+            .map(|m| m.label.as_str())
+            .collect::<Vec<_>>()
+            .join(" | "),
+    ]);
     for c in &r.paper_vs_us {
         cmp.row(&[&c.quantity, &c.paper, &c.this_project]);
     }
@@ -278,7 +429,12 @@ pub fn summary(r: &ReproduceReport) -> String {
 
 /// Allan deviation of a steady (warm) record: 2 h at 10 Hz, input axis vertical.
 fn steady_allan(params: &GyroParams, seed: u64) -> Result<(Vec<f64>, Vec<f64>, Option<f64>)> {
-    let spec = RunSpec { minutes: 120.0, raw_rate_hz: 10.0, start: StartState::Warm, ..RunSpec::paper(20.0, seed) };
+    let spec = RunSpec {
+        minutes: 120.0,
+        raw_rate_hz: 10.0,
+        start: StartState::Warm,
+        ..RunSpec::paper(20.0, seed)
+    };
     let mut gyro = SimGyro::new(params, &spec).map_err(|e| anyhow!("simulator: {e}"))?;
     let n = (spec.minutes * 60.0 * spec.raw_rate_hz) as usize;
     let y: Vec<f64> = (0..n)
@@ -289,7 +445,11 @@ fn steady_allan(params: &GyroParams, seed: u64) -> Result<(Vec<f64>, Vec<f64>, O
         .collect();
     let adev = metrics::allan_deviation(&y, 1.0 / spec.raw_rate_hz);
     let arw = metrics::arw_dpsh(&adev);
-    Ok((adev.iter().map(|p| p.tau_s).collect(), adev.iter().map(|p| p.adev_dph).collect(), arw))
+    Ok((
+        adev.iter().map(|p| p.tau_s).collect(),
+        adev.iter().map(|p| p.adev_dph).collect(),
+        arw,
+    ))
 }
 
 /// Plots of one model variant: startup before/after at room temperature and the azimuths.
@@ -303,7 +463,11 @@ fn write_model_plots(
     tag: &str,
 ) -> Result<()> {
     let sub = dir.join(format!("model{tag}"));
-    let target = if tag.is_empty() { dir.to_path_buf() } else { sub };
+    let target = if tag.is_empty() {
+        dir.to_path_buf()
+    } else {
+        sub
+    };
     crate::report::ensure_dir(&target, "--plots")?;
     let (room_runs, room_series): (Vec<Run>, Vec<_>) = heldout
         .iter()
@@ -312,13 +476,23 @@ fn write_model_plots(
         .map(|(c, s)| (c.run.clone(), s.clone()))
         .unzip();
     if !room_runs.is_empty() {
-        write_startup_plots(&target, &room_runs, &room_series, &format!(" ({room_c} degC, held out, {label})"))?;
+        write_startup_plots(
+            &target,
+            &room_runs,
+            &room_series,
+            &format!(" ({room_c} degC, held out, {label})"),
+        )?;
     }
     let pts = |az: &Vec<Vec<f64>>| -> Vec<(usize, f64)> {
-        az.iter().flat_map(|s| s.iter().enumerate().map(|(k, a)| (k + 1, *a))).collect()
+        az.iter()
+            .flat_map(|s| s.iter().enumerate().map(|(k, a)| (k + 1, *a)))
+            .collect()
     };
     let chart = azimuth_scatter_chart(
-        &format!("north seek after a cold start, {} starts x {} seeks ({label})", ns.starts, ns.seeks_per_start),
+        &format!(
+            "north seek after a cold start, {} starts x {} seeks ({label})",
+            ns.starts, ns.seeks_per_start
+        ),
         ns.true_azimuth_deg,
         &pts(&ns.uncompensated.azimuths_deg),
         &pts(&ns.compensated.azimuths_deg),
@@ -333,20 +507,50 @@ fn write_campaign_plots(dir: &Path, params: &GyroParams, campaign: &[CampaignRun
     let temps: Vec<(String, Vec<f64>, Vec<f64>)> = campaign
         .iter()
         .filter(|c| c.index == 1)
-        .map(|c| (format!("{:+.0} degC", c.ambient_c), c.run.t_s().to_vec(), c.run.temp_c().to_vec()))
+        .map(|c| {
+            (
+                format!("{:+.0} degC", c.ambient_c),
+                c.run.t_s().to_vec(),
+                c.run.temp_c().to_vec(),
+            )
+        })
         .collect();
-    write_svg(&dir.join("temperature.svg"), &temperature_chart("gyro temperature after power-on", &temps))?;
+    write_svg(
+        &dir.join("temperature.svg"),
+        &temperature_chart("gyro temperature after power-on", &temps),
+    )?;
     let (tau, adev, arw) = steady_allan(params, 7)?;
     let mut fits = Vec::new();
     if let Some(n) = arw {
         let line = tau.iter().map(|&t| (t, n / (t / 3600.0).sqrt())).collect();
-        fits.push(Series::line(format!("ARW {n:.5} deg/sqrt(h) (slope -1/2)"), line, 1));
+        fits.push(Series::line(
+            format!("ARW {n:.5} deg/sqrt(h) (slope -1/2)"),
+            line,
+            1,
+        ));
     }
-    write_svg(&dir.join("allan.svg"), &allan_chart("Allan deviation, steady 2 h record (20 degC)", &tau, &adev, fits))?;
+    write_svg(
+        &dir.join("allan.svg"),
+        &allan_chart(
+            "Allan deviation, steady 2 h record (20 degC)",
+            &tau,
+            &adev,
+            fits,
+        ),
+    )?;
     Ok(())
 }
 
 /// The per-run held-out tables of every model variant (`reproduce` prints them in full).
 pub fn validation_tables(r: &ReproduceReport) -> String {
-    r.models.iter().map(|m| format!("held-out runs, {}:\n{}\n", m.label, compensate_table(&m.validation))).collect()
+    r.models
+        .iter()
+        .map(|m| {
+            format!(
+                "held-out runs, {}:\n{}\n",
+                m.label,
+                compensate_table(&m.validation)
+            )
+        })
+        .collect()
 }

@@ -29,7 +29,11 @@ pub fn load_signing_key(path: &Path) -> anyhow::Result<KeyPair> {
         .with_context(|| format!("reading signing key {}", path.display()))?;
     let hex = text.trim();
     let seed = decode_hex::<32>(hex).with_context(|| {
-        format!("{}: expected 64 hex digits (an Ed25519 seed), found {:?}", path.display(), hex)
+        format!(
+            "{}: expected 64 hex digits (an Ed25519 seed), found {:?}",
+            path.display(),
+            hex
+        )
     })?;
     Ok(key_from_seed(seed))
 }
@@ -40,7 +44,12 @@ pub fn key_from_seed(seed: [u8; 32]) -> KeyPair {
 }
 
 fn decode_hex<const N: usize>(hex: &str) -> anyhow::Result<[u8; N]> {
-    anyhow::ensure!(hex.len() == 2 * N, "length {} instead of {}", hex.len(), 2 * N);
+    anyhow::ensure!(
+        hex.len() == 2 * N,
+        "length {} instead of {}",
+        hex.len(),
+        2 * N
+    );
     let mut out = [0u8; N];
     for (i, byte) in out.iter_mut().enumerate() {
         *byte = u8::from_str_radix(&hex[2 * i..2 * i + 2], 16)
@@ -120,7 +129,11 @@ impl<T: Read + Write + Send> Link for T {}
 impl<L: Read + Write> UploadClient<L> {
     /// Wraps a link; `timeout` bounds each request/response exchange.
     pub fn new(link: L, timeout: Duration) -> Self {
-        Self { link, rx: FrameReceiver::new(), timeout }
+        Self {
+            link,
+            rx: FrameReceiver::new(),
+            timeout,
+        }
     }
 
     /// The underlying link.
@@ -141,12 +154,26 @@ impl<L: Read + Write> UploadClient<L> {
         // A leading delimiter flushes any partial frame left in the device's buffer.
         let n = encode_frame(request, &mut wire[1..]).map_err(ClientError::Frame)?;
         self.send_raw(&wire[..n + 1])?;
-        self.read_response()
+        // That delimiter makes the device answer any stale partial frame (line noise)
+        // with a frame-level rejection first: skip those. The answer to our own frame,
+        // if the wire corrupted it, is one too; then the deadline ends the wait.
+        let deadline = Instant::now() + self.timeout;
+        loop {
+            let left = deadline.saturating_duration_since(Instant::now());
+            match self.read_response_within(left)? {
+                Response::Rejected(e) if is_frame_level(e) => continue,
+                response => return Ok(response),
+            }
+        }
     }
 
     /// Waits for the next response frame.
     pub fn read_response(&mut self) -> Result<Response, ClientError> {
-        let deadline = Instant::now() + self.timeout;
+        self.read_response_within(self.timeout)
+    }
+
+    fn read_response_within(&mut self, wait: Duration) -> Result<Response, ClientError> {
+        let deadline = Instant::now() + wait;
         let mut byte = [0u8; 1];
         loop {
             if Instant::now() >= deadline {
@@ -174,7 +201,9 @@ impl<L: Read + Write> UploadClient<L> {
 
     /// `Hello`: checks the protocol version and returns the device status.
     pub fn hello(&mut self) -> Result<DeviceStatus, ClientError> {
-        expect_status(self.request(&Request::Hello { protocol_version: PROTOCOL_VERSION })?)
+        expect_status(self.request(&Request::Hello {
+            protocol_version: PROTOCOL_VERSION,
+        })?)
     }
 
     /// `Status`: what the device runs now.
@@ -200,9 +229,13 @@ impl<L: Read + Write> UploadClient<L> {
         };
         let mut offset = 0usize;
         for data in model_bytes.chunks(max_chunk) {
-            let chunk = Request::Chunk { offset: offset as u32, data };
+            let chunk = Request::Chunk {
+                offset: offset as u32,
+                data,
+            };
             match self.request(&chunk)? {
-                Response::ChunkAccepted { received } if received as usize == offset + data.len() => {}
+                Response::ChunkAccepted { received }
+                    if received as usize == offset + data.len() => {}
                 other => return Err(unexpected(other)),
             }
             offset += data.len();
@@ -213,6 +246,17 @@ impl<L: Read + Write> UploadClient<L> {
             other => Err(unexpected(other)),
         }
     }
+}
+
+/// Rejections of a frame as such (not of a request's content).
+fn is_frame_level(e: UploadError) -> bool {
+    matches!(
+        e,
+        UploadError::FrameCorrupt
+            | UploadError::FrameCrcMismatch
+            | UploadError::FrameTooLong
+            | UploadError::MessageMalformed
+    )
 }
 
 fn expect_status(response: Response) -> Result<DeviceStatus, ClientError> {

@@ -14,40 +14,95 @@ fn rejects(dir: &Path, args: &[&str], needles: &[&str]) {
     let err = stderr(&out);
     assert!(!out.status.success(), "{args:?} should fail");
     assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
-    let line = err.lines().find(|l| l.contains("error")).unwrap_or_else(|| panic!("{args:?}: no error line: {err}"));
+    let line = err
+        .lines()
+        .find(|l| l.contains("error"))
+        .unwrap_or_else(|| panic!("{args:?}: no error line: {err}"));
     for n in needles {
         assert!(line.contains(n), "{args:?}: error line lacks `{n}`: {line}");
     }
-    assert!(!dir.join("report.json").exists(), "{args:?} left a report behind");
+    assert!(
+        !dir.join("report.json").exists(),
+        "{args:?} left a report behind"
+    );
 }
 
-const GOOD_RUN: &str = "# fog-runs v1\n# ambient_c: 20\nt_s,rate_dph,temp_c\n10,0.1,20.0\n20,0.1,20.1\n30,0.1,20.2\n";
+const GOOD_RUN: &str =
+    "# fog-runs v1\n# ambient_c: 20\nt_s,rate_dph,temp_c\n10,0.1,20.0\n20,0.1,20.1\n30,0.1,20.2\n";
 
 #[test]
 fn malformed_files_and_impossible_options_are_rejected() {
     let dir = scratch_dir("bad");
-    std::fs::write(dir.join("ragged.csv"), "# fog-runs v1\nt_s,rate_dph,temp_c\n10,0.1,20.0\n20,0.1\n").unwrap();
+    std::fs::write(
+        dir.join("ragged.csv"),
+        "# fog-runs v1\nt_s,rate_dph,temp_c\n10,0.1,20.0\n20,0.1\n",
+    )
+    .unwrap();
     std::fs::write(dir.join("good.csv"), GOOD_RUN).unwrap();
     std::fs::write(dir.join("garbage.bin"), b"not a model at all").unwrap();
     let json = ["--json", "report.json"];
 
     // A malformed run: the file and its line are named.
-    let args = [&["compensate", "ragged.csv", "--model", "garbage.bin"][..], &json].concat();
+    let args = [
+        &["compensate", "ragged.csv", "--model", "garbage.bin"][..],
+        &json,
+    ]
+    .concat();
     rejects(&dir, &args, &["ragged.csv", "4"]);
     // A model that fails validation: the option and the file are named.
-    let args = [&["compensate", "good.csv", "--model", "garbage.bin"][..], &json].concat();
+    let args = [
+        &["compensate", "good.csv", "--model", "garbage.bin"][..],
+        &json,
+    ]
+    .concat();
     rejects(&dir, &args, &["--model", "garbage.bin"]);
-    let args = [&["compensate", "good.csv", "--model", "missing.bin"][..], &json].concat();
+    let args = [
+        &["compensate", "good.csv", "--model", "missing.bin"][..],
+        &json,
+    ]
+    .concat();
     rejects(&dir, &args, &["--model", "missing.bin"]);
     // Impossible options.
-    rejects(&dir, &[&["north-seek", "--latitude", "95"][..], &json].concat(), &["--latitude"]);
-    rejects(&dir, &[&["north-seek", "--positions", "3"][..], &json].concat(), &["--positions"]);
-    rejects(&dir, &[&["north-seek", "--starts", "0"][..], &json].concat(), &["--starts"]);
-    rejects(&dir, &[&["north-seek", "--model", "garbage.bin"][..], &json].concat(), &["--model"]);
-    rejects(&dir, &[&["reproduce", "--minutes", "-5"][..], &json].concat(), &["--minutes"]);
-    rejects(&dir, &[&["reproduce", "--runs", "3"][..], &json].concat(), &["--runs"]);
-    rejects(&dir, &[&["reproduce", "--ambient", "-40,500"][..], &json].concat(), &["--ambient"]);
+    rejects(
+        &dir,
+        &[&["north-seek", "--latitude", "95"][..], &json].concat(),
+        &["--latitude"],
+    );
+    rejects(
+        &dir,
+        &[&["north-seek", "--positions", "3"][..], &json].concat(),
+        &["--positions"],
+    );
+    rejects(
+        &dir,
+        &[&["north-seek", "--starts", "0"][..], &json].concat(),
+        &["--starts"],
+    );
+    rejects(
+        &dir,
+        &[&["north-seek", "--model", "garbage.bin"][..], &json].concat(),
+        &["--model"],
+    );
+    rejects(
+        &dir,
+        &[&["reproduce", "--minutes", "-5"][..], &json].concat(),
+        &["--minutes"],
+    );
+    rejects(
+        &dir,
+        &[&["reproduce", "--runs", "3"][..], &json].concat(),
+        &["--runs"],
+    );
+    rejects(
+        &dir,
+        &[&["reproduce", "--ambient", "-40,500"][..], &json].concat(),
+        &["--ambient"],
+    );
     // An output path in a missing directory is refused before any work.
-    rejects(&dir, &["north-seek", "--json", "no/such/dir/report.json"], &["--json"]);
+    rejects(
+        &dir,
+        &["north-seek", "--json", "no/such/dir/report.json"],
+        &["--json"],
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -8,7 +8,11 @@ use app_support::{campaign_and_model, fogsim, scratch_dir, stderr};
 use serde_json::Value;
 
 fn stats(v: &Value) -> (f64, f64, Option<f64>) {
-    (v["std_dph"].as_f64().unwrap(), v["max_dev_dph"].as_f64().unwrap(), v["time_to_spec_s"].as_f64())
+    (
+        v["std_dph"].as_f64().unwrap(),
+        v["max_dev_dph"].as_f64().unwrap(),
+        v["time_to_spec_s"].as_f64(),
+    )
 }
 
 #[test]
@@ -17,13 +21,23 @@ fn compensation_improves_held_out_runs_and_json_has_the_issue_shape() {
     let runs = campaign_and_model(&dir, 5);
     let out = fogsim(
         &dir,
-        &["compensate", "runs", "--model", "model.bin", "--json", "report.json", "--plots", "plots"],
+        &[
+            "compensate",
+            "runs",
+            "--model",
+            "model.bin",
+            "--json",
+            "report.json",
+            "--plots",
+            "plots",
+        ],
     );
     assert!(out.status.success(), "{}", stderr(&out));
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("overall (pooled)"), "{text}");
 
-    let json: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
+    let json: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
     let rows = json["runs"].as_array().unwrap();
     assert_eq!(rows.len(), runs.len());
     for r in rows {
@@ -33,7 +47,10 @@ fn compensation_improves_held_out_runs_and_json_has_the_issue_shape() {
         let (sa, ma, ta) = stats(&r["after"]);
         assert!(sa < 0.6 * sb, "std {sb} -> {sa}");
         assert!(ma < mb, "max dev {mb} -> {ma}");
-        let (tb, ta) = (tb.expect("uncompensated run reaches spec"), ta.expect("compensated run reaches spec"));
+        let (tb, ta) = (
+            tb.expect("uncompensated run reaches spec"),
+            ta.expect("compensated run reaches spec"),
+        );
         assert!(tb > 300.0 && ta < tb, "time to spec {tb} -> {ta}");
     }
     for part in ["before", "after"] {
@@ -42,7 +59,10 @@ fn compensation_improves_held_out_runs_and_json_has_the_issue_shape() {
             assert!(o.get(key).is_some(), "overall.{part}.{key} missing");
         }
     }
-    assert!(json["overall"]["after"]["std_dph"].as_f64() < json["overall"]["before"]["std_dph"].as_f64());
+    assert!(
+        json["overall"]["after"]["std_dph"].as_f64()
+            < json["overall"]["before"]["std_dph"].as_f64()
+    );
     for f in ["startup_before.svg", "startup_after.svg"] {
         let svg = std::fs::read_to_string(dir.join("plots").join(f)).unwrap();
         assert!(svg.contains("<svg") && svg.contains("</svg>"), "{f}");

@@ -9,16 +9,30 @@ use app_support::{fogsim, scratch_dir, stderr};
 use serde_json::Value;
 
 fn f(v: &Value, path: &[&str]) -> f64 {
-    path.iter().fold(v, |v, k| &v[*k]).as_f64().unwrap_or_else(|| panic!("{path:?} missing"))
+    path.iter()
+        .fold(v, |v, k| &v[*k])
+        .as_f64()
+        .unwrap_or_else(|| panic!("{path:?} missing"))
 }
 
 #[test]
 fn compensated_cold_start_seeks_beat_uncompensated_ones() {
     let dir = scratch_dir("northseek");
-    let args = ["north-seek", "--starts", "6", "--seeks", "3", "--json", "ns.json", "--threads", "2"];
+    let args = [
+        "north-seek",
+        "--starts",
+        "6",
+        "--seeks",
+        "3",
+        "--json",
+        "ns.json",
+        "--threads",
+        "2",
+    ];
     let out = fogsim(&dir, &args);
     assert!(out.status.success(), "{}", stderr(&out));
-    let json: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("ns.json")).unwrap()).unwrap();
+    let json: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("ns.json")).unwrap()).unwrap();
     assert_eq!(json["starts"].as_u64(), Some(6));
     assert_eq!(json["seeks_per_start"].as_u64(), Some(3));
     let floor = f(&json, &["noise_floor_deg"]);
@@ -38,10 +52,25 @@ fn compensated_cold_start_seeks_beat_uncompensated_ones() {
         first("compensated"),
         first("uncompensated")
     );
-    assert!(f(&json, &["compensated", "rms_error_deg"]) < f(&json, &["uncompensated", "rms_error_deg"]));
+    assert!(
+        f(&json, &["compensated", "rms_error_deg"]) < f(&json, &["uncompensated", "rms_error_deg"])
+    );
 
     // Same seed, one thread: identical report.
-    let out = fogsim(&dir, &["north-seek", "--starts", "6", "--seeks", "3", "--json", "ns1.json", "--threads", "1"]);
+    let out = fogsim(
+        &dir,
+        &[
+            "north-seek",
+            "--starts",
+            "6",
+            "--seeks",
+            "3",
+            "--json",
+            "ns1.json",
+            "--threads",
+            "1",
+        ],
+    );
     assert!(out.status.success(), "{}", stderr(&out));
     let a = std::fs::read_to_string(dir.join("ns.json")).unwrap();
     let b = std::fs::read_to_string(dir.join("ns1.json")).unwrap();

@@ -10,13 +10,24 @@ use serde_json::Value;
 fn small_reproduce_writes_report_and_plots() {
     let dir = scratch_dir("reproduce");
     let args = [
-        "reproduce", "--ambient", "0,20", "--runs", "4", "--starts", "2", "--json", "r.json", "--plots", "plots",
+        "reproduce",
+        "--ambient",
+        "0,20",
+        "--runs",
+        "4",
+        "--starts",
+        "2",
+        "--json",
+        "r.json",
+        "--plots",
+        "plots",
     ];
     let out = fogsim(&dir, &args);
     assert!(out.status.success(), "{}", stderr(&out));
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("paper vs this project"), "{stdout}");
-    let json: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("r.json")).unwrap()).unwrap();
+    let json: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("r.json")).unwrap()).unwrap();
     let models = json["models"].as_array().unwrap();
     assert_eq!(models.len(), 2, "paper inputs and extended inputs");
     for m in models {
@@ -24,7 +35,9 @@ fn small_reproduce_writes_report_and_plots() {
         assert_eq!(amb.len(), 2);
         for a in amb {
             assert_eq!(a["heldout_runs"].as_u64(), Some(1));
-            assert!(a["after"]["std_dph"].as_f64().unwrap() < a["before"]["std_dph"].as_f64().unwrap());
+            assert!(
+                a["after"]["std_dph"].as_f64().unwrap() < a["before"]["std_dph"].as_f64().unwrap()
+            );
         }
         assert_eq!(m["validation"]["runs"].as_array().unwrap().len(), 2);
         assert!(m["training"]["n_centers"].as_u64().unwrap() >= 1);
@@ -32,11 +45,21 @@ fn small_reproduce_writes_report_and_plots() {
         assert!(m["targets"]["azimuth_std_over_floor"].as_f64().is_some());
     }
     assert!(json["paper_vs_us"].as_array().unwrap().len() >= 10);
-    for f in ["model_extended/startup_after.svg", "model_extended/azimuth_scatter.svg"] {
+    for f in [
+        "model_extended/startup_after.svg",
+        "model_extended/azimuth_scatter.svg",
+    ] {
         assert!(dir.join("plots").join(f).exists(), "{f}");
     }
-    for f in ["startup_before.svg", "startup_after.svg", "temperature.svg", "allan.svg", "azimuth_scatter.svg"] {
-        let svg = std::fs::read_to_string(dir.join("plots").join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+    for f in [
+        "startup_before.svg",
+        "startup_after.svg",
+        "temperature.svg",
+        "allan.svg",
+        "azimuth_scatter.svg",
+    ] {
+        let svg = std::fs::read_to_string(dir.join("plots").join(f))
+            .unwrap_or_else(|e| panic!("{f}: {e}"));
         assert!(svg.contains("</svg>"), "{f}");
     }
     std::fs::remove_dir_all(&dir).unwrap();

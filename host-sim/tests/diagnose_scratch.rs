@@ -7,7 +7,8 @@ use planted::*;
 fn scratch() {
     let eff = match std::env::var("EFF").as_deref() { Ok("accel") => Effect::TempAccel, Ok("null") => Effect::Null, Ok("value") => Effect::ColumnValue, _ => Effect::PowerOnTransient };
     let seed: u64 = std::env::var("SEED").ok().and_then(|s| s.parse().ok()).unwrap_or(11);
-    let (runs, _) = campaign(eff, seed, Shape::default());
+    let sig: f64 = std::env::var("SIG").ok().and_then(|s| s.parse().ok()).unwrap_or(1.0);
+    let (runs, _) = campaign(eff, seed, Shape { sigmas: sig, ..Shape::default() });
     let c = input::prepare(&runs).unwrap();
     let st = models::Stacked::new(&c);
     let folds = cv::Folds::new(&st.run_lengths).unwrap();
@@ -45,4 +46,16 @@ fn scratch() {
     }
     let d = diagnose(&runs).unwrap();
     println!("{}", report::render_text(&d.report));
+}
+
+#[test]
+fn scratch_effect_size() {
+    for eff in [Effect::PowerOnTransient, Effect::TempAccel, Effect::ColumnValue] {
+        let (a, _) = campaign(Effect::Null, 11, Shape::default());
+        let (b, _) = campaign(eff, 11, Shape::default());
+        let d: Vec<f64> = a.iter().zip(&b).flat_map(|(x, y)| x.rate_dph().iter().zip(y.rate_dph()).map(|(p, q)| q - p).collect::<Vec<_>>()).collect();
+        let peak = d.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let rms = (d.iter().map(|v| v * v).sum::<f64>() / d.len() as f64).sqrt();
+        println!("{eff:?}: peak {peak:.4} rms {rms:.4} first {:?}", &d[..5]);
+    }
 }

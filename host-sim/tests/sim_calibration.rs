@@ -5,8 +5,8 @@
 
 use fog_sim::campaign::{simulate_campaign, CampaignSpec};
 use fog_sim::metrics::{
-    allan_deviation, arw_dpsh, bias_instability_dph, max_deviation, mean, std_dev, time_to_spec_s,
-    SPEC_DPH,
+    allan_deviation, arw_dpsh, bias_instability_dph, max_deviation, mean, settled_mean, std_dev,
+    time_to_spec_s, SPEC_DPH,
 };
 use fog_sim::plots::{allan_chart, startup_chart, write_svg, Series, StartupCurve};
 use fog_sim::runs::{format_run, Run};
@@ -154,7 +154,7 @@ fn allan_deviation_of_a_steady_record_gives_the_noise_parameters() {
 
 #[test]
 fn ambient_temperature_changes_the_startup_curve() {
-    let runs: Vec<Run> = [-40.0, 20.0, 60.0]
+    let runs: Vec<Run> = [-40.0, 0.0, 20.0, 60.0]
         .iter()
         .map(|&a| paper_run(a, 5))
         .collect();
@@ -163,10 +163,32 @@ fn ambient_temperature_changes_the_startup_curve() {
         .map(|r| max_deviation(r.t_s(), &r.drift_dph()))
         .collect();
     assert!(
-        devs[0] > devs[1] && devs[1] > devs[2],
+        devs.windows(2).all(|w| w[0] > w[1]),
         "cold gyros drift more: {devs:?}"
     );
-    assert!(devs[0] / devs[2] > 1.5, "{devs:?}");
+    assert!(devs[0] / devs[3] > 1.5, "{devs:?}");
+    let curves: Vec<StartupCurve> = runs
+        .iter()
+        .map(|r| {
+            let d = r.drift_dph();
+            let nominal = settled_mean(r.t_s(), &d);
+            StartupCurve {
+                label: format!("ambient {} degC", r.ambient_c().unwrap()),
+                t_s: r.t_s().to_vec(),
+                drift_dph: d.iter().map(|v| v - nominal).collect(),
+            }
+        })
+        .collect();
+    let chart = startup_chart(
+        "Simulated startup drift, uncompensated",
+        &curves,
+        Some(SPEC_DPH),
+    );
+    write_svg(
+        &Path::new(env!("CARGO_TARGET_TMPDIR")).join("simulator-startup.svg"),
+        &chart,
+    )
+    .unwrap();
     for r in &runs {
         let temp = r.temp_c();
         let rise = temp[temp.len() - 1] - temp[0];

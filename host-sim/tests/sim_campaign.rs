@@ -55,6 +55,27 @@ fn writes_one_file_per_power_on_in_order() {
         let earth = r.column("earth_dph").unwrap();
         assert!((earth[0] - 15.041067 * 39.9f64.to_radians().sin()).abs() < 1e-9);
     }
+    // Re-running into the same directory is fine; a campaign that would leave stale runs is not.
+    assert!(fogsim(&args).status.success());
+    let fewer = [
+        "campaign",
+        "--out",
+        o,
+        "--ambient",
+        "-10",
+        "--runs",
+        "1",
+        "--minutes",
+        "3",
+    ];
+    let r = fogsim(&fewer);
+    assert!(!r.status.success());
+    assert!(String::from_utf8_lossy(&r.stderr).contains("not part of this campaign"));
+    assert_eq!(
+        read_runs(&[&out]).unwrap().len(),
+        4,
+        "nothing written or removed"
+    );
     let first = std::fs::read(out.join(&names[0])).unwrap();
     let again = scratch("again");
     let mut args2 = args;

@@ -226,3 +226,29 @@ fn impossible_specifications_are_rejected_with_their_name() {
         Err(SimError::BadSeries { .. })
     ));
 }
+
+#[test]
+fn a_scale_factor_error_is_a_term_on_the_input_rate() {
+    let mut base = GyroParams::paper_default();
+    base.noise.quantization_arcsec = 0.0;
+    let sf = base.clone().with_term(DriftTerm {
+        label: "earth_dph:value".into(),
+        source: AuxSource::InputRateDph,
+        transform: AuxTransform::Value,
+        coeff_dph: 500e-6,
+        column: None,
+    });
+    let spec = RunSpec {
+        minutes: 1.0,
+        ..RunSpec::paper(20.0, 13)
+    };
+    let (a, b) = (
+        simulate_run(&base, &spec).unwrap(),
+        simulate_run(&sf, &spec).unwrap(),
+    );
+    let earth = a.earth_dph();
+    for i in 0..a.len() {
+        let d = b.rate_dph()[i] - a.rate_dph()[i];
+        assert!((d - 500e-6 * earth[i]).abs() < 1e-9, "{d}");
+    }
+}

@@ -225,10 +225,17 @@ fn scenario(evaluator: Evaluator, tag: &str) {
         .iter()
         .find_map(|l| l.strip_prefix("# stack_high_water_bytes "))
         .expect("firmware reports its stack high-water mark");
-    let used: usize = stack_line.split_whitespace().next().unwrap().parse().unwrap();
+    let words: Vec<&str> = stack_line.split_whitespace().collect();
+    let (running, boot): (usize, usize) = (words[0].parse().unwrap(), words[2].parse().unwrap());
+    // Regression bounds, about 1.3x the values measured when this test was written
+    // (docs/firmware.md): the sample loop and the boot-time construction peak.
     assert!(
-        used > 256 && used < 16 * 1024,
-        "stack high-water {used} bytes is implausible or over 16 KiB"
+        running > 256 && running < 32 * 1024,
+        "sample-loop stack high-water {running} bytes is implausible or over 32 KiB"
+    );
+    assert!(
+        boot < 72 * 1024,
+        "boot stack peak {boot} bytes over 72 KiB"
     );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -27,8 +27,14 @@ fn reboot<F: NorFlash>(flash: F) -> (Found, F) {
     let found = match store.active().copied() {
         None => Found::Nothing,
         Some(active) => {
-            let bytes = store.read_active(&mut buf).expect("active slot reads back").unwrap();
-            Found::Model { sequence: active.header.sequence, bytes: bytes.to_vec() }
+            let bytes = store
+                .read_active(&mut buf)
+                .expect("active slot reads back")
+                .unwrap();
+            Found::Model {
+                sequence: active.header.sequence,
+                bytes: bytes.to_vec(),
+            }
         }
     };
     (found, store.into_flash())
@@ -67,7 +73,10 @@ fn cut_everywhere<const N: usize, const W: usize, const E: usize>(
     // Every page erase and word write of the layout is one cut point.
     let expected_ops = store_len(E) / 2 / E + new.len().div_ceil(W) + 96 / W + 32 / W;
     assert_eq!(total_ops as usize, expected_ops, "operations of one commit");
-    let want_new = Found::Model { sequence: old_sequence + 1, bytes: new.to_vec() };
+    let want_new = Found::Model {
+        sequence: old_sequence + 1,
+        bytes: new.to_vec(),
+    };
     assert_eq!(reboot(probe).0, want_new);
 
     let (mut to_old, mut to_new) = (0, 0);
@@ -111,7 +120,11 @@ fn all_situations<const N: usize, const W: usize, const E: usize>() {
     for history in [vec![a.clone()], vec![a.clone(), b.clone()]] {
         let (ops, old, new) = cut_everywhere::<N, W, E>(&history, &c);
         // Only the very last operation (the marker's last word) can switch models.
-        assert_eq!((old, new), (ops, 0), "the switch happens only after the final write");
+        assert_eq!(
+            (old, new),
+            (ops, 0),
+            "the switch happens only after the final write"
+        );
     }
 }
 
@@ -144,5 +157,11 @@ fn a_bad_slot_next_to_a_good_one_is_ignored() {
     let mut corrupted = RamNorFlash::<{ store_len(256) }, 4, 256>::new();
     corrupted.write(0, &image).unwrap();
     flash = corrupted;
-    assert_eq!(reboot(flash).0, Found::Model { sequence: 1, bytes: a });
+    assert_eq!(
+        reboot(flash).0,
+        Found::Model {
+            sequence: 1,
+            bytes: a
+        }
+    );
 }

@@ -19,7 +19,9 @@ use upload_support::*;
 fn install_first(server: &mut Server) -> ModelInfo {
     let bytes = encode(&sample_model("FOG-A17", 35, 1.0));
     let sig = sign_with_test_key(&bytes);
-    let info = client(server).upload(&bytes, &sig, |_, _| {}).expect("good upload commits");
+    let info = client(server)
+        .upload(&bytes, &sig, |_, _| {})
+        .expect("good upload commits");
     assert_eq!(info.sequence, 1);
     info
 }
@@ -43,7 +45,10 @@ fn upload_then_status_shows_new_model_and_survives_reboot() {
     let mut c = client(&mut server);
     let second = c.upload(&second_bytes, &sig, |_, _| {}).unwrap();
     assert_eq!(c.link_mut().model_changes, 1);
-    assert_eq!((second.slot, second.sequence, second.n_centers), (1 - first.slot, 2, 64));
+    assert_eq!(
+        (second.slot, second.sequence, second.n_centers),
+        (1 - first.slot, 2, 64)
+    );
     assert_eq!(second.model_crc32, crc32(&second_bytes));
     let status = c.status().unwrap();
     assert_eq!(status.active.as_ref(), Some(&second));
@@ -66,15 +71,24 @@ fn every_bad_upload_is_refused_with_its_typed_error_and_the_model_stays() {
     let mut c = client(&mut server);
 
     // Unsigned: an empty signature.
-    expect_rejected(c.upload(&bytes, &[], |_, _| {}), UploadError::SignatureMalformed);
+    expect_rejected(
+        c.upload(&bytes, &[], |_, _| {}),
+        UploadError::SignatureMalformed,
+    );
     // Wrong key: signed by a key the device does not hold.
     let wrong = sign_model(&key_from_seed([7u8; 32]), &bytes);
-    expect_rejected(c.upload(&bytes, &wrong, |_, _| {}), UploadError::SignatureInvalid);
+    expect_rejected(
+        c.upload(&bytes, &wrong, |_, _| {}),
+        UploadError::SignatureInvalid,
+    );
     // Bit-flipped after signing (the CRC in Begin matches the flipped bytes).
     for bit in [0usize, 77, bytes.len() * 8 / 2, bytes.len() * 8 - 1] {
         let mut flipped = bytes.clone();
         flipped[bit / 8] ^= 1 << (bit % 8);
-        expect_rejected(c.upload(&flipped, &sig, |_, _| {}), UploadError::SignatureInvalid);
+        expect_rejected(
+            c.upload(&flipped, &sig, |_, _| {}),
+            UploadError::SignatureInvalid,
+        );
     }
     // Truncated, correctly signed: authentic but not a whole model.
     let truncated = &bytes[..bytes.len() - 9];
@@ -103,41 +117,105 @@ fn every_bad_upload_is_refused_with_its_typed_error_and_the_model_stays() {
     let huge = vec![0x55u8; MAX_ENCODED_LEN + 1];
     expect_rejected(
         c.upload(&huge, &sig, |_, _| {}),
-        UploadError::ModelTooLarge { max_len: MAX_ENCODED_LEN as u32 },
+        UploadError::ModelTooLarge {
+            max_len: MAX_ENCODED_LEN as u32,
+        },
     );
-    let begin = Request::Begin { model_len: bytes.len() as u32, model_crc32: crc32(&bytes) };
+    let begin = Request::Begin {
+        model_len: bytes.len() as u32,
+        model_crc32: crc32(&bytes),
+    };
     assert!(matches!(c.request(&begin).unwrap(), Response::Ready { .. }));
     let long = [0u8; MAX_CHUNK_LEN + 1];
-    let reply = c.request(&Request::Chunk { offset: 0, data: &long }).unwrap();
+    let reply = c
+        .request(&Request::Chunk {
+            offset: 0,
+            data: &long,
+        })
+        .unwrap();
     assert_eq!(reply, Response::Rejected(UploadError::ChunkTooLong));
     // Out of order, past the end, early commit, wrong CRC.
-    let reply = c.request(&Request::Chunk { offset: 8, data: &bytes[8..16] }).unwrap();
-    assert_eq!(reply, Response::Rejected(UploadError::ChunkOutOfOrder { expected_offset: 0 }));
+    let reply = c
+        .request(&Request::Chunk {
+            offset: 8,
+            data: &bytes[8..16],
+        })
+        .unwrap();
+    assert_eq!(
+        reply,
+        Response::Rejected(UploadError::ChunkOutOfOrder { expected_offset: 0 })
+    );
     let reply = c.request(&Request::Commit { signature: &sig }).unwrap();
-    assert_eq!(reply, Response::Rejected(UploadError::UploadIncomplete { received: 0 }));
-    let reply = c.request(&Request::Chunk { offset: 0, data: &[1, 2] }).unwrap();
+    assert_eq!(
+        reply,
+        Response::Rejected(UploadError::UploadIncomplete { received: 0 })
+    );
+    let reply = c
+        .request(&Request::Chunk {
+            offset: 0,
+            data: &[1, 2],
+        })
+        .unwrap();
     assert_eq!(reply, Response::ChunkAccepted { received: 2 });
     assert_eq!(
         c.status().unwrap().upload,
-        UploadPhase::Receiving { received: 2, model_len: bytes.len() as u32 }
+        UploadPhase::Receiving {
+            received: 2,
+            model_len: bytes.len() as u32
+        }
     );
     assert_eq!(c.request(&Request::Abort).unwrap(), Response::Aborted);
-    let reply = c.request(&Request::Chunk { offset: 2, data: &[3] }).unwrap();
+    let reply = c
+        .request(&Request::Chunk {
+            offset: 2,
+            data: &[3],
+        })
+        .unwrap();
     assert_eq!(reply, Response::Rejected(UploadError::NoUploadInProgress));
-    let bad_crc = Request::Begin { model_len: 4, model_crc32: 0 };
-    assert!(matches!(c.request(&bad_crc).unwrap(), Response::Ready { .. }));
-    let reply = c.request(&Request::Chunk { offset: 0, data: &[9, 9, 9, 9, 9] }).unwrap();
+    let bad_crc = Request::Begin {
+        model_len: 4,
+        model_crc32: 0,
+    };
+    assert!(matches!(
+        c.request(&bad_crc).unwrap(),
+        Response::Ready { .. }
+    ));
+    let reply = c
+        .request(&Request::Chunk {
+            offset: 0,
+            data: &[9, 9, 9, 9, 9],
+        })
+        .unwrap();
     assert_eq!(reply, Response::Rejected(UploadError::ChunkPastEnd));
-    c.request(&Request::Chunk { offset: 0, data: &[9, 9, 9, 9] }).unwrap();
+    c.request(&Request::Chunk {
+        offset: 0,
+        data: &[9, 9, 9, 9],
+    })
+    .unwrap();
     let reply = c.request(&Request::Commit { signature: &sig }).unwrap();
     assert_eq!(reply, Response::Rejected(UploadError::ModelCrcMismatch));
     // Protocol version.
-    let reply = c.request(&Request::Hello { protocol_version: 99 }).unwrap();
-    assert!(matches!(reply, Response::Rejected(UploadError::ProtocolVersion { .. })));
+    let reply = c
+        .request(&Request::Hello {
+            protocol_version: 99,
+        })
+        .unwrap();
+    assert!(matches!(
+        reply,
+        Response::Rejected(UploadError::ProtocolVersion { .. })
+    ));
 
     // Random byte streams: each frame they form is answered with a frame-level error.
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x5EED);
-    let noise: Vec<u8> = (0..8192).map(|_| if rng.random_ratio(1, 40) { 0 } else { rng.random() }).collect();
+    let noise: Vec<u8> = (0..8192)
+        .map(|_| {
+            if rng.random_ratio(1, 40) {
+                0
+            } else {
+                rng.random()
+            }
+        })
+        .collect();
     c.send_raw(&noise).unwrap();
     let mut answered = 0;
     while let Ok(reply) = c.read_response() {

@@ -4,7 +4,8 @@
 //! to an output file for `tests/tests/qemu_replay.rs` to compare with the host.
 //!
 //! Arguments: `MODEL GYRO_STREAM TABLE_LOG OUT RATE_HZ SEEKS [f32|fixed]`.
-//! It also paints the stack and appends the high-water mark to OUT.
+//! It also paints the stack and appends to OUT the high-water mark of the sample loop
+//! (steady state) and of the boot (model decode and application construction).
 #![no_std]
 #![no_main]
 
@@ -55,7 +56,13 @@ fn run() -> Result<(), &'static str> {
     let gyro = semi::HostReader::open(args.path(1)?)?;
     let table = semi::HostReader::open(args.path(2)?)?;
     let mut out = semi::HostWriter::create(args.path(3)?)?;
-    let sum = replay::run(cfg, Some(model), gyro, table, &mut out).map_err(|e| match e {
+    let mut boot_stack = 0;
+    let on_ready = || {
+        boot_stack = stack::high_water_bytes();
+        stack::paint();
+    };
+    let sum = replay::run_with_hook(cfg, Some(model), gyro, table, &mut out, on_ready);
+    let sum = sum.map_err(|e| match e {
         replay::ReplayError::App(_) => "application rejected the configuration",
         replay::ReplayError::Output => "cannot write the output file",
     })?;
@@ -76,8 +83,9 @@ fn run() -> Result<(), &'static str> {
     );
     let _ = writeln!(
         out,
-        "# stack_high_water_bytes {} of {}",
+        "# stack_high_water_bytes {} boot_peak {} of {}",
         stack::high_water_bytes(),
+        boot_stack,
         stack::size_bytes()
     );
     out.flush()

@@ -30,6 +30,20 @@ pub struct GyroStats {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct UartError(pub ErrorKind);
 
+#[cfg(feature = "defmt")]
+impl defmt::Format for UartError {
+    fn format(&self, f: defmt::Formatter) {
+        let kind = match self.0 {
+            ErrorKind::Overrun => "overrun",
+            ErrorKind::FrameFormat => "framing",
+            ErrorKind::Parity => "parity",
+            ErrorKind::Noise => "noise",
+            _ => "other",
+        };
+        defmt::write!(f, "UART {}", kind)
+    }
+}
+
 impl core::fmt::Display for UartError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         write!(f, "gyro UART error: {:?}", self.0)
@@ -82,6 +96,11 @@ impl<S: Read<u8>> FogSerialGyro<S> {
     /// Sample period, s.
     pub fn period_s(&self) -> f64 {
         self.period_s
+    }
+
+    /// The UART (e.g. to refill a test source).
+    pub fn uart_mut(&mut self) -> &mut S {
+        &mut self.uart
     }
 
     /// Give the UART back (e.g. to reconfigure it).

@@ -53,7 +53,12 @@ impl<const N: usize, const W: usize, const E: usize> Default for RamNorFlash<N, 
 impl<const N: usize, const W: usize, const E: usize> RamNorFlash<N, W, E> {
     /// A fully erased device.
     pub const fn new() -> Self {
-        Self { mem: [0xFF; N], ops_before_cut: None, powered: true, ops_done: 0 }
+        Self {
+            mem: [0xFF; N],
+            ops_before_cut: None,
+            powered: true,
+            ops_done: 0,
+        }
     }
 
     /// Cuts the power after `ops` more word writes / page erases: operation number `ops`
@@ -155,7 +160,10 @@ impl<const N: usize, const W: usize, const E: usize> NorFlash for RamNorFlash<N,
                 target.iter_mut().zip(word).for_each(|(m, w)| *m &= w);
             } else {
                 // Torn write: only the first half of the word's bytes got programmed.
-                target[..W.div_ceil(2)].iter_mut().zip(word).for_each(|(m, w)| *m &= w);
+                target[..W.div_ceil(2)]
+                    .iter_mut()
+                    .zip(word)
+                    .for_each(|(m, w)| *m &= w);
                 return Err(RamFlashError::PowerLost);
             }
         }

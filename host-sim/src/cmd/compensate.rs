@@ -8,8 +8,13 @@ use anyhow::{bail, Result};
 
 use crate::metrics::SPEC_DPH;
 use crate::plots::{startup_chart, write_svg, StartupCurve};
-use crate::report::{check_output_path, ensure_dir, fmt_minutes, write_json, BeforeAfter, CompensateReport, CompensatedRun, Table};
-use crate::report_compensation::{check_model_inputs, compensate_run, drift_stats, pooled_stats, CompensatedSeries};
+use crate::report::{
+    check_output_path, ensure_dir, fmt_minutes, write_json, BeforeAfter, CompensateReport,
+    CompensatedRun, Table,
+};
+use crate::report_compensation::{
+    check_model_inputs, compensate_run, drift_stats, pooled_stats, CompensatedSeries,
+};
 use crate::report_pipeline::read_model;
 use crate::runs::{read_runs, Run};
 
@@ -31,13 +36,19 @@ pub struct Args {
 }
 
 /// Compensates every run and builds the report (series kept for plots).
-pub fn compensate_all(runs: &[Run], model: &fog_core::model::RbfModel) -> Result<(CompensateReport, Vec<CompensatedSeries>)> {
+pub fn compensate_all(
+    runs: &[Run],
+    model: &fog_core::model::RbfModel,
+) -> Result<(CompensateReport, Vec<CompensatedSeries>)> {
     let mut series = Vec::with_capacity(runs.len());
     let mut rows = Vec::with_capacity(runs.len());
     for run in runs {
         let s = compensate_run(run, Some(model))?;
         if s.after_dph.len() < 2 {
-            bail!("{}: the model compensated fewer than two 10 s windows", run.path.display());
+            bail!(
+                "{}: the model compensated fewer than two 10 s windows",
+                run.path.display()
+            );
         }
         rows.push(CompensatedRun {
             file: run.path.display().to_string(),
@@ -48,10 +59,26 @@ pub fn compensate_all(runs: &[Run], model: &fog_core::model::RbfModel) -> Result
         });
         series.push(s);
     }
-    let before: Vec<(&[f64], &[f64])> = series.iter().map(|s| (s.t_s.as_slice(), s.before_dph.as_slice())).collect();
-    let after: Vec<(&[f64], &[f64])> = series.iter().map(|s| (s.after_t_s.as_slice(), s.after_dph.as_slice())).collect();
-    let overall = BeforeAfter { before: pooled_stats(&before), after: pooled_stats(&after) };
-    Ok((CompensateReport { runs: rows, overall, spec_dph: SPEC_DPH }, series))
+    let before: Vec<(&[f64], &[f64])> = series
+        .iter()
+        .map(|s| (s.t_s.as_slice(), s.before_dph.as_slice()))
+        .collect();
+    let after: Vec<(&[f64], &[f64])> = series
+        .iter()
+        .map(|s| (s.after_t_s.as_slice(), s.after_dph.as_slice()))
+        .collect();
+    let overall = BeforeAfter {
+        before: pooled_stats(&before),
+        after: pooled_stats(&after),
+    };
+    Ok((
+        CompensateReport {
+            runs: rows,
+            overall,
+            spec_dph: SPEC_DPH,
+        },
+        series,
+    ))
 }
 
 /// The per-run table printed to the terminal.
@@ -67,8 +94,15 @@ pub fn compensate_table(report: &CompensateReport) -> String {
         "to spec after",
     ]);
     let amb = |a: Option<f64>| a.map_or("-".to_string(), |a| format!("{a:+.0} degC"));
-    let name = |f: &str| Path::new(f).file_name().map_or(f.to_string(), |n| n.to_string_lossy().into_owned());
-    let mut add = |label: String, ambient: String, b: &crate::report::DriftStats, a: &crate::report::DriftStats| {
+    let name = |f: &str| {
+        Path::new(f)
+            .file_name()
+            .map_or(f.to_string(), |n| n.to_string_lossy().into_owned())
+    };
+    let mut add = |label: String,
+                   ambient: String,
+                   b: &crate::report::DriftStats,
+                   a: &crate::report::DriftStats| {
         t.row(&[
             label,
             ambient,
@@ -83,25 +117,53 @@ pub fn compensate_table(report: &CompensateReport) -> String {
     for r in &report.runs {
         add(name(&r.file), amb(r.ambient_c), &r.before, &r.after);
     }
-    add("overall (pooled)".into(), String::new(), &report.overall.before, &report.overall.after);
-    format!("drift of 10 s means, deg/h (spec {} deg/h, 1 sigma)\n{}", report.spec_dph, t.render())
+    add(
+        "overall (pooled)".into(),
+        String::new(),
+        &report.overall.before,
+        &report.overall.after,
+    );
+    format!(
+        "drift of 10 s means, deg/h (spec {} deg/h, 1 sigma)\n{}",
+        report.spec_dph,
+        t.render()
+    )
 }
 
 /// Fig. 4/5-style startup curves (deviation from each run's settled mean) before and after.
-pub fn write_startup_plots(dir: &Path, runs: &[Run], series: &[CompensatedSeries], tag: &str) -> Result<()> {
+pub fn write_startup_plots(
+    dir: &Path,
+    runs: &[Run],
+    series: &[CompensatedSeries],
+    tag: &str,
+) -> Result<()> {
     let curves = |after: bool| -> Vec<StartupCurve> {
         runs.iter()
             .zip(series)
             .map(|(run, s)| {
-                let (t, y) = if after { (&s.after_t_s, &s.after_dph) } else { (&s.t_s, &s.before_dph) };
+                let (t, y) = if after {
+                    (&s.after_t_s, &s.after_dph)
+                } else {
+                    (&s.t_s, &s.before_dph)
+                };
                 let settled = crate::metrics::settled_mean(t, y);
-                StartupCurve { label: run.name(), t_s: t.clone(), drift_dph: y.iter().map(|v| v - settled).collect() }
+                StartupCurve {
+                    label: run.name(),
+                    t_s: t.clone(),
+                    drift_dph: y.iter().map(|v| v - settled).collect(),
+                }
             })
             .collect()
     };
     let title = |what: &str| format!("startup drift {what} compensation{tag}");
-    write_svg(&dir.join("startup_before.svg"), &startup_chart(&title("before"), &curves(false), Some(SPEC_DPH)))?;
-    write_svg(&dir.join("startup_after.svg"), &startup_chart(&title("after"), &curves(true), Some(SPEC_DPH)))?;
+    write_svg(
+        &dir.join("startup_before.svg"),
+        &startup_chart(&title("before"), &curves(false), Some(SPEC_DPH)),
+    )?;
+    write_svg(
+        &dir.join("startup_after.svg"),
+        &startup_chart(&title("after"), &curves(true), Some(SPEC_DPH)),
+    )?;
     Ok(())
 }
 

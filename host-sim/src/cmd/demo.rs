@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 
 use crate::cmd::reproduce::options;
-use crate::report::write_json;
+use crate::report::{ensure_dir, write_json};
 use crate::report_pipeline::CampaignSpec;
 use crate::report_reproduce::{reproduce, summary};
 use crate::sim::GyroParams;
@@ -28,12 +28,22 @@ pub struct Args {
 
 /// The demo's campaign: every 20 degC from -40 to +60, 4 runs of 45 min (3 train, 1 held out).
 pub fn demo_campaign(seed: u64) -> CampaignSpec {
-    CampaignSpec { ambients_c: vec![-40.0, -20.0, 0.0, 20.0, 40.0, 60.0], runs_per_ambient: 4, ..CampaignSpec::paper(seed) }
+    CampaignSpec {
+        ambients_c: vec![-40.0, -20.0, 0.0, 20.0, 40.0, 60.0],
+        runs_per_ambient: 4,
+        ..CampaignSpec::paper(seed)
+    }
 }
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
-    let opts = options(demo_campaign(args.seed), args.starts, None, Some(args.out.clone()))?;
+    let opts = options(
+        demo_campaign(args.seed),
+        args.starts,
+        None,
+        Some(args.out.clone()),
+    )?;
+    ensure_dir(&args.out, "--out")?;
     let started = std::time::Instant::now();
     let report = reproduce(&GyroParams::paper_default(), &opts)?;
     print!("{}", summary(&report));

@@ -7,7 +7,9 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use fog_core::northfinder::SeekMode;
 
-use crate::northseek::{build_report, default_threads, run_monte_carlo, seek_table, MonteCarloConfig};
+use crate::northseek::{
+    build_report, default_threads, run_monte_carlo, seek_table, MonteCarloConfig,
+};
 use crate::report::{check_output_path, progress_bar, write_json};
 use crate::report_pipeline::{read_model, simulate_campaign, train_default, CampaignSpec};
 use crate::sim::GyroParams;
@@ -37,7 +39,7 @@ pub struct Args {
     #[arg(long, default_value_t = crate::northseek::PAPER_AZIMUTH_DEG, allow_negative_numbers = true)]
     pub azimuth: f64,
     /// Measuring time per main position, s.
-    #[arg(long, default_value_t = 120.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 110.0, allow_negative_numbers = true)]
     pub dwell: f32,
     /// Seed of the whole Monte Carlo (and of the default training campaign).
     #[arg(long, default_value_t = 1)]
@@ -103,7 +105,15 @@ pub fn run(args: Args) -> Result<()> {
                 trained.report.n_centers,
                 trained.report.heldout_rms_dph
             );
-            (trained.model, format!("trained on {} simulated runs at {} degC, seed {}", runs.len(), cfg.ambient_c, cfg.seed))
+            (
+                trained.model,
+                format!(
+                    "trained on {} simulated runs at {} degC, seed {}",
+                    runs.len(),
+                    cfg.ambient_c,
+                    cfg.seed
+                ),
+            )
         }
     };
     let bar = progress_bar(cfg.starts, "north-seek cold starts");

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 
 use crate::northseek::{default_threads, MonteCarloConfig};
-use crate::report::{check_output_path, write_json};
+use crate::report::{check_output_path, ensure_dir, write_json};
 use crate::report_pipeline::{validate_plan, CampaignSpec};
 use crate::report_reproduce::{reproduce, summary, validation_tables, ReproduceOptions};
 use crate::sim::GyroParams;
@@ -28,7 +28,7 @@ pub struct Args {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Ambient temperatures, degC (comma separated).
-    #[arg(long, value_delimiter = ',', allow_negative_numbers = true,
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true,
           default_values_t = crate::campaign::PAPER_AMBIENTS_C.to_vec())]
     pub ambient: Vec<f64>,
     /// Runs per temperature (runs 1-3 train, the rest validate).
@@ -46,7 +46,12 @@ pub struct Args {
 }
 
 /// Checks the options and builds the pipeline's settings.
-pub fn options(campaign: CampaignSpec, starts: usize, threads: Option<usize>, plots: Option<PathBuf>) -> Result<ReproduceOptions> {
+pub fn options(
+    campaign: CampaignSpec,
+    starts: usize,
+    threads: Option<usize>,
+    plots: Option<PathBuf>,
+) -> Result<ReproduceOptions> {
     validate_plan(&campaign)?;
     if campaign.runs_per_ambient <= TRAIN_RUNS {
         bail!(
@@ -56,9 +61,16 @@ pub fn options(campaign: CampaignSpec, starts: usize, threads: Option<usize>, pl
         );
     }
     if campaign.minutes < 30.0 {
-        bail!("--minutes {}: a record must reach the settled state (>= 30 min; the paper records 45)", campaign.minutes);
+        bail!(
+            "--minutes {}: a record must reach the settled state (>= 30 min; the paper records 45)",
+            campaign.minutes
+        );
     }
-    let room_c = if campaign.ambients_c.contains(&20.0) { 20.0 } else { campaign.ambients_c[campaign.ambients_c.len() / 2] };
+    let room_c = if campaign.ambients_c.contains(&20.0) {
+        20.0
+    } else {
+        campaign.ambients_c[campaign.ambients_c.len() / 2]
+    };
     let north_seek = MonteCarloConfig {
         starts,
         ambient_c: room_c,
@@ -67,7 +79,12 @@ pub fn options(campaign: CampaignSpec, starts: usize, threads: Option<usize>, pl
         ..MonteCarloConfig::paper(campaign.seed)
     };
     north_seek.validate()?;
-    Ok(ReproduceOptions { campaign, n_train: TRAIN_RUNS, north_seek, plots })
+    Ok(ReproduceOptions {
+        campaign,
+        n_train: TRAIN_RUNS,
+        north_seek,
+        plots,
+    })
 }
 
 /// Runs the subcommand.
@@ -75,8 +92,16 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(p) = &args.json {
         check_output_path(p, "--json")?;
     }
-    let campaign = CampaignSpec { ambients_c: args.ambient.clone(), runs_per_ambient: args.runs, minutes: args.minutes, ..CampaignSpec::paper(args.seed) };
+    let campaign = CampaignSpec {
+        ambients_c: args.ambient.clone(),
+        runs_per_ambient: args.runs,
+        minutes: args.minutes,
+        ..CampaignSpec::paper(args.seed)
+    };
     let opts = options(campaign, args.starts, args.threads, args.plots.clone())?;
+    if let Some(dir) = &args.plots {
+        ensure_dir(dir, "--plots")?;
+    }
     let report = reproduce(&GyroParams::paper_default(), &opts)?;
     print!("{}\n{}", validation_tables(&report), summary(&report));
     if let Some(p) = &args.json {

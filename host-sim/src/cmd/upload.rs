@@ -4,11 +4,12 @@
 //! training PC's Ed25519 key, uploads it in chunks, commits, then asks the device for
 //! its status and confirms that the new model (sequence, CRC) is the one in use.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{bail, Context};
 use fog_core::model::RbfModel;
+use fog_core::protocol::SIGNATURE_LEN;
 
 use crate::upload::{
     describe_model, load_signing_key, open_link, sign_model, test_key_path, UploadClient,
@@ -41,8 +42,16 @@ pub struct Args {
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
     if !(args.timeout_s.is_finite() && args.timeout_s > 0.0) {
-        bail!("--timeout-s must be a positive number of seconds, got {}", args.timeout_s);
+        bail!(
+            "--timeout-s must be a positive number of seconds, got {}",
+            args.timeout_s
+        );
     }
+    // Check everything local first: a bad file or key never reaches the device.
+    let prepared = match &args.model {
+        Some(path) => Some(prepare(path, args.key.clone())?),
+        None => None,
+    };
     let link = open_link(&args.port, args.baud)?;
     let mut client = UploadClient::new(link, Duration::from_secs_f64(args.timeout_s));
     let before = client.hello().context("handshake (Hello)")?;
@@ -50,28 +59,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Some(info) => println!("device model before: {}", describe_model(info)),
         None => println!("device model before: none"),
     }
-    let Some(model_path) = args.model else {
+    let Some((bytes, signature)) = prepared else {
         return Ok(());
     };
-    let bytes = std::fs::read(&model_path)
-        .with_context(|| format!("reading model {}", model_path.display()))?;
-    let model = RbfModel::decode(&bytes)
-        .map_err(|e| anyhow::anyhow!("{}: not a valid model file: {e}", model_path.display()))?;
-    let key_path = args.key.unwrap_or_else(test_key_path);
-    if key_path == test_key_path() {
-        eprintln!("fogsim upload: WARNING signing with the public TEST key (keys/README.md)");
-    }
-    let key = load_signing_key(&key_path)?;
-    let signature = sign_model(&key, &bytes);
-    println!(
-        "uploading {} ({} bytes, gyro {}, {} centres)",
-        model_path.display(),
-        bytes.len(),
-        model.meta.gyro_id,
-        model.centers.len()
-    );
     let committed = client
-        .upload(&bytes, &signature, |done, total| eprint!("\r  sent {done}/{total} bytes"))
+        .upload(&bytes, &signature, |done, total| {
+            eprint!("\r  sent {done}/{total} bytes")
+        })
         .context("upload")?;
     eprintln!();
     let after = client.status().context("status after commit")?;
@@ -82,4 +76,29 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
         other => bail!("device committed {committed:?} but reports {other:?} as active"),
     }
+}
+
+/// Reads and validates the model file, loads the key and signs: (model bytes, signature).
+fn prepare(
+    model_path: &Path,
+    key: Option<PathBuf>,
+) -> anyhow::Result<(Vec<u8>, [u8; SIGNATURE_LEN])> {
+    let bytes = std::fs::read(model_path)
+        .with_context(|| format!("reading model {}", model_path.display()))?;
+    let model = RbfModel::decode(&bytes)
+        .map_err(|e| anyhow::anyhow!("{}: not a valid model file: {e}", model_path.display()))?;
+    let key_path = key.unwrap_or_else(test_key_path);
+    if key_path == test_key_path() {
+        eprintln!("fogsim upload: WARNING signing with the public TEST key (keys/README.md)");
+    }
+    let signature = sign_model(&load_signing_key(&key_path)?, &bytes);
+    println!(
+        "model {}: {} bytes, gyro {}, {} centres, {} inputs",
+        model_path.display(),
+        bytes.len(),
+        model.meta.gyro_id,
+        model.centers.len(),
+        model.inputs.len()
+    );
+    Ok((bytes, signature))
 }

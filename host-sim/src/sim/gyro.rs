@@ -75,6 +75,7 @@ pub struct SimGyro {
     rng_gyro: ChaCha8Rng,
     rng_sensor: ChaCha8Rng,
     last: Option<RawSample>,
+    last_input_rate_dph: f64,
 }
 
 impl SimGyro {
@@ -123,6 +124,7 @@ impl SimGyro {
             rng_gyro,
             rng_sensor: stream_rng(spec.seed, STREAM_SENSOR),
             last: None,
+            last_input_rate_dph: 0.0,
         };
         gyro.sensor_c = gyro.sensor_node_c();
         Ok(gyro)
@@ -213,7 +215,9 @@ impl SimGyro {
             housing_c: self.thermal.housing_c(),
             sensor_c: self.sensor_c,
             azimuth_deg,
+            input_rate_dph: earth_dph + table_dph,
         };
+        self.last_input_rate_dph = earth_dph + table_dph;
         let mut drift_dph = self.physics_drift_dph() + self.turn_on_bias_dph;
         for (state, term) in self.terms.iter_mut().zip(&self.params.extra_terms) {
             drift_dph += state.update(term, &inputs, self.dt_s);
@@ -257,6 +261,7 @@ impl SimGyro {
             housing_c: self.thermal.housing_c(),
             sensor_c: self.sensor_c,
             azimuth_deg: self.heading_deg + self.table_angle_deg(t),
+            input_rate_dph: self.last_input_rate_dph,
         }
     }
 }

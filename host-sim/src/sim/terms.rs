@@ -21,6 +21,9 @@ pub enum AuxSource {
     HeadingCos,
     /// sin of the input axis azimuth.
     HeadingSin,
+    /// The true angular rate along the input axis (Earth + table), deg/h: a coefficient
+    /// on it is a scale-factor error (dK/K).
+    InputRateDph,
     /// A measured or synthetic series (e.g. a `supply_v` column): linear interpolation
     /// in `t_s`, held constant outside it.
     Series { t_s: Vec<f64>, values: Vec<f64> },
@@ -96,6 +99,7 @@ pub struct TermInputs {
     pub housing_c: f64,
     pub sensor_c: f64,
     pub azimuth_deg: f64,
+    pub input_rate_dph: f64,
 }
 
 /// Source value at an instant.
@@ -107,6 +111,7 @@ pub fn source_value(source: &AuxSource, x: &TermInputs) -> f64 {
         AuxSource::PowerOnDecay { tau_s } => (-x.t_s / tau_s).exp(),
         AuxSource::HeadingCos => x.azimuth_deg.to_radians().cos(),
         AuxSource::HeadingSin => x.azimuth_deg.to_radians().sin(),
+        AuxSource::InputRateDph => x.input_rate_dph,
         AuxSource::Series { t_s, values } => interpolate(t_s, values, x.t_s),
     }
 }

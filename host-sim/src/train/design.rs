@@ -165,11 +165,9 @@ pub fn gauss_exp(x: f32) -> f32 {
     let p = p * r + 5.000_000_1e-1;
     let p = (p * r * r + r) + 1.0;
     let scale = f32::from_bits(((n as i32 + 127) as u32) << 23);
-    if x < MIN_EXP_ARG {
-        0.0
-    } else {
-        p * scale
-    }
+    // Branch-free select (keeps the loop vectorisable): all-ones mask when x >= MIN.
+    let keep = u32::from(x >= MIN_EXP_ARG).wrapping_neg();
+    f32::from_bits((p * scale).to_bits() & keep)
 }
 
 /// Dot product of two f32 vectors: 16 f32 lanes within blocks of 512 values (so the
@@ -184,6 +182,8 @@ pub fn dot_f32(a: &[f32], b: &[f32]) -> f64 {
         let (ea, eb) = (ba.chunks_exact(LANES), bb.chunks_exact(LANES));
         let tail: f32 = ea.remainder().iter().zip(eb.remainder()).map(|(x, y)| x * y).sum();
         for (x, y) in ea.zip(eb) {
+            let x: &[f32; LANES] = x.try_into().unwrap_or(&[0.0; LANES]);
+            let y: &[f32; LANES] = y.try_into().unwrap_or(&[0.0; LANES]);
             for l in 0..LANES {
                 acc[l] += x[l] * y[l];
             }

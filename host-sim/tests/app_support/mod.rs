@@ -12,7 +12,11 @@ use fog_sim::sim::GyroParams;
 
 /// Runs `fogsim` with `args` in `dir`.
 pub fn fogsim(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fogsim")).current_dir(dir).args(args).output().expect("fogsim runs")
+    Command::new(env!("CARGO_BIN_EXE_fogsim"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("fogsim runs")
 }
 
 /// stderr as text.
@@ -32,10 +36,20 @@ pub fn scratch_dir(name: &str) -> PathBuf {
 /// trained on the first three into `dir/model.bin`; returns the held-out run paths.
 pub fn campaign_and_model(dir: &Path, runs: usize) -> Vec<PathBuf> {
     let params = GyroParams::paper_default();
-    let plan = CampaignSpec { ambients_c: vec![20.0], runs_per_ambient: runs, ..CampaignSpec::paper(11) };
+    let plan = CampaignSpec {
+        ambients_c: vec![20.0],
+        runs_per_ambient: runs,
+        ..CampaignSpec::paper(11)
+    };
     let campaign = simulate_campaign(&params, &plan).unwrap();
-    let train: Vec<_> = campaign.iter().filter(|c| c.index <= 3).map(|c| &c.run).collect();
-    let model = train_default(&train, &fog_sim::train::default_specs(), "test").unwrap().model;
+    let train: Vec<_> = campaign
+        .iter()
+        .filter(|c| c.index <= 3)
+        .map(|c| &c.run)
+        .collect();
+    let model = train_default(&train, &fog_sim::train::default_specs(), "test")
+        .unwrap()
+        .model;
     let mut buf = [0u8; fog_core::model::MAX_ENCODED_LEN];
     let n = model.encode(&mut buf).unwrap();
     std::fs::write(dir.join("model.bin"), &buf[..n]).unwrap();

@@ -1,7 +1,7 @@
 //! Seeded generator of "measured" campaigns with one hidden effect (or none), for the
 //! `diagnose` tests. Deliberately unlike the project's simulator: its own two-node
 //! thermal response with randomised time constants and amplitudes, random ambients and
-//! latitudes, cold and warm restarts, sensor quantisation and noise, white plus slowly
+//! latitudes, cold, warm and hot restarts, chamber set-point steps and air wander, sensor quantisation and noise, white plus slowly
 //! correlated gyro noise, run-to-run bias offsets, a turntable indexing the heading
 //! during each run, and decoy columns that wander slowly and mean nothing.
 
@@ -44,7 +44,7 @@ impl Default for Shape {
 
 /// Extra columns every campaign carries (the planted column is one of the first two).
 pub const AUX_COLUMNS: [&str; 2] = ["supply_v", "board_c"];
-pub const DECOY_COLUMNS: [&str; 2] = ["decoy_wander", "chamber_c"];
+pub const DECOY_COLUMNS: [&str; 2] = ["decoy_wander", "spare_adc"];
 
 /// A smooth random signal: position of an integrated Ornstein-Uhlenbeck velocity.
 fn wander(rng: &mut ChaCha8Rng, n: usize, dt: f64, tau_s: f64, scale: f64) -> (Vec<f64>, Vec<f64>) {
@@ -63,6 +63,18 @@ fn wander(rng: &mut ChaCha8Rng, n: usize, dt: f64, tau_s: f64, scale: f64) -> (V
     let m = xs.iter().sum::<f64>() / n as f64;
     let sd = (xs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / n as f64).sqrt().max(1e-9);
     (xs.iter().map(|x| scale * x / sd).collect(), vs.iter().map(|v| scale * v / tau_s / sd).collect())
+}
+
+/// First-order lag of a sampled signal (exact for linear interpolation is not needed here).
+fn lagged(x: &[f64], dt: f64, tau_s: f64) -> Vec<f64> {
+    let a = 1.0 - (-dt / tau_s).exp();
+    let mut y = x[0];
+    x.iter()
+        .map(|v| {
+            y += a * (v - y);
+            y
+        })
+        .collect()
 }
 
 /// Rescales `e` so that its rms over the points where |e| exceeds 10 % of its peak is `target`.
@@ -117,8 +129,25 @@ pub fn campaign(effect: Effect, seed: u64, shape: Shape) -> (Vec<Run>, Expected)
     for r in 0..shape.runs {
         let ambient = ambients[r % ambients.len()] + g.sample(&mut rng) * 0.5;
         let gain = 1.0 + 0.004 * (ambient - 20.0);
-        // warm restart: the gyro ran to equilibrium, then was off for t_off
-        let t_off = if rng.random_bool(0.5) { rng.random_range(60.0..1800.0) } else { f64::INFINITY };
+        // cold start, warm restart (off for 10-60 min) or hot restart (a 10-300 s power
+        // interruption): the gyro had reached equilibrium before it was switched off.
+        let t_off = match rng.random_range(0..10) {
+            0..=3 => f64::INFINITY,
+            4..=6 => rng.random_range(600.0..3600.0),
+            _ => rng.random_range(5.0..60.0),
+        };
+        // half the runs see a chamber set-point step mid-run, felt through two lags
+        let step_c = if rng.random_bool(0.5) { rng.random_range(1.0..4.0) * if rng.random_bool(0.5) { 1.0 } else { -1.0 } } else { 0.0 };
+        let step_at_s = rng.random_range(600.0..1800.0);
+        let (lag_a, lag_b) = (taus[1], rng.random_range(60.0..150.0));
+        // the chamber air wanders (regulation, door, lab): a smooth random excursion
+        // felt through a first-order lag; its d2T/dt2 is not a function of T and dT/dt
+        let (air, _) = {
+            let tau = rng.random_range(100.0..250.0);
+            let amp = rng.random_range(0.5..1.5);
+            wander(&mut rng, n + 2, dt, tau, amp)
+        };
+        let felt = lagged(&air, dt, lag_b);
         let a: Vec<f64> = amps.iter().map(|x| x * gain).collect();
         let x0: Vec<f64> = a.iter().zip(&taus).map(|(ai, ti)| ai * (-t_off / ti).exp()).collect();
         let mut t = Vec::new();
@@ -138,6 +167,15 @@ pub fn campaign(effect: Effect, seed: u64, shape: Shape) -> (Vec<Run>, Expected)
                 rate -= (x0[i] - a[i]) / taus[i] * e;
                 acc += (x0[i] - a[i]) / (taus[i] * taus[i]) * e;
             }
+            if tc > step_at_s {
+                let (ea, eb) = ((-(tc - step_at_s) / lag_a).exp(), (-(tc - step_at_s) / lag_b).exp());
+                temp += step_c * (1.0 - (lag_a * ea - lag_b * eb) / (lag_a - lag_b));
+                rate += step_c * (ea - eb) / (lag_a - lag_b);
+                acc += step_c * (eb / lag_b - ea / lag_a) / (lag_a - lag_b);
+            }
+            temp += felt[k + 1];
+            rate += (felt[k + 2] - felt[k]) / (2.0 * dt);
+            acc += (felt[k + 2] - 2.0 * felt[k + 1] + felt[k]) / (dt * dt);
             // sensor: 1 Hz samples, noise, 0.0625 degC steps, averaged over the window
             let mut s = 0.0;
             for j in 0..10 {

@@ -16,8 +16,14 @@ use fog_sim::upload::{load_signing_key, sign_model, test_key_path, UploadClient}
 /// A valid 2-input model (T, dT/dt) with `n_centers` centres for gyro `gyro_id`.
 pub fn sample_model(gyro_id: &str, n_centers: usize, weight_scale: f32) -> RbfModel {
     let inputs = [
-        FeatureSpec { kind: FeatureKind::TempC, tau_s: 0.0 },
-        FeatureSpec { kind: FeatureKind::TempRateCps, tau_s: 0.0 },
+        FeatureSpec {
+            kind: FeatureKind::TempC,
+            tau_s: 0.0,
+        },
+        FeatureSpec {
+            kind: FeatureKind::TempRateCps,
+            tau_s: 0.0,
+        },
     ];
     let mut m = RbfModel {
         n_rbf_inputs: 2,
@@ -102,7 +108,11 @@ pub struct InMemoryLink<'s> {
 
 impl<'s> InMemoryLink<'s> {
     pub fn new(server: &'s mut Server) -> Self {
-        Self { server, replies: VecDeque::new(), model_changes: 0 }
+        Self {
+            server,
+            replies: VecDeque::new(),
+            model_changes: 0,
+        }
     }
 }
 

@@ -1,0 +1,97 @@
+//! The model-slot flash region as an `embedded_storage` NOR flash. Under QEMU the
+//! region (linker symbols `_models_start`/`_models_end`, see memory.x) is plain memory,
+//! so this driver enforces NOR semantics itself: erase sets 4 KiB sectors to 0xFF,
+//! a write can only clear bits. A real board replaces this file with its flash
+//! controller driver (same traits, same geometry or its own).
+
+use core::ptr::{addr_of, read_volatile, write_volatile};
+
+use embedded_storage::nor_flash::{
+    check_erase, check_read, check_write, ErrorType, NorFlash, NorFlashError,
+    NorFlashErrorKind, ReadNorFlash,
+};
+
+extern "C" {
+    static _models_start: u8;
+    static _models_end: u8;
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FlashError(pub NorFlashErrorKind);
+
+impl NorFlashError for FlashError {
+    fn kind(&self) -> NorFlashErrorKind {
+        self.0
+    }
+}
+
+pub struct ModelFlash {
+    base: usize,
+    len: usize,
+}
+
+impl ModelFlash {
+    /// # Safety
+    /// Only one `ModelFlash` may exist: it owns the region.
+    pub unsafe fn take() -> Self {
+        let base = addr_of!(_models_start) as usize;
+        let end = addr_of!(_models_end) as usize;
+        Self {
+            base,
+            len: end - base,
+        }
+    }
+
+    fn byte(&self, off: usize) -> u8 {
+        // SAFETY: off < len (checked by the callers), region owned by self.
+        unsafe { read_volatile((self.base + off) as *const u8) }
+    }
+
+    fn set(&mut self, off: usize, v: u8) {
+        // SAFETY: as above.
+        unsafe { write_volatile((self.base + off) as *mut u8, v) }
+    }
+}
+
+impl ErrorType for ModelFlash {
+    type Error = FlashError;
+}
+
+impl ReadNorFlash for ModelFlash {
+    const READ_SIZE: usize = 1;
+
+    fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), FlashError> {
+        check_read(self, offset, bytes.len()).map_err(FlashError)?;
+        for (i, b) in bytes.iter_mut().enumerate() {
+            *b = self.byte(offset as usize + i);
+        }
+        Ok(())
+    }
+
+    fn capacity(&self) -> usize {
+        self.len
+    }
+}
+
+impl NorFlash for ModelFlash {
+    const WRITE_SIZE: usize = 4;
+    const ERASE_SIZE: usize = 4096;
+
+    fn erase(&mut self, from: u32, to: u32) -> Result<(), FlashError> {
+        check_erase(self, from, to).map_err(FlashError)?;
+        for off in from as usize..to as usize {
+            self.set(off, 0xFF);
+        }
+        Ok(())
+    }
+
+    fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), FlashError> {
+        check_write(self, offset, bytes.len()).map_err(FlashError)?;
+        for (i, &b) in bytes.iter().enumerate() {
+            let off = offset as usize + i;
+            let old = self.byte(off);
+            self.set(off, old & b);
+        }
+        Ok(())
+    }
+}
