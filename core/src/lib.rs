@@ -8,6 +8,7 @@
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
 
+pub mod accuracy;
 pub mod compensator;
 pub mod consts;
 pub mod features;

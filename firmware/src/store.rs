@@ -165,8 +165,8 @@ impl<F: NorFlash> ModelStore<F> {
             .is_some_and(|end| end <= flash.capacity());
         if !fits
             || F::WRITE_SIZE > MAX_WRITE_SIZE
-            || MAX_WRITE_SIZE % F::WRITE_SIZE != 0
-            || base as usize % F::ERASE_SIZE != 0
+            || !MAX_WRITE_SIZE.is_multiple_of(F::WRITE_SIZE)
+            || !(base as usize).is_multiple_of(F::ERASE_SIZE)
         {
             return Err(StoreError::Geometry);
         }

@@ -246,9 +246,9 @@ fn a_scale_factor_error_is_a_term_on_the_input_rate() {
         simulate_run(&base, &spec).unwrap(),
         simulate_run(&sf, &spec).unwrap(),
     );
-    let earth = a.earth_dph();
-    for i in 0..a.len() {
-        let d = b.rate_dph()[i] - a.rate_dph()[i];
-        assert!((d - 500e-6 * earth[i]).abs() < 1e-9, "{d}");
+    let pairs = a.rate_dph().iter().zip(b.rate_dph());
+    for ((ra, rb), e) in pairs.zip(a.earth_dph()) {
+        let d = rb - ra;
+        assert!((d - 500e-6 * e).abs() < 1e-9, "{d}");
     }
 }

@@ -15,6 +15,8 @@ use std::time::{Duration, Instant};
 
 /// The firmware's target triple.
 pub const FW_TARGET: &str = "thumbv7em-none-eabihf";
+/// Cargo profile of firmware builds (release, optimised for size; root Cargo.toml).
+pub const FW_PROFILE: &str = "fw";
 /// QEMU machine: MPS2 AN386, Cortex-M4F, 25 MHz core clock.
 pub const QEMU_MACHINE: &str = "mps2-an386";
 
@@ -93,7 +95,7 @@ pub fn firmware_target_dir() -> PathBuf {
     }
 }
 
-/// Build every firmware binary (release, semihosting logs) once per test process and
+/// Build every firmware binary (profile `fw`, semihosting logs) once per test process and
 /// return the directory holding the ELFs. Concurrent test processes serialise on
 /// cargo's own lock of the target directory.
 pub fn build_firmware() -> Result<PathBuf, String> {
@@ -106,7 +108,7 @@ pub fn build_firmware() -> Result<PathBuf, String> {
     let target_dir = firmware_target_dir();
     let out = Command::new(cargo())
         .current_dir(workspace_root())
-        .args(["build", "-p", "fog-firmware", "--release", "--bins"])
+        .args(["build", "-p", "fog-firmware", "--profile", FW_PROFILE, "--bins"])
         .args(["--target", FW_TARGET, "--features", "log-semihosting"])
         .arg("--target-dir")
         .arg(&target_dir)
@@ -115,7 +117,7 @@ pub fn build_firmware() -> Result<PathBuf, String> {
         .map_err(|e| format!("cannot run cargo: {e}"));
     let result = out.and_then(|o| {
         if o.status.success() {
-            Ok(target_dir.join(FW_TARGET).join("release"))
+            Ok(target_dir.join(FW_TARGET).join(FW_PROFILE))
         } else {
             Err(format!(
                 "firmware build failed ({}):\n{}",

@@ -92,7 +92,7 @@ fn kmeans(pts: &[Vec<f64>], k: usize) -> Vec<Vec<f64>> {
         }
     }
     let mut assign = vec![0usize; pts.len()];
-    for _ in 0..20 {
+    for _ in 0..12 {
         let mut changed = false;
         for (i, p) in pts.iter().enumerate() {
             let best = (0..centres.len()).min_by(|&a, &b| dist2(p, &centres[a]).total_cmp(&dist2(p, &centres[b]))).unwrap_or(0);

@@ -14,7 +14,7 @@ pub const WIDTH_FACTORS: [f64; 3] = [0.5, 1.0, 2.0];
 /// Relative ridge values tried.
 pub const RIDGES: [f64; 4] = [1e-6, 1e-4, 1e-2, 1e-1];
 /// Centre counts tried, as fractions of `centre_count`.
-pub const CENTRE_FRACTIONS: [f64; 3] = [0.3, 0.6, 1.0];
+pub const CENTRE_FRACTIONS: [f64; 2] = [0.5, 1.0];
 
 /// The campaign stacked run after run.
 #[derive(Clone, Debug)]

@@ -45,7 +45,7 @@ impl Default for TrainConfig {
             method: Method::Ols,
             rho: 0.01,
             max_centers: MAX_CENTERS,
-            width_candidates: vec![0.1, 0.2, 0.35, 0.6, 1.0],
+            width_candidates: vec![0.2, 0.35, 0.6, 1.0, 1.6],
             folds: 3,
             linear_only_inputs: 0,
             linear_on_rbf_inputs: false,

@@ -1,0 +1,171 @@
+//! Firmware budgets, checked in CI and tabulated by `scripts/budgets.sh`:
+//!
+//! - flash and static RAM of the application binary `fog-app` (llvm-size);
+//! - panic paths left in `fog-app` (calls into `core::panicking` found by disassembly);
+//! - instruction counts under `qemu -icount shift=0` (`src/bin/bench.rs`): per raw
+//!   sample, per 10 s update (35/64 centres, f32/fixed), per RBF evaluation, per Ed25519
+//!   verification; and from them the CPU load at 2 kHz on a 168 MHz Cortex-M4F.
+//!
+//! With `FOG_BUDGETS_OUT=<file>` the test also writes the Markdown budget table there.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::process::Command;
+use std::time::Duration;
+
+use fog_tests::{
+    firmware_elf, firmware_size, llvm_tool, qemu_ready, run_qemu, scratch_dir, QemuOptions,
+};
+
+/// The budgets.
+const FLASH_TARGET_BYTES: u64 = 64 * 1024;
+const STATIC_RAM_BUDGET_BYTES: u64 = 16 * 1024;
+/// Regression ceiling for flash. The 64 KiB target is NOT met yet (measured 71,976 bytes
+/// when this was written; docs/firmware.md explains where the bytes go): the check fails
+/// on any growth past this ceiling so the gap can only shrink.
+const FLASH_CEILING_BYTES: u64 = 74 * 1024;
+/// Regression ceiling for call sites into panic stubs in `fog-app` (measured: see docs).
+const PANIC_CALL_SITES_CEILING: usize = 40;
+/// Sample rate and clock of the CPU-load estimate.
+const LOAD_RATE_HZ: f64 = 2000.0;
+const LOAD_CPU_HZ: f64 = 168e6;
+/// Regression ceilings for instruction counts (about 1.5x the measured values).
+const SAMPLE_INSTR_CEILING: u64 = 3_000;
+const UPDATE_INSTR_CEILING: u64 = 80_000;
+const VERIFY_INSTR_CEILING: u64 = 3_000_000;
+
+/// Call sites in `elf` that branch to `core::panicking::*` or to a panic stub, per caller.
+fn panic_call_sites(elf: &std::path::Path) -> BTreeMap<String, usize> {
+    let objdump = llvm_tool("llvm-objdump").expect("llvm-objdump");
+    let out = Command::new(objdump)
+        .args(["-d", "--no-show-raw-insn", "-C"])
+        .arg(elf)
+        .output()
+        .expect("run llvm-objdump");
+    let text = String::from_utf8_lossy(&out.stdout);
+    let mut sites = BTreeMap::new();
+    let mut func = String::new();
+    for line in text.lines() {
+        if let Some(name) = line.split_once(" <").and_then(|(_, r)| r.strip_suffix(">:")) {
+            if !name.starts_with('$') {
+                func = name.to_string();
+            }
+            continue;
+        }
+        let is_branch = line.contains("\tbl\t") || line.contains("\tb.w\t") || line.contains("\tb\t");
+        let to_panic = line.contains("core::panicking") || line.contains("_fail>");
+        if is_branch && to_panic && !func.contains("core::panicking") && !func.ends_with("_fail") {
+            *sites.entry(func.clone()).or_insert(0) += 1;
+        }
+    }
+    sites
+}
+
+fn parse_bench(stdout: &str) -> BTreeMap<String, u64> {
+    stdout
+        .lines()
+        .filter_map(|l| {
+            let (k, v) = l.split_once(' ')?;
+            Some((k.to_string(), v.trim().parse().ok()?))
+        })
+        .collect()
+}
+
+#[test]
+fn firmware_fits_its_budgets() {
+    if !qemu_ready("fw_budgets") {
+        return;
+    }
+    let app = firmware_elf("fog-app");
+    let size = firmware_size(&app).expect("llvm-size");
+    let sites = panic_call_sites(&app);
+    let n_sites: usize = sites.values().sum();
+
+    // Instruction counts, with a really signed model for the Ed25519 verification.
+    let dir = scratch_dir("bench");
+    let key = fog_sim::upload::load_signing_key(&fog_sim::upload::test_key_path()).expect("test key");
+    let model = fog_core::synthetic::warmup_model(35, 2, 0.05, 35);
+    let mut buf = [0u8; fog_core::model::MAX_ENCODED_LEN];
+    let n = model.encode(&mut buf).expect("encode");
+    std::fs::write(dir.join("model.bin"), &buf[..n]).unwrap();
+    std::fs::write(dir.join("model.sig"), fog_sim::upload::sign_model(&key, &buf[..n])).unwrap();
+    let opts = QemuOptions {
+        args: vec!["model.bin".into(), "model.sig".into()],
+        icount: true,
+        cwd: Some(dir.clone()),
+        ..QemuOptions::default()
+    };
+    let run = run_qemu(&firmware_elf("bench"), &opts, Duration::from_secs(120)).unwrap();
+    assert!(run.status.success(), "bench failed: {}", run.stderr);
+    let b = parse_bench(&String::from_utf8_lossy(&run.stdout));
+    let get = |k: &str| *b.get(k).unwrap_or_else(|| panic!("bench output lacks {k}: {b:?}"));
+    let sample = get("sample_instr");
+    let update64 = get("update_instr_64_f32");
+    let load_pct = (sample as f64 * LOAD_RATE_HZ + update64 as f64 / 10.0) / LOAD_CPU_HZ * 100.0;
+
+    let mut table = String::new();
+    let _ = writeln!(table, "| budget | measured | limit |\n|---|---|---|");
+    let _ = writeln!(
+        table,
+        "| flash (`fog-app`, text+rodata+data) | {} B ({:.1} KiB) | target 64 KiB: {}; CI ceiling {} KiB |",
+        size.flash,
+        size.flash as f64 / 1024.0,
+        if size.flash <= FLASH_TARGET_BYTES { "met" } else { "NOT met" },
+        FLASH_CEILING_BYTES / 1024
+    );
+    let _ = writeln!(
+        table,
+        "| static RAM (`fog-app`, data+bss) | {} B | 16 KiB |",
+        size.static_ram
+    );
+    let _ = writeln!(
+        table,
+        "| panic call sites left in `fog-app` | {n_sites} in {} functions | ceiling {PANIC_CALL_SITES_CEILING} |",
+        sites.len()
+    );
+    for (k, label) in [
+        ("sample_instr", "instructions per raw sample (2 kHz, frame decode + averager)"),
+        ("update_instr_35_f32", "instructions per 10 s update, 35 centres, f32"),
+        ("update_instr_35_fixed", "instructions per 10 s update, 35 centres, fixed point"),
+        ("update_instr_64_f32", "instructions per 10 s update, 64 centres, f32"),
+        ("update_instr_64_fixed", "instructions per 10 s update, 64 centres, fixed point"),
+        ("predict_instr_35_f32", "instructions per RBF evaluation, 35 centres, f32"),
+        ("predict_instr_35_fixed", "instructions per RBF evaluation, 35 centres, fixed point"),
+        ("predict_instr_64_f32", "instructions per RBF evaluation, 64 centres, f32"),
+        ("predict_instr_64_fixed", "instructions per RBF evaluation, 64 centres, fixed point"),
+        ("verify_instr", "instructions per Ed25519 model verification"),
+    ] {
+        let _ = writeln!(table, "| {label} | {} | |", get(k));
+    }
+    let _ = writeln!(
+        table,
+        "| CPU load at 2 kHz on a 168 MHz M4F (1 instr = 1 cycle) | {load_pct:.2} % | |"
+    );
+    eprintln!("{table}\npanic call sites: {sites:#?}");
+    if let Ok(path) = std::env::var("FOG_BUDGETS_OUT") {
+        std::fs::write(&path, &table).expect("write budgets table");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+
+    assert!(
+        size.static_ram <= STATIC_RAM_BUDGET_BYTES,
+        "static RAM {} B over the 16 KiB budget",
+        size.static_ram
+    );
+    assert!(
+        size.flash <= FLASH_CEILING_BYTES,
+        "flash {} B grew past the {} B ceiling (target {} B)",
+        size.flash,
+        FLASH_CEILING_BYTES,
+        FLASH_TARGET_BYTES
+    );
+    assert!(n_sites <= PANIC_CALL_SITES_CEILING, "panic call sites grew: {sites:#?}");
+    assert_eq!(get("verify_valid"), 1, "the signed model verifies on the target");
+    assert!(sample > 100 && sample <= SAMPLE_INSTR_CEILING, "per-sample {sample}");
+    for k in ["update_instr_35_f32", "update_instr_35_fixed", "update_instr_64_f32", "update_instr_64_fixed"] {
+        let v = get(k);
+        assert!(v > 1000 && v <= UPDATE_INSTR_CEILING, "{k} = {v}");
+    }
+    let v = get("verify_instr");
+    assert!(v > 10_000 && v <= VERIFY_INSTR_CEILING, "verify {v}");
+}
