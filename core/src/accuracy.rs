@@ -40,7 +40,7 @@ pub fn worst_errors(
         max_abs_drift_dph: 0.0,
         n_points: 0,
     };
-    let mut check = |u: &[f64; MAX_INPUTS], rep: &mut ErrorReport| {
+    let check = |u: &[f64; MAX_INPUTS], rep: &mut ErrorReport| {
         let mut x32 = [0.0f32; MAX_INPUTS];
         let mut x64 = [0.0f64; MAX_INPUTS];
         for j in 0..n {

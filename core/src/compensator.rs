@@ -437,7 +437,14 @@ impl Compensator {
             if v < lo || v > hi {
                 outside.get_or_insert(j as u8);
             }
-            clamped[j] = v.clamp(lo, hi);
+            // Not f32::clamp: it panics on a NaN bound (an infinite range times 0 margin).
+            clamped[j] = if v < lo {
+                lo
+            } else if v > hi {
+                hi
+            } else {
+                v
+            };
         }
         let xs = &clamped[..x.len()];
         let drift: Result<f32, RbfError> = match &self.fixed {

@@ -143,7 +143,7 @@ impl WindowAverager {
 
     /// End of the window currently being filled, s.
     pub fn current_end_s(&self) -> f64 {
-        (self.index + 1) as f64 * self.window_s
+        self.index.saturating_add(1) as f64 * self.window_s
     }
 
     fn close(&mut self) -> WindowMean {
@@ -174,7 +174,7 @@ impl WindowAverager {
             n_gaps,
             max_gap_s: max_gap as f32,
         };
-        self.index += 1;
+        self.index = self.index.saturating_add(1);
         self.sum = 0.0;
         self.n = 0;
         self.n_gaps = 0;
@@ -563,7 +563,9 @@ impl FeatureExtractor {
 ///
 /// `aux[ch][row]` is aux channel `ch`; `out` must have one entry per row. Causal: row k uses
 /// rows 0..=k only; rows whose `ready` is false (estimator warm-up) should be left out of
-/// training, exactly as the device marks those windows invalid.
+/// training, exactly as the device marks those windows invalid. Rows must be the 10 s means
+/// the device computes: the estimators keep at most `EXTRACTOR_RATE_POINTS` rows, so denser
+/// (raw-rate) rows would shorten the least-squares span.
 pub fn features_for_series(
     specs: &[FeatureSpec],
     t_s: &[f64],

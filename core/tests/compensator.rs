@@ -282,3 +282,37 @@ fn pipeline_state_fits_a_small_mcu() {
     println!("Compensator {comp} B, NorthFinder {nf} B");
     assert!(comp + nf <= 10 * 1024, "{comp} + {nf}");
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 300, failure_persistence: None, ..Default::default() })]
+
+    #[test]
+    fn arbitrary_sensor_data_never_panics(
+        events in proptest::collection::vec((0u8..4, proptest::prelude::any::<f64>(), proptest::prelude::any::<f32>()), 0..80),
+        fixed in proptest::prelude::any::<bool>(),
+    ) {
+        let ev = if fixed { Evaluator::Fixed } else { Evaluator::F32 };
+        let mut comp = Compensator::new(config(ev), Some(model())).unwrap();
+        let mut nf = fog_core::northfinder::NorthFinder::new(Default::default()).unwrap();
+        struct Table;
+        impl fog_core::hal::Turntable for Table {
+            type Error = ();
+            fn command_heading(&mut self, _: f32) -> Result<(), ()> { Ok(()) }
+            fn poll(&mut self) -> Result<fog_core::hal::TableState, ()> {
+                Ok(fog_core::hal::TableState::Settled { heading_deg: 0.0 })
+            }
+        }
+        let _ = nf.start(&mut Table, 0.0);
+        for (kind, t, v) in events {
+            let r = match kind {
+                0 => comp.push_gyro(GyroSample { t_s: t, rate_dph: v }),
+                1 => { comp.push_temp(TempSample { t_s: t, temp_c: v }); None }
+                2 => { comp.report_fault(t); None }
+                _ => comp.poll(t),
+            };
+            if let Some(w) = r {
+                let _ = nf.on_window(&w, &mut Table);
+            }
+        }
+    }
+}

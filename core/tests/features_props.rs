@@ -232,3 +232,29 @@ fn accel_feature_needs_three_rows() {
         .collect();
     assert_eq!(r, [false, false, true, true]);
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 500, failure_persistence: None, ..ProptestConfig::default() })]
+
+    #[test]
+    fn arbitrary_samples_never_panic(
+        samples in prop::collection::vec((any::<f64>(), any::<f32>()), 0..50),
+        rate_hz in 0.5f32..20_000.0,
+    ) {
+        let mut avg = WindowAverager::new(10.0, rate_hz).unwrap();
+        let mut est: TempRateEstimator<16> = TempRateEstimator::new(60.0).unwrap();
+        let mut fx = FeatureExtractor::new(&[
+            FeatureSpec { kind: FeatureKind::TempRateCps, tau_s: 0.0 },
+            FeatureSpec { kind: FeatureKind::TempAccelCps2, tau_s: 0.0 },
+            FeatureSpec { kind: FeatureKind::TempLagC, tau_s: 100.0 },
+            FeatureSpec { kind: FeatureKind::PowerOnDecay, tau_s: 100.0 },
+        ])
+        .unwrap();
+        for (t, v) in samples {
+            let _ = avg.push(t, v);
+            let _ = avg.poll(t);
+            let _ = est.push(t, v as f64);
+            let _ = fx.push(t, v, &[]);
+        }
+    }
+}

@@ -3,7 +3,7 @@
 
 use fog_core::accuracy::worst_errors as worst_errors_in_box;
 use fog_core::fixed::{exp_neg_q30, f32_to_fixed, fixed_to_f32, FixedModel};
-use fog_core::model::{FeatureKind, FeatureSpec, RbfModel, TrainingMeta, MAX_INPUTS};
+use fog_core::model::{FeatureKind, FeatureSpec, RbfModel, TrainingMeta};
 use fog_core::rbf::{predict_f32, predict_f64, RbfError};
 use fog_core::synthetic::{random_warmup_point, warmup_model, SplitMix64};
 use proptest::prelude::*;

@@ -278,7 +278,12 @@ pub fn write_seek<E>(out: &mut impl Write, s: &SeekOutcome<E>) -> core::fmt::Res
             r.bias_dph.to_bits()
         ),
         SeekOutcome::Failed(f) => {
-            writeln!(out, "F {} {:016x}", seek_error_code(f.error), f.t_s.to_bits())
+            writeln!(
+                out,
+                "F {} {:016x}",
+                seek_error_code(f.error),
+                f.t_s.to_bits()
+            )
         }
     }
 }

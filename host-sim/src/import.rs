@@ -1,1 +1,195 @@
-//! (to be written)
+//! Converts a foreign recording into fog-runs v1 so `diagnose` can read it.
+//!
+//! Supported: the PAN "Cold TVC ETU Test 3/7/2020" MEMS log (`TVCtest3_7_20.csv`, see
+//! `shared/data/measured/pan-tvac-mems/SOURCE.md`; MIT, Copyright (c) 2020 Pathfinder for
+//! Autonomous Navigation (PAN)). Columns: time (ms), magnetometer x/y/z (T), gyro x/y/z
+//! (rad/s), raw temperature register (uint16 as written). Conversion, as SOURCE.md says:
+//! - temperature `T = 25 + int16(raw) / 256` degC (LSM6DSM; absolute offset unverified);
+//! - the 5 s bursts at 50 Hz become one row each: the burst's mean time, rates and
+//!   temperature (a burst is a run of samples less than 1 s apart);
+//! - rad/s -> deg/h; outliers: a sample whose rate on any axis lies more than
+//!   `OUTLIER_MADS` robust sigmas (1.4826 MAD) from its burst's median is dropped (this
+//!   removes the 3 gyro-x spikes <= -0.08 rad/s that the original authors deleted);
+//! - one run per gyro axis (`--axis`), the magnetometer as extra columns in uT;
+//!   Earth rate is negligible next to the MEMS bias and its projection is unknown: 0.
+//! Bad input (wrong header, non-numeric cell, ragged row, time going backwards) is
+//! rejected with the line named; nothing is written then.
+
+use crate::runs::Run;
+use std::fmt;
+use std::path::Path;
+
+/// The header the PAN file must have.
+pub const PAN_HEADER: &str = "time (ms),mag1x [T],mag1y [T],mag1z [T],gyrox rad/s,gyroy rad/s,gyroz rad/s,temp";
+/// Samples further apart than this start a new burst, s.
+pub const BURST_GAP_S: f64 = 1.0;
+/// Outlier threshold in robust sigmas.
+pub const OUTLIER_MADS: f64 = 10.0;
+const RADS_TO_DPH: f64 = 180.0 / std::f64::consts::PI * 3600.0;
+
+/// Why a recording cannot be imported.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImportError {
+    pub file: String,
+    pub line: Option<usize>,
+    pub what: String,
+}
+
+impl fmt::Display for ImportError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.line {
+            Some(l) => write!(f, "{}:{l}: {}", self.file, self.what),
+            None => write!(f, "{}: {}", self.file, self.what),
+        }
+    }
+}
+
+impl std::error::Error for ImportError {}
+
+/// One raw sample.
+#[derive(Clone, Copy, Debug)]
+struct Sample {
+    t_s: f64,
+    mag_t: [f64; 3],
+    gyro_rads: [f64; 3],
+    temp_c: f64,
+}
+
+/// Import summary for the report.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PanImport {
+    /// One run per requested axis.
+    pub runs: Vec<Run>,
+    pub samples: usize,
+    pub bursts: usize,
+    pub outliers_dropped: usize,
+}
+
+/// LSM6DSM temperature register (written as unsigned 16 bit) to degC.
+pub fn lsm6dsm_temp_c(raw: f64) -> f64 {
+    let r = raw.round() as i64;
+    let s = if r > 32767 { r - 65536 } else { r };
+    25.0 + s as f64 / 256.0
+}
+
+fn parse(file: &str, text: &str) -> Result<Vec<Sample>, ImportError> {
+    let err = |line: Option<usize>, what: String| ImportError { file: file.to_owned(), line, what };
+    let mut lines = text.lines().enumerate();
+    match lines.next() {
+        Some((_, h)) if h.trim() == PAN_HEADER => {}
+        Some((_, h)) => return Err(err(Some(1), format!("unexpected header `{}` (want `{PAN_HEADER}`)", h.trim()))),
+        None => return Err(err(None, "empty file".into())),
+    }
+    let mut out: Vec<Sample> = Vec::new();
+    for (i, l) in lines {
+        let n = i + 1;
+        if l.trim().is_empty() {
+            continue;
+        }
+        let cells: Vec<&str> = l.split(',').map(str::trim).collect();
+        if cells.len() != 8 {
+            return Err(err(Some(n), format!("{} cells, expected 8", cells.len())));
+        }
+        let mut v = [0.0f64; 8];
+        for (k, c) in cells.iter().enumerate() {
+            v[k] = c.parse().ok().filter(|x: &f64| x.is_finite()).ok_or_else(|| err(Some(n), format!("column {} is not a finite number: `{c}`", k + 1)))?;
+        }
+        let t_s = v[0] / 1000.0;
+        if out.last().is_some_and(|p| t_s <= p.t_s) {
+            return Err(err(Some(n), "time is not strictly increasing".into()));
+        }
+        out.push(Sample { t_s, mag_t: [v[1], v[2], v[3]], gyro_rads: [v[4], v[5], v[6]], temp_c: lsm6dsm_temp_c(v[7]) });
+    }
+    if out.is_empty() {
+        return Err(err(None, "no data rows".into()));
+    }
+    Ok(out)
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Drops outliers in a burst (any axis beyond `OUTLIER_MADS` robust sigmas of the burst median).
+fn clean_burst(b: &[Sample]) -> Vec<Sample> {
+    let mut limits = [(0.0, f64::INFINITY); 3];
+    for (axis, lim) in limits.iter_mut().enumerate() {
+        let mut v: Vec<f64> = b.iter().map(|s| s.gyro_rads[axis]).collect();
+        let med = median(&mut v);
+        let mut dev: Vec<f64> = b.iter().map(|s| (s.gyro_rads[axis] - med).abs()).collect();
+        let mad = median(&mut dev) * 1.4826;
+        *lim = (med, OUTLIER_MADS * mad.max(1e-12));
+    }
+    b.iter().copied().filter(|s| (0..3).all(|a| (s.gyro_rads[a] - limits[a].0).abs() <= limits[a].1)).collect()
+}
+
+/// Imports the PAN TVAC file; `axes` are 0 = x, 1 = y, 2 = z.
+pub fn import_pan(path: &Path, axes: &[usize]) -> Result<PanImport, ImportError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| ImportError { file: file.clone(), line: None, what: e.to_string() })?;
+    let samples = parse(&file, &text)?;
+    let mut bursts: Vec<Vec<Sample>> = Vec::new();
+    for s in &samples {
+        match bursts.last_mut() {
+            Some(b) if s.t_s - b.last().map_or(s.t_s, |p| p.t_s) <= BURST_GAP_S => b.push(*s),
+            _ => bursts.push(vec![*s]),
+        }
+    }
+    let cleaned: Vec<Vec<Sample>> = bursts.iter().map(|b| clean_burst(b)).collect();
+    let kept: usize = cleaned.iter().map(Vec::len).sum();
+    let mean = |b: &[Sample], f: &dyn Fn(&Sample) -> f64| b.iter().map(f).sum::<f64>() / b.len() as f64;
+    let stem = path.file_stem().map_or_else(|| "pan".into(), |s| s.to_string_lossy().into_owned());
+    let mut runs = Vec::new();
+    for &axis in axes {
+        let name = ["x", "y", "z"][axis.min(2)];
+        let cols = vec![
+            ("t_s".to_owned(), cleaned.iter().map(|b| mean(b, &|s| s.t_s)).collect()),
+            ("rate_dph".to_owned(), cleaned.iter().map(|b| mean(b, &|s| s.gyro_rads[axis] * RADS_TO_DPH)).collect()),
+            ("temp_c".to_owned(), cleaned.iter().map(|b| mean(b, &|s| s.temp_c)).collect()),
+            ("mag_x_ut".to_owned(), cleaned.iter().map(|b| mean(b, &|s| s.mag_t[0] * 1e6)).collect()),
+            ("mag_y_ut".to_owned(), cleaned.iter().map(|b| mean(b, &|s| s.mag_t[1] * 1e6)).collect()),
+            ("mag_z_ut".to_owned(), cleaned.iter().map(|b| mean(b, &|s| s.mag_t[2] * 1e6)).collect()),
+        ];
+        let meta = vec![
+            ("gyro".to_owned(), format!("PAN-ETU-LSM6DSM-{name}")),
+            ("earth_dph".to_owned(), "0".to_owned()),
+            ("source".to_owned(), format!("{stem}.csv (pathfinder-for-autonomous-navigation/psim 91d70ad), gyro axis {name}")),
+            ("license".to_owned(), "MIT, Copyright (c) 2020 Pathfinder for Autonomous Navigation (PAN)".to_owned()),
+            ("conversion".to_owned(), format!("one row per 5 s burst (mean); T = 25 + int16(raw)/256 degC; rad/s -> deg/h; {} outlier samples dropped", samples.len() - kept)),
+            ("note".to_owned(), "cooling in a thermal-vacuum chamber, not a power-on warm-up; t_s is time since flight-computer boot".to_owned()),
+        ];
+        let path = format!("{stem}_gyro_{name}.csv");
+        runs.push(Run::new(path, meta, cols).map_err(|e| ImportError { file: file.clone(), line: None, what: e.to_string() })?);
+    }
+    Ok(PanImport { runs, samples: samples.len(), bursts: bursts.len(), outliers_dropped: samples.len() - kept })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn temperature_register_conversion() {
+        assert_eq!(lsm6dsm_temp_c(0.0), 25.0);
+        assert!((lsm6dsm_temp_c(65236.0) - (25.0 - 300.0 / 256.0)).abs() < 1e-12);
+        assert!((lsm6dsm_temp_c(512.0) - 27.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_rows_are_rejected_with_the_line() {
+        let bad = format!("{PAN_HEADER}\n1,0,0,0,0,0,0,1\n2,0,0,0,x,0,0,1\n");
+        let e = parse("f.csv", &bad).unwrap_err();
+        assert_eq!(e.line, Some(3));
+        let back = format!("{PAN_HEADER}\n2,0,0,0,0,0,0,1\n1,0,0,0,0,0,0,1\n");
+        assert!(parse("f.csv", &back).is_err());
+        assert!(parse("f.csv", "a,b\n").is_err());
+        let ragged = format!("{PAN_HEADER}\n1,0,0\n");
+        assert!(parse("f.csv", &ragged).is_err());
+    }
+}

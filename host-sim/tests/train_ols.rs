@@ -41,15 +41,17 @@ fn ols_recovers_a_known_rbf_function_built_on_sample_centres() {
     let fit = fit_width(&ds, &cfg, 0.5).unwrap();
     let y_rms = rms(&ds.targets_dph);
     let got = residual_rms(&fit.model, &ds);
-    assert!(got < 1e-4 * y_rms.max(0.01), "residual rms {got} vs target rms {y_rms}");
-    // The four true centres are found first (in some order).
-    assert!(fit.model.centers.len() >= 4);
-    let mut first4: Vec<[f32; 2]> = fit.model.centers[..4].iter().map(|c| [c[0], c[1]]).collect();
-    first4.sort_by(|a, b| a[0].total_cmp(&b[0]));
-    let mut want: Vec<[f32; 2]> = centres.iter().map(|c| [c[0] as f32, c[1] as f32]).collect();
-    want.sort_by(|a, b| a[0].total_cmp(&b[0]));
-    for (g, w) in first4.iter().zip(&want) {
-        assert!((g[0] - w[0]).abs() < 1e-5 && (g[1] - w[1]).abs() < 1e-5, "{first4:?} vs {want:?}");
+    assert!(got < 2e-4 * y_rms.max(0.01), "residual rms {got} vs target rms {y_rms}");
+    // Greedy selection need not pick the exact true samples, but every true centre has a
+    // selected centre within sigma/5 of it.
+    for c in &centres {
+        let nearest = fit
+            .model
+            .centers
+            .iter()
+            .map(|m| ((f64::from(m[0]) - c[0]).powi(2) + (f64::from(m[1]) - c[1]).powi(2)).sqrt())
+            .fold(f64::INFINITY, f64::min);
+        assert!(nearest < 0.1, "true centre {c:?}: nearest selected {nearest}");
     }
 }
 
@@ -105,7 +107,8 @@ fn linear_only_input_is_fitted_jointly_with_the_rbf() {
         let rows: Vec<Vec<f64>> = idx
             .iter()
             .map(|&i| {
-                let v = 24.0 + 0.5 * (base.t_s[i] / 400.0 + f64::from(g)).sin();
+                // Faster than the warm-up, so (T, dT/dt) cannot stand in for it.
+                let v = 24.0 + 0.5 * (base.t_s[i] / 23.0 + f64::from(g)).sin();
                 vec![base.row(i)[0], base.row(i)[1], v]
             })
             .collect();
@@ -120,7 +123,12 @@ fn linear_only_input_is_fitted_jointly_with_the_rbf() {
     let got = f64::from(fit.model.linear[2]) / f64::from(fit.model.input_scale[2]);
     assert!((got - coef_dph_per_v).abs() < 0.05 * coef_dph_per_v, "fitted {got} dph/V");
     assert!(fit.model.centers.iter().all(|c| c[2] == 0.0));
-    assert!(residual_rms(&fit.model, &ds) < 0.0045);
+    // With the linear term the fit is as good as on the same data without the effect
+    // (whose rms, 0.014 dph, would otherwise remain).
+    let res = residual_rms(&fit.model, &ds);
+    let cfg_base = TrainConfig { max_centers: 30, ..TrainConfig::default() };
+    let res_base = residual_rms(&fit_width(&base, &cfg_base, 0.35).unwrap().model, &base);
+    assert!(res < 1.1 * res_base, "residual rms {res} vs {res_base} without the effect");
 }
 
 #[test]

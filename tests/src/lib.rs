@@ -63,10 +63,7 @@ pub fn qemu_ready(name: &str) -> bool {
     let Some(why) = missing_tool() else {
         return true;
     };
-    assert!(
-        !qemu_required(),
-        "{name}: FOG_REQUIRE_QEMU=1 but {why}"
-    );
+    assert!(!qemu_required(), "{name}: FOG_REQUIRE_QEMU=1 but {why}");
     eprintln!("\n**********************************************************************");
     eprintln!("** SKIPPING QEMU SCENARIO `{name}`: {why}");
     eprintln!("** (set FOG_REQUIRE_QEMU=1 to make this a failure)");
@@ -108,7 +105,14 @@ pub fn build_firmware() -> Result<PathBuf, String> {
     let target_dir = firmware_target_dir();
     let out = Command::new(cargo())
         .current_dir(workspace_root())
-        .args(["build", "-p", "fog-firmware", "--profile", FW_PROFILE, "--bins"])
+        .args([
+            "build",
+            "-p",
+            "fog-firmware",
+            "--profile",
+            FW_PROFILE,
+            "--bins",
+        ])
         .args(["--target", FW_TARGET, "--features", "log-semihosting"])
         .arg("--target-dir")
         .arg(&target_dir)

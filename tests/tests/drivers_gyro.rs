@@ -23,7 +23,7 @@ fn frame(seq: u8, rate_dph: f64, temp_c: f64) -> GyroFrame {
 fn drain(bytes: &[u8]) -> (Vec<GyroSample>, FogSerialGyro<Mock<u8>>) {
     let mut gyro = FogSerialGyro::new(
         Mock::new(&[
-            Transaction::read_many(bytes.to_vec()),
+            Transaction::read_many(bytes),
             Transaction::read_error(nb::Error::WouldBlock),
         ]),
         RATE_HZ,
@@ -55,7 +55,9 @@ fn frames_round_trip_to_rate_temperature_and_time() {
         assert_eq!(s.t_s, (i + 1) as f64 * PERIOD_S);
         assert!((f64::from(s.rate_dph) - r).abs() <= 0.5 * lsb_dph + 1e-6 * r.abs());
     }
-    let t = gyro.latest_temp().expect("valid frames carry a temperature");
+    let t = gyro
+        .latest_temp()
+        .expect("valid frames carry a temperature");
     assert!((t.temp_c - 21.54).abs() <= 1.0 / 512.0 + 1e-6);
     assert_eq!(gyro.stats().frames.frames_ok, 5);
     assert_eq!(gyro.stats().frames_lost, 0);
@@ -64,7 +66,9 @@ fn frames_round_trip_to_rate_temperature_and_time() {
 
 #[test]
 fn corrupted_frame_is_counted_skipped_and_leaves_a_time_gap() {
-    let mut bytes: Vec<u8> = (0..5u8).flat_map(|i| frame(i, 10.0, 20.0).encode()).collect();
+    let mut bytes: Vec<u8> = (0..5u8)
+        .flat_map(|i| frame(i, 10.0, 20.0).encode())
+        .collect();
     bytes[2 * FRAME_LEN + 5] ^= 0x10; // a bit flip inside frame 2's rate field
     let (samples, gyro) = drain(&bytes);
     let times: Vec<f64> = samples.iter().map(|s| s.t_s / PERIOD_S).collect();
@@ -87,7 +91,10 @@ fn resynchronises_after_garbage_and_false_sync() {
     assert_eq!(samples[1].t_s, 2.0 * PERIOD_S);
     let stats = gyro.stats();
     assert_eq!(stats.frames.frames_ok, 2);
-    assert_eq!(stats.frames.crc_errors, 1, "the false sync swallowed a real frame once");
+    assert_eq!(
+        stats.frames.crc_errors, 1,
+        "the false sync swallowed a real frame once"
+    );
     assert_eq!(stats.frames_lost, 0);
     finish(gyro);
 }
@@ -116,9 +123,9 @@ fn uart_error_is_reported_and_the_stream_continues() {
     let f1 = frame(1, 2.0, 20.0).encode();
     let mut gyro = FogSerialGyro::new(
         Mock::new(&[
-            Transaction::read_many(f0[..6].to_vec()),
+            Transaction::read_many(&f0[..6]),
             Transaction::read_error(nb::Error::Other(ErrorKind::Overrun)),
-            Transaction::read_many(f1.to_vec()),
+            Transaction::read_many(f1),
             Transaction::read_error(nb::Error::WouldBlock),
         ]),
         RATE_HZ,

@@ -54,7 +54,11 @@ fn a_newer_silicon_revision_is_accepted() {
 #[test]
 fn wrong_part_is_rejected_at_init() {
     // An ADT7420 or similar answering at the same address.
-    let tx = [Transaction::write_read(A, vec![REG_DEVICE_ID], vec![0x00, 0xCB])];
+    let tx = [Transaction::write_read(
+        A,
+        vec![REG_DEVICE_ID],
+        vec![0x00, 0xCB],
+    )];
     let mut mock = Mock::new(&tx);
     let err = Tmp117::new(mock.clone(), A, Cell::new(0.0)).err();
     assert_eq!(err, Some(Tmp117Error::WrongDevice { id: 0x00CB }));
@@ -68,7 +72,10 @@ fn silent_sensor_is_a_bus_error_not_a_temperature() {
     tx.push(temp_read(0x0C, 0x80).with_error(nack));
     tx.push(temp_read(0x0C, 0x80)); // it comes back
     let mut dev = Tmp117::new(Mock::new(&tx), A, Cell::new(0.0)).unwrap();
-    assert_eq!(dev.read_temp(), Err(Tmp117Error::Bus(I2cFault::NoAcknowledge)));
+    assert_eq!(
+        dev.read_temp(),
+        Err(Tmp117Error::Bus(I2cFault::NoAcknowledge))
+    );
     assert_eq!(dev.read_temp().unwrap().temp_c, 25.0);
     dev.release().done();
 }
@@ -80,7 +87,10 @@ fn reset_value_and_out_of_range_readings_are_faults() {
     tx.push(temp_read(0x4B, 0x01)); // 150.0078 degC: past the specified range
     let mut dev = Tmp117::new(Mock::new(&tx), A, Cell::new(0.0)).unwrap();
     assert_eq!(dev.read_temp(), Err(Tmp117Error::NotReady));
-    assert_eq!(dev.read_temp(), Err(Tmp117Error::OutOfRange { raw: 0x4B01 }));
+    assert_eq!(
+        dev.read_temp(),
+        Err(Tmp117Error::OutOfRange { raw: 0x4B01 })
+    );
     dev.release().done();
 }
 
@@ -88,8 +98,14 @@ fn reset_value_and_out_of_range_readings_are_faults() {
 fn range_edges_follow_the_datasheet() {
     assert_eq!(raw_to_celsius(0x4B00), Ok(150.0));
     assert_eq!(raw_to_celsius(0xE480), Ok(-55.0));
-    assert_eq!(raw_to_celsius(0xE47F), Err(Tmp117Error::OutOfRange { raw: 0xE47F }));
-    assert_eq!(raw_to_celsius(0x7FFF), Err(Tmp117Error::OutOfRange { raw: 0x7FFF }));
+    assert_eq!(
+        raw_to_celsius(0xE47F),
+        Err(Tmp117Error::OutOfRange { raw: 0xE47F })
+    );
+    assert_eq!(
+        raw_to_celsius(0x7FFF),
+        Err(Tmp117Error::OutOfRange { raw: 0x7FFF })
+    );
     for raw in 0xE480u16..=0xFFFF {
         let t = raw_to_celsius(raw).unwrap();
         assert_eq!(t, f32::from(raw as i16) / 128.0);

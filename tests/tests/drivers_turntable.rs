@@ -14,19 +14,22 @@ fn idle() -> Transaction<u8> {
 }
 
 fn reply(line: &str) -> [Transaction<u8>; 2] {
-    [Transaction::read_many(line.as_bytes().to_vec()), idle()]
+    [Transaction::read_many(line.as_bytes()), idle()]
 }
 
 /// A reply that ends the poll with an error: the driver stops reading at it.
 fn fatal(line: &str) -> Transaction<u8> {
-    Transaction::read_many(line.as_bytes().to_vec())
+    Transaction::read_many(line.as_bytes())
 }
 
 fn sends(line: &str) -> Transaction<u8> {
-    Transaction::write_many(line.as_bytes().to_vec())
+    Transaction::write_many(line.as_bytes())
 }
 
-fn table<'c>(tx: &[Transaction<u8>], clock: &'c Cell<f64>) -> SerialTurntable<Mock<u8>, &'c Cell<f64>> {
+fn table<'c>(
+    tx: &[Transaction<u8>],
+    clock: &'c Cell<f64>,
+) -> SerialTurntable<Mock<u8>, &'c Cell<f64>> {
     SerialTurntable::new(Mock::new(tx), clock, TurntableConfig::default())
 }
 

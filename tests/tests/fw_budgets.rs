@@ -46,13 +46,17 @@ fn panic_call_sites(elf: &std::path::Path) -> BTreeMap<String, usize> {
     let mut sites = BTreeMap::new();
     let mut func = String::new();
     for line in text.lines() {
-        if let Some(name) = line.split_once(" <").and_then(|(_, r)| r.strip_suffix(">:")) {
+        if let Some(name) = line
+            .split_once(" <")
+            .and_then(|(_, r)| r.strip_suffix(">:"))
+        {
             if !name.starts_with('$') {
                 func = name.to_string();
             }
             continue;
         }
-        let is_branch = line.contains("\tbl\t") || line.contains("\tb.w\t") || line.contains("\tb\t");
+        let is_branch =
+            line.contains("\tbl\t") || line.contains("\tb.w\t") || line.contains("\tb\t");
         let to_panic = line.contains("core::panicking") || line.contains("_fail>");
         if is_branch && to_panic && !func.contains("core::panicking") && !func.ends_with("_fail") {
             *sites.entry(func.clone()).or_insert(0) += 1;
@@ -83,12 +87,17 @@ fn firmware_fits_its_budgets() {
 
     // Instruction counts, with a really signed model for the Ed25519 verification.
     let dir = scratch_dir("bench");
-    let key = fog_sim::upload::load_signing_key(&fog_sim::upload::test_key_path()).expect("test key");
+    let key =
+        fog_sim::upload::load_signing_key(&fog_sim::upload::test_key_path()).expect("test key");
     let model = fog_core::synthetic::warmup_model(35, 2, 0.05, 35);
     let mut buf = [0u8; fog_core::model::MAX_ENCODED_LEN];
     let n = model.encode(&mut buf).expect("encode");
     std::fs::write(dir.join("model.bin"), &buf[..n]).unwrap();
-    std::fs::write(dir.join("model.sig"), fog_sim::upload::sign_model(&key, &buf[..n])).unwrap();
+    std::fs::write(
+        dir.join("model.sig"),
+        fog_sim::upload::sign_model(&key, &buf[..n]),
+    )
+    .unwrap();
     let opts = QemuOptions {
         args: vec!["model.bin".into(), "model.sig".into()],
         icount: true,
@@ -98,7 +107,10 @@ fn firmware_fits_its_budgets() {
     let run = run_qemu(&firmware_elf("bench"), &opts, Duration::from_secs(120)).unwrap();
     assert!(run.status.success(), "bench failed: {}", run.stderr);
     let b = parse_bench(&String::from_utf8_lossy(&run.stdout));
-    let get = |k: &str| *b.get(k).unwrap_or_else(|| panic!("bench output lacks {k}: {b:?}"));
+    let get = |k: &str| {
+        *b.get(k)
+            .unwrap_or_else(|| panic!("bench output lacks {k}: {b:?}"))
+    };
     let sample = get("sample_instr");
     let update64 = get("update_instr_64_f32");
     let load_pct = (sample as f64 * LOAD_RATE_HZ + update64 as f64 / 10.0) / LOAD_CPU_HZ * 100.0;
@@ -124,16 +136,46 @@ fn firmware_fits_its_budgets() {
         sites.len()
     );
     for (k, label) in [
-        ("sample_instr", "instructions per raw sample (2 kHz, frame decode + averager)"),
-        ("update_instr_35_f32", "instructions per 10 s update, 35 centres, f32"),
-        ("update_instr_35_fixed", "instructions per 10 s update, 35 centres, fixed point"),
-        ("update_instr_64_f32", "instructions per 10 s update, 64 centres, f32"),
-        ("update_instr_64_fixed", "instructions per 10 s update, 64 centres, fixed point"),
-        ("predict_instr_35_f32", "instructions per RBF evaluation, 35 centres, f32"),
-        ("predict_instr_35_fixed", "instructions per RBF evaluation, 35 centres, fixed point"),
-        ("predict_instr_64_f32", "instructions per RBF evaluation, 64 centres, f32"),
-        ("predict_instr_64_fixed", "instructions per RBF evaluation, 64 centres, fixed point"),
-        ("verify_instr", "instructions per Ed25519 model verification"),
+        (
+            "sample_instr",
+            "instructions per raw sample (2 kHz, frame decode + averager)",
+        ),
+        (
+            "update_instr_35_f32",
+            "instructions per 10 s update, 35 centres, f32",
+        ),
+        (
+            "update_instr_35_fixed",
+            "instructions per 10 s update, 35 centres, fixed point",
+        ),
+        (
+            "update_instr_64_f32",
+            "instructions per 10 s update, 64 centres, f32",
+        ),
+        (
+            "update_instr_64_fixed",
+            "instructions per 10 s update, 64 centres, fixed point",
+        ),
+        (
+            "predict_instr_35_f32",
+            "instructions per RBF evaluation, 35 centres, f32",
+        ),
+        (
+            "predict_instr_35_fixed",
+            "instructions per RBF evaluation, 35 centres, fixed point",
+        ),
+        (
+            "predict_instr_64_f32",
+            "instructions per RBF evaluation, 64 centres, f32",
+        ),
+        (
+            "predict_instr_64_fixed",
+            "instructions per RBF evaluation, 64 centres, fixed point",
+        ),
+        (
+            "verify_instr",
+            "instructions per Ed25519 model verification",
+        ),
     ] {
         let _ = writeln!(table, "| {label} | {} | |", get(k));
     }
@@ -159,10 +201,25 @@ fn firmware_fits_its_budgets() {
         FLASH_CEILING_BYTES,
         FLASH_TARGET_BYTES
     );
-    assert!(n_sites <= PANIC_CALL_SITES_CEILING, "panic call sites grew: {sites:#?}");
-    assert_eq!(get("verify_valid"), 1, "the signed model verifies on the target");
-    assert!(sample > 100 && sample <= SAMPLE_INSTR_CEILING, "per-sample {sample}");
-    for k in ["update_instr_35_f32", "update_instr_35_fixed", "update_instr_64_f32", "update_instr_64_fixed"] {
+    assert!(
+        n_sites <= PANIC_CALL_SITES_CEILING,
+        "panic call sites grew: {sites:#?}"
+    );
+    assert_eq!(
+        get("verify_valid"),
+        1,
+        "the signed model verifies on the target"
+    );
+    assert!(
+        sample > 100 && sample <= SAMPLE_INSTR_CEILING,
+        "per-sample {sample}"
+    );
+    for k in [
+        "update_instr_35_f32",
+        "update_instr_35_fixed",
+        "update_instr_64_f32",
+        "update_instr_64_fixed",
+    ] {
         let v = get(k);
         assert!(v > 1000 && v <= UPDATE_INSTR_CEILING, "{k} = {v}");
     }

@@ -63,8 +63,12 @@ fn record(model: &RbfModel, evaluator: Evaluator) -> Recording {
         seed: 20_260_521,
         start: StartState::Soaked,
     };
-    let (mut sim, table) =
-        rig(&GyroParams::paper_default(), &spec, TurntableParams::default()).expect("sim rig");
+    let (mut sim, table) = rig(
+        &GyroParams::paper_default(),
+        &spec,
+        TurntableParams::default(),
+    )
+    .expect("sim rig");
     let log = RefCell::new(Vec::new());
     let table = RecordingTurntable::new(table, |r| log.borrow_mut().extend(r.encode()));
     let mut app = App::new(config(evaluator), Some(model.clone()), table).expect("app config");
@@ -184,8 +188,15 @@ fn scenario(evaluator: Evaluator, tag: &str) {
     )
     .expect("host replay");
     assert_same("host replay vs live recording", &rec.live_out, &host_out);
-    assert_eq!(host_sum.seeks_done, u32::from(SEEKS), "both seeks finish:\n{host_out}");
-    assert!(host_sum.gyro.frames.crc_errors > 0, "injected corruption was seen");
+    assert_eq!(
+        host_sum.seeks_done,
+        u32::from(SEEKS),
+        "both seeks finish:\n{host_out}"
+    );
+    assert!(
+        host_sum.gyro.frames.crc_errors > 0,
+        "injected corruption was seen"
+    );
     assert!(host_sum.valid_windows > 0 && host_sum.valid_windows < host_sum.windows);
 
     // Firmware replay under QEMU.
@@ -233,10 +244,7 @@ fn scenario(evaluator: Evaluator, tag: &str) {
         running > 256 && running < 32 * 1024,
         "sample-loop stack high-water {running} bytes is implausible or over 32 KiB"
     );
-    assert!(
-        boot < 72 * 1024,
-        "boot stack peak {boot} bytes over 72 KiB"
-    );
+    assert!(boot < 72 * 1024, "boot stack peak {boot} bytes over 72 KiB");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

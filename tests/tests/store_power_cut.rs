@@ -8,7 +8,7 @@
 
 mod upload_support;
 
-use embedded_storage::nor_flash::NorFlash;
+use embedded_storage::nor_flash::{NorFlash, ReadNorFlash};
 use fog_core::model::MAX_ENCODED_LEN;
 use fog_firmware::store::ram_flash::RamNorFlash;
 use fog_firmware::store::{store_len, ModelStore};
@@ -164,4 +164,32 @@ fn a_bad_slot_next_to_a_good_one_is_ignored() {
             bytes: a
         }
     );
+}
+
+#[test]
+fn the_flash_mock_obeys_nor_rules_and_tears_cut_operations() {
+    use fog_firmware::store::ram_flash::RamFlashError;
+    let mut f = RamNorFlash::<1024, 4, 256>::new();
+    f.write(0, &[0x0F, 0xF0, 0x00, 0xAA]).unwrap();
+    // A second write to a programmed word is refused (NOR: no rewrite before erase).
+    assert_eq!(f.write(0, &[0; 4]), Err(RamFlashError::NotErased { offset: 0 }));
+    assert_eq!(&f.contents()[..4], &[0x0F, 0xF0, 0x00, 0xAA]);
+    // Misaligned writes and erases are refused.
+    assert!(f.write(2, &[0; 4]).is_err());
+    assert!(f.erase(0, 100).is_err());
+    // A cut write programs half of its word, then everything fails until power returns.
+    f.cut_power_after(1);
+    assert_eq!(f.write(4, &[0u8; 8]), Err(RamFlashError::PowerLost));
+    assert_eq!(&f.contents()[4..12], &[0, 0, 0, 0, 0, 0, 0xFF, 0xFF]);
+    let mut buf = [0u8; 4];
+    assert_eq!(f.read(0, &mut buf), Err(RamFlashError::PowerLost));
+    f.power_cycle();
+    // A cut erase leaves its page half erased.
+    f.cut_power_after(0);
+    assert_eq!(f.erase(0, 256), Err(RamFlashError::PowerLost));
+    f.power_cycle();
+    assert!(f.contents()[..128].iter().all(|&b| b == 0xFF));
+    assert_eq!(&f.contents()[128..132], &[0xFF; 4]);
+    f.erase(0, 256).unwrap();
+    assert!(f.contents().iter().all(|&b| b == 0xFF));
 }

@@ -86,7 +86,11 @@ fn signal(t_s: f64) -> (f64, f64) {
 
 /// Mean instructions per raw sample over 30 s of 2 kHz frames (windows excluded).
 fn bench_sample(model: &RbfModel) -> u32 {
-    let Ok(mut app) = App::new(config(Evaluator::F32, RATE_HZ), Some(model.clone()), NoTable) else {
+    let Ok(mut app) = App::new(
+        config(Evaluator::F32, RATE_HZ),
+        Some(model.clone()),
+        NoTable,
+    ) else {
         return 0;
     };
     let uart = ChunkUart {
@@ -176,18 +180,28 @@ fn main() -> ! {
         semihosting::process::abort()
     };
     icount::start_counter(cp.SYST);
-    let (_, empty) = icount::ticks(|| ());
-    let _ = empty;
     let m35 = warmup_model(35, 2, 0.05, 35);
     let m64 = warmup_model(64, 2, 0.05, 64);
     semihosting::println!("instr_per_tick {}", icount::INSTR_PER_TICK);
     semihosting::println!("sample_instr {}", bench_sample(&m35));
     for (name, m) in [("35", &m35), ("64", &m64)] {
-        semihosting::println!("update_instr_{}_f32 {}", name, bench_update(m, Evaluator::F32));
-        semihosting::println!("update_instr_{}_fixed {}", name, bench_update(m, Evaluator::Fixed));
+        semihosting::println!(
+            "update_instr_{}_f32 {}",
+            name,
+            bench_update(m, Evaluator::F32)
+        );
+        semihosting::println!(
+            "update_instr_{}_fixed {}",
+            name,
+            bench_update(m, Evaluator::Fixed)
+        );
         semihosting::println!("predict_instr_{}_f32 {}", name, bench_predict(m, None));
         match FixedModel::from_model(m) {
-            Ok(f) => semihosting::println!("predict_instr_{}_fixed {}", name, bench_predict(m, Some(&f))),
+            Ok(f) => semihosting::println!(
+                "predict_instr_{}_fixed {}",
+                name,
+                bench_predict(m, Some(&f))
+            ),
             Err(_) => semihosting::println!("predict_instr_{}_fixed 0", name),
         }
     }
@@ -208,6 +222,9 @@ fn bench_verify(fallback: &RbfModel) {
         _ => (fallback.encode(&mut model_buf).unwrap_or(0), false),
     };
     let (t, r) = icount::ticks(|| verify_model(&TEST_PUBLIC_KEY, &model_buf[..len], &sig_buf));
-    semihosting::println!("verify_instr {}", u64::from(t) * u64::from(icount::INSTR_PER_TICK));
+    semihosting::println!(
+        "verify_instr {}",
+        u64::from(t) * u64::from(icount::INSTR_PER_TICK)
+    );
     semihosting::println!("verify_valid {}", u8::from(valid_expected && r.is_ok()));
 }

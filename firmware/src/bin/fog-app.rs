@@ -18,10 +18,10 @@
 
 #[path = "target/flash.rs"]
 mod flash;
-#[path = "target/panic.rs"]
-mod panic;
 #[path = "target/millis.rs"]
 mod millis;
+#[path = "target/panic.rs"]
+mod panic;
 #[path = "target/uart.rs"]
 mod uart;
 

@@ -45,7 +45,10 @@ fn run() -> Result<(), &'static str> {
     let mut model_buf = [0u8; MAX_ENCODED_LEN];
     let model_bytes = semi::read_file(args.path(0)?, &mut model_buf)?;
     let model = RbfModel::decode(model_bytes).map_err(|_| "model file fails validation")?;
-    let rate_hz: f32 = args.str(4)?.parse().map_err(|_| "RATE_HZ is not a number")?;
+    let rate_hz: f32 = args
+        .str(4)?
+        .parse()
+        .map_err(|_| "RATE_HZ is not a number")?;
     let seeks: u16 = args.str(5)?.parse().map_err(|_| "SEEKS is not a number")?;
     let mut cfg = AppConfig::for_rate(rate_hz);
     cfg.seeks = seeks;

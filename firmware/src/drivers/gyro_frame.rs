@@ -163,7 +163,12 @@ impl FrameDecoder {
             return Some(GyroFrame {
                 seq: self.buf[2],
                 status: self.buf[3],
-                dtheta_lsb: i32::from_le_bytes([self.buf[4], self.buf[5], self.buf[6], self.buf[7]]),
+                dtheta_lsb: i32::from_le_bytes([
+                    self.buf[4],
+                    self.buf[5],
+                    self.buf[6],
+                    self.buf[7],
+                ]),
                 temp_lsb: i16::from_le_bytes([self.buf[8], self.buf[9]]),
             });
         }

@@ -74,9 +74,15 @@ impl From<ErrorKind> for I2cFault {
 impl core::fmt::Display for Tmp117Error {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
-            Self::Bus(k) => write!(f, "TMP117: I2C transfer failed ({k:?}): sensor not answering"),
+            Self::Bus(k) => write!(
+                f,
+                "TMP117: I2C transfer failed ({k:?}): sensor not answering"
+            ),
             Self::WrongDevice { id } => {
-                write!(f, "TMP117: device id {id:#06x} is not 0x?117: wrong part or address")
+                write!(
+                    f,
+                    "TMP117: device id {id:#06x} is not 0x?117: wrong part or address"
+                )
             }
             Self::NotReady => write!(f, "TMP117: no conversion completed yet (reads reset value)"),
             Self::OutOfRange { raw } => write!(

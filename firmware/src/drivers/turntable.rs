@@ -123,9 +123,16 @@ impl core::error::Error for TurntableError {}
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Phase {
     Idle,
-    AwaitAck { deadline_s: f64 },
-    Moving { query_deadline_s: Option<f64>, next_query_s: f64 },
-    Settled { heading_deg: f32 },
+    AwaitAck {
+        deadline_s: f64,
+    },
+    Moving {
+        query_deadline_s: Option<f64>,
+        next_query_s: f64,
+    },
+    Settled {
+        heading_deg: f32,
+    },
     Failed(TurntableError),
 }
 
@@ -310,7 +317,8 @@ impl<S: Read<u8> + Write<u8>, C: Clock> Turntable for SerialTurntable<S, C> {
         self.phase = Phase::AwaitAck {
             deadline_s: now + self.config.reply_timeout_s,
         };
-        self.flush_tx().inspect_err(|&e| self.phase = Phase::Failed(e))
+        self.flush_tx()
+            .inspect_err(|&e| self.phase = Phase::Failed(e))
     }
 
     fn poll(&mut self) -> Result<TableState, TurntableError> {

@@ -38,9 +38,10 @@ pub struct Args {
     /// True azimuth of the table's zero, deg (the paper's was about 108.4).
     #[arg(long, default_value_t = crate::northseek::PAPER_AZIMUTH_DEG, allow_negative_numbers = true)]
     pub azimuth: f64,
-    /// Measuring time per main position, s.
-    #[arg(long, default_value_t = 110.0, allow_negative_numbers = true)]
-    pub dwell: f32,
+    /// Measuring time per main position, s (default: 110 for two positions, 60 for four,
+    /// so that one seek fits the paper's 4 min 56 s).
+    #[arg(long, allow_negative_numbers = true)]
+    pub dwell: Option<f32>,
     /// Seed of the whole Monte Carlo (and of the default training campaign).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -69,7 +70,10 @@ pub fn config_from_args(a: &Args) -> Result<MonteCarloConfig> {
         latitude_deg: a.latitude,
         ambient_c: a.ambient,
         true_azimuth_deg: a.azimuth,
-        dwell_s: a.dwell,
+        dwell_s: a.dwell.unwrap_or(match mode {
+            SeekMode::TwoPosition => 110.0,
+            SeekMode::FourPosition => 60.0,
+        }),
         seed: a.seed,
         threads: a.threads.unwrap_or_else(default_threads),
         ..MonteCarloConfig::paper(a.seed)

@@ -99,6 +99,7 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
             validation: folds.describe(),
             excluded_columns: campaign.exclusions.clone(),
             skipped_candidates: screening.skipped.iter().map(to_excl).collect(),
+            smallest_attainable_p: signflip::smallest_p(folds.unit_rows.len()),
         },
         baseline: ModelSummary {
             inputs: base_inputs,

@@ -99,6 +99,8 @@ pub struct CampaignSummary {
     pub validation: String,
     pub excluded_columns: Vec<Exclusion>,
     pub skipped_candidates: Vec<Exclusion>,
+    /// Smallest p-value the sign-flip test can reach with this many validation units.
+    pub smallest_attainable_p: f64,
 }
 
 /// The whole diagnosis.
@@ -166,7 +168,15 @@ pub fn cause_in_words(c: Option<&Cause>, coef: &[f64]) -> String {
 pub fn render_text(r: &Report) -> String {
     let mut s = String::new();
     let c = &r.campaign;
-    let _ = writeln!(s, "fogsim diagnose: {} runs, {} points (10 s means); validation: {}", c.runs, c.points, c.validation);
+    let _ = writeln!(s, "fogsim diagnose: {} runs, {} points (10 s means, or one row per slower sample); validation: {}", c.runs, c.points, c.validation);
+    if c.smallest_attainable_p >= super::screen::ALPHA {
+        let _ = writeln!(
+            s,
+            "  note: with this few validation units the smallest attainable p is {:.3} >= alpha {}: no cause can be named",
+            c.smallest_attainable_p,
+            super::screen::ALPHA
+        );
+    }
     for e in &c.excluded_columns {
         let _ = writeln!(s, "  excluded column `{}`: {}", e.column, e.reason);
     }

@@ -6,6 +6,8 @@ use super::input::Campaign;
 use super::models::Stacked;
 use serde::Serialize;
 
+/// Ambients closer than this belong to one group, degC.
+pub const AMBIENT_GAP_C: f64 = 3.0;
 /// Time-since-power-on bins, s.
 pub const TIME_BINS_S: [f64; 7] = [0.0, 120.0, 300.0, 600.0, 1200.0, 2700.0, f64::INFINITY];
 
@@ -65,6 +67,27 @@ pub fn within_run_correlation(folds: &Folds, a: &[f64], b: &[f64]) -> f64 {
     }
 }
 
+/// Runs grouped by ambient temperature: sorted, a new group wherever the gap to the
+/// previous ambient exceeds `AMBIENT_GAP_C`. Runs without an ambient are left out.
+fn ambient_groups(c: &Campaign) -> Vec<(String, Vec<usize>)> {
+    let mut idx: Vec<(usize, f64)> = c.runs.iter().enumerate().filter_map(|(i, s)| s.ambient_c.map(|a| (i, a))).collect();
+    idx.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let mut groups: Vec<Vec<(usize, f64)>> = Vec::new();
+    for (i, a) in idx {
+        match groups.last_mut() {
+            Some(g) if g.last().is_some_and(|l| a - l.1 <= AMBIENT_GAP_C) => g.push((i, a)),
+            _ => groups.push(vec![(i, a)]),
+        }
+    }
+    groups
+        .into_iter()
+        .map(|g| {
+            let mean = g.iter().map(|x| x.1).sum::<f64>() / g.len() as f64;
+            (format!("{mean:.1} degC ({} runs)", g.len()), g.into_iter().map(|x| x.0).collect())
+        })
+        .collect()
+}
+
 /// Builds the structure tables for `residual` (stacked, one per row).
 pub fn structure(c: &Campaign, folds: &Folds, st: &Stacked, residual: &[f64]) -> Structure {
     let by_time = TIME_BINS_S
@@ -77,19 +100,11 @@ pub fn structure(c: &Campaign, folds: &Folds, st: &Stacked, residual: &[f64]) ->
             (s.n > 0).then_some(s)
         })
         .collect();
-    let mut ambients: Vec<f64> = c.runs.iter().filter_map(|s| s.ambient_c.map(|a| (a * 10.0).round() / 10.0)).collect();
-    ambients.sort_by(f64::total_cmp);
-    ambients.dedup();
-    let by_ambient = ambients
-        .iter()
-        .map(|&a| {
-            let rows = c
-                .runs
-                .iter()
-                .zip(&folds.run_rows)
-                .filter(|(s, _)| s.ambient_c.is_some_and(|x| (x - a).abs() < 0.05))
-                .flat_map(|(_, r)| r.clone());
-            slice(format!("{a:.1} degC"), rows.map(|i| residual[i]))
+    let by_ambient = ambient_groups(c)
+        .into_iter()
+        .map(|(label, members)| {
+            let rows = members.iter().flat_map(|&i| folds.run_rows[i].clone());
+            slice(label, rows.map(|i| residual[i]))
         })
         .collect();
     let mut by_signal = vec![

@@ -51,6 +51,15 @@ pub fn max_t_pvalues(gains: &[Vec<f64>], seed: u64) -> Vec<f64> {
         .collect()
 }
 
+/// Smallest p-value attainable with `units` validation units.
+pub fn smallest_p(units: usize) -> f64 {
+    if units <= MAX_EXACT_UNITS {
+        1.0 / (1u64 << units) as f64
+    } else {
+        1.0 / (RANDOM_FLIPS + 1) as f64
+    }
+}
+
 /// One-sided paired p-value that `gains` (per unit) are positive, by sign flips.
 pub fn paired_pvalue(gains: &[f64], seed: u64) -> f64 {
     max_t_pvalues(&[gains.to_vec()], seed)[0]

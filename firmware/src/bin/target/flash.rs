@@ -7,8 +7,8 @@
 use core::ptr::{addr_of, read_volatile, write_volatile};
 
 use embedded_storage::nor_flash::{
-    check_erase, check_read, check_write, ErrorType, NorFlash, NorFlashError,
-    NorFlashErrorKind, ReadNorFlash,
+    check_erase, check_read, check_write, ErrorType, NorFlash, NorFlashError, NorFlashErrorKind,
+    ReadNorFlash,
 };
 
 extern "C" {

@@ -1,5 +1,7 @@
 //! Semihosting file I/O for the QEMU scenarios: program arguments, an `embedded_io`
 //! reader over a host file, a buffered `core::fmt::Write` into a host file.
+//! Shared by the `replay` and `bench` binaries, each of which uses a subset.
+#![allow(dead_code)]
 
 use core::ffi::CStr;
 
@@ -16,12 +18,14 @@ pub struct Args {
 
 impl Args {
     pub fn get() -> Result<Self, &'static str> {
-        let raw = semihosting::experimental::env::args::<512>().map_err(|_| "no semihosting args")?;
+        let raw =
+            semihosting::experimental::env::args::<512>().map_err(|_| "no semihosting args")?;
         let mut items = heapless::Vec::new();
         for a in (&raw).skip(1) {
             let a = a.map_err(|_| "argument is not UTF-8")?;
             let mut v = heapless::Vec::new();
-            v.extend_from_slice(a.as_bytes()).map_err(|_| "argument too long")?;
+            v.extend_from_slice(a.as_bytes())
+                .map_err(|_| "argument too long")?;
             v.push(0).map_err(|_| "argument too long")?;
             items.push(v).map_err(|_| "too many arguments")?;
         }
@@ -50,7 +54,9 @@ pub struct HostReader(pub File);
 
 impl HostReader {
     pub fn open(path: &CStr) -> Result<Self, &'static str> {
-        File::open(path).map(Self).map_err(|_| "cannot open input file")
+        File::open(path)
+            .map(Self)
+            .map_err(|_| "cannot open input file")
     }
 }
 

@@ -14,7 +14,10 @@ extern "C" {
 
 fn bounds() -> (usize, usize) {
     // Linker symbols from cortex-m-rt; only their addresses are used.
-    (addr_of!(_stack_end) as usize, addr_of!(_stack_start) as usize)
+    (
+        addr_of!(_stack_end) as usize,
+        addr_of!(_stack_start) as usize,
+    )
 }
 
 /// Paint from the stack limit up to just below the current stack pointer.

@@ -1,0 +1,84 @@
+//! `diagnose` on bad input: clear errors or stated exclusions, never a panic.
+
+#[path = "common/planted.rs"]
+mod planted;
+use fog_sim::diagnose::{diagnose, DiagnoseError};
+use fog_sim::runs::Run;
+use planted::{campaign, Effect, Shape};
+
+fn small() -> Vec<Run> {
+    campaign(Effect::Null, 5, Shape { runs: 6, minutes: 20.0, sigmas: 1.0 }).0
+}
+
+fn set_column(run: &mut Run, name: &str, values: Vec<f64>) {
+    match run.columns.iter().position(|c| c == name) {
+        Some(i) => run.data[i] = values,
+        None => {
+            run.columns.push(name.to_owned());
+            run.data.push(values);
+        }
+    }
+}
+
+#[test]
+fn too_few_runs_is_a_clear_error() {
+    let runs = campaign(Effect::Null, 1, Shape { runs: 2, minutes: 2.0, sigmas: 1.0 }).0;
+    let e = diagnose(&runs).unwrap_err();
+    assert!(matches!(e, DiagnoseError::TooFewRuns { runs: 2, .. }), "{e}");
+    assert!(e.to_string().contains("too few"), "{e}");
+    assert!(matches!(diagnose(&[]), Err(DiagnoseError::NoRuns)));
+}
+
+#[test]
+fn nan_in_a_required_column_names_run_column_and_row() {
+    let mut runs = small();
+    let mut rate = runs[3].rate_dph().to_vec();
+    rate[7] = f64::NAN;
+    set_column(&mut runs[3], "rate_dph", rate);
+    let e = diagnose(&runs).unwrap_err();
+    assert_eq!(e, DiagnoseError::NotFinite { run: "run_03.csv".into(), column: "rate_dph".into(), row: 7 });
+}
+
+#[test]
+fn mismatched_lengths_are_refused() {
+    let mut runs = small();
+    let n = runs[1].len();
+    set_column(&mut runs[1], "supply_v", vec![1.0; n - 3]);
+    let e = diagnose(&runs).unwrap_err();
+    assert!(matches!(e, DiagnoseError::MismatchedLength { ref column, .. } if column == "supply_v"), "{e}");
+}
+
+#[test]
+fn nan_and_constant_extra_columns_are_excluded_with_a_reason() {
+    let mut runs = small();
+    for r in runs.iter_mut() {
+        let n = r.len();
+        set_column(r, "stuck_v", vec![5.0; n]);
+        let mut bad: Vec<f64> = (0..n).map(|i| i as f64).collect();
+        bad[2] = f64::NAN;
+        set_column(r, "broken_c", bad);
+    }
+    let d = diagnose(&runs).expect("extra-column problems are exclusions, not errors");
+    let ex = &d.report.campaign.excluded_columns;
+    assert!(ex.iter().any(|e| e.column == "stuck_v" && e.reason.contains("constant")), "{ex:?}");
+    assert!(ex.iter().any(|e| e.column == "broken_c" && e.reason.contains("NaN")), "{ex:?}");
+    assert!(d.report.candidates.iter().all(|c| c.column != "stuck_v" && c.column != "broken_c"));
+}
+
+#[test]
+fn constant_temperature_is_refused() {
+    let mut runs = small();
+    for r in runs.iter_mut() {
+        let n = r.len();
+        set_column(r, "temp_c", vec![20.0; n]);
+    }
+    assert!(matches!(diagnose(&runs), Err(DiagnoseError::ConstantRequired { .. })));
+}
+
+#[test]
+fn a_single_record_is_validated_on_time_blocks_and_says_so() {
+    let runs = campaign(Effect::Null, 9, Shape { runs: 1, minutes: 45.0, sigmas: 1.0 }).0;
+    let d = diagnose(&runs).expect("one long record is enough for time blocks");
+    assert!(d.report.campaign.validation.contains("time blocks"), "{}", d.report.campaign.validation);
+    assert!(d.report.named_cause.is_none());
+}

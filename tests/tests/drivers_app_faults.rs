@@ -1,0 +1,120 @@
+//! Host tests of the application's fault policy (`fog_firmware::app`) with the real
+//! drivers on embedded-hal-mock: a turntable that stops answering aborts the seek with
+//! the driver's own error; a temperature sensor that fails marks its window invalid and
+//! the north finder never gets a result from it.
+
+use std::cell::Cell;
+
+use embedded_hal_mock::eh1::serial::{Mock, Transaction};
+use embedded_hal_nb::nb;
+use fog_core::compensator::WindowStatus;
+use fog_core::hal::{GyroSample, TableState, TempSample, Turntable};
+use fog_core::northfinder::SeekError;
+use fog_firmware::app::{App, AppConfig, SeekOutcome};
+use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig, TurntableError};
+
+const RATE_HZ: f64 = 10.0;
+
+fn config(seeks: u16) -> AppConfig {
+    let mut cfg = AppConfig::for_rate(RATE_HZ as f32);
+    cfg.seeks = seeks;
+    cfg
+}
+
+/// A table that settles at once wherever it is told to go.
+struct InstantTable(f32);
+
+impl Turntable for InstantTable {
+    type Error = ();
+    fn command_heading(&mut self, h: f32) -> Result<(), ()> {
+        self.0 = h;
+        Ok(())
+    }
+    fn poll(&mut self) -> Result<TableState, ()> {
+        Ok(TableState::Settled { heading_deg: self.0 })
+    }
+}
+
+#[test]
+fn silent_turntable_aborts_the_seek_with_the_driver_error() {
+    let clock = Cell::new(0.0);
+    let mut tx = vec![Transaction::write_many(b"MOV 0.000\r")];
+    // The controller never answers: every poll finds no byte.
+    tx.extend((0..8).map(|_| Transaction::read_error(nb::Error::WouldBlock)));
+    let table = SerialTurntable::new(Mock::new(&tx), &clock, TurntableConfig::default());
+    let mut app = App::new(config(6), None, table).expect("config");
+    let mut failure = None;
+    for i in 1..=10 {
+        let t_s = f64::from(i) / RATE_HZ;
+        clock.set(t_s);
+        let step = app.on_gyro(GyroSample { t_s, rate_dph: 9.7 });
+        if let Some(SeekOutcome::Failed(f)) = step.seek {
+            failure = Some(f);
+            break;
+        }
+    }
+    let f = failure.expect("the missing ACK ends the seek within the reply timeout");
+    assert_eq!(f.error, SeekError::Turntable);
+    assert_eq!(f.table_error, Some(TurntableError::Timeout));
+    assert!(f.t_s > 0.5 && f.t_s <= 0.7, "reported at {} s", f.t_s);
+    assert!(app.finished(), "no silent retry after a table fault");
+    assert!(app.on_gyro(GyroSample { t_s: 1.1, rate_dph: 9.7 }).seek.is_none());
+}
+
+#[test]
+fn temperature_fault_invalidates_its_window_only() {
+    let mut app = App::new(config(0), None, InstantTable(0.0)).expect("config");
+    let mut statuses = Vec::new();
+    for i in 1..=300 {
+        let t_s = f64::from(i) / RATE_HZ;
+        if app.temp_due(t_s) {
+            // Sensor silent between 12 and 15 s (e.g. I2C NACK): reported as a fault.
+            let reading = (!(12.0..15.0).contains(&t_s)).then_some(TempSample {
+                t_s,
+                temp_c: 20.0 + 0.01 * t_s as f32,
+            });
+            app.on_temp(t_s, reading);
+        }
+        if let Some(w) = app.on_gyro(GyroSample { t_s, rate_dph: 9.7 }).window {
+            statuses.push((w.t_end_s, w.status));
+        }
+    }
+    assert_eq!(statuses.len(), 30);
+    for (t_end, status) in statuses {
+        if t_end == 20.0 {
+            assert_eq!(status, WindowStatus::SensorFault, "window 10..20 s had the fault");
+        } else {
+            assert_ne!(status, WindowStatus::SensorFault, "window ending {t_end} s");
+        }
+    }
+}
+
+#[test]
+fn seeks_run_back_to_back_and_report_each_result() {
+    // Input axis horizontal at latitude 39.9: Earth rate 15.041 * cos(39.9) * cos(heading).
+    let omega_h = 15.041_067 * 39.9f64.to_radians().cos();
+    let truth_deg = 108.4f64;
+    let mut app = App::new(config(2), None, InstantTable(0.0)).expect("config");
+    let mut results = Vec::new();
+    let mut heading = 0.0f32;
+    for i in 1..=(2 * 400 * RATE_HZ as u32) {
+        let t_s = f64::from(i) / RATE_HZ;
+        if app.temp_due(t_s) {
+            app.on_temp(t_s, Some(TempSample { t_s, temp_c: 25.0 }));
+        }
+        let az = (truth_deg + f64::from(heading)).to_radians();
+        let rate_dph = (omega_h * az.cos()) as f32;
+        let step = app.on_gyro(GyroSample { t_s, rate_dph });
+        heading = app.table().0;
+        if let Some(s) = step.seek {
+            results.push(s);
+        }
+    }
+    assert_eq!(results.len(), 2, "{results:?}");
+    for r in results {
+        let SeekOutcome::Done(r) = r else {
+            panic!("seek failed: {r:?}")
+        };
+        assert!((r.azimuth_deg - truth_deg).abs() < 0.05, "azimuth {}", r.azimuth_deg);
+    }
+}
