@@ -8,9 +8,9 @@
 //! Number formats:
 //! - raw input j: i64 with `F_j` fraction bits chosen from its trained range (|x| < 2^(40-F_j)
 //!   gets full precision, larger values saturate; such inputs are out of range anyway);
-//! - normalised inputs and centres: Q.24 (`XN_FRAC`) in i64;
-//! - per-centre gain g_i = 1/(sqrt(2) s_i): Q.24, so ||xn - c||^2/(2 s^2) = sum (g (xn - c))^2
-//!   is a sum of squares in Q.48;
+//! - normalised inputs and centres: Q.28 (`XN_FRAC`) in i64;
+//! - per-centre gain g_i = 1/(sqrt(2) s_i): Q.24 (`GAIN_FRAC`), so ||xn - c||^2/(2 s^2) =
+//!   sum (g (xn - c))^2 is a sum of squares of Q.28 values, in Q.56;
 //! - exp(-u): range-reduced as 2^-(u log2 e) = 2^-n * 2^-(k/32) * 2^-r with r < 1/32, a
 //!   32-entry Q.30 table and a 4th-order polynomial (truncation error < 5e-11); Q.30 result;
 //! - weights, bias, linear terms: Q.`w_frac`, scaled per model so the largest fits in 31 bits;
@@ -23,14 +23,16 @@ use crate::model::{ModelError, RbfModel, MAX_CENTERS, MAX_INPUTS};
 use crate::rbf::RbfError;
 
 /// Fraction bits of normalised inputs and centres.
-pub const XN_FRAC: u32 = 24;
+pub const XN_FRAC: u32 = 28;
+/// Fraction bits of the per-centre gains 1/(sqrt(2) s).
+pub const GAIN_FRAC: u32 = 24;
 /// Fraction bits of the exponential's result.
 pub const EXP_FRAC: u32 = 30;
 /// exp(-u) is taken as 0 for u >= this (exp(-23) = 1e-10 < 2^-30).
 pub const EXP_CUTOFF: u64 = 23;
 /// Bits of precision kept for raw inputs inside their trained range.
 const RAW_BITS: i32 = 40;
-/// Largest |normalised input| representable, Q.24 (about 120).
+/// Largest |normalised input| accepted (about 120; beyond it inputs saturate).
 const XN_LIMIT: i64 = 120 << XN_FRAC;
 
 /// 2^(-k/32) in Q.30 for k = 0..32.
@@ -101,9 +103,9 @@ pub struct FixedModel {
     in_offset_q: [i64; MAX_INPUTS],
     /// 1/scale of input j, Q.in_gain_frac (about 2^40).
     in_gain_q: [i64; MAX_INPUTS],
-    /// Right shift that brings (x - offset) * gain to Q.24.
+    /// Right shift that brings (x - offset) * gain to Q.28.
     in_shift: [u8; MAX_INPUTS],
-    centers_q: [[i32; MAX_INPUTS]; MAX_CENTERS],
+    centers_q: [[i64; MAX_INPUTS]; MAX_CENTERS],
     gain_q: [i32; MAX_CENTERS],
     weights_q: [i32; MAX_CENTERS],
     linear_q: [i32; MAX_INPUTS],
@@ -169,13 +171,13 @@ impl FixedModel {
                 if v.abs() >= 100.0 {
                     return Err(FixedError::CenterOutOfRange { center: i as u8 });
                 }
-                *q = to_q(v as f64, XN_FRAC as i32) as i32;
+                *q = to_q(v as f64, XN_FRAC as i32);
             }
             let g = 1.0 / (core::f64::consts::SQRT_2 * model.widths[i] as f64);
             if g >= 127.0 {
                 return Err(FixedError::WidthTooSmall { center: i as u8 });
             }
-            fm.gain_q[i] = to_q(g, XN_FRAC as i32) as i32;
+            fm.gain_q[i] = to_q(g, GAIN_FRAC as i32) as i32;
         }
         let max_abs = model
             .weights
@@ -212,8 +214,8 @@ impl FixedModel {
         self.w_frac as u32
     }
 
-    /// Raw inputs -> normalised Q.24, integer-only.
-    pub fn normalise_q24(&self, x_raw: &[f32]) -> Result<[i64; MAX_INPUTS], RbfError> {
+    /// Raw inputs -> normalised Q.28 (`XN_FRAC`), integer-only.
+    pub fn normalise_q28(&self, x_raw: &[f32]) -> Result<[i64; MAX_INPUTS], RbfError> {
         let n = self.n_inputs as usize;
         if x_raw.len() != n {
             return Err(RbfError::WrongInputCount {
@@ -232,22 +234,32 @@ impl FixedModel {
         Ok(xn)
     }
 
-    /// Drift in Q.`weight_frac_bits()` deg/h from normalised Q.24 inputs (integer-only core).
+    /// Drift in Q.`weight_frac_bits()` deg/h from normalised Q.28 inputs (integer-only core).
+    /// Inputs beyond +-`XN_LIMIT` (about 120 normalised units) are clamped to it.
     pub fn predict_from_normalised(&self, xn: &[i64; MAX_INPUTS]) -> i64 {
+        let xn = xn.map(|x| x.clamp(-XN_LIMIT, XN_LIMIT));
         let n = self.n_inputs as usize;
         let nr = self.n_rbf as usize;
         let mut acc = self.bias_q;
         for (&l, &x) in self.linear_q.iter().zip(xn.iter()).take(n) {
-            acc += (l as i64 * x) >> XN_FRAC;
+            // |l| < 2^31 and |x| < 2^35: exact in i128 (only n_inputs products).
+            acc += ((l as i128 * x as i128) >> XN_FRAC) as i64;
         }
         let z_limit: i64 = 5 << XN_FRAC; // z^2 >= 25 > EXP_CUTOFF
         let u_limit: i64 = (EXP_CUTOFF as i64) << (2 * XN_FRAC);
         'centres: for i in 0..self.n_centers as usize {
-            let g = self.gain_q[i] as i64;
+            let g = self.gain_q[i] as i64; // < 127 * 2^24 < 2^31
             let c = &self.centers_q[i];
             let mut u: i64 = 0;
             for j in 0..nr {
-                let z = ((xn[j] - c[j] as i64) * g) >> XN_FRAC;
+                let d = xn[j] - c[j]; // Q.28, |d| < 220 * 2^28
+                let z = if d.unsigned_abs() < 1 << 32 {
+                    (d * g) >> GAIN_FRAC
+                } else {
+                    // |d| >= 16 normalised units: only very wide Gaussians get here; drop
+                    // 8 bits first so that d * g cannot overflow.
+                    ((d >> 8) * g) >> (GAIN_FRAC - 8)
+                };
                 if z.abs() >= z_limit {
                     continue 'centres;
                 }
@@ -256,6 +268,7 @@ impl FixedModel {
             if u >= u_limit {
                 continue;
             }
+            // u is Q.56 (< 23 * 2^56); the exponential takes Q.28.
             let e = exp_neg_q30((u >> (2 * XN_FRAC - 28)) as u64);
             acc += (self.weights_q[i] as i64 * e as i64) >> EXP_FRAC;
         }
@@ -264,7 +277,7 @@ impl FixedModel {
 
     /// Predicted drift, deg/h (integer-only; f32 only at the boundary, by bit manipulation).
     pub fn predict(&self, x_raw: &[f32]) -> Result<f32, RbfError> {
-        let xn = self.normalise_q24(x_raw)?;
+        let xn = self.normalise_q28(x_raw)?;
         Ok(fixed_to_f32(
             self.predict_from_normalised(&xn),
             self.w_frac as u32,
@@ -273,7 +286,7 @@ impl FixedModel {
 
     /// Predicted drift as Q16.16 deg/h (saturating), integer-only end to end.
     pub fn predict_q16(&self, x_raw: &[f32]) -> Result<i32, RbfError> {
-        let xn = self.normalise_q24(x_raw)?;
+        let xn = self.normalise_q28(x_raw)?;
         let acc = self.predict_from_normalised(&xn);
         let wf = self.w_frac as i32;
         let q16 = if wf >= 16 {

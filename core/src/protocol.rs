@@ -405,6 +405,42 @@ mod tests {
     }
 
     #[test]
+    fn largest_response_fits_a_frame() {
+        let info = ModelInfo {
+            slot: 1,
+            sequence: u32::MAX,
+            model_len: u32::MAX,
+            model_crc32: u32::MAX,
+            gyro_id: String::try_from("0123456789ABCDEF").unwrap(),
+            n_centers: u16::MAX,
+            n_inputs: u8::MAX,
+            heldout_rms_dph: f32::MAX,
+        };
+        let status = DeviceStatus {
+            protocol_version: u16::MAX,
+            active: Some(info.clone()),
+            upload: UploadPhase::Receiving {
+                received: u32::MAX,
+                model_len: u32::MAX,
+            },
+            frames_rejected: u32::MAX,
+            uploads_rejected: u32::MAX,
+        };
+        let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
+        for response in [
+            Response::Status(status),
+            Response::Committed(info),
+            Response::Rejected(UploadError::ChunkOutOfOrder {
+                expected_offset: u32::MAX,
+            }),
+        ] {
+            let n = encode_frame(&response, &mut wire).unwrap();
+            let back: Response = decode_message(decode_frame(&mut wire[..n - 1]).unwrap()).unwrap();
+            assert_eq!(back, response);
+        }
+    }
+
+    #[test]
     fn flipped_bit_is_a_crc_or_cobs_error() {
         let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
         let n = encode_frame(

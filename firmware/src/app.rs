@@ -152,6 +152,11 @@ where
         &self.table.table
     }
 
+    /// Take the turntable driver back (shutdown, tests).
+    pub fn into_table(self) -> T {
+        self.table.table
+    }
+
     /// Seeks started so far.
     pub fn seeks_started(&self) -> u16 {
         self.seeks_started

@@ -108,8 +108,8 @@ impl<F: NorFlash> UploadServer<F> {
                 (Response::Rejected(e), false)
             }
             Ok(request) => {
-                // `request` borrows `self.rx`; copy it out of the frame buffer's lifetime
-                // by handling it with disjoint field borrows.
+                // `request` borrows the receive buffer, so the handler gets the other
+                // fields as separate borrows.
                 handle(
                     request,
                     &mut Fields {
@@ -124,7 +124,8 @@ impl<F: NorFlash> UploadServer<F> {
                 )
             }
         };
-        // Every response fits MAX_WIRE_FRAME_LEN (checked by the protocol tests).
+        // Every response fits MAX_WIRE_FRAME_LEN (`largest_response_fits_a_frame` in
+        // fog-core), so the empty fallback is unreachable.
         let len = encode_frame(&response, &mut self.tx).unwrap_or(0);
         Some(Reply {
             frame: &self.tx[..len],

@@ -12,6 +12,7 @@
 //!   removes the 3 gyro-x spikes <= -0.08 rad/s that the original authors deleted);
 //! - one run per gyro axis (`--axis`), the magnetometer as extra columns in uT;
 //!   Earth rate is negligible next to the MEMS bias and its projection is unknown: 0.
+//!
 //! Bad input (wrong header, non-numeric cell, ragged row, time going backwards) is
 //! rejected with the line named; nothing is written then.
 
@@ -20,7 +21,8 @@ use std::fmt;
 use std::path::Path;
 
 /// The header the PAN file must have.
-pub const PAN_HEADER: &str = "time (ms),mag1x [T],mag1y [T],mag1z [T],gyrox rad/s,gyroy rad/s,gyroz rad/s,temp";
+pub const PAN_HEADER: &str =
+    "time (ms),mag1x [T],mag1y [T],mag1z [T],gyrox rad/s,gyroy rad/s,gyroz rad/s,temp";
 /// Samples further apart than this start a new burst, s.
 pub const BURST_GAP_S: f64 = 1.0;
 /// Outlier threshold in robust sigmas.
@@ -73,11 +75,20 @@ pub fn lsm6dsm_temp_c(raw: f64) -> f64 {
 }
 
 fn parse(file: &str, text: &str) -> Result<Vec<Sample>, ImportError> {
-    let err = |line: Option<usize>, what: String| ImportError { file: file.to_owned(), line, what };
+    let err = |line: Option<usize>, what: String| ImportError {
+        file: file.to_owned(),
+        line,
+        what,
+    };
     let mut lines = text.lines().enumerate();
     match lines.next() {
         Some((_, h)) if h.trim() == PAN_HEADER => {}
-        Some((_, h)) => return Err(err(Some(1), format!("unexpected header `{}` (want `{PAN_HEADER}`)", h.trim()))),
+        Some((_, h)) => {
+            return Err(err(
+                Some(1),
+                format!("unexpected header `{}` (want `{PAN_HEADER}`)", h.trim()),
+            ))
+        }
         None => return Err(err(None, "empty file".into())),
     }
     let mut out: Vec<Sample> = Vec::new();
@@ -92,13 +103,27 @@ fn parse(file: &str, text: &str) -> Result<Vec<Sample>, ImportError> {
         }
         let mut v = [0.0f64; 8];
         for (k, c) in cells.iter().enumerate() {
-            v[k] = c.parse().ok().filter(|x: &f64| x.is_finite()).ok_or_else(|| err(Some(n), format!("column {} is not a finite number: `{c}`", k + 1)))?;
+            v[k] = c
+                .parse()
+                .ok()
+                .filter(|x: &f64| x.is_finite())
+                .ok_or_else(|| {
+                    err(
+                        Some(n),
+                        format!("column {} is not a finite number: `{c}`", k + 1),
+                    )
+                })?;
         }
         let t_s = v[0] / 1000.0;
         if out.last().is_some_and(|p| t_s <= p.t_s) {
             return Err(err(Some(n), "time is not strictly increasing".into()));
         }
-        out.push(Sample { t_s, mag_t: [v[1], v[2], v[3]], gyro_rads: [v[4], v[5], v[6]], temp_c: lsm6dsm_temp_c(v[7]) });
+        out.push(Sample {
+            t_s,
+            mag_t: [v[1], v[2], v[3]],
+            gyro_rads: [v[4], v[5], v[6]],
+            temp_c: lsm6dsm_temp_c(v[7]),
+        });
     }
     if out.is_empty() {
         return Err(err(None, "no data rows".into()));
@@ -126,13 +151,20 @@ fn clean_burst(b: &[Sample]) -> Vec<Sample> {
         let mad = median(&mut dev) * 1.4826;
         *lim = (med, OUTLIER_MADS * mad.max(1e-12));
     }
-    b.iter().copied().filter(|s| (0..3).all(|a| (s.gyro_rads[a] - limits[a].0).abs() <= limits[a].1)).collect()
+    b.iter()
+        .copied()
+        .filter(|s| (0..3).all(|a| (s.gyro_rads[a] - limits[a].0).abs() <= limits[a].1))
+        .collect()
 }
 
 /// Imports the PAN TVAC file; `axes` are 0 = x, 1 = y, 2 = z.
 pub fn import_pan(path: &Path, axes: &[usize]) -> Result<PanImport, ImportError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| ImportError { file: file.clone(), line: None, what: e.to_string() })?;
+    let text = std::fs::read_to_string(path).map_err(|e| ImportError {
+        file: file.clone(),
+        line: None,
+        what: e.to_string(),
+    })?;
     let samples = parse(&file, &text)?;
     let mut bursts: Vec<Vec<Sample>> = Vec::new();
     for s in &samples {
@@ -143,18 +175,51 @@ pub fn import_pan(path: &Path, axes: &[usize]) -> Result<PanImport, ImportError>
     }
     let cleaned: Vec<Vec<Sample>> = bursts.iter().map(|b| clean_burst(b)).collect();
     let kept: usize = cleaned.iter().map(Vec::len).sum();
-    let mean = |b: &[Sample], f: &dyn Fn(&Sample) -> f64| b.iter().map(f).sum::<f64>() / b.len() as f64;
-    let stem = path.file_stem().map_or_else(|| "pan".into(), |s| s.to_string_lossy().into_owned());
+    let mean =
+        |b: &[Sample], f: &dyn Fn(&Sample) -> f64| b.iter().map(f).sum::<f64>() / b.len() as f64;
+    let stem = path
+        .file_stem()
+        .map_or_else(|| "pan".into(), |s| s.to_string_lossy().into_owned());
     let mut runs = Vec::new();
     for &axis in axes {
         let name = ["x", "y", "z"][axis.min(2)];
         let cols = vec![
-            ("t_s".to_owned(), cleaned.iter().map(|b| mean(b, &|s| s.t_s)).collect()),
-            ("rate_dph".to_owned(), cleaned.iter().map(|b| mean(b, &|s| s.gyro_rads[axis] * RADS_TO_DPH)).collect()),
-            ("temp_c".to_owned(), cleaned.iter().map(|b| mean(b, &|s| s.temp_c)).collect()),
-            ("mag_x_ut".to_owned(), cleaned.iter().map(|b| mean(b, &|s| s.mag_t[0] * 1e6)).collect()),
-            ("mag_y_ut".to_owned(), cleaned.iter().map(|b| mean(b, &|s| s.mag_t[1] * 1e6)).collect()),
-            ("mag_z_ut".to_owned(), cleaned.iter().map(|b| mean(b, &|s| s.mag_t[2] * 1e6)).collect()),
+            (
+                "t_s".to_owned(),
+                cleaned.iter().map(|b| mean(b, &|s| s.t_s)).collect(),
+            ),
+            (
+                "rate_dph".to_owned(),
+                cleaned
+                    .iter()
+                    .map(|b| mean(b, &|s| s.gyro_rads[axis] * RADS_TO_DPH))
+                    .collect(),
+            ),
+            (
+                "temp_c".to_owned(),
+                cleaned.iter().map(|b| mean(b, &|s| s.temp_c)).collect(),
+            ),
+            (
+                "mag_x_ut".to_owned(),
+                cleaned
+                    .iter()
+                    .map(|b| mean(b, &|s| s.mag_t[0] * 1e6))
+                    .collect(),
+            ),
+            (
+                "mag_y_ut".to_owned(),
+                cleaned
+                    .iter()
+                    .map(|b| mean(b, &|s| s.mag_t[1] * 1e6))
+                    .collect(),
+            ),
+            (
+                "mag_z_ut".to_owned(),
+                cleaned
+                    .iter()
+                    .map(|b| mean(b, &|s| s.mag_t[2] * 1e6))
+                    .collect(),
+            ),
         ];
         let meta = vec![
             ("gyro".to_owned(), format!("PAN-ETU-LSM6DSM-{name}")),
@@ -165,9 +230,18 @@ pub fn import_pan(path: &Path, axes: &[usize]) -> Result<PanImport, ImportError>
             ("note".to_owned(), "cooling in a thermal-vacuum chamber, not a power-on warm-up; t_s is time since flight-computer boot".to_owned()),
         ];
         let path = format!("{stem}_gyro_{name}.csv");
-        runs.push(Run::new(path, meta, cols).map_err(|e| ImportError { file: file.clone(), line: None, what: e.to_string() })?);
+        runs.push(Run::new(path, meta, cols).map_err(|e| ImportError {
+            file: file.clone(),
+            line: None,
+            what: e.to_string(),
+        })?);
     }
-    Ok(PanImport { runs, samples: samples.len(), bursts: bursts.len(), outliers_dropped: samples.len() - kept })
+    Ok(PanImport {
+        runs,
+        samples: samples.len(),
+        bursts: bursts.len(),
+        outliers_dropped: samples.len() - kept,
+    })
 }
 
 #[cfg(test)]

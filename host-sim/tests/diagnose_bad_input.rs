@@ -1,5 +1,6 @@
 //! `diagnose` on bad input: clear errors or stated exclusions, never a panic.
 
+#[allow(dead_code)]
 #[path = "common/planted.rs"]
 mod planted;
 use fog_sim::diagnose::{diagnose, DiagnoseError};
@@ -7,7 +8,16 @@ use fog_sim::runs::Run;
 use planted::{campaign, Effect, Shape};
 
 fn small() -> Vec<Run> {
-    campaign(Effect::Null, 5, Shape { runs: 6, minutes: 20.0, sigmas: 1.0 }).0
+    campaign(
+        Effect::Null,
+        5,
+        Shape {
+            runs: 6,
+            minutes: 20.0,
+            sigmas: 1.0,
+        },
+    )
+    .0
 }
 
 fn set_column(run: &mut Run, name: &str, values: Vec<f64>) {
@@ -22,9 +32,21 @@ fn set_column(run: &mut Run, name: &str, values: Vec<f64>) {
 
 #[test]
 fn too_few_runs_is_a_clear_error() {
-    let runs = campaign(Effect::Null, 1, Shape { runs: 2, minutes: 2.0, sigmas: 1.0 }).0;
+    let runs = campaign(
+        Effect::Null,
+        1,
+        Shape {
+            runs: 2,
+            minutes: 2.0,
+            sigmas: 1.0,
+        },
+    )
+    .0;
     let e = diagnose(&runs).unwrap_err();
-    assert!(matches!(e, DiagnoseError::TooFewRuns { runs: 2, .. }), "{e}");
+    assert!(
+        matches!(e, DiagnoseError::TooFewRuns { runs: 2, .. }),
+        "{e}"
+    );
     assert!(e.to_string().contains("too few"), "{e}");
     assert!(matches!(diagnose(&[]), Err(DiagnoseError::NoRuns)));
 }
@@ -36,7 +58,14 @@ fn nan_in_a_required_column_names_run_column_and_row() {
     rate[7] = f64::NAN;
     set_column(&mut runs[3], "rate_dph", rate);
     let e = diagnose(&runs).unwrap_err();
-    assert_eq!(e, DiagnoseError::NotFinite { run: "run_03.csv".into(), column: "rate_dph".into(), row: 7 });
+    assert_eq!(
+        e,
+        DiagnoseError::NotFinite {
+            run: "run_03.csv".into(),
+            column: "rate_dph".into(),
+            row: 7
+        }
+    );
 }
 
 #[test]
@@ -45,7 +74,10 @@ fn mismatched_lengths_are_refused() {
     let n = runs[1].len();
     set_column(&mut runs[1], "supply_v", vec![1.0; n - 3]);
     let e = diagnose(&runs).unwrap_err();
-    assert!(matches!(e, DiagnoseError::MismatchedLength { ref column, .. } if column == "supply_v"), "{e}");
+    assert!(
+        matches!(e, DiagnoseError::MismatchedLength { ref column, .. } if column == "supply_v"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -60,9 +92,21 @@ fn nan_and_constant_extra_columns_are_excluded_with_a_reason() {
     }
     let d = diagnose(&runs).expect("extra-column problems are exclusions, not errors");
     let ex = &d.report.campaign.excluded_columns;
-    assert!(ex.iter().any(|e| e.column == "stuck_v" && e.reason.contains("constant")), "{ex:?}");
-    assert!(ex.iter().any(|e| e.column == "broken_c" && e.reason.contains("NaN")), "{ex:?}");
-    assert!(d.report.candidates.iter().all(|c| c.column != "stuck_v" && c.column != "broken_c"));
+    assert!(
+        ex.iter()
+            .any(|e| e.column == "stuck_v" && e.reason.contains("constant")),
+        "{ex:?}"
+    );
+    assert!(
+        ex.iter()
+            .any(|e| e.column == "broken_c" && e.reason.contains("NaN")),
+        "{ex:?}"
+    );
+    assert!(d
+        .report
+        .candidates
+        .iter()
+        .all(|c| c.column != "stuck_v" && c.column != "broken_c"));
 }
 
 #[test]
@@ -72,13 +116,29 @@ fn constant_temperature_is_refused() {
         let n = r.len();
         set_column(r, "temp_c", vec![20.0; n]);
     }
-    assert!(matches!(diagnose(&runs), Err(DiagnoseError::ConstantRequired { .. })));
+    assert!(matches!(
+        diagnose(&runs),
+        Err(DiagnoseError::ConstantRequired { .. })
+    ));
 }
 
 #[test]
 fn a_single_record_is_validated_on_time_blocks_and_says_so() {
-    let runs = campaign(Effect::Null, 9, Shape { runs: 1, minutes: 45.0, sigmas: 1.0 }).0;
+    let runs = campaign(
+        Effect::Null,
+        9,
+        Shape {
+            runs: 1,
+            minutes: 45.0,
+            sigmas: 1.0,
+        },
+    )
+    .0;
     let d = diagnose(&runs).expect("one long record is enough for time blocks");
-    assert!(d.report.campaign.validation.contains("time blocks"), "{}", d.report.campaign.validation);
+    assert!(
+        d.report.campaign.validation.contains("time blocks"),
+        "{}",
+        d.report.campaign.validation
+    );
     assert!(d.report.named_cause.is_none());
 }

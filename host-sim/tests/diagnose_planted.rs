@@ -4,8 +4,8 @@
 
 #[path = "common/planted.rs"]
 mod planted;
-use planted::{campaign, Effect, Shape};
 use fog_sim::diagnose::diagnose;
+use planted::{campaign, Effect, Shape};
 
 const SEEDS: [u64; 3] = [11, 22, 33];
 
@@ -38,7 +38,11 @@ fn check(effect: Effect) {
                 })
             })
             .collect();
-        handles.into_iter().map(|h| h.join().expect("case thread")).map(|(ok, l)| format!("{} {l}", if ok { "ok  " } else { "FAIL" })).collect()
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("case thread"))
+            .map(|(ok, l)| format!("{} {l}", if ok { "ok  " } else { "FAIL" }))
+            .collect()
     });
     for l in &results {
         println!("{l}");

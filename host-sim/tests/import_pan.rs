@@ -20,7 +20,11 @@ fn synthetic() -> String {
     for burst in 0..2 {
         for k in 0..10 {
             let t_ms = 15_000 + burst * 300_000 + k * 20;
-            let gx = if burst == 0 && k == 4 { -0.09 } else { -0.065 + 0.0001 * (k % 3) as f64 };
+            let gx = if burst == 0 && k == 4 {
+                -0.09
+            } else {
+                -0.065 + 0.0001 * (k % 3) as f64
+            };
             let raw = 65236 - burst * 100;
             s += &format!("{t_ms},-1.4E-05,2.7E-05,2.8E-05,{gx},0.057,0.029,{raw}\n");
         }
@@ -35,8 +39,14 @@ fn bursts_become_rows_in_fog_runs_units() {
     assert_eq!((imp.samples, imp.bursts, imp.outliers_dropped), (20, 2, 1));
     let x = &imp.runs[0];
     assert_eq!(x.len(), 2);
-    let expect_x = (-0.065 + 0.0001 * (0.0 + 1.0 + 2.0 + 0.0 + 1.0 + 2.0 + 0.0 + 1.0 + 2.0 - 1.0) / 9.0) * RADS_TO_DPH;
-    assert!((x.rate_dph()[0] - expect_x).abs() < 1e-6, "{} vs {expect_x}", x.rate_dph()[0]);
+    let expect_x = (-0.065
+        + 0.0001 * (0.0 + 1.0 + 2.0 + 0.0 + 1.0 + 2.0 + 0.0 + 1.0 + 2.0 - 1.0) / 9.0)
+        * RADS_TO_DPH;
+    assert!(
+        (x.rate_dph()[0] - expect_x).abs() < 1e-6,
+        "{} vs {expect_x}",
+        x.rate_dph()[0]
+    );
     assert!((x.temp_c()[1] - lsm6dsm_temp_c(65136.0)).abs() < 1e-12);
     assert!((imp.runs[1].rate_dph()[1] - 0.057 * RADS_TO_DPH).abs() < 1e-6);
     assert!((x.column("mag_x_ut").unwrap()[0] + 14.0).abs() < 1e-9);
@@ -45,7 +55,10 @@ fn bursts_become_rows_in_fog_runs_units() {
 
 #[test]
 fn malformed_files_are_rejected_with_the_line() {
-    let p = write_tmp("bad.csv", &format!("{PAN_HEADER}\n1,0,0,0,0,0,0,1\n2,0,0,0,oops,0,0,1\n"));
+    let p = write_tmp(
+        "bad.csv",
+        &format!("{PAN_HEADER}\n1,0,0,0,0,0,0,1\n2,0,0,0,oops,0,0,1\n"),
+    );
     let e = import_pan(&p, &[0]).unwrap_err();
     assert_eq!(e.line, Some(3), "{e}");
     let p = write_tmp("hdr.csv", "time,gyro\n1,2\n");
@@ -55,13 +68,22 @@ fn malformed_files_are_rejected_with_the_line() {
 
 #[test]
 fn the_real_recording_when_present_gives_25_bursts_and_3_outliers() {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/measured/pan-tvac-mems/TVCtest3_7_20.csv");
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/data/measured/pan-tvac-mems/TVCtest3_7_20.csv");
     if !p.exists() {
         eprintln!("skipped: {} not present on this machine", p.display());
         return;
     }
     let imp = import_pan(&p, &[0, 1, 2]).unwrap();
-    assert_eq!((imp.samples, imp.bursts, imp.outliers_dropped), (6250, 25, 3));
+    assert_eq!(
+        (imp.samples, imp.bursts, imp.outliers_dropped),
+        (6250, 25, 3)
+    );
     let t = imp.runs[0].temp_c();
-    assert!((t[0] - 23.8).abs() < 0.1 && (t[24] - 15.7).abs() < 0.1, "{} .. {}", t[0], t[24]);
+    assert!(
+        (t[0] - 23.8).abs() < 0.1 && (t[24] - 15.7).abs() < 0.1,
+        "{} .. {}",
+        t[0],
+        t[24]
+    );
 }

@@ -31,21 +31,28 @@ impl Turntable for InstantTable {
         Ok(())
     }
     fn poll(&mut self) -> Result<TableState, ()> {
-        Ok(TableState::Settled { heading_deg: self.0 })
+        Ok(TableState::Settled {
+            heading_deg: self.0,
+        })
     }
 }
 
 #[test]
 fn silent_turntable_aborts_the_seek_with_the_driver_error() {
+    // 8 Hz samples and a 0.125 s poll period: exact binary times, so the number of
+    // polls (each one UART read) is known: 0.25, 0.375, 0.5, 0.625 and 0.75 s, when the
+    // 0.5 s reply timeout of the command sent at 0.125 s has passed.
     let clock = Cell::new(0.0);
     let mut tx = vec![Transaction::write_many(b"MOV 0.000\r")];
     // The controller never answers: every poll finds no byte.
-    tx.extend((0..8).map(|_| Transaction::read_error(nb::Error::WouldBlock)));
+    tx.extend((0..5).map(|_| Transaction::read_error(nb::Error::WouldBlock)));
     let table = SerialTurntable::new(Mock::new(&tx), &clock, TurntableConfig::default());
-    let mut app = App::new(config(6), None, table).expect("config");
+    let mut cfg = AppConfig::for_rate(8.0);
+    cfg.table_poll_s = 0.125;
+    let mut app = App::new(cfg, None, table).expect("config");
     let mut failure = None;
     for i in 1..=10 {
-        let t_s = f64::from(i) / RATE_HZ;
+        let t_s = f64::from(i) / 8.0;
         clock.set(t_s);
         let step = app.on_gyro(GyroSample { t_s, rate_dph: 9.7 });
         if let Some(SeekOutcome::Failed(f)) = step.seek {
@@ -56,16 +63,23 @@ fn silent_turntable_aborts_the_seek_with_the_driver_error() {
     let f = failure.expect("the missing ACK ends the seek within the reply timeout");
     assert_eq!(f.error, SeekError::Turntable);
     assert_eq!(f.table_error, Some(TurntableError::Timeout));
-    assert!(f.t_s > 0.5 && f.t_s <= 0.7, "reported at {} s", f.t_s);
+    assert_eq!(f.t_s, 0.75, "reported at the first poll past the timeout");
     assert!(app.finished(), "no silent retry after a table fault");
-    assert!(app.on_gyro(GyroSample { t_s: 1.1, rate_dph: 9.7 }).seek.is_none());
+    assert!(app
+        .on_gyro(GyroSample {
+            t_s: 1.5,
+            rate_dph: 9.7
+        })
+        .seek
+        .is_none());
+    app.into_table().release().done();
 }
 
 #[test]
 fn temperature_fault_invalidates_its_window_only() {
     let mut app = App::new(config(0), None, InstantTable(0.0)).expect("config");
     let mut statuses = Vec::new();
-    for i in 1..=300 {
+    for i in 1..=3000 {
         let t_s = f64::from(i) / RATE_HZ;
         if app.temp_due(t_s) {
             // Sensor silent between 12 and 15 s (e.g. I2C NACK): reported as a fault.
@@ -82,7 +96,11 @@ fn temperature_fault_invalidates_its_window_only() {
     assert_eq!(statuses.len(), 30);
     for (t_end, status) in statuses {
         if t_end == 20.0 {
-            assert_eq!(status, WindowStatus::SensorFault, "window 10..20 s had the fault");
+            assert_eq!(
+                status,
+                WindowStatus::SensorFault,
+                "window 10..20 s had the fault"
+            );
         } else {
             assert_ne!(status, WindowStatus::SensorFault, "window ending {t_end} s");
         }
@@ -115,6 +133,10 @@ fn seeks_run_back_to_back_and_report_each_result() {
         let SeekOutcome::Done(r) = r else {
             panic!("seek failed: {r:?}")
         };
-        assert!((r.azimuth_deg - truth_deg).abs() < 0.05, "azimuth {}", r.azimuth_deg);
+        assert!(
+            (r.azimuth_deg - truth_deg).abs() < 0.05,
+            "azimuth {}",
+            r.azimuth_deg
+        );
     }
 }

@@ -20,7 +20,7 @@ use fog_tests::{
 /// The budgets.
 const FLASH_TARGET_BYTES: u64 = 64 * 1024;
 const STATIC_RAM_BUDGET_BYTES: u64 = 16 * 1024;
-/// Regression ceiling for flash. The 64 KiB target is NOT met yet (measured 71,976 bytes
+/// Regression ceiling for flash. The 64 KiB target is NOT met yet (measured 72,776 bytes
 /// when this was written; docs/firmware.md explains where the bytes go): the check fails
 /// on any growth past this ceiling so the gap can only shrink.
 const FLASH_CEILING_BYTES: u64 = 74 * 1024;

@@ -221,6 +221,8 @@ fn scenario(evaluator: Evaluator, tag: &str) {
         run.stderr
     );
     let fw_out = std::fs::read_to_string(dir.join("out.txt")).expect("firmware wrote out.txt");
+    // (During development: a fog-core edit between building this test and the firmware
+    // subprocess build shows up here as a difference; rerun.)
     assert_same("firmware (QEMU) vs host", &host_out, &fw_out);
     let summary: Vec<&str> = fw_out.lines().filter(|l| l.starts_with('#')).collect();
     eprintln!(

@@ -247,3 +247,27 @@ fn every_bad_upload_is_refused_with_its_typed_error_and_the_model_stays() {
         sample_model("FOG-A17", 35, 1.0)
     );
 }
+
+#[test]
+fn test_key_files_agree_and_bad_key_files_are_refused_clearly() {
+    use fog_sim::upload::{load_signing_key, test_key_path};
+    let key = load_signing_key(&test_key_path()).unwrap();
+    assert_eq!(
+        *key.pk, TEST_PUBLIC_KEY,
+        "keys/ seed and the firmware's public key differ"
+    );
+    let dir = std::env::temp_dir().join(format!("fog-upload-key-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let short = dir.join("short.hex");
+    std::fs::write(&short, "deadbeef\n").unwrap();
+    let msg = format!("{:#}", load_signing_key(&short).unwrap_err());
+    assert!(
+        msg.contains("short.hex") && msg.contains("64 hex digits"),
+        "{msg}"
+    );
+    let not_hex = dir.join("nothex.hex");
+    std::fs::write(&not_hex, "zz".repeat(32)).unwrap();
+    let msg = format!("{:#}", load_signing_key(&not_hex).unwrap_err());
+    assert!(msg.contains("not hex at character 0"), "{msg}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -52,6 +52,8 @@ const HOST_BAUD: u32 = 115_200;
 const GYRO_BAUD: u32 = 460_800;
 const TABLE_BAUD: u32 = 115_200;
 
+type Table = SerialTurntable<uart::CmsdkUart, millis::MillisClock>;
+
 #[entry]
 fn main() -> ! {
     let Some(cp) = cortex_m::Peripherals::take() else {
@@ -70,12 +72,17 @@ fn main() -> ! {
     defmt::info!("fog-app: boot");
 
     // The repository's TEST key (keys/README.md): a product build embeds its own.
-    let mut server = match UploadServer::new(flash, 0, TEST_PUBLIC_KEY) {
+    // The long-lived state lives in statics (counted in the static-RAM budget by the
+    // linker), not in main's stack frame.
+    let server = match UploadServer::new(flash, 0, TEST_PUBLIC_KEY) {
         Ok(s) => s,
         Err(e) => {
             defmt::error!("model store unusable: {}", e);
             semihosting::process::abort()
         }
+    };
+    let Some(server) = cortex_m::singleton!(: UploadServer<flash::ModelFlash> = server) else {
+        semihosting::process::abort()
     };
     let model = server.load_active_model().unwrap_or_else(|e| {
         defmt::warn!("stored model not loaded ({}): running uncompensated", e);
@@ -84,12 +91,15 @@ fn main() -> ! {
     defmt::info!("model active: {}", model.is_some());
 
     let table = SerialTurntable::new(table_uart, millis::MillisClock, TurntableConfig::default());
-    let mut app = match App::new(AppConfig::for_rate(GYRO_RATE_HZ as f32), model, table) {
+    let app = match App::new(AppConfig::for_rate(GYRO_RATE_HZ as f32), model, table) {
         Ok(a) => a,
         Err(e) => {
             defmt::error!("configuration rejected: {}", e);
             semihosting::process::abort()
         }
+    };
+    let Some(app) = cortex_m::singleton!(: App<Table> = app) else {
+        semihosting::process::abort()
     };
     let mut gyro = FogSerialGyro::new(gyro_uart, GYRO_RATE_HZ);
     let mut last_t_s = 0.0;

@@ -1,7 +1,7 @@
 //! `fogsim diagnose RUNS... [--json FILE] [--plots DIR]`: what the simulation and the
 //! paper's model get wrong on a measured campaign, the cause, the extension and its gain.
 
-use crate::diagnose::{diagnose, plots, report};
+use crate::diagnose::{diagnose, olscheck, plots, report};
 use anyhow::Context;
 use std::path::PathBuf;
 
@@ -24,13 +24,40 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let runs = crate::runs::read_runs(&args.runs)?;
     let d = diagnose(&runs).context("diagnose")?;
     print!("{}", report::render_text(&d.report));
+    let check = if runs.len() >= 4 {
+        match olscheck::ols_check(&runs, d.report.named_cause.as_ref()) {
+            Ok(c) => {
+                println!(
+                    "  cross-check, project's OLS trainer ({} folds, fog-core features): paper's model held-out std {:.4} deg/h{}",
+                    c.folds,
+                    c.baseline.heldout_std_dph,
+                    c.extended.as_ref().map_or_else(
+                        || c.note.clone().map_or_else(String::new, |n| format!("; {n}")),
+                        |e| format!(", extended {:.4} deg/h", e.heldout_std_dph)
+                    )
+                );
+                Some(c)
+            }
+            Err(e) => {
+                println!("  cross-check with the project's OLS trainer not run: {e:#}");
+                None
+            }
+        }
+    } else {
+        None
+    };
     if let Some(path) = &args.json {
-        let text = serde_json::to_string_pretty(&d.report)?;
-        write_atomic(path, text.as_bytes()).with_context(|| format!("writing {}", path.display()))?;
+        let mut value = serde_json::to_value(&d.report)?;
+        value["ols_trainer_check"] = serde_json::to_value(&check)?;
+        let text = serde_json::to_string_pretty(&value)?;
+        write_atomic(path, text.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
         println!("JSON written to {}", path.display());
     }
     if let Some(dir) = &args.plots {
-        for p in plots::write_plots(dir, &d).with_context(|| format!("plots in {}", dir.display()))? {
+        for p in
+            plots::write_plots(dir, &d).with_context(|| format!("plots in {}", dir.display()))?
+        {
             println!("plot: {}", p.display());
         }
     }

@@ -26,7 +26,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         "all" => vec![0, 1, 2],
         other => anyhow::bail!("--axis {other}: expected x, y, z or all"),
     };
-    let file = if args.input.is_dir() { args.input.join("TVCtest3_7_20.csv") } else { args.input.clone() };
+    let file = if args.input.is_dir() {
+        args.input.join("TVCtest3_7_20.csv")
+    } else {
+        args.input.clone()
+    };
     let imp = import_pan(&file, &axes)?;
     std::fs::create_dir_all(&args.out)?;
     for run in &imp.runs {

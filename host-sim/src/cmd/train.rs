@@ -5,7 +5,9 @@
 
 use crate::report::write_atomic;
 use crate::runs::read_runs;
-use crate::train::{dataset_from_runs, default_specs, train_model, Method, TrainConfig, TrainOutcome};
+use crate::train::{
+    dataset_from_runs, default_specs, train_model, Method, TrainConfig, TrainOutcome,
+};
 use anyhow::Context;
 use fog_core::model::MAX_ENCODED_LEN;
 use std::path::PathBuf;
@@ -83,7 +85,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Some(_) => Some(serde_json::to_vec_pretty(&outcome.report)?),
         None => None,
     };
-    write_atomic(&args.out, &buf[..len]).with_context(|| format!("writing {}", args.out.display()))?;
+    write_atomic(&args.out, &buf[..len])
+        .with_context(|| format!("writing {}", args.out.display()))?;
     if let (Some(path), Some(bytes)) = (&args.json, json) {
         write_atomic(path, &bytes).with_context(|| format!("writing {}", path.display()))?;
     }

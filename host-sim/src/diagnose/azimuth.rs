@@ -25,19 +25,32 @@ pub struct AzimuthEffect {
 }
 
 /// Azimuth effect of `residual` (stacked; `t_s` likewise).
-pub fn azimuth_effect(folds: &Folds, t_s: &[f64], residual: &[f64], latitude_deg: f64) -> AzimuthEffect {
+pub fn azimuth_effect(
+    folds: &Folds,
+    t_s: &[f64],
+    residual: &[f64],
+    latitude_deg: f64,
+) -> AzimuthEffect {
     let mut db = Vec::new();
     for r in &folds.run_rows {
         let t = &t_s[r.clone()];
         let e = &residual[r.clone()];
         let t0 = t.first().copied().unwrap_or(0.0);
         let mean_in = |a: f64, b: f64| {
-            let v: Vec<f64> = t.iter().zip(e).filter(|(x, _)| **x >= a && **x < b).map(|(_, y)| *y).collect();
+            let v: Vec<f64> = t
+                .iter()
+                .zip(e)
+                .filter(|(x, _)| **x >= a && **x < b)
+                .map(|(_, y)| *y)
+                .collect();
             (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
         };
         let mut start = t0;
         while start + 2.0 * DWELL_S <= t.last().copied().unwrap_or(0.0) + 1e-9 {
-            if let (Some(a), Some(b)) = (mean_in(start, start + DWELL_S), mean_in(start + DWELL_S, start + 2.0 * DWELL_S)) {
+            if let (Some(a), Some(b)) = (
+                mean_in(start, start + DWELL_S),
+                mean_in(start + DWELL_S, start + 2.0 * DWELL_S),
+            ) {
                 db.push(b - a);
             }
             start += 2.0 * DWELL_S;

@@ -26,10 +26,21 @@ impl RbfBasis {
             mean[j] = m;
             scale[j] = if v.sqrt() > 1e-300 { v.sqrt() } else { 1.0 };
         }
-        let pts: Vec<Vec<f64>> = (0..n).map(|i| (0..d).map(|j| (inputs[j][i] - mean[j]) / scale[j]).collect()).collect();
+        let pts: Vec<Vec<f64>> = (0..n)
+            .map(|i| {
+                (0..d)
+                    .map(|j| (inputs[j][i] - mean[j]) / scale[j])
+                    .collect()
+            })
+            .collect();
         let centres = kmeans(&pts, k.min(n).max(1));
         let spacing = mean_nearest_distance(&centres).max(1e-3);
-        Self { mean, scale, centres, width: width_factor * spacing }
+        Self {
+            mean,
+            scale,
+            centres,
+            width: width_factor * spacing,
+        }
     }
 
     /// The design columns: one Gaussian per centre, then the normalised inputs.
@@ -40,8 +51,8 @@ impl RbfBasis {
         let mut cols: Vec<Vec<f64>> = vec![Vec::with_capacity(n); self.centres.len() + d];
         let mut x = vec![0.0; d];
         for i in 0..n {
-            for j in 0..d {
-                x[j] = (inputs[j][i] - self.mean[j]) / self.scale[j];
+            for (j, xj) in x.iter_mut().enumerate() {
+                *xj = (inputs[j][i] - self.mean[j]) / self.scale[j];
             }
             for (c, col) in self.centres.iter().zip(cols.iter_mut()) {
                 let r2: f64 = c.iter().zip(&x).map(|(a, b)| (a - b) * (a - b)).sum();
@@ -67,7 +78,12 @@ fn mean_nearest_distance(c: &[Vec<f64>]) -> f64 {
         .iter()
         .enumerate()
         .map(|(i, a)| {
-            c.iter().enumerate().filter(|(j, _)| *j != i).map(|(_, b)| dist2(a, b)).fold(f64::INFINITY, f64::min).sqrt()
+            c.iter()
+                .enumerate()
+                .filter(|(j, _)| *j != i)
+                .map(|(_, b)| dist2(a, b))
+                .fold(f64::INFINITY, f64::min)
+                .sqrt()
         })
         .sum();
     total / c.len() as f64
@@ -82,7 +98,11 @@ fn kmeans(pts: &[Vec<f64>], k: usize) -> Vec<Vec<f64>> {
     let mut centres = vec![pts[0].clone()];
     let mut near: Vec<f64> = pts.iter().map(|p| dist2(p, &pts[0])).collect();
     while centres.len() < k {
-        let (far, &dmax) = near.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1)).unwrap_or((0, &0.0));
+        let (far, &dmax) = near
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(b.1))
+            .unwrap_or((0, &0.0));
         if dmax <= 1e-18 {
             break;
         }
@@ -95,7 +115,9 @@ fn kmeans(pts: &[Vec<f64>], k: usize) -> Vec<Vec<f64>> {
     for _ in 0..12 {
         let mut changed = false;
         for (i, p) in pts.iter().enumerate() {
-            let best = (0..centres.len()).min_by(|&a, &b| dist2(p, &centres[a]).total_cmp(&dist2(p, &centres[b]))).unwrap_or(0);
+            let best = (0..centres.len())
+                .min_by(|&a, &b| dist2(p, &centres[a]).total_cmp(&dist2(p, &centres[b])))
+                .unwrap_or(0);
             changed |= best != assign[i];
             assign[i] = best;
         }

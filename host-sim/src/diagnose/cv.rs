@@ -46,9 +46,17 @@ impl Folds {
         }
         if run_lengths.len() >= MIN_RUNS_GROUPED {
             if run_lengths.iter().any(|&n| n < 3) {
-                return Err(DiagnoseError::TooFewRuns { runs: run_lengths.len(), points, why: "a run has fewer than 3 points" });
+                return Err(DiagnoseError::TooFewRuns {
+                    runs: run_lengths.len(),
+                    points,
+                    why: "a run has fewer than 3 points",
+                });
             }
-            return Ok(Self { unit_rows: run_rows.clone(), run_rows, offsets: Offsets::PerUnit });
+            return Ok(Self {
+                unit_rows: run_rows.clone(),
+                run_rows,
+                offsets: Offsets::PerUnit,
+            });
         }
         if run_lengths.iter().any(|&n| n < MIN_POINTS_PER_BLOCK_RUN) {
             return Err(DiagnoseError::TooFewRuns {
@@ -61,10 +69,15 @@ impl Folds {
         for r in &run_rows {
             let n = r.len();
             for b in 0..BLOCKS_PER_RUN {
-                unit_rows.push(r.start + b * n / BLOCKS_PER_RUN..r.start + (b + 1) * n / BLOCKS_PER_RUN);
+                unit_rows
+                    .push(r.start + b * n / BLOCKS_PER_RUN..r.start + (b + 1) * n / BLOCKS_PER_RUN);
             }
         }
-        Ok(Self { unit_rows, run_rows, offsets: Offsets::RunDummies })
+        Ok(Self {
+            unit_rows,
+            run_rows,
+            offsets: Offsets::RunDummies,
+        })
     }
 
     /// Total number of rows.
@@ -152,9 +165,19 @@ impl Prepared {
                 }
             }
             grams.push(g);
-            xty.push((0..p).map(|i| dot(&adj[i][r.clone()], &y[r.clone()])).collect());
+            xty.push(
+                (0..p)
+                    .map(|i| dot(&adj[i][r.clone()], &y[r.clone()]))
+                    .collect(),
+            );
         }
-        Self { cols: adj, y, grams, xty, ridge }
+        Self {
+            cols: adj,
+            y,
+            grams,
+            xty,
+            ridge,
+        }
     }
 
     /// Changes the relative ridge (the Gram matrices do not depend on it).
@@ -173,7 +196,11 @@ impl Prepared {
     }
 
     /// Held-out validation of this design plus `extra` columns (raw, full length).
-    pub fn validate_with(&self, folds: &Folds, extra: &[Vec<f64>]) -> Result<CvResult, DiagnoseError> {
+    pub fn validate_with(
+        &self,
+        folds: &Folds,
+        extra: &[Vec<f64>],
+    ) -> Result<CvResult, DiagnoseError> {
         let (grams, xty, cols) = self.augmented(folds, extra);
         let q = cols.len();
         let total_g = sum_all(&grams);
@@ -185,7 +212,9 @@ impl Prepared {
             let mut a: Vec<f64> = total_g.iter().zip(&grams[u]).map(|(t, g)| t - g).collect();
             let mut b: Vec<f64> = total_c.iter().zip(&xty[u]).map(|(t, g)| t - g).collect();
             self.regularise(&mut a, &diag_scale, q);
-            solve_spd(&mut a, &mut b, q).map_err(|_| DiagnoseError::Singular { what: "held-out fit" })?;
+            solve_spd(&mut a, &mut b, q).map_err(|_| DiagnoseError::Singular {
+                what: "held-out fit",
+            })?;
             let mut sse = 0.0;
             for row in r.clone() {
                 let pred: f64 = cols.iter().zip(&b).map(|(c, w)| c[row] * w).sum();
@@ -199,7 +228,11 @@ impl Prepared {
     }
 
     /// Fit on every unit: (weights, fitted values) for this design plus `extra`.
-    pub fn fit_all(&self, folds: &Folds, extra: &[Vec<f64>]) -> Result<(Vec<f64>, Vec<f64>), DiagnoseError> {
+    pub fn fit_all(
+        &self,
+        folds: &Folds,
+        extra: &[Vec<f64>],
+    ) -> Result<(Vec<f64>, Vec<f64>), DiagnoseError> {
         let (grams, xty, cols) = self.augmented(folds, extra);
         let q = cols.len();
         let mut a = sum_all(&grams);
@@ -207,7 +240,9 @@ impl Prepared {
         let diag_scale: Vec<f64> = (0..q).map(|i| a[i * q + i]).collect();
         self.regularise(&mut a, &diag_scale, q);
         solve_spd(&mut a, &mut b, q).map_err(|_| DiagnoseError::Singular { what: "full fit" })?;
-        let fitted = (0..folds.rows()).map(|row| cols.iter().zip(&b).map(|(c, w)| c[row] * w).sum()).collect();
+        let fitted = (0..folds.rows())
+            .map(|row| cols.iter().zip(&b).map(|(c, w)| c[row] * w).sum())
+            .collect();
         Ok((b, fitted))
     }
 
@@ -224,12 +259,16 @@ impl Prepared {
     }
 
     /// Per-unit Grams of the design augmented by `extra` columns (cross terms only).
-    fn augmented<'a>(&'a self, folds: &Folds, extra: &[Vec<f64>]) -> (Vec<Vec<f64>>, Vec<Vec<f64>>, Vec<std::borrow::Cow<'a, [f64]>>) {
+    fn augmented<'a>(&'a self, folds: &Folds, extra: &[Vec<f64>]) -> Augmented<'a> {
         let p = self.cols.len();
         let m = extra.len();
         let q = p + m;
         let ex: Vec<Vec<f64>> = extra.iter().map(|c| adjust(folds, c)).collect();
-        let mut cols: Vec<std::borrow::Cow<'a, [f64]>> = self.cols.iter().map(|c| std::borrow::Cow::Borrowed(c.as_slice())).collect();
+        let mut cols: Vec<std::borrow::Cow<'a, [f64]>> = self
+            .cols
+            .iter()
+            .map(|c| std::borrow::Cow::Borrowed(c.as_slice()))
+            .collect();
         let mut grams = Vec::with_capacity(folds.unit_rows.len());
         let mut xty = Vec::with_capacity(folds.unit_rows.len());
         for (u, r) in folds.unit_rows.iter().enumerate() {
@@ -265,6 +304,13 @@ impl Prepared {
     }
 }
 
+/// Per-unit Grams, per-unit X'y and the (borrowed or new) design columns.
+type Augmented<'a> = (
+    Vec<Vec<f64>>,
+    Vec<Vec<f64>>,
+    Vec<std::borrow::Cow<'a, [f64]>>,
+);
+
 fn sum_all(v: &[Vec<f64>]) -> Vec<f64> {
     let mut out = vec![0.0; v.first().map_or(0, Vec::len)];
     for x in v {
@@ -283,7 +329,9 @@ mod tests {
         let folds = Folds::new(&lens).unwrap();
         let n = folds.rows();
         let x: Vec<f64> = (0..n).map(|i| ((i * 7919) % 101) as f64 / 10.0).collect();
-        let y: Vec<f64> = (0..n).map(|i| 2.0 * x[i] + (i / 50) as f64 * 100.0).collect();
+        let y: Vec<f64> = (0..n)
+            .map(|i| 2.0 * x[i] + (i / 50) as f64 * 100.0)
+            .collect();
         let p = Prepared::new(&folds, &[x], &y, 1e-9);
         let cv = p.validate(&folds).unwrap();
         assert!(cv.rms() < 1e-6, "rms {}", cv.rms());

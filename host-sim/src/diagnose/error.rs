@@ -8,13 +8,26 @@ pub enum DiagnoseError {
     /// No runs were given.
     NoRuns,
     /// Too few runs/points to validate on held-out data.
-    TooFewRuns { runs: usize, points: usize, why: &'static str },
+    TooFewRuns {
+        runs: usize,
+        points: usize,
+        why: &'static str,
+    },
     /// A column's length differs from the run's `t_s` length.
-    MismatchedLength { run: String, column: String, expected: usize, found: usize },
+    MismatchedLength {
+        run: String,
+        column: String,
+        expected: usize,
+        found: usize,
+    },
     /// A required column is missing.
     MissingColumn { run: String, column: String },
     /// A required column holds NaN or infinity.
-    NotFinite { run: String, column: String, row: usize },
+    NotFinite {
+        run: String,
+        column: String,
+        row: usize,
+    },
     /// `t_s` is not strictly increasing.
     TimeNotIncreasing { run: String, row: usize },
     /// A required signal is constant over the whole campaign (nothing to learn from).

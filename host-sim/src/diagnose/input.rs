@@ -63,16 +63,28 @@ pub fn prepare(runs: &[Run]) -> Result<Campaign, DiagnoseError> {
     }
     let (extra_names, exclusions) = usable_extras(runs);
     let series = runs.iter().map(|r| to_series(r, &extra_names)).collect();
-    let campaign = Campaign { runs: series, extra_names, exclusions };
+    let campaign = Campaign {
+        runs: series,
+        extra_names,
+        exclusions,
+    };
     for (name, pick) in [("temp_c", 0usize), ("rate_dph", 1)] {
         let all: Vec<f64> = campaign
             .runs
             .iter()
-            .flat_map(|s| if pick == 0 { s.temp_c.iter() } else { s.drift_dph.iter() })
+            .flat_map(|s| {
+                if pick == 0 {
+                    s.temp_c.iter()
+                } else {
+                    s.drift_dph.iter()
+                }
+            })
             .copied()
             .collect();
         if is_constant(&all) {
-            return Err(DiagnoseError::ConstantRequired { column: name.to_owned() });
+            return Err(DiagnoseError::ConstantRequired {
+                column: name.to_owned(),
+            });
         }
     }
     Ok(campaign)
@@ -82,10 +94,16 @@ fn check_run(run: &Run) -> Result<(), DiagnoseError> {
     let name = run.name();
     let t = run
         .column("t_s")
-        .ok_or_else(|| DiagnoseError::MissingColumn { run: name.clone(), column: "t_s".into() })?;
+        .ok_or_else(|| DiagnoseError::MissingColumn {
+            run: name.clone(),
+            column: "t_s".into(),
+        })?;
     for req in ["rate_dph", "temp_c"] {
         if run.column(req).is_none() {
-            return Err(DiagnoseError::MissingColumn { run: name.clone(), column: req.into() });
+            return Err(DiagnoseError::MissingColumn {
+                run: name.clone(),
+                column: req.into(),
+            });
         }
     }
     if run.columns.len() != run.data.len() {
@@ -108,19 +126,31 @@ fn check_run(run: &Run) -> Result<(), DiagnoseError> {
         let required = ["t_s", "rate_dph", "temp_c", "earth_dph"].contains(&col.as_str());
         if required {
             if let Some(row) = values.iter().position(|v| !v.is_finite()) {
-                return Err(DiagnoseError::NotFinite { run: name.clone(), column: col.clone(), row });
+                return Err(DiagnoseError::NotFinite {
+                    run: name.clone(),
+                    column: col.clone(),
+                    row,
+                });
             }
         }
     }
     if let Some(row) = t.windows(2).position(|w| w[1] <= w[0]) {
-        return Err(DiagnoseError::TimeNotIncreasing { run: name, row: row + 1 });
+        return Err(DiagnoseError::TimeNotIncreasing {
+            run: name,
+            row: row + 1,
+        });
     }
     Ok(())
 }
 
 fn is_constant(v: &[f64]) -> bool {
-    let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| (lo.min(x), hi.max(x)));
-    !(hi - lo > 1e-12 * (1.0 + hi.abs().max(lo.abs())))
+    let (lo, hi) = v
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
+            (lo.min(x), hi.max(x))
+        });
+    let tol = 1e-12 * (1.0 + hi.abs().max(lo.abs()));
+    (hi - lo).partial_cmp(&tol) != Some(std::cmp::Ordering::Greater)
 }
 
 /// Extra columns usable in every run, plus the stated exclusions.
@@ -136,21 +166,41 @@ fn usable_extras(runs: &[Run]) -> (Vec<String>, Vec<Exclusion>) {
     let mut keep = Vec::new();
     let mut excl = Vec::new();
     for n in names {
-        let missing: Vec<String> = runs.iter().filter(|r| r.column(&n).is_none()).map(Run::name).collect();
+        let missing: Vec<String> = runs
+            .iter()
+            .filter(|r| r.column(&n).is_none())
+            .map(Run::name)
+            .collect();
         if !missing.is_empty() {
-            excl.push(Exclusion { column: n, reason: format!("missing in run(s) {}", missing.join(", ")) });
+            excl.push(Exclusion {
+                column: n,
+                reason: format!("missing in run(s) {}", missing.join(", ")),
+            });
             continue;
         }
         let bad = runs.iter().find_map(|r| {
-            r.column(&n).unwrap_or(&[]).iter().position(|v| !v.is_finite()).map(|row| (r.name(), row))
+            r.column(&n)
+                .unwrap_or(&[])
+                .iter()
+                .position(|v| !v.is_finite())
+                .map(|row| (r.name(), row))
         });
         if let Some((run, row)) = bad {
-            excl.push(Exclusion { column: n, reason: format!("NaN or infinite value (run {run}, row {row})") });
+            excl.push(Exclusion {
+                column: n,
+                reason: format!("NaN or infinite value (run {run}, row {row})"),
+            });
             continue;
         }
-        let all: Vec<f64> = runs.iter().flat_map(|r| r.column(&n).unwrap_or(&[]).iter().copied()).collect();
+        let all: Vec<f64> = runs
+            .iter()
+            .flat_map(|r| r.column(&n).unwrap_or(&[]).iter().copied())
+            .collect();
         if is_constant(&all) {
-            excl.push(Exclusion { column: n, reason: "constant over the whole campaign".into() });
+            excl.push(Exclusion {
+                column: n,
+                reason: "constant over the whole campaign".into(),
+            });
             continue;
         }
         keep.push(n);
@@ -162,10 +212,15 @@ fn to_series(run: &Run, extra_names: &[String]) -> Series {
     let t = run.t_s();
     let drift = run.drift_dph();
     let temp = run.temp_c();
-    let extras: Vec<&[f64]> = extra_names.iter().map(|n| run.column(n).unwrap_or(&[])).collect();
+    let extras: Vec<&[f64]> = extra_names
+        .iter()
+        .map(|n| run.column(n).unwrap_or(&[]))
+        .collect();
     let bins = window_bins(t);
     let mean_of = |v: &[f64]| -> Vec<f64> {
-        bins.iter().map(|b| v[b.0..b.1].iter().sum::<f64>() / (b.1 - b.0) as f64).collect()
+        bins.iter()
+            .map(|b| v[b.0..b.1].iter().sum::<f64>() / (b.1 - b.0) as f64)
+            .collect()
     };
     Series {
         name: run.name(),
@@ -215,7 +270,14 @@ mod tests {
     #[test]
     fn raw_samples_become_10s_means() {
         let t: Vec<f64> = (0..100).map(|i| 0.5 + i as f64).collect();
-        let r = run("a", vec![("t_s", t.clone()), ("rate_dph", t.clone()), ("temp_c", t.iter().map(|x| x * 0.1).collect())]);
+        let r = run(
+            "a",
+            vec![
+                ("t_s", t.clone()),
+                ("rate_dph", t.clone()),
+                ("temp_c", t.iter().map(|x| x * 0.1).collect()),
+            ],
+        );
         let c = prepare(&[r]).unwrap();
         assert_eq!(c.runs[0].t_s.len(), 10);
         assert!((c.runs[0].drift_dph[0] - 5.0).abs() < 1e-12);
@@ -224,13 +286,39 @@ mod tests {
     #[test]
     fn bad_input_is_named() {
         let t = vec![10.0, 20.0, 30.0];
-        let short = run("s", vec![("t_s", t.clone()), ("rate_dph", vec![1.0, 2.0]), ("temp_c", t.clone())]);
-        assert!(matches!(prepare(&[short]), Err(DiagnoseError::MismatchedLength { .. })));
-        let nan = run("n", vec![("t_s", t.clone()), ("rate_dph", vec![1.0, f64::NAN, 2.0]), ("temp_c", t.clone())]);
-        assert!(matches!(prepare(&[nan]), Err(DiagnoseError::NotFinite { row: 1, .. })));
+        let short = run(
+            "s",
+            vec![
+                ("t_s", t.clone()),
+                ("rate_dph", vec![1.0, 2.0]),
+                ("temp_c", t.clone()),
+            ],
+        );
+        assert!(matches!(
+            prepare(&[short]),
+            Err(DiagnoseError::MismatchedLength { .. })
+        ));
+        let nan = run(
+            "n",
+            vec![
+                ("t_s", t.clone()),
+                ("rate_dph", vec![1.0, f64::NAN, 2.0]),
+                ("temp_c", t.clone()),
+            ],
+        );
+        assert!(matches!(
+            prepare(&[nan]),
+            Err(DiagnoseError::NotFinite { row: 1, .. })
+        ));
         let extra = run(
             "e",
-            vec![("t_s", t.clone()), ("rate_dph", vec![1.0, 3.0, 2.0]), ("temp_c", t.clone()), ("k", vec![1.0; 3]), ("q", vec![0.0, f64::NAN, 1.0])],
+            vec![
+                ("t_s", t.clone()),
+                ("rate_dph", vec![1.0, 3.0, 2.0]),
+                ("temp_c", t.clone()),
+                ("k", vec![1.0; 3]),
+                ("q", vec![0.0, f64::NAN, 1.0]),
+            ],
         );
         let c = prepare(&[extra]).unwrap();
         assert!(c.extra_names.is_empty());

@@ -1,15 +1,19 @@
 //! Small dense linear algebra for the least-squares fits (Cholesky on normal equations).
 
+/// The matrix was not (numerically) positive definite.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct NotPositiveDefinite;
+
 /// Solves `a x = b` in place for a symmetric positive-definite `n x n` row-major `a`
 /// (`b` becomes `x`). Err when a pivot is not positive (singular or indefinite).
-pub fn solve_spd(a: &mut [f64], b: &mut [f64], n: usize) -> Result<(), ()> {
+pub fn solve_spd(a: &mut [f64], b: &mut [f64], n: usize) -> Result<(), NotPositiveDefinite> {
     for j in 0..n {
         let mut d = a[j * n + j];
         for k in 0..j {
             d -= a[j * n + k] * a[j * n + k];
         }
-        if !(d > 0.0) || !d.is_finite() {
-            return Err(());
+        if d.is_nan() || d <= 0.0 || !d.is_finite() {
+            return Err(NotPositiveDefinite);
         }
         let d = d.sqrt();
         a[j * n + j] = d;

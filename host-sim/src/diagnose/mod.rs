@@ -15,6 +15,7 @@ pub mod error;
 pub mod input;
 pub mod linalg;
 pub mod models;
+pub mod olscheck;
 pub mod plots;
 pub mod report;
 pub mod residuals;
@@ -30,7 +31,10 @@ use crate::runs::Run;
 use cv::Folds;
 use input::Exclusion;
 use models::Stacked;
-use report::{Azimuth, CampaignSummary, CandidateRow, Competitor, DriftStd, Extended, ModelSummary, Simulation};
+use report::{
+    Azimuth, CampaignSummary, CandidateRow, Competitor, DriftStd, Extended, ModelSummary,
+    Simulation,
+};
 
 /// Everything the diagnosis computed: the report plus the series the plots need.
 #[derive(Clone, Debug)]
@@ -64,34 +68,66 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
     let base = models::fit_baseline(&folds, &st)?;
     let base_rms = base.cv.rms();
     let structure = residuals::structure(&campaign, &folds, &st, &base.cv.residual);
-    let screening = screen::screen(&campaign, &folds, &st, &base, transforms::enumerate(&campaign))?;
+    let screening = screen::screen(
+        &campaign,
+        &folds,
+        &st,
+        &base,
+        transforms::enumerate(&campaign),
+    )?;
 
     let named = screening.named.map(|i| &screening.scored[i]);
-    let cause = named.map(|s| Cause { column: s.cand.column.clone(), transform: s.cand.transform, tau_s: s.cand.tau_s });
-    let sim = simfit::calibrate(&campaign, &folds.run_rows, &st.y, named.map(|s| s.cols.as_slice()))?;
+    let cause = named.map(|s| Cause {
+        column: s.cand.column.clone(),
+        transform: s.cand.transform,
+        tau_s: s.cand.tau_s,
+    });
+    let sim = simfit::calibrate(
+        &campaign,
+        &folds.run_rows,
+        &st.y,
+        named.map(|s| s.cols.as_slice()),
+    )?;
     let base_inputs = vec!["temp_c:value".to_owned(), "temp_c:rate".to_owned()];
     let (extended, ext_resid) = match named {
         Some(s) => {
             let mut inputs = base_inputs.clone();
             inputs.push(cause.as_ref().map(Cause::label).unwrap_or_default());
             (
-                Extended { inputs, mode: Some(s.mode), heldout_rms_dph: s.heldout_rms_dph, gain_pct: s.gain_pct },
+                Extended {
+                    inputs,
+                    mode: Some(s.mode),
+                    heldout_rms_dph: s.heldout_rms_dph,
+                    gain_pct: s.gain_pct,
+                },
                 s.cv.residual.clone(),
             )
         }
         None => (
-            Extended { inputs: base_inputs.clone(), mode: None, heldout_rms_dph: base_rms, gain_pct: 0.0 },
+            Extended {
+                inputs: base_inputs.clone(),
+                mode: None,
+                heldout_rms_dph: base_rms,
+                gain_pct: 0.0,
+            },
             base.cv.residual.clone(),
         ),
     };
     let has_heading = campaign.extra_names.iter().any(|n| n.contains("heading"));
-    let latitude = campaign.runs.iter().find_map(|s| s.latitude_deg).unwrap_or(azimuth::DEFAULT_LATITUDE_DEG);
+    let latitude = campaign
+        .runs
+        .iter()
+        .find_map(|s| s.latitude_deg)
+        .unwrap_or(azimuth::DEFAULT_LATITUDE_DEG);
     let azimuth = has_heading.then(|| Azimuth {
         baseline: azimuth::azimuth_effect(&folds, &st.t_s, &base.cv.residual, latitude),
         extended: azimuth::azimuth_effect(&folds, &st.t_s, &ext_resid, latitude),
     });
     let words = report::cause_in_words(cause.as_ref(), &sim.effect_coef);
-    let to_excl = |(c, r): &(String, String)| Exclusion { column: c.clone(), reason: r.clone() };
+    let to_excl = |(c, r): &(String, String)| Exclusion {
+        column: c.clone(),
+        reason: r.clone(),
+    };
     let report = Report {
         campaign: CampaignSummary {
             runs: campaign.runs.len(),
@@ -129,7 +165,10 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
         competing: screening
             .competing
             .iter()
-            .map(|(c, g)| Competitor { candidate: c.clone(), conditional_gain_pct: *g })
+            .map(|(c, g)| Competitor {
+                candidate: c.clone(),
+                conditional_gain_pct: *g,
+            })
             .collect(),
         parsimony_note: screening.parsimony_note.clone(),
         drift_std: DriftStd {

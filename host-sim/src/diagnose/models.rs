@@ -29,7 +29,9 @@ pub struct Stacked {
 impl Stacked {
     /// Stacks drift, time, temperature and dT/dt (centred least-squares slope).
     pub fn new(c: &Campaign) -> Self {
-        let cat = |f: &dyn Fn(&super::input::Series) -> Vec<f64>| c.runs.iter().flat_map(f).collect::<Vec<f64>>();
+        let cat = |f: &dyn Fn(&super::input::Series) -> Vec<f64>| {
+            c.runs.iter().flat_map(f).collect::<Vec<f64>>()
+        };
         Self {
             y: cat(&|s| s.drift_dph.clone()),
             t_s: cat(&|s| s.t_s.clone()),
@@ -57,7 +59,12 @@ pub fn centre_count(n: usize, inputs: usize) -> usize {
 }
 
 /// Fits an RBF on `inputs` (plus `linear` columns) choosing width and ridge on held-out data.
-pub fn fit_rbf(folds: &Folds, inputs: &[Vec<f64>], linear: &[Vec<f64>], y: &[f64]) -> Result<RbfFit, DiagnoseError> {
+pub fn fit_rbf(
+    folds: &Folds,
+    inputs: &[Vec<f64>],
+    linear: &[Vec<f64>],
+    y: &[f64],
+) -> Result<RbfFit, DiagnoseError> {
     let k_max = centre_count(y.len(), inputs.len());
     let mut best: Option<RbfFit> = None;
     for frac in CENTRE_FRACTIONS {
@@ -69,9 +76,18 @@ pub fn fit_rbf(folds: &Folds, inputs: &[Vec<f64>], linear: &[Vec<f64>], y: &[f64
             let mut prepared = Prepared::new(folds, &cols, y, RIDGES[0]);
             for ridge in RIDGES {
                 prepared.set_ridge(ridge);
-                let Ok(cv) = prepared.validate(folds) else { continue };
+                let Ok(cv) = prepared.validate(folds) else {
+                    continue;
+                };
                 if best.as_ref().is_none_or(|b| cv.rms() < b.cv.rms()) {
-                    best = Some(RbfFit { basis: basis.clone(), prepared: prepared.clone(), cv, centres: k, width_factor: wf, ridge });
+                    best = Some(RbfFit {
+                        basis: basis.clone(),
+                        prepared: prepared.clone(),
+                        cv,
+                        centres: k,
+                        width_factor: wf,
+                        ridge,
+                    });
                 }
             }
         }
@@ -81,11 +97,20 @@ pub fn fit_rbf(folds: &Folds, inputs: &[Vec<f64>], linear: &[Vec<f64>], y: &[f64
 
 /// The paper's model: RBF on (T, dT/dt).
 pub fn fit_baseline(folds: &Folds, st: &Stacked) -> Result<RbfFit, DiagnoseError> {
-    fit_rbf(folds, &[st.temp_c.clone(), st.temp_rate_cps.clone()], &[], &st.y)
+    fit_rbf(
+        folds,
+        &[st.temp_c.clone(), st.temp_rate_cps.clone()],
+        &[],
+        &st.y,
+    )
 }
 
 /// The candidate as a further RBF input (its columns also kept as linear terms).
-pub fn fit_rbf_input(folds: &Folds, st: &Stacked, cand: &[Vec<f64>]) -> Result<RbfFit, DiagnoseError> {
+pub fn fit_rbf_input(
+    folds: &Folds,
+    st: &Stacked,
+    cand: &[Vec<f64>],
+) -> Result<RbfFit, DiagnoseError> {
     let mut inputs = vec![st.temp_c.clone(), st.temp_rate_cps.clone()];
     inputs.extend(cand.iter().cloned());
     fit_rbf(folds, &inputs, &[], &st.y)

@@ -15,7 +15,13 @@ fn range(v: &[f64]) -> (f64, f64) {
     }
 }
 
-fn scatter(path: &Path, title: &str, xlabel: &str, x: &[f64], series: &[(&str, &[f64], RGBColor)]) -> anyhow::Result<()> {
+fn scatter(
+    path: &Path,
+    title: &str,
+    xlabel: &str,
+    x: &[f64],
+    series: &[(&str, &[f64], RGBColor)],
+) -> anyhow::Result<()> {
     let root = SVGBackend::new(path, (900, 500)).into_drawing_area();
     root.fill(&WHITE)?;
     let (x0, x1) = range(x);
@@ -27,15 +33,27 @@ fn scatter(path: &Path, title: &str, xlabel: &str, x: &[f64], series: &[(&str, &
         .x_label_area_size(40)
         .y_label_area_size(60)
         .build_cartesian_2d(x0..x1, y0..y1)?;
-    chart.configure_mesh().x_desc(xlabel).y_desc("residual, deg/h").draw()?;
+    chart
+        .configure_mesh()
+        .x_desc(xlabel)
+        .y_desc("residual, deg/h")
+        .draw()?;
     for (name, y, color) in series {
         let c = *color;
         chart
-            .draw_series(x.iter().zip(y.iter()).map(|(a, b)| Circle::new((*a, *b), 2, c.mix(0.5).filled())))?
+            .draw_series(
+                x.iter()
+                    .zip(y.iter())
+                    .map(|(a, b)| Circle::new((*a, *b), 2, c.mix(0.5).filled())),
+            )?
             .label(*name)
             .legend(move |(px, py)| Circle::new((px, py), 4, c.filled()));
     }
-    chart.configure_series_labels().border_style(BLACK).background_style(WHITE.mix(0.8)).draw()?;
+    chart
+        .configure_series_labels()
+        .border_style(BLACK)
+        .background_style(WHITE.mix(0.8))
+        .draw()?;
     root.present()?;
     Ok(())
 }
@@ -51,7 +69,10 @@ pub fn write_plots(dir: &Path, d: &Diagnosis) -> anyhow::Result<Vec<PathBuf>> {
         "Held-out residual vs time since power-on",
         "time since power-on, min",
         &t_min,
-        &[("paper's model (T, dT/dt)", &d.baseline_residual, RED), ("extended model", &d.extended_residual, BLUE)],
+        &[
+            ("paper's model (T, dT/dt)", &d.baseline_residual, RED),
+            ("extended model", &d.extended_residual, BLUE),
+        ],
     )?;
     out.push(p);
     if let (Some(f), Some(c)) = (&d.cause_feature, &d.report.named_cause) {
@@ -61,7 +82,11 @@ pub fn write_plots(dir: &Path, d: &Diagnosis) -> anyhow::Result<Vec<PathBuf>> {
             &format!("Paper's model residual vs {}", c.label()),
             &c.label(),
             f,
-            &[("held-out residual of the paper's model", &d.baseline_residual, RED)],
+            &[(
+                "held-out residual of the paper's model",
+                &d.baseline_residual,
+                RED,
+            )],
         )?;
         out.push(p);
     }

@@ -181,7 +181,13 @@ pub fn render_text(r: &Report) -> String {
         let _ = writeln!(s, "  excluded column `{}`: {}", e.column, e.reason);
     }
     if !c.skipped_candidates.is_empty() {
-        let _ = writeln!(s, "  {} candidate(s) skipped (e.g. {}: {})", c.skipped_candidates.len(), c.skipped_candidates[0].column, c.skipped_candidates[0].reason);
+        let _ = writeln!(
+            s,
+            "  {} candidate(s) skipped (e.g. {}: {})",
+            c.skipped_candidates.len(),
+            c.skipped_candidates[0].column,
+            c.skipped_candidates[0].reason
+        );
     }
     let sim = &r.simulation.calibration;
     let _ = writeln!(s, "\n1. Baseline");
@@ -191,7 +197,11 @@ pub fn render_text(r: &Report) -> String {
          Shupe {:.3} deg/h per degC/s, white noise {:.4} deg/h (10 s)",
         sim.tau_fast_s, sim.tau_slow_s, sim.temp_rms_c, sim.bias_dph_per_c, sim.shupe_dph_per_cps, sim.noise_10s_dph
     );
-    let _ = writeln!(s, "  simulation vs measured drift: rms {:.4} deg/h (run offsets removed)", r.simulation.before_rms_dph);
+    let _ = writeln!(
+        s,
+        "  simulation vs measured drift: rms {:.4} deg/h (run offsets removed)",
+        r.simulation.before_rms_dph
+    );
     let _ = writeln!(
         s,
         "  paper's model RBF({}): held-out rms {:.4} deg/h ({} centres); uncompensated drift std {:.4} deg/h",
@@ -202,18 +212,39 @@ pub fn render_text(r: &Report) -> String {
     );
     let _ = writeln!(s, "\n2. What the model gets wrong (held-out residual)");
     for b in &r.residual_structure.by_time {
-        let _ = writeln!(s, "  {:>12}: rms {:.4}  mean {:+.4} deg/h  (n={})", b.label, b.rms_dph, b.mean_dph, b.n);
+        let _ = writeln!(
+            s,
+            "  {:>12}: rms {:.4}  mean {:+.4} deg/h  (n={})",
+            b.label, b.rms_dph, b.mean_dph, b.n
+        );
     }
     for b in &r.residual_structure.by_ambient {
-        let _ = writeln!(s, "  ambient {:>10}: rms {:.4} deg/h (n={})", b.label, b.rms_dph, b.n);
+        let _ = writeln!(
+            s,
+            "  ambient {:>10}: rms {:.4} deg/h (n={})",
+            b.label, b.rms_dph, b.n
+        );
     }
     let mut links = r.residual_structure.by_signal.clone();
     links.sort_by(|a, b| b.correlation.abs().total_cmp(&a.correlation.abs()));
-    let top: Vec<String> = links.iter().take(5).map(|l| format!("{} {:+.2}", l.signal, l.correlation)).collect();
-    let _ = writeln!(s, "  within-run correlation with signals: {}", top.join(", "));
+    let top: Vec<String> = links
+        .iter()
+        .take(5)
+        .map(|l| format!("{} {:+.2}", l.signal, l.correlation))
+        .collect();
+    let _ = writeln!(
+        s,
+        "  within-run correlation with signals: {}",
+        top.join(", ")
+    );
     let _ = writeln!(s, "\n3. Candidate causes (ranked by held-out rms; p = family-wise sign-flip test over whole validation units)");
     for row in r.candidates.iter().take(8) {
-        let label = Cause { column: row.column.clone(), transform: row.transform, tau_s: row.tau_s }.label();
+        let label = Cause {
+            column: row.column.clone(),
+            transform: row.transform,
+            tau_s: row.tau_s,
+        }
+        .label();
         let _ = writeln!(
             s,
             "  {:<28} {:>9} rms {:.4}  gain {:+6.2}%  p {:.4}  units improved {:>3.0}%{}",

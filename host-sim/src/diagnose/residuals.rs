@@ -41,7 +41,12 @@ fn slice(label: String, r: impl Iterator<Item = f64>) -> Slice {
     let n = v.len();
     let mean = v.iter().sum::<f64>() / n.max(1) as f64;
     let rms = (v.iter().map(|x| x * x).sum::<f64>() / n.max(1) as f64).sqrt();
-    Slice { label, n, mean_dph: mean, rms_dph: rms }
+    Slice {
+        label,
+        n,
+        mean_dph: mean,
+        rms_dph: rms,
+    }
 }
 
 fn demeaned_by_run(folds: &Folds, v: &[f64]) -> Vec<f64> {
@@ -70,7 +75,12 @@ pub fn within_run_correlation(folds: &Folds, a: &[f64], b: &[f64]) -> f64 {
 /// Runs grouped by ambient temperature: sorted, a new group wherever the gap to the
 /// previous ambient exceeds `AMBIENT_GAP_C`. Runs without an ambient are left out.
 fn ambient_groups(c: &Campaign) -> Vec<(String, Vec<usize>)> {
-    let mut idx: Vec<(usize, f64)> = c.runs.iter().enumerate().filter_map(|(i, s)| s.ambient_c.map(|a| (i, a))).collect();
+    let mut idx: Vec<(usize, f64)> = c
+        .runs
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| s.ambient_c.map(|a| (i, a)))
+        .collect();
     idx.sort_by(|a, b| a.1.total_cmp(&b.1));
     let mut groups: Vec<Vec<(usize, f64)>> = Vec::new();
     for (i, a) in idx {
@@ -83,7 +93,10 @@ fn ambient_groups(c: &Campaign) -> Vec<(String, Vec<usize>)> {
         .into_iter()
         .map(|g| {
             let mean = g.iter().map(|x| x.1).sum::<f64>() / g.len() as f64;
-            (format!("{mean:.1} degC ({} runs)", g.len()), g.into_iter().map(|x| x.0).collect())
+            (
+                format!("{mean:.1} degC ({} runs)", g.len()),
+                g.into_iter().map(|x| x.0).collect(),
+            )
         })
         .collect()
 }
@@ -94,8 +107,16 @@ pub fn structure(c: &Campaign, folds: &Folds, st: &Stacked, residual: &[f64]) ->
         .windows(2)
         .filter_map(|w| {
             let s = slice(
-                if w[1].is_finite() { format!("{:.0}-{:.0} min", w[0] / 60.0, w[1] / 60.0) } else { format!(">{:.0} min", w[0] / 60.0) },
-                st.t_s.iter().zip(residual).filter(|(t, _)| **t >= w[0] && **t < w[1]).map(|(_, r)| *r),
+                if w[1].is_finite() {
+                    format!("{:.0}-{:.0} min", w[0] / 60.0, w[1] / 60.0)
+                } else {
+                    format!(">{:.0} min", w[0] / 60.0)
+                },
+                st.t_s
+                    .iter()
+                    .zip(residual)
+                    .filter(|(t, _)| **t >= w[0] && **t < w[1])
+                    .map(|(_, r)| *r),
             );
             (s.n > 0).then_some(s)
         })
@@ -108,13 +129,33 @@ pub fn structure(c: &Campaign, folds: &Folds, st: &Stacked, residual: &[f64]) ->
         })
         .collect();
     let mut by_signal = vec![
-        SignalLink { signal: "t_s".into(), correlation: within_run_correlation(folds, &st.t_s, residual) },
-        SignalLink { signal: "temp_c".into(), correlation: within_run_correlation(folds, &st.temp_c, residual) },
-        SignalLink { signal: "temp_c:rate".into(), correlation: within_run_correlation(folds, &st.temp_rate_cps, residual) },
+        SignalLink {
+            signal: "t_s".into(),
+            correlation: within_run_correlation(folds, &st.t_s, residual),
+        },
+        SignalLink {
+            signal: "temp_c".into(),
+            correlation: within_run_correlation(folds, &st.temp_c, residual),
+        },
+        SignalLink {
+            signal: "temp_c:rate".into(),
+            correlation: within_run_correlation(folds, &st.temp_rate_cps, residual),
+        },
     ];
     for (i, name) in c.extra_names.iter().enumerate() {
-        let v: Vec<f64> = c.runs.iter().flat_map(|s| s.extras[i].iter().copied()).collect();
-        by_signal.push(SignalLink { signal: name.clone(), correlation: within_run_correlation(folds, &v, residual) });
+        let v: Vec<f64> = c
+            .runs
+            .iter()
+            .flat_map(|s| s.extras[i].iter().copied())
+            .collect();
+        by_signal.push(SignalLink {
+            signal: name.clone(),
+            correlation: within_run_correlation(folds, &v, residual),
+        });
     }
-    Structure { by_time, by_ambient, by_signal }
+    Structure {
+        by_time,
+        by_ambient,
+        by_signal,
+    }
 }

@@ -27,7 +27,7 @@ pub const MIN_GAIN_PCT: f64 = 0.2;
 /// Candidates refitted as RBF inputs.
 pub const REFIT_TOP: usize = 4;
 /// Seed of the sign-flip patterns (results are deterministic).
-pub const FLIP_SEED: u64 = 0x00D1_A6_05E;
+pub const FLIP_SEED: u64 = 0x0D1A_605E;
 
 /// How a candidate enters the extended model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
@@ -75,7 +75,10 @@ fn has_within_unit_variation(folds: &Folds, col: &[f64]) -> bool {
         .iter()
         .map(|r| {
             let m = col[r.clone()].iter().sum::<f64>() / r.len() as f64;
-            col[r.clone()].iter().map(|v| (v - m) * (v - m)).sum::<f64>()
+            col[r.clone()]
+                .iter()
+                .map(|v| (v - m) * (v - m))
+                .sum::<f64>()
         })
         .sum();
     within > 1e-10 * total && within > 1e-200
@@ -98,16 +101,24 @@ pub fn screen(
     let mut scored = Vec::new();
     for cand in cands {
         let cols: Vec<Vec<f64>> = {
-            let per_run: Vec<Vec<Vec<f64>>> = campaign.runs.iter().map(|s| cand.compute(s)).collect();
+            let per_run: Vec<Vec<Vec<f64>>> =
+                campaign.runs.iter().map(|s| cand.compute(s)).collect();
             let m = per_run.first().map_or(0, Vec::len);
-            (0..m).map(|j| per_run.iter().flat_map(|r| r[j].iter().copied()).collect()).collect()
+            (0..m)
+                .map(|j| per_run.iter().flat_map(|r| r[j].iter().copied()).collect())
+                .collect()
         };
         if cols.iter().any(|c| c.iter().any(|v| !v.is_finite())) {
             skipped.push((cand.label(), "not finite".to_owned()));
             continue;
         }
-        if folds.offsets == super::cv::Offsets::PerUnit && !cols.iter().any(|c| has_within_unit_variation(folds, c)) {
-            skipped.push((cand.label(), "no variation within runs: cannot be told from run offsets".to_owned()));
+        if folds.offsets == super::cv::Offsets::PerUnit
+            && !cols.iter().any(|c| has_within_unit_variation(folds, c))
+        {
+            skipped.push((
+                cand.label(),
+                "no variation within runs: cannot be told from run offsets".to_owned(),
+            ));
             continue;
         }
         let cv = base.prepared.validate_with(folds, &cols)?;
@@ -130,7 +141,11 @@ pub fn screen(
         s.p_value = p;
     }
     scored.sort_by(|a, b| a.heldout_rms_dph.total_cmp(&b.heldout_rms_dph));
-    for s in scored.iter_mut().take(REFIT_TOP).filter(|s| s.gain_pct > 0.0) {
+    for s in scored
+        .iter_mut()
+        .take(REFIT_TOP)
+        .filter(|s| s.gain_pct > 0.0)
+    {
         if let Ok(fit) = fit_rbf_input(folds, st, &s.cols) {
             if fit.cv.rms() < s.heldout_rms_dph {
                 s.mode = Mode::RbfInput;
@@ -178,17 +193,32 @@ pub fn screen(
         Some(i) => competitors(folds, base, &scored, i)?,
         None => vec![],
     };
-    Ok(Screening { scored, skipped, named, competing, parsimony_note })
+    Ok(Screening {
+        scored,
+        skipped,
+        named,
+        competing,
+        parsimony_note,
+    })
 }
 
 /// Per-unit drop in held-out squared error from `from` to `to`.
 pub fn unit_gains(from: &CvResult, to: &CvResult) -> Vec<f64> {
-    from.unit_sse.iter().zip(&to.unit_sse).map(|(a, b)| a - b).collect()
+    from.unit_sse
+        .iter()
+        .zip(&to.unit_sse)
+        .map(|(a, b)| a - b)
+        .collect()
 }
 
 /// Significant candidates of other columns whose held-out gain (as linear terms) mostly
 /// vanishes once the named cause is in the model: they explain the same thing.
-fn competitors(folds: &Folds, base: &RbfFit, scored: &[Scored], named: usize) -> Result<Vec<(String, f64)>, DiagnoseError> {
+fn competitors(
+    folds: &Folds,
+    base: &RbfFit,
+    scored: &[Scored],
+    named: usize,
+) -> Result<Vec<(String, f64)>, DiagnoseError> {
     let with_named = base.prepared.validate_with(folds, &scored[named].cols)?;
     let mut out = Vec::new();
     let mut seen_columns: Vec<String> = vec![scored[named].cand.column.clone()];

@@ -27,7 +27,17 @@ fn patterns(units: usize, seed: u64) -> Vec<u64> {
 }
 
 fn flipped_sum(gains: &[f64], mask: u64) -> f64 {
-    gains.iter().enumerate().map(|(u, g)| if u < 64 && (mask >> u) & 1 == 1 { -g } else { *g }).sum()
+    gains
+        .iter()
+        .enumerate()
+        .map(|(u, g)| {
+            if u < 64 && (mask >> u) & 1 == 1 {
+                -g
+            } else {
+                *g
+            }
+        })
+        .sum()
 }
 
 /// Family-wise adjusted one-sided p-values: for each candidate (row of per-unit gains),
@@ -35,18 +45,29 @@ fn flipped_sum(gains: &[f64], mask: u64) -> f64 {
 /// the candidate's observed total. (Studentising each candidate's total was measured to
 /// lose power with 16 units: its maximum is only sqrt(units).)
 pub fn max_t_pvalues(gains: &[Vec<f64>], seed: u64) -> Vec<f64> {
-    let Some(units) = gains.first().map(Vec::len) else { return vec![] };
+    let Some(units) = gains.first().map(Vec::len) else {
+        return vec![];
+    };
     let pats = patterns(units, seed);
     let null_max: Vec<f64> = pats
         .iter()
-        .map(|&m| gains.iter().map(|g| flipped_sum(g, m)).fold(f64::NEG_INFINITY, f64::max))
+        .map(|&m| {
+            gains
+                .iter()
+                .map(|g| flipped_sum(g, m))
+                .fold(f64::NEG_INFINITY, f64::max)
+        })
         .collect();
     let n = null_max.len() as f64;
     gains
         .iter()
         .map(|g| {
             let obs: f64 = g.iter().sum();
-            null_max.iter().filter(|&&m| m >= obs - 1e-12 * obs.abs()).count() as f64 / n
+            null_max
+                .iter()
+                .filter(|&&m| m >= obs - 1e-12 * obs.abs())
+                .count() as f64
+                / n
         })
         .collect()
 }

@@ -14,7 +14,9 @@ use super::linalg::solve_spd;
 use serde::Serialize;
 
 /// Thermal time constants tried, s (pairs tau_fast < tau_slow).
-pub const THERMAL_TAUS_S: [f64; 10] = [30.0, 60.0, 120.0, 240.0, 480.0, 960.0, 1920.0, 3840.0, 7680.0, 15360.0];
+pub const THERMAL_TAUS_S: [f64; 10] = [
+    30.0, 60.0, 120.0, 240.0, 480.0, 960.0, 1920.0, 3840.0, 7680.0, 15360.0,
+];
 
 /// Fitted simulator parameters and how well they reproduce the measurements.
 #[derive(Clone, Debug, Serialize)]
@@ -40,7 +42,11 @@ pub struct SimCalibration {
 }
 
 /// Least squares with one free offset per run: returns (coefficients, residuals).
-fn fit_with_offsets(run_rows: &[std::ops::Range<usize>], cols: &[Vec<f64>], y: &[f64]) -> Result<(Vec<f64>, Vec<f64>), DiagnoseError> {
+fn fit_with_offsets(
+    run_rows: &[std::ops::Range<usize>],
+    cols: &[Vec<f64>],
+    y: &[f64],
+) -> Result<(Vec<f64>, Vec<f64>), DiagnoseError> {
     let dm = |v: &[f64]| {
         let mut o = v.to_vec();
         for r in run_rows {
@@ -64,8 +70,12 @@ fn fit_with_offsets(run_rows: &[std::ops::Range<usize>], cols: &[Vec<f64>], y: &
     for i in 0..p {
         a[i * p + i] += 1e-12 * tr + 1e-300;
     }
-    solve_spd(&mut a, &mut b, p).map_err(|_| DiagnoseError::Singular { what: "simulator calibration" })?;
-    let resid = (0..y.len()).map(|r| yd[r] - x.iter().zip(&b).map(|(c, w)| c[r] * w).sum::<f64>()).collect();
+    solve_spd(&mut a, &mut b, p).map_err(|_| DiagnoseError::Singular {
+        what: "simulator calibration",
+    })?;
+    let resid = (0..y.len())
+        .map(|r| yd[r] - x.iter().zip(&b).map(|(c, w)| c[r] * w).sum::<f64>())
+        .collect();
     Ok((b, resid))
 }
 
@@ -105,7 +115,11 @@ fn fit_thermal(c: &Campaign) -> Thermal {
                     a[r * 4] += 1e-9 * tr;
                 }
                 if solve_spd(&mut a, &mut b, 3).is_err() {
-                    b = vec![s.temp_c.iter().sum::<f64>() / s.temp_c.len() as f64, 0.0, 0.0];
+                    b = vec![
+                        s.temp_c.iter().sum::<f64>() / s.temp_c.len() as f64,
+                        0.0,
+                        0.0,
+                    ];
                 }
                 for (k, &t) in s.t_s.iter().enumerate() {
                     let m = b[0] + b[1] * cols[1][k] + b[2] * cols[2][k];
@@ -116,11 +130,21 @@ fn fit_thermal(c: &Campaign) -> Thermal {
             }
             let r = (sse / temp.len().max(1) as f64).sqrt();
             if best.as_ref().is_none_or(|b| r < b.rms) {
-                best = Some(Thermal { tau: (t1, t2), temp, rate, rms: r });
+                best = Some(Thermal {
+                    tau: (t1, t2),
+                    temp,
+                    rate,
+                    rms: r,
+                });
             }
         }
     }
-    best.unwrap_or(Thermal { tau: (0.0, 0.0), temp: vec![], rate: vec![], rms: f64::NAN })
+    best.unwrap_or(Thermal {
+        tau: (0.0, 0.0),
+        temp: vec![],
+        rate: vec![],
+        rms: f64::NAN,
+    })
 }
 
 /// Calibrates (see the module header); `effect` are the named cause's stacked columns.
@@ -133,7 +157,11 @@ pub fn calibrate(
     let th = fit_thermal(c);
     let t_mean = th.temp.iter().sum::<f64>() / th.temp.len().max(1) as f64;
     let dt: Vec<f64> = th.temp.iter().map(|t| t - t_mean).collect();
-    let cols = vec![dt.clone(), dt.iter().map(|d| d * d).collect(), th.rate.clone()];
+    let cols = vec![
+        dt.clone(),
+        dt.iter().map(|d| d * d).collect(),
+        th.rate.clone(),
+    ];
     let (coef, resid) = fit_with_offsets(run_rows, &cols, y)?;
     let mut out = SimCalibration {
         tau_fast_s: th.tau.0,
@@ -160,6 +188,14 @@ pub fn calibrate(
 
 /// sigma of white noise from first differences within runs (slow structure cancels).
 fn white_noise(run_rows: &[std::ops::Range<usize>], r: &[f64]) -> f64 {
-    let d: Vec<f64> = run_rows.iter().flat_map(|rr| r[rr.clone()].windows(2).map(|w| w[1] - w[0]).collect::<Vec<_>>()).collect();
+    let d: Vec<f64> = run_rows
+        .iter()
+        .flat_map(|rr| {
+            r[rr.clone()]
+                .windows(2)
+                .map(|w| w[1] - w[0])
+                .collect::<Vec<_>>()
+        })
+        .collect();
     rms(&d) / std::f64::consts::SQRT_2
 }

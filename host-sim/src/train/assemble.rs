@@ -35,7 +35,9 @@ pub struct ModelParts<'a> {
 }
 
 fn capacity(what: &str) -> TrainError {
-    TrainError::Model { why: format!("{what} exceed the model format's capacity") }
+    TrainError::Model {
+        why: format!("{what} exceed the model format's capacity"),
+    }
 }
 
 /// Builds and validates the model.
@@ -62,11 +64,26 @@ pub fn assemble(parts: &ModelParts<'_>) -> Result<RbfModel> {
     };
     let norm = parts.normalizer;
     for j in 0..d {
-        model.inputs.push(parts.specs[j]).map_err(|_| capacity("inputs"))?;
-        model.input_offset.push(norm.offset[j]).map_err(|_| capacity("inputs"))?;
-        model.input_scale.push(norm.scale[j]).map_err(|_| capacity("inputs"))?;
-        model.input_min.push(norm.min[j]).map_err(|_| capacity("inputs"))?;
-        model.input_max.push(norm.max[j]).map_err(|_| capacity("inputs"))?;
+        model
+            .inputs
+            .push(parts.specs[j])
+            .map_err(|_| capacity("inputs"))?;
+        model
+            .input_offset
+            .push(norm.offset[j])
+            .map_err(|_| capacity("inputs"))?;
+        model
+            .input_scale
+            .push(norm.scale[j])
+            .map_err(|_| capacity("inputs"))?;
+        model
+            .input_min
+            .push(norm.min[j])
+            .map_err(|_| capacity("inputs"))?;
+        model
+            .input_max
+            .push(norm.max[j])
+            .map_err(|_| capacity("inputs"))?;
         model.linear.push(0.0).map_err(|_| capacity("inputs"))?;
     }
     for (term, &coef) in parts.forced.iter().zip(parts.theta) {
@@ -81,14 +98,25 @@ pub fn assemble(parts: &ModelParts<'_>) -> Result<RbfModel> {
         // Linear-only coordinates play no part in the distance; keep them at 0.
         c[parts.n_rbf_inputs..].iter_mut().for_each(|v| *v = 0.0);
         model.centers.push(c).map_err(|_| capacity("centres"))?;
-        model.widths.push(parts.width as f32).map_err(|_| capacity("centres"))?;
-        model.weights.push(w as f32).map_err(|_| capacity("centres"))?;
+        model
+            .widths
+            .push(parts.width as f32)
+            .map_err(|_| capacity("centres"))?;
+        model
+            .weights
+            .push(w as f32)
+            .map_err(|_| capacity("centres"))?;
     }
     model
         .meta
         .gyro_id
         .push_str(parts.gyro_id)
-        .map_err(|_| TrainError::BadConfig { option: "gyro id", why: "longer than 16 bytes".into() })?;
-    model.validate().map_err(|e| TrainError::Model { why: e.to_string() })?;
+        .map_err(|_| TrainError::BadConfig {
+            option: "gyro id",
+            why: "longer than 16 bytes".into(),
+        })?;
+    model
+        .validate()
+        .map_err(|e| TrainError::Model { why: e.to_string() })?;
     Ok(model)
 }

@@ -64,28 +64,47 @@ impl TrainConfig {
             return bad("rho", format!("{} is outside 0 < rho < 1", self.rho));
         }
         if self.max_centers == 0 || self.max_centers > MAX_CENTERS {
-            return bad("max-centers", format!("{} is outside 1..={MAX_CENTERS}", self.max_centers));
+            return bad(
+                "max-centers",
+                format!("{} is outside 1..={MAX_CENTERS}", self.max_centers),
+            );
         }
         if self.width_candidates.is_empty() {
             return bad("widths", "no Gaussian width candidates given".into());
         }
-        if let Some(w) = self.width_candidates.iter().find(|w| !(w.is_finite() && **w > 0.0)) {
+        if let Some(w) = self
+            .width_candidates
+            .iter()
+            .find(|w| !(w.is_finite() && **w > 0.0))
+        {
             return bad("widths", format!("width {w} is not a positive number"));
         }
         if self.folds < 2 {
-            return bad("folds", format!("{} folds: grouped validation needs at least 2", self.folds));
+            return bad(
+                "folds",
+                format!("{} folds: grouped validation needs at least 2", self.folds),
+            );
         }
         if self.linear_only_inputs >= n_inputs {
             return bad(
                 "linear-only inputs",
-                format!("{} of {n_inputs} inputs: at least one RBF input is needed", self.linear_only_inputs),
+                format!(
+                    "{} of {n_inputs} inputs: at least one RBF input is needed",
+                    self.linear_only_inputs
+                ),
             );
         }
         if !(self.collinearity_tol > 0.0 && self.collinearity_tol < 1.0) {
-            return bad("collinearity tolerance", format!("{} is outside (0, 1)", self.collinearity_tol));
+            return bad(
+                "collinearity tolerance",
+                format!("{} is outside (0, 1)", self.collinearity_tol),
+            );
         }
         if self.gyro_id.len() > 16 {
-            return bad("gyro id", format!("`{}` is longer than 16 bytes", self.gyro_id));
+            return bad(
+                "gyro id",
+                format!("`{}` is longer than 16 bytes", self.gyro_id),
+            );
         }
         if self.threads == Some(0) {
             return bad("threads", "0 threads".into());

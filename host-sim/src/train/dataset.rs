@@ -34,7 +34,10 @@ impl Dataset {
             });
         }
         if specs.len() > MAX_INPUTS {
-            return Err(TrainError::TooManyInputs { found: specs.len(), max: MAX_INPUTS });
+            return Err(TrainError::TooManyInputs {
+                found: specs.len(),
+                max: MAX_INPUTS,
+            });
         }
         if input_names.len() != specs.len() {
             return Err(TrainError::InputCount {
@@ -80,10 +83,18 @@ impl Dataset {
                 });
             }
             if let Some(j) = row.iter().position(|v| !v.is_finite()) {
-                return Err(TrainError::NonFinite { what: "model input", row: base + i, input: j });
+                return Err(TrainError::NonFinite {
+                    what: "model input",
+                    row: base + i,
+                    input: j,
+                });
             }
             if !y.is_finite() {
-                return Err(TrainError::NonFinite { what: "target drift", row: base + i, input: 0 });
+                return Err(TrainError::NonFinite {
+                    what: "target drift",
+                    row: base + i,
+                    input: 0,
+                });
             }
         }
         let id = self.group_names.len() as u32;

@@ -38,8 +38,9 @@ impl GaussianDesign {
         // Column k only needs rows i >= k computed (the matrix is symmetric); the
         // upper part is mirrored afterwards. Jobs interleave columns to balance work.
         // Coordinates as one array per dimension, so the distance loop vectorises.
-        let coords: Vec<Vec<f32>> =
-            (0..dims).map(|d| points.chunks_exact(stride).map(|p| p[d]).collect()).collect();
+        let coords: Vec<Vec<f32>> = (0..dims)
+            .map(|d| points.chunks_exact(stride).map(|p| p[d]).collect())
+            .collect();
         let shared = SharedColumns::new(&mut values, n);
         std::thread::scope(|scope| {
             for job in 0..threads {
@@ -69,7 +70,12 @@ impl GaussianDesign {
             .chunks_exact(n.max(1))
             .map(|c| c.iter().map(|&v| f64::from(v) * f64::from(v)).sum())
             .collect();
-        Self { n, values, col_sq_norm, threads }
+        Self {
+            n,
+            values,
+            col_sq_norm,
+            threads,
+        }
     }
 
     /// Number of points (rows = candidates).
@@ -137,11 +143,18 @@ struct SharedColumns<'a> {
 
 impl<'a> SharedColumns<'a> {
     fn new(values: &'a mut [f32], n: usize) -> Self {
-        Self { columns: values.chunks_mut(n.max(1)).map(std::sync::Mutex::new).collect() }
+        Self {
+            columns: values
+                .chunks_mut(n.max(1))
+                .map(std::sync::Mutex::new)
+                .collect(),
+        }
     }
 
     fn column(&self, k: usize) -> std::sync::MutexGuard<'_, &'a mut [f32]> {
-        self.columns[k].lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+        self.columns[k]
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 }
 
@@ -180,7 +193,12 @@ pub fn dot_f32(a: &[f32], b: &[f32]) -> f64 {
     for (ba, bb) in a.chunks(BLOCK).zip(b.chunks(BLOCK)) {
         let mut acc = [0.0f32; LANES];
         let (ea, eb) = (ba.chunks_exact(LANES), bb.chunks_exact(LANES));
-        let tail: f32 = ea.remainder().iter().zip(eb.remainder()).map(|(x, y)| x * y).sum();
+        let tail: f32 = ea
+            .remainder()
+            .iter()
+            .zip(eb.remainder())
+            .map(|(x, y)| x * y)
+            .sum();
         for (x, y) in ea.zip(eb) {
             let x: &[f32; LANES] = x.try_into().unwrap_or(&[0.0; LANES]);
             let y: &[f32; LANES] = y.try_into().unwrap_or(&[0.0; LANES]);
@@ -212,13 +230,16 @@ mod tests {
 
     #[test]
     fn design_is_symmetric_gaussian_and_thread_count_free() {
-        let pts: Vec<f32> = (0..37).flat_map(|i| [i as f32 * 0.1, (i as f32 * 0.7).sin()]).collect();
+        let pts: Vec<f32> = (0..37)
+            .flat_map(|i| [i as f32 * 0.1, (i as f32 * 0.7).sin()])
+            .collect();
         let one = GaussianDesign::build(&pts, 2, 2, 0.5, 1);
         let three = GaussianDesign::build(&pts, 2, 2, 0.5, 3);
         for k in 0..37 {
             assert_eq!(one.column(k), three.column(k));
             for i in 0..37 {
-                let d2 = (pts[2 * i] - pts[2 * k]).powi(2) + (pts[2 * i + 1] - pts[2 * k + 1]).powi(2);
+                let d2 =
+                    (pts[2 * i] - pts[2 * k]).powi(2) + (pts[2 * i + 1] - pts[2 * k + 1]).powi(2);
                 let want = (-f64::from(d2) / 0.5).exp();
                 assert!((f64::from(one.column(k)[i]) - want).abs() < 1e-6);
                 assert_eq!(one.column(k)[i], one.column(i)[k]);
@@ -228,7 +249,12 @@ mod tests {
         let mut out = vec![0.0; 37];
         three.dot_columns(&v, &mut out);
         for (k, o) in out.iter().enumerate() {
-            let want: f64 = one.column(k).iter().zip(&v).map(|(&a, b)| f64::from(a) * b).sum();
+            let want: f64 = one
+                .column(k)
+                .iter()
+                .zip(&v)
+                .map(|(&a, b)| f64::from(a) * b)
+                .sum();
             assert!((o - want).abs() < 1e-5 * want.abs().max(1.0));
         }
     }

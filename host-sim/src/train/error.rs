@@ -9,13 +9,25 @@ pub enum TrainError {
     /// The dataset has no rows.
     EmptyDataset,
     /// A row or a spec list does not have the dataset's number of inputs.
-    InputCount { expected: usize, found: usize, row: usize },
+    InputCount {
+        expected: usize,
+        found: usize,
+        row: usize,
+    },
     /// The dataset has more inputs than a model can hold.
     TooManyInputs { found: usize, max: usize },
     /// Rows, targets and group ids have different lengths.
-    LengthMismatch { rows: usize, targets: usize, groups: usize },
+    LengthMismatch {
+        rows: usize,
+        targets: usize,
+        groups: usize,
+    },
     /// A NaN or infinite input or target.
-    NonFinite { what: &'static str, row: usize, input: usize },
+    NonFinite {
+        what: &'static str,
+        row: usize,
+        input: usize,
+    },
     /// An input has (numerically) no spread, so it cannot be normalised.
     ConstantInput { input: usize },
     /// Grouped validation needs more distinct groups (runs) than the data holds.
@@ -36,13 +48,24 @@ impl fmt::Display for TrainError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::EmptyDataset => write!(f, "training data is empty (no usable 10 s points)"),
-            Self::InputCount { expected, found, row } => {
+            Self::InputCount {
+                expected,
+                found,
+                row,
+            } => {
                 write!(f, "row {row} has {found} inputs, expected {expected}")
             }
             Self::TooManyInputs { found, max } => {
-                write!(f, "{found} model inputs requested, a model holds at most {max}")
+                write!(
+                    f,
+                    "{found} model inputs requested, a model holds at most {max}"
+                )
             }
-            Self::LengthMismatch { rows, targets, groups } => write!(
+            Self::LengthMismatch {
+                rows,
+                targets,
+                groups,
+            } => write!(
                 f,
                 "dataset lengths differ: {rows} input rows, {targets} targets, {groups} group ids"
             ),
@@ -60,7 +83,10 @@ impl fmt::Display for TrainError {
             Self::BadConfig { option, why } => write!(f, "option {option}: {why}"),
             Self::Features { run, why } => write!(f, "{run}: computing model inputs: {why}"),
             Self::MissingColumn { run, column } => {
-                write!(f, "{run}: column `{column}` needed by a model input is missing")
+                write!(
+                    f,
+                    "{run}: column `{column}` needed by a model input is missing"
+                )
             }
             Self::Model { why } => write!(f, "trained model rejected by fog-core: {why}"),
             Self::Predict { row, why } => write!(f, "RBF evaluation failed at row {row}: {why}"),

@@ -11,8 +11,14 @@ use fog_core::model::{FeatureKind, FeatureSpec, MAX_INPUTS};
 /// The paper's inputs: gyro temperature and its rate.
 pub fn default_specs() -> Vec<FeatureSpec> {
     vec![
-        FeatureSpec { kind: FeatureKind::TempC, tau_s: 0.0 },
-        FeatureSpec { kind: FeatureKind::TempRateCps, tau_s: 0.0 },
+        FeatureSpec {
+            kind: FeatureKind::TempC,
+            tau_s: 0.0,
+        },
+        FeatureSpec {
+            kind: FeatureKind::TempRateCps,
+            tau_s: 0.0,
+        },
     ]
 }
 
@@ -45,22 +51,38 @@ pub fn dataset_from_runs_with_aux(
     specs: &[FeatureSpec],
     aux_columns: &[&str],
 ) -> Result<Dataset> {
-    let names = specs.iter().map(|s| feature_name_with_aux(s, aux_columns)).collect();
+    let names = specs
+        .iter()
+        .map(|s| feature_name_with_aux(s, aux_columns))
+        .collect();
     let mut ds = Dataset::with_specs(specs.to_vec(), names)?;
     for run in runs {
         let name = run.name();
-        let fail = |why: String| TrainError::Features { run: name.clone(), why };
+        let fail = |why: String| TrainError::Features {
+            run: name.clone(),
+            why,
+        };
         let aux: Vec<Vec<f32>> = aux_columns
             .iter()
             .map(|&c| {
                 run.column(c)
                     .map(|v| v.iter().map(|&x| x as f32).collect())
-                    .ok_or_else(|| TrainError::MissingColumn { run: name.clone(), column: c.to_string() })
+                    .ok_or_else(|| TrainError::MissingColumn {
+                        run: name.clone(),
+                        column: c.to_string(),
+                    })
             })
             .collect::<Result<_>>()?;
         let aux_refs: Vec<&[f32]> = aux.iter().map(Vec::as_slice).collect();
         let temp: Vec<f32> = run.temp_c().iter().map(|&x| x as f32).collect();
-        let mut vectors = vec![FeatureVector { values: [0.0; MAX_INPUTS], len: 0, ready: false }; run.len()];
+        let mut vectors = vec![
+            FeatureVector {
+                values: [0.0; MAX_INPUTS],
+                len: 0,
+                ready: false
+            };
+            run.len()
+        ];
         features_for_series(specs, run.t_s(), &temp, &aux_refs, &mut vectors)
             .map_err(|e| fail(e.to_string()))?;
         let drift = run.drift_dph();
@@ -72,7 +94,8 @@ pub fn dataset_from_runs_with_aux(
             targets.push(drift[i]);
             times.push(run.t_s()[i]);
         }
-        ds.push_group(&name, &rows, &targets, &times).map_err(|e| fail(e.to_string()))?;
+        ds.push_group(&name, &rows, &targets, &times)
+            .map_err(|e| fail(e.to_string()))?;
     }
     if ds.is_empty() {
         return Err(TrainError::EmptyDataset);
@@ -82,7 +105,11 @@ pub fn dataset_from_runs_with_aux(
 
 /// `feature_name`, with aux channels named by their run column.
 pub fn feature_name_with_aux(spec: &FeatureSpec, aux_columns: &[&str]) -> String {
-    let col = |n: u8| aux_columns.get(n as usize).map_or_else(|| format!("aux{n}"), |c| c.to_string());
+    let col = |n: u8| {
+        aux_columns
+            .get(n as usize)
+            .map_or_else(|| format!("aux{n}"), |c| c.to_string())
+    };
     match spec.kind {
         FeatureKind::AuxValue(n) => format!("{}:value", col(n)),
         FeatureKind::AuxRate(n) => format!("{}:rate", col(n)),

@@ -65,5 +65,10 @@ pub fn fit_width(ds: &Dataset, cfg: &TrainConfig, width: f64) -> Result<Fit> {
         heldout_rms_dph: 0.0,
         n_train: ds.len(),
     })?;
-    Ok(Fit { model, width, path, design_bytes: design.bytes() })
+    Ok(Fit {
+        model,
+        width,
+        path,
+        design_bytes: design.bytes(),
+    })
 }

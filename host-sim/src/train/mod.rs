@@ -34,7 +34,8 @@ pub use dataset::Dataset;
 pub use design::GaussianDesign;
 pub use error::{Result, TrainError};
 pub use features::{
-    dataset_from_runs, dataset_from_runs_with_aux, default_specs, feature_name, feature_name_with_aux,
+    dataset_from_runs, dataset_from_runs_with_aux, default_specs, feature_name,
+    feature_name_with_aux,
 };
 pub use fit::{fit_width, Fit};
 pub use normalize::Normalizer;
@@ -101,7 +102,12 @@ pub fn train_model(ds: &Dataset, cfg: &TrainConfig) -> Result<TrainOutcome> {
     let final_fit_s = started.elapsed().as_secs_f64();
     fit.model.meta.heldout_rms_dph = cv.best.heldout_rms_dph as f32;
     let pred = predict_batch(&fit.model, ds.rows())?;
-    let resid: Vec<f64> = ds.targets_dph.iter().zip(&pred).map(|(y, p)| y - p).collect();
+    let resid: Vec<f64> = ds
+        .targets_dph
+        .iter()
+        .zip(&pred)
+        .map(|(y, p)| y - p)
+        .collect();
     let report = TrainReport {
         method: cfg.method,
         inputs: ds.input_names.clone(),
@@ -118,11 +124,18 @@ pub fn train_model(ds: &Dataset, cfg: &TrainConfig) -> Result<TrainOutcome> {
         train_rms_dph: rms(&resid),
         heldout_rms_dph: cv.best.heldout_rms_dph,
         heldout_std_dph: cv.best.heldout_std_dph,
-        max_abs_weight_dph: fit.model.weights.iter().fold(0.0f64, |m, w| m.max(f64::from(w.abs()))),
+        max_abs_weight_dph: fit
+            .model
+            .weights
+            .iter()
+            .fold(0.0f64, |m, w| m.max(f64::from(w.abs()))),
         design_bytes: fit.design_bytes,
         cross_validation: cv,
         validation_s,
         final_fit_s,
     };
-    Ok(TrainOutcome { model: fit.model, report })
+    Ok(TrainOutcome {
+        model: fit.model,
+        report,
+    })
 }

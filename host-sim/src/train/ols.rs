@@ -33,6 +33,10 @@ pub fn select_ols(sel: &mut Selection<'_>, rho: f64, max_centers: usize) -> Path
         lambda: None,
         gcv: None,
         center_err,
-        err_sum: if yy > 0.0 { 1.0 - sel.residual_energy() / yy } else { 1.0 },
+        err_sum: if yy > 0.0 {
+            1.0 - sel.residual_energy() / yy
+        } else {
+            1.0
+        },
     }
 }

@@ -95,11 +95,14 @@ fn minimise_gcv(n: f64, forced_res: f64, nf: usize, z: &[f64], s: &[f64]) -> (f6
     const LO: f64 = -10.0;
     const STEP: f64 = 0.25;
     let grid: Vec<f64> = (0..=56).map(|i| LO + STEP * f64::from(i)).collect();
-    let (i_best, _) = grid
-        .iter()
-        .map(|&x| f(x))
-        .enumerate()
-        .fold((0, f64::INFINITY), |acc, (i, v)| if v < acc.1 { (i, v) } else { acc });
+    let (i_best, _) =
+        grid.iter()
+            .map(|&x| f(x))
+            .enumerate()
+            .fold(
+                (0, f64::INFINITY),
+                |acc, (i, v)| if v < acc.1 { (i, v) } else { acc },
+            );
     let (mut a, mut b) = (grid[i_best] - STEP, grid[i_best] + STEP);
     let phi = (5f64.sqrt() - 1.0) / 2.0;
     for _ in 0..40 {
@@ -111,6 +114,10 @@ fn minimise_gcv(n: f64, forced_res: f64, nf: usize, z: &[f64], s: &[f64]) -> (f6
         }
     }
     let x = 0.5 * (a + b);
-    let (x, g) = if f(x) <= f(grid[i_best]) { (x, f(x)) } else { (grid[i_best], f(grid[i_best])) };
+    let (x, g) = if f(x) <= f(grid[i_best]) {
+        (x, f(x))
+    } else {
+        (grid[i_best], f(grid[i_best]))
+    };
     (median * 10f64.powf(x), g)
 }

@@ -25,7 +25,10 @@ pub fn predict_batch<'r>(
             }
             fog_core::rbf::predict_f32(model, &x[..row.len()])
                 .map(f64::from)
-                .map_err(|e| TrainError::Predict { row: i, why: e.to_string() })
+                .map_err(|e| TrainError::Predict {
+                    row: i,
+                    why: e.to_string(),
+                })
         })
         .collect()
 }

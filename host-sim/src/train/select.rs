@@ -79,7 +79,12 @@ impl<'a> Selection<'a> {
 
     /// Adds candidate centre k.
     pub fn add_candidate(&mut self, k: usize) -> Added {
-        let column: Vec<f64> = self.design.column(k).iter().map(|&v| f64::from(v)).collect();
+        let column: Vec<f64> = self
+            .design
+            .column(k)
+            .iter()
+            .map(|&v| f64::from(v))
+            .collect();
         self.taken[k] = true;
         let added = self.add_column(&column);
         if added == Added::Yes {

@@ -43,7 +43,10 @@ pub fn fold_of_rows(ds: &Dataset, folds: usize) -> Result<Vec<usize>> {
     present.sort_unstable();
     present.dedup();
     if present.len() < folds.max(2) {
-        return Err(TrainError::TooFewGroups { found: present.len(), needed: folds.max(2) });
+        return Err(TrainError::TooFewGroups {
+            found: present.len(),
+            needed: folds.max(2),
+        });
     }
     let fold_of_group = |g: u32| present.binary_search(&g).map_or(0, |rank| rank % folds);
     Ok(ds.groups.iter().map(|&g| fold_of_group(g)).collect())
@@ -79,13 +82,21 @@ pub fn cross_validate(ds: &Dataset, cfg: &TrainConfig, folds: usize) -> Result<C
             heldout_std_dph: std_within_groups(&residuals, &ds.groups),
             mean_centers: centers as f64 / folds as f64,
         };
-        if best.as_ref().is_none_or(|(b, _)| score.heldout_rms_dph < scan_rms(&scan, *b)) {
+        if best
+            .as_ref()
+            .is_none_or(|(b, _)| score.heldout_rms_dph < scan_rms(&scan, *b))
+        {
             best = Some((scan.len(), residuals));
         }
         scan.push(score);
     }
     let (b, residuals_dph) = best.ok_or(TrainError::EmptyDataset)?;
-    Ok(CvReport { folds, best: scan[b].clone(), scan, residuals_dph })
+    Ok(CvReport {
+        folds,
+        best: scan[b].clone(),
+        scan,
+        residuals_dph,
+    })
 }
 
 fn scan_rms(scan: &[WidthScore], i: usize) -> f64 {

@@ -38,7 +38,11 @@ pub struct Shape {
 
 impl Default for Shape {
     fn default() -> Self {
-        Self { runs: 20, minutes: 45.0, sigmas: 1.0 }
+        Self {
+            runs: 20,
+            minutes: 45.0,
+            sigmas: 1.0,
+        }
     }
 }
 
@@ -61,8 +65,13 @@ fn wander(rng: &mut ChaCha8Rng, n: usize, dt: f64, tau_s: f64, scale: f64) -> (V
         v = a * v + (1.0 - a * a).sqrt() * g.sample(rng);
     }
     let m = xs.iter().sum::<f64>() / n as f64;
-    let sd = (xs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / n as f64).sqrt().max(1e-9);
-    (xs.iter().map(|x| scale * x / sd).collect(), vs.iter().map(|v| scale * v / tau_s / sd).collect())
+    let sd = (xs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / n as f64)
+        .sqrt()
+        .max(1e-9);
+    (
+        xs.iter().map(|x| scale * x / sd).collect(),
+        vs.iter().map(|v| scale * v / tau_s / sd).collect(),
+    )
 }
 
 /// First-order lag of a sampled signal (exact for linear interpolation is not needed here).
@@ -83,7 +92,12 @@ fn scale_while_present(e: &mut [Vec<f64>], target: f64) {
     if peak <= 0.0 {
         return;
     }
-    let live: Vec<f64> = e.iter().flatten().copied().filter(|v| v.abs() > 0.1 * peak).collect();
+    let live: Vec<f64> = e
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|v| v.abs() > 0.1 * peak)
+        .collect();
     let rms = (live.iter().map(|v| v * v).sum::<f64>() / live.len() as f64).sqrt();
     e.iter_mut().flatten().for_each(|v| *v *= target / rms);
 }
@@ -102,8 +116,16 @@ pub fn campaign(effect: Effect, seed: u64, shape: Shape) -> (Vec<Run>, Expected)
     // Gyro and thermal parameters of this campaign.
     // Three thermal modes (source, coil, housing): with only two, d2T/dt2 would be an
     // affine function of T and dT/dt and no data could tell them apart.
-    let taus = [rng.random_range(60.0..200.0), rng.random_range(300.0..800.0), rng.random_range(1500.0..4000.0)];
-    let amps = [rng.random_range(0.5..2.0), rng.random_range(2.0..5.0), rng.random_range(1.0..4.0)];
+    let taus = [
+        rng.random_range(60.0..200.0),
+        rng.random_range(300.0..800.0),
+        rng.random_range(1500.0..4000.0),
+    ];
+    let amps = [
+        rng.random_range(0.5..2.0),
+        rng.random_range(2.0..5.0),
+        rng.random_range(1.0..4.0),
+    ];
     let bias_per_c = rng.random_range(0.002..0.01) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
     let bias_per_c2 = rng.random_range(-2e-4..2e-4);
     let shupe = rng.random_range(4.0..10.0) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
@@ -113,7 +135,9 @@ pub fn campaign(effect: Effect, seed: u64, shape: Shape) -> (Vec<Run>, Expected)
     let transient_tau = rng.random_range(100.0..400.0);
     let mag_phase = rng.random_range(40.0..140.0) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
     let planted_aux = rng.random_range(0..AUX_COLUMNS.len());
-    let ambients: Vec<f64> = (0..4).map(|_| rng.random_range(-4i32..=6) as f64 * 10.0).collect();
+    let ambients: Vec<f64> = (0..4)
+        .map(|_| rng.random_range(-4i32..=6) as f64 * 10.0)
+        .collect();
 
     struct Raw {
         t: Vec<f64>,
@@ -138,7 +162,11 @@ pub fn campaign(effect: Effect, seed: u64, shape: Shape) -> (Vec<Run>, Expected)
             _ => rng.random_range(5.0..60.0),
         };
         // half the runs see a chamber set-point step mid-run, felt through two lags
-        let step_c = if rng.random_bool(0.5) { rng.random_range(1.0..4.0) * if rng.random_bool(0.5) { 1.0 } else { -1.0 } } else { 0.0 };
+        let step_c = if rng.random_bool(0.5) {
+            rng.random_range(1.0..4.0) * if rng.random_bool(0.5) { 1.0 } else { -1.0 }
+        } else {
+            0.0
+        };
         let step_at_s = rng.random_range(600.0..1800.0);
         let (lag_a, lag_b) = (taus[1], rng.random_range(60.0..150.0));
         // the chamber air wanders (regulation, door, lab): a smooth random excursion
@@ -150,7 +178,11 @@ pub fn campaign(effect: Effect, seed: u64, shape: Shape) -> (Vec<Run>, Expected)
         };
         let felt = lagged(&air, dt, lag_b);
         let a: Vec<f64> = amps.iter().map(|x| x * gain).collect();
-        let x0: Vec<f64> = a.iter().zip(&taus).map(|(ai, ti)| ai * (-t_off / ti).exp()).collect();
+        let x0: Vec<f64> = a
+            .iter()
+            .zip(&taus)
+            .map(|(ai, ti)| ai * (-t_off / ti).exp())
+            .collect();
         let mut t = Vec::new();
         let mut temp_meas = Vec::new();
         let mut base = Vec::new();
@@ -169,7 +201,10 @@ pub fn campaign(effect: Effect, seed: u64, shape: Shape) -> (Vec<Run>, Expected)
                 acc += (x0[i] - a[i]) / (taus[i] * taus[i]) * e;
             }
             if tc > step_at_s {
-                let (ea, eb) = ((-(tc - step_at_s) / lag_a).exp(), (-(tc - step_at_s) / lag_b).exp());
+                let (ea, eb) = (
+                    (-(tc - step_at_s) / lag_a).exp(),
+                    (-(tc - step_at_s) / lag_b).exp(),
+                );
                 temp += step_c * (1.0 - (lag_a * ea - lag_b * eb) / (lag_a - lag_b));
                 rate += step_c * (ea - eb) / (lag_a - lag_b);
                 acc += step_c * (eb / lag_b - ea / lag_a) / (lag_a - lag_b);
@@ -192,15 +227,28 @@ pub fn campaign(effect: Effect, seed: u64, shape: Shape) -> (Vec<Run>, Expected)
             accel.push(acc);
             heading.push((psi0 + step * (tc / dwell).floor()).rem_euclid(360.0));
         }
-        let aux = (0..AUX_COLUMNS.len()).map(|_| {
+        let aux = (0..AUX_COLUMNS.len())
+            .map(|_| {
                 let tau = rng.random_range(150.0..600.0);
                 wander(&mut rng, n, dt, tau, 1.0)
-            }).collect();
-        let decoys = (0..DECOY_COLUMNS.len()).map(|_| {
+            })
+            .collect();
+        let decoys = (0..DECOY_COLUMNS.len())
+            .map(|_| {
                 let tau = rng.random_range(300.0..1500.0);
                 wander(&mut rng, n, dt, tau, 1.0).0
-            }).collect();
-        raws.push(Raw { t, temp_meas, base, accel, heading, aux, decoys, ambient });
+            })
+            .collect();
+        raws.push(Raw {
+            t,
+            temp_meas,
+            base,
+            accel,
+            heading,
+            aux,
+            decoys,
+            ambient,
+        });
     }
     // The planted effect, scaled to `sigmas` x sigma while present.
     let mut eff: Vec<Vec<f64>> = raws
@@ -214,8 +262,16 @@ pub fn campaign(effect: Effect, seed: u64, shape: Shape) -> (Vec<Run>, Expected)
             }
             Effect::ColumnRate => r.aux[planted_aux].1.clone(),
             Effect::TempAccel => r.accel.clone(),
-            Effect::PowerOnTransient => r.t.iter().map(|t| (-(t - 5.0) / transient_tau).exp()).collect(),
-            Effect::HeadingMagnetic => r.heading.iter().map(|h| (h - mag_phase).to_radians().cos()).collect(),
+            Effect::PowerOnTransient => {
+                r.t.iter()
+                    .map(|t| (-(t - 5.0) / transient_tau).exp())
+                    .collect()
+            }
+            Effect::HeadingMagnetic => r
+                .heading
+                .iter()
+                .map(|h| (h - mag_phase).to_radians().cos())
+                .collect(),
         })
         .collect();
     scale_while_present(&mut eff, shape.sigmas * sigma);
@@ -234,11 +290,11 @@ pub fn campaign(effect: Effect, seed: u64, shape: Shape) -> (Vec<Run>, Expected)
         let mut slow = 0.0;
         let mut rate_dph = Vec::with_capacity(n);
         let mut earth = Vec::with_capacity(n);
-        for k in 0..n {
+        for (k, e_k) in e.iter().enumerate() {
             slow = phi * slow + (1.0 - phi * phi).sqrt() * 0.3 * sigma * g.sample(&mut rng);
             let earth_k = omega_h * r.heading[k].to_radians().cos();
             earth.push(earth_k);
-            rate_dph.push(earth_k + offset + r.base[k] + e[k] + slow + sigma * g.sample(&mut rng));
+            rate_dph.push(earth_k + offset + r.base[k] + e_k + slow + sigma * g.sample(&mut rng));
         }
         let mut cols = vec![
             ("t_s".to_owned(), r.t.clone()),
@@ -248,7 +304,10 @@ pub fn campaign(effect: Effect, seed: u64, shape: Shape) -> (Vec<Run>, Expected)
             ("heading_deg".to_owned(), r.heading.clone()),
         ];
         for (name, (x, _)) in AUX_COLUMNS.iter().zip(&r.aux) {
-            cols.push((name.to_string(), x.iter().map(|v| v + 0.01 * g.sample(&mut rng)).collect()));
+            cols.push((
+                name.to_string(),
+                x.iter().map(|v| v + 0.01 * g.sample(&mut rng)).collect(),
+            ));
         }
         for (name, x) in DECOY_COLUMNS.iter().zip(&r.decoys) {
             cols.push((name.to_string(), x.clone()));
@@ -258,7 +317,9 @@ pub fn campaign(effect: Effect, seed: u64, shape: Shape) -> (Vec<Run>, Expected)
             ("latitude_deg".to_owned(), format!("{latitude:.3}")),
             ("ambient_c".to_owned(), format!("{:.2}", r.ambient)),
         ];
-        runs.push(Run::new(format!("run_{i:02}.csv"), meta, cols).expect("generator builds valid runs"));
+        runs.push(
+            Run::new(format!("run_{i:02}.csv"), meta, cols).expect("generator builds valid runs"),
+        );
     }
     (runs, expected)
 }

@@ -22,8 +22,14 @@ pub fn warmup(ambient_c: f64, t_s: f64) -> (f64, f64) {
 /// The paper's two inputs.
 pub fn specs_t_rate() -> Vec<FeatureSpec> {
     vec![
-        FeatureSpec { kind: FeatureKind::TempC, tau_s: 0.0 },
-        FeatureSpec { kind: FeatureKind::TempRateCps, tau_s: 0.0 },
+        FeatureSpec {
+            kind: FeatureKind::TempC,
+            tau_s: 0.0,
+        },
+        FeatureSpec {
+            kind: FeatureKind::TempRateCps,
+            tau_s: 0.0,
+        },
     ]
 }
 
@@ -38,7 +44,11 @@ pub fn campaign(
 ) -> Dataset {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let noise = Normal::new(0.0, noise_dph.max(1e-300)).unwrap();
-    let mut ds = Dataset::with_specs(specs_t_rate(), vec!["temp_c:value".into(), "temp_c:rate".into()]).unwrap();
+    let mut ds = Dataset::with_specs(
+        specs_t_rate(),
+        vec!["temp_c:value".into(), "temp_c:rate".into()],
+    )
+    .unwrap();
     for &amb in ambients_c {
         for r in 0..runs_per_ambient {
             let mut rows = Vec::new();
@@ -49,11 +59,16 @@ pub fn campaign(
                 // Run-to-run variation of the warm-up so runs are not identical.
                 let (temp, rate) = warmup(amb + 0.3 * r as f64, ts * (1.0 + 0.05 * r as f64));
                 rows.push(vec![temp, rate]);
-                let e = if noise_dph > 0.0 { noise.sample(&mut rng) } else { 0.0 };
+                let e = if noise_dph > 0.0 {
+                    noise.sample(&mut rng)
+                } else {
+                    0.0
+                };
                 y.push(f(temp, rate) + e);
                 t.push(ts);
             }
-            ds.push_group(&format!("amb{amb}_run{r}"), &rows, &y, &t).unwrap();
+            ds.push_group(&format!("amb{amb}_run{r}"), &rows, &y, &t)
+                .unwrap();
         }
     }
     ds

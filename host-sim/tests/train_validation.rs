@@ -1,0 +1,106 @@
+//! Model selection: the Gaussian width is chosen by grouped (whole runs held out)
+//! validation rather than training error, and Orr's regularised GCV-stopped selection
+//! is compared with plain OLS on held-out runs.
+
+mod train_support;
+
+use fog_sim::train::{cross_validate, fold_of_rows, Method, TrainConfig};
+use train_support::{campaign, shupe_like};
+
+const AMBIENTS: [f64; 5] = [-30.0, -10.0, 10.0, 30.0, 50.0];
+
+#[test]
+fn folds_hold_out_whole_runs_one_per_ambient() {
+    let ds = campaign(&AMBIENTS, 3, 0.01, 11, shupe_like);
+    let fold = fold_of_rows(&ds, 3).unwrap();
+    for g in 0..ds.n_groups() as u32 {
+        let folds: Vec<usize> = ds
+            .indices_where(|x| x == g)
+            .iter()
+            .map(|&i| fold[i])
+            .collect();
+        assert!(
+            folds.windows(2).all(|w| w[0] == w[1]),
+            "run {g} split across folds"
+        );
+        // Runs are ambient-major: run r of every ambient lands in fold r.
+        assert_eq!(folds[0], g as usize % 3);
+    }
+}
+
+#[test]
+fn width_is_chosen_by_held_out_error_and_matches_the_true_scale() {
+    // Truth: bumps of sigma 0.2 (normalised units) on the data's own points, plus noise.
+    let base = campaign(&AMBIENTS, 3, 0.0, 12, |_, _| 0.0);
+    let norm = fog_sim::train::Normalizer::fit(&base).unwrap();
+    let bumps: Vec<(f64, f64, f64)> = (0..12)
+        .map(|k| {
+            let r = base.row(k * 331 % base.len());
+            (
+                norm.apply(0, r[0]),
+                norm.apply(1, r[1]),
+                if k % 2 == 0 { 0.05 } else { -0.04 },
+            )
+        })
+        .collect();
+    let truth = |t: f64, r: f64| {
+        let (x, y) = (norm.apply(0, t), norm.apply(1, r));
+        bumps
+            .iter()
+            .map(|(cx, cy, w)| w * (-((x - cx).powi(2) + (y - cy).powi(2)) / (2.0 * 0.04)).exp())
+            .sum()
+    };
+    let ds = campaign(&AMBIENTS, 3, 0.01, 12, truth);
+    let cfg = TrainConfig {
+        width_candidates: vec![0.03, 0.2, 2.0],
+        ..TrainConfig::default()
+    };
+    let cv = cross_validate(&ds, &cfg, 3).unwrap();
+    for s in &cv.scan {
+        eprintln!(
+            "width {:.2}: held-out {:.5} dph, {:.1} centres",
+            s.width, s.heldout_rms_dph, s.mean_centers
+        );
+    }
+    assert_eq!(cv.best.width, 0.2);
+    for s in cv.scan.iter().filter(|s| s.width != 0.2) {
+        assert!(
+            s.heldout_rms_dph > 1.05 * cv.best.heldout_rms_dph,
+            "width {} not clearly worse",
+            s.width
+        );
+    }
+}
+
+#[test]
+fn orr_gcv_needs_fewer_centres_than_ols_for_the_same_held_out_error() {
+    let ds = campaign(&AMBIENTS, 3, 0.02, 13, shupe_like);
+    let base = TrainConfig {
+        width_candidates: vec![0.35],
+        rho: 1e-6,
+        ..TrainConfig::default()
+    };
+    let ols = cross_validate(&ds, &base, 3).unwrap();
+    let orr = cross_validate(
+        &ds,
+        &TrainConfig {
+            method: Method::OrrGcv,
+            ..base.clone()
+        },
+        3,
+    )
+    .unwrap();
+    eprintln!(
+        "OLS: {:.5} dph held-out, {:.1} centres; Orr: {:.5} dph, {:.1} centres",
+        ols.best.heldout_rms_dph,
+        ols.best.mean_centers,
+        orr.best.heldout_rms_dph,
+        orr.best.mean_centers
+    );
+    assert_eq!(
+        ols.best.mean_centers, 64.0,
+        "OLS with a tiny rho runs to the maximum"
+    );
+    assert!(orr.best.mean_centers < 0.75 * ols.best.mean_centers);
+    assert!(orr.best.heldout_rms_dph < 1.05 * ols.best.heldout_rms_dph);
+}
