@@ -6,16 +6,19 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 out="$PWD/docs/budgets.md"
 table="$(mktemp)"
-trap 'rm -f "$table"' EXIT
+stack="$(mktemp)"
+trap 'rm -f "$table" "$stack"' EXIT
 FOG_REQUIRE_QEMU=1 FOG_BUDGETS_OUT="$table" \
     cargo test -p fog-tests --test fw_budgets -- --nocapture
+FOG_REQUIRE_QEMU=1 FOG_BUDGETS_STACK_OUT="$stack" \
+    cargo test -p fog-tests --test qemu_replay -- --nocapture
 {
     echo "# Firmware budgets"
     echo
     echo "Measured by \`scripts/budgets.sh\` on $(date -u +%Y-%m-%d) with $(rustc --version | cut -d' ' -f1-2)"
-    echo "(\`cargo test -p fog-tests --test fw_budgets\`; firmware profile \`fw\`, QEMU"
+    echo "(\`cargo test -p fog-tests --test fw_budgets\` and \`--test qemu_replay\`; firmware profile \`fw\`, QEMU"
     echo "\`mps2-an386\` with \`-icount shift=0\`: instruction counts, not cycles)."
     echo
-    cat "$table"
+    cat "$table" "$stack"
 } > "$out"
 echo "wrote $out"

@@ -20,7 +20,7 @@ use fog_tests::{
 /// The budgets.
 const FLASH_TARGET_BYTES: u64 = 64 * 1024;
 const STATIC_RAM_BUDGET_BYTES: u64 = 16 * 1024;
-/// Regression ceiling for flash. The 64 KiB target is NOT met yet (measured 72,776 bytes
+/// Regression ceiling for flash. The 64 KiB target is NOT met yet (measured 72,040 bytes
 /// when this was written; docs/firmware.md explains where the bytes go): the check fails
 /// on any growth past this ceiling so the gap can only shrink.
 const FLASH_CEILING_BYTES: u64 = 74 * 1024;
@@ -78,6 +78,11 @@ fn parse_bench(stdout: &str) -> BTreeMap<String, u64> {
 #[test]
 fn firmware_fits_its_budgets() {
     if !qemu_ready("fw_budgets") {
+        return;
+    }
+    if let Err(why) = llvm_tool("llvm-size").and(llvm_tool("llvm-objdump")) {
+        assert!(!fog_tests::qemu_required(), "fw_budgets: {why}");
+        eprintln!("\n** SKIPPING fw_budgets: {why} **\n");
         return;
     }
     let app = firmware_elf("fog-app");

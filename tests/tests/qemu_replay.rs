@@ -12,6 +12,9 @@
 //! sides. Any difference is therefore a real bug (uninitialised state, a target-
 //! dependent cast, a different code path), not rounding noise.
 //!
+//! With `FOG_BUDGETS_STACK_OUT=<file>` the stack rows of the budget table are written
+//! there (scripts/budgets.sh).
+//!
 //! The stream includes injected faults: corrupted frames (CRC errors, counted and
 //! skipped) and a 3 s temperature dropout (windows marked invalid).
 
@@ -240,13 +243,21 @@ fn scenario(evaluator: Evaluator, tag: &str) {
         .expect("firmware reports its stack high-water mark");
     let words: Vec<&str> = stack_line.split_whitespace().collect();
     let (running, boot): (usize, usize) = (words[0].parse().unwrap(), words[2].parse().unwrap());
-    // Regression bounds, about 1.3x the values measured when this test was written
-    // (docs/firmware.md): the sample loop and the boot-time construction peak.
+    // Regression bounds (docs/firmware.md has the measured values, 30 KB and 70 KB): the
+    // sample loop, and the boot-time construction peak, which together with the static
+    // RAM must stay inside the 128 KiB of RAM that memory.x gives a real board.
     assert!(
-        running > 256 && running < 32 * 1024,
-        "sample-loop stack high-water {running} bytes is implausible or over 32 KiB"
+        running > 256 && running < 48 * 1024,
+        "sample-loop stack high-water {running} bytes is implausible or over 48 KiB"
     );
-    assert!(boot < 72 * 1024, "boot stack peak {boot} bytes over 72 KiB");
+    assert!(boot < 96 * 1024, "boot stack peak {boot} bytes over 96 KiB");
+    if let (Ok(path), "f32") = (std::env::var("FOG_BUDGETS_STACK_OUT"), tag) {
+        let rows = format!(
+            "| stack high-water, replay sample loop (painted) | {running} B | CI bound 48 KiB |\n\
+             | stack peak at boot (model decode, construction) | {boot} B | CI bound 96 KiB |\n"
+        );
+        std::fs::write(path, rows).expect("write stack rows");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -16,12 +16,10 @@
 //! a controller fault code is `Fault`. After an error the driver stays failed (each
 //! `poll` repeats the error) until a new command is given.
 
-use core::fmt::Write as _;
-
 use embedded_hal_nb::nb;
 use embedded_hal_nb::serial::{Error as _, ErrorKind, Read, Write};
 use fog_core::hal::{TableState, Turntable};
-use heapless::{String, Vec};
+use heapless::Vec;
 
 use crate::clock::Clock;
 
@@ -171,11 +169,11 @@ impl<S: Read<u8> + Write<u8>, C: Clock> SerialTurntable<S, C> {
         self.uart
     }
 
-    fn queue_line(&mut self, line: &str) {
+    fn queue_line(&mut self, line: &[u8]) {
         self.tx.clear();
         self.tx_sent = 0;
         // LINE_MAX holds the longest command ("MOV 359.999\r" is 12 bytes).
-        let _ = self.tx.extend_from_slice(line.as_bytes());
+        let _ = self.tx.extend_from_slice(line);
         let _ = self.tx.push(b'\r');
     }
 
@@ -234,7 +232,7 @@ impl<S: Read<u8> + Write<u8>, C: Clock> SerialTurntable<S, C> {
                 query_deadline_s: None,
                 next_query_s,
             } if now >= next_query_s => {
-                self.queue_line("POS?");
+                self.queue_line(b"POS?");
                 self.flush_tx()?;
                 self.phase = Phase::Moving {
                     query_deadline_s: Some(now + self.config.reply_timeout_s),
@@ -305,11 +303,8 @@ impl<S: Read<u8> + Write<u8>, C: Clock> Turntable for SerialTurntable<S, C> {
             return Err(TurntableError::BadHeading);
         }
         let heading = wrap_360(heading_deg);
-        // Millidegrees, formatted without float formatting (smaller code, exact digits).
         let mdeg = ((heading * 1000.0 + 0.5) as u32) % 360_000;
-        let mut line: String<LINE_MAX> = String::new();
-        let _ = write!(line, "MOV {}.{:03}", mdeg / 1000, mdeg % 1000);
-        self.queue_line(&line);
+        self.queue_line(&move_command(mdeg));
         self.rx.clear();
         let now = self.clock.now_s();
         self.target_deg = mdeg as f32 / 1000.0;
@@ -330,6 +325,27 @@ impl<S: Read<u8> + Write<u8>, C: Clock> Turntable for SerialTurntable<S, C> {
         }
         result
     }
+}
+
+/// `MOV d.ddd` for a heading in millidegrees (0..360,000), formatted by hand: exact
+/// digits and no `core::fmt` machinery in the firmware.
+fn move_command(mdeg: u32) -> Vec<u8, LINE_MAX> {
+    let mut line = Vec::new();
+    let _ = line.extend_from_slice(b"MOV ");
+    let deg = mdeg / 1000;
+    let mut started = false;
+    for div in [100, 10, 1] {
+        let d = (deg / div) % 10;
+        started |= d != 0 || div == 1;
+        if started {
+            let _ = line.push(b'0' + d as u8);
+        }
+    }
+    let _ = line.push(b'.');
+    for div in [100, 10, 1] {
+        let _ = line.push(b'0' + ((mdeg % 1000) / div % 10) as u8);
+    }
+    line
 }
 
 /// Signed shortest difference a - b on the circle, deg.

@@ -296,10 +296,18 @@ pub fn render_text(r: &Report) -> String {
         );
     }
     let _ = writeln!(s, "\n5. Simulator extended with the named effect");
-    let _ = writeln!(
-        s,
-        "  sim vs measured rms: {:.4} -> {:.4} deg/h (effect coefficient(s) {:?})",
-        r.simulation.before_rms_dph, r.simulation.after_rms_dph, sim.effect_coef
-    );
+    if r.named_cause.is_some() {
+        let _ = writeln!(
+            s,
+            "  sim vs measured rms: {:.4} -> {:.4} deg/h (fitted coefficient(s) of the new term: {:?})",
+            r.simulation.before_rms_dph, r.simulation.after_rms_dph, sim.effect_coef
+        );
+    } else {
+        let _ = writeln!(
+            s,
+            "  no named effect: the simulator is left as calibrated (rms {:.4} deg/h)",
+            r.simulation.before_rms_dph
+        );
+    }
     s
 }

@@ -39,7 +39,8 @@ impl Normalizer {
             let std = var.sqrt();
             let lo = col().fold(f64::INFINITY, f64::min);
             let hi = col().fold(f64::NEG_INFINITY, f64::max);
-            if !(std > MIN_RELATIVE_STD * mean.abs().max(1e-30)) || (std as f32) == 0.0 {
+            let spread_ok = std > MIN_RELATIVE_STD * mean.abs().max(1e-30) && (std as f32) > 0.0;
+            if !spread_ok {
                 return Err(TrainError::ConstantInput { input: j });
             }
             out.offset.push(mean as f32);

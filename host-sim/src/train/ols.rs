@@ -11,7 +11,8 @@ pub fn select_ols(sel: &mut Selection<'_>, rho: f64, max_centers: usize) -> Path
     let mut center_err = Vec::new();
     let stop = loop {
         // NaN (y'y = 0: nothing to fit) also stops here.
-        if !(sel.residual_energy() / yy >= rho) {
+        let still_above_rho = sel.residual_energy() / yy >= rho;
+        if !still_above_rho {
             break StopReason::Rho;
         }
         if sel.selected().len() >= max_centers {

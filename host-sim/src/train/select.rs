@@ -104,7 +104,8 @@ impl<'a> Selection<'a> {
             }
         }
         let norm2 = dot(&u, &u);
-        if !(norm2 > self.collinearity_tol * dot(v, v)) {
+        let has_new_energy = norm2 > self.collinearity_tol * dot(v, v);
+        if !has_new_energy {
             return Added::Collinear;
         }
         let norm = norm2.sqrt();
