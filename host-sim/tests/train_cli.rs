@@ -8,12 +8,12 @@ use std::process::Command;
 /// Writes one fog-runs v1 file of a warm-up whose drift follows dT/dt.
 fn write_run(path: &Path, ambient_c: f64, run: usize) {
     let mut s = format!("# fog-runs v1\n# ambient_c: {ambient_c}\nt_s,rate_dph,temp_c,earth_dph\n");
-    for i in 1..=120 {
+    for i in 1..=120u32 {
         let t = 10.0 * f64::from(i);
         let tau = 500.0 + 50.0 * run as f64;
         let temp = ambient_c + 5.0 * (1.0 - (-t / tau).exp());
         let rate = 5.0 / tau * (-t / tau).exp();
-        let drift = 15.0 * rate + 0.003 * ((i * 7 + run) % 5) as f64;
+        let drift = 15.0 * rate + 0.003 * f64::from((i * 7 + run as u32) % 5);
         s += &format!("{t},{},{temp:.4},9.7\n", 9.7 + drift);
     }
     std::fs::write(path, s).unwrap();

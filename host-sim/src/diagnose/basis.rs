@@ -44,6 +44,8 @@ impl RbfBasis {
     }
 
     /// The design columns: one Gaussian per centre, then the normalised inputs.
+    // Row-wise walk over column-major inputs: the row index is the natural loop variable.
+    #[allow(clippy::needless_range_loop)]
     pub fn columns(&self, inputs: &[Vec<f64>]) -> Vec<Vec<f64>> {
         let d = inputs.len();
         let n = inputs.first().map_or(0, Vec::len);
@@ -58,8 +60,8 @@ impl RbfBasis {
                 let r2: f64 = c.iter().zip(&x).map(|(a, b)| (a - b) * (a - b)).sum();
                 col.push((-r2 * inv).exp());
             }
-            for j in 0..d {
-                cols[self.centres.len() + j].push(x[j]);
+            for (col, xj) in cols[self.centres.len()..].iter_mut().zip(&x) {
+                col.push(*xj);
             }
         }
         cols

@@ -216,7 +216,9 @@ mod tests {
             }
         }
         let line: Vec<f64> = t.iter().map(|t| 1.0 - 0.5 * t).collect();
-        assert!(local_derivative(&t, &line, 1, RATE_HALF_S).iter().all(|r| (r + 0.5).abs() < 1e-9));
+        assert!(local_derivative(&t, &line, 1, RATE_HALF_S)
+            .iter()
+            .all(|r| (r + 0.5).abs() < 1e-9));
     }
 
     #[test]
