@@ -6,6 +6,9 @@ pub const EARTH_RATE_DPH: f64 = 15.041_067;
 pub const WINDOW_S: f32 = 10.0;
 
 /// Horizontal component of Earth rate at a latitude, deg/h.
+///
+/// Cosine via `numeric::sin_cos_deg` (exact reduction in degrees, f64 to ~2 ulps) instead
+/// of libm's `cos`: same precision, without libm's radian argument reduction in the firmware.
 pub fn earth_rate_horizontal_dph(latitude_deg: f64) -> f64 {
-    EARTH_RATE_DPH * libm::cos(latitude_deg.to_radians())
+    EARTH_RATE_DPH * crate::numeric::sin_cos_deg(latitude_deg).1
 }

@@ -138,7 +138,8 @@ impl WindowAverager {
 
     /// Index of the window containing time `t_s`.
     pub fn window_index(&self, t_s: f64) -> i64 {
-        libm::floor(t_s / self.window_s) as i64
+        // Time since power-on stays f64 (10 s windows must index exactly for days).
+        crate::numeric::floor_i64(t_s / self.window_s)
     }
 
     /// End of the window currently being filled, s.
@@ -389,7 +390,10 @@ impl FirstOrderLag {
             Some((t_last, y)) => {
                 let dt = t_s - t_last;
                 if dt > 0.0 {
-                    y + (x - y) * (1.0 - libm::exp(-dt / self.tau_s))
+                    // 1 - exp(-a) as -expm1f(-a) in f32: relative error ~1e-7 for any a (1 - expf
+                    // would lose digits for the small a = dt / tau of 10 s rows); the state
+                    // itself stays f64. The output is an f32 feature.
+                    y + (x - y) * -(libm::expm1f((-dt / self.tau_s) as f32) as f64)
                 } else {
                     y
                 }
@@ -401,8 +405,11 @@ impl FirstOrderLag {
 }
 
 /// Power-on transient shape exp(-t / tau).
+///
+/// `expf` in f32 (the ratio t / tau computed in f64): relative error about
+/// (1 + |t / tau|) * 6e-8, i.e. a few f32 ulps of the f32 feature while the decay matters.
 pub fn power_on_decay(t_s: f64, tau_s: f64) -> f64 {
-    libm::exp(-t_s / tau_s)
+    libm::expf((-t_s / tau_s) as f32) as f64
 }
 
 /// Model input vector for one row.
@@ -543,8 +550,10 @@ impl FeatureExtractor {
                 (FeatureKind::AuxRate(_), FeatureState::Rate(e)) => {
                     e.push(t_s, aux_v.unwrap_or(0.0)).map(|r| r.rate_per_s)
                 }
-                (FeatureKind::AuxCos(_), _) => aux_v.map(|d| libm::cos(d.to_radians())),
-                (FeatureKind::AuxSin(_), _) => aux_v.map(|d| libm::sin(d.to_radians())),
+                // Sine/cosine of degrees reduced exactly in degrees (`numeric::sin_cos_deg`,
+                // f64 to ~2 ulps): no libm radian reduction linked into the firmware.
+                (FeatureKind::AuxCos(_), _) => aux_v.map(|d| crate::numeric::sin_cos_deg(d).1),
+                (FeatureKind::AuxSin(_), _) => aux_v.map(|d| crate::numeric::sin_cos_deg(d).0),
                 _ => None,
             };
             match value {

@@ -16,6 +16,7 @@ pub mod fixed;
 pub mod hal;
 pub mod model;
 pub mod northfinder;
+pub mod numeric;
 pub mod protocol;
 pub mod rbf;
 pub mod synthetic;

@@ -21,6 +21,7 @@
 use crate::compensator::WindowResult;
 use crate::consts::earth_rate_horizontal_dph;
 use crate::hal::{TableState, Turntable};
+use crate::numeric::wrap_360_deg as wrap_360;
 
 /// Most table positions in one seek.
 pub const MAX_POSITIONS: usize = 4;
@@ -196,15 +197,6 @@ pub struct NorthFinder {
     last: Option<SeekResult>,
 }
 
-fn wrap_360(deg: f64) -> f64 {
-    let r = deg - 360.0 * libm::floor(deg / 360.0);
-    if r >= 360.0 {
-        0.0
-    } else {
-        r
-    }
-}
-
 impl NorthFinder {
     pub fn new(cfg: SeekConfig) -> Result<Self, SeekError> {
         let pos = |v: f32| v.is_finite() && v > 0.0;
@@ -263,7 +255,8 @@ impl NorthFinder {
     /// dc / |sin psi| with var(dc) = N^2 / (2 tau) equals ds with var(ds) = N^2 / tau_90,
     /// i.e. |sin psi| = sqrt(tau_90 / (2 tau)) (0.29 for 120 s / 20 s dwells).
     pub fn direct_sine_below(&self) -> f64 {
-        libm::sqrt(self.cfg.ambiguity_dwell_s as f64 / (2.0 * self.cfg.dwell_s as f64)).min(0.5)
+        // f32 inputs, so f32 `sqrtf` loses nothing.
+        (libm::sqrtf(self.cfg.ambiguity_dwell_s / (2.0 * self.cfg.dwell_s)) as f64).min(0.5)
     }
 
     fn dwell_of(&self, k: usize) -> f64 {
@@ -411,7 +404,8 @@ impl NorthFinder {
         let mean = a.sum / n;
         let sigma = if a.n >= 2 {
             let var = ((a.sum_sq - n * mean * mean) / (n - 1.0)).max(0.0);
-            libm::sqrt(var / n)
+            // A 1-sigma estimate: f32 `sqrtf` (7 significant digits) is plenty.
+            libm::sqrtf((var / n) as f32) as f64
         } else {
             0.0
         };
@@ -437,25 +431,31 @@ impl NorthFinder {
                 if libm::fabs(c) > 1.1 {
                     return Err(SeekError::InconsistentRates);
                 }
-                let psi0 = libm::acos(c.clamp(-1.0, 1.0));
+                // Angles in f32 (acosf/atan2f, ~1e-7 rad = 6e-6 deg, plus the rounding of c
+                // to f32, 6e-8 / |sin psi| rad <= 2e-7 rad for the default dwells' |sin psi| >= 0.29): far inside
+                // the 1e-4 deg noiseless tests and any gyro's noise, and the firmware then
+                // needs no f64 trigonometry. Sums and rates stay f64.
+                let c_in = c.clamp(-1.0, 1.0);
+                let psi0 = libm::acosf(c_in as f32) as f64;
                 let bias = 0.5 * (p1.mean_rate_dph + p2.mean_rate_dph);
                 // w3 = -Omega_H sin(psi) + bias.
                 let s = (bias - p3.mean_rate_dph) / oh;
                 let var_c =
                     (p1.sigma_dph * p1.sigma_dph + p2.sigma_dph * p2.sigma_dph) / (4.0 * oh * oh);
                 let var_s = (p3.sigma_dph * p3.sigma_dph) / (oh * oh) + var_c;
-                let sin0 = libm::sin(psi0);
+                // sin(acos c) = sqrt((1 - c)(1 + c)): exact identity, no sine needed.
+                let sin0 = libm::sqrtf(((1.0 - c_in) * (1.0 + c_in)) as f32) as f64;
                 if sin0 >= self.direct_sine_below() {
                     // Main branch: acos of the two main dwells, sign from the +90 dwell.
                     let psi = if s >= 0.0 { psi0 } else { -psi0 };
-                    (psi, libm::sqrt(var_c) / sin0, bias)
+                    (psi, libm::sqrtf(var_c as f32) as f64 / sin0, bias)
                 } else {
                     // Near psi = 0/180 acos is ill-conditioned (d psi = dc / |sin psi|): the
                     // +90 dwell measures sin(psi) directly and is the better estimate there.
-                    let psi = libm::atan2(s, c);
+                    let psi = libm::atan2f(s as f32, c as f32) as f64;
                     let r2 = c * c + s * s;
                     let var = (c * c * var_s + s * s * var_c) / (r2 * r2);
-                    (psi, libm::sqrt(var), bias)
+                    (psi, libm::sqrtf(var as f32) as f64, bias)
                 }
             }
             SeekMode::FourPosition => {
@@ -469,9 +469,9 @@ impl NorthFinder {
                 if r2 <= 0.0 {
                     return Err(SeekError::InconsistentRates);
                 }
-                let psi = libm::atan2(ds, dc);
+                let psi = libm::atan2f(ds as f32, dc as f32) as f64;
                 let var = (dc * dc * (v[1] + v[3]) + ds * ds * (v[0] + v[2])) / (r2 * r2);
-                (psi, libm::sqrt(var), 0.25 * (m[0] + m[1] + m[2] + m[3]))
+                (psi, libm::sqrtf(var as f32) as f64, 0.25 * (m[0] + m[1] + m[2] + m[3]))
             }
         };
         let azimuth = wrap_360(psi.to_degrees() - self.cfg.start_heading_deg as f64);

@@ -36,6 +36,10 @@ pub struct Args {
     /// Folds of the grouped (whole runs held out) cross-validation.
     #[arg(long, default_value_t = TrainConfig::default().folds)]
     pub folds: usize,
+    /// Drop a candidate once less than this fraction of its energy is new (orthogonal
+    /// to the selection); larger values give smaller, better-conditioned weights.
+    #[arg(long, default_value_t = TrainConfig::default().collinearity_tol)]
+    pub collinearity_tol: f64,
     /// Gyro id stored in the model (at most 16 bytes).
     #[arg(long, default_value = "sim")]
     pub gyro_id: String,
@@ -61,6 +65,7 @@ impl Args {
             max_centers: self.max_centers,
             width_candidates: self.widths.clone(),
             folds: self.folds,
+            collinearity_tol: self.collinearity_tol,
             gyro_id: self.gyro_id.clone(),
             ..TrainConfig::default()
         }

@@ -171,12 +171,12 @@ pub fn screen(
                 *i != top
                     && s.significant
                     && s.cand.column == scored[top].cand.column
-                    && s.cand.transform.complexity() < scored[top].cand.transform.complexity()
+                    && s.cand.complexity() < scored[top].cand.complexity()
             })
             .filter(|(_, s)| paired_pvalue(&unit_gains(&s.cv, &scored[top].cv), FLIP_SEED) >= 0.05)
             .min_by(|a, b| {
-                (a.1.cand.transform.complexity(), a.1.heldout_rms_dph)
-                    .partial_cmp(&(b.1.cand.transform.complexity(), b.1.heldout_rms_dph))
+                (a.1.cand.complexity(), a.1.heldout_rms_dph)
+                    .partial_cmp(&(b.1.cand.complexity(), b.1.heldout_rms_dph))
                     .unwrap_or(std::cmp::Ordering::Equal)
             })
             .map(|(i, _)| i);

@@ -72,6 +72,17 @@ impl Candidate {
         }
     }
 
+    /// Parsimony rank within a column (see `Transform::complexity`), except that for an
+    /// angle (`*_deg`) the harmonic is the natural form: its raw value wraps at 360 deg
+    /// and is only equivalent when few headings occur (e.g. two, 180 deg apart).
+    pub fn complexity(&self) -> u8 {
+        match self.transform {
+            Transform::Harmonic if self.column.ends_with("_deg") => 0,
+            Transform::Value if self.column.ends_with("_deg") => Transform::Harmonic.complexity(),
+            t => t.complexity(),
+        }
+    }
+
     /// The feature's columns for one run.
     pub fn compute(&self, s: &Series) -> Vec<Vec<f64>> {
         let x: &[f64] = match self.source {

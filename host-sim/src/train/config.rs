@@ -49,7 +49,7 @@ impl Default for TrainConfig {
             folds: 3,
             linear_only_inputs: 0,
             linear_on_rbf_inputs: false,
-            collinearity_tol: 1e-6,
+            collinearity_tol: 1e-4,
             gyro_id: String::from("sim"),
             threads: None,
         }

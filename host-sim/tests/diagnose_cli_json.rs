@@ -1,0 +1,72 @@
+//! `fogsim diagnose` end to end from fog-runs files: the JSON carries at least the issue's
+//! schema, plots are written, and the cross-check with the OLS trainer is included.
+
+#[allow(dead_code)]
+#[path = "common/planted.rs"]
+mod planted;
+use fog_sim::cmd::diagnose::{run, Args};
+use planted::{campaign, Effect, Shape};
+
+#[test]
+fn json_has_the_issue_schema_and_plots_are_written() {
+    let dir = std::env::temp_dir().join(format!("fog-diag-cli-{}", std::process::id()));
+    let runs_dir = dir.join("runs");
+    std::fs::create_dir_all(&runs_dir).unwrap();
+    let (runs, _) = campaign(
+        Effect::ColumnValue,
+        3,
+        Shape {
+            runs: 8,
+            minutes: 30.0,
+            sigmas: 1.0,
+        },
+    );
+    for r in &runs {
+        fog_sim::runs::write_run(runs_dir.join(r.name()), r).unwrap();
+    }
+    let json = dir.join("d.json");
+    let plots = dir.join("plots");
+    run(Args {
+        runs: vec![runs_dir.clone()],
+        json: Some(json.clone()),
+        plots: Some(plots.clone()),
+    })
+    .unwrap();
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(
+        v["baseline"]["inputs"],
+        serde_json::json!(["temp_c:value", "temp_c:rate"])
+    );
+    assert!(v["baseline"]["heldout_rms_dph"].as_f64().unwrap() > 0.0);
+    let c0 = &v["candidates"][0];
+    for key in [
+        "column",
+        "transform",
+        "tau_s",
+        "heldout_rms_dph",
+        "gain_pct",
+        "p_value",
+        "significant",
+    ] {
+        assert!(c0.get(key).is_some(), "candidate lacks {key}: {c0}");
+    }
+    assert!(v.get("named_cause").is_some());
+    for key in ["inputs", "heldout_rms_dph", "gain_pct"] {
+        assert!(v["extended"].get(key).is_some(), "extended lacks {key}");
+    }
+    for key in ["before_rms_dph", "after_rms_dph"] {
+        assert!(
+            v["simulation"][key].as_f64().is_some(),
+            "simulation lacks {key}"
+        );
+    }
+    assert!(
+        v["ols_trainer_check"]["baseline"]["heldout_std_dph"]
+            .as_f64()
+            .unwrap()
+            > 0.0
+    );
+    assert!(plots.join("residual_vs_time.svg").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
