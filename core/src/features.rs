@@ -109,6 +109,9 @@ pub struct WindowAverager {
     n_gaps: u32,
     max_gap_s: f64,
     last_t_s: Option<f64>,
+    /// Times in [sure_lo_s, sure_hi_s) certainly lie in window `index` (see `set_index`).
+    sure_lo_s: f64,
+    sure_hi_s: f64,
 }
 
 impl WindowAverager {
@@ -119,7 +122,7 @@ impl WindowAverager {
         {
             return Err(FeatureError::BadTimeConstant);
         }
-        Ok(WindowAverager {
+        let mut avg = WindowAverager {
             window_s: window_s as f64,
             period_s: 1.0 / nominal_rate_hz as f64,
             index: 0,
@@ -128,7 +131,25 @@ impl WindowAverager {
             n_gaps: 0,
             max_gap_s: 0.0,
             last_t_s: None,
-        })
+            sure_lo_s: 0.0,
+            sure_hi_s: 0.0,
+        };
+        avg.set_index(0);
+        Ok(avg)
+    }
+
+    /// Make `k` the current window and cache the interior of [k w, (k+1) w) where
+    /// `floor(t / w) == k` holds whatever the rounding: a margin of 1e-9 of the bounds'
+    /// magnitude dwarfs the few 2^-53 relative errors of k w and t / w. Samples there (all
+    /// but those within 1e-9 |t| of a boundary, 10 us after a day) skip the f64 division
+    /// in `window_index`; the result is the same as with the division.
+    fn set_index(&mut self, k: i64) {
+        self.index = k;
+        let start = k as f64 * self.window_s;
+        let end = start + self.window_s;
+        let margin = 1e-9 * start.abs().max(end.abs()).max(self.window_s);
+        self.sure_lo_s = start + margin;
+        self.sure_hi_s = end - margin;
     }
 
     /// Window length, s.
@@ -138,6 +159,10 @@ impl WindowAverager {
 
     /// Index of the window containing time `t_s`.
     pub fn window_index(&self, t_s: f64) -> i64 {
+        // Fast path for the 2 kHz sample stream: inside the current window (NaN fails it).
+        if t_s >= self.sure_lo_s && t_s < self.sure_hi_s {
+            return self.index;
+        }
         // Time since power-on stays f64 (10 s windows must index exactly for days).
         crate::numeric::floor_i64(t_s / self.window_s)
     }
@@ -175,7 +200,7 @@ impl WindowAverager {
             n_gaps,
             max_gap_s: max_gap as f32,
         };
-        self.index = self.index.saturating_add(1);
+        self.set_index(self.index.saturating_add(1));
         self.sum = 0.0;
         self.n = 0;
         self.n_gaps = 0;
@@ -200,7 +225,7 @@ impl WindowAverager {
             if self.n > 0 || self.last_t_s.is_some_and(|t| t >= self.window_start()) {
                 closed = Some(self.close());
             }
-            self.index = k;
+            self.set_index(k);
         }
         let start = self.window_start();
         let gap = match self.last_t_s {
@@ -230,7 +255,7 @@ impl WindowAverager {
             let out = self.close();
             let k = self.window_index(t_now_s);
             if k > self.index {
-                self.index = k;
+                self.set_index(k);
             }
             Some(out)
         } else {
@@ -390,10 +415,9 @@ impl FirstOrderLag {
             Some((t_last, y)) => {
                 let dt = t_s - t_last;
                 if dt > 0.0 {
-                    // 1 - exp(-a) as -expm1f(-a) in f32: relative error ~1e-7 for any a (1 - expf
-                    // would lose digits for the small a = dt / tau of 10 s rows); the state
-                    // itself stays f64. The output is an f32 feature.
-                    y + (x - y) * -(libm::expm1f((-dt / self.tau_s) as f32) as f64)
+                    // f64 `exp` kept on purpose: 1 - exp(-a) for the small a = dt / tau of 10 s
+                    // rows cancels digits, which f32 `expf` could not spare (the lag state is f64).
+                    y + (x - y) * (1.0 - libm::exp(-dt / self.tau_s))
                 } else {
                     y
                 }
@@ -405,11 +429,9 @@ impl FirstOrderLag {
 }
 
 /// Power-on transient shape exp(-t / tau).
-///
-/// `expf` in f32 (the ratio t / tau computed in f64): relative error about
-/// (1 + |t / tau|) * 6e-8, i.e. a few f32 ulps of the f32 feature while the decay matters.
+/// (f64 `exp`: it is linked for `FirstOrderLag` anyway.)
 pub fn power_on_decay(t_s: f64, tau_s: f64) -> f64 {
-    libm::expf((-t_s / tau_s) as f32) as f64
+    libm::exp(-t_s / tau_s)
 }
 
 /// Model input vector for one row.
