@@ -471,7 +471,11 @@ impl NorthFinder {
                 }
                 let psi = libm::atan2f(ds as f32, dc as f32) as f64;
                 let var = (dc * dc * (v[1] + v[3]) + ds * ds * (v[0] + v[2])) / (r2 * r2);
-                (psi, libm::sqrtf(var as f32) as f64, 0.25 * (m[0] + m[1] + m[2] + m[3]))
+                (
+                    psi,
+                    libm::sqrtf(var as f32) as f64,
+                    0.25 * (m[0] + m[1] + m[2] + m[3]),
+                )
             }
         };
         let azimuth = wrap_360(psi.to_degrees() - self.cfg.start_heading_deg as f64);

@@ -75,9 +75,25 @@ mod tests {
     #[test]
     fn floor_i64_matches_libm_floor() {
         let cases = [
-            0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 2.999_999_999, -2.999_999_999, 1e15 + 0.5,
-            -1e15 - 0.5, 9.3e18, -9.3e18, 1e300, -1e300, f64::NAN, f64::INFINITY,
-            f64::NEG_INFINITY, f64::MIN_POSITIVE, -f64::MIN_POSITIVE,
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            2.999_999_999,
+            -2.999_999_999,
+            1e15 + 0.5,
+            -1e15 - 0.5,
+            9.3e18,
+            -9.3e18,
+            1e300,
+            -1e300,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::MIN_POSITIVE,
+            -f64::MIN_POSITIVE,
         ];
         for x in cases {
             assert_eq!(floor_i64(x), libm::floor(x) as i64, "x = {x}");
