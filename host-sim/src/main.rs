@@ -4,7 +4,11 @@ use clap::{Parser, Subcommand};
 use fog_sim::cmd;
 
 #[derive(Parser)]
-#[command(name = "fogsim", version, about = "FOG warm-up drift: simulate, train, compensate, north-seek, diagnose, upload")]
+#[command(
+    name = "fogsim",
+    version,
+    about = "FOG warm-up drift: simulate, train, compensate, north-seek, diagnose, upload"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
