@@ -14,7 +14,7 @@ use crate::features::{
 };
 use crate::fixed::{FixedError, FixedModel};
 use crate::hal::{GyroSample, TempSample};
-use crate::model::{FeatureKind, FeatureSpec, ModelError, RbfModel, MAX_AUX, MAX_INPUTS};
+use crate::model::{FeatureSpec, ModelError, RbfModel, MAX_AUX, MAX_INPUTS};
 use crate::rbf::{predict_f32, RbfError};
 
 /// Which evaluator computes the drift.
@@ -171,16 +171,7 @@ pub struct Compensator {
     fault_windows: Option<(i64, i64)>,
 }
 
-const DEFAULT_SPECS: [FeatureSpec; 2] = [
-    FeatureSpec {
-        kind: FeatureKind::TempC,
-        tau_s: 0.0,
-    },
-    FeatureSpec {
-        kind: FeatureKind::TempRateCps,
-        tau_s: 0.0,
-    },
-];
+const DEFAULT_SPECS: [FeatureSpec; 2] = crate::model::PAPER_INPUTS;
 
 impl Compensator {
     /// Pipeline with an optional model (None: windows are reported uncompensated).

@@ -56,6 +56,19 @@ pub struct FeatureSpec {
     pub tau_s: f32,
 }
 
+impl FeatureSpec {
+    /// An input without a time constant (rate and accel then use the estimator's default span).
+    pub const fn plain(kind: FeatureKind) -> Self {
+        Self { kind, tau_s: 0.0 }
+    }
+}
+
+/// The paper's inputs: gyro temperature and its rate.
+pub const PAPER_INPUTS: [FeatureSpec; 2] = [
+    FeatureSpec::plain(FeatureKind::TempC),
+    FeatureSpec::plain(FeatureKind::TempRateCps),
+];
+
 /// Where the model came from.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrainingMeta {

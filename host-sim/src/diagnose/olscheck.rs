@@ -84,16 +84,7 @@ fn score(
 pub fn ols_check(runs: &[Run], cause: Option<&Cause>) -> anyhow::Result<OlsCheck> {
     let folds = runs.len().min(5);
     anyhow::ensure!(folds >= 4, "the trainer cross-check needs at least 4 runs");
-    let base_specs = [
-        FeatureSpec {
-            kind: FeatureKind::TempC,
-            tau_s: 0.0,
-        },
-        FeatureSpec {
-            kind: FeatureKind::TempRateCps,
-            tau_s: 0.0,
-        },
-    ];
+    let base_specs = fog_core::model::PAPER_INPUTS;
     let baseline = score(runs, &base_specs, &[], 0, folds)?;
     let (extended, note) = match cause.map(|c| (c, cause_specs(c))) {
         None => (None, None),

@@ -10,16 +10,7 @@ use fog_core::model::{FeatureKind, FeatureSpec, MAX_INPUTS};
 
 /// The paper's inputs: gyro temperature and its rate.
 pub fn default_specs() -> Vec<FeatureSpec> {
-    vec![
-        FeatureSpec {
-            kind: FeatureKind::TempC,
-            tau_s: 0.0,
-        },
-        FeatureSpec {
-            kind: FeatureKind::TempRateCps,
-            tau_s: 0.0,
-        },
-    ]
+    fog_core::model::PAPER_INPUTS.to_vec()
 }
 
 /// Report name of an input, `<column>:<transform>` as in the fog-runs format notes.

@@ -7,7 +7,7 @@ use std::collections::VecDeque;
 use std::io::{Read, Write};
 use std::time::Duration;
 
-use fog_core::model::{FeatureKind, FeatureSpec, RbfModel, TrainingMeta, MAX_ENCODED_LEN};
+use fog_core::model::{RbfModel, TrainingMeta, MAX_ENCODED_LEN};
 use fog_firmware::signature::TEST_PUBLIC_KEY;
 use fog_firmware::store::EmulatedModelFlash;
 use fog_firmware::upload::UploadServer;
@@ -15,16 +15,7 @@ use fog_sim::upload::{load_signing_key, sign_model, test_key_path, UploadClient}
 
 /// A valid 2-input model (T, dT/dt) with `n_centers` centres for gyro `gyro_id`.
 pub fn sample_model(gyro_id: &str, n_centers: usize, weight_scale: f32) -> RbfModel {
-    let inputs = [
-        FeatureSpec {
-            kind: FeatureKind::TempC,
-            tau_s: 0.0,
-        },
-        FeatureSpec {
-            kind: FeatureKind::TempRateCps,
-            tau_s: 0.0,
-        },
-    ];
+    let inputs = fog_core::model::PAPER_INPUTS;
     let mut m = RbfModel {
         n_rbf_inputs: 2,
         inputs: inputs.iter().copied().collect(),
