@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Refresh the firmware budget table (flash, static RAM, panic paths, instruction counts,
-# CPU load) in docs/budgets.md. Needs qemu-system-arm and the thumbv7em-none-eabihf
+# CPU load) in docs/budgets.md and in the README. Needs qemu-system-arm and the thumbv7em-none-eabihf
 # target; runs the same check CI runs (tests/tests/fw_budgets.rs) and keeps its table.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -22,3 +22,19 @@ FOG_REQUIRE_QEMU=1 FOG_BUDGETS_STACK_OUT="$stack" \
     cat "$table" "$stack"
 } > "$out"
 echo "wrote $out"
+
+# The README carries the same table between its budget markers.
+readme="$PWD/README.md"
+if grep -q '<!-- budgets:begin -->' "$readme"; then
+    python3 - "$readme" "$table" "$stack" <<'PY'
+import sys
+readme, parts = sys.argv[1], sys.argv[2:]
+text = open(readme).read()
+begin, end = "<!-- budgets:begin -->", "<!-- budgets:end -->"
+head, rest = text.split(begin, 1)
+_, tail = rest.split(end, 1)
+table = "".join(open(p).read() for p in parts).strip()
+open(readme, "w").write(head + begin + "\n" + table + "\n" + end + tail)
+PY
+    echo "updated the budget table in $readme"
+fi
