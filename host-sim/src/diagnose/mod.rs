@@ -22,6 +22,7 @@ pub mod residuals;
 pub mod screen;
 pub mod signflip;
 pub mod simfit;
+pub mod simterm;
 pub mod transforms;
 
 pub use error::DiagnoseError;
@@ -49,6 +50,9 @@ pub struct Diagnosis {
     pub extended_residual: Vec<f64>,
     /// The named cause's first feature column (stacked), if any.
     pub cause_feature: Option<Vec<f64>>,
+    /// The named effect as `fog_sim::sim` drift terms, per run in `run_names` order
+    /// (empty lists when nothing is named): add them with `GyroParams::with_term`.
+    pub sim_terms: Vec<Vec<crate::sim::DriftTerm>>,
 }
 
 fn pooled_within_std(rows: &[std::ops::Range<usize>], v: &[f64]) -> f64 {
@@ -124,6 +128,13 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
         extended: azimuth::azimuth_effect(&folds, &st.t_s, &ext_resid, latitude),
     });
     let words = report::cause_in_words(cause.as_ref(), &sim.effect_coef);
+    let sim_terms = simterm::terms_per_run(runs, cause.as_ref(), &sim.effect_coef);
+    let term_summaries: Vec<simterm::TermSummary> = sim_terms
+        .first()
+        .into_iter()
+        .flatten()
+        .map(|t| simterm::summarize(t, cause.as_ref().map_or("", |c| c.column.as_str())))
+        .collect();
     let to_excl = |(c, r): &(String, String)| Exclusion {
         column: c.clone(),
         reason: r.clone(),
@@ -181,6 +192,8 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
         simulation: Simulation {
             before_rms_dph: sim.before_rms_dph,
             after_rms_dph: sim.after_rms_dph.unwrap_or(sim.before_rms_dph),
+            term: term_summaries.first().cloned(),
+            terms: term_summaries,
             calibration: sim,
         },
     };
@@ -193,5 +206,6 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
         baseline_residual: base.cv.residual.clone(),
         extended_residual: ext_resid,
         cause_feature: named.and_then(|s| s.cols.first().cloned()),
+        sim_terms,
     })
 }

@@ -5,6 +5,7 @@ use super::input::Exclusion;
 use super::residuals::Structure;
 use super::screen::Mode;
 use super::simfit::SimCalibration;
+use super::simterm::TermSummary;
 use super::transforms::Transform;
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -88,6 +89,10 @@ pub struct Azimuth {
 pub struct Simulation {
     pub before_rms_dph: f64,
     pub after_rms_dph: f64,
+    /// The named effect as a `fog_sim::sim::DriftTerm` (the first one for a harmonic).
+    pub term: Option<TermSummary>,
+    /// Every term added (two for a harmonic: cos and sin).
+    pub terms: Vec<TermSummary>,
     pub calibration: SimCalibration,
 }
 
@@ -302,6 +307,14 @@ pub fn render_text(r: &Report) -> String {
             "  sim vs measured rms: {:.4} -> {:.4} deg/h (fitted coefficient(s) of the new term: {:?})",
             r.simulation.before_rms_dph, r.simulation.after_rms_dph, sim.effect_coef
         );
+        for t in &r.simulation.terms {
+            let tau = t.tau_s.map_or(String::new(), |v| format!(", tau {v:.0} s"));
+            let _ = writeln!(
+                s,
+                "  simulator extended with: {} = {:.4e} deg/h x {}({}{tau}) (fog_sim::sim::DriftTerm)",
+                t.label, t.coeff_dph, t.transform, t.source
+            );
+        }
     } else {
         let _ = writeln!(
             s,
