@@ -49,22 +49,6 @@ pub struct CompensatorConfig {
     pub evaluator: Evaluator,
 }
 
-impl Default for CompensatorConfig {
-    fn default() -> Self {
-        CompensatorConfig {
-            window_s: crate::consts::WINDOW_S,
-            gyro_rate_hz: 100.0,
-            temp_rate_hz: 1.0,
-            min_fill: 0.9,
-            temp_plausible_min_c: -60.0,
-            temp_plausible_max_c: 125.0,
-            range_margin_frac: 0.05,
-            n_aux: 0,
-            evaluator: Evaluator::F32,
-        }
-    }
-}
-
 /// Why the compensator could not be set up.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -155,11 +139,22 @@ pub struct WindowResult {
 }
 
 /// The 10 s compensation pipeline.
+///
+/// About 8 KB (model, fixed-point copy, feature history), so it is built and re-set in
+/// place: `unconfigured` is a `const fn` (a `static` or a slot in a bigger struct), and
+/// `configure` / `set_model_from` write the fields without building a whole temporary.
 #[derive(Clone, Debug)]
 pub struct Compensator {
     cfg: CompensatorConfig,
-    model: Option<RbfModel>,
-    fixed: Option<FixedModel>,
+    /// False until `configure` succeeds: samples are then ignored.
+    configured: bool,
+    /// The model in use, valid if `has_model` (stored in place, not as an `Option`, so it
+    /// can be overwritten with `RbfModel::copy_from`).
+    model: RbfModel,
+    has_model: bool,
+    /// The fixed-point copy of `model`, used if `use_fixed`.
+    fixed: FixedModel,
+    use_fixed: bool,
     features: FeatureExtractor,
     rate_report: TempRateEstimator<EXTRACTOR_RATE_POINTS>,
     gyro: WindowAverager,
@@ -173,9 +168,82 @@ pub struct Compensator {
 
 const DEFAULT_SPECS: [FeatureSpec; 2] = crate::model::PAPER_INPUTS;
 
+/// The default configuration as a constant.
+const DEFAULT_CONFIG: CompensatorConfig = CompensatorConfig {
+    window_s: crate::consts::WINDOW_S,
+    gyro_rate_hz: 100.0,
+    temp_rate_hz: 1.0,
+    min_fill: 0.9,
+    temp_plausible_min_c: -60.0,
+    temp_plausible_max_c: 125.0,
+    range_margin_frac: 0.05,
+    n_aux: 0,
+    evaluator: Evaluator::F32,
+};
+
+/// What `unconfigured` holds: all zero bytes, so that a `static` holding an unconfigured
+/// compensator goes to `.bss` and costs no flash (it is never used: `configure` checks
+/// and replaces it).
+const ZERO_CONFIG: CompensatorConfig = CompensatorConfig {
+    window_s: 0.0,
+    gyro_rate_hz: 0.0,
+    temp_rate_hz: 0.0,
+    min_fill: 0.0,
+    temp_plausible_min_c: 0.0,
+    temp_plausible_max_c: 0.0,
+    range_margin_frac: 0.0,
+    n_aux: 0,
+    evaluator: Evaluator::F32,
+};
+
+impl Default for CompensatorConfig {
+    fn default() -> Self {
+        DEFAULT_CONFIG
+    }
+}
+
 impl Compensator {
     /// Pipeline with an optional model (None: windows are reported uncompensated).
     pub fn new(cfg: CompensatorConfig, model: Option<RbfModel>) -> Result<Self, CompensatorError> {
+        let mut c = Compensator::unconfigured();
+        c.configure(cfg, model.as_ref())?;
+        Ok(c)
+    }
+
+    /// Storage for a compensator that ignores every sample until `configure` succeeds
+    /// (its `config()` is all zeros until then).
+    pub const fn unconfigured() -> Self {
+        Compensator {
+            cfg: ZERO_CONFIG,
+            configured: false,
+            model: RbfModel::empty(),
+            has_model: false,
+            fixed: FixedModel::empty(),
+            use_fixed: false,
+            features: FeatureExtractor::empty(),
+            rate_report: TempRateEstimator::placeholder(),
+            gyro: WindowAverager::placeholder(),
+            temp: WindowAverager::placeholder(),
+            temp_pending: None,
+            aux: [
+                WindowAverager::placeholder(),
+                WindowAverager::placeholder(),
+                WindowAverager::placeholder(),
+                WindowAverager::placeholder(),
+            ],
+            aux_pending: [None; MAX_AUX],
+            fault_windows: None,
+        }
+    }
+
+    /// Become `new(cfg, model)` in place. On error the compensator is unconfigured
+    /// (it ignores samples) until a `configure` succeeds.
+    pub fn configure(
+        &mut self,
+        cfg: CompensatorConfig,
+        model: Option<&RbfModel>,
+    ) -> Result<(), CompensatorError> {
+        self.configured = false;
         let ok_rate = |r: f32| r.is_finite() && r > 0.0 && r <= 10_000.0;
         if !(cfg.window_s.is_finite()
             && cfg.window_s > 0.0
@@ -190,61 +258,76 @@ impl Compensator {
             return Err(CompensatorError::BadConfig);
         }
         let bad = |_| CompensatorError::BadConfig;
-        let temp = WindowAverager::new(cfg.window_s, cfg.temp_rate_hz).map_err(bad)?;
-        let mut c = Compensator {
-            cfg,
-            model: None,
-            fixed: None,
-            features: FeatureExtractor::new(&DEFAULT_SPECS).map_err(CompensatorError::Feature)?,
-            rate_report: TempRateEstimator::new(DEFAULT_RATE_SPAN_S).map_err(bad)?,
-            gyro: WindowAverager::new(cfg.window_s, cfg.gyro_rate_hz).map_err(bad)?,
-            temp: temp.clone(),
-            temp_pending: None,
-            aux: [temp.clone(), temp.clone(), temp.clone(), temp],
-            aux_pending: [None; MAX_AUX],
-            fault_windows: None,
-        };
-        c.set_model(model)?;
-        Ok(c)
+        self.gyro = WindowAverager::new(cfg.window_s, cfg.gyro_rate_hz).map_err(bad)?;
+        self.temp = WindowAverager::new(cfg.window_s, cfg.temp_rate_hz).map_err(bad)?;
+        for aux in self.aux.iter_mut() {
+            aux.clone_from(&self.temp);
+        }
+        self.rate_report = TempRateEstimator::new(DEFAULT_RATE_SPAN_S).map_err(bad)?;
+        self.temp_pending = None;
+        self.aux_pending = [None; MAX_AUX];
+        self.fault_windows = None;
+        self.cfg = cfg;
+        // No model yet: a failing `set_model_from` below leaves "no model", as `new` did.
+        self.has_model = false;
+        self.use_fixed = false;
+        self.features
+            .reset_to(&DEFAULT_SPECS)
+            .map_err(CompensatorError::Feature)?;
+        self.set_model_from(model)?;
+        self.configured = true;
+        Ok(())
     }
 
     /// Replace the model (e.g. after an upload). Feature history restarts.
     pub fn set_model(&mut self, model: Option<RbfModel>) -> Result<(), CompensatorError> {
-        let (features, fixed) = match &model {
-            Some(m) => {
-                m.validate().map_err(CompensatorError::Model)?;
-                for spec in m.inputs.iter() {
-                    if let Some(ch) = spec.kind.aux_channel() {
-                        if ch >= self.cfg.n_aux {
-                            return Err(CompensatorError::AuxNotConfigured { channel: ch });
-                        }
-                    }
-                }
-                let fixed = match self.cfg.evaluator {
-                    Evaluator::Fixed => {
-                        Some(FixedModel::from_model(m).map_err(CompensatorError::Fixed)?)
-                    }
-                    Evaluator::F32 => None,
-                };
-                (
-                    FeatureExtractor::new(&m.inputs).map_err(CompensatorError::Feature)?,
-                    fixed,
-                )
-            }
-            None => (
-                FeatureExtractor::new(&DEFAULT_SPECS).map_err(CompensatorError::Feature)?,
-                None,
-            ),
+        self.set_model_from(model.as_ref())
+    }
+
+    /// `set_model` from a reference, in place. On error the old model (and its feature
+    /// history) stays: everything is checked before the first write.
+    pub fn set_model_from(&mut self, model: Option<&RbfModel>) -> Result<(), CompensatorError> {
+        let Some(m) = model else {
+            self.features
+                .reset_to(&DEFAULT_SPECS)
+                .map_err(CompensatorError::Feature)?;
+            self.has_model = false;
+            self.use_fixed = false;
+            return Ok(());
         };
-        self.features = features;
-        self.fixed = fixed;
-        self.model = model;
+        m.validate().map_err(CompensatorError::Model)?;
+        for spec in m.inputs.iter() {
+            if let Some(ch) = spec.kind.aux_channel() {
+                if ch >= self.cfg.n_aux {
+                    return Err(CompensatorError::AuxNotConfigured { channel: ch });
+                }
+            }
+        }
+        // Check the specs without touching the history...
+        FeatureExtractor::check_specs(&m.inputs).map_err(CompensatorError::Feature)?;
+        let use_fixed = self.cfg.evaluator == Evaluator::Fixed;
+        if use_fixed {
+            if let Err(e) = self.fixed.fill_from(m) {
+                // Conversion is deterministic: refill from the old model, which converted.
+                if self.use_fixed && self.has_model {
+                    let _ = self.fixed.fill_from(&self.model);
+                }
+                return Err(CompensatorError::Fixed(e));
+            }
+        }
+        // ...so this cannot fail any more.
+        self.features
+            .reset_to(&m.inputs)
+            .map_err(CompensatorError::Feature)?;
+        self.model.copy_from(m);
+        self.has_model = true;
+        self.use_fixed = use_fixed;
         Ok(())
     }
 
     /// The model in use.
     pub fn model(&self) -> Option<&RbfModel> {
-        self.model.as_ref()
+        self.has_model.then_some(&self.model)
     }
 
     pub fn config(&self) -> &CompensatorConfig {
@@ -253,7 +336,7 @@ impl Compensator {
 
     /// Add a gyro sample; returns the result of the window it closed, if any.
     pub fn push_gyro(&mut self, s: GyroSample) -> Option<WindowResult> {
-        if !s.rate_dph.is_finite() || !s.t_s.is_finite() {
+        if !self.configured || !s.rate_dph.is_finite() || !s.t_s.is_finite() {
             return None;
         }
         let closed = self.gyro.push(s.t_s, s.rate_dph)?;
@@ -262,6 +345,9 @@ impl Compensator {
 
     /// Add a temperature reading. Implausible values mark the window as faulty.
     pub fn push_temp(&mut self, s: TempSample) {
+        if !self.configured {
+            return;
+        }
         if !s.temp_c.is_finite()
             || s.temp_c < self.cfg.temp_plausible_min_c
             || s.temp_c > self.cfg.temp_plausible_max_c
@@ -277,7 +363,7 @@ impl Compensator {
     /// Add a reading of aux channel `channel` (< `n_aux`; others are ignored).
     pub fn push_aux(&mut self, channel: u8, t_s: f64, value: f32) {
         let ch = channel as usize;
-        if channel >= self.cfg.n_aux {
+        if !self.configured || channel >= self.cfg.n_aux {
             return;
         }
         if let Some(m) = self.aux[ch].push(t_s, value) {
@@ -287,7 +373,7 @@ impl Compensator {
 
     /// A sensor reported a fault at `t_s` (read error, timeout): that window is invalid.
     pub fn report_fault(&mut self, t_s: f64) {
-        if t_s.is_finite() {
+        if self.configured && t_s.is_finite() {
             let k = self.gyro.window_index(t_s);
             // Faults arrive in real time, so one range (conservatively merged) suffices.
             self.fault_windows = Some(match self.fault_windows {
@@ -300,6 +386,9 @@ impl Compensator {
     /// Close the current window by time (no gyro sample needed), e.g. from a timer, so a
     /// silent gyro still yields an (invalid) result.
     pub fn poll(&mut self, t_now_s: f64) -> Option<WindowResult> {
+        if !self.configured {
+            return None;
+        }
         let closed = self.gyro.poll(t_now_s)?;
         Some(self.finish(closed))
     }
@@ -416,9 +505,10 @@ impl Compensator {
     /// Drift at the inputs clamped to the (margin-widened) trained range, and the first
     /// input that was outside it.
     fn evaluate(&self, x: &[f32]) -> (Option<f32>, Option<u8>) {
-        let Some(m) = &self.model else {
+        if !self.has_model {
             return (None, None);
-        };
+        }
+        let m = &self.model;
         let mut clamped = [0.0f32; MAX_INPUTS];
         let mut outside = None;
         for (j, &v) in x.iter().enumerate() {
@@ -438,9 +528,10 @@ impl Compensator {
             };
         }
         let xs = &clamped[..x.len()];
-        let drift: Result<f32, RbfError> = match &self.fixed {
-            Some(f) => f.predict(xs),
-            None => predict_f32(m, xs),
+        let drift: Result<f32, RbfError> = if self.use_fixed {
+            self.fixed.predict(xs)
+        } else {
+            predict_f32(m, xs)
         };
         (drift.ok(), outside)
     }

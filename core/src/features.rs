@@ -115,6 +115,23 @@ pub struct WindowAverager {
 }
 
 impl WindowAverager {
+    /// Storage before `new` is assigned (all zero bytes): not usable as an averager; the
+    /// compensator holds these only while it is unconfigured and then ignores samples.
+    pub(crate) const fn placeholder() -> Self {
+        WindowAverager {
+            window_s: 0.0,
+            period_s: 0.0,
+            index: 0,
+            sum: 0.0,
+            n: 0,
+            n_gaps: 0,
+            max_gap_s: 0.0,
+            last_t_s: None,
+            sure_lo_s: 0.0,
+            sure_hi_s: 0.0,
+        }
+    }
+
     /// Windows of `window_s` (> 0) for samples arriving at `nominal_rate_hz` (> 0).
     pub fn new(window_s: f32, nominal_rate_hz: f32) -> Result<Self, FeatureError> {
         if !(window_s.is_finite() && window_s > 0.0 && nominal_rate_hz.is_finite())
@@ -298,6 +315,15 @@ impl<const N: usize> TempRateEstimator<N> {
             span_s,
             points: Deque::new(),
         })
+    }
+
+    /// Storage before `new` is assigned (span 0, all zero bytes, so a `static` holding
+    /// it costs no flash): not usable as an estimator.
+    pub(crate) const fn placeholder() -> Self {
+        TempRateEstimator {
+            span_s: 0.0,
+            points: Deque::new(),
+        }
     }
 
     /// Span, s.
@@ -484,41 +510,78 @@ pub fn span_for(spec: &FeatureSpec) -> f64 {
     }
 }
 
+/// The fresh state of one spec, or why the spec is invalid.
+fn fresh_state(spec: &FeatureSpec) -> Result<FeatureState, FeatureError> {
+    let state = match spec.kind {
+        FeatureKind::TempRateCps | FeatureKind::TempAccelCps2 | FeatureKind::AuxRate(_) => {
+            FeatureState::Rate(TempRateEstimator::new(span_for(spec))?)
+        }
+        FeatureKind::TempLagC => FeatureState::Lag(FirstOrderLag::new(spec.tau_s as f64)?),
+        FeatureKind::PowerOnDecay => {
+            if !(spec.tau_s.is_finite() && spec.tau_s > 0.0) {
+                return Err(FeatureError::BadTimeConstant);
+            }
+            FeatureState::Plain
+        }
+        _ => FeatureState::Plain,
+    };
+    if let Some(ch) = spec.kind.aux_channel() {
+        if ch as usize >= MAX_AUX {
+            return Err(FeatureError::MissingAux { channel: ch });
+        }
+    }
+    Ok(state)
+}
+
 impl FeatureExtractor {
+    /// An extractor without specs (every row gives an empty, ready vector): the initial
+    /// value of storage that `reset_to` sets up in place.
+    pub const fn empty() -> Self {
+        FeatureExtractor {
+            specs: Vec::new(),
+            states: Vec::new(),
+            last_t_s: None,
+            row: 0,
+        }
+    }
+
     /// Extractor for `specs` (at most `MAX_INPUTS`).
     pub fn new(specs: &[FeatureSpec]) -> Result<Self, FeatureError> {
-        let mut v = Vec::new();
-        let mut states = Vec::new();
-        for spec in specs {
-            let state = match spec.kind {
-                FeatureKind::TempRateCps | FeatureKind::TempAccelCps2 | FeatureKind::AuxRate(_) => {
-                    FeatureState::Rate(TempRateEstimator::new(span_for(spec))?)
-                }
-                FeatureKind::TempLagC => FeatureState::Lag(FirstOrderLag::new(spec.tau_s as f64)?),
-                FeatureKind::PowerOnDecay => {
-                    if !(spec.tau_s.is_finite() && spec.tau_s > 0.0) {
-                        return Err(FeatureError::BadTimeConstant);
-                    }
-                    FeatureState::Plain
-                }
-                _ => FeatureState::Plain,
-            };
-            if let Some(ch) = spec.kind.aux_channel() {
-                if ch as usize >= MAX_AUX {
-                    return Err(FeatureError::MissingAux { channel: ch });
-                }
+        let mut fe = FeatureExtractor::empty();
+        fe.reset_to(specs)?;
+        Ok(fe)
+    }
+
+    /// The error `new(specs)` would return, if any, without building an extractor.
+    pub fn check_specs(specs: &[FeatureSpec]) -> Result<(), FeatureError> {
+        for (i, spec) in specs.iter().enumerate() {
+            fresh_state(spec)?;
+            if i >= MAX_INPUTS {
+                return Err(FeatureError::TooManyFeatures);
             }
-            v.push(*spec).map_err(|_| FeatureError::TooManyFeatures)?;
-            states
+        }
+        Ok(())
+    }
+
+    /// Become `new(specs)` in place, history cleared. On error `self` is unchanged:
+    /// every spec is checked before anything is written.
+    pub fn reset_to(&mut self, specs: &[FeatureSpec]) -> Result<(), FeatureError> {
+        Self::check_specs(specs)?;
+        self.specs.clear();
+        self.states.clear();
+        self.last_t_s = None;
+        self.row = 0;
+        for spec in specs {
+            // Checked above: neither the state nor the pushes can fail.
+            let state = fresh_state(spec)?;
+            self.specs
+                .push(*spec)
+                .map_err(|_| FeatureError::TooManyFeatures)?;
+            self.states
                 .push(state)
                 .map_err(|_| FeatureError::TooManyFeatures)?;
         }
-        Ok(FeatureExtractor {
-            specs: v,
-            states,
-            last_t_s: None,
-            row: 0,
-        })
+        Ok(())
     }
 
     /// The specs, in order.

@@ -128,14 +128,13 @@ fn to_q(v: f64, frac: i32) -> i64 {
 }
 
 impl FixedModel {
-    /// Convert a model (validated here) for integer-only evaluation.
-    pub fn from_model(model: &RbfModel) -> Result<FixedModel, FixedError> {
-        model.validate().map_err(FixedError::Model)?;
-        let n = model.inputs.len();
-        let mut fm = FixedModel {
-            n_inputs: n as u8,
-            n_rbf: model.n_rbf_inputs,
-            n_centers: model.centers.len() as u8,
+    /// A model with no inputs and no centres (every prediction is a wrong-input-count
+    /// error): the initial value of storage that `fill_from` overwrites in place.
+    pub const fn empty() -> Self {
+        FixedModel {
+            n_inputs: 0,
+            n_rbf: 0,
+            n_centers: 0,
             in_frac: [0; MAX_INPUTS],
             in_offset_q: [0; MAX_INPUTS],
             in_gain_q: [0; MAX_INPUTS],
@@ -146,7 +145,35 @@ impl FixedModel {
             linear_q: [0; MAX_INPUTS],
             bias_q: 0,
             w_frac: 0,
-        };
+        }
+    }
+
+    /// Convert a model (validated here) for integer-only evaluation.
+    pub fn from_model(model: &RbfModel) -> Result<FixedModel, FixedError> {
+        let mut fm = FixedModel::empty();
+        fm.fill_from(model)?;
+        Ok(fm)
+    }
+
+    /// `from_model` in place (no 2.7 KB temporary on the stack). On error `self` is left
+    /// partly written: fill it again (or discard it) before predicting.
+    pub fn fill_from(&mut self, model: &RbfModel) -> Result<(), FixedError> {
+        model.validate().map_err(FixedError::Model)?;
+        let n = model.inputs.len();
+        let fm = self;
+        fm.n_inputs = n as u8;
+        fm.n_rbf = model.n_rbf_inputs;
+        fm.n_centers = model.centers.len() as u8;
+        fm.in_frac = [0; MAX_INPUTS];
+        fm.in_offset_q = [0; MAX_INPUTS];
+        fm.in_gain_q = [0; MAX_INPUTS];
+        fm.in_shift = [0; MAX_INPUTS];
+        fm.centers_q = [[0; MAX_INPUTS]; MAX_CENTERS];
+        fm.gain_q = [0; MAX_CENTERS];
+        fm.weights_q = [0; MAX_CENTERS];
+        fm.linear_q = [0; MAX_INPUTS];
+        fm.bias_q = 0;
+        fm.w_frac = 0;
         for j in 0..n {
             let off = model.input_offset[j] as f64;
             let bound = (model.input_min[j] as f64)
@@ -201,7 +228,7 @@ impl FixedModel {
             *q = to_q(w as f64, w_frac) as i32;
         }
         fm.bias_q = to_q(model.bias_dph as f64, w_frac);
-        Ok(fm)
+        Ok(())
     }
 
     /// Number of inputs the model expects.

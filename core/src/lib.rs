@@ -15,6 +15,7 @@ pub mod features;
 pub mod fixed;
 pub mod hal;
 pub mod model;
+mod model_in_place;
 pub mod northfinder;
 pub mod numeric;
 pub mod protocol;

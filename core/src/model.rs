@@ -11,6 +11,7 @@
 //! them are linear-only terms (diagnose may add a cause that way).
 
 use heapless::{String, Vec};
+use serde::de::DeserializeSeed as _;
 use serde::{Deserialize, Serialize};
 
 /// Most RBF centres a model may hold.
@@ -324,6 +325,54 @@ impl FeatureKind {
 }
 
 impl RbfModel {
+    /// A placeholder with no inputs (fails `validate`): the initial value of model storage
+    /// that lives in a `static` or is overwritten in place with `copy_from`.
+    pub const fn empty() -> Self {
+        RbfModel {
+            n_rbf_inputs: 0,
+            inputs: Vec::new(),
+            input_offset: Vec::new(),
+            input_scale: Vec::new(),
+            input_min: Vec::new(),
+            input_max: Vec::new(),
+            linear: Vec::new(),
+            centers: Vec::new(),
+            widths: Vec::new(),
+            weights: Vec::new(),
+            bias_dph: 0.0,
+            meta: TrainingMeta {
+                gyro_id: String::new(),
+                heldout_rms_dph: 0.0,
+                n_train: 0,
+            },
+        }
+    }
+
+    /// Make `self` equal to `src`, field by field in place (`*self = src.clone()` would
+    /// build the ~1.7 KB model as a temporary on the stack first).
+    pub fn copy_from(&mut self, src: &RbfModel) {
+        fn copy<T: Copy, const N: usize>(dst: &mut Vec<T, N>, src: &Vec<T, N>) {
+            dst.clear();
+            // Same capacity on both sides: cannot fail.
+            let _ = dst.extend_from_slice(src);
+        }
+        self.n_rbf_inputs = src.n_rbf_inputs;
+        copy(&mut self.inputs, &src.inputs);
+        copy(&mut self.input_offset, &src.input_offset);
+        copy(&mut self.input_scale, &src.input_scale);
+        copy(&mut self.input_min, &src.input_min);
+        copy(&mut self.input_max, &src.input_max);
+        copy(&mut self.linear, &src.linear);
+        copy(&mut self.centers, &src.centers);
+        copy(&mut self.widths, &src.widths);
+        copy(&mut self.weights, &src.weights);
+        self.bias_dph = src.bias_dph;
+        self.meta.gyro_id.clear();
+        let _ = self.meta.gyro_id.push_str(&src.meta.gyro_id);
+        self.meta.heldout_rms_dph = src.meta.heldout_rms_dph;
+        self.meta.n_train = src.meta.n_train;
+    }
+
     /// Number of inputs.
     pub fn n_inputs(&self) -> usize {
         self.inputs.len()
@@ -463,6 +512,16 @@ impl RbfModel {
 
     /// Decode and fully validate an encoded model.
     pub fn decode(bytes: &[u8]) -> Result<RbfModel, ModelError> {
+        let mut model = RbfModel::empty();
+        model.decode_into(bytes)?;
+        Ok(model)
+    }
+
+    /// `decode` into `self`, in place: the model is read element by element into the
+    /// existing storage (`model_in_place`), never built on the stack, so a device can
+    /// decode into a `static`. On error `self` holds a partly decoded model: decode again
+    /// or discard it.
+    pub fn decode_into(&mut self, bytes: &[u8]) -> Result<(), ModelError> {
         if bytes.len() > MAX_ENCODED_LEN {
             return Err(ModelError::TooLarge {
                 len: bytes.len() as u32,
@@ -503,8 +562,12 @@ impl RbfModel {
                 count: counts.n_centers,
             });
         }
-        let (model, left) = postcard::take_from_bytes::<RbfModel>(model_bytes)
+        let mut de = postcard::Deserializer::from_bytes(model_bytes);
+        crate::model_in_place::ModelInPlace(self)
+            .deserialize(&mut de)
             .map_err(|_| ModelError::Malformed)?;
+        let left = de.finalize().map_err(|_| ModelError::Malformed)?;
+        let model = &*self;
         if !left.is_empty() {
             return Err(ModelError::TrailingBytes {
                 count: left.len() as u16,
@@ -520,8 +583,7 @@ impl RbfModel {
             counts.n_centers as usize,
             model.centers.len(),
         )?;
-        model.validate()?;
-        Ok(model)
+        model.validate()
     }
 }
 

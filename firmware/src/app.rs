@@ -10,6 +10,8 @@
 //! `SeekConfig::max_invalid_windows`); a turntable error aborts the seek and is reported
 //! with the driver's own error, never retried silently.
 
+use core::borrow::BorrowMut;
+
 use fog_core::compensator::{Compensator, CompensatorConfig, CompensatorError, WindowResult};
 use fog_core::hal::{GyroSample, TableState, TempSample, Turntable};
 use fog_core::model::RbfModel;
@@ -107,9 +109,13 @@ where
 }
 
 /// The application state machine.
-pub struct App<T: Turntable> {
+///
+/// `C` is where the ~8 KB `Compensator` lives: inside the `App` (the default, `new`), or
+/// borrowed from a `static` (`&'static mut Compensator`, `with_compensator`) so that the
+/// `App` itself is a few hundred bytes and nothing big is ever built on the stack.
+pub struct App<T: Turntable, C: BorrowMut<Compensator> = Compensator> {
     cfg: AppConfig,
-    compensator: Compensator,
+    compensator: C,
     finder: NorthFinder,
     table: ErrorLatch<T>,
     next_temp_s: f64,
@@ -122,11 +128,34 @@ where
     T::Error: Copy,
 {
     /// `model`: the active drift model (None: no compensation, windows pass through).
+    /// The result is ~9 KB: a small MCU uses `with_compensator` and a `static`.
     pub fn new(cfg: AppConfig, model: Option<RbfModel>, table: T) -> Result<Self, AppError> {
+        Self::with_compensator(cfg, model.as_ref(), table, Compensator::unconfigured())
+    }
+}
+
+impl<T: Turntable, C: BorrowMut<Compensator>> App<T, C>
+where
+    T::Error: Copy,
+{
+    /// `new` with the compensator in `compensator` (e.g. `&'static mut` of a `static`
+    /// holding `Compensator::unconfigured()`), configured there in place.
+    pub fn with_compensator(
+        cfg: AppConfig,
+        model: Option<&RbfModel>,
+        table: T,
+        mut compensator: C,
+    ) -> Result<Self, AppError> {
+        // Same order of checks as before: compensator first, then the seek.
+        compensator
+            .borrow_mut()
+            .configure(cfg.compensator, model)
+            .map_err(AppError::Compensator)?;
+        let finder = NorthFinder::new(cfg.seek).map_err(AppError::Seek)?;
         Ok(Self {
             cfg,
-            compensator: Compensator::new(cfg.compensator, model).map_err(AppError::Compensator)?,
-            finder: NorthFinder::new(cfg.seek).map_err(AppError::Seek)?,
+            compensator,
+            finder,
             table: ErrorLatch {
                 table,
                 last_error: None,
@@ -139,12 +168,17 @@ where
 
     /// Replace the drift model (after a verified upload). On error the old one stays.
     pub fn set_model(&mut self, model: Option<RbfModel>) -> Result<(), CompensatorError> {
-        self.compensator.set_model(model)
+        self.compensator.borrow_mut().set_model_from(model.as_ref())
+    }
+
+    /// `set_model` from a reference (no copy of the model on the stack).
+    pub fn set_model_from(&mut self, model: Option<&RbfModel>) -> Result<(), CompensatorError> {
+        self.compensator.borrow_mut().set_model_from(model)
     }
 
     /// The active model.
     pub fn model(&self) -> Option<&RbfModel> {
-        self.compensator.model()
+        self.compensator.borrow().model()
     }
 
     /// The turntable driver (e.g. for its statistics).
@@ -179,15 +213,15 @@ where
             self.next_temp_s += self.cfg.temp_period_s;
         }
         match reading {
-            Some(s) => self.compensator.push_temp(s),
-            None => self.compensator.report_fault(t_s),
+            Some(s) => self.compensator.borrow_mut().push_temp(s),
+            None => self.compensator.borrow_mut().report_fault(t_s),
         }
     }
 
     /// A sensor fault other than the temperature (e.g. a gyro UART error) at `t_s`:
     /// the window containing it is marked invalid.
     pub fn on_fault(&mut self, t_s: f64) {
-        self.compensator.report_fault(t_s);
+        self.compensator.borrow_mut().report_fault(t_s);
     }
 
     /// One raw gyro sample: feeds the averager, and drives the seek.
@@ -206,7 +240,7 @@ where
                 step.seek = Some(self.fail(e, s.t_s));
             }
         }
-        if let Some(w) = self.compensator.push_gyro(s) {
+        if let Some(w) = self.compensator.borrow_mut().push_gyro(s) {
             if self.finder.is_busy() {
                 match self.finder.on_window(&w, &mut self.table) {
                     Ok(SeekStatus::Done(r)) => step.seek = Some(SeekOutcome::Done(r)),

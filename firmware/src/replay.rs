@@ -10,11 +10,12 @@
 //! - output: one text line per 10 s window and per seek, every float as its exact IEEE
 //!   bit pattern in hex, so host and target outputs compare byte for byte.
 
+use core::borrow::BorrowMut;
 use core::fmt::Write;
 
 use embedded_hal_nb::nb;
 use embedded_hal_nb::serial::{ErrorKind, ErrorType, Read as SerialRead};
-use fog_core::compensator::{WindowResult, WindowStatus};
+use fog_core::compensator::{Compensator, WindowResult, WindowStatus};
 use fog_core::hal::{Gyro, TableState, Turntable};
 use fog_core::model::RbfModel;
 use fog_core::northfinder::SeekError;
@@ -331,9 +332,33 @@ pub fn run_with_hook<G: embedded_io::Read, L: embedded_io::Read, W: Write>(
     out: &mut W,
     on_ready: impl FnOnce(),
 ) -> Result<ReplaySummary, ReplayError> {
+    let mut compensator = Compensator::unconfigured();
+    run_in(
+        &mut compensator,
+        cfg,
+        model.as_ref(),
+        gyro_stream,
+        table_log,
+        out,
+        on_ready,
+    )
+}
+
+/// `run_with_hook` with the compensator (the ~8 KB of the application state) configured
+/// in place in `compensator`: the firmware passes a `static`, so nothing big is ever on
+/// the stack.
+pub fn run_in<G: embedded_io::Read, L: embedded_io::Read, W: Write>(
+    compensator: &mut Compensator,
+    cfg: AppConfig,
+    model: Option<&RbfModel>,
+    gyro_stream: G,
+    table_log: L,
+    out: &mut W,
+    on_ready: impl FnOnce(),
+) -> Result<ReplaySummary, ReplayError> {
     // Construction and the sample loop are separate frames: the construction temporaries
     // (model validation, fixed-point conversion) are not kept on the stack while running.
-    let mut app = build(cfg, model, table_log)?;
+    let mut app = build(compensator, cfg, model, table_log)?;
     let mut gyro = FogSerialGyro::new(
         ReaderUart::<G, 512>::new(gyro_stream),
         libm::roundf(cfg.compensator.gyro_rate_hz) as u32,
@@ -343,17 +368,19 @@ pub fn run_with_hook<G: embedded_io::Read, L: embedded_io::Read, W: Write>(
 }
 
 #[inline(never)]
-fn build<L: embedded_io::Read>(
+fn build<'c, L: embedded_io::Read>(
+    compensator: &'c mut Compensator,
     cfg: AppConfig,
-    model: Option<RbfModel>,
+    model: Option<&RbfModel>,
     table_log: L,
-) -> Result<App<ReplayTurntable<L>>, ReplayError> {
-    App::new(cfg, model, ReplayTurntable::new(table_log)).map_err(ReplayError::App)
+) -> Result<App<ReplayTurntable<L>, &'c mut Compensator>, ReplayError> {
+    App::with_compensator(cfg, model, ReplayTurntable::new(table_log), compensator)
+        .map_err(ReplayError::App)
 }
 
 #[inline(never)]
-fn process<T: Turntable, U: SerialRead<u8>, W: Write>(
-    app: &mut App<T>,
+fn process<T: Turntable, C: BorrowMut<Compensator>, U: SerialRead<u8>, W: Write>(
+    app: &mut App<T, C>,
     gyro: &mut FogSerialGyro<U>,
     out: &mut W,
 ) -> Result<ReplaySummary, ReplayError>

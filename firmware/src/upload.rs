@@ -159,6 +159,14 @@ impl<F: NorFlash> UploadServer<F> {
 
     /// Reads and decodes the active model from flash (`Ok(None)`: no model stored).
     pub fn load_active_model(&mut self) -> Result<Option<RbfModel>, LoadError> {
+        let mut model = RbfModel::empty();
+        Ok(self.load_active_model_into(&mut model)?.then_some(model))
+    }
+
+    /// `load_active_model` decoded in place into `dst` (e.g. a `static`, so the ~1.7 KB
+    /// model is never on the stack): `Ok(true)` if a model was stored and `dst` now holds
+    /// it, `Ok(false)` if none is stored. On error `dst` must not be used.
+    pub fn load_active_model_into(&mut self, dst: &mut RbfModel) -> Result<bool, LoadError> {
         if matches!(self.session, Session::Receiving { .. }) {
             return Err(LoadError::UploadInProgress);
         }
@@ -167,8 +175,11 @@ impl<F: NorFlash> UploadServer<F> {
             .read_active(&mut self.model_buf)
             .map_err(LoadError::Store)?
         {
-            None => Ok(None),
-            Some(bytes) => RbfModel::decode(bytes).map(Some).map_err(LoadError::Model),
+            None => Ok(false),
+            Some(bytes) => dst
+                .decode_into(bytes)
+                .map(|()| true)
+                .map_err(LoadError::Model),
         }
     }
 

@@ -33,7 +33,9 @@ use defmt_semihosting as _;
 use cortex_m_rt::entry;
 use embedded_hal_nb::nb;
 use embedded_hal_nb::serial::Write as _;
+use fog_core::compensator::Compensator;
 use fog_core::hal::Gyro;
+use fog_core::model::RbfModel;
 use fog_firmware::app::{App, AppConfig, SeekOutcome};
 use fog_firmware::drivers::fog_serial::FogSerialGyro;
 use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig};
@@ -52,10 +54,15 @@ const HOST_BAUD: u32 = 115_200;
 const GYRO_BAUD: u32 = 460_800;
 const TABLE_BAUD: u32 = 115_200;
 
-type Table = SerialTurntable<uart::CmsdkUart, millis::MillisClock>;
-
 #[entry]
 fn main() -> ! {
+    // The application's big state (the compensator, ~8 KB) and the model buffer live in
+    // statics, set up there in place and never built on the stack. Their `const` values
+    // are all zero bytes, so they go to `.bss` (no flash); cortex-m-rt hands them out
+    // as `&'static mut` exactly once (no unsafe here).
+    static mut COMPENSATOR: Compensator = Compensator::unconfigured();
+    static mut MODEL: RbfModel = RbfModel::empty();
+    let (compensator, model) = (COMPENSATOR, MODEL);
     let Some(cp) = cortex_m::Peripherals::take() else {
         semihosting::process::abort()
     };
@@ -71,35 +78,25 @@ fn main() -> ! {
     };
     defmt::info!("fog-app: boot");
 
-    // The repository's TEST key (keys/README.md): a product build embeds its own.
     // The long-lived state lives in statics (counted in the static-RAM budget by the
     // linker), not in main's stack frame.
-    let server = match UploadServer::new(flash, 0, TEST_PUBLIC_KEY) {
-        Ok(s) => s,
-        Err(e) => {
-            defmt::error!("model store unusable: {}", e);
-            semihosting::process::abort()
-        }
-    };
-    let Some(server) = cortex_m::singleton!(: UploadServer<flash::ModelFlash> = server) else {
-        semihosting::process::abort()
-    };
-    let model = server.load_active_model().unwrap_or_else(|e| {
+    let server = start_upload_server(flash);
+    // Decoded in place into `MODEL` (the compensator keeps its own copy).
+    let stored = server.load_active_model_into(model).unwrap_or_else(|e| {
         defmt::warn!("stored model not loaded ({}): running uncompensated", e);
-        None
+        false
     });
-    defmt::info!("model active: {}", model.is_some());
+    defmt::info!("model active: {}", stored);
 
     let table = SerialTurntable::new(table_uart, millis::MillisClock, TurntableConfig::default());
-    let app = match App::new(AppConfig::for_rate(GYRO_RATE_HZ as f32), model, table) {
+    // Configured in place in `COMPENSATOR`; the `App` around it is a few hundred bytes.
+    let cfg = AppConfig::for_rate(GYRO_RATE_HZ as f32);
+    let mut app = match App::with_compensator(cfg, stored.then_some(&*model), table, compensator) {
         Ok(a) => a,
         Err(e) => {
             defmt::error!("configuration rejected: {}", e);
             semihosting::process::abort()
         }
-    };
-    let Some(app) = cortex_m::singleton!(: App<Table> = app) else {
-        semihosting::process::abort()
     };
     let mut gyro = FogSerialGyro::new(gyro_uart, GYRO_RATE_HZ);
     let mut last_t_s = 0.0;
@@ -114,8 +111,8 @@ fn main() -> ! {
                 let _ = nb::block!(host.write(b));
             }
             if reply.model_changed {
-                match server.load_active_model() {
-                    Ok(m) => match app.set_model(m) {
+                match server.load_active_model_into(model) {
+                    Ok(stored) => match app.set_model_from(stored.then_some(&*model)) {
                         Ok(()) => defmt::info!("new model in use"),
                         Err(e) => defmt::error!("new model refused: {}", e),
                     },
@@ -177,4 +174,25 @@ fn report<E: defmt::Format>(step: fog_firmware::app::Step<E>) {
         ),
         None => {}
     }
+}
+
+type Server = UploadServer<flash::ModelFlash>;
+
+/// The upload server, in a static. Its own frame (never inlined into `main`): building it
+/// (store scan, decoding the active model for its identity) needs ~10 KB of temporaries,
+/// which are then given back instead of staying in `main`'s frame for good.
+#[inline(never)]
+fn start_upload_server(flash: flash::ModelFlash) -> &'static mut Server {
+    // The repository's TEST key (keys/README.md): a product build embeds its own.
+    let server = match UploadServer::new(flash, 0, TEST_PUBLIC_KEY) {
+        Ok(s) => s,
+        Err(e) => {
+            defmt::error!("model store unusable: {}", e);
+            semihosting::process::abort()
+        }
+    };
+    let Some(server) = cortex_m::singleton!(: Server = server) else {
+        semihosting::process::abort()
+    };
+    server
 }

@@ -16,9 +16,11 @@ mod semi;
 #[path = "target/stack.rs"]
 mod stack;
 
+use core::ffi::CStr;
 use core::fmt::Write as _;
 
 use cortex_m_rt::entry;
+use fog_core::compensator::Compensator;
 use fog_core::compensator::Evaluator;
 use fog_core::model::{RbfModel, MAX_ENCODED_LEN};
 use fog_firmware::app::AppConfig;
@@ -26,8 +28,13 @@ use fog_firmware::replay;
 
 #[entry]
 fn main() -> ! {
+    // The application's big state and the model live in statics (zero-initialised
+    // `.bss`: the `const` values are all zero bytes) and are set up there in place, never
+    // on the stack; cortex-m-rt hands them out as `&'static mut` once (no unsafe here).
+    static mut COMPENSATOR: Compensator = Compensator::unconfigured();
+    static mut MODEL: RbfModel = RbfModel::empty();
     stack::paint();
-    let code = match run() {
+    let code = match run(COMPENSATOR, MODEL) {
         Ok(()) => 0,
         Err(msg) => {
             semihosting::eprintln!("replay: {}", msg);
@@ -37,14 +44,12 @@ fn main() -> ! {
     semihosting::process::exit(code)
 }
 
-fn run() -> Result<(), &'static str> {
+fn run(compensator: &mut Compensator, model: &mut RbfModel) -> Result<(), &'static str> {
     let args = semi::Args::get()?;
     if args.len() < 6 {
         return Err("usage: replay MODEL GYRO_STREAM TABLE_LOG OUT RATE_HZ SEEKS [f32|fixed]");
     }
-    let mut model_buf = [0u8; MAX_ENCODED_LEN];
-    let model_bytes = semi::read_file(args.path(0)?, &mut model_buf)?;
-    let model = RbfModel::decode(model_bytes).map_err(|_| "model file fails validation")?;
+    load_model(args.path(0)?, model)?;
     let rate_hz: f32 = args
         .str(4)?
         .parse()
@@ -64,7 +69,15 @@ fn run() -> Result<(), &'static str> {
         boot_stack = stack::high_water_bytes();
         stack::paint();
     };
-    let sum = replay::run_with_hook(cfg, Some(model), gyro, table, &mut out, on_ready);
+    let sum = replay::run_in(
+        compensator,
+        cfg,
+        Some(model),
+        gyro,
+        table,
+        &mut out,
+        on_ready,
+    );
     let sum = sum.map_err(|e| match e {
         replay::ReplayError::App(_) => "application rejected the configuration",
         replay::ReplayError::Output => "cannot write the output file",
@@ -92,4 +105,14 @@ fn run() -> Result<(), &'static str> {
         stack::size_bytes()
     );
     out.flush()
+}
+
+/// Read and decode the model file into `dst` (in place). Its own frame: the file buffer
+/// is only on the stack while decoding.
+#[inline(never)]
+fn load_model(path: &CStr, dst: &mut RbfModel) -> Result<(), &'static str> {
+    let mut buf = [0u8; MAX_ENCODED_LEN];
+    let bytes = semi::read_file(path, &mut buf)?;
+    dst.decode_into(bytes)
+        .map_err(|_| "model file fails validation")
 }
