@@ -108,21 +108,13 @@ pub fn warmup_model(
     let mut rng = SplitMix64::new(seed);
     let mut m = RbfModel {
         n_rbf_inputs: n_inputs as u8,
-        inputs: heapless::Vec::new(),
-        input_offset: heapless::Vec::new(),
-        input_scale: heapless::Vec::new(),
-        input_min: heapless::Vec::new(),
-        input_max: heapless::Vec::new(),
-        linear: heapless::Vec::new(),
-        centers: heapless::Vec::new(),
-        widths: heapless::Vec::new(),
-        weights: heapless::Vec::new(),
         bias_dph: 0.02,
         meta: TrainingMeta {
             gyro_id: heapless::String::new(),
             heldout_rms_dph: 0.0,
             n_train: 8910,
         },
+        ..RbfModel::empty()
     };
     let _ = m.meta.gyro_id.push_str("synthetic");
     for j in 0..n_inputs {

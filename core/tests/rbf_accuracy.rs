@@ -19,21 +19,13 @@ fn model_from(
 ) -> RbfModel {
     let mut m = RbfModel {
         n_rbf_inputs: n_inputs as u8,
-        inputs: heapless::Vec::new(),
-        input_offset: heapless::Vec::new(),
-        input_scale: heapless::Vec::new(),
-        input_min: heapless::Vec::new(),
-        input_max: heapless::Vec::new(),
-        linear: heapless::Vec::new(),
-        centers: heapless::Vec::new(),
-        widths: heapless::Vec::new(),
-        weights: heapless::Vec::new(),
         bias_dph: bias,
         meta: TrainingMeta {
             gyro_id: heapless::String::new(),
             heldout_rms_dph: 0.0,
             n_train: 0,
         },
+        ..RbfModel::empty()
     };
     for j in 0..n_inputs {
         m.inputs

@@ -46,21 +46,13 @@ pub fn assemble(parts: &ModelParts<'_>) -> Result<RbfModel> {
     let nf = parts.forced.len();
     let mut model = RbfModel {
         n_rbf_inputs: parts.n_rbf_inputs as u8,
-        inputs: heapless::Vec::new(),
-        input_offset: heapless::Vec::new(),
-        input_scale: heapless::Vec::new(),
-        input_min: heapless::Vec::new(),
-        input_max: heapless::Vec::new(),
-        linear: heapless::Vec::new(),
-        centers: heapless::Vec::new(),
-        widths: heapless::Vec::new(),
-        weights: heapless::Vec::new(),
         bias_dph: 0.0,
         meta: TrainingMeta {
             gyro_id: heapless::String::new(),
             heldout_rms_dph: parts.heldout_rms_dph as f32,
             n_train: parts.n_train as u32,
         },
+        ..RbfModel::empty()
     };
     let norm = parts.normalizer;
     for j in 0..d {
