@@ -142,14 +142,7 @@ impl WindowAverager {
         let mut avg = WindowAverager {
             window_s: window_s as f64,
             period_s: 1.0 / nominal_rate_hz as f64,
-            index: 0,
-            sum: 0.0,
-            n: 0,
-            n_gaps: 0,
-            max_gap_s: 0.0,
-            last_t_s: None,
-            sure_lo_s: 0.0,
-            sure_hi_s: 0.0,
+            ..Self::placeholder()
         };
         avg.set_index(0);
         Ok(avg)
