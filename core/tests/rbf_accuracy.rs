@@ -86,67 +86,71 @@ fn centers_strategy() -> impl Strategy<Value = Vec<([f32; 4], f32, f32)>> {
     )
 }
 
+/// One random case: a model (trailing inputs possibly linear-only), a raw f32 input point
+/// and its f64 copy, and the f32 rounding tolerance for that point.
+#[derive(Debug)]
+struct Case {
+    model: RbfModel,
+    x32: Vec<f32>,
+    x64: Vec<f64>,
+    tol: f64,
+}
+
+fn case_strategy() -> impl Strategy<Value = Case> {
+    (
+        1usize..=4,
+        0usize..=3,
+        centers_strategy(),
+        (-50.0f32..50.0, 0.001f32..100.0, -1.0f32..1.0, -1.0f32..1.0),
+        prop::array::uniform4(-3.0f64..3.0),
+    )
+        .prop_map(
+            |(n_inputs, linear_only, centers, (offset, scale, bias, linear), xn)| {
+                let mut m = model_from(n_inputs, &centers, offset, scale, bias, linear);
+                // Trailing inputs may be linear-only terms (diagnose adds causes that way).
+                m.n_rbf_inputs = (n_inputs - linear_only.min(n_inputs - 1)) as u8;
+                // Raw inputs as f32 (what the device has), evaluated by every path.
+                let x32: Vec<f32> = (0..n_inputs)
+                    .map(|j| (m.input_offset[j] as f64 + xn[j] * m.input_scale[j] as f64) as f32)
+                    .collect();
+                let x64: Vec<f64> = x32.iter().map(|&v| v as f64).collect();
+                // f32 rounding: ~1e-7 relative per operation; normalisation of an input that is
+                // large against its scale adds |x| ulp / scale.
+                let cond: f64 = (0..n_inputs)
+                    .map(|j| {
+                        1.0 + (x64[j].abs() + (m.input_offset[j] as f64).abs())
+                            / m.input_scale[j] as f64
+                    })
+                    .fold(1.0, f64::max);
+                let tol = 2e-6 * magnitude(&m, &x64) * cond;
+                Case {
+                    model: m,
+                    x32,
+                    x64,
+                    tol,
+                }
+            },
+        )
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 300, failure_persistence: None, ..ProptestConfig::default() })]
 
     #[test]
-    fn f32_matches_f64_reference(
-        n_inputs in 1usize..=4,
-        linear_only in 0usize..=3,
-        centers in centers_strategy(),
-        offset in -50.0f32..50.0,
-        scale in 0.001f32..100.0,
-        bias in -1.0f32..1.0,
-        linear in -1.0f32..1.0,
-        xn in prop::array::uniform4(-3.0f64..3.0),
-    ) {
-        let mut m = model_from(n_inputs, &centers, offset, scale, bias, linear);
-        // Trailing inputs may be linear-only terms (diagnose adds causes that way).
-        m.n_rbf_inputs = (n_inputs - linear_only.min(n_inputs - 1)) as u8;
-        // Raw inputs as f32 (what the device has), evaluated by both paths.
-        let x32: Vec<f32> = (0..n_inputs)
-            .map(|j| (m.input_offset[j] as f64 + xn[j] * m.input_scale[j] as f64) as f32)
-            .collect();
-        let x64: Vec<f64> = x32.iter().map(|&v| v as f64).collect();
-        let f = predict_f32(&m, &x32).unwrap() as f64;
-        let r = predict_f64(&m, &x64).unwrap();
-        // f32 rounding: ~1e-7 relative per operation; normalisation of an input that is large
-        // against its scale adds |x| ulp / scale.
-        let cond: f64 = (0..n_inputs)
-            .map(|j| 1.0 + (x64[j].abs() + (m.input_offset[j] as f64).abs()) / m.input_scale[j] as f64)
-            .fold(1.0, f64::max);
-        let tol = 2e-6 * magnitude(&m, &x64) * cond;
-        prop_assert!((f - r).abs() <= tol, "f32 {f} f64 {r} tol {tol}");
+    fn f32_matches_f64_reference(c in case_strategy()) {
+        let f = predict_f32(&c.model, &c.x32).unwrap() as f64;
+        let r = predict_f64(&c.model, &c.x64).unwrap();
+        prop_assert!((f - r).abs() <= c.tol, "f32 {f} f64 {r} tol {}", c.tol);
     }
 
     #[test]
-    fn fixed_matches_f32(
-        n_inputs in 1usize..=4,
-        linear_only in 0usize..=3,
-        centers in centers_strategy(),
-        offset in -50.0f32..50.0,
-        scale in 0.001f32..100.0,
-        bias in -1.0f32..1.0,
-        linear in -1.0f32..1.0,
-        xn in prop::array::uniform4(-3.0f64..3.0),
-    ) {
-        let mut m = model_from(n_inputs, &centers, offset, scale, bias, linear);
-        // Trailing inputs may be linear-only terms (diagnose adds causes that way).
-        m.n_rbf_inputs = (n_inputs - linear_only.min(n_inputs - 1)) as u8;
-        let fx = FixedModel::from_model(&m).unwrap();
-        let x32: Vec<f32> = (0..n_inputs)
-            .map(|j| (m.input_offset[j] as f64 + xn[j] * m.input_scale[j] as f64) as f32)
-            .collect();
-        let x64: Vec<f64> = x32.iter().map(|&v| v as f64).collect();
-        let q = fx.predict(&x32).unwrap() as f64;
-        let f = predict_f32(&m, &x32).unwrap() as f64;
-        let r = predict_f64(&m, &x64).unwrap();
-        let cond: f64 = (0..n_inputs)
-            .map(|j| 1.0 + (x64[j].abs() + (m.input_offset[j] as f64).abs()) / m.input_scale[j] as f64)
-            .fold(1.0, f64::max);
-        let tol = 2e-6 * magnitude(&m, &x64) * cond;
-        prop_assert!((q - f).abs() <= 2.0 * tol, "fixed {q} f32 {f} tol {tol}");
-        prop_assert!((q - r).abs() <= tol, "fixed {q} f64 {r} tol {tol}");
+    fn fixed_matches_f32(c in case_strategy()) {
+        let fx = FixedModel::from_model(&c.model).unwrap();
+        let q = fx.predict(&c.x32).unwrap() as f64;
+        let f = predict_f32(&c.model, &c.x32).unwrap() as f64;
+        let r = predict_f64(&c.model, &c.x64).unwrap();
+        prop_assert!((q - f).abs() <= 2.0 * c.tol, "fixed {q} f32 {f} tol {}", c.tol);
+        prop_assert!((q - r).abs() <= c.tol, "fixed {q} f64 {r} tol {}", c.tol);
     }
 
     #[test]
