@@ -76,18 +76,9 @@ pub fn warmup_model(
     let n_centers = n_centers.min(MAX_CENTERS);
     let n_inputs = n_inputs.clamp(1, MAX_INPUTS);
     let kinds = [
-        FeatureSpec {
-            kind: FeatureKind::TempC,
-            tau_s: 0.0,
-        },
-        FeatureSpec {
-            kind: FeatureKind::TempRateCps,
-            tau_s: 0.0,
-        },
-        FeatureSpec {
-            kind: FeatureKind::TempAccelCps2,
-            tau_s: 0.0,
-        },
+        FeatureSpec::plain(FeatureKind::TempC),
+        FeatureSpec::plain(FeatureKind::TempRateCps),
+        FeatureSpec::plain(FeatureKind::TempAccelCps2),
         FeatureSpec {
             kind: FeatureKind::TempLagC,
             tau_s: LAG_TAU_S as f32,

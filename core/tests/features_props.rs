@@ -165,22 +165,13 @@ fn first_order_lag_matches_closed_form() {
 #[test]
 fn series_helper_equals_the_device_extractor() {
     let specs = [
-        FeatureSpec {
-            kind: FeatureKind::TempC,
-            tau_s: 0.0,
-        },
-        FeatureSpec {
-            kind: FeatureKind::TempRateCps,
-            tau_s: 0.0,
-        },
+        FeatureSpec::plain(FeatureKind::TempC),
+        FeatureSpec::plain(FeatureKind::TempRateCps),
         FeatureSpec {
             kind: FeatureKind::TempLagC,
             tau_s: 200.0,
         },
-        FeatureSpec {
-            kind: FeatureKind::AuxCos(0),
-            tau_s: 0.0,
-        },
+        FeatureSpec::plain(FeatureKind::AuxCos(0)),
     ];
     let n = 100;
     let t: Vec<f64> = (1..=n).map(|k| 10.0 * k as f64).collect();
@@ -219,10 +210,7 @@ fn series_helper_equals_the_device_extractor() {
 
 #[test]
 fn accel_feature_needs_three_rows() {
-    let specs = [FeatureSpec {
-        kind: FeatureKind::TempAccelCps2,
-        tau_s: 0.0,
-    }];
+    let specs = [FeatureSpec::plain(FeatureKind::TempAccelCps2)];
     let mut fx = FeatureExtractor::new(&specs).unwrap();
     let r: Vec<bool> = (1..=4)
         .map(|k| {
@@ -245,8 +233,8 @@ proptest! {
         let mut avg = WindowAverager::new(10.0, rate_hz).unwrap();
         let mut est: TempRateEstimator<16> = TempRateEstimator::new(60.0).unwrap();
         let mut fx = FeatureExtractor::new(&[
-            FeatureSpec { kind: FeatureKind::TempRateCps, tau_s: 0.0 },
-            FeatureSpec { kind: FeatureKind::TempAccelCps2, tau_s: 0.0 },
+            FeatureSpec::plain(FeatureKind::TempRateCps),
+            FeatureSpec::plain(FeatureKind::TempAccelCps2),
             FeatureSpec { kind: FeatureKind::TempLagC, tau_s: 100.0 },
             FeatureSpec { kind: FeatureKind::PowerOnDecay, tau_s: 100.0 },
         ])

@@ -29,10 +29,7 @@ fn model_from(
     };
     for j in 0..n_inputs {
         m.inputs
-            .push(FeatureSpec {
-                kind: FeatureKind::AuxValue(j as u8),
-                tau_s: 0.0,
-            })
+            .push(FeatureSpec::plain(FeatureKind::AuxValue(j as u8)))
             .unwrap();
         m.input_offset.push(offset * (j + 1) as f32).unwrap();
         m.input_scale.push(scale).unwrap();

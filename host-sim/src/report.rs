@@ -247,6 +247,28 @@ pub fn progress_bar(len: usize, message: &str) -> indicatif::ProgressBar {
     bar
 }
 
+/// Column headers of the before/after drift comparison shared by the terminal tables.
+pub const DRIFT_COLUMNS: [&str; 6] = [
+    "std before",
+    "std after",
+    "max dev before",
+    "max dev after",
+    "to spec before",
+    "to spec after",
+];
+
+/// The cells under `DRIFT_COLUMNS` for one before/after pair.
+pub fn drift_cells(before: &DriftStats, after: &DriftStats) -> [String; 6] {
+    [
+        format!("{:.4}", before.std_dph),
+        format!("{:.4}", after.std_dph),
+        format!("{:.4}", before.max_dev_dph),
+        format!("{:.4}", after.max_dev_dph),
+        fmt_minutes(before.time_to_spec_s),
+        fmt_minutes(after.time_to_spec_s),
+    ]
+}
+
 /// Formats an optional time in seconds as minutes ("12.5 min"), "never" when absent.
 pub fn fmt_minutes(t_s: Option<f64>) -> String {
     match t_s {

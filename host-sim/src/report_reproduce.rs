@@ -15,7 +15,8 @@ use crate::northseek::{
 };
 use crate::plots::{allan_chart, azimuth_scatter_chart, temperature_chart, write_svg, Series};
 use crate::report::{
-    fmt_minutes, progress_bar, CompensateReport, DriftStats, NorthSeekReport, Table,
+    drift_cells, fmt_minutes, progress_bar, CompensateReport, DriftStats, NorthSeekReport, Table,
+    DRIFT_COLUMNS,
 };
 use crate::report_compensation::{pooled_stats, CompensatedSeries};
 use crate::report_pipeline::{
@@ -39,10 +40,7 @@ pub struct ReproduceOptions {
 /// The model inputs compared: the paper's (T, dT/dt) and this project's (T, dT/dt, d2T/dt2).
 pub fn input_variants() -> Vec<(&'static str, Vec<FeatureSpec>)> {
     let mut extended = default_specs();
-    extended.push(FeatureSpec {
-        kind: FeatureKind::TempAccelCps2,
-        tau_s: 0.0,
-    });
+    extended.push(FeatureSpec::plain(FeatureKind::TempAccelCps2));
     vec![
         ("paper inputs (T, dT/dt)", default_specs()),
         ("extended inputs (T, dT/dt, d2T/dt2)", extended),
@@ -344,27 +342,13 @@ fn compare(models: &[ModelResult], room_c: f64) -> Vec<Comparison> {
 
 /// The human-readable summary of one model variant.
 fn model_summary(m: &ModelResult) -> String {
-    let mut amb = Table::new(&[
-        "ambient",
-        "held-out runs",
-        "std before",
-        "std after",
-        "max dev before",
-        "max dev after",
-        "to spec before",
-        "to spec after",
-    ]);
+    let mut amb = Table::new(&[&["ambient", "held-out runs"][..], &DRIFT_COLUMNS].concat());
     for a in &m.per_ambient {
-        amb.row(&[
+        let label = [
             format!("{:+.0} degC", a.ambient_c),
-            format!("{}", a.heldout_runs),
-            format!("{:.4}", a.before.std_dph),
-            format!("{:.4}", a.after.std_dph),
-            format!("{:.4}", a.before.max_dev_dph),
-            format!("{:.4}", a.after.max_dev_dph),
-            fmt_minutes(a.before.time_to_spec_s),
-            fmt_minutes(a.after.time_to_spec_s),
-        ]);
+            a.heldout_runs.to_string(),
+        ];
+        amb.row(&[&label[..], &drift_cells(&a.before, &a.after)].concat());
     }
     let t = &m.targets;
     let ok = |b: bool| if b { "MET" } else { "MISSED" };

@@ -9,8 +9,7 @@ use anyhow::{bail, Result};
 use crate::metrics::SPEC_DPH;
 use crate::plots::{startup_chart, write_svg, StartupCurve};
 use crate::report::{
-    check_output_path, ensure_dir, fmt_minutes, write_json, BeforeAfter, CompensateReport,
-    CompensatedRun, Table,
+    check_output_path, ensure_dir, write_json, BeforeAfter, CompensateReport, CompensatedRun, Table,
 };
 use crate::report_compensation::{
     check_model_inputs, compensate_run, drift_stats, pooled_stats, CompensatedSeries,
@@ -83,16 +82,7 @@ pub fn compensate_all(
 
 /// The per-run table printed to the terminal.
 pub fn compensate_table(report: &CompensateReport) -> String {
-    let mut t = Table::new(&[
-        "run",
-        "ambient",
-        "std before",
-        "std after",
-        "max dev before",
-        "max dev after",
-        "to spec before",
-        "to spec after",
-    ]);
+    let mut t = Table::new(&[&["run", "ambient"][..], &crate::report::DRIFT_COLUMNS].concat());
     let amb = |a: Option<f64>| a.map_or("-".to_string(), |a| format!("{a:+.0} degC"));
     let name = |f: &str| {
         Path::new(f)
@@ -103,16 +93,7 @@ pub fn compensate_table(report: &CompensateReport) -> String {
                    ambient: String,
                    b: &crate::report::DriftStats,
                    a: &crate::report::DriftStats| {
-        t.row(&[
-            label,
-            ambient,
-            format!("{:.4}", b.std_dph),
-            format!("{:.4}", a.std_dph),
-            format!("{:.4}", b.max_dev_dph),
-            format!("{:.4}", a.max_dev_dph),
-            fmt_minutes(b.time_to_spec_s),
-            fmt_minutes(a.time_to_spec_s),
-        ]);
+        t.row(&[&[label, ambient][..], &crate::report::drift_cells(b, a)].concat());
     };
     for r in &report.runs {
         add(name(&r.file), amb(r.ambient_c), &r.before, &r.after);
