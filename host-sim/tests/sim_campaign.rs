@@ -1,9 +1,10 @@
 //! `fogsim campaign` end to end: the paper's file layout, determinism across
 //! invocations, and one-line errors with no output for impossible options.
 
+mod app_support;
+
 use fog_sim::runs::read_runs;
 use std::path::PathBuf;
-use std::process::Command;
 
 fn scratch(tag: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("fog_sim_campaign_{tag}_{}", std::process::id()));
@@ -11,11 +12,9 @@ fn scratch(tag: &str) -> PathBuf {
     d
 }
 
+/// Runs `fogsim` (every path argument here is absolute, so any working directory does).
 fn fogsim(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_fogsim"))
-        .args(args)
-        .output()
-        .unwrap()
+    app_support::fogsim(&std::env::temp_dir(), args)
 }
 
 #[test]

@@ -1,9 +1,10 @@
 //! `fogsim train` end to end on small fog-runs files: a valid model file is written and
 //! decodes with fog-core; bad input gives a one-line error, a non-zero exit and no file.
 
+mod app_support;
+
 use fog_core::model::RbfModel;
 use std::path::Path;
-use std::process::Command;
 
 /// Writes one fog-runs v1 file of a warm-up whose drift follows dT/dt.
 fn write_run(path: &Path, ambient_c: f64, run: usize) {
@@ -19,11 +20,9 @@ fn write_run(path: &Path, ambient_c: f64, run: usize) {
     std::fs::write(path, s).unwrap();
 }
 
+/// Runs `fogsim` (every path argument here is absolute, so any working directory does).
 fn fogsim(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_fogsim"))
-        .args(args)
-        .output()
-        .unwrap()
+    app_support::fogsim(&std::env::temp_dir(), args)
 }
 
 #[test]
