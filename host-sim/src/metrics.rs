@@ -24,6 +24,11 @@ pub fn std_dev(x: &[f64]) -> f64 {
     (x.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (x.len() - 1) as f64).sqrt()
 }
 
+/// Root mean square (0 for an empty slice).
+pub fn rms(x: &[f64]) -> f64 {
+    (x.iter().map(|v| v * v).sum::<f64>() / x.len().max(1) as f64).sqrt()
+}
+
 /// Pooled standard deviation of several groups (runs): each about its own mean,
 /// sqrt(sum of squared deviations / (N - groups)). 0 when there are no degrees of freedom.
 pub fn pooled_std(groups: &[&[f64]]) -> f64 {

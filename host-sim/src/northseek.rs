@@ -20,6 +20,7 @@ use fog_core::hal::{GyroSample, TempSample};
 use fog_core::model::RbfModel;
 use fog_core::northfinder::{NorthFinder, SeekConfig, SeekMode, SeekStatus};
 
+use crate::metrics::{rms, std_dev};
 use crate::report::{NorthSeekReport, SeekStats, Table};
 use crate::sim::{rig, GyroParams, RunSpec, StartState, TurntableParams};
 
@@ -340,19 +341,6 @@ pub fn noise_floor_deg(
 
 fn mean(v: &[f64]) -> f64 {
     v.iter().sum::<f64>() / v.len().max(1) as f64
-}
-
-/// Sample standard deviation (n - 1), 0 for fewer than two values.
-fn std_dev(v: &[f64]) -> f64 {
-    if v.len() < 2 {
-        return 0.0;
-    }
-    let m = mean(v);
-    (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64).sqrt()
-}
-
-fn rms(v: &[f64]) -> f64 {
-    (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt()
 }
 
 /// Statistics of one arm: `seeks[start][seek]` against the true azimuth.

@@ -11,6 +11,7 @@
 use super::error::DiagnoseError;
 use super::input::Campaign;
 use super::linalg::solve_spd;
+use crate::metrics::rms;
 use serde::Serialize;
 
 /// Thermal time constants tried, s (pairs tau_fast < tau_slow).
@@ -77,10 +78,6 @@ fn fit_with_offsets(
         .map(|r| yd[r] - x.iter().zip(&b).map(|(c, w)| c[r] * w).sum::<f64>())
         .collect();
     Ok((b, resid))
-}
-
-fn rms(v: &[f64]) -> f64 {
-    (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt()
 }
 
 /// Fitted temperature and its time derivative per run for the best tau pair.

@@ -8,6 +8,7 @@ use super::dataset::Dataset;
 use super::error::{Result, TrainError};
 use super::fit::fit_width;
 use super::predict::predict_batch;
+pub use crate::metrics::rms;
 use serde::Serialize;
 
 /// Held-out score of one width.
@@ -101,14 +102,6 @@ pub fn cross_validate(ds: &Dataset, cfg: &TrainConfig, folds: usize) -> Result<C
 
 fn scan_rms(scan: &[WidthScore], i: usize) -> f64 {
     scan[i].heldout_rms_dph
-}
-
-/// Root mean square.
-pub fn rms(v: &[f64]) -> f64 {
-    if v.is_empty() {
-        return 0.0;
-    }
-    (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
 }
 
 /// Pooled rms after removing each group's mean: the within-run scatter.
