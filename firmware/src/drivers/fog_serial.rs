@@ -6,12 +6,35 @@
 //! gyro fault flag are counted and skipped, lost frames (counter jumps) are counted and
 //! leave a gap in time that the 10 s averager sees. Time is sample index x period since
 //! the first frame (the gyro's crystal is the time base of the whole measurement).
+//!
+//! The frame counter has 8 bits, so a stall of 256 frames or more (128 ms at 2 kHz)
+//! cannot be seen in it. A driver built `with_clock` also reads a hardware clock when
+//! each frame completes and takes the whole number of counter wraps that best matches
+//! the elapsed time, so the index (and every later time stamp) is right again from the
+//! first frame after any stall, and every lost frame is counted. This needs the clock
+//! read within +-64 ms (half a wrap at 2 kHz) of the frame's arrival: the firmware's
+//! receive ring holds far less than that. Without a clock (`new`: the bit-exact replay
+//! of a recorded stream) only the counter is used.
 
 use embedded_hal_nb::nb;
 use embedded_hal_nb::serial::{Error as _, ErrorKind, Read};
 use fog_core::hal::{Gyro, GyroSample, TempSample};
 
 use super::gyro_frame::{FrameDecoder, FrameStats, GyroFrame, ANGLE_LSB_DEG};
+use crate::clock::Clock;
+
+/// Frames per wrap of the 8-bit frame counter.
+const COUNTER_WRAP: u64 = 256;
+
+/// The clock of a driver that has none (`FogSerialGyro::new`): never read.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoClock;
+
+impl Clock for NoClock {
+    fn now_s(&self) -> f64 {
+        0.0
+    }
+}
 
 /// Sample-level counters on top of the frame decoder's.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -52,9 +75,12 @@ impl core::fmt::Display for UartError {
 
 impl core::error::Error for UartError {}
 
-/// Driver for a FOG with framed serial output.
-pub struct FogSerialGyro<S> {
+/// Driver for a FOG with framed serial output; `C` is the arrival clock (if any).
+pub struct FogSerialGyro<S, C = NoClock> {
     uart: S,
+    clock: Option<C>,
+    /// Clock reading at the previous frame, s.
+    last_arrival_s: Option<f64>,
     decoder: FrameDecoder,
     period_s: f64,
     dtheta_to_dph: f32,
@@ -66,11 +92,26 @@ pub struct FogSerialGyro<S> {
 }
 
 impl<S: Read<u8>> FogSerialGyro<S> {
-    /// `sample_rate_hz`: the gyro's configured output rate (1..=10,000 Hz).
+    /// `sample_rate_hz`: the gyro's configured output rate (1..=10,000 Hz). Time from the
+    /// frame counter only: a stall of 256 frames or more goes unseen.
     pub fn new(uart: S, sample_rate_hz: u32) -> Self {
+        Self::build(uart, sample_rate_hz, None)
+    }
+}
+
+impl<S: Read<u8>, C: Clock> FogSerialGyro<S, C> {
+    /// `new` plus a monotonic hardware clock read as each frame completes: counter
+    /// wraps during a stall are recovered from the elapsed time.
+    pub fn with_clock(uart: S, sample_rate_hz: u32, clock: C) -> Self {
+        Self::build(uart, sample_rate_hz, Some(clock))
+    }
+
+    fn build(uart: S, sample_rate_hz: u32, clock: Option<C>) -> Self {
         let period_s = 1.0 / f64::from(sample_rate_hz.clamp(1, 10_000));
         Self {
             uart,
+            clock,
+            last_arrival_s: None,
             decoder: FrameDecoder::new(),
             period_s,
             dtheta_to_dph: (ANGLE_LSB_DEG * 3600.0 / period_s) as f32,
@@ -108,21 +149,41 @@ impl<S: Read<u8>> FogSerialGyro<S> {
         self.uart
     }
 
+    /// Frames from the previous frame to this one (1 = none lost): the counter step,
+    /// plus the whole wraps the clock says passed.
+    fn frame_step(&mut self, prev_seq: u8, seq: u8) -> u64 {
+        // The counter never repeats in a healthy stream, so an unchanged counter means
+        // at least 256 frames were lost.
+        let counter_step = match seq.wrapping_sub(prev_seq) {
+            0 => COUNTER_WRAP,
+            s => u64::from(s),
+        };
+        let now_s = self.clock.as_ref().map(Clock::now_s);
+        let elapsed_frames = match (now_s, self.last_arrival_s) {
+            (Some(now), Some(then)) if now >= then => (now - then) / self.period_s,
+            _ => return counter_step,
+        };
+        // The number of wraps that brings the step nearest the elapsed time.
+        let wraps = libm::round((elapsed_frames - counter_step as f64) / COUNTER_WRAP as f64);
+        if wraps >= 1.0 && wraps < u32::MAX as f64 {
+            counter_step + wraps as u64 * COUNTER_WRAP
+        } else {
+            counter_step
+        }
+    }
+
     /// Turn a decoded frame into a sample (None if the gyro flags it invalid).
     pub fn accept_frame(&mut self, frame: GyroFrame) -> Option<GyroSample> {
         let index = match self.last_seq {
             None => 0,
             Some(prev) => {
-                // The counter never repeats in a healthy stream, so an unchanged
-                // counter means exactly 256 frames were lost.
-                let step = match frame.seq.wrapping_sub(prev) {
-                    0 => 256,
-                    s => u32::from(s),
-                };
-                self.stats.frames_lost += step - 1;
-                self.next_index + u64::from(step) - 1
+                let step = self.frame_step(prev, frame.seq);
+                let lost = u32::try_from(step - 1).unwrap_or(u32::MAX);
+                self.stats.frames_lost = self.stats.frames_lost.saturating_add(lost);
+                self.next_index + step - 1
             }
         };
+        self.last_arrival_s = self.clock.as_ref().map(Clock::now_s);
         self.last_seq = Some(frame.seq);
         self.next_index = index + 1;
         // End of this sample's integration interval.
@@ -143,7 +204,7 @@ impl<S: Read<u8>> FogSerialGyro<S> {
     }
 }
 
-impl<S: Read<u8>> Gyro for FogSerialGyro<S> {
+impl<S: Read<u8>, C: Clock> Gyro for FogSerialGyro<S, C> {
     type Error = UartError;
 
     fn read(&mut self) -> Result<Option<GyroSample>, UartError> {
