@@ -12,13 +12,25 @@
 //! The PC sends [`Request`]s, the device answers each with exactly one [`Response`].
 //! Everything is `no_std`, no allocation: a decoded request borrows its chunk bytes
 //! from the receive buffer.
+//!
+//! Security (version 2): the Ed25519 signature covers [`signed_prefix`] (a domain tag,
+//! the monotonic security counter and the gyro id the model is for) followed by the
+//! model bytes, so a model can neither be rolled back to an older counter nor moved to
+//! another gyro. An upload is a session: `Begin` returns its id, and only requests
+//! carrying that id may add to, commit or abort it.
+//!
+//! Reply budget: the device never sends more bytes than it received (a credit of
+//! received bytes pays for each reply; a frame-level rejection is sent only if the bad
+//! frame was at least as long as the reply). A `Hello`/`Status` request is therefore
+//! preceded by [`STATUS_REQUEST_PADDING`] zero bytes (empty frames, ignored), which pay
+//! for the longer status reply.
 
 use crate::model::ModelError;
 use heapless::String;
 use serde::{Deserialize, Serialize};
 
 /// Protocol version spoken by this build (sent in `Hello` and `DeviceStatus`).
-pub const PROTOCOL_VERSION: u16 = 1;
+pub const PROTOCOL_VERSION: u16 = 2;
 /// Most model bytes in one `Chunk`.
 pub const MAX_CHUNK_LEN: usize = 256;
 /// Length of an Ed25519 signature, bytes.
@@ -29,6 +41,31 @@ pub const MAX_PAYLOAD_LEN: usize = 320;
 pub const MAX_WIRE_FRAME_LEN: usize = MAX_PAYLOAD_LEN + MAX_PAYLOAD_LEN / 254 + 2;
 /// Length of the CRC trailer inside a payload.
 const CRC_LEN: usize = 4;
+/// Zero bytes a client sends before `Hello`/`Status`: they pay for the status reply
+/// (longer than the request) under the device's reply budget.
+pub const STATUS_REQUEST_PADDING: usize = 128;
+/// Bytes of the gyro id field (`TrainingMeta::gyro_id` capacity), NUL padded.
+pub const GYRO_ID_LEN: usize = 16;
+/// Domain tag that starts every signed message (no other message signed by the
+/// training key can be mistaken for a model).
+const SIGNING_DOMAIN: [u8; 16] = *b"FOG-MODEL-SIG-v2";
+/// Length of [`signed_prefix`].
+pub const SIGNED_PREFIX_LEN: usize = SIGNING_DOMAIN.len() + 4 + GYRO_ID_LEN;
+
+/// What the signature covers before the model bytes: the domain tag, the security
+/// counter (little-endian) and the target gyro id (NUL padded; `None` if the id is
+/// longer than [`GYRO_ID_LEN`] bytes).
+pub fn signed_prefix(security_counter: u32, gyro_id: &str) -> Option<[u8; SIGNED_PREFIX_LEN]> {
+    let id = gyro_id.as_bytes();
+    if id.len() > GYRO_ID_LEN {
+        return None;
+    }
+    let mut p = [0u8; SIGNED_PREFIX_LEN];
+    p[..16].copy_from_slice(&SIGNING_DOMAIN);
+    p[16..20].copy_from_slice(&security_counter.to_le_bytes());
+    p[20..20 + id.len()].copy_from_slice(id);
+    Some(p)
+}
 
 /// CRC-32/ISO-HDLC, the checksum of frames and of whole models in `Begin`.
 pub const CRC32: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC);
@@ -45,33 +82,43 @@ pub enum Request<'a> {
     Hello { protocol_version: u16 },
     /// What is running now; answered with `Response::Status`.
     Status,
-    /// Start an upload of `model_len` bytes whose CRC-32 is `model_crc32`.
-    /// Discards any unfinished upload. Answered with `Response::Ready`.
+    /// Start an upload session for `model_len` bytes whose CRC-32 is `model_crc32`.
+    /// Refused with `Busy` while another session is active (it expires after
+    /// `SESSION_IDLE_TIMEOUT_S` without requests). Answered with `Response::Ready`.
     Begin { model_len: u32, model_crc32: u32 },
     /// Model bytes at `offset`; chunks must arrive in order, each `<= MAX_CHUNK_LEN`.
     /// Answered with `Response::ChunkAccepted`.
     Chunk {
+        session: u32,
         offset: u32,
         #[serde(borrow)]
         data: &'a [u8],
     },
-    /// All bytes sent: check CRC, Ed25519 `signature` over the model bytes, validate the
-    /// model, write it to the inactive flash slot and switch. Answered with `Committed`.
+    /// All bytes sent: check CRC, that the model is for this gyro, the security counter
+    /// (no rollback), the Ed25519 `signature` over `signed_prefix ++ model`, validate the
+    /// model, write it to the inactive flash slot and switch. Answered with `Committed`
+    /// (without touching the flash if exactly this model is already active).
     Commit {
+        session: u32,
+        security_counter: u32,
         #[serde(borrow)]
         signature: &'a [u8],
     },
-    /// Drop the unfinished upload; answered with `Response::Aborted`.
-    Abort,
+    /// Drop this session's unfinished upload; answered with `Response::Aborted`.
+    Abort { session: u32 },
 }
+
+/// Seconds without a request after which an upload session may be taken over.
+pub const SESSION_IDLE_TIMEOUT_S: f64 = 10.0;
 
 /// Device -> PC.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Response {
     /// Answer to `Hello` and `Status`.
     Status(DeviceStatus),
-    /// `Begin` accepted; send chunks of at most `max_chunk_len` bytes.
-    Ready { max_chunk_len: u16 },
+    /// `Begin` accepted; send chunks of at most `max_chunk_len` bytes, all tagged
+    /// with `session`.
+    Ready { max_chunk_len: u16, session: u32 },
     /// Chunk stored; `received` model bytes so far.
     ChunkAccepted { received: u32 },
     /// The new model is in flash and in use.
@@ -93,6 +140,48 @@ pub struct DeviceStatus {
     pub frames_rejected: u32,
     /// Uploads refused at `Commit` since boot.
     pub uploads_rejected: u32,
+    /// Replies not sent since boot (reply budget exhausted or TX buffer full).
+    pub replies_suppressed: u32,
+    /// The gyro this device is bound to: only models for it are accepted.
+    pub gyro_id: String<GYRO_ID_LEN>,
+    /// Why the device last reset, and boots since power-on.
+    pub last_reset: ResetRecord,
+}
+
+/// Why the firmware last restarted (kept in no-init RAM across the reset).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ResetCause {
+    /// Power-on (no valid record in no-init RAM).
+    PowerOn,
+    /// The watchdog expired: the main loop stalled or the gyro path was not serviced.
+    Watchdog,
+    /// A Rust panic (`detail`: source line).
+    Panic,
+    /// A fatal boot error (`detail`: `BootFault` code).
+    FatalBoot,
+    /// A hard fault or other CPU exception (`detail`: exception number).
+    Exception,
+}
+
+/// The reset record reported in `DeviceStatus`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ResetRecord {
+    pub cause: ResetCause,
+    /// Cause-specific detail (panic line, boot fault code, exception number).
+    pub detail: u32,
+    /// Boots since power-on (1 = first boot).
+    pub boots: u32,
+}
+
+impl ResetRecord {
+    /// A first boot after power-on.
+    pub const POWER_ON: Self = Self {
+        cause: ResetCause::PowerOn,
+        detail: 0,
+        boots: 1,
+    };
 }
 
 /// Upload session state.
@@ -112,7 +201,9 @@ pub struct ModelInfo {
     pub model_len: u32,
     /// CRC-32 of the model bytes.
     pub model_crc32: u32,
-    pub gyro_id: String<16>,
+    /// Security counter the model was signed with (a lower one is refused).
+    pub security_counter: u32,
+    pub gyro_id: String<GYRO_ID_LEN>,
     pub n_centers: u16,
     pub n_inputs: u8,
     /// Held-out rms of the compensated 10 s drift the trainer reported, deg/h.
@@ -187,6 +278,14 @@ pub enum UploadError {
     FlashFailure,
     /// Sequence counter exhausted (u32::MAX uploads).
     SequenceExhausted,
+    /// The security counter is below the active model's (or equal for another model).
+    Rollback { active_counter: u32 },
+    /// The model was trained for another gyro than this device's.
+    WrongGyro,
+    /// The request's session id is not the active upload session's.
+    SessionMismatch,
+    /// Another upload session is active; retry after it ends or expires.
+    Busy,
 }
 
 impl core::fmt::Display for UploadError {
@@ -220,6 +319,13 @@ impl core::fmt::Display for UploadError {
             Self::ModelInvalid(r) => write!(f, "model rejected: {r:?}"),
             Self::FlashFailure => write!(f, "flash write/readback failed; old model kept"),
             Self::SequenceExhausted => write!(f, "store sequence counter exhausted"),
+            Self::Rollback { active_counter } => write!(
+                f,
+                "security counter not above the active model's ({active_counter}): rollback refused"
+            ),
+            Self::WrongGyro => write!(f, "model is for another gyro id than this device's"),
+            Self::SessionMismatch => write!(f, "request is not for the active upload session"),
+            Self::Busy => write!(f, "another upload session is active"),
         }
     }
 }
@@ -397,11 +503,16 @@ mod tests {
             model_crc32: 0xDEAD_BEEF,
         });
         roundtrip(&Request::Chunk {
+            session: u32::MAX,
             offset: 1792,
             data: &data,
         });
-        roundtrip(&Request::Commit { signature: &sig });
-        roundtrip(&Request::Abort);
+        roundtrip(&Request::Commit {
+            session: 7,
+            security_counter: u32::MAX,
+            signature: &sig,
+        });
+        roundtrip(&Request::Abort { session: 3 });
     }
 
     #[test]
@@ -411,6 +522,7 @@ mod tests {
             sequence: u32::MAX,
             model_len: u32::MAX,
             model_crc32: u32::MAX,
+            security_counter: u32::MAX,
             gyro_id: String::try_from("0123456789ABCDEF").unwrap(),
             n_centers: u16::MAX,
             n_inputs: u8::MAX,
@@ -425,7 +537,18 @@ mod tests {
             },
             frames_rejected: u32::MAX,
             uploads_rejected: u32::MAX,
+            replies_suppressed: u32::MAX,
+            gyro_id: String::try_from("0123456789ABCDEF").unwrap(),
+            last_reset: ResetRecord {
+                cause: ResetCause::Exception,
+                detail: u32::MAX,
+                boots: u32::MAX,
+            },
         };
+        // The padding before a status request pays for the largest status reply.
+        let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
+        let n = encode_frame(&Response::Status(status.clone()), &mut wire).unwrap();
+        assert!(n <= STATUS_REQUEST_PADDING, "status reply {n} B");
         let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
         for response in [
             Response::Status(status),
@@ -438,6 +561,16 @@ mod tests {
             let back: Response = decode_message(decode_frame(&mut wire[..n - 1]).unwrap()).unwrap();
             assert_eq!(back, response);
         }
+    }
+
+    #[test]
+    fn signed_prefix_binds_counter_and_gyro() {
+        let a = signed_prefix(5, "FOG-A").unwrap();
+        assert_ne!(a, signed_prefix(6, "FOG-A").unwrap());
+        assert_ne!(a, signed_prefix(5, "FOG-B").unwrap());
+        assert_eq!(&a[16..20], &5u32.to_le_bytes());
+        assert!(signed_prefix(1, "0123456789ABCDEF").is_some());
+        assert!(signed_prefix(1, "0123456789ABCDEFG").is_none());
     }
 
     #[test]

@@ -5,14 +5,15 @@
 //! | offset | bytes | field |
 //! |---|---|---|
 //! | 0 | 4 | magic `"FOGS"` (0x5347_4F46 LE) |
-//! | 4 | 2 | slot layout version (1) |
+//! | 4 | 2 | slot layout version (2) |
 //! | 6 | 2 | reserved, 0xFFFF |
 //! | 8 | 4 | sequence number (newest valid slot wins) |
 //! | 12 | 4 | model length, bytes |
 //! | 16 | 4 | CRC-32 of the model bytes |
-//! | 20 | 64 | Ed25519 signature of the model bytes |
-//! | 84 | 4 | CRC-32 of bytes 0..84 |
-//! | 88 | 8 | 0xFF |
+//! | 20 | 64 | Ed25519 signature of `signed_prefix(counter, gyro) ++ model` |
+//! | 84 | 4 | security counter the signature covers |
+//! | 88 | 4 | CRC-32 of bytes 0..88 |
+//! | 92 | 4 | 0xFF |
 //! | 96 | 32 | commit marker, written LAST |
 //! | 128 | len | model bytes (`RbfModel::encode`), padded to the write size with 0xFF |
 //!
@@ -30,9 +31,9 @@ use fog_core::protocol::{CRC32, SIGNATURE_LEN};
 /// Slot magic "FOGS".
 const SLOT_MAGIC: u32 = 0x5347_4F46;
 /// Slot layout version.
-const SLOT_VERSION: u16 = 1;
+const SLOT_VERSION: u16 = 2;
 /// Bytes covered by the header CRC.
-const HEADER_CRC_SPAN: usize = 84;
+const HEADER_CRC_SPAN: usize = 88;
 /// Header bytes written before the marker (header + padding).
 const HEADER_LEN: usize = 96;
 /// Offset and length of the commit marker.
@@ -83,6 +84,8 @@ pub struct SlotHeader {
     pub model_len: u32,
     pub model_crc32: u32,
     pub signature: [u8; SIGNATURE_LEN],
+    /// The security counter the signature covers (rollback floor).
+    pub security_counter: u32,
 }
 
 impl SlotHeader {
@@ -94,8 +97,9 @@ impl SlotHeader {
         b[12..16].copy_from_slice(&self.model_len.to_le_bytes());
         b[16..20].copy_from_slice(&self.model_crc32.to_le_bytes());
         b[20..84].copy_from_slice(&self.signature);
+        b[84..88].copy_from_slice(&self.security_counter.to_le_bytes());
         let crc = CRC32.checksum(&b[..HEADER_CRC_SPAN]);
-        b[84..88].copy_from_slice(&crc.to_le_bytes());
+        b[88..92].copy_from_slice(&crc.to_le_bytes());
         b
     }
 
@@ -104,7 +108,7 @@ impl SlotHeader {
         let word = |at: usize| u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]);
         let header_ok = word(0) == SLOT_MAGIC
             && u16::from_le_bytes([b[4], b[5]]) == SLOT_VERSION
-            && CRC32.checksum(&b[..HEADER_CRC_SPAN]) == word(84);
+            && CRC32.checksum(&b[..HEADER_CRC_SPAN]) == word(88);
         let model_len = word(12);
         if !header_ok || model_len == 0 || model_len as usize > MAX_ENCODED_LEN {
             return None;
@@ -116,6 +120,7 @@ impl SlotHeader {
             model_len,
             model_crc32: word(16),
             signature,
+            security_counter: word(84),
         })
     }
 }
@@ -205,12 +210,34 @@ impl<F: NorFlash> ModelStore<F> {
         Ok(Some(dest))
     }
 
+    /// The other slot, if it holds a complete, intact model (the boot path falls back
+    /// to it when the active slot's signature does not verify).
+    pub fn inactive(&mut self) -> Option<ActiveSlot> {
+        let slot = 1 - self.active?.slot;
+        self.read_slot(slot).map(|header| ActiveSlot { slot, header })
+    }
+
+    /// Makes `slot` (as returned by `inactive`) active, or none (`None`): the boot
+    /// path's decision after re-checking signatures. Nothing is written to flash.
+    pub fn select(&mut self, slot: Option<ActiveSlot>) {
+        self.active = slot;
+    }
+
+    /// The highest security counter of the intact slots (0 if none): a new model must
+    /// carry a higher one.
+    pub fn security_floor(&mut self) -> u32 {
+        let a = self.read_slot(0).map_or(0, |h| h.security_counter);
+        let b = self.read_slot(1).map_or(0, |h| h.security_counter);
+        a.max(b)
+    }
+
     /// Writes `model` (already verified by the caller) to the inactive slot and makes it
     /// active. On any error the previously active slot stays active.
     pub fn commit(
         &mut self,
         model: &[u8],
         signature: &[u8; SIGNATURE_LEN],
+        security_counter: u32,
     ) -> Result<ActiveSlot, StoreError> {
         if model.is_empty() || model.len() > MAX_ENCODED_LEN {
             return Err(StoreError::ModelSize);
@@ -225,6 +252,7 @@ impl<F: NorFlash> ModelStore<F> {
             model_len: model.len() as u32,
             model_crc32: CRC32.checksum(model),
             signature: *signature,
+            security_counter,
         };
         let base = self.slot_base(slot);
         let flash_err = |_| StoreError::Flash;

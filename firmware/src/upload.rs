@@ -1,20 +1,35 @@
 //! The device side of the model upload: a byte-driven state machine over the UART.
 //!
 //! The application feeds every received UART byte to [`UploadServer::push_byte`] and
-//! writes the returned response frame back; nothing here touches hardware, so the
-//! same code runs in host tests and in the firmware. A model becomes active only
-//! after its CRC, its Ed25519 signature (checked before any parsing of the bytes) and
-//! `RbfModel::decode` all pass and the A/B store committed it; any refusal answers
-//! with a typed `Response::Rejected` and leaves the running model in place.
+//! queues the returned response frame for sending; nothing here touches hardware, so
+//! the same code runs in host tests and in the firmware. A model becomes active only
+//! after its CRC, its security counter (no rollback), its Ed25519 signature over
+//! `signed_prefix(counter, this gyro) ++ model` (checked before any parsing of the
+//! bytes), `RbfModel::decode` and the gyro id all pass and the A/B store committed it;
+//! any refusal answers with a typed `Response::Rejected` and leaves the running model
+//! in place. Committing the model already active changes nothing (no flash erase).
+//!
+//! Uploads are sessions: only requests with the id `Begin` returned may add to,
+//! commit or abort one; another `Begin` is refused (`Busy`) until the session has been
+//! idle for `SESSION_IDLE_TIMEOUT_S` (time from `set_time_s`).
+//!
+//! Reply budget: the server never answers with more bytes than it received. Each
+//! received byte is one byte of credit (capped at one wire frame); a reply longer than
+//! the credit is not sent, and a frame-level rejection is sent only if the bad frame
+//! was at least as long as the rejection. Suppressed replies are counted in the status.
+//!
+//! At boot (`new`) the active slot's signature is checked again; a slot that fails
+//! (another key, tampered flash) is not used and the other slot is tried.
 
-use embedded_hal_nb::nb;
 use embedded_storage::nor_flash::NorFlash;
 use fog_core::model::{ModelError, RbfModel, MAX_ENCODED_LEN};
 use fog_core::protocol::{
-    decode_message, encode_frame, DeviceStatus, FrameReceiver, ModelInfo, ModelRejection, Request,
-    Response, UploadError, UploadPhase, MAX_CHUNK_LEN, MAX_WIRE_FRAME_LEN, PROTOCOL_VERSION,
-    SIGNATURE_LEN,
+    decode_message, encode_frame, signed_prefix, DeviceStatus, FrameReceiver, ModelInfo,
+    ModelRejection, Request, ResetRecord, Response, UploadError, UploadPhase, GYRO_ID_LEN,
+    MAX_CHUNK_LEN, MAX_WIRE_FRAME_LEN, PROTOCOL_VERSION, SESSION_IDLE_TIMEOUT_S,
+    SIGNATURE_LEN, SIGNED_PREFIX_LEN,
 };
+use heapless::String;
 
 use crate::signature::verify_model;
 use crate::store::{ActiveSlot, ModelStore, StoreError};
@@ -48,13 +63,19 @@ impl core::fmt::Display for LoadError {
     }
 }
 
+/// Largest reply credit, bytes (one wire frame): a long quiet period cannot be saved
+/// up for a burst of replies.
+const REPLY_CREDIT_CAP: usize = MAX_WIRE_FRAME_LEN;
+
 #[derive(Clone, Copy)]
 enum Session {
     Idle,
     Receiving {
+        id: u32,
         model_len: u32,
         model_crc32: u32,
         received: u32,
+        last_activity_s: f64,
     },
 }
 
@@ -62,39 +83,133 @@ enum Session {
 pub struct UploadServer<F> {
     store: ModelStore<F>,
     public_key: [u8; 32],
+    gyro_id: String<GYRO_ID_LEN>,
     rx: FrameReceiver,
     tx: [u8; MAX_WIRE_FRAME_LEN],
-    model_buf: [u8; MAX_ENCODED_LEN],
+    /// `signed_prefix` followed by the model bytes: the message the signature covers.
+    buf: [u8; SIGNED_PREFIX_LEN + MAX_ENCODED_LEN],
     session: Session,
+    next_session_id: u32,
+    now_s: f64,
     active_info: Option<ModelInfo>,
+    counters: Counters,
+    reply_credit: usize,
+    /// Bytes of the frame being received, delimiter included.
+    frame_bytes: usize,
+    last_reset: ResetRecord,
+    slots_refused_at_boot: u8,
+}
+
+#[derive(Clone, Copy, Default)]
+struct Counters {
     frames_rejected: u32,
     uploads_rejected: u32,
+    replies_suppressed: u32,
 }
 
 impl<F: NorFlash> UploadServer<F> {
-    /// Boots the store on `flash` at `base` (picks the newest valid slot) and accepts
-    /// models signed by `public_key`.
-    pub fn new(flash: F, base: u32, public_key: [u8; 32]) -> Result<Self, StoreError> {
+    /// Boots the store on `flash` at `base` (the newest intact slot whose signature
+    /// verifies) and accepts models for gyro `gyro_id` signed by `public_key`.
+    pub fn new(
+        flash: F,
+        base: u32,
+        public_key: [u8; 32],
+        gyro_id: String<GYRO_ID_LEN>,
+    ) -> Result<Self, StoreError> {
         let mut server = Self {
             store: ModelStore::open(flash, base)?,
             public_key,
+            // Distinct first session ids per key (not a secret: ids only keep one
+            // client's requests from acting on another client's session).
+            next_session_id: u32::from_le_bytes([
+                public_key[0],
+                public_key[1],
+                public_key[2],
+                public_key[3],
+            ]) | 1,
+            gyro_id,
             rx: FrameReceiver::new(),
             tx: [0; MAX_WIRE_FRAME_LEN],
-            model_buf: [0; MAX_ENCODED_LEN],
+            buf: [0; SIGNED_PREFIX_LEN + MAX_ENCODED_LEN],
             session: Session::Idle,
+            now_s: 0.0,
             active_info: None,
-            frames_rejected: 0,
-            uploads_rejected: 0,
+            counters: Counters::default(),
+            reply_credit: 0,
+            frame_bytes: 0,
+            last_reset: ResetRecord::POWER_ON,
+            slots_refused_at_boot: 0,
         };
-        server.active_info = match (server.store.active().copied(), server.load_active_model()) {
-            (Some(slot), Ok(Some(model))) => Some(model_info(&slot, &model)),
-            _ => None,
-        };
+        server.select_verified_slot();
         Ok(server)
     }
 
-    /// Feeds one received UART byte; at the end of a frame returns the response to send.
+    /// Re-checks the active slot's signature (and then the other slot's): the first
+    /// that verifies and decodes is used, none if neither does.
+    fn select_verified_slot(&mut self) {
+        let first = self.store.active().copied();
+        let second = self.store.inactive();
+        for candidate in [first, second].into_iter().flatten() {
+            self.store.select(Some(candidate));
+            let mut model = RbfModel::empty();
+            if self.verify_active_into(&mut model) {
+                self.active_info = Some(model_info(&candidate, &model));
+                return;
+            }
+            self.slots_refused_at_boot += 1;
+        }
+        self.store.select(None);
+        self.active_info = None;
+    }
+
+    /// Reads the active slot, checks its signature for this gyro and decodes it.
+    fn verify_active_into(&mut self, model: &mut RbfModel) -> bool {
+        let Some(slot) = self.store.active().copied() else {
+            return false;
+        };
+        let Some(prefix) = signed_prefix(slot.header.security_counter, &self.gyro_id) else {
+            return false;
+        };
+        let (head, body) = self.buf.split_at_mut(SIGNED_PREFIX_LEN);
+        head.copy_from_slice(&prefix);
+        let Ok(Some(bytes)) = self.store.read_active(body) else {
+            return false;
+        };
+        let len = SIGNED_PREFIX_LEN + bytes.len();
+        verify_model(&self.public_key, &self.buf[..len], &slot.header.signature).is_ok()
+            && model.decode_into(&self.buf[SIGNED_PREFIX_LEN..len]).is_ok()
+            && model.meta.gyro_id == self.gyro_id
+    }
+
+    /// Slots whose signature did not verify at boot (0 normally).
+    pub fn slots_refused_at_boot(&self) -> u8 {
+        self.slots_refused_at_boot
+    }
+
+    /// The time now, s since power-on (session expiry).
+    pub fn set_time_s(&mut self, now_s: f64) {
+        self.now_s = now_s;
+    }
+
+    /// The reset record the status reports (from no-init RAM at boot).
+    pub fn set_reset_record(&mut self, record: ResetRecord) {
+        self.last_reset = record;
+    }
+
+    /// Counts replies the application could not send (e.g. its TX buffer was full).
+    pub fn note_reply_dropped(&mut self) {
+        self.counters.replies_suppressed = self.counters.replies_suppressed.saturating_add(1);
+    }
+
+    /// Feeds one received UART byte; at the end of a frame returns the response to send
+    /// (`None` too if the reply budget does not allow one).
     pub fn push_byte(&mut self, byte: u8) -> Option<Reply<'_>> {
+        self.reply_credit = (self.reply_credit + 1).min(REPLY_CREDIT_CAP);
+        self.frame_bytes = self.frame_bytes.saturating_add(1);
+        let frame_len = self.frame_bytes;
+        if byte == 0 {
+            self.frame_bytes = 0;
+        }
         let outcome = match self.rx.push(byte)? {
             Err(e) => Err(e.as_upload_error()),
             Ok(payload) => match decode_message::<Request<'_>>(payload) {
@@ -104,7 +219,7 @@ impl<F: NorFlash> UploadServer<F> {
         };
         let (response, model_changed) = match outcome {
             Err(e) => {
-                self.frames_rejected = self.frames_rejected.saturating_add(1);
+                self.counters.frames_rejected = self.counters.frames_rejected.saturating_add(1);
                 (Response::Rejected(e), false)
             }
             Ok(request) => {
@@ -115,11 +230,14 @@ impl<F: NorFlash> UploadServer<F> {
                     &mut Fields {
                         store: &mut self.store,
                         public_key: &self.public_key,
-                        model_buf: &mut self.model_buf,
+                        gyro_id: &self.gyro_id,
+                        buf: &mut self.buf,
                         session: &mut self.session,
+                        next_session_id: &mut self.next_session_id,
+                        now_s: self.now_s,
                         active_info: &mut self.active_info,
-                        frames_rejected: self.frames_rejected,
-                        uploads_rejected: &mut self.uploads_rejected,
+                        counters: &mut self.counters,
+                        last_reset: self.last_reset,
                     },
                 )
             }
@@ -127,34 +245,19 @@ impl<F: NorFlash> UploadServer<F> {
         // Every response fits MAX_WIRE_FRAME_LEN (`largest_response_fits_a_frame` in
         // fog-core), so the empty fallback is unreachable.
         let len = encode_frame(&response, &mut self.tx).unwrap_or(0);
+        let frame_level = outcome_is_frame_level(&response, model_changed);
+        if len > self.reply_credit || (frame_level && len > frame_len) {
+            self.note_reply_dropped();
+            return model_changed.then_some(Reply {
+                frame: &[],
+                model_changed,
+            });
+        }
+        self.reply_credit -= len;
         Some(Reply {
             frame: &self.tx[..len],
             model_changed,
         })
-    }
-
-    /// Drains every byte the UART has ready into the server and writes each response
-    /// back (blocking on a full TX FIFO). Returns `true` if the active model changed:
-    /// then call `load_active_model` and hand the model to the compensator.
-    /// This is the whole hook of the application's main loop.
-    pub fn poll_uart<U>(&mut self, uart: &mut U) -> bool
-    where
-        U: embedded_hal_nb::serial::Read<u8> + embedded_hal_nb::serial::Write<u8>,
-    {
-        let mut changed = false;
-        // A UART error (overrun, framing) loses bytes; the frame CRC catches the rest.
-        while let Ok(byte) = uart.read() {
-            if let Some(reply) = self.push_byte(byte) {
-                changed |= reply.model_changed;
-                for &b in reply.frame {
-                    if nb::block!(uart.write(b)).is_err() {
-                        break;
-                    }
-                }
-            }
-        }
-        let _ = nb::block!(uart.flush());
-        changed
     }
 
     /// Reads and decodes the active model from flash (`Ok(None)`: no model stored).
@@ -172,7 +275,7 @@ impl<F: NorFlash> UploadServer<F> {
         }
         match self
             .store
-            .read_active(&mut self.model_buf)
+            .read_active(&mut self.buf[SIGNED_PREFIX_LEN..])
             .map_err(LoadError::Store)?
         {
             None => Ok(false),
@@ -193,8 +296,9 @@ impl<F: NorFlash> UploadServer<F> {
         device_status(
             &self.session,
             &self.active_info,
-            self.frames_rejected,
-            self.uploads_rejected,
+            &self.counters,
+            &self.gyro_id,
+            self.last_reset,
         )
     }
 
@@ -204,15 +308,71 @@ impl<F: NorFlash> UploadServer<F> {
     }
 }
 
+/// A frame-level rejection (the frame itself was bad), which is never worth more
+/// bytes than the bad frame.
+fn outcome_is_frame_level(response: &Response, model_changed: bool) -> bool {
+    !model_changed
+        && matches!(
+            response,
+            Response::Rejected(
+                UploadError::FrameCorrupt
+                    | UploadError::FrameCrcMismatch
+                    | UploadError::FrameTooLong
+                    | UploadError::MessageMalformed
+            )
+        )
+}
+
 /// The server's fields a request may touch, borrowed apart from the receive buffer.
 struct Fields<'s, F> {
     store: &'s mut ModelStore<F>,
     public_key: &'s [u8; 32],
-    model_buf: &'s mut [u8; MAX_ENCODED_LEN],
+    gyro_id: &'s String<GYRO_ID_LEN>,
+    buf: &'s mut [u8; SIGNED_PREFIX_LEN + MAX_ENCODED_LEN],
     session: &'s mut Session,
+    next_session_id: &'s mut u32,
+    now_s: f64,
     active_info: &'s mut Option<ModelInfo>,
-    frames_rejected: u32,
-    uploads_rejected: &'s mut u32,
+    counters: &'s mut Counters,
+    last_reset: ResetRecord,
+}
+
+impl<F> Fields<'_, F> {
+    /// The session's id if `id` names the active one.
+    fn check_session(&self, id: u32) -> Result<(), UploadError> {
+        match *self.session {
+            Session::Receiving { id: active, .. } if active == id => Ok(()),
+            Session::Receiving { .. } => Err(UploadError::SessionMismatch),
+            Session::Idle => Err(UploadError::NoUploadInProgress),
+        }
+    }
+
+    fn begin(&mut self, model_len: u32, model_crc32: u32) -> Result<u32, UploadError> {
+        if model_len == 0 || model_len as usize > MAX_ENCODED_LEN {
+            return Err(UploadError::ModelTooLarge {
+                max_len: MAX_ENCODED_LEN as u32,
+            });
+        }
+        if let Session::Receiving {
+            last_activity_s, ..
+        } = *self.session
+        {
+            if self.now_s - last_activity_s < SESSION_IDLE_TIMEOUT_S {
+                return Err(UploadError::Busy);
+            }
+        }
+        // Odd multiplier: a full-period sequence of ids.
+        let id = *self.next_session_id;
+        *self.next_session_id = id.wrapping_mul(0x9E37_79B9).wrapping_add(0x7F4A_7C15);
+        *self.session = Session::Receiving {
+            id,
+            model_len,
+            model_crc32,
+            received: 0,
+            last_activity_s: self.now_s,
+        };
+        Ok(id)
+    }
 }
 
 fn handle<F: NorFlash>(request: Request<'_>, s: &mut Fields<'_, F>) -> (Response, bool) {
@@ -220,8 +380,9 @@ fn handle<F: NorFlash>(request: Request<'_>, s: &mut Fields<'_, F>) -> (Response
         Response::Status(device_status(
             s.session,
             s.active_info,
-            s.frames_rejected,
-            *s.uploads_rejected,
+            s.counters,
+            s.gyro_id,
+            s.last_reset,
         ))
     };
     let response = match request {
@@ -234,40 +395,47 @@ fn handle<F: NorFlash>(request: Request<'_>, s: &mut Fields<'_, F>) -> (Response
         Request::Begin {
             model_len,
             model_crc32,
-        } => {
-            if model_len == 0 || model_len as usize > MAX_ENCODED_LEN {
-                Response::Rejected(UploadError::ModelTooLarge {
-                    max_len: MAX_ENCODED_LEN as u32,
-                })
-            } else {
-                *s.session = Session::Receiving {
-                    model_len,
-                    model_crc32,
-                    received: 0,
-                };
-                Response::Ready {
-                    max_chunk_len: MAX_CHUNK_LEN as u16,
-                }
-            }
-        }
-        Request::Chunk { offset, data } => match accept_chunk(s, offset, data) {
+        } => match s.begin(model_len, model_crc32) {
+            Ok(session) => Response::Ready {
+                max_chunk_len: MAX_CHUNK_LEN as u16,
+                session,
+            },
+            Err(e) => Response::Rejected(e),
+        },
+        Request::Chunk {
+            session,
+            offset,
+            data,
+        } => match s
+            .check_session(session)
+            .and_then(|()| accept_chunk(s, offset, data))
+        {
             Ok(received) => Response::ChunkAccepted { received },
             Err(e) => Response::Rejected(e),
         },
-        Request::Commit { signature } => {
-            let outcome = commit(s, signature);
+        Request::Commit {
+            session,
+            security_counter,
+            signature,
+        } => {
+            let outcome = s
+                .check_session(session)
+                .and_then(|()| commit(s, security_counter, signature));
             if outcome.is_err() {
-                *s.uploads_rejected = s.uploads_rejected.saturating_add(1);
+                s.counters.uploads_rejected = s.counters.uploads_rejected.saturating_add(1);
             }
             return match outcome {
-                Ok(info) => (Response::Committed(info), true),
+                Ok((info, changed)) => (Response::Committed(info), changed),
                 Err(e) => (Response::Rejected(e), false),
             };
         }
-        Request::Abort => {
-            *s.session = Session::Idle;
-            Response::Aborted
-        }
+        Request::Abort { session } => match s.check_session(session) {
+            Ok(()) => {
+                *s.session = Session::Idle;
+                Response::Aborted
+            }
+            Err(e) => Response::Rejected(e),
+        },
     };
     (response, false)
 }
@@ -275,9 +443,11 @@ fn handle<F: NorFlash>(request: Request<'_>, s: &mut Fields<'_, F>) -> (Response
 /// Stores one in-order chunk; returns the bytes received so far. A refused chunk keeps
 /// the session, so the client can resend from the expected offset.
 fn accept_chunk<F>(s: &mut Fields<'_, F>, offset: u32, data: &[u8]) -> Result<u32, UploadError> {
+    let now_s = s.now_s;
     let Session::Receiving {
         model_len,
         received,
+        last_activity_s,
         ..
     } = s.session
     else {
@@ -295,17 +465,25 @@ fn accept_chunk<F>(s: &mut Fields<'_, F>, offset: u32, data: &[u8]) -> Result<u3
     if end > *model_len {
         return Err(UploadError::ChunkPastEnd);
     }
-    s.model_buf[*received as usize..end as usize].copy_from_slice(data);
+    let at = SIGNED_PREFIX_LEN + *received as usize;
+    s.buf[at..at + data.len()].copy_from_slice(data);
     *received = end;
+    *last_activity_s = now_s;
     Ok(end)
 }
 
-/// Verifies and commits the received model. The session ends whatever the outcome.
-fn commit<F: NorFlash>(s: &mut Fields<'_, F>, signature: &[u8]) -> Result<ModelInfo, UploadError> {
+/// Verifies and commits the received model; `true` if the active model changed (false
+/// for a re-commit of the model already active). The session ends whatever the outcome.
+fn commit<F: NorFlash>(
+    s: &mut Fields<'_, F>,
+    security_counter: u32,
+    signature: &[u8],
+) -> Result<(ModelInfo, bool), UploadError> {
     let Session::Receiving {
         model_len,
         model_crc32,
         received,
+        ..
     } = *s.session
     else {
         return Err(UploadError::NoUploadInProgress);
@@ -314,30 +492,56 @@ fn commit<F: NorFlash>(s: &mut Fields<'_, F>, signature: &[u8]) -> Result<ModelI
         return Err(UploadError::UploadIncomplete { received });
     }
     *s.session = Session::Idle;
-    let bytes = &s.model_buf[..model_len as usize];
-    if fog_core::protocol::crc32(bytes) != model_crc32 {
+    let end = SIGNED_PREFIX_LEN + model_len as usize;
+    if fog_core::protocol::crc32(&s.buf[SIGNED_PREFIX_LEN..end]) != model_crc32 {
         return Err(UploadError::ModelCrcMismatch);
     }
     let signature: &[u8; SIGNATURE_LEN] = signature
         .try_into()
         .map_err(|_| UploadError::SignatureMalformed)?;
-    verify_model(s.public_key, bytes, signature).map_err(|_| UploadError::SignatureInvalid)?;
+    if let (Some(active), Some(info)) = (s.store.active().copied(), s.active_info.as_ref()) {
+        let same = active.header.model_crc32 == model_crc32
+            && active.header.model_len == model_len
+            && active.header.security_counter == security_counter
+            && active.header.signature == *signature;
+        if same {
+            return Ok((info.clone(), false));
+        }
+    }
+    let floor = s.store.security_floor();
+    if floor > 0 && security_counter <= floor {
+        return Err(UploadError::Rollback {
+            active_counter: floor,
+        });
+    }
+    let prefix = signed_prefix(security_counter, s.gyro_id).ok_or(UploadError::WrongGyro)?;
+    s.buf[..SIGNED_PREFIX_LEN].copy_from_slice(&prefix);
+    verify_model(s.public_key, &s.buf[..end], signature)
+        .map_err(|_| UploadError::SignatureInvalid)?;
+    let bytes = &s.buf[SIGNED_PREFIX_LEN..end];
     let model =
         RbfModel::decode(bytes).map_err(|e| UploadError::ModelInvalid(ModelRejection::from(e)))?;
-    let slot = s.store.commit(bytes, signature).map_err(|e| match e {
-        StoreError::SequenceExhausted => UploadError::SequenceExhausted,
-        _ => UploadError::FlashFailure,
-    })?;
+    if model.meta.gyro_id != *s.gyro_id {
+        return Err(UploadError::WrongGyro);
+    }
+    let slot = s
+        .store
+        .commit(bytes, signature, security_counter)
+        .map_err(|e| match e {
+            StoreError::SequenceExhausted => UploadError::SequenceExhausted,
+            _ => UploadError::FlashFailure,
+        })?;
     let info = model_info(&slot, &model);
     *s.active_info = Some(info.clone());
-    Ok(info)
+    Ok((info, true))
 }
 
 fn device_status(
     session: &Session,
     active_info: &Option<ModelInfo>,
-    frames_rejected: u32,
-    uploads_rejected: u32,
+    counters: &Counters,
+    gyro_id: &String<GYRO_ID_LEN>,
+    last_reset: ResetRecord,
 ) -> DeviceStatus {
     DeviceStatus {
         protocol_version: PROTOCOL_VERSION,
@@ -353,8 +557,11 @@ fn device_status(
                 model_len,
             },
         },
-        frames_rejected,
-        uploads_rejected,
+        frames_rejected: counters.frames_rejected,
+        uploads_rejected: counters.uploads_rejected,
+        replies_suppressed: counters.replies_suppressed,
+        gyro_id: gyro_id.clone(),
+        last_reset,
     }
 }
 
@@ -364,6 +571,7 @@ fn model_info(slot: &ActiveSlot, model: &RbfModel) -> ModelInfo {
         sequence: slot.header.sequence,
         model_len: slot.header.model_len,
         model_crc32: slot.header.model_crc32,
+        security_counter: slot.header.security_counter,
         gyro_id: model.meta.gyro_id.clone(),
         n_centers: model.centers.len() as u16,
         n_inputs: model.inputs.len() as u8,

@@ -13,9 +13,9 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use ed25519_compact::{KeyPair, Seed};
 use fog_core::protocol::{
-    crc32, decode_message, encode_frame, DeviceStatus, FrameError, FrameReceiver, ModelInfo,
-    Request, Response, UploadError, MAX_CHUNK_LEN, MAX_WIRE_FRAME_LEN, PROTOCOL_VERSION,
-    SIGNATURE_LEN,
+    crc32, decode_message, encode_frame, signed_prefix, DeviceStatus, FrameError, FrameReceiver,
+    ModelInfo, Request, Response, UploadError, MAX_CHUNK_LEN, MAX_WIRE_FRAME_LEN,
+    PROTOCOL_VERSION, SIGNATURE_LEN, STATUS_REQUEST_PADDING,
 };
 
 /// The repository's TEST signing seed (public! see keys/README.md).
@@ -58,9 +58,25 @@ fn decode_hex<const N: usize>(hex: &str) -> anyhow::Result<[u8; N]> {
     Ok(out)
 }
 
-/// Deterministic Ed25519 signature of the model bytes (what `Commit` carries).
+/// Deterministic Ed25519 signature of raw bytes (the bench's verification input).
 pub fn sign_model(key: &KeyPair, model_bytes: &[u8]) -> [u8; SIGNATURE_LEN] {
     *key.sk.sign(model_bytes, None)
+}
+
+/// The signature `Commit` carries: over `signed_prefix(security_counter, gyro_id)`
+/// followed by the model bytes, so the device refuses it for another gyro or after a
+/// model with a higher counter.
+pub fn sign_upload(
+    key: &KeyPair,
+    security_counter: u32,
+    gyro_id: &str,
+    model_bytes: &[u8],
+) -> anyhow::Result<[u8; SIGNATURE_LEN]> {
+    let prefix = signed_prefix(security_counter, gyro_id)
+        .with_context(|| format!("gyro id {gyro_id:?} longer than 16 bytes"))?;
+    let mut message = prefix.to_vec();
+    message.extend_from_slice(model_bytes);
+    Ok(sign_model(key, &message))
 }
 
 /// Why an exchange with the device failed.
@@ -199,37 +215,55 @@ impl<L: Read + Write> UploadClient<L> {
         }
     }
 
+    /// A status-answered request, preceded by the zero bytes that pay for the longer
+    /// reply under the device's reply budget (empty frames, ignored by the device).
+    fn padded_status_request(&mut self, request: &Request<'_>) -> Result<Response, ClientError> {
+        self.send_raw(&[0u8; STATUS_REQUEST_PADDING])?;
+        self.request(request)
+    }
+
     /// `Hello`: checks the protocol version and returns the device status.
     pub fn hello(&mut self) -> Result<DeviceStatus, ClientError> {
-        expect_status(self.request(&Request::Hello {
+        expect_status(self.padded_status_request(&Request::Hello {
             protocol_version: PROTOCOL_VERSION,
         })?)
     }
 
     /// `Status`: what the device runs now.
     pub fn status(&mut self) -> Result<DeviceStatus, ClientError> {
-        expect_status(self.request(&Request::Status)?)
+        expect_status(self.padded_status_request(&Request::Status)?)
     }
 
-    /// Uploads `model_bytes` with `signature`: Begin, in-order chunks, Commit.
-    /// Returns the committed model's identity as the device reports it.
-    pub fn upload(
-        &mut self,
-        model_bytes: &[u8],
-        signature: &[u8],
-        mut progress: impl FnMut(usize, usize),
-    ) -> Result<ModelInfo, ClientError> {
+    /// `Begin`: opens an upload session; returns (session id, largest chunk).
+    pub fn begin(&mut self, model_bytes: &[u8]) -> Result<(u32, usize), ClientError> {
         let begin = Request::Begin {
             model_len: model_bytes.len() as u32,
             model_crc32: crc32(model_bytes),
         };
-        let max_chunk = match self.request(&begin)? {
-            Response::Ready { max_chunk_len } => usize::from(max_chunk_len).clamp(1, MAX_CHUNK_LEN),
-            other => return Err(unexpected(other)),
-        };
+        match self.request(&begin)? {
+            Response::Ready {
+                max_chunk_len,
+                session,
+            } => Ok((session, usize::from(max_chunk_len).clamp(1, MAX_CHUNK_LEN))),
+            other => Err(unexpected(other)),
+        }
+    }
+
+    /// Uploads `model_bytes` with the `signature` made for `security_counter`
+    /// (`sign_upload`): Begin, in-order chunks, Commit, in one session.
+    /// Returns the committed model's identity as the device reports it.
+    pub fn upload(
+        &mut self,
+        model_bytes: &[u8],
+        security_counter: u32,
+        signature: &[u8],
+        mut progress: impl FnMut(usize, usize),
+    ) -> Result<ModelInfo, ClientError> {
+        let (session, max_chunk) = self.begin(model_bytes)?;
         let mut offset = 0usize;
         for data in model_bytes.chunks(max_chunk) {
             let chunk = Request::Chunk {
+                session,
                 offset: offset as u32,
                 data,
             };
@@ -241,7 +275,12 @@ impl<L: Read + Write> UploadClient<L> {
             offset += data.len();
             progress(offset, model_bytes.len());
         }
-        match self.request(&Request::Commit { signature })? {
+        let commit = Request::Commit {
+            session,
+            security_counter,
+            signature,
+        };
+        match self.request(&commit)? {
             Response::Committed(info) => Ok(info),
             other => Err(unexpected(other)),
         }
@@ -276,9 +315,10 @@ fn unexpected(response: Response) -> ClientError {
 /// One line describing a stored model, as `fogsim upload` prints it.
 pub fn describe_model(info: &ModelInfo) -> String {
     format!(
-        "slot {} seq {} | {} bytes, CRC-32 0x{:08X} | gyro {} | {} centres, {} inputs | held-out rms {:.4} deg/h",
+        "slot {} seq {} counter {} | {} bytes, CRC-32 0x{:08X} | gyro {} | {} centres, {} inputs | held-out rms {:.4} deg/h",
         if info.slot == 0 { 'A' } else { 'B' },
         info.sequence,
+        info.security_counter,
         info.model_len,
         info.model_crc32,
         info.gyro_id,

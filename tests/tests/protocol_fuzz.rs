@@ -25,7 +25,7 @@ fn noisy_bytes(max_len: usize) -> impl Strategy<Value = Vec<u8>> {
 fn mutated_request() -> impl Strategy<Value = Vec<u8>> {
     let request = prop_oneof![
         Just(Request::Status),
-        Just(Request::Abort),
+        any::<u32>().prop_map(|session| Request::Abort { session }),
         any::<u16>().prop_map(|v| Request::Hello {
             protocol_version: v
         }),
@@ -44,6 +44,7 @@ fn mutated_request() -> impl Strategy<Value = Vec<u8>> {
     )
         .prop_map(|(req, data, offset, edits, cut)| {
             let chunk = Request::Chunk {
+                session: offset.rotate_left(7),
                 offset,
                 data: &data,
             };
@@ -110,9 +111,9 @@ proptest! {
         streams in prop::collection::vec(prop_oneof![noisy_bytes(600), mutated_request()], 1..6)
     ) {
         let mut server = fresh_server();
-        let model = encode(&sample_model("FUZZ", 8, 1.0));
-        let sig = sign_with_test_key(&model);
-        let before = client(&mut server).upload(&model, &sig, |_, _| {}).unwrap();
+        let model = encode(&sample_model(TEST_GYRO, 8, 1.0));
+        let sig = sign_with_test_key(1, &model);
+        let before = client(&mut server).upload(&model, 1, &sig, |_, _| {}).unwrap();
         let mut answers = 0u32;
         for bytes in &streams {
             for &b in bytes {

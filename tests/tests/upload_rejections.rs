@@ -10,20 +10,27 @@ use fog_core::protocol::{
     crc32, ModelInfo, ModelRejection, Request, Response, UploadError, UploadPhase, MAX_CHUNK_LEN,
 };
 use fog_firmware::signature::TEST_PUBLIC_KEY;
-use fog_firmware::upload::UploadServer;
-use fog_sim::upload::{key_from_seed, sign_model, ClientError};
+use fog_sim::upload::{key_from_seed, sign_upload, ClientError};
 use rand::{Rng, SeedableRng};
 use upload_support::*;
 
 /// Installs a first good model and returns its info.
 fn install_first(server: &mut Server) -> ModelInfo {
     let bytes = encode(&sample_model("FOG-A17", 35, 1.0));
-    let sig = sign_with_test_key(&bytes);
+    let sig = sign_with_test_key(1, &bytes);
     let info = client(server)
-        .upload(&bytes, &sig, |_, _| {})
+        .upload(&bytes, 1, &sig, |_, _| {})
         .expect("good upload commits");
     assert_eq!(info.sequence, 1);
     info
+}
+
+fn commit_req(session: u32, signature: &[u8]) -> Request<'_> {
+    Request::Commit {
+        session,
+        security_counter: 2,
+        signature,
+    }
 }
 
 fn expect_rejected(result: Result<ModelInfo, ClientError>, want: UploadError) {
@@ -41,9 +48,9 @@ fn upload_then_status_shows_new_model_and_survives_reboot() {
     assert_eq!(first.gyro_id.as_str(), "FOG-A17");
     assert_eq!(first.n_centers, 35);
     let second_bytes = encode(&sample_model("FOG-A17", 64, 0.5));
-    let sig = sign_with_test_key(&second_bytes);
+    let sig = sign_with_test_key(2, &second_bytes);
     let mut c = client(&mut server);
-    let second = c.upload(&second_bytes, &sig, |_, _| {}).unwrap();
+    let second = c.upload(&second_bytes, 2, &sig, |_, _| {}).unwrap();
     assert_eq!(c.link_mut().model_changes, 1);
     assert_eq!(
         (second.slot, second.sequence, second.n_centers),
@@ -57,7 +64,7 @@ fn upload_then_status_shows_new_model_and_survives_reboot() {
     let loaded = server.load_active_model().unwrap().unwrap();
     assert_eq!(loaded, sample_model("FOG-A17", 64, 0.5));
     // Reboot: a new server on the same flash finds the same model.
-    let mut rebooted = UploadServer::new(server.into_flash(), 0, TEST_PUBLIC_KEY).unwrap();
+    let mut rebooted = reboot(server.into_flash());
     assert_eq!(rebooted.active_info(), Some(&second));
     assert_eq!(client(&mut rebooted).status().unwrap().active, Some(second));
 }
@@ -66,19 +73,19 @@ fn upload_then_status_shows_new_model_and_survives_reboot() {
 fn every_bad_upload_is_refused_with_its_typed_error_and_the_model_stays() {
     let mut server = fresh_server();
     let good = install_first(&mut server);
-    let bytes = encode(&sample_model("FOG-B02", 20, 1.0));
-    let sig = sign_with_test_key(&bytes);
+    let bytes = encode(&sample_model("FOG-A17", 20, 1.0));
+    let sig = sign_with_test_key(2, &bytes);
     let mut c = client(&mut server);
 
     // Unsigned: an empty signature.
     expect_rejected(
-        c.upload(&bytes, &[], |_, _| {}),
+        c.upload(&bytes, 2, &[], |_, _| {}),
         UploadError::SignatureMalformed,
     );
     // Wrong key: signed by a key the device does not hold.
-    let wrong = sign_model(&key_from_seed([7u8; 32]), &bytes);
+    let wrong = sign_upload(&key_from_seed([7u8; 32]), 2, TEST_GYRO, &bytes).unwrap();
     expect_rejected(
-        c.upload(&bytes, &wrong, |_, _| {}),
+        c.upload(&bytes, 2, &wrong, |_, _| {}),
         UploadError::SignatureInvalid,
     );
     // Bit-flipped after signing (the CRC in Begin matches the flipped bytes).
@@ -86,37 +93,37 @@ fn every_bad_upload_is_refused_with_its_typed_error_and_the_model_stays() {
         let mut flipped = bytes.clone();
         flipped[bit / 8] ^= 1 << (bit % 8);
         expect_rejected(
-            c.upload(&flipped, &sig, |_, _| {}),
+            c.upload(&flipped, 2, &sig, |_, _| {}),
             UploadError::SignatureInvalid,
         );
     }
     // Truncated, correctly signed: authentic but not a whole model.
     let truncated = &bytes[..bytes.len() - 9];
-    let sig_trunc = sign_with_test_key(truncated);
+    let sig_trunc = sign_with_test_key(2, truncated);
     expect_rejected(
-        c.upload(truncated, &sig_trunc, |_, _| {}),
+        c.upload(truncated, 2, &sig_trunc, |_, _| {}),
         UploadError::ModelInvalid(ModelRejection::Malformed),
     );
     // Wrong version, correctly signed (version varint is the byte after the 5-byte magic).
     let mut v2 = bytes.clone();
     assert_eq!(v2[5], 1, "version byte");
     v2[5] = 2;
-    let sig_v2 = sign_with_test_key(&v2);
+    let sig_v2 = sign_with_test_key(2, &v2);
     expect_rejected(
-        c.upload(&v2, &sig_v2, |_, _| {}),
+        c.upload(&v2, 2, &sig_v2, |_, _| {}),
         UploadError::ModelInvalid(ModelRejection::WrongVersion),
     );
     // NaN weight, correctly signed, model CRC fixed up.
     let nan = nan_weight_model_bytes();
-    let sig_nan = sign_with_test_key(&nan);
+    let sig_nan = sign_with_test_key(2, &nan);
     expect_rejected(
-        c.upload(&nan, &sig_nan, |_, _| {}),
+        c.upload(&nan, 2, &sig_nan, |_, _| {}),
         UploadError::ModelInvalid(ModelRejection::InvalidContent),
     );
     // Oversized: announced too long, and a chunk too long.
     let huge = vec![0x55u8; MAX_ENCODED_LEN + 1];
     expect_rejected(
-        c.upload(&huge, &sig, |_, _| {}),
+        c.upload(&huge, 2, &sig, |_, _| {}),
         UploadError::ModelTooLarge {
             max_len: MAX_ENCODED_LEN as u32,
         },
@@ -125,10 +132,13 @@ fn every_bad_upload_is_refused_with_its_typed_error_and_the_model_stays() {
         model_len: bytes.len() as u32,
         model_crc32: crc32(&bytes),
     };
-    assert!(matches!(c.request(&begin).unwrap(), Response::Ready { .. }));
+    let Response::Ready { session, .. } = c.request(&begin).unwrap() else {
+        panic!("Begin not answered with Ready")
+    };
     let long = [0u8; MAX_CHUNK_LEN + 1];
     let reply = c
         .request(&Request::Chunk {
+            session,
             offset: 0,
             data: &long,
         })
@@ -137,6 +147,7 @@ fn every_bad_upload_is_refused_with_its_typed_error_and_the_model_stays() {
     // Out of order, past the end, early commit, wrong CRC.
     let reply = c
         .request(&Request::Chunk {
+            session,
             offset: 8,
             data: &bytes[8..16],
         })
@@ -145,13 +156,14 @@ fn every_bad_upload_is_refused_with_its_typed_error_and_the_model_stays() {
         reply,
         Response::Rejected(UploadError::ChunkOutOfOrder { expected_offset: 0 })
     );
-    let reply = c.request(&Request::Commit { signature: &sig }).unwrap();
+    let reply = c.request(&commit_req(session, &sig)).unwrap();
     assert_eq!(
         reply,
         Response::Rejected(UploadError::UploadIncomplete { received: 0 })
     );
     let reply = c
         .request(&Request::Chunk {
+            session,
             offset: 0,
             data: &[1, 2],
         })
@@ -164,9 +176,10 @@ fn every_bad_upload_is_refused_with_its_typed_error_and_the_model_stays() {
             model_len: bytes.len() as u32
         }
     );
-    assert_eq!(c.request(&Request::Abort).unwrap(), Response::Aborted);
+    assert_eq!(c.request(&Request::Abort { session }).unwrap(), Response::Aborted);
     let reply = c
         .request(&Request::Chunk {
+            session,
             offset: 2,
             data: &[3],
         })
@@ -176,23 +189,24 @@ fn every_bad_upload_is_refused_with_its_typed_error_and_the_model_stays() {
         model_len: 4,
         model_crc32: 0,
     };
-    assert!(matches!(
-        c.request(&bad_crc).unwrap(),
-        Response::Ready { .. }
-    ));
+    let Response::Ready { session, .. } = c.request(&bad_crc).unwrap() else {
+        panic!("Begin not answered with Ready")
+    };
     let reply = c
         .request(&Request::Chunk {
+            session,
             offset: 0,
             data: &[9, 9, 9, 9, 9],
         })
         .unwrap();
     assert_eq!(reply, Response::Rejected(UploadError::ChunkPastEnd));
     c.request(&Request::Chunk {
+        session,
         offset: 0,
         data: &[9, 9, 9, 9],
     })
     .unwrap();
-    let reply = c.request(&Request::Commit { signature: &sig }).unwrap();
+    let reply = c.request(&commit_req(session, &sig)).unwrap();
     assert_eq!(reply, Response::Rejected(UploadError::ModelCrcMismatch));
     // Protocol version.
     let reply = c
@@ -240,7 +254,7 @@ fn every_bad_upload_is_refused_with_its_typed_error_and_the_model_stays() {
     assert_eq!(status.active, Some(good.clone()));
     assert_eq!(status.uploads_rejected, 11);
     assert_eq!(c.link_mut().model_changes, 0);
-    let mut rebooted = UploadServer::new(server.into_flash(), 0, TEST_PUBLIC_KEY).unwrap();
+    let mut rebooted = reboot(server.into_flash());
     assert_eq!(rebooted.active_info(), Some(&good));
     assert_eq!(
         rebooted.load_active_model().unwrap().unwrap(),

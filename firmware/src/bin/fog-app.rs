@@ -7,12 +7,18 @@
 //!   the gyro's internal coil temperature comes with every frame and is read at 1 Hz
 //!   (a board with a TMP117 on I2C uses `drivers::tmp117` instead);
 //! - UART2 (0x4000_6000): the turntable controller (`SerialTurntable`);
-//! - SysTick: 1 kHz time base for turntable timeouts;
+//! - SysTick: 1 kHz time base for turntable timeouts and the gyro's frame time base
+//!   (counter wraps during a stall are recovered from it);
+//! - the CMSDK watchdog (0x4000_8000): 500 ms, fed only while the gyro path is serviced;
 //! - the last 16 KiB of flash: the two model slots.
 //!
-//! Main loop: upload bytes -> upload server (a committed model is swapped into the
-//! compensator at once); gyro samples -> application (10 s windows, compensation,
-//! north seeks on the table); results and faults -> defmt log.
+//! Main loop, gyro path first: every gyro byte the RX interrupt put in its ring ->
+//! samples -> application (10 s windows, compensation, north seeks on the table);
+//! then at most `HOST_BYTES_PER_PASS` host bytes -> upload server, whose replies go to
+//! a TX queue sent without blocking (a full queue drops the reply and counts it);
+//! results and faults -> defmt log. The watchdog is fed only when the gyro ring was
+//! drained and lost nothing in this pass. Any fatal error records its reason in no-init
+//! RAM and resets; the next boot logs it and reports it in `DeviceStatus`.
 #![no_std]
 #![no_main]
 
@@ -20,10 +26,17 @@
 mod flash;
 #[path = "target/millis.rs"]
 mod millis;
-#[path = "target/panic.rs"]
-mod panic;
+#[path = "target/panic_reset.rs"]
+mod panic_reset;
+#[path = "target/resets.rs"]
+mod resets;
+#[cfg(feature = "log-semihosting")]
+#[path = "target/semi.rs"]
+mod semi;
 #[path = "target/uart.rs"]
 mod uart;
+#[path = "target/watchdog.rs"]
+mod watchdog;
 
 #[cfg(feature = "log-rtt")]
 use defmt_rtt as _;
@@ -31,28 +44,39 @@ use defmt_rtt as _;
 use defmt_semihosting as _;
 
 use cortex_m_rt::entry;
-use embedded_hal_nb::nb;
-use embedded_hal_nb::serial::Write as _;
+use embedded_hal_nb::serial::{Read as _, Write as _};
 use fog_core::compensator::Compensator;
 use fog_core::hal::Gyro;
 use fog_core::model::RbfModel;
+use fog_core::protocol::ResetRecord;
 use fog_firmware::app::{App, AppConfig, SeekOutcome};
+use fog_firmware::clock::Clock;
 use fog_firmware::drivers::fog_serial::FogSerialGyro;
 use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig};
-use fog_firmware::signature::TEST_PUBLIC_KEY;
 use fog_firmware::upload::UploadServer;
+use resets::BootFault;
 
 #[cfg(not(any(feature = "log-semihosting", feature = "log-rtt")))]
 compile_error!("fog-app needs a defmt logger: feature log-semihosting (QEMU) or log-rtt");
 
 /// Gyro output rate, Hz.
 const GYRO_RATE_HZ: u32 = 2000;
-const UART1_BASE: usize = 0x4000_5000;
-const UART2_BASE: usize = 0x4000_6000;
 /// Host link and turntable baud rates; the gyro link runs at 460,800 baud.
 const HOST_BAUD: u32 = 115_200;
 const GYRO_BAUD: u32 = 460_800;
 const TABLE_BAUD: u32 = 115_200;
+/// Watchdog deadline between feeds, ms.
+const WATCHDOG_TIMEOUT_MS: u32 = 500;
+/// Host bytes handled per main-loop pass (the gyro ring is drained in between).
+const HOST_BYTES_PER_PASS: usize = 64;
+/// Reply bytes waiting for the host UART.
+const TX_QUEUE_LEN: usize = 512;
+/// No gyro sample for this long marks the gyro silent (a fault in the window), s.
+const GYRO_SILENCE_S: f64 = 0.1;
+
+/// The model-verifying public key and the gyro id, chosen at build time (build.rs).
+const VERIFY_KEY: [u8; 32] = *include_bytes!(concat!(env!("OUT_DIR"), "/verify_key.bin"));
+const GYRO_ID: &str = include_str!(concat!(env!("OUT_DIR"), "/gyro_id.txt"));
 
 #[entry]
 fn main() -> ! {
@@ -62,31 +86,39 @@ fn main() -> ! {
     // as `&'static mut` exactly once (no unsafe here).
     static mut COMPENSATOR: Compensator = Compensator::unconfigured();
     static mut MODEL: RbfModel = RbfModel::empty();
-    let (compensator, model) = (COMPENSATOR, MODEL);
+    static mut TX_QUEUE: heapless::Deque<u8, TX_QUEUE_LEN> = heapless::Deque::new();
+    let (compensator, model, tx_queue) = (COMPENSATOR, MODEL, TX_QUEUE);
+    let reset = resets::boot_record();
+    announce_boot(&reset);
     let Some(cp) = cortex_m::Peripherals::take() else {
-        semihosting::process::abort()
+        resets::fatal_boot(BootFault::CorePeripherals)
     };
     millis::start_millis(cp.SYST);
+    watchdog::start(WATCHDOG_TIMEOUT_MS);
+    inject_fault_for_tests(&reset);
     // SAFETY: each UART block and the model region are taken exactly once, here.
     let (mut host, gyro_uart, table_uart, flash) = unsafe {
         (
-            uart::CmsdkUart::new(uart::UART0_BASE, HOST_BAUD),
-            uart::CmsdkUart::new(UART1_BASE, GYRO_BAUD),
-            uart::CmsdkUart::new(UART2_BASE, TABLE_BAUD),
+            uart::CmsdkUart::new(0, HOST_BAUD),
+            uart::CmsdkUart::new(1, GYRO_BAUD),
+            uart::CmsdkUart::new(2, TABLE_BAUD),
             flash::ModelFlash::take(),
         )
     };
-    defmt::info!("fog-app: boot");
 
     // The long-lived state lives in statics (counted in the static-RAM budget by the
     // linker), not in main's stack frame.
-    let server = start_upload_server(flash);
+    let server = start_upload_server(flash, reset);
     // Decoded in place into `MODEL` (the compensator keeps its own copy).
     let stored = server.load_active_model_into(model).unwrap_or_else(|e| {
         defmt::warn!("stored model not loaded ({}): running uncompensated", e);
         false
     });
-    defmt::info!("model active: {}", stored);
+    defmt::info!(
+        "model active: {} (slots refused at boot: {})",
+        stored,
+        server.slots_refused_at_boot()
+    );
 
     let table = SerialTurntable::new(table_uart, millis::MillisClock, TurntableConfig::default());
     // Configured in place in `COMPENSATOR`; the `App` around it is a few hundred bytes.
@@ -95,37 +127,28 @@ fn main() -> ! {
         Ok(a) => a,
         Err(e) => {
             defmt::error!("configuration rejected: {}", e);
-            semihosting::process::abort()
+            resets::fatal_boot(BootFault::Configuration)
         }
     };
-    let mut gyro = FogSerialGyro::new(gyro_uart, GYRO_RATE_HZ);
+    let mut gyro = FogSerialGyro::with_clock(gyro_uart, GYRO_RATE_HZ, millis::MillisClock);
     let mut last_t_s = 0.0;
+    let mut last_sample_clock_s = millis::MillisClock.now_s();
+    let mut gyro_silent = false;
 
     loop {
-        // 1. Host link: the upload hook.
-        while let Ok(byte) = embedded_hal_nb::serial::Read::read(&mut host) {
-            let Some(reply) = server.push_byte(byte) else {
-                continue;
-            };
-            for &b in reply.frame {
-                let _ = nb::block!(host.write(b));
-            }
-            if reply.model_changed {
-                match server.load_active_model_into(model) {
-                    Ok(stored) => match app.set_model_from(stored.then_some(&*model)) {
-                        Ok(()) => defmt::info!("new model in use"),
-                        Err(e) => defmt::error!("new model refused: {}", e),
-                    },
-                    Err(e) => defmt::error!("new model not loaded: {}", e),
-                }
-            }
-        }
-
-        // 2. Gyro samples: everything the UART has buffered.
-        loop {
+        let now_s = millis::MillisClock.now_s();
+        // 1. Gyro first: everything its ring holds.
+        let drops_before = gyro.uart_mut().dropped();
+        let mut drained = false;
+        while !drained {
             match gyro.read() {
                 Ok(Some(s)) => {
                     last_t_s = s.t_s;
+                    last_sample_clock_s = now_s;
+                    if gyro_silent {
+                        gyro_silent = false;
+                        defmt::info!("t={} s: gyro samples again", s.t_s);
+                    }
                     if app.temp_due(s.t_s) {
                         let t = gyro.latest_temp();
                         if t.is_none() {
@@ -135,14 +158,105 @@ fn main() -> ! {
                     }
                     report(app.on_gyro(s));
                 }
-                Ok(None) => break,
+                Ok(None) => drained = true,
                 Err(e) => {
                     defmt::warn!("gyro UART error {}", e);
                     app.on_fault(last_t_s);
                 }
             }
         }
+        if !gyro_silent && now_s - last_sample_clock_s > GYRO_SILENCE_S {
+            gyro_silent = true;
+            defmt::warn!("t={} s: gyro silent (dead sensor or cable): window invalid", last_t_s);
+            app.on_fault(last_t_s);
+        }
+        // The gyro path is healthy when its ring was drained and lost nothing.
+        if gyro.uart_mut().dropped() == drops_before {
+            watchdog::feed();
+        }
+
+        // 2. Host link: a bounded number of bytes per pass, replies queued.
+        server.set_time_s(now_s);
+        for _ in 0..HOST_BYTES_PER_PASS {
+            let Ok(byte) = host.read() else { break };
+            let Some(reply) = server.push_byte(byte) else {
+                continue;
+            };
+            let (frame, changed) = (reply.frame, reply.model_changed);
+            let fits = frame.len() <= TX_QUEUE_LEN - tx_queue.len();
+            if fits {
+                for &b in frame {
+                    let _ = tx_queue.push_back(b);
+                }
+            }
+            if !fits {
+                server.note_reply_dropped();
+            }
+            if changed {
+                swap_model(server, model, &mut app);
+            }
+        }
+        // 3. Replies out, never waiting for the UART.
+        while let Some(&b) = tx_queue.front() {
+            if host.write(b).is_err() {
+                break;
+            }
+            let _ = tx_queue.pop_front();
+        }
     }
+}
+
+/// A committed model: load it and hand it to the compensator.
+fn swap_model<T, C>(server: &mut Server, model: &mut RbfModel, app: &mut App<T, C>)
+where
+    T: fog_core::hal::Turntable,
+    T::Error: Copy,
+    C: core::borrow::BorrowMut<Compensator>,
+{
+    match server.load_active_model_into(model) {
+        Ok(stored) => match app.set_model_from(stored.then_some(&*model)) {
+            Ok(()) => defmt::info!("new model in use"),
+            Err(e) => defmt::error!("new model refused: {}", e),
+        },
+        Err(e) => defmt::error!("new model not loaded: {}", e),
+    }
+}
+
+/// The boot line: why the previous run ended. Under QEMU also as plain text on the
+/// semihosting console, where the fault tests count boots.
+fn announce_boot(reset: &ResetRecord) {
+    defmt::info!(
+        "fog-app: boot {} after {} (detail {})",
+        reset.boots,
+        reset.cause,
+        reset.detail
+    );
+    #[cfg(feature = "log-semihosting")]
+    semihosting::eprintln!(
+        "FOG-BOOT {} reset={:?} detail={}",
+        reset.boots,
+        reset.cause,
+        reset.detail
+    );
+}
+
+/// QEMU fault scenarios (tests/tests/qemu_faults.rs): the semihosting argument
+/// `inject=panic` or `inject=hang` makes the first boot fail that way. Absent from
+/// hardware builds (no semihosting there).
+fn inject_fault_for_tests(reset: &ResetRecord) {
+    #[cfg(feature = "log-semihosting")]
+    if reset.boots == 1 {
+        let Ok(args) = semi::Args::get() else { return };
+        match args.str(0) {
+            Ok("inject=panic") => core::panic!("injected panic"),
+            Ok("inject=hang") => loop {
+                cortex_m::asm::nop();
+            },
+            _ => {}
+        }
+    }
+    #[cfg(not(feature = "log-semihosting"))]
+    let _ = reset;
 }
 
 fn report<E: defmt::Format>(step: fog_firmware::app::Step<E>) {
@@ -179,20 +293,23 @@ fn report<E: defmt::Format>(step: fog_firmware::app::Step<E>) {
 type Server = UploadServer<flash::ModelFlash>;
 
 /// The upload server, in a static. Its own frame (never inlined into `main`): building it
-/// (store scan, decoding the active model for its identity) needs ~10 KB of temporaries,
-/// which are then given back instead of staying in `main`'s frame for good.
+/// (store scan, signature re-check, decoding the active model for its identity) needs
+/// ~10 KB of temporaries, which are then given back instead of staying in `main`'s frame.
 #[inline(never)]
-fn start_upload_server(flash: flash::ModelFlash) -> &'static mut Server {
-    // The repository's TEST key (keys/README.md): a product build embeds its own.
-    let server = match UploadServer::new(flash, 0, TEST_PUBLIC_KEY) {
+fn start_upload_server(flash: flash::ModelFlash, reset: ResetRecord) -> &'static mut Server {
+    let Ok(gyro_id) = heapless::String::try_from(GYRO_ID) else {
+        resets::fatal_boot(BootFault::Configuration)
+    };
+    let mut server = match UploadServer::new(flash, 0, VERIFY_KEY, gyro_id) {
         Ok(s) => s,
         Err(e) => {
             defmt::error!("model store unusable: {}", e);
-            semihosting::process::abort()
+            resets::fatal_boot(BootFault::StoreGeometry)
         }
     };
+    server.set_reset_record(reset);
     let Some(server) = cortex_m::singleton!(: Server = server) else {
-        semihosting::process::abort()
+        resets::fatal_boot(BootFault::Singleton)
     };
     server
 }

@@ -1,8 +1,10 @@
 //! `fogsim upload`: sign a trained model and install it on the gyro over its UART.
 //!
 //! Checks the model file locally first (a bad file never goes out), signs it with the
-//! training PC's Ed25519 key, uploads it in chunks, commits, then asks the device for
-//! its status and confirms that the new model (sequence, CRC) is the one in use.
+//! training PC's Ed25519 key for its gyro and the given security counter, checks that
+//! the device is that gyro and runs a lower counter, uploads it in chunks (one
+//! session), commits, then asks the device for its status and confirms that the new
+//! model (sequence, CRC, counter) is the one in use.
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -12,7 +14,7 @@ use fog_core::model::RbfModel;
 use fog_core::protocol::SIGNATURE_LEN;
 
 use crate::upload::{
-    describe_model, load_signing_key, open_link, sign_model, test_key_path, UploadClient,
+    describe_model, load_signing_key, open_link, sign_upload, test_key_path, UploadClient,
 };
 
 /// Options of `fogsim upload`.
@@ -31,6 +33,10 @@ pub struct Args {
     /// Seconds to wait for each response.
     #[arg(long, default_value_t = 5.0)]
     pub timeout_s: f64,
+    /// Security counter signed with the model: must exceed the counter of the model the
+    /// device runs (rollback protection); keep one increasing counter per gyro.
+    #[arg(long, required_unless_present = "status_only")]
+    pub security_counter: Option<u32>,
     /// Only query and print the device status; no upload.
     #[arg(long)]
     pub status_only: bool,
@@ -48,9 +54,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         );
     }
     // Check everything local first: a bad file or key never reaches the device.
-    let prepared = match &args.model {
-        Some(path) => Some(prepare(path, args.key.clone())?),
-        None => None,
+    let prepared = match (&args.model, args.security_counter) {
+        (Some(path), Some(counter)) => Some(prepare(path, args.key.clone(), counter)?),
+        _ => None,
     };
     let link = open_link(&args.port, args.baud)?;
     let mut client = UploadClient::new(link, Duration::from_secs_f64(args.timeout_s));
@@ -59,11 +65,29 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Some(info) => println!("device model before: {}", describe_model(info)),
         None => println!("device model before: none"),
     }
-    let Some((bytes, signature)) = prepared else {
+    println!(
+        "device: gyro {}, last reset {:?} (detail {}), boot {}",
+        before.gyro_id, before.last_reset.cause, before.last_reset.detail, before.last_reset.boots
+    );
+    let Some((bytes, gyro_id, counter, signature)) = prepared else {
         return Ok(());
     };
+    if gyro_id != before.gyro_id.as_str() {
+        bail!(
+            "model is for gyro {gyro_id} but the device is gyro {}: not sent",
+            before.gyro_id
+        );
+    }
+    if let Some(active) = before.active.as_ref().filter(|a| a.security_counter >= counter) {
+        if active.model_crc32 != fog_core::protocol::crc32(&bytes) {
+            bail!(
+                "--security-counter {counter} is not above the device's {}: the device would refuse it as a rollback",
+                active.security_counter
+            );
+        }
+    }
     let committed = client
-        .upload(&bytes, &signature, |done, total| {
+        .upload(&bytes, counter, &signature, |done, total| {
             eprint!("\r  sent {done}/{total} bytes")
         })
         .context("upload")?;
@@ -78,11 +102,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
 }
 
-/// Reads and validates the model file, loads the key and signs: (model bytes, signature).
-fn prepare(
-    model_path: &Path,
-    key: Option<PathBuf>,
-) -> anyhow::Result<(Vec<u8>, [u8; SIGNATURE_LEN])> {
+/// What `prepare` hands to the upload: model bytes, its gyro id, counter, signature.
+type Prepared = (Vec<u8>, String, u32, [u8; SIGNATURE_LEN]);
+
+/// Reads and validates the model file, loads the key and signs it for its gyro and
+/// `counter`.
+fn prepare(model_path: &Path, key: Option<PathBuf>, counter: u32) -> anyhow::Result<Prepared> {
     let bytes = std::fs::read(model_path)
         .with_context(|| format!("reading model {}", model_path.display()))?;
     let model = RbfModel::decode(&bytes)
@@ -91,7 +116,8 @@ fn prepare(
     if key_path == test_key_path() {
         eprintln!("fogsim upload: WARNING signing with the public TEST key (keys/README.md)");
     }
-    let signature = sign_model(&load_signing_key(&key_path)?, &bytes);
+    let gyro_id = model.meta.gyro_id.as_str();
+    let signature = sign_upload(&load_signing_key(&key_path)?, counter, gyro_id, &bytes)?;
     println!(
         "model {}: {} bytes, gyro {}, {} centres, {} inputs",
         model_path.display(),
@@ -100,5 +126,5 @@ fn prepare(
         model.centers.len(),
         model.inputs.len()
     );
-    Ok((bytes, signature))
+    Ok((bytes, gyro_id.to_string(), counter, signature))
 }

@@ -11,7 +11,10 @@ use fog_core::model::{RbfModel, TrainingMeta, MAX_ENCODED_LEN};
 use fog_firmware::signature::TEST_PUBLIC_KEY;
 use fog_firmware::store::EmulatedModelFlash;
 use fog_firmware::upload::UploadServer;
-use fog_sim::upload::{load_signing_key, sign_model, test_key_path, UploadClient};
+use fog_sim::upload::{load_signing_key, sign_upload, test_key_path, UploadClient};
+
+/// The gyro the host-test device is bound to.
+pub const TEST_GYRO: &str = "FOG-A17";
 
 /// A valid 2-input model (T, dT/dt) with `n_centers` centres for gyro `gyro_id`.
 pub fn sample_model(gyro_id: &str, n_centers: usize, weight_scale: f32) -> RbfModel {
@@ -51,10 +54,16 @@ pub fn encode(model: &RbfModel) -> Vec<u8> {
     buf
 }
 
-/// Signature of `bytes` with the repository's TEST key.
-pub fn sign_with_test_key(bytes: &[u8]) -> [u8; 64] {
+/// Upload signature of `bytes` for `TEST_GYRO` and `counter` with the repository's
+/// TEST key.
+pub fn sign_with_test_key(counter: u32, bytes: &[u8]) -> [u8; 64] {
+    sign_for_gyro(counter, TEST_GYRO, bytes)
+}
+
+/// Upload signature of `bytes` for `gyro` and `counter` with the TEST key.
+pub fn sign_for_gyro(counter: u32, gyro: &str, bytes: &[u8]) -> [u8; 64] {
     let key = load_signing_key(&test_key_path()).expect("test key loads");
-    sign_model(&key, bytes)
+    sign_upload(&key, counter, gyro, bytes).expect("gyro id fits")
 }
 
 /// Rewrites the body of an encoded model (the envelope is postcard of
@@ -69,10 +78,18 @@ pub fn patch_body(encoded: &[u8], patch: impl FnOnce(&mut Vec<u8>)) -> Vec<u8> {
     postcard::to_allocvec(&(magic, version, body.as_slice(), crc)).expect("re-encodes")
 }
 
-/// A model whose first weight is NaN but whose envelope CRC is right.
+/// The gyro id of the QEMU test build of `fog-app` (firmware/build.rs).
+pub const QEMU_GYRO: &str = "QEMU-FOG-1";
+
+/// A model for `TEST_GYRO` whose first weight is NaN but whose envelope CRC is right.
 pub fn nan_weight_model_bytes() -> Vec<u8> {
+    nan_weight_model_bytes_for(TEST_GYRO)
+}
+
+/// `nan_weight_model_bytes` for another gyro.
+pub fn nan_weight_model_bytes_for(gyro: &str) -> Vec<u8> {
     let marker = 1234.5f32;
-    let mut model = sample_model("NANGYRO", 8, 1.0);
+    let mut model = sample_model(gyro, 8, 1.0);
     model.weights[0] = marker;
     patch_body(&encode(&model), |body| {
         let at = body
@@ -85,9 +102,15 @@ pub fn nan_weight_model_bytes() -> Vec<u8> {
 
 pub type Server = UploadServer<EmulatedModelFlash>;
 
-/// A fresh device: erased emulated flash, the TEST public key.
+/// A fresh device: erased emulated flash, the TEST public key, bound to `TEST_GYRO`.
 pub fn fresh_server() -> Server {
-    UploadServer::new(EmulatedModelFlash::new(), 0, TEST_PUBLIC_KEY).expect("store opens")
+    reboot(EmulatedModelFlash::new())
+}
+
+/// A device booting on `flash` (TEST key, `TEST_GYRO`).
+pub fn reboot(flash: EmulatedModelFlash) -> Server {
+    UploadServer::new(flash, 0, TEST_PUBLIC_KEY, TEST_GYRO.try_into().unwrap())
+        .expect("store opens")
 }
 
 /// Bytes written by the client go straight into the server; its replies queue for reading.
