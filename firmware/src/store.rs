@@ -214,7 +214,8 @@ impl<F: NorFlash> ModelStore<F> {
     /// to it when the active slot's signature does not verify).
     pub fn inactive(&mut self) -> Option<ActiveSlot> {
         let slot = 1 - self.active?.slot;
-        self.read_slot(slot).map(|header| ActiveSlot { slot, header })
+        self.read_slot(slot)
+            .map(|header| ActiveSlot { slot, header })
     }
 
     /// Makes `slot` (as returned by `inactive`) active, or none (`None`): the boot

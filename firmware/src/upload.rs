@@ -26,8 +26,8 @@ use fog_core::model::{ModelError, RbfModel, MAX_ENCODED_LEN};
 use fog_core::protocol::{
     decode_message, encode_frame, signed_prefix, DeviceStatus, FrameReceiver, ModelInfo,
     ModelRejection, Request, ResetRecord, Response, UploadError, UploadPhase, GYRO_ID_LEN,
-    MAX_CHUNK_LEN, MAX_WIRE_FRAME_LEN, PROTOCOL_VERSION, SESSION_IDLE_TIMEOUT_S,
-    SIGNATURE_LEN, SIGNED_PREFIX_LEN,
+    MAX_CHUNK_LEN, MAX_WIRE_FRAME_LEN, PROTOCOL_VERSION, SESSION_IDLE_TIMEOUT_S, SIGNATURE_LEN,
+    SIGNED_PREFIX_LEN,
 };
 use heapless::String;
 

@@ -14,8 +14,8 @@ use anyhow::Context;
 use ed25519_compact::{KeyPair, Seed};
 use fog_core::protocol::{
     crc32, decode_message, encode_frame, signed_prefix, DeviceStatus, FrameError, FrameReceiver,
-    ModelInfo, Request, Response, UploadError, MAX_CHUNK_LEN, MAX_WIRE_FRAME_LEN,
-    PROTOCOL_VERSION, SIGNATURE_LEN, STATUS_REQUEST_PADDING,
+    ModelInfo, Request, Response, UploadError, MAX_CHUNK_LEN, MAX_WIRE_FRAME_LEN, PROTOCOL_VERSION,
+    SIGNATURE_LEN, STATUS_REQUEST_PADDING,
 };
 
 /// The repository's TEST signing seed (public! see keys/README.md).

@@ -113,7 +113,12 @@ pub fn build_firmware() -> Result<PathBuf, String> {
             FW_PROFILE,
             "--bins",
         ])
-        .args(["--target", FW_TARGET, "--features", "log-semihosting,test-key"])
+        .args([
+            "--target",
+            FW_TARGET,
+            "--features",
+            "log-semihosting,test-key",
+        ])
         .arg("--target-dir")
         .arg(&target_dir)
         .env_remove("CARGO_TARGET_DIR")

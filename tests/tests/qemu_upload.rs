@@ -73,11 +73,20 @@ fn qemu_upload_installs_signed_model_and_refuses_bad_ones() {
     let start_sequence = hello.active.as_ref().map_or(0, |m| m.sequence);
 
     // 1. A signed 35-centre model installs; status shows it in use.
-    assert_eq!(hello.gyro_id.as_str(), QEMU_GYRO, "the test build's gyro id");
+    assert_eq!(
+        hello.gyro_id.as_str(),
+        QEMU_GYRO,
+        "the test build's gyro id"
+    );
     let counter = hello.active.as_ref().map_or(0, |m| m.security_counter) + 1;
     let first = encode(&sample_model(QEMU_GYRO, 35, 1.0));
     let info = client
-        .upload(&first, counter, &sign_for_gyro(counter, QEMU_GYRO, &first), |_, _| {})
+        .upload(
+            &first,
+            counter,
+            &sign_for_gyro(counter, QEMU_GYRO, &first),
+            |_, _| {},
+        )
         .expect("upload 1");
     assert_eq!(info.sequence, start_sequence + 1);
     assert_eq!(info.model_crc32, crc32(&first));
@@ -86,13 +95,19 @@ fn qemu_upload_installs_signed_model_and_refuses_bad_ones() {
 
     // 2. Bad uploads: typed refusals, model unchanged.
     let second = encode(&sample_model(QEMU_GYRO, 64, 0.5));
-    let wrong_key = sign_upload(&key_from_seed([0x42; 32]), counter + 1, QEMU_GYRO, &second).unwrap();
+    let wrong_key =
+        sign_upload(&key_from_seed([0x42; 32]), counter + 1, QEMU_GYRO, &second).unwrap();
     match client.upload(&second, counter + 1, &wrong_key, |_, _| {}) {
         Err(ClientError::Rejected(UploadError::SignatureInvalid)) => {}
         other => panic!("wrong-key upload: {other:?}"),
     }
     let nan = nan_weight_model_bytes_for(QEMU_GYRO);
-    match client.upload(&nan, counter + 1, &sign_for_gyro(counter + 1, QEMU_GYRO, &nan), |_, _| {}) {
+    match client.upload(
+        &nan,
+        counter + 1,
+        &sign_for_gyro(counter + 1, QEMU_GYRO, &nan),
+        |_, _| {},
+    ) {
         Err(ClientError::Rejected(UploadError::ModelInvalid(ModelRejection::InvalidContent))) => {}
         other => panic!("NaN-weight upload: {other:?}"),
     }
@@ -110,11 +125,21 @@ fn qemu_upload_installs_signed_model_and_refuses_bad_ones() {
     // 3. A second signed model goes to the other slot with the next sequence number.
     // The model already active, committed again: a no-op (same slot and sequence).
     let again = client
-        .upload(&first, counter, &sign_for_gyro(counter, QEMU_GYRO, &first), |_, _| {})
+        .upload(
+            &first,
+            counter,
+            &sign_for_gyro(counter, QEMU_GYRO, &first),
+            |_, _| {},
+        )
         .expect("re-commit of the active model");
     assert_eq!(again, info);
     let info2 = client
-        .upload(&second, counter + 1, &sign_for_gyro(counter + 1, QEMU_GYRO, &second), |_, _| {})
+        .upload(
+            &second,
+            counter + 1,
+            &sign_for_gyro(counter + 1, QEMU_GYRO, &second),
+            |_, _| {},
+        )
         .expect("upload 2");
     assert_eq!(
         (info2.sequence, info2.slot, info2.n_centers),
@@ -122,7 +147,12 @@ fn qemu_upload_installs_signed_model_and_refuses_bad_ones() {
     );
     assert_eq!(client.status().unwrap().active, Some(info2));
     // Rollback: the first model with its (valid) older counter is refused.
-    match client.upload(&first, counter, &sign_for_gyro(counter, QEMU_GYRO, &first), |_, _| {}) {
+    match client.upload(
+        &first,
+        counter,
+        &sign_for_gyro(counter, QEMU_GYRO, &first),
+        |_, _| {},
+    ) {
         Err(ClientError::Rejected(UploadError::Rollback { .. })) => {}
         other => panic!("rollback upload: {other:?}"),
     }

@@ -42,7 +42,9 @@ fn reboot<F: NorFlash>(flash: F) -> (Found, F) {
 
 fn commit<F: NorFlash>(flash: F, model: &[u8]) -> (bool, F) {
     let mut store = ModelStore::open(flash, 0).expect("store opens");
-    let ok = store.commit(model, &sign_with_test_key(1, model), 1).is_ok();
+    let ok = store
+        .commit(model, &sign_with_test_key(1, model), 1)
+        .is_ok();
     (ok, store.into_flash())
 }
 

@@ -176,7 +176,10 @@ fn every_bad_upload_is_refused_with_its_typed_error_and_the_model_stays() {
             model_len: bytes.len() as u32
         }
     );
-    assert_eq!(c.request(&Request::Abort { session }).unwrap(), Response::Aborted);
+    assert_eq!(
+        c.request(&Request::Abort { session }).unwrap(),
+        Response::Aborted
+    );
     let reply = c
         .request(&Request::Chunk {
             session,

@@ -46,7 +46,8 @@ fn an_older_counter_is_refused_as_rollback_even_with_a_valid_signature() {
     assert_eq!(c.status().unwrap().active, Some(info.clone()));
     // The floor survives a reboot (it is in the slot headers).
     let mut rebooted = reboot(server.into_flash());
-    let e = rejected(client(&mut rebooted).upload(&old, 5, &sign_with_test_key(5, &old), |_, _| {}));
+    let e =
+        rejected(client(&mut rebooted).upload(&old, 5, &sign_with_test_key(5, &old), |_, _| {}));
     assert_eq!(e, UploadError::Rollback { active_counter: 9 });
 }
 
@@ -69,7 +70,9 @@ fn recommitting_the_active_model_is_a_no_op_without_erase() {
     let mut server = fresh_server();
     let bytes = encode(&sample_model(TEST_GYRO, 35, 1.0));
     let sig = sign_with_test_key(1, &bytes);
-    let first = client(&mut server).upload(&bytes, 1, &sig, |_, _| {}).unwrap();
+    let first = client(&mut server)
+        .upload(&bytes, 1, &sig, |_, _| {})
+        .unwrap();
     let flash = server.into_flash();
     let ops_after_first = flash.ops_done();
     let mut server = reboot(flash);
@@ -141,8 +144,11 @@ fn slot_signatures_are_rechecked_at_boot() {
     let a = encode(&sample_model(TEST_GYRO, 35, 1.0));
     let b = encode(&sample_model(TEST_GYRO, 20, 0.5));
     let mut c = client(&mut server);
-    let info_a = c.upload(&a, 1, &sign_with_test_key(1, &a), |_, _| {}).unwrap();
-    c.upload(&b, 2, &sign_with_test_key(2, &b), |_, _| {}).unwrap();
+    let info_a = c
+        .upload(&a, 1, &sign_with_test_key(1, &a), |_, _| {})
+        .unwrap();
+    c.upload(&b, 2, &sign_with_test_key(2, &b), |_, _| {})
+        .unwrap();
     let flash = server.into_flash();
     // A device with another key trusts neither slot.
     let other_key = *key_from_seed([9; 32]).pk;

@@ -78,7 +78,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             before.gyro_id
         );
     }
-    if let Some(active) = before.active.as_ref().filter(|a| a.security_counter >= counter) {
+    if let Some(active) = before
+        .active
+        .as_ref()
+        .filter(|a| a.security_counter >= counter)
+    {
         if active.model_crc32 != fog_core::protocol::crc32(&bytes) {
             bail!(
                 "--security-counter {counter} is not above the device's {}: the device would refuse it as a rollback",

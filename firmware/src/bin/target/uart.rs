@@ -156,13 +156,16 @@ impl CmsdkUart {
     }
 }
 
-/// RX interrupt of UART `index`: drain the holding register into the ring.
+/// RX interrupt of UART `index`: drain the holding register into the ring. The
+/// interrupt is cleared BEFORE draining: a byte arriving after the last read then
+/// raises it again (clearing after the loop could swallow that byte's interrupt and
+/// leave the receiver full for good, which a host-port flood made happen in QEMU).
 fn on_rx(index: usize) {
     let base = BASES[index];
+    write_reg(base, INTCLEAR, INT_RX);
     while read_reg(base, STATE) & STATE_RX_FULL != 0 {
         RINGS[index].push(read_reg(base, DATA) as u8);
     }
-    write_reg(base, INTCLEAR, INT_RX);
 }
 
 /// The combined overrun interrupt: count and clear on every UART.
