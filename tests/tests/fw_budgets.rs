@@ -17,13 +17,14 @@ use fog_tests::{
     firmware_elf, firmware_size, llvm_tool, qemu_ready, run_qemu, scratch_dir, QemuOptions,
 };
 
-/// The issue's budgets.
-const FLASH_TARGET_BYTES: u64 = 64 * 1024;
-const STATIC_RAM_BUDGET_BYTES: u64 = 16 * 1024;
-/// Flash check: the 64 KiB budget itself (measured 64,484 bytes after the f32/exact-degree
-/// trigonometry diet of fog-core, down from 72,040; docs/budgets.md has the current value).
-const FLASH_CEILING_BYTES: u64 = FLASH_TARGET_BYTES;
-/// Regression ceiling for call sites into panic stubs in `fog-app` (measured: see docs).
+/// The budgets (issue 11): 128 KiB of flash and 32 KiB of static RAM per binary, no
+/// further. `fog-app` now carries the recovery, interrupt rings, sessions and boot
+/// signature re-check (docs/budgets.md has the measured values).
+const FLASH_CEILING_BYTES: u64 = 128 * 1024;
+const STATIC_RAM_BUDGET_BYTES: u64 = 32 * 1024;
+/// Regression ceiling for call sites into panic stubs in `fog-app`; the remaining ones
+/// are listed and justified in docs/budgets.md (a panic there records its line and
+/// resets, it never halts).
 const PANIC_CALL_SITES_CEILING: usize = 50;
 /// Sample rate and clock of the CPU-load estimate.
 const LOAD_RATE_HZ: f64 = 2000.0;
@@ -123,16 +124,16 @@ fn firmware_fits_its_budgets() {
     let _ = writeln!(table, "| budget | measured | limit |\n|---|---|---|");
     let _ = writeln!(
         table,
-        "| flash (`fog-app`, text+rodata+data) | {} B ({:.1} KiB) | target 64 KiB: {}; CI ceiling {} KiB |",
+        "| flash (`fog-app`, text+rodata+data) | {} B ({:.1} KiB) | {} KiB |",
         size.flash,
         size.flash as f64 / 1024.0,
-        if size.flash <= FLASH_TARGET_BYTES { "met" } else { "NOT met" },
         FLASH_CEILING_BYTES / 1024
     );
     let _ = writeln!(
         table,
-        "| static RAM (`fog-app`, data+bss) | {} B | 16 KiB |",
-        size.static_ram
+        "| static RAM (`fog-app`, data+bss+uninit) | {} B | {} KiB |",
+        size.static_ram,
+        STATIC_RAM_BUDGET_BYTES / 1024
     );
     let _ = writeln!(
         table,
@@ -195,15 +196,15 @@ fn firmware_fits_its_budgets() {
 
     assert!(
         size.static_ram <= STATIC_RAM_BUDGET_BYTES,
-        "static RAM {} B over the 16 KiB budget",
-        size.static_ram
+        "static RAM {} B over the {} B budget",
+        size.static_ram,
+        STATIC_RAM_BUDGET_BYTES
     );
     assert!(
         size.flash <= FLASH_CEILING_BYTES,
-        "flash {} B grew past the {} B ceiling (target {} B)",
+        "flash {} B grew past the {} B ceiling",
         size.flash,
-        FLASH_CEILING_BYTES,
-        FLASH_TARGET_BYTES
+        FLASH_CEILING_BYTES
     );
     assert!(
         n_sites <= PANIC_CALL_SITES_CEILING,

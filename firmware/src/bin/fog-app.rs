@@ -258,8 +258,9 @@ fn announce_boot(reset: &ResetRecord) {
 fn window_line(w: &fog_core::compensator::WindowResult, frames_lost: u32, bytes_dropped: u32) {
     #[cfg(feature = "log-semihosting")]
     semihosting::eprintln!(
-        "FOG-WINDOW t_end_s={} status={:?} valid={} n_samples={} frames_lost={} gyro_bytes_dropped={}",
-        w.t_end_s,
+        "FOG-WINDOW t_end_ms={} status={:?} valid={} n_samples={} frames_lost={} gyro_bytes_dropped={}",
+        // Integer ms: no f64 formatting code in the image.
+        (w.t_end_s * 1000.0) as u64,
         w.status,
         w.status.is_valid(),
         w.n_samples,
