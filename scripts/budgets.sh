@@ -12,6 +12,8 @@ FOG_REQUIRE_QEMU=1 FOG_BUDGETS_OUT="$table" \
     cargo test -p fog-tests --test fw_budgets -- --nocapture
 FOG_REQUIRE_QEMU=1 FOG_BUDGETS_STACK_OUT="$stack" \
     cargo test -p fog-tests --test qemu_replay -- --nocapture
+# Hand-written notes below the table (from the marker on) are kept.
+notes="$(sed -n '/<!-- notes:begin -->/,$p' "$out" 2>/dev/null || true)"
 {
     echo "# Firmware budgets"
     echo
@@ -20,6 +22,10 @@ FOG_REQUIRE_QEMU=1 FOG_BUDGETS_STACK_OUT="$stack" \
     echo "\`mps2-an386\` with \`-icount shift=0\`: instruction counts, not cycles)."
     echo
     cat "$table" "$stack"
+    if [ -n "$notes" ]; then
+        echo
+        echo "$notes"
+    fi
 } > "$out"
 echo "wrote $out"
 
