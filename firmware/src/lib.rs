@@ -3,7 +3,8 @@
 //! Everything here builds and is tested on the host; the target-only glue (runtime,
 //! UART registers, semihosting, SysTick) lives in `src/bin/`. Modules:
 //! `clock` (time for drivers), `drivers` (gyro frames, TMP117, turntable),
-//! `app` (samples -> 10 s windows -> compensation -> north seek), `replay` (the QEMU
+//! `app` (samples -> 10 s windows -> compensation -> north seek), `health` (stuck-sensor
+//! detection), `replay` (the QEMU
 //! replay scenario's file formats, shared with the host test).
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
@@ -11,6 +12,7 @@
 pub mod app;
 pub mod clock;
 pub mod drivers;
+pub mod health;
 pub mod replay;
 pub mod signature;
 pub mod store;

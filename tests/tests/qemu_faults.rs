@@ -174,12 +174,17 @@ fn stream_gyro(mut link: TcpStream, stop: Arc<AtomicBool>) -> u64 {
     let period_s = 1.0 / f64::from(FLOOD_GYRO_HZ);
     let start = Instant::now();
     let mut sent = 0u64;
+    // White rate noise of a FOG with ARW 0.005 deg/sqrt(h) at this rate, deg/h.
+    let noise = rand_distr::Normal::new(0.0, 0.005 * 60.0 / period_s.sqrt()).unwrap();
+    let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(7);
     while !stop.load(Ordering::Relaxed) {
         let due = (start.elapsed().as_secs_f64() / period_s) as u64;
         let mut batch = Vec::new();
         while sent < due {
-            // A physical-looking signal: Earth rate component plus a slow ripple.
-            let rate_dph = 9.7 + 0.3 * (sent as f64 * 0.001).sin();
+            // Earth rate component plus a slow ripple plus the gyro's white noise.
+            let rate_dph = 9.7
+                + 0.3 * (sent as f64 * 0.001).sin()
+                + rand_distr::Distribution::sample(&noise, &mut rng);
             batch.extend(GyroFrame::from_physical(sent as u8, rate_dph, 25.0, period_s).encode());
             sent += 1;
         }

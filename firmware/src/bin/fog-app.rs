@@ -53,6 +53,7 @@ use fog_firmware::app::{App, AppConfig, SeekOutcome};
 use fog_firmware::clock::Clock;
 use fog_firmware::drivers::fog_serial::FogSerialGyro;
 use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig};
+use fog_firmware::health::{StuckDetector, StuckEvent, DEFAULT_STUCK_RUN};
 use fog_firmware::upload::UploadServer;
 use resets::BootFault;
 
@@ -137,6 +138,7 @@ fn main() -> ! {
     // Clock reading at the last gyro sample (`None` until the gyro starts).
     let mut last_sample_clock_s: Option<f64> = None;
     let mut gyro_silent = false;
+    let mut stuck = StuckDetector::new(DEFAULT_STUCK_RUN);
 
     loop {
         let now_s = millis::MillisClock.now_s();
@@ -151,6 +153,18 @@ fn main() -> ! {
                     if gyro_silent {
                         gyro_silent = false;
                         defmt::info!("t={} s: gyro samples again", s.t_s);
+                    }
+                    match stuck.push(s.rate_dph) {
+                        Some(StuckEvent::Stuck) => {
+                            defmt::warn!("t={} s: gyro output stuck: windows invalid", s.t_s)
+                        }
+                        Some(StuckEvent::Recovered) => {
+                            defmt::info!("t={} s: gyro output moving again", s.t_s)
+                        }
+                        None => {}
+                    }
+                    if stuck.is_stuck() {
+                        app.on_fault(s.t_s);
                     }
                     if app.temp_due(s.t_s) {
                         let t = gyro.latest_temp();
