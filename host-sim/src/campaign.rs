@@ -3,7 +3,7 @@
 //! simulated in parallel (each from its own derived seed, so the bytes never depend
 //! on the thread schedule) and written only when all succeeded.
 
-use crate::runs::{write_run, Run, RunError};
+use crate::io::runs::{write_run, Run, RunError};
 use crate::sim::{simulate_run, GyroParams, RunSpec, SimError, DEFAULT_LATITUDE_DEG};
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -158,7 +158,7 @@ pub fn write_campaign(dir: &Path, runs: &[(String, Run)]) -> Result<Vec<PathBuf>
             path: dir.to_path_buf(),
             line: None,
             column: None,
-            kind: crate::runs::RunErrorKind::Io(e.to_string()),
+            kind: crate::io::runs::RunErrorKind::Io(e.to_string()),
         })
     };
     if dir.is_dir() {

@@ -7,7 +7,7 @@
 pub mod campaign;
 pub mod cmd;
 pub mod diagnose;
-pub mod import;
+pub mod io;
 pub mod metrics;
 pub mod northseek;
 pub mod plots;
@@ -15,7 +15,6 @@ pub mod report;
 pub mod report_compensation;
 pub mod report_pipeline;
 pub mod report_reproduce;
-pub mod runs;
 pub mod sim;
 pub mod train;
 pub mod upload;

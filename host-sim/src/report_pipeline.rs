@@ -9,7 +9,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use fog_core::model::{FeatureSpec, RbfModel, MAX_ENCODED_LEN};
 
 pub use crate::campaign::CampaignSpec;
-use crate::runs::Run;
+use crate::io::runs::Run;
 use crate::sim::GyroParams;
 use crate::train::{dataset_from_runs, train_model, TrainConfig, TrainOutcome};
 

@@ -9,6 +9,7 @@ use anyhow::{anyhow, Result};
 use serde::Serialize;
 
 use crate::cmd::compensate::{compensate_all, compensate_table, write_startup_plots};
+use crate::io::runs::Run;
 use crate::metrics::{self, SPEC_DPH};
 use crate::northseek::{
     build_report, run_monte_carlo, seek_table, MonteCarloConfig, PAPER_SEEK_DURATION_S,
@@ -22,7 +23,6 @@ use crate::report_compensation::{pooled_stats, CompensatedSeries};
 use crate::report_pipeline::{
     simulate_campaign, split_train_validate, train_default, CampaignRun, CampaignSpec,
 };
-use crate::runs::Run;
 use crate::sim::{GyroParams, RunSpec, SimGyro, StartState};
 use crate::train::{default_specs, TrainReport};
 use fog_core::model::{FeatureKind, FeatureSpec};

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
 
+use crate::io::runs::{read_runs, Run};
 use crate::metrics::SPEC_DPH;
 use crate::plots::{startup_chart, write_svg, StartupCurve};
 use crate::report::{
@@ -15,7 +16,6 @@ use crate::report_compensation::{
     check_model_inputs, compensate_run, drift_stats, pooled_stats, CompensatedSeries,
 };
 use crate::report_pipeline::read_model;
-use crate::runs::{read_runs, Run};
 
 /// Options of `fogsim compensate`.
 #[derive(clap::Args, Debug)]

@@ -21,7 +21,7 @@ pub struct Args {
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let runs = crate::runs::read_runs(&args.runs)?;
+    let runs = crate::io::runs::read_runs(&args.runs)?;
     let d = diagnose(&runs).context("diagnose")?;
     print!("{}", report::render_text(&d.report));
     let check = if runs.len() >= 4 {

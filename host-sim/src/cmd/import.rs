@@ -1,7 +1,7 @@
 //! `fogsim import FILE --out DIR [--axis x|y|z|all]`: a foreign recording to fog-runs v1
-//! (currently the PAN thermal-vacuum MEMS log; see `fog_sim::import`).
+//! (currently the PAN thermal-vacuum MEMS log; see `fog_sim::io::import`).
 
-use crate::import::import_pan;
+use crate::io::import::import_pan;
 use std::path::PathBuf;
 
 /// Options of `fogsim import`.
@@ -35,7 +35,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     std::fs::create_dir_all(&args.out)?;
     for run in &imp.runs {
         let path = args.out.join(run.name());
-        crate::runs::write_run(&path, run)?;
+        crate::io::runs::write_run(&path, run)?;
         println!("wrote {} ({} rows)", path.display(), run.len());
     }
     println!(

@@ -3,8 +3,8 @@
 //! an optional JSON report. Everything is checked and encoded before any file is
 //! written, and files are written atomically, so a failure leaves no partial output.
 
+use crate::io::runs::read_runs;
 use crate::report::write_atomic;
-use crate::runs::read_runs;
 use crate::train::{
     dataset_from_runs, default_specs, train_model, Method, TrainConfig, TrainOutcome,
 };

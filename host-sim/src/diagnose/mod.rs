@@ -28,7 +28,7 @@ pub mod transforms;
 pub use error::DiagnoseError;
 pub use report::{Cause, Report};
 
-use crate::runs::Run;
+use crate::io::runs::Run;
 use cv::Folds;
 use input::Exclusion;
 use models::Stacked;

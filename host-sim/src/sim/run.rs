@@ -7,7 +7,7 @@ use super::params::GyroParams;
 use super::spec::{RunSpec, StartState};
 use super::terms::source_value;
 use super::turntable::{SimTurntable, TurntableParams};
-use crate::runs::Run;
+use crate::io::runs::Run;
 use fog_core::consts::WINDOW_S;
 
 /// Length of one output row, s (the paper's 10 s means).

@@ -5,7 +5,7 @@
 //! correlated gyro noise, run-to-run bias offsets, a turntable indexing the heading
 //! during each run, and decoy columns that wander slowly and mean nothing.
 
-use fog_sim::runs::Run;
+use fog_sim::io::runs::Run;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};

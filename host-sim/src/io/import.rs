@@ -16,7 +16,7 @@
 //! Bad input (wrong header, non-numeric cell, ragged row, time going backwards) is
 //! rejected with the line named; nothing is written then.
 
-use crate::runs::Run;
+use crate::io::runs::Run;
 use std::fmt;
 use std::path::Path;
 
