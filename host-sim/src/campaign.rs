@@ -154,12 +154,12 @@ pub fn simulate_campaign(
 /// files written by this call are removed again: no partial campaign is left.
 pub fn write_campaign(dir: &Path, runs: &[(String, Run)]) -> Result<Vec<PathBuf>, CampaignError> {
     let io = |e: std::io::Error| {
-        CampaignError::Write(RunError {
-            path: dir.to_path_buf(),
-            line: None,
-            column: None,
-            kind: crate::io::runs::RunErrorKind::Io(e.to_string()),
-        })
+        CampaignError::Write(RunError::new(
+            dir,
+            None,
+            None,
+            crate::io::runs::RunErrorKind::Io(e.to_string()),
+        ))
     };
     if dir.is_dir() {
         // Stale runs of another campaign would silently join this one when the directory

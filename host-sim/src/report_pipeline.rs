@@ -1,31 +1,15 @@
-//! The steps `north-seek`, `reproduce` and `demo` share: reading a model file, simulating
+//! The steps `north-seek`, `reproduce` and `demo` share: simulating
 //! a campaign in memory (`fog_sim::campaign`, the paper's protocol, seeded), training the
 //! default model on it, and splitting a campaign into training runs (1-3 of each
 //! temperature) and held-out runs (4-5).
 
-use std::path::Path;
-
 use anyhow::{anyhow, bail, Context, Result};
-use fog_core::model::{FeatureSpec, RbfModel, MAX_ENCODED_LEN};
+use fog_core::model::FeatureSpec;
 
 pub use crate::campaign::CampaignSpec;
 use crate::io::runs::Run;
 use crate::sim::GyroParams;
 use crate::train::{dataset_from_runs, train_model, TrainConfig, TrainOutcome};
-
-/// Reads and validates a fog-core model file (postcard, as written by `fogsim train`).
-pub fn read_model(path: &Path) -> Result<RbfModel> {
-    let bytes =
-        std::fs::read(path).map_err(|e| anyhow!("--model {}: cannot read: {e}", path.display()))?;
-    if bytes.len() > MAX_ENCODED_LEN {
-        bail!(
-            "--model {}: {} bytes, a model is at most {MAX_ENCODED_LEN} bytes",
-            path.display(),
-            bytes.len()
-        );
-    }
-    RbfModel::decode(&bytes).map_err(|e| anyhow!("--model {}: {e}", path.display()))
-}
 
 /// One simulated power-on of a campaign.
 #[derive(Clone, Debug)]

@@ -452,7 +452,7 @@ fn write_model_plots(
     } else {
         sub
     };
-    crate::report::ensure_dir(&target, "--plots")?;
+    crate::io::guard::create_dir(&target)?;
     let (room_runs, room_series): (Vec<Run>, Vec<_>) = heldout
         .iter()
         .zip(series)
@@ -487,7 +487,7 @@ fn write_model_plots(
 
 /// Plots of the campaign itself: coil temperature after power-on, Allan deviation.
 fn write_campaign_plots(dir: &Path, params: &GyroParams, campaign: &[CampaignRun]) -> Result<()> {
-    crate::report::ensure_dir(dir, "--plots")?;
+    crate::io::guard::create_dir(dir)?;
     let temps: Vec<(String, Vec<f64>, Vec<f64>)> = campaign
         .iter()
         .filter(|c| c.index == 1)

@@ -6,16 +6,16 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
 
+use super::{check_output_file, prepare_output_dir};
+use crate::io::model::read_model;
 use crate::io::runs::{read_runs, Run};
+use crate::io::OutputGuard;
 use crate::metrics::SPEC_DPH;
 use crate::plots::{startup_chart, write_svg, StartupCurve};
-use crate::report::{
-    check_output_path, ensure_dir, write_json, BeforeAfter, CompensateReport, CompensatedRun, Table,
-};
+use crate::report::{write_json, BeforeAfter, CompensateReport, CompensatedRun, Table};
 use crate::report_compensation::{
     check_model_inputs, compensate_run, drift_stats, pooled_stats, CompensatedSeries,
 };
-use crate::report_pipeline::read_model;
 
 /// Options of `fogsim compensate`.
 #[derive(clap::Args, Debug)]
@@ -150,19 +150,18 @@ pub fn write_startup_plots(
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
-    if let Some(p) = &args.json {
-        check_output_path(p, "--json")?;
-    }
+    let guard = OutputGuard::new(&args.runs).with_input(&args.model);
+    check_output_file(&guard, args.json.as_deref(), "--json")?;
+    prepare_output_dir(&guard, args.plots.as_deref(), "--plots")?;
     let runs = read_runs(&args.runs).map_err(|e| anyhow::anyhow!("{e}"))?;
     if runs.is_empty() {
         bail!("no fog-runs files found in {:?}", args.runs);
     }
-    let model = read_model(&args.model)?;
+    let model = read_model(&args.model).map_err(|e| anyhow::anyhow!("--model {e}"))?;
     check_model_inputs(&model, &format!("--model {}", args.model.display()))?;
     let (report, series) = compensate_all(&runs, &model)?;
     print!("{}", compensate_table(&report));
     if let Some(dir) = &args.plots {
-        ensure_dir(dir, "--plots")?;
         write_startup_plots(dir, &runs, &series, "")?;
     }
     if let Some(p) = &args.json {

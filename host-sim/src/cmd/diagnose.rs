@@ -1,7 +1,9 @@
 //! `fogsim diagnose RUNS... [--json FILE] [--plots DIR]`: what the simulation and the
 //! paper's model get wrong on a measured campaign, the cause, the extension and its gain.
 
+use super::{check_output_file, prepare_output_dir};
 use crate::diagnose::{diagnose, olscheck, plots, report};
+use crate::io::{write_atomic, OutputGuard};
 use anyhow::Context;
 use std::path::PathBuf;
 
@@ -21,6 +23,9 @@ pub struct Args {
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    let guard = OutputGuard::new(&args.runs);
+    check_output_file(&guard, args.json.as_deref(), "--json")?;
+    prepare_output_dir(&guard, args.plots.as_deref(), "--plots")?;
     let runs = crate::io::runs::read_runs(&args.runs)?;
     let d = diagnose(&runs).context("diagnose")?;
     print!("{}", report::render_text(&d.report));
@@ -62,11 +67,4 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
     }
     Ok(())
-}
-
-/// Writes a file via a temporary sibling and a rename, so no partial file is left.
-pub fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
-    let tmp = path.with_extension("tmp-fogsim");
-    std::fs::write(&tmp, bytes)?;
-    std::fs::rename(&tmp, path)
 }

@@ -7,11 +7,14 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use fog_core::northfinder::SeekMode;
 
+use super::check_output_file;
+use crate::io::model::read_model;
+use crate::io::OutputGuard;
 use crate::northseek::{
     build_report, default_threads, run_monte_carlo, seek_table, MonteCarloConfig,
 };
-use crate::report::{check_output_path, progress_bar, write_json};
-use crate::report_pipeline::{read_model, simulate_campaign, train_default, CampaignSpec};
+use crate::report::{progress_bar, write_json};
+use crate::report_pipeline::{simulate_campaign, train_default, CampaignSpec};
 use crate::sim::GyroParams;
 
 /// Options of `fogsim north-seek`.
@@ -85,12 +88,17 @@ pub fn config_from_args(a: &Args) -> Result<MonteCarloConfig> {
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
     let cfg = config_from_args(&args)?;
-    if let Some(p) = &args.json {
-        check_output_path(p, "--json")?;
-    }
+    let guard = match &args.model {
+        Some(m) => OutputGuard::new(&[m]),
+        None => OutputGuard::default(),
+    };
+    check_output_file(&guard, args.json.as_deref(), "--json")?;
     let params = GyroParams::paper_default();
     let (model, source) = match &args.model {
-        Some(p) => (read_model(p)?, p.display().to_string()),
+        Some(p) => (
+            read_model(p).map_err(|e| anyhow::anyhow!("--model {e}"))?,
+            p.display().to_string(),
+        ),
         None => {
             let plan = CampaignSpec {
                 ambients_c: vec![cfg.ambient_c],

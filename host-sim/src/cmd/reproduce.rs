@@ -6,8 +6,10 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 
+use super::{check_output_file, prepare_output_dir};
+use crate::io::OutputGuard;
 use crate::northseek::{default_threads, MonteCarloConfig};
-use crate::report::{check_output_path, ensure_dir, write_json};
+use crate::report::write_json;
 use crate::report_pipeline::{validate_plan, CampaignSpec};
 use crate::report_reproduce::{reproduce, summary, validation_tables, ReproduceOptions};
 use crate::sim::GyroParams;
@@ -89,9 +91,8 @@ pub fn options(
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
-    if let Some(p) = &args.json {
-        check_output_path(p, "--json")?;
-    }
+    let guard = OutputGuard::default();
+    check_output_file(&guard, args.json.as_deref(), "--json")?;
     let campaign = CampaignSpec {
         ambients_c: args.ambient.clone(),
         runs_per_ambient: args.runs,
@@ -99,9 +100,7 @@ pub fn run(args: Args) -> Result<()> {
         ..CampaignSpec::paper(args.seed)
     };
     let opts = options(campaign, args.starts, args.threads, args.plots.clone())?;
-    if let Some(dir) = &args.plots {
-        ensure_dir(dir, "--plots")?;
-    }
+    prepare_output_dir(&guard, args.plots.as_deref(), "--plots")?;
     let report = reproduce(&GyroParams::paper_default(), &opts)?;
     print!("{}\n{}", validation_tables(&report), summary(&report));
     if let Some(p) = &args.json {

@@ -1,5 +1,13 @@
-//! Everything that touches files: fog-runs records, foreign recordings (import) and
-//! output safety. Kept in one place so every command reads and writes the same way.
+//! Everything that touches files: fog-runs records (streamed, then binned into 10 s
+//! windows), foreign recordings (import), the one atomic writer and the output guard
+//! every command runs before it computes anything.
 
+pub mod atomic;
+pub mod guard;
 pub mod import;
+pub mod model;
+pub mod reader;
 pub mod runs;
+
+pub use atomic::{write_atomic, write_atomic_with};
+pub use guard::{OutputError, OutputGuard};
