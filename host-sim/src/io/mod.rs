@@ -3,6 +3,7 @@
 //! every command runs before it computes anything.
 
 pub mod atomic;
+pub mod bin;
 pub mod guard;
 pub mod import;
 pub mod model;
@@ -10,4 +11,7 @@ pub mod reader;
 pub mod runs;
 
 pub use atomic::{write_atomic, write_atomic_with};
+pub use bin::{read_binned, read_runs_binned, WindowBinner};
 pub use guard::{OutputError, OutputGuard};
+pub use reader::{visit_rows, RunHeader, RunReader};
+pub use runs::{read_run, read_runs, Run, RunError, RunErrorKind};

@@ -515,18 +515,22 @@ pub fn list_run_files(dir: &Path) -> Result<Vec<PathBuf>, RunError> {
 /// Reads files and directories (a directory's `.csv` files in name order), in argument
 /// order. The first bad file rejects the whole call.
 pub fn read_runs<P: AsRef<Path>>(paths: &[P]) -> Result<Vec<Run>, RunError> {
-    let mut runs = Vec::new();
+    run_files(paths)?.iter().map(read_run).collect()
+}
+
+/// The run files named by files and directories (a directory's `.csv` files in name
+/// order), in argument order.
+pub fn run_files<P: AsRef<Path>>(paths: &[P]) -> Result<Vec<PathBuf>, RunError> {
+    let mut files = Vec::new();
     for p in paths {
         let p = p.as_ref();
         if p.is_dir() {
-            for f in list_run_files(p)? {
-                runs.push(read_run(&f)?);
-            }
+            files.extend(list_run_files(p)?);
         } else {
-            runs.push(read_run(p)?);
+            files.push(p.to_path_buf());
         }
     }
-    Ok(runs)
+    Ok(files)
 }
 
 /// Writes the fog-runs v1 text of a run (numbers in shortest round-trip form).
