@@ -4,17 +4,13 @@
 //! thermal model and turntable, trains the RBF drift model by orthogonal least
 //! squares, and analyses measured records.
 
-pub mod campaign;
 pub mod cmd;
 pub mod diagnose;
 pub mod io;
 pub mod metrics;
-pub mod northseek;
+pub mod pipeline;
 pub mod plots;
 pub mod report;
-pub mod report_compensation;
-pub mod report_pipeline;
-pub mod report_reproduce;
 pub mod sim;
 pub mod train;
 pub mod upload;

@@ -3,12 +3,12 @@
 //! determinism, the dependence on the ambient, and that the drift is largely (not
 //! perfectly) explainable by the sensor's T and dT/dt.
 
-use fog_sim::campaign::{simulate_campaign, CampaignSpec};
 use fog_sim::io::runs::{format_run, Run};
 use fog_sim::metrics::{
     allan_deviation, arw_dpsh, bias_instability_dph, max_deviation, mean, settled_mean, std_dev,
     time_to_spec_s, SPEC_DPH,
 };
+use fog_sim::pipeline::campaign::{simulate_campaign, CampaignSpec};
 use fog_sim::plots::{allan_chart, startup_chart, write_svg, Series, StartupCurve};
 use fog_sim::sim::{simulate_run, GyroParams, RunSpec, SimGyro, StartState};
 use std::path::Path;
@@ -290,7 +290,7 @@ fn startup_over_the_paper_ambients() {
     );
     println!("|---:|---:|---:|---:|");
     let mut devs = Vec::new();
-    for ambient in fog_sim::campaign::PAPER_AMBIENTS_C {
+    for ambient in fog_sim::pipeline::campaign::PAPER_AMBIENTS_C {
         let runs: Vec<Run> = (0..5).map(|s| paper_run(ambient, 7000 + s)).collect();
         let dev = mean(
             &runs

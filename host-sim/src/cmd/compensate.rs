@@ -11,11 +11,11 @@ use crate::io::model::read_model;
 use crate::io::runs::{read_runs, Run};
 use crate::io::OutputGuard;
 use crate::metrics::SPEC_DPH;
-use crate::plots::{startup_chart, write_svg, StartupCurve};
-use crate::report::{write_json, BeforeAfter, CompensateReport, CompensatedRun, Table};
-use crate::report_compensation::{
+use crate::pipeline::compensation_replay::{
     check_model_inputs, compensate_run, drift_stats, pooled_stats, CompensatedSeries,
 };
+use crate::plots::{startup_chart, write_svg, StartupCurve};
+use crate::report::{write_json, BeforeAfter, CompensateReport, CompensatedRun, Table};
 
 /// Options of `fogsim compensate`.
 #[derive(clap::Args, Debug)]

@@ -9,9 +9,9 @@ use anyhow::Result;
 use super::prepare_output_dir;
 use crate::cmd::reproduce::options;
 use crate::io::OutputGuard;
+use crate::pipeline::campaign_steps::CampaignSpec;
+use crate::pipeline::reproduce::{reproduce, summary};
 use crate::report::write_json;
-use crate::report_pipeline::CampaignSpec;
-use crate::report_reproduce::{reproduce, summary};
 use crate::sim::GyroParams;
 
 /// Options of `fogsim demo`.

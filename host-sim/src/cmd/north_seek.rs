@@ -10,11 +10,11 @@ use fog_core::northfinder::SeekMode;
 use super::check_output_file;
 use crate::io::model::read_model;
 use crate::io::OutputGuard;
-use crate::northseek::{
+use crate::pipeline::campaign_steps::{simulate_campaign, train_default, CampaignSpec};
+use crate::pipeline::northseek::{
     build_report, default_threads, run_monte_carlo, seek_table, MonteCarloConfig,
 };
 use crate::report::{progress_bar, write_json};
-use crate::report_pipeline::{simulate_campaign, train_default, CampaignSpec};
 use crate::sim::GyroParams;
 
 /// Options of `fogsim north-seek`.
@@ -39,7 +39,7 @@ pub struct Args {
     #[arg(long, default_value_t = 20.0, allow_negative_numbers = true)]
     pub ambient: f64,
     /// True azimuth of the table's zero, deg (the paper's was about 108.4).
-    #[arg(long, default_value_t = crate::northseek::PAPER_AZIMUTH_DEG, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = crate::pipeline::northseek::PAPER_AZIMUTH_DEG, allow_negative_numbers = true)]
     pub azimuth: f64,
     /// Measuring time per main position, s (default: 110 for two positions, 60 for four,
     /// so that one seek fits the paper's 4 min 56 s).

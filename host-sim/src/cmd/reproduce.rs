@@ -8,10 +8,10 @@ use anyhow::{bail, Result};
 
 use super::{check_output_file, prepare_output_dir};
 use crate::io::OutputGuard;
-use crate::northseek::{default_threads, MonteCarloConfig};
+use crate::pipeline::campaign_steps::{validate_plan, CampaignSpec};
+use crate::pipeline::northseek::{default_threads, MonteCarloConfig};
+use crate::pipeline::reproduce::{reproduce, summary, validation_tables, ReproduceOptions};
 use crate::report::write_json;
-use crate::report_pipeline::{validate_plan, CampaignSpec};
-use crate::report_reproduce::{reproduce, summary, validation_tables, ReproduceOptions};
 use crate::sim::GyroParams;
 
 /// Training runs per temperature (the paper's protocol).
@@ -31,7 +31,7 @@ pub struct Args {
     pub seed: u64,
     /// Ambient temperatures, degC (comma separated).
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true,
-          default_values_t = crate::campaign::PAPER_AMBIENTS_C.to_vec())]
+          default_values_t = crate::pipeline::campaign::PAPER_AMBIENTS_C.to_vec())]
     pub ambient: Vec<f64>,
     /// Runs per temperature (runs 1-3 train, the rest validate).
     #[arg(long, default_value_t = 5)]

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use fog_sim::io::runs::write_run;
-use fog_sim::report_pipeline::{simulate_campaign, train_default, CampaignSpec};
+use fog_sim::pipeline::campaign_steps::{simulate_campaign, train_default, CampaignSpec};
 use fog_sim::sim::GyroParams;
 
 /// Runs `fogsim` with `args` in `dir`.

@@ -11,17 +11,17 @@ use serde::Serialize;
 use crate::cmd::compensate::{compensate_all, compensate_table, write_startup_plots};
 use crate::io::runs::Run;
 use crate::metrics::{self, SPEC_DPH};
-use crate::northseek::{
+use crate::pipeline::campaign_steps::{
+    simulate_campaign, split_train_validate, train_default, CampaignRun, CampaignSpec,
+};
+use crate::pipeline::compensation_replay::{pooled_stats, CompensatedSeries};
+use crate::pipeline::northseek::{
     build_report, run_monte_carlo, seek_table, MonteCarloConfig, PAPER_SEEK_DURATION_S,
 };
 use crate::plots::{allan_chart, azimuth_scatter_chart, temperature_chart, write_svg, Series};
 use crate::report::{
     drift_cells, fmt_minutes, progress_bar, CompensateReport, DriftStats, NorthSeekReport, Table,
     DRIFT_COLUMNS,
-};
-use crate::report_compensation::{pooled_stats, CompensatedSeries};
-use crate::report_pipeline::{
-    simulate_campaign, split_train_validate, train_default, CampaignRun, CampaignSpec,
 };
 use crate::sim::{GyroParams, RunSpec, SimGyro, StartState};
 use crate::train::{default_specs, TrainReport};

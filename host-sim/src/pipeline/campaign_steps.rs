@@ -1,13 +1,13 @@
 //! The steps `north-seek`, `reproduce` and `demo` share: simulating
-//! a campaign in memory (`fog_sim::campaign`, the paper's protocol, seeded), training the
+//! a campaign in memory (`fog_sim::pipeline::campaign`, the paper's protocol, seeded), training the
 //! default model on it, and splitting a campaign into training runs (1-3 of each
 //! temperature) and held-out runs (4-5).
 
 use anyhow::{anyhow, bail, Context, Result};
 use fog_core::model::FeatureSpec;
 
-pub use crate::campaign::CampaignSpec;
 use crate::io::runs::Run;
+pub use crate::pipeline::campaign::CampaignSpec;
 use crate::sim::GyroParams;
 use crate::train::{dataset_from_runs, train_model, TrainConfig, TrainOutcome};
 
@@ -44,12 +44,12 @@ pub fn validate_plan(plan: &CampaignSpec) -> Result<()> {
     Ok(())
 }
 
-/// Simulates the campaign in memory with `fog_sim::campaign` (same seeds and files as
+/// Simulates the campaign in memory with `fog_sim::pipeline::campaign` (same seeds and files as
 /// `fogsim campaign --seed`), tagging each run with its ambient and 1-based index.
 pub fn simulate_campaign(params: &GyroParams, plan: &CampaignSpec) -> Result<Vec<CampaignRun>> {
     validate_plan(plan)?;
-    let runs =
-        crate::campaign::simulate_campaign(params, plan).map_err(|e| anyhow!("campaign: {e}"))?;
+    let runs = crate::pipeline::campaign::simulate_campaign(params, plan)
+        .map_err(|e| anyhow!("campaign: {e}"))?;
     let per = plan.runs_per_ambient;
     Ok(runs
         .into_iter()
