@@ -4,6 +4,7 @@
 
 pub mod campaign;
 pub mod campaign_steps;
+pub mod compensate;
 pub mod compensation_replay;
 pub mod northseek;
 pub mod reproduce;

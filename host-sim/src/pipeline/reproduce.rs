@@ -8,12 +8,12 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, Result};
 use serde::Serialize;
 
-use crate::cmd::compensate::{compensate_all, compensate_table, write_startup_plots};
 use crate::io::runs::Run;
 use crate::metrics::{self, SPEC_DPH};
 use crate::pipeline::campaign_steps::{
     simulate_campaign, split_train_validate, train_default, CampaignRun, CampaignSpec,
 };
+use crate::pipeline::compensate::{compensate_all, compensate_table, write_startup_plots};
 use crate::pipeline::compensation_replay::{pooled_stats, CompensatedSeries};
 use crate::pipeline::northseek::{
     build_report, run_monte_carlo, seek_table, MonteCarloConfig, PAPER_SEEK_DURATION_S,
