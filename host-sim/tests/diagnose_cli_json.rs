@@ -28,8 +28,10 @@ fn json_has_the_issue_schema_and_plots_are_written() {
     let plots = dir.join("plots");
     run(Args {
         runs: vec![runs_dir.clone()],
-        json: Some(json.clone()),
-        plots: Some(plots.clone()),
+        outputs: fog_sim::cmd::ReportOutputs {
+            json: Some(json.clone()),
+            plots: Some(plots.clone()),
+        },
     })
     .unwrap();
     let v: serde_json::Value =

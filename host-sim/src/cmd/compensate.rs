@@ -6,7 +6,6 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 
-use super::{check_output_file, prepare_output_dir};
 use crate::io::model::read_model;
 use crate::io::runs::read_runs;
 use crate::io::OutputGuard;
@@ -23,19 +22,14 @@ pub struct Args {
     /// Drift model (fog-core postcard, from `fogsim train`).
     #[arg(long)]
     pub model: PathBuf,
-    /// Write the JSON report here.
-    #[arg(long)]
-    pub json: Option<PathBuf>,
-    /// Write startup plots (SVG) into this directory.
-    #[arg(long)]
-    pub plots: Option<PathBuf>,
+    #[command(flatten)]
+    pub outputs: super::ReportOutputs,
 }
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
     let guard = OutputGuard::new(&args.runs).with_input(&args.model);
-    check_output_file(&guard, args.json.as_deref(), "--json")?;
-    prepare_output_dir(&guard, args.plots.as_deref(), "--plots")?;
+    args.outputs.check(&guard)?;
     let runs = read_runs(&args.runs).map_err(|e| anyhow::anyhow!("{e}"))?;
     if runs.is_empty() {
         bail!("no fog-runs files found in {:?}", args.runs);
@@ -44,10 +38,10 @@ pub fn run(args: Args) -> Result<()> {
     check_model_inputs(&model, &format!("--model {}", args.model.display()))?;
     let (report, series) = compensate_all(&runs, &model)?;
     print!("{}", compensate_table(&report));
-    if let Some(dir) = &args.plots {
+    if let Some(dir) = &args.outputs.plots {
         write_startup_plots(dir, &runs, &series, "")?;
     }
-    if let Some(p) = &args.json {
+    if let Some(p) = &args.outputs.json {
         write_json(p, &report)?;
     }
     Ok(())

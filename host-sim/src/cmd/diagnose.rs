@@ -1,7 +1,6 @@
 //! `fogsim diagnose RUNS... [--json FILE] [--plots DIR]`: what the simulation and the
 //! paper's model get wrong on a measured campaign, the cause, the extension and its gain.
 
-use super::{check_output_file, prepare_output_dir};
 use crate::diagnose::{diagnose, olscheck, plots, report};
 use crate::io::{write_atomic, OutputGuard};
 use anyhow::Context;
@@ -13,19 +12,14 @@ pub struct Args {
     /// fog-runs v1 files or directories (read in name order).
     #[arg(required = true)]
     pub runs: Vec<PathBuf>,
-    /// Write the diagnosis as JSON here.
-    #[arg(long)]
-    pub json: Option<PathBuf>,
-    /// Write SVG plots into this directory.
-    #[arg(long)]
-    pub plots: Option<PathBuf>,
+    #[command(flatten)]
+    pub outputs: super::ReportOutputs,
 }
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let guard = OutputGuard::new(&args.runs);
-    check_output_file(&guard, args.json.as_deref(), "--json")?;
-    prepare_output_dir(&guard, args.plots.as_deref(), "--plots")?;
+    args.outputs.check(&guard)?;
     let runs = crate::io::runs::read_runs(&args.runs)?;
     let d = diagnose(&runs).context("diagnose")?;
     print!("{}", report::render_text(&d.report));
@@ -51,7 +45,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     } else {
         None
     };
-    if let Some(path) = &args.json {
+    if let Some(path) = &args.outputs.json {
         let mut value = serde_json::to_value(&d.report)?;
         value["ols_trainer_check"] = serde_json::to_value(&check)?;
         let text = serde_json::to_string_pretty(&value)?;
@@ -59,7 +53,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             .with_context(|| format!("writing {}", path.display()))?;
         println!("JSON written to {}", path.display());
     }
-    if let Some(dir) = &args.plots {
+    if let Some(dir) = &args.outputs.plots {
         for p in
             plots::write_plots(dir, &d).with_context(|| format!("plots in {}", dir.display()))?
         {

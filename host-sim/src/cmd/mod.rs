@@ -12,7 +12,7 @@ pub mod train;
 pub mod upload;
 
 use crate::io::OutputGuard;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Checks an output file before any computation, naming the flag in the error.
 pub(crate) fn check_output_file(
@@ -39,5 +39,24 @@ pub(crate) fn prepare_output_dir(
             .prepare_dir(d)
             .map_err(|e| anyhow::anyhow!("{flag} {e}")),
         None => Ok(()),
+    }
+}
+
+/// The report outputs shared by `compensate`, `diagnose` and `reproduce`.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct ReportOutputs {
+    /// Write the JSON report here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Write the SVG plots into this directory (created if missing).
+    #[arg(long)]
+    pub plots: Option<PathBuf>,
+}
+
+impl ReportOutputs {
+    /// Checks the JSON path and creates the plot directory, before any computation.
+    pub(crate) fn check(&self, guard: &OutputGuard) -> anyhow::Result<()> {
+        check_output_file(guard, self.json.as_deref(), "--json")?;
+        prepare_output_dir(guard, self.plots.as_deref(), "--plots")
     }
 }

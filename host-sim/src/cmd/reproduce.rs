@@ -6,7 +6,6 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 
-use super::{check_output_file, prepare_output_dir};
 use crate::io::OutputGuard;
 use crate::pipeline::campaign_steps::{validate_plan, CampaignSpec};
 use crate::pipeline::northseek::{default_threads, MonteCarloConfig};
@@ -20,12 +19,8 @@ pub const TRAIN_RUNS: usize = 3;
 /// Options of `fogsim reproduce`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Write the JSON report here.
-    #[arg(long)]
-    pub json: Option<PathBuf>,
-    /// Write the SVG plots into this directory.
-    #[arg(long)]
-    pub plots: Option<PathBuf>,
+    #[command(flatten)]
+    pub outputs: super::ReportOutputs,
     /// Seed of the campaign and of the Monte Carlo.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -92,18 +87,22 @@ pub fn options(
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
     let guard = OutputGuard::default();
-    check_output_file(&guard, args.json.as_deref(), "--json")?;
+    args.outputs.check(&guard)?;
     let campaign = CampaignSpec {
         ambients_c: args.ambient.clone(),
         runs_per_ambient: args.runs,
         minutes: args.minutes,
         ..CampaignSpec::paper(args.seed)
     };
-    let opts = options(campaign, args.starts, args.threads, args.plots.clone())?;
-    prepare_output_dir(&guard, args.plots.as_deref(), "--plots")?;
+    let opts = options(
+        campaign,
+        args.starts,
+        args.threads,
+        args.outputs.plots.clone(),
+    )?;
     let report = reproduce(&GyroParams::paper_default(), &opts)?;
     print!("{}\n{}", validation_tables(&report), summary(&report));
-    if let Some(p) = &args.json {
+    if let Some(p) = &args.outputs.json {
         write_json(p, &report)?;
     }
     Ok(())
