@@ -61,10 +61,7 @@ mod tests {
     use super::*;
 
     fn scratch(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("fogsim-atomic-{name}-{}", std::process::id()));
-        let _ = fs::remove_dir_all(&d);
-        fs::create_dir_all(&d).unwrap();
-        d
+        crate::io::test_scratch_dir(&format!("atomic-{name}"))
     }
 
     fn leftovers(dir: &Path) -> Vec<String> {

@@ -15,3 +15,12 @@ pub use bin::{read_binned, read_runs_binned, WindowBinner};
 pub use guard::{OutputError, OutputGuard};
 pub use reader::{visit_rows, RunHeader, RunReader};
 pub use runs::{read_run, read_runs, Run, RunError, RunErrorKind};
+
+/// A fresh, empty scratch directory for one unit test of this module.
+#[cfg(test)]
+pub(crate) fn test_scratch_dir(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("fogsim-io-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
