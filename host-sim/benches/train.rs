@@ -21,7 +21,7 @@ fn paper_training_set() -> Dataset {
     let runs: Vec<_> = simulate_campaign(&GyroParams::paper_default(), &spec)
         .expect("campaign")
         .into_iter()
-        .map(|(_, r)| r)
+        .map(|c| c.run)
         .collect();
     dataset_from_runs(&runs, &default_specs()).expect("dataset")
 }

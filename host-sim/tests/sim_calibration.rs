@@ -43,12 +43,12 @@ fn same_seed_same_bytes() {
     let x: Vec<String> = simulate_campaign(&p, &cs)
         .unwrap()
         .iter()
-        .map(|(n, r)| n.clone() + &format_run(r))
+        .map(|c| c.run.name() + &format_run(&c.run))
         .collect();
     let y: Vec<String> = simulate_campaign(&p, &cs)
         .unwrap()
         .iter()
-        .map(|(n, r)| n.clone() + &format_run(r))
+        .map(|c| c.run.name() + &format_run(&c.run))
         .collect();
     assert_eq!(x, y);
     assert_ne!(x[0], x[1], "runs of one ambient differ");

@@ -10,7 +10,7 @@ use fog_core::northfinder::SeekMode;
 use super::check_output_file;
 use crate::io::model::read_model;
 use crate::io::OutputGuard;
-use crate::pipeline::campaign_steps::{simulate_campaign, train_default, CampaignSpec};
+use crate::pipeline::campaign_steps::{simulate_checked, train_default, CampaignSpec};
 use crate::pipeline::northseek::{
     build_report, default_threads, run_monte_carlo, seek_table, MonteCarloConfig,
 };
@@ -106,7 +106,7 @@ pub fn run(args: Args) -> Result<()> {
                 latitude_deg: cfg.latitude_deg,
                 ..CampaignSpec::paper(cfg.seed)
             };
-            let campaign = simulate_campaign(&params, &plan)?;
+            let campaign = simulate_checked(&params, &plan)?;
             let runs: Vec<_> = campaign.iter().map(|c| &c.run).collect();
             let trained = train_default(&runs, &crate::train::default_specs(), "sim")?;
             eprintln!(

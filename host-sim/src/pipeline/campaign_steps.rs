@@ -1,4 +1,4 @@
-//! The steps `north-seek`, `reproduce` and `demo` share: simulating
+//! The steps `north-seek`, `reproduce` and `demo` share: checking and simulating
 //! a campaign in memory (`fog_sim::pipeline::campaign`, the paper's protocol, seeded), training the
 //! default model on it, and splitting a campaign into training runs (1-3 of each
 //! temperature) and held-out runs (4-5).
@@ -7,18 +7,9 @@ use anyhow::{anyhow, bail, Context, Result};
 use fog_core::model::FeatureSpec;
 
 use crate::io::runs::Run;
-pub use crate::pipeline::campaign::CampaignSpec;
+pub use crate::pipeline::campaign::{CampaignRun, CampaignSpec};
 use crate::sim::GyroParams;
 use crate::train::{dataset_from_runs, train_model, TrainConfig, TrainOutcome};
-
-/// One simulated power-on of a campaign.
-#[derive(Clone, Debug)]
-pub struct CampaignRun {
-    pub ambient_c: f64,
-    /// 1-based index of the run at its temperature (the paper trains on 1-3).
-    pub index: usize,
-    pub run: Run,
-}
 
 /// Checks a campaign plan, naming the option at fault.
 pub fn validate_plan(plan: &CampaignSpec) -> Result<()> {
@@ -44,22 +35,11 @@ pub fn validate_plan(plan: &CampaignSpec) -> Result<()> {
     Ok(())
 }
 
-/// Simulates the campaign in memory with `fog_sim::pipeline::campaign` (same seeds and files as
-/// `fogsim campaign --seed`), tagging each run with its ambient and 1-based index.
-pub fn simulate_campaign(params: &GyroParams, plan: &CampaignSpec) -> Result<Vec<CampaignRun>> {
+/// Simulates the campaign in memory after checking the plan ([`validate_plan`]); same
+/// seeds and files as `fogsim campaign --seed` ([`crate::pipeline::campaign::simulate_campaign`]).
+pub fn simulate_checked(params: &GyroParams, plan: &CampaignSpec) -> Result<Vec<CampaignRun>> {
     validate_plan(plan)?;
-    let runs = crate::pipeline::campaign::simulate_campaign(params, plan)
-        .map_err(|e| anyhow!("campaign: {e}"))?;
-    let per = plan.runs_per_ambient;
-    Ok(runs
-        .into_iter()
-        .enumerate()
-        .map(|(k, (_, run))| CampaignRun {
-            ambient_c: plan.ambients_c[k / per],
-            index: k % per + 1,
-            run,
-        })
-        .collect())
+    crate::pipeline::campaign::simulate_campaign(params, plan).map_err(|e| anyhow!("campaign: {e}"))
 }
 
 /// Splits a campaign: runs 1..=`n_train` of each temperature train, the others validate.

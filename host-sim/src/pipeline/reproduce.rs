@@ -11,7 +11,7 @@ use serde::Serialize;
 use crate::io::runs::Run;
 use crate::metrics::{self, SPEC_DPH};
 use crate::pipeline::campaign_steps::{
-    simulate_campaign, split_train_validate, train_default, CampaignRun, CampaignSpec,
+    simulate_checked, split_train_validate, train_default, CampaignRun, CampaignSpec,
 };
 use crate::pipeline::compensate::{compensate_all, compensate_table, write_startup_plots};
 use crate::pipeline::compensation_replay::{pooled_stats, CompensatedSeries};
@@ -109,7 +109,7 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
     let plan = &opts.campaign;
     let variants = input_variants();
     let steps = progress_bar(1 + 2 * variants.len(), "campaign, training, validation");
-    let campaign = simulate_campaign(params, plan)?;
+    let campaign = simulate_checked(params, plan)?;
     steps.inc(1);
     let (train, heldout) = split_train_validate(&campaign, opts.n_train);
     if train.is_empty() || heldout.is_empty() {
