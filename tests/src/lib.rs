@@ -337,3 +337,25 @@ pub fn llvm_tool(name: &str) -> Result<PathBuf, String> {
         ))
     }
 }
+
+/// A loopback TCP port nobody listens on right now (for QEMU's `-serial tcp:...,server`).
+pub fn free_loopback_port() -> u16 {
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").expect("bind loopback");
+    listener.local_addr().expect("local addr").port()
+}
+
+/// Connects to QEMU's serial server on `port`, retrying until it listens (bounded).
+pub fn connect_loopback(port: u16, within: Duration) -> std::net::TcpStream {
+    let start = Instant::now();
+    loop {
+        match std::net::TcpStream::connect(("127.0.0.1", port)) {
+            Ok(stream) => return stream,
+            Err(e) if start.elapsed() > within => {
+                panic!(
+                    "QEMU serial server on 127.0.0.1:{port} not reachable within {within:?}: {e}"
+                )
+            }
+            Err(_) => std::thread::sleep(Duration::from_millis(50)),
+        }
+    }
+}

@@ -15,7 +15,7 @@
 mod upload_support;
 
 use std::io::{BufRead, BufReader, Write};
-use std::net::{TcpListener, TcpStream};
+use std::net::TcpStream;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{channel, Receiver};
 use std::sync::Arc;
@@ -24,26 +24,11 @@ use std::time::{Duration, Instant};
 use fog_core::protocol::ResetCause;
 use fog_firmware::drivers::gyro_frame::GyroFrame;
 use fog_sim::upload::{ClientError, UploadClient};
-use fog_tests::{firmware_elf, qemu_ready, spawn_qemu, KillOnDrop, QemuOptions};
+use fog_tests::{
+    connect_loopback, firmware_elf, free_loopback_port, qemu_ready, spawn_qemu, KillOnDrop,
+    QemuOptions,
+};
 use upload_support::*;
-
-fn free_loopback_port() -> u16 {
-    let listener = TcpListener::bind("127.0.0.1:0").expect("bind loopback");
-    listener.local_addr().expect("local addr").port()
-}
-
-fn connect(port: u16) -> TcpStream {
-    let start = Instant::now();
-    loop {
-        match TcpStream::connect(("127.0.0.1", port)) {
-            Ok(stream) => return stream,
-            Err(e) if start.elapsed() > Duration::from_secs(30) => {
-                panic!("QEMU serial server on port {port} not reachable: {e}")
-            }
-            Err(_) => std::thread::sleep(Duration::from_millis(50)),
-        }
-    }
-}
 
 /// Starts fog-app with `args` and `serial_ports.len()` UARTs on loopback servers;
 /// returns QEMU, the connected streams and the semihosting console lines.
@@ -60,7 +45,10 @@ fn start(args: &[&str], serial_ports: usize) -> (KillOnDrop, Vec<TcpStream>, Rec
         ..QemuOptions::default()
     };
     let mut qemu = spawn_qemu(&firmware_elf("fog-app"), &opts).expect("start QEMU");
-    let streams = ports.iter().map(|&p| connect(p)).collect();
+    let streams = ports
+        .iter()
+        .map(|&p| connect_loopback(p, Duration::from_secs(30)))
+        .collect();
     let (tx, rx) = channel();
     let stderr = qemu.0.stderr.take().expect("piped");
     std::thread::spawn(move || {

@@ -10,36 +10,15 @@
 
 mod upload_support;
 
-use std::net::{TcpListener, TcpStream};
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use fog_core::protocol::{crc32, ModelRejection, UploadError, UploadPhase, PROTOCOL_VERSION};
 use fog_sim::upload::{key_from_seed, sign_upload, ClientError, UploadClient};
-use fog_tests::{firmware_elf, qemu_ready, spawn_qemu, QemuOptions};
+use fog_tests::{
+    connect_loopback, firmware_elf, free_loopback_port, qemu_ready, spawn_qemu, QemuOptions,
+};
 use upload_support::*;
-
-/// A loopback port nobody listens on right now.
-fn free_loopback_port() -> u16 {
-    let listener = TcpListener::bind("127.0.0.1:0").expect("bind loopback");
-    listener.local_addr().expect("local addr").port()
-}
-
-/// Connects to QEMU's serial server, retrying until it listens (bounded).
-fn connect(port: u16, within: Duration) -> TcpStream {
-    let start = Instant::now();
-    loop {
-        match TcpStream::connect(("127.0.0.1", port)) {
-            Ok(stream) => return stream,
-            Err(e) if start.elapsed() > within => {
-                panic!(
-                    "QEMU serial server on 127.0.0.1:{port} not reachable within {within:?}: {e}"
-                )
-            }
-            Err(_) => std::thread::sleep(Duration::from_millis(50)),
-        }
-    }
-}
 
 #[test]
 fn qemu_upload_installs_signed_model_and_refuses_bad_ones() {
@@ -59,7 +38,7 @@ fn qemu_upload_installs_signed_model_and_refuses_bad_ones() {
         ..QemuOptions::default()
     };
     let _qemu = spawn_qemu(&elf, &opts).expect("start QEMU");
-    let stream = connect(port, Duration::from_secs(20));
+    let stream = connect_loopback(port, Duration::from_secs(20));
     stream
         .set_read_timeout(Some(Duration::from_millis(50)))
         .unwrap();
