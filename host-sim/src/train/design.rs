@@ -158,29 +158,13 @@ impl<'a> SharedColumns<'a> {
     }
 }
 
-/// exp(x) for the Gaussian, x <= 0: exact 0 below `MIN_EXP_ARG`, otherwise a branch-free
-/// Cephes-style 2^n * p(r) with |r| <= ln2/2 (relative error < 2e-7), which the compiler
-/// vectorises, unlike a call to the C library's expf.
+/// exp(x) for the Gaussian, x <= 0: fog-core's `exp_neg_f32` (the device's exp, branch
+/// free, so the compiler vectorises it, unlike a call to the C library's expf); exact 0
+/// below `MIN_EXP_ARG`, which keeps f32 denormals (slow on x86) out of the matrix.
 #[inline]
 pub fn gauss_exp(x: f32) -> f32 {
-    const LOG2E: f32 = std::f32::consts::LOG2_E;
-    const LN2_HI: f32 = 0.693_359_4;
-    const LN2_LO: f32 = -2.121_944_4e-4;
-    const ROUND: f32 = 12_582_912.0; // 1.5 * 2^23: adding it rounds to an integer.
-    let xc = x.max(MIN_EXP_ARG);
-    let n = (xc * LOG2E + ROUND) - ROUND;
-    let r = xc - n * LN2_HI - n * LN2_LO;
-    let p = 1.987_569_1e-4f32;
-    let p = p * r + 1.398_199_9e-3;
-    let p = p * r + 8.333_452e-3;
-    let p = p * r + 4.166_579_6e-2;
-    let p = p * r + 1.666_666_5e-1;
-    let p = p * r + 0.5;
-    let p = (p * r * r + r) + 1.0;
-    let scale = f32::from_bits(((n as i32 + 127) as u32) << 23);
-    // Branch-free select (keeps the loop vectorisable): all-ones mask when x >= MIN.
     let keep = u32::from(x >= MIN_EXP_ARG).wrapping_neg();
-    f32::from_bits((p * scale).to_bits() & keep)
+    f32::from_bits(fog_core::rbf::exp_neg_f32(-x).to_bits() & keep)
 }
 
 /// Dot product of two f32 vectors: 16 f32 lanes within blocks of 512 values (so the
