@@ -548,7 +548,7 @@ impl RbfModel {
             return out(ModelField::Widths, i);
         }
         let worst = self.worst_case_output_dph();
-        if !(worst <= MAX_OUTPUT_DPH) {
+        if worst.is_nan() || worst > MAX_OUTPUT_DPH {
             return Err(ModelError::OutputUnbounded {
                 worst_dph: if worst < u32::MAX as f64 {
                     worst as u32
