@@ -95,7 +95,8 @@ pub fn exp_neg_f32(u: f32) -> f32 {
     const LN2_LO: f32 = -2.121_944_4e-4;
     const ROUND: f32 = 12_582_912.0; // 1.5 * 2^23: adding it rounds to an integer.
     const MAX_U: f32 = 87.0;
-    let x = -u.min(MAX_U);
+    // A compare and select, not `f32::min` (a libm call with NaN handling on the M4F).
+    let x = if u < MAX_U { -u } else { -MAX_U };
     let n = (x * LOG2E + ROUND) - ROUND;
     let r = x - n * LN2_HI - n * LN2_LO;
     let p = 1.987_569_1e-4f32;
@@ -133,11 +134,12 @@ pub fn predict_f32(model: &RbfModel, x_raw: &[f32]) -> Result<f32, RbfError> {
         .zip(model.widths.iter())
         .zip(model.weights.iter())
     {
-        let mut d2 = 0.0f32;
-        for j in 0..nr {
-            let d = xn[j] - c[j];
-            d2 += d * d;
-        }
+        // Slices of known length: no bounds check per coordinate.
+        let d2: f32 = xn[..nr]
+            .iter()
+            .zip(&c[..nr])
+            .map(|(x, c)| (x - c) * (x - c))
+            .sum();
         acc += w * exp_neg_f32(d2 / (2.0 * s * s));
     }
     Ok(acc)
