@@ -27,7 +27,6 @@ mod predict;
 mod select;
 mod validate;
 
-pub mod export;
 pub mod features;
 
 pub use candidates::grid_candidates;
