@@ -128,18 +128,15 @@ pub fn predict_f32(model: &RbfModel, x_raw: &[f32]) -> Result<f32, RbfError> {
     for (&l, &x) in model.linear.iter().zip(xn.iter()).take(n) {
         acc += l * x;
     }
+    // Sliced once, outside the loop: no bounds check or index call per centre.
+    let xr = xn.get(..nr).unwrap_or(&[]);
     for ((c, &s), &w) in model
         .centers
         .iter()
         .zip(model.widths.iter())
         .zip(model.weights.iter())
     {
-        // Slices of known length: no bounds check per coordinate.
-        let d2: f32 = xn[..nr]
-            .iter()
-            .zip(&c[..nr])
-            .map(|(x, c)| (x - c) * (x - c))
-            .sum();
+        let d2: f32 = xr.iter().zip(c).map(|(x, c)| (x - c) * (x - c)).sum();
         acc += w * exp_neg_f32(d2 / (2.0 * s * s));
     }
     Ok(acc)
