@@ -47,5 +47,8 @@ fn a_training_set_beyond_the_memory_limit_is_refused_before_any_fit() {
     let err = train_model(&ds, &cfg).unwrap_err();
     let msg = err.to_string();
     assert!(matches!(err, TrainError::TooLarge { .. }), "{msg}");
-    assert!(msg.contains("training points") && msg.contains("MiB"), "{msg}");
+    assert!(
+        msg.contains("training points") && msg.contains("MiB"),
+        "{msg}"
+    );
 }

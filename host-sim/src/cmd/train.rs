@@ -44,6 +44,10 @@ pub struct Args {
     /// Write the model even if held-out validation shows it does not clearly help.
     #[arg(long)]
     pub force: bool,
+    /// Benchmarks: also write the normalised training points, targets, chosen width and
+    /// candidate indices here as JSON (`bench/sklearn_omp.py` rebuilds the same design).
+    #[arg(long)]
+    pub export_design: Option<PathBuf>,
     /// Selection method: `ols` (Chen-Cowan-Grant) or `orr` (regularised, GCV stop).
     #[arg(long, default_value = "ols", value_parser = parse_method)]
     pub method: Method,
@@ -142,6 +146,30 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .with_context(|| format!("writing {}", args.out.display()))?;
     if let (Some(path), Some(bytes)) = (&args.json, json) {
         write_atomic(path, &bytes).with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(path) = &args.export_design {
+        let normalizer = crate::train::Normalizer::fit(&ds)?;
+        let points = normalizer.normalized_rows(&ds);
+        let d = ds.n_inputs();
+        let width = outcome.report.width;
+        let candidates = crate::train::grid_candidates(
+            &points,
+            d,
+            d - cfg.linear_only_inputs,
+            width,
+            cfg.max_candidates,
+        );
+        let export = serde_json::json!({
+            "n_inputs": d,
+            "points": points,
+            "targets_dph": ds.targets_dph,
+            "width": width,
+            "candidates": candidates,
+            "n_centers": outcome.report.n_centers,
+            "heldout_rms_dph": outcome.report.heldout_rms_dph,
+        });
+        write_atomic(path, &serde_json::to_vec(&export)?)
+            .with_context(|| format!("writing {}", path.display()))?;
     }
     print!("{}", summary(&outcome, runs.len(), len));
     Ok(())
