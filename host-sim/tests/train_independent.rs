@@ -172,11 +172,12 @@ fn cubic_heldout_std(train: &Dataset, held: &Dataset) -> f64 {
             .max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))
             .unwrap();
         a.swap(c, piv);
-        for i in 0..p {
+        let pivot_row = a[c].clone();
+        for (i, row) in a.iter_mut().enumerate() {
             if i != c {
-                let k = a[i][c] / a[c][c];
-                for j in c..=p {
-                    a[i][j] -= k * a[c][j];
+                let k = row[c] / pivot_row[c];
+                for (v, pv) in row.iter_mut().zip(&pivot_row).skip(c) {
+                    *v -= k * pv;
                 }
             }
         }
