@@ -7,6 +7,7 @@
 //! static bias, no Shupe term, a sinusoidal gradient response) checks the same claims.
 
 use fog_core::model::PAPER_INPUTS;
+use fog_sim::diagnose::linalg::solve_spd;
 use fog_sim::train::{pooled_std, predict_batch, train_model, Dataset, TrainConfig, Verdict};
 
 const WINDOW_S: f64 = 10.0;
@@ -157,32 +158,17 @@ fn cubic_heldout_std(train: &Dataset, held: &Dataset) -> f64 {
         ]
     };
     let p = 10;
-    let mut a = vec![vec![0.0; p + 1]; p];
+    let (mut ata, mut coef) = (vec![0.0; p * p], vec![0.0; p]);
     for (r, &t) in train.rows().zip(&train.targets_dph) {
         let f = terms(r);
         for i in 0..p {
             for j in 0..p {
-                a[i][j] += f[i] * f[j];
+                ata[i * p + j] += f[i] * f[j];
             }
-            a[i][p] += f[i] * t;
+            coef[i] += f[i] * t;
         }
     }
-    for c in 0..p {
-        let piv = (c..p)
-            .max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))
-            .unwrap();
-        a.swap(c, piv);
-        let pivot_row = a[c].clone();
-        for (i, row) in a.iter_mut().enumerate() {
-            if i != c {
-                let k = row[c] / pivot_row[c];
-                for (v, pv) in row.iter_mut().zip(&pivot_row).skip(c) {
-                    *v -= k * pv;
-                }
-            }
-        }
-    }
-    let coef: Vec<f64> = (0..p).map(|i| a[i][p] / a[i][i]).collect();
+    solve_spd(&mut ata, &mut coef, p).expect("cubic normal equations are positive definite");
     let resid: Vec<f64> = held
         .rows()
         .zip(&held.targets_dph)
