@@ -284,6 +284,18 @@ impl NorthFinder {
         (libm::sqrtf(self.cfg.ambiguity_dwell_s / (2.0 * self.cfg.dwell_s)) as f64).min(0.5)
     }
 
+    /// 10 s windows position `k` needs (its dwell rounded up to whole windows).
+    pub fn windows_needed(&self, k: usize) -> u16 {
+        let n = self.dwell_of(k) / crate::consts::WINDOW_S as f64;
+        let whole = crate::numeric::floor_i64(n);
+        (if (whole as f64) < n - 1e-6 {
+            whole + 1
+        } else {
+            whole
+        })
+        .clamp(1, u16::MAX as i64) as u16
+    }
+
     fn dwell_of(&self, k: usize) -> f64 {
         match (self.cfg.mode, k) {
             (SeekMode::TwoPosition, 2) => self.cfg.ambiguity_dwell_s as f64,
