@@ -9,6 +9,7 @@ pub mod cmd;
 pub mod diagnose;
 pub mod import;
 pub mod metrics;
+pub mod monitor;
 pub mod northseek;
 pub mod plots;
 pub mod report;

@@ -5,6 +5,7 @@ pub mod compensate;
 pub mod demo;
 pub mod diagnose;
 pub mod import;
+pub mod monitor;
 pub mod north_seek;
 pub mod reproduce;
 pub mod train;
