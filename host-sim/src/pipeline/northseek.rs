@@ -219,6 +219,36 @@ pub struct Arm<'a> {
     pub heading: Option<HeadingHarmonic>,
 }
 
+/// Inclinometer readings (1 Hz) averaged over one 10 s window, as the firmware does.
+#[derive(Default)]
+struct TiltMean {
+    sum_deg: [f64; 2],
+    n: u32,
+}
+
+impl TiltMean {
+    fn add(&mut self, t: Tilt) {
+        self.sum_deg[0] += t.pitch_deg as f64;
+        self.sum_deg[1] += t.roll_deg as f64;
+        self.n += 1;
+    }
+
+    /// The window's mean (level when `feed` is false: a finder that ignores tilt), reset.
+    fn take(&mut self, feed: bool) -> Tilt {
+        let n = self.n.max(1) as f64;
+        let mean = Tilt {
+            pitch_deg: (self.sum_deg[0] / n) as f32,
+            roll_deg: (self.sum_deg[1] / n) as f32,
+        };
+        *self = Self::default();
+        if feed {
+            mean
+        } else {
+            Tilt::LEVEL
+        }
+    }
+}
+
 /// Direction of the base tilt of a start, deg (pitch = tilt cos, roll = tilt sin).
 fn tilt_direction_deg(seed: u64) -> f64 {
     (seed % 3600) as f64 / 10.0
@@ -259,9 +289,7 @@ pub fn run_seeks(
     let mut comp = Compensator::new(comp_cfg, model.cloned()).map_err(|e| anyhow!("{e}"))?;
     let mut finder = NorthFinder::new(cfg.seek_config()).map_err(|e| anyhow!("{e}"))?;
     finder.set_heading_correction(arm.heading);
-    // Inclinometer readings (1 Hz) summed until the next window closes.
-    let mut tilt_sum = [0.0f64; 2];
-    let mut tilt_n = 0u32;
+    let mut inclinometer = TiltMean::default();
     let temp_every = ((temp_period_s / dt_s).round() as u64).max(1);
     let poll_every = ((1.0 / dt_s).round() as u64).max(1);
     // Generous bound: a seek that has not finished in 4x its nominal time never will.
@@ -291,10 +319,7 @@ pub fn run_seeks(
             });
         }
         if step.is_multiple_of(poll_every) {
-            let t = gyro.read_inclinometer();
-            tilt_sum[0] += t.pitch_deg as f64;
-            tilt_sum[1] += t.roll_deg as f64;
-            tilt_n += 1;
+            inclinometer.add(gyro.read_inclinometer());
             if started {
                 finder
                     .poll(&mut table, s.t_s)
@@ -309,16 +334,7 @@ pub fn run_seeks(
         let Some(w) = comp.push_gyro(sample) else {
             continue;
         };
-        let n = tilt_n.max(1) as f64;
-        let tilt = if arm.feed_tilt {
-            Tilt {
-                pitch_deg: (tilt_sum[0] / n) as f32,
-                roll_deg: (tilt_sum[1] / n) as f32,
-            }
-        } else {
-            Tilt::LEVEL
-        };
-        (tilt_sum, tilt_n) = ([0.0; 2], 0);
+        let tilt = inclinometer.take(arm.feed_tilt);
         if !started {
             continue;
         }
