@@ -23,7 +23,8 @@
 //! with Omega_H = Omega cos L, Omega_V = Omega sin L. Level (p = r = 0) this is the familiar
 //! Omega_H cos(A + h). At h = 0 it is the textbook Omega (cos L cos A cos p + sin L sin p):
 //! the vertical Earth rate leaks in through sin p and the horizontal one shrinks by cos p;
-//! roll enters only at headings off the pitch axis.
+//! roll enters only at headings off the pitch axis. The simulator (`fog-sim`, `sim::base`)
+//! computes the same rate with explicit rotation matrices, and its tests compare the two.
 
 use crate::consts::EARTH_RATE_DPH;
 use crate::numeric::sin_cos_deg;
@@ -96,60 +97,6 @@ pub fn earth_rate_on_axis_dph(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Independent check: rotate Earth rate with explicit 3x3 matrices.
-    fn by_matrices(lat: f64, az: f64, pitch: f64, roll: f64, h: f64) -> f64 {
-        let (l, a, p, r, h) = (
-            lat.to_radians(),
-            az.to_radians(),
-            pitch.to_radians(),
-            roll.to_radians(),
-            h.to_radians(),
-        );
-        let rz = [
-            [a.cos(), -a.sin(), 0.0],
-            [a.sin(), a.cos(), 0.0],
-            [0.0, 0.0, 1.0],
-        ];
-        let ry = [
-            [p.cos(), 0.0, p.sin()],
-            [0.0, 1.0, 0.0],
-            [-p.sin(), 0.0, p.cos()],
-        ];
-        let rx = [
-            [1.0, 0.0, 0.0],
-            [0.0, r.cos(), -r.sin()],
-            [0.0, r.sin(), r.cos()],
-        ];
-        let mul = |m: [[f64; 3]; 3], v: [f64; 3]| -> [f64; 3] {
-            core::array::from_fn(|i| (0..3).map(|j| m[i][j] * v[j]).sum())
-        };
-        let b = [h.cos(), h.sin(), 0.0];
-        let axis_ned = mul(rz, mul(ry, mul(rx, b)));
-        let omega = [EARTH_RATE_DPH * l.cos(), 0.0, -EARTH_RATE_DPH * l.sin()];
-        (0..3).map(|i| axis_ned[i] * omega[i]).sum()
-    }
-
-    #[test]
-    fn closed_form_matches_rotation_matrices() {
-        let mut worst = 0.0f64;
-        for lat in [-60.0, 0.0, 39.9, 75.0] {
-            for az in (0..360).step_by(23) {
-                for (p, r) in [(0.0, 0.0), (5.0, -3.0), (-30.0, 30.0), (12.5, 0.0)] {
-                    for h in (0..360).step_by(45) {
-                        let tilt = Tilt {
-                            pitch_deg: p as f32,
-                            roll_deg: r as f32,
-                        };
-                        let got = earth_rate_on_axis_dph(lat, az as f64, tilt, h as f64);
-                        let want = by_matrices(lat, az as f64, p, r, h as f64);
-                        worst = worst.max((got - want).abs());
-                    }
-                }
-            }
-        }
-        assert!(worst < 1e-9, "worst {worst:e} deg/h");
-    }
 
     #[test]
     fn pitched_axis_at_heading_zero_is_the_textbook_formula() {

@@ -8,18 +8,14 @@ use anyhow::{bail, Result};
 use fog_core::link::Command;
 use indicatif::{ProgressBar, ProgressStyle};
 
+use super::upload::LinkArgs;
 use crate::monitor::{monitor, MonitorOptions, ResultLog};
-use crate::upload::open_link;
 
 /// Options of `fogsim monitor`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// `tcp:HOST:PORT` (QEMU, a TCP-serial bridge) or a serial device path.
-    #[arg(long)]
-    pub port: String,
-    /// Serial baud rate.
-    #[arg(long, default_value_t = 115_200)]
-    pub baud: u32,
+    #[command(flatten)]
+    pub link: LinkArgs,
     /// Results CSV, appended to (created with a header).
     #[arg(long)]
     pub csv: PathBuf,
@@ -56,7 +52,7 @@ pub fn run(a: Args) -> Result<()> {
     }
     commands.push(Command::GetStatus);
     let mut log = ResultLog::open(&a.csv)?;
-    let mut link = open_link(&a.port, a.baud)?;
+    let mut link = a.link.open()?;
     let bar = ProgressBar::new(1000);
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {percent:>3}% {msg}")
