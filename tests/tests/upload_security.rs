@@ -228,3 +228,31 @@ fn replies_never_exceed_what_caused_them() {
     // A padded status request (what the client sends) is always answered.
     assert!(client(&mut server).status().is_ok());
 }
+
+#[test]
+fn a_signed_model_with_an_unbounded_weight_is_refused_on_upload() {
+    // Finite but huge: it would give > 1e6 deg/h "Valid" windows (issue 11, item 4).
+    // fog-core's validation bounds it; this checks the device refuses it on Commit.
+    let mut server = fresh_server();
+    let good = encode(&sample_model(TEST_GYRO, 8, 1.0));
+    let active = client(&mut server)
+        .upload(&good, 1, &sign_with_test_key(1, &good), |_, _| {})
+        .unwrap();
+    let marker = 1234.5f32;
+    let mut model = sample_model(TEST_GYRO, 8, 1.0);
+    model.weights[0] = marker;
+    let huge = patch_body(&encode(&model), |body| {
+        let at = body
+            .windows(4)
+            .position(|w| w == marker.to_le_bytes())
+            .expect("marker weight in body");
+        body[at..at + 4].copy_from_slice(&1.0e9f32.to_le_bytes());
+    });
+    let mut c = client(&mut server);
+    let e = rejected(c.upload(&huge, 2, &sign_with_test_key(2, &huge), |_, _| {}));
+    assert_eq!(
+        e,
+        UploadError::ModelInvalid(fog_core::protocol::ModelRejection::InvalidContent)
+    );
+    assert_eq!(c.status().unwrap().active, Some(active));
+}
