@@ -20,9 +20,9 @@ use fog_core::hal::{GyroSample, TempSample};
 use fog_core::model::RbfModel;
 use fog_core::northfinder::{NorthFinder, SeekConfig, SeekMode, SeekStatus};
 
-use crate::metrics::{rms, std_dev};
 use crate::report::{NorthSeekReport, SeekStats, Table};
 use crate::sim::{rig, GyroParams, RunSpec, StartState, TurntableParams};
+use crate::stats::{rms, std_dev};
 
 /// The paper's seek time, 4 min 56 s.
 pub const PAPER_SEEK_DURATION_S: f64 = 296.0;

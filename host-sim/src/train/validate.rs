@@ -8,7 +8,7 @@ use super::dataset::Dataset;
 use super::error::{Result, TrainError};
 use super::fit::fit_width;
 use super::predict::predict_batch;
-pub use crate::metrics::rms;
+pub use crate::stats::rms;
 use serde::Serialize;
 
 /// Held-out score of one width.
