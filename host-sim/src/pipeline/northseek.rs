@@ -6,12 +6,9 @@
 //! code path, while the gyro keeps warming up and the table turns. Every start is run twice
 //! with the same seed (same gyro, same noise, same table errors): once without a model
 //! (uncompensated) and once with the drift model (compensated), so the two arms differ only
-//! by the compensation. Starts are spread over threads with `std::thread::scope`; each has
+//! by the compensation. Starts are spread over threads by `crate::fanout`; each has
 //! its own seed derived from the campaign seed and its index, so the result does not depend
 //! on the thread count or scheduling.
-
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
 
 use anyhow::{anyhow, bail, Context, Result};
 use fog_core::compensator::{Compensator, CompensatorConfig};
@@ -121,22 +118,13 @@ impl MonteCarloConfig {
 
     /// Seed of start `index`: a SplitMix64 mix of the campaign seed and the index.
     pub fn start_seed(&self, index: usize) -> u64 {
-        let mut z = self.seed
-            ^ (index as u64)
-                .wrapping_add(1)
-                .wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        crate::seed::derive_seed(self.seed, index as u64 + 1, 0)
     }
 }
 
 /// Both cores by default, as the machine the demo targets has two.
 pub fn default_threads() -> usize {
-    std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1)
-        .min(8)
+    crate::fanout::thread_count(None).min(8)
 }
 
 /// One finished seek.
@@ -263,52 +251,19 @@ pub fn run_monte_carlo(
     on_start_done: &(dyn Fn() + Sync),
 ) -> Result<Vec<StartOutcome>> {
     cfg.validate()?;
-    let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<Result<StartOutcome>>>> =
-        Mutex::new((0..cfg.starts).map(|_| None).collect());
-    std::thread::scope(|scope| {
-        for _ in 0..cfg.threads.min(cfg.starts) {
-            scope.spawn(|| loop {
-                let i = next.fetch_add(1, Ordering::Relaxed);
-                if i >= cfg.starts {
-                    break;
-                }
-                let seed = cfg.start_seed(i);
-                let r = run_seeks(params, cfg, None, seed)
-                    .with_context(|| format!("start {} (seed {seed}), uncompensated", i + 1))
-                    .and_then(|unc| {
-                        let comp =
-                            run_seeks(params, cfg, Some(model), seed).with_context(|| {
-                                format!("start {} (seed {seed}), compensated", i + 1)
-                            })?;
-                        Ok(StartOutcome {
-                            seed,
-                            uncompensated: unc,
-                            compensated: comp,
-                        })
-                    });
-                let failed = r.is_err();
-                results.lock().expect("no panics while holding the lock")[i] = Some(r);
-                on_start_done();
-                if failed {
-                    // Stop handing out work: the first error is reported.
-                    next.store(cfg.starts, Ordering::Relaxed);
-                    break;
-                }
-            });
-        }
-    });
-    let results = results
-        .into_inner()
-        .expect("no panics while holding the lock");
-    let mut out = Vec::with_capacity(cfg.starts);
-    for r in results {
-        match r {
-            Some(r) => out.push(r?),
-            None => bail!("north-seek Monte Carlo stopped early"),
-        }
-    }
-    Ok(out)
+    crate::fanout::try_map_in_order(cfg.starts, cfg.threads, |i| {
+        let seed = cfg.start_seed(i);
+        let unc = run_seeks(params, cfg, None, seed)
+            .with_context(|| format!("start {} (seed {seed}), uncompensated", i + 1))?;
+        let comp = run_seeks(params, cfg, Some(model), seed)
+            .with_context(|| format!("start {} (seed {seed}), compensated", i + 1))?;
+        on_start_done();
+        Ok(StartOutcome {
+            seed,
+            uncompensated: unc,
+            compensated: comp,
+        })
+    })
 }
 
 /// Signed azimuth difference a - b wrapped to [-180, 180), deg.
