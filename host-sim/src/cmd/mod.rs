@@ -14,6 +14,23 @@ pub mod upload;
 use crate::io::OutputGuard;
 use std::path::{Path, PathBuf};
 
+/// Names the flag of a campaign-plan error (`--ambient`, `--minutes`, `--runs`); other
+/// errors pass unchanged.
+pub(crate) fn with_plan_flag(e: anyhow::Error) -> anyhow::Error {
+    use crate::pipeline::campaign_steps::{PlanError, PlanSetting};
+    match e.downcast_ref::<PlanError>() {
+        Some(p) => {
+            let flag = match p.setting() {
+                PlanSetting::Ambients => "--ambient",
+                PlanSetting::Minutes => "--minutes",
+                PlanSetting::RunsPerAmbient => "--runs",
+            };
+            anyhow::anyhow!("{flag}: {p}")
+        }
+        None => e,
+    }
+}
+
 /// Checks an output file before any computation, naming the flag in the error.
 pub(crate) fn check_output_file(
     guard: &OutputGuard,

@@ -113,11 +113,11 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
     steps.inc(1);
     let (train, heldout) = split_train_validate(&campaign, opts.n_train);
     if train.is_empty() || heldout.is_empty() {
-        return Err(anyhow!(
-            "--runs {}: need more runs per temperature than the {} training runs, so that some are held out",
-            plan.runs_per_ambient,
-            opts.n_train
-        ));
+        return Err(crate::pipeline::campaign_steps::PlanError::NoHeldOutRuns {
+            runs: plan.runs_per_ambient,
+            train_runs: opts.n_train,
+        }
+        .into());
     }
     let train_runs: Vec<&Run> = train.iter().map(|c| &c.run).collect();
     let heldout_runs: Vec<Run> = heldout.iter().map(|c| c.run.clone()).collect();
