@@ -37,12 +37,7 @@ pub(crate) fn check_output_file(
     path: Option<&Path>,
     flag: &str,
 ) -> anyhow::Result<()> {
-    match path {
-        Some(p) => guard
-            .check_file(p)
-            .map_err(|e| anyhow::anyhow!("{flag} {e}")),
-        None => Ok(()),
-    }
+    check_flagged(path, flag, |p| guard.check_file(p))
 }
 
 /// Creates an output directory before any computation, naming the flag in the error.
@@ -51,10 +46,17 @@ pub(crate) fn prepare_output_dir(
     dir: Option<&Path>,
     flag: &str,
 ) -> anyhow::Result<()> {
-    match dir {
-        Some(d) => guard
-            .prepare_dir(d)
-            .map_err(|e| anyhow::anyhow!("{flag} {e}")),
+    check_flagged(dir, flag, |d| guard.prepare_dir(d))
+}
+
+/// Runs `check` on an optional output path, prefixing a failure with the flag.
+fn check_flagged<E: std::fmt::Display>(
+    path: Option<&Path>,
+    flag: &str,
+    check: impl FnOnce(&Path) -> Result<(), E>,
+) -> anyhow::Result<()> {
+    match path {
+        Some(p) => check(p).map_err(|e| anyhow::anyhow!("{flag} {e}")),
         None => Ok(()),
     }
 }
