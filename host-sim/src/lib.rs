@@ -28,6 +28,7 @@ pub mod cmd;
 pub mod diagnose;
 pub mod fanout;
 pub mod io;
+pub mod monitor;
 pub mod pipeline;
 pub mod plots;
 pub mod report;
