@@ -13,13 +13,14 @@
 //!   sum (g (xn - c))^2 is a sum of squares of Q.28 values, in Q.56;
 //! - exp(-u): range-reduced as 2^-(u log2 e) = 2^-n * 2^-(k/32) * 2^-r with r < 1/32, a
 //!   32-entry Q.30 table and a 4th-order polynomial (truncation error < 5e-11); Q.30 result;
-//! - weights, bias, linear terms: Q.`w_frac`, scaled per model so the largest fits in 31 bits;
-//!   the weighted sum accumulates in i64.
+//! - weights, bias, linear and polynomial terms: Q.`w_frac`, scaled per model so the
+//!   largest fits in 31 bits; the weighted sum accumulates in i64;
+//! - polynomial base: Horner in i128 on t = xn_0 (Q.28) held to input 0's trained range.
 //!
 //! Worst error against the f64 reference: see `docs/core.md` (measured by the
 //! `fixed_worst_error_*` tests: `cargo test -p fog-core --test rbf_accuracy fixed_worst -- --nocapture`).
 
-use crate::model::{ModelError, RbfModel, MAX_CENTERS, MAX_INPUTS};
+use crate::model::{ModelError, RbfModel, MAX_CENTERS, MAX_INPUTS, MAX_POLY_DEGREE};
 use crate::rbf::RbfError;
 
 /// Fraction bits of normalised inputs and centres.
@@ -111,6 +112,12 @@ pub struct FixedModel {
     linear_q: [i32; MAX_INPUTS],
     bias_q: i64,
     w_frac: u8,
+    /// Polynomial coefficients (Q.w_frac) of t^1..t^n_poly.
+    poly_q: [i32; MAX_POLY_DEGREE],
+    n_poly: u8,
+    /// Trained range of normalised input 0, Q.28: the polynomial's domain.
+    poly_lo_q: i64,
+    poly_hi_q: i64,
 }
 
 /// Smallest e with v <= 2^e, for v > 0.
@@ -145,6 +152,10 @@ impl FixedModel {
             linear_q: [0; MAX_INPUTS],
             bias_q: 0,
             w_frac: 0,
+            poly_q: [0; MAX_POLY_DEGREE],
+            n_poly: 0,
+            poly_lo_q: 0,
+            poly_hi_q: 0,
         }
     }
 
@@ -174,6 +185,11 @@ impl FixedModel {
         fm.linear_q = [0; MAX_INPUTS];
         fm.bias_q = 0;
         fm.w_frac = 0;
+        fm.poly_q = [0; MAX_POLY_DEGREE];
+        fm.n_poly = model.poly.len() as u8;
+        let (lo, hi) = model.poly_domain();
+        fm.poly_lo_q = to_q(lo as f64, XN_FRAC as i32);
+        fm.poly_hi_q = to_q(hi as f64, XN_FRAC as i32);
         for j in 0..n {
             let off = model.input_offset[j] as f64;
             let bound = (model.input_min[j] as f64)
@@ -210,6 +226,7 @@ impl FixedModel {
             .weights
             .iter()
             .chain(model.linear.iter())
+            .chain(model.poly.iter())
             .chain(core::iter::once(&model.bias_dph))
             .fold(0.0f64, |m, &w| m.max((w as f64).abs()));
         if max_abs >= (1u64 << 30) as f64 {
@@ -226,6 +243,9 @@ impl FixedModel {
         }
         for (q, &w) in fm.linear_q.iter_mut().zip(model.linear.iter()) {
             *q = to_q(w as f64, w_frac) as i32;
+        }
+        for (q, &p) in fm.poly_q.iter_mut().zip(model.poly.iter()) {
+            *q = to_q(p as f64, w_frac) as i32;
         }
         fm.bias_q = to_q(model.bias_dph as f64, w_frac);
         Ok(())
@@ -267,7 +287,7 @@ impl FixedModel {
         let xn = xn.map(|x| x.clamp(-XN_LIMIT, XN_LIMIT));
         let n = self.n_inputs as usize;
         let nr = self.n_rbf as usize;
-        let mut acc = self.bias_q;
+        let mut acc = self.bias_q + self.poly_from_normalised(xn[0]);
         for (&l, &x) in self.linear_q.iter().zip(xn.iter()).take(n) {
             // |l| < 2^31 and |x| < 2^35: exact in i128 (only n_inputs products).
             acc += ((l as i128 * x as i128) >> XN_FRAC) as i64;
@@ -300,6 +320,18 @@ impl FixedModel {
             acc += (self.weights_q[i] as i64 * e as i64) >> EXP_FRAC;
         }
         acc
+    }
+
+    /// The polynomial base in Q.w_frac: Horner on t = xn0 (Q.28) held to the trained
+    /// range; |t| <= 120 * 2^28 and every partial sum < 2^31 * 120^3 fit in i128.
+    fn poly_from_normalised(&self, xn0: i64) -> i64 {
+        let t = xn0.max(self.poly_lo_q).min(self.poly_hi_q) as i128;
+        let n = (self.n_poly as usize).min(MAX_POLY_DEGREE);
+        let mut acc: i128 = 0;
+        for &p in self.poly_q[..n].iter().rev() {
+            acc = ((acc + p as i128) * t) >> XN_FRAC;
+        }
+        acc as i64
     }
 
     /// Predicted drift, deg/h (integer-only; f32 only at the boundary, by bit manipulation).

@@ -5,10 +5,16 @@
 //! (magic, version, body, CRC-32 of the body bytes); decoding validates sizes,
 //! finiteness, positive widths and ranges and returns a `ModelError`.
 //!
-//! drift_dph = bias_dph + sum_j linear[j] * xn_j + sum_i weights[i] * exp(-||xn - c_i||^2 / (2 widths[i]^2))
-//! with xn_j = (x_j - input_offset[j]) / input_scale[j] (normalised inputs).
-//! Only the first `n_rbf_inputs` inputs enter the Gaussian distance; inputs after
-//! them are linear-only terms (diagnose may add a cause that way).
+//! drift_dph = bias_dph + sum_j linear[j] * xn_j + sum_k poly[k-1] * t^k
+//!             + sum_i weights[i] * exp(-||xn - c_i||^2 / (2 widths[i]^2))
+//! with xn_j = (x_j - input_offset[j]) / input_scale[j] (normalised inputs, each held to
+//! +-`XN_CLAMP`) and t = xn_0 held to the trained range of input 0 (a polynomial is not
+//! extrapolated). Only the first `n_rbf_inputs` inputs enter the Gaussian distance; inputs
+//! after them are linear-only terms (diagnose may add a cause that way).
+//!
+//! Format versions: 1 has no `poly` (decoded with an empty one), 2 appends `poly` after
+//! `meta`. Validation bounds every parameter's magnitude so that any model that decodes
+//! gives a finite drift below `MAX_OUTPUT_DPH` at any finite input.
 
 use heapless::{String, Vec};
 use serde::de::DeserializeSeed as _;
@@ -20,8 +26,26 @@ pub const MAX_CENTERS: usize = 64;
 pub const MAX_INPUTS: usize = 4;
 /// Magic at the start of every encoded model: "FOGM".
 pub const MODEL_MAGIC: u32 = 0x4D47_4F46;
-/// Current format version.
-pub const MODEL_VERSION: u16 = 1;
+/// Current format version (2: polynomial base in the first input).
+pub const MODEL_VERSION: u16 = 2;
+/// Oldest format version still decoded (1: no polynomial base).
+pub const MODEL_VERSION_OLDEST: u16 = 1;
+/// Highest power of the polynomial base in the first input.
+pub const MAX_POLY_DEGREE: usize = 3;
+/// Normalised inputs are held to +-this many standard deviations before evaluation
+/// (the fixed-point path's Q.28 limit).
+pub const XN_CLAMP: f32 = 120.0;
+/// Largest |drift| a valid model can produce at any input, deg/h: validation refuses a
+/// model whose worst-case sum of terms exceeds it.
+pub const MAX_OUTPUT_DPH: f64 = 1.0e6;
+/// Largest |raw| input offset and trained-range bound (any unit).
+pub const MAX_ABS_RAW_INPUT: f32 = 1.0e6;
+/// Allowed input scales (raw units per normalised unit).
+pub const INPUT_SCALE_RANGE: (f32, f32) = (1.0e-6, 1.0e6);
+/// Largest |centre coordinate|, normalised units (fixed point needs < 100).
+pub const MAX_ABS_CENTER: f32 = 99.0;
+/// Allowed Gaussian widths, normalised units (fixed point additionally needs >= 0.0056).
+pub const WIDTH_RANGE: (f32, f32) = (1.0e-3, 100.0);
 /// Largest encoded model, bytes (a 64-centre, 4-input model must fit).
 pub const MAX_ENCODED_LEN: usize = 2048;
 
@@ -101,6 +125,9 @@ pub struct RbfModel {
     pub weights: Vec<f32, MAX_CENTERS>,
     pub bias_dph: f32,
     pub meta: TrainingMeta,
+    /// Polynomial base (format version 2): coefficient k-1 multiplies t^k, deg/h, with
+    /// t = normalised input 0 held to its trained range; at most `MAX_POLY_DEGREE` terms.
+    pub poly: Vec<f32, MAX_POLY_DEGREE>,
 }
 
 /// Most auxiliary (extra sensor) channels a model may refer to.
@@ -124,6 +151,7 @@ pub enum ModelField {
     Bias,
     HeldoutRms,
     TimeConstant,
+    Poly,
 }
 
 impl ModelField {
@@ -142,6 +170,7 @@ impl ModelField {
             ModelField::Bias => "bias_dph",
             ModelField::HeldoutRms => "meta.heldout_rms_dph",
             ModelField::TimeConstant => "inputs[].tau_s",
+            ModelField::Poly => "poly",
         }
     }
 }
@@ -192,6 +221,11 @@ pub enum ModelError {
     BadTimeConstant { input: u8 },
     /// An auxiliary channel index >= `MAX_AUX`.
     BadAuxChannel { input: u8, channel: u8 },
+    /// A parameter outside its allowed magnitude (see the bound constants).
+    OutOfBounds { field: ModelField, index: u16 },
+    /// The worst case of |bias| + sum |linear| XN_CLAMP + sum |poly_k| t^k + sum |w|
+    /// exceeds `MAX_OUTPUT_DPH` (value in deg/h, saturated to u32).
+    OutputUnbounded { worst_dph: u32 },
 }
 
 impl core::fmt::Display for ModelError {
@@ -210,7 +244,7 @@ impl core::fmt::Display for ModelError {
             ),
             ModelError::UnsupportedVersion { found } => write!(
                 f,
-                "model: format version {found} is not supported (this build reads version {MODEL_VERSION})"
+                "model: format version {found} is not supported (this build reads versions {MODEL_VERSION_OLDEST}..={MODEL_VERSION})"
             ),
             ModelError::CrcMismatch { stored, computed } => write!(
                 f,
@@ -255,6 +289,15 @@ impl core::fmt::Display for ModelError {
             ModelError::BadAuxChannel { input, channel } => write!(
                 f,
                 "model: input {input} uses aux channel {channel}, at most {MAX_AUX} channels exist"
+            ),
+            ModelError::OutOfBounds { field, index } => write!(
+                f,
+                "model: field `{}`[{index}] is outside its allowed magnitude",
+                field.name()
+            ),
+            ModelError::OutputUnbounded { worst_dph } => write!(
+                f,
+                "model: parameters allow a drift of {worst_dph} deg/h, above the {MAX_OUTPUT_DPH} deg/h limit"
             ),
         }
     }
@@ -343,6 +386,7 @@ impl RbfModel {
                 heldout_rms_dph: 0.0,
                 n_train: 0,
             },
+            poly: Vec::new(),
         }
     }
 
@@ -364,6 +408,7 @@ impl RbfModel {
         copy(&mut self.centers, &src.centers);
         copy(&mut self.widths, &src.widths);
         copy(&mut self.weights, &src.weights);
+        copy(&mut self.poly, &src.poly);
         self.bias_dph = src.bias_dph;
         self.meta.gyro_id.clear();
         let _ = self.meta.gyro_id.push_str(&src.meta.gyro_id);
@@ -447,7 +492,103 @@ impl RbfModel {
         check_finite(ModelField::Weights, &self.weights)?;
         check_finite(ModelField::Bias, &[self.bias_dph])?;
         check_finite(ModelField::HeldoutRms, &[self.meta.heldout_rms_dph])?;
+        check_finite(ModelField::Poly, &self.poly)?;
+        if self.poly.len() > MAX_POLY_DEGREE {
+            return Err(ModelError::OutOfBounds {
+                field: ModelField::Poly,
+                index: self.poly.len() as u16,
+            });
+        }
+        self.check_bounds()
+    }
+
+    /// Magnitude bounds: every intermediate of the evaluators stays finite and the
+    /// drift stays below `MAX_OUTPUT_DPH` whatever the (finite) inputs.
+    fn check_bounds(&self) -> Result<(), ModelError> {
+        let out = |field, index: usize| {
+            Err(ModelError::OutOfBounds {
+                field,
+                index: index as u16,
+            })
+        };
+        let raw_ok = |v: &f32| v.abs() <= MAX_ABS_RAW_INPUT;
+        for (field, values) in [
+            (ModelField::InputOffset, &self.input_offset),
+            (ModelField::InputMin, &self.input_min),
+            (ModelField::InputMax, &self.input_max),
+        ] {
+            if let Some(i) = values.iter().position(|v| !raw_ok(v)) {
+                return out(field, i);
+            }
+        }
+        let (s_lo, s_hi) = INPUT_SCALE_RANGE;
+        if let Some(i) = self
+            .input_scale
+            .iter()
+            .position(|&s| !(s_lo..=s_hi).contains(&s))
+        {
+            return out(ModelField::InputScale, i);
+        }
+        let n = self.inputs.len();
+        if let Some(i) = self
+            .centers
+            .iter()
+            .position(|c| c[..n].iter().any(|v| v.abs() > MAX_ABS_CENTER))
+        {
+            return out(ModelField::Centers, i);
+        }
+        let (w_lo, w_hi) = WIDTH_RANGE;
+        if let Some(i) = self
+            .widths
+            .iter()
+            .position(|&w| !(w_lo..=w_hi).contains(&w))
+        {
+            return out(ModelField::Widths, i);
+        }
+        let worst = self.worst_case_output_dph();
+        if worst.is_nan() || worst > MAX_OUTPUT_DPH {
+            return Err(ModelError::OutputUnbounded {
+                worst_dph: if worst < u32::MAX as f64 {
+                    worst as u32
+                } else {
+                    u32::MAX
+                },
+            });
+        }
         Ok(())
+    }
+
+    /// Trained range of input 0 in normalised units (the polynomial's domain), f32 as the
+    /// evaluator computes it.
+    pub fn poly_domain(&self) -> (f32, f32) {
+        let first = |v: &Vec<f32, MAX_INPUTS>| v.first().copied();
+        match (
+            first(&self.input_min),
+            first(&self.input_max),
+            first(&self.input_offset),
+            first(&self.input_scale),
+        ) {
+            (Some(lo), Some(hi), Some(off), Some(scale)) => {
+                let norm = |v: f32| ((v - off) / scale).clamp(-XN_CLAMP, XN_CLAMP);
+                (norm(lo), norm(hi))
+            }
+            _ => (0.0, 0.0),
+        }
+    }
+
+    /// Upper bound of |drift| over all inputs, deg/h (f64, from the stored f32 values).
+    pub fn worst_case_output_dph(&self) -> f64 {
+        let (lo, hi) = self.poly_domain();
+        let t = libm::fmax(libm::fabs(lo as f64), libm::fabs(hi as f64));
+        let abs = |v: &f32| libm::fabs(*v as f64);
+        let linear: f64 = self.linear.iter().map(abs).sum::<f64>() * XN_CLAMP as f64;
+        let mut power = 1.0;
+        let mut poly = 0.0;
+        for p in &self.poly {
+            power *= t;
+            poly += abs(p) * power;
+        }
+        abs(&self.bias_dph) + linear + poly + self.weights.iter().map(abs).sum::<f64>()
     }
 
     /// Validate and encode into `buf`; returns the number of bytes written.
@@ -531,7 +672,7 @@ impl RbfModel {
             return Err(ModelError::BadMagic { found: magic });
         }
         let (version, _) = postcard::take_from_bytes::<u16>(rest).map_err(map_postcard)?;
-        if version != MODEL_VERSION {
+        if !(MODEL_VERSION_OLDEST..=MODEL_VERSION).contains(&version) {
             return Err(ModelError::UnsupportedVersion { found: version });
         }
         let (wire, trailing) =
@@ -561,9 +702,12 @@ impl RbfModel {
             });
         }
         let mut de = postcard::Deserializer::from_bytes(model_bytes);
-        crate::model_in_place::ModelInPlace(self)
-            .deserialize(&mut de)
-            .map_err(|_| ModelError::Malformed)?;
+        crate::model_in_place::ModelInPlace {
+            model: self,
+            has_poly: version >= 2,
+        }
+        .deserialize(&mut de)
+        .map_err(|_| ModelError::Malformed)?;
         let left = de.finalize().map_err(|_| ModelError::Malformed)?;
         let model = &*self;
         if !left.is_empty() {

@@ -29,16 +29,26 @@ const FIELDS: &[&str] = &[
     "weights",
     "bias_dph",
     "meta",
+    "poly",
 ];
 
-/// Seed that fills `.0` with the model being deserialised.
-pub(crate) struct ModelInPlace<'a>(pub(crate) &'a mut RbfModel);
+/// Seed that fills `model` with the model being deserialised; `has_poly` is false for
+/// format version 1 (no `poly` field: it is left empty).
+pub(crate) struct ModelInPlace<'a> {
+    pub(crate) model: &'a mut RbfModel,
+    pub(crate) has_poly: bool,
+}
 
 impl<'de> DeserializeSeed<'de> for ModelInPlace<'_> {
     type Value = ();
 
     fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<(), D::Error> {
-        d.deserialize_struct("RbfModel", FIELDS, self)
+        let fields = if self.has_poly {
+            FIELDS
+        } else {
+            &FIELDS[..FIELDS.len() - 1]
+        };
+        d.deserialize_struct("RbfModel", fields, self)
     }
 }
 
@@ -69,7 +79,7 @@ impl<'de> Visitor<'de> for ModelInPlace<'_> {
     }
 
     fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<(), A::Error> {
-        let m = self.0;
+        let m = self.model;
         m.n_rbf_inputs = next(&mut seq, 0)?;
         next_vec(&mut seq, 1, &mut m.inputs)?;
         next_vec(&mut seq, 2, &mut m.input_offset)?;
@@ -82,6 +92,11 @@ impl<'de> Visitor<'de> for ModelInPlace<'_> {
         next_vec(&mut seq, 9, &mut m.weights)?;
         m.bias_dph = next(&mut seq, 10)?;
         m.meta = next(&mut seq, 11)?;
+        if self.has_poly {
+            next_vec(&mut seq, 12, &mut m.poly)?;
+        } else {
+            m.poly.clear();
+        }
         Ok(())
     }
 }
@@ -131,9 +146,12 @@ mod tests {
         // Stale content must be replaced, not appended to.
         target.copy_from(&derived);
         let mut de = postcard::Deserializer::from_bytes(bytes);
-        ModelInPlace(&mut target)
-            .deserialize(&mut de)
-            .expect("in place");
+        ModelInPlace {
+            model: &mut target,
+            has_poly: true,
+        }
+        .deserialize(&mut de)
+        .expect("in place");
         assert!(de.finalize().expect("finalize").is_empty());
         assert_eq!(target, derived);
         assert_eq!(target, model);
@@ -148,8 +166,12 @@ mod tests {
         for len in 0..bytes.len() {
             let mut target = RbfModel::empty();
             let mut de = postcard::Deserializer::from_bytes(&bytes[..len]);
+            let seed = ModelInPlace {
+                model: &mut target,
+                has_poly: true,
+            };
             assert!(
-                ModelInPlace(&mut target).deserialize(&mut de).is_err(),
+                seed.deserialize(&mut de).is_err(),
                 "{len} of {} bytes accepted",
                 bytes.len()
             );

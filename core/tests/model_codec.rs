@@ -30,6 +30,7 @@ struct LooseModel {
     weights: Vec<f32>,
     bias_dph: f32,
     meta: fog_core::model::TrainingMeta,
+    poly: Vec<f32>,
 }
 
 impl From<&RbfModel> for LooseModel {
@@ -47,6 +48,7 @@ impl From<&RbfModel> for LooseModel {
             weights: m.weights.to_vec(),
             bias_dph: m.bias_dph,
             meta: m.meta.clone(),
+            poly: m.poly.to_vec(),
         }
     }
 }
@@ -165,8 +167,8 @@ fn every_flipped_byte_is_rejected() {
 fn wrong_version_and_magic_are_named() {
     let m = LooseModel::from(&warmup_model(35, 2, 2.0, 5));
     assert_eq!(
-        RbfModel::decode(&encode_loose(&m, 2)),
-        Err(ModelError::UnsupportedVersion { found: 2 })
+        RbfModel::decode(&encode_loose(&m, 3)),
+        Err(ModelError::UnsupportedVersion { found: 3 })
     );
     let mut bytes = encode_loose(&m, MODEL_VERSION);
     bytes[0] = 0x01; // still a valid varint, different value
@@ -316,5 +318,90 @@ fn random_bytes_never_panic() {
             b[..8].copy_from_slice(&good[..8]); // valid envelope start
         }
         assert!(RbfModel::decode(&b).is_err());
+    }
+}
+
+/// Format version 1 (before the polynomial base): the body ends after `meta`.
+fn encode_v1(m: &RbfModel) -> Vec<u8> {
+    let loose = LooseModel::from(m);
+    let v1 = (
+        loose.n_rbf_inputs,
+        &loose.inputs,
+        &loose.input_offset,
+        &loose.input_scale,
+        &loose.input_min,
+        &loose.input_max,
+        &loose.linear,
+        &loose.centers,
+        &loose.widths,
+        &loose.weights,
+        loose.bias_dph,
+        &loose.meta,
+    );
+    let body = postcard::to_allocvec(&(m.inputs.len() as u16, m.centers.len() as u16, v1)).unwrap();
+    postcard::to_allocvec(&Wire {
+        magic: MODEL_MAGIC,
+        version: 1,
+        body: &body,
+        crc32: crc32(&body),
+    })
+    .unwrap()
+}
+
+#[test]
+fn version_1_models_still_decode_without_a_polynomial() {
+    let mut m = warmup_model(35, 2, 2.0, 5);
+    m.poly.clear();
+    assert_eq!(RbfModel::decode(&encode_v1(&m)), Ok(m.clone()));
+    // A version-2 body announced as version 1 has trailing bytes (the poly field).
+    let mut with_poly = m.clone();
+    with_poly.poly.extend_from_slice(&[0.1, -0.02]).unwrap();
+    let v2_body_as_v1 = encode_loose(&LooseModel::from(&with_poly), 1);
+    assert!(matches!(
+        RbfModel::decode(&v2_body_as_v1),
+        Err(ModelError::TrailingBytes { .. })
+    ));
+}
+
+#[test]
+fn polynomial_base_round_trips() {
+    let mut m = warmup_model(35, 2, 2.0, 5);
+    m.poly.extend_from_slice(&[0.3, -0.05, 0.01]).unwrap();
+    assert_eq!(RbfModel::decode(&encode(&m)), Ok(m));
+}
+
+/// Issue 11 item 4: a model that decoded before the magnitude bounds and gave a huge or
+/// infinite drift is now refused.
+#[test]
+fn models_that_could_give_huge_or_infinite_drift_are_refused() {
+    use fog_core::rbf::predict_f32;
+    let good = warmup_model(35, 2, 2.0, 5);
+    let mut huge_weight = good.clone();
+    huge_weight.weights[0] = 3.0e38;
+    let mut tiny_scale = good.clone();
+    tiny_scale.input_scale[0] = 1.0e-30;
+    tiny_scale.linear[0] = 1.0e30;
+    let mut wild_poly = good.clone();
+    wild_poly
+        .poly
+        .extend_from_slice(&[0.0, 0.0, 1.0e30])
+        .unwrap();
+    for (name, m) in [
+        ("weight", &huge_weight),
+        ("scale", &tiny_scale),
+        ("poly", &wild_poly),
+    ] {
+        // Before: finite parameters, inf/huge output at some input.
+        let x = [m.input_max[0], m.input_max[1]];
+        let y = predict_f32(m, &x).unwrap();
+        assert!(y.is_nan() || y.abs() >= 1.0e6, "{name}: {y}");
+        let got = RbfModel::decode(&encode_loose(&LooseModel::from(m), MODEL_VERSION));
+        assert!(
+            matches!(
+                got,
+                Err(ModelError::OutOfBounds { .. } | ModelError::OutputUnbounded { .. })
+            ),
+            "{name}: {got:?}"
+        );
     }
 }

@@ -267,3 +267,52 @@ fn q16_output_agrees_with_f32_output() {
         assert!((a - b).abs() <= 1.0 / 65536.0, "{a} {b}");
     }
 }
+
+/// The f32 path's exponential: relative error <= 1e-6 over the whole range a Gaussian
+/// uses (u = d^2/(2 s^2) in [0, 87]; beyond it the result is 0, as f32 underflows).
+#[test]
+fn exp_neg_f32_relative_error() {
+    use fog_core::rbf::exp_neg_f32;
+    let mut worst = 0.0f64;
+    for i in 0..=870_000 {
+        let u = i as f32 * 1e-4;
+        let want = (-f64::from(u)).exp();
+        worst = worst.max((f64::from(exp_neg_f32(u)) - want).abs() / want);
+    }
+    println!("exp_neg_f32 worst relative error over [0, 87]: {worst:.3e}");
+    assert!(worst <= 1e-6, "{worst:e}");
+    assert_eq!(exp_neg_f32(0.0), 1.0);
+    assert_eq!(exp_neg_f32(88.0), 0.0);
+    assert_eq!(exp_neg_f32(f32::INFINITY), 0.0);
+}
+
+/// A model with a cubic polynomial base: f32 and fixed point against the f64 reference,
+/// inside and outside the polynomial's (trained) domain.
+#[test]
+fn polynomial_base_agrees_across_paths() {
+    let mut m = warmup_model(35, 2, 1.0, 9);
+    m.poly.extend_from_slice(&[0.4, -0.08, 0.03]).unwrap();
+    m.validate().unwrap();
+    let fm = FixedModel::from_model(&m).unwrap();
+    let mut worst_fixed = 0.0f64;
+    for k in 0..=200 {
+        let t = m.input_min[0] - 10.0 + k as f32 * (m.input_max[0] - m.input_min[0] + 20.0) / 200.0;
+        let x = [t, 0.5 * (m.input_min[1] + m.input_max[1])];
+        let want = predict_f64(&m, &[f64::from(x[0]), f64::from(x[1])]).unwrap();
+        let f = f64::from(predict_f32(&m, &x).unwrap());
+        let q = f64::from(fm.predict(&x).unwrap());
+        assert!((f - want).abs() < 1e-4, "f32 {f} vs {want} at T={t}");
+        worst_fixed = worst_fixed.max((q - want).abs());
+    }
+    assert!(worst_fixed < 1e-3, "fixed worst {worst_fixed}");
+    // Held at the domain's edge, not extrapolated.
+    let below = predict_f32(&m, &[m.input_min[0] - 50.0, 0.0]).unwrap();
+    let edge = predict_f32(&m, &[m.input_min[0], 0.0]).unwrap();
+    let rbf_only = {
+        let mut r = m.clone();
+        r.poly.clear();
+        predict_f32(&r, &[m.input_min[0] - 50.0, 0.0]).unwrap()
+            - predict_f32(&r, &[m.input_min[0], 0.0]).unwrap()
+    };
+    assert!((below - edge - rbf_only).abs() < 1e-4);
+}

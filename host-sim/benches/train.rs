@@ -7,8 +7,8 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use fog_sim::pipeline::campaign::{simulate_campaign, CampaignSpec};
 use fog_sim::sim::GyroParams;
 use fog_sim::train::{
-    dataset_from_runs, default_specs, fit_width, Dataset, GaussianDesign, Method, Normalizer,
-    TrainConfig,
+    dataset_from_runs, default_specs, fit_width, grid_candidates, Dataset, GaussianDesign, Method,
+    Normalizer, TrainConfig,
 };
 use std::hint::black_box;
 
@@ -32,14 +32,16 @@ fn bench_train(c: &mut Criterion) {
     let points = Normalizer::fit(&ds)
         .expect("normaliser")
         .normalized_rows(&ds);
-    let mut g = c.benchmark_group(format!("train_{n}_candidates"));
+    let candidates = grid_candidates(&points, 2, 2, 0.6, TrainConfig::default().max_candidates);
+    let k = candidates.len();
+    let mut g = c.benchmark_group(format!("train_{n}_points_{k}_candidates"));
     g.sample_size(10);
     g.bench_function("design_build_f32", |b| {
-        b.iter(|| black_box(GaussianDesign::build(&points, 2, 2, 0.6, 2)))
+        b.iter(|| black_box(GaussianDesign::build(&points, 2, 2, &candidates, 0.6, 2)))
     });
-    let design = GaussianDesign::build(&points, 2, 2, 0.6, 2);
+    let design = GaussianDesign::build(&points, 2, 2, &candidates, 0.6, 2);
     let v = vec![1.0; n];
-    let mut out = vec![0.0; n];
+    let mut out = vec![0.0; k];
     g.bench_function("selection_pass_all_candidates", |b| {
         b.iter(|| design.dot_columns(black_box(&v), &mut out))
     });

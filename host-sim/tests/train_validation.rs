@@ -73,7 +73,7 @@ fn width_is_chosen_by_held_out_error_and_matches_the_true_scale() {
 }
 
 #[test]
-fn orr_gcv_needs_fewer_centres_than_ols_for_the_same_held_out_error() {
+fn orr_gcv_and_validated_ols_both_stop_well_below_the_maximum() {
     let ds = campaign(&AMBIENTS, 3, 0.02, 13, shupe_like);
     let base = TrainConfig {
         width_candidates: vec![0.35],
@@ -97,10 +97,9 @@ fn orr_gcv_needs_fewer_centres_than_ols_for_the_same_held_out_error() {
         orr.best.heldout_rms_dph,
         orr.best.mean_centers
     );
-    assert_eq!(
-        ols.best.mean_centers, 64.0,
-        "OLS with a tiny rho runs to the maximum"
-    );
-    assert!(orr.best.mean_centers < 0.75 * ols.best.mean_centers);
+    // A tiny rho no longer drives OLS to 64 centres: grouped validation picks the size.
+    assert!(ols.best.mean_centers < 0.75 * 64.0);
+    assert!(orr.best.mean_centers < 0.75 * 64.0);
     assert!(orr.best.heldout_rms_dph < 1.05 * ols.best.heldout_rms_dph);
+    assert!(ols.best.heldout_rms_dph < 1.05 * orr.best.heldout_rms_dph);
 }

@@ -174,7 +174,13 @@ fn scenario(evaluator: Evaluator, tag: &str) {
     if !qemu_ready("qemu_replay") {
         return;
     }
-    let model = warmup_model(35, 2, 0.05, 35);
+    // With a cubic polynomial base in T (model format version 2), evaluated by fog-core
+    // on both sides.
+    let mut model = warmup_model(35, 2, 0.05, 35);
+    model
+        .poly
+        .extend_from_slice(&[0.03, -0.012, 0.004])
+        .expect("3 polynomial terms fit");
     let mut buf = [0u8; MAX_ENCODED_LEN];
     let n = model.encode(&mut buf).expect("model encodes");
     let model = RbfModel::decode(&buf[..n]).expect("model decodes");

@@ -97,10 +97,15 @@ fn every_bad_upload_is_refused_with_its_typed_error_and_the_model_stays() {
         c.upload(truncated, &sig_trunc, |_, _| {}),
         UploadError::ModelInvalid(ModelRejection::Malformed),
     );
-    // Wrong version, correctly signed (version varint is the byte after the 5-byte magic).
+    // Unknown (future) version, correctly signed (version varint is the byte after the
+    // 5-byte magic).
     let mut v2 = bytes.clone();
-    assert_eq!(v2[5], 1, "version byte");
-    v2[5] = 2;
+    assert_eq!(
+        u16::from(v2[5]),
+        fog_core::model::MODEL_VERSION,
+        "version byte"
+    );
+    v2[5] = (fog_core::model::MODEL_VERSION + 1) as u8;
     let sig_v2 = sign_with_test_key(&v2);
     expect_rejected(
         c.upload(&v2, &sig_v2, |_, _| {}),

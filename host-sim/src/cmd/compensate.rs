@@ -38,6 +38,17 @@ pub fn run(args: Args) -> Result<()> {
     check_model_inputs(&model, &format!("--model {}", args.model.display()))?;
     let (report, series) = compensate_all(&runs, &model)?;
     print!("{}", compensate_table(&report));
+    for r in report
+        .runs
+        .iter()
+        .filter(|r| r.after.std_dph > r.before.std_dph)
+    {
+        eprintln!(
+            "fogsim compensate: WARNING: {}: the model makes this record worse \
+             (drift std {:.4} -> {:.4} deg/h)",
+            r.file, r.before.std_dph, r.after.std_dph
+        );
+    }
     if let Some(dir) = &args.outputs.plots {
         write_startup_plots(dir, &runs, &series, "")?;
     }

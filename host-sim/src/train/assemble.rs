@@ -14,6 +14,8 @@ pub enum ForcedTerm {
     Bias,
     /// Input j's normalised value: the model's `linear[j]`.
     Linear(usize),
+    /// Normalised input 0 to the power k (1..=3): the model's `poly[k-1]`.
+    Poly(usize),
 }
 
 /// The parts of a trained model in plain f64 form.
@@ -82,6 +84,15 @@ pub fn assemble(parts: &ModelParts<'_>) -> Result<RbfModel> {
         match *term {
             ForcedTerm::Bias => model.bias_dph = coef as f32,
             ForcedTerm::Linear(j) => model.linear[j] = coef as f32,
+            ForcedTerm::Poly(k) => {
+                while model.poly.len() < k {
+                    model
+                        .poly
+                        .push(0.0)
+                        .map_err(|_| capacity("polynomial terms"))?;
+                }
+                model.poly[k - 1] = coef as f32;
+            }
         }
     }
     for (&k, &w) in parts.centers.iter().zip(&parts.theta[nf..]) {

@@ -18,8 +18,19 @@ pub enum Method {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TrainConfig {
     pub method: Method,
-    /// OLS stop: selection ends when 1 - sum(err) < rho (0 < rho < 1).
+    /// Optional OLS stop: selection ends when 1 - sum(err) < rho, i.e. when the residual
+    /// energy falls below rho * y'y (0 <= rho < 1; 0 = off, the default: y'y includes the
+    /// static bias, so a relative stop fires before the drift is modelled).
     pub rho: f64,
+    /// Optional OLS stop: training rms reaches this many deg/h (e.g. the bias spec).
+    pub target_dph: Option<f64>,
+    /// Polynomial degrees in the first input (T) tried by grouped validation (0..=3).
+    pub poly_degrees: Vec<usize>,
+    /// Most candidate centres (grid over the normalised inputs); bounds the design to
+    /// n x max_candidates.
+    pub max_candidates: usize,
+    /// Largest design matrix allowed, bytes; bigger training sets are refused up front.
+    pub max_design_bytes: usize,
     /// Most RBF centres (1..=64, fog-core's MAX_CENTERS).
     pub max_centers: usize,
     /// Gaussian widths (sigma, in normalised input units) tried by grouped validation.
@@ -43,7 +54,11 @@ impl Default for TrainConfig {
     fn default() -> Self {
         Self {
             method: Method::Ols,
-            rho: 0.01,
+            rho: 0.0,
+            target_dph: None,
+            poly_degrees: vec![0, 1, 2, 3],
+            max_candidates: 1000,
+            max_design_bytes: 2 << 30,
             max_centers: MAX_CENTERS,
             width_candidates: vec![0.2, 0.35, 0.6, 1.0, 1.6],
             folds: 3,
@@ -60,8 +75,32 @@ impl TrainConfig {
     /// Checks every option against its allowed range and against the input count.
     pub fn check(&self, n_inputs: usize) -> Result<()> {
         let bad = |option, why: String| Err(TrainError::BadConfig { option, why });
-        if !(self.rho > 0.0 && self.rho < 1.0) {
-            return bad("rho", format!("{} is outside 0 < rho < 1", self.rho));
+        if !(self.rho >= 0.0 && self.rho < 1.0) {
+            return bad("rho", format!("{} is outside 0 <= rho < 1", self.rho));
+        }
+        if self.target_dph.is_some_and(|t| !(t.is_finite() && t > 0.0)) {
+            return bad("target-dph", "must be a positive number of deg/h".into());
+        }
+        if self.poly_degrees.is_empty()
+            || self
+                .poly_degrees
+                .iter()
+                .any(|&k| k > fog_core::model::MAX_POLY_DEGREE)
+        {
+            return bad(
+                "poly-degrees",
+                format!(
+                    "{:?}: give degrees in 0..={}",
+                    self.poly_degrees,
+                    fog_core::model::MAX_POLY_DEGREE
+                ),
+            );
+        }
+        if self.max_candidates < self.max_centers {
+            return bad(
+                "max-candidates",
+                format!("{} is below max-centers", self.max_candidates),
+            );
         }
         if self.max_centers == 0 || self.max_centers > MAX_CENTERS {
             return bad(

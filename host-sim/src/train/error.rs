@@ -42,6 +42,12 @@ pub enum TrainError {
     Model { why: String },
     /// fog-core's RBF evaluation rejected an input row.
     Predict { row: usize, why: String },
+    /// The training set would need a design matrix above the memory limit.
+    TooLarge {
+        rows: usize,
+        bytes: usize,
+        limit: usize,
+    },
 }
 
 impl fmt::Display for TrainError {
@@ -90,6 +96,13 @@ impl fmt::Display for TrainError {
             }
             Self::Model { why } => write!(f, "trained model rejected by fog-core: {why}"),
             Self::Predict { row, why } => write!(f, "RBF evaluation failed at row {row}: {why}"),
+            Self::TooLarge { rows, bytes, limit } => write!(
+                f,
+                "{rows} training points need a {} MiB design matrix, above the {} MiB limit: \
+                 train on fewer runs or average to 10 s rows first",
+                bytes >> 20,
+                limit >> 20
+            ),
         }
     }
 }

@@ -13,6 +13,7 @@
 //! [`cross_validate`].
 
 mod assemble;
+mod candidates;
 mod config;
 mod dataset;
 mod design;
@@ -28,6 +29,7 @@ mod validate;
 
 pub mod features;
 
+pub use candidates::grid_candidates;
 pub use config::{Method, TrainConfig};
 pub use dataset::Dataset;
 pub use design::GaussianDesign;
@@ -36,11 +38,13 @@ pub use features::{
     dataset_from_runs, dataset_from_runs_with_aux, default_specs, feature_name,
     feature_name_with_aux,
 };
-pub use fit::{fit_width, Fit};
+pub use fit::{fit_path, fit_shape, fit_width, Fit, PathFit, Shape};
 pub use normalize::Normalizer;
 pub use path::StopReason;
 pub use predict::predict_batch;
-pub use validate::{cross_validate, fold_of_rows, rms, std_within_groups, CvReport, WidthScore};
+pub use validate::{
+    cross_validate, fold_of_rows, pooled_std, rms, std_within_groups, CvReport, WidthScore,
+};
 
 use fog_core::model::RbfModel;
 use serde::Serialize;
@@ -59,6 +63,11 @@ pub struct TrainReport {
     pub n_centers: usize,
     /// Chosen Gaussian sigma, normalised input units.
     pub width: f64,
+    /// Chosen polynomial degree in the first input.
+    pub poly_degree: usize,
+    /// `better` when the held-out compensated drift std is below `GUARD_RATIO` times the
+    /// uncompensated one, else `not_better` (the model does not clearly help).
+    pub verdict: Verdict,
     pub stop: StopReason,
     /// Sum of the error-reduction ratios of the final fit (bias and linear terms included).
     pub err_sum: f64,
@@ -83,6 +92,18 @@ pub struct TrainReport {
     pub final_fit_s: f64,
 }
 
+/// Held-out compensated std must be below this fraction of the raw std to count as
+/// clearly better.
+pub const GUARD_RATIO: f64 = 0.9;
+
+/// Whether grouped validation shows the model helps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    Better,
+    NotBetter,
+}
+
 /// The trained model and its report.
 #[derive(Clone, Debug)]
 pub struct TrainOutcome {
@@ -90,14 +111,32 @@ pub struct TrainOutcome {
     pub report: TrainReport,
 }
 
-/// Full training: grouped cross-validation over `cfg.width_candidates` (cfg.folds folds),
-/// then the final fit on all rows at the best width. Needs at least `cfg.folds` runs.
+/// Full training: grouped cross-validation over widths, polynomial degrees and numbers
+/// of centres (cfg.folds folds), then the final fit on all rows at the best shape.
+/// Needs at least `cfg.folds` runs. A training set whose design would exceed
+/// `cfg.max_design_bytes` is refused before any fit.
 pub fn train_model(ds: &Dataset, cfg: &TrainConfig) -> Result<TrainOutcome> {
+    let design = GaussianDesign::bytes_for(ds.len(), cfg.max_candidates.min(ds.len()));
+    if design > cfg.max_design_bytes {
+        return Err(TrainError::TooLarge {
+            rows: ds.len(),
+            bytes: design,
+            limit: cfg.max_design_bytes,
+        });
+    }
     let started = Instant::now();
     let cv = cross_validate(ds, cfg, cfg.folds)?;
     let validation_s = started.elapsed().as_secs_f64();
     let started = Instant::now();
-    let mut fit = fit_width(ds, cfg, cv.best.width)?;
+    let mut fit = fit_shape(
+        ds,
+        cfg,
+        &Shape {
+            width: cv.best.width,
+            degree: cv.best.degree,
+            centers: cv.best.centers,
+        },
+    )?;
     let final_fit_s = started.elapsed().as_secs_f64();
     fit.model.meta.heldout_rms_dph = cv.best.heldout_rms_dph as f32;
     let pred = predict_batch(&fit.model, ds.rows())?;
@@ -115,6 +154,12 @@ pub fn train_model(ds: &Dataset, cfg: &TrainConfig) -> Result<TrainOutcome> {
         n_runs: ds.n_groups(),
         n_centers: fit.model.centers.len(),
         width: fit.width,
+        poly_degree: cv.best.degree,
+        verdict: if cv.compensated_std_dph < GUARD_RATIO * cv.raw_std_dph {
+            Verdict::Better
+        } else {
+            Verdict::NotBetter
+        },
         stop: fit.path.stop,
         err_sum: fit.path.err_sum,
         center_err: fit.path.center_err.clone(),

@@ -9,6 +9,8 @@ use serde::Serialize;
 pub enum StopReason {
     /// OLS: 1 - sum(err) fell below rho.
     Rho,
+    /// OLS: the training rms reached `--target-dph`.
+    Target,
     /// The maximum number of centres was reached.
     MaxCenters,
     /// No candidate left that is not (numerically) in the span of the selection.

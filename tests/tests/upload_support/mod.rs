@@ -33,6 +33,7 @@ pub fn sample_model(gyro_id: &str, n_centers: usize, weight_scale: f32) -> RbfMo
             heldout_rms_dph: 0.0042,
             n_train: 1350,
         },
+        poly: Default::default(),
     };
     for i in 0..n_centers {
         let u = i as f32 / n_centers.max(1) as f32;
