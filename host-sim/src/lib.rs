@@ -19,17 +19,21 @@
 //! report/     JSON report structures and terminal tables; plots/ the SVG charts
 //! io/         fog-runs reader (streaming, csv crate) and writer, 10 s binning, model
 //!   |         files, import, the one atomic writer, the output guard
-//! metrics     statistics: std/rms, pooled within-run std, drift metrics, windows
+//! stats/      statistics: std/rms, the one pooled within-run std, drift metrics, Allan,
+//!             windows in fog-core's convention; seed (the one SplitMix64 seed mix) and
+//!             fanout (the one thread fan-out, results in job order)
 //! ```
 
 pub mod cmd;
 pub mod diagnose;
+pub mod fanout;
 pub mod io;
-pub mod metrics;
 pub mod monitor;
 pub mod pipeline;
 pub mod plots;
 pub mod report;
+pub mod seed;
 pub mod sim;
+pub mod stats;
 pub mod train;
 pub mod upload;

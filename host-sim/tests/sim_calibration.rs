@@ -4,13 +4,13 @@
 //! perfectly) explainable by the sensor's T and dT/dt.
 
 use fog_sim::io::runs::{format_run, Run};
-use fog_sim::metrics::{
-    allan_deviation, arw_dpsh, bias_instability_dph, max_deviation, mean, settled_mean, std_dev,
-    time_to_spec_s, SPEC_DPH,
-};
 use fog_sim::pipeline::campaign::{simulate_campaign, CampaignSpec};
 use fog_sim::plots::{allan_chart, startup_chart, write_svg, Series, StartupCurve};
 use fog_sim::sim::{simulate_run, GyroParams, RunSpec, SimGyro, StartState};
+use fog_sim::stats::{
+    allan_deviation, arw_dpsh, bias_instability_dph, max_deviation, mean, settled_mean, std_dev,
+    time_to_spec_s, SPEC_DPH,
+};
 use std::path::Path;
 
 fn paper_run(ambient_c: f64, seed: u64) -> Run {

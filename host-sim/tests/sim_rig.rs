@@ -3,11 +3,11 @@
 
 use fog_core::consts::EARTH_RATE_DPH;
 use fog_core::hal::{Gyro, TableState, TemperatureSensor, Turntable};
-use fog_sim::metrics::{std_dev, window_means};
 use fog_sim::sim::{
     rig, simulate_run, AuxSource, AuxTransform, DriftTerm, GyroParams, RunSpec, SimError, SimGyro,
     StartState, TurntableParams,
 };
+use fog_sim::stats::{std_dev, window_means};
 
 fn warm(rate_hz: f64, seed: u64) -> RunSpec {
     RunSpec {

@@ -47,7 +47,7 @@ pub fn run(args: Args) -> Result<()> {
     )?;
     prepare_output_dir(&OutputGuard::default(), Some(&args.out), "--out")?;
     let started = std::time::Instant::now();
-    let report = reproduce(&GyroParams::paper_default(), &opts)?;
+    let report = reproduce(&GyroParams::paper_default(), &opts).map_err(super::with_plan_flag)?;
     print!("{}", summary(&report));
     write_json(&args.out.join("report.json"), &report)?;
     println!(

@@ -15,18 +15,30 @@ pub mod upload;
 use crate::io::OutputGuard;
 use std::path::{Path, PathBuf};
 
+/// Names the flag of a campaign-plan error (`--ambient`, `--minutes`, `--runs`); other
+/// errors pass unchanged.
+pub(crate) fn with_plan_flag(e: anyhow::Error) -> anyhow::Error {
+    use crate::pipeline::campaign_steps::{PlanError, PlanSetting};
+    match e.downcast_ref::<PlanError>() {
+        Some(p) => {
+            let flag = match p.setting() {
+                PlanSetting::Ambients => "--ambient",
+                PlanSetting::Minutes => "--minutes",
+                PlanSetting::RunsPerAmbient => "--runs",
+            };
+            anyhow::anyhow!("{flag}: {p}")
+        }
+        None => e,
+    }
+}
+
 /// Checks an output file before any computation, naming the flag in the error.
 pub(crate) fn check_output_file(
     guard: &OutputGuard,
     path: Option<&Path>,
     flag: &str,
 ) -> anyhow::Result<()> {
-    match path {
-        Some(p) => guard
-            .check_file(p)
-            .map_err(|e| anyhow::anyhow!("{flag} {e}")),
-        None => Ok(()),
-    }
+    check_flagged(path, flag, |p| guard.check_file(p))
 }
 
 /// Creates an output directory before any computation, naming the flag in the error.
@@ -35,10 +47,17 @@ pub(crate) fn prepare_output_dir(
     dir: Option<&Path>,
     flag: &str,
 ) -> anyhow::Result<()> {
-    match dir {
-        Some(d) => guard
-            .prepare_dir(d)
-            .map_err(|e| anyhow::anyhow!("{flag} {e}")),
+    check_flagged(dir, flag, |d| guard.prepare_dir(d))
+}
+
+/// Runs `check` on an optional output path, prefixing a failure with the flag.
+fn check_flagged<E: std::fmt::Display>(
+    path: Option<&Path>,
+    flag: &str,
+    check: impl FnOnce(&Path) -> Result<(), E>,
+) -> anyhow::Result<()> {
+    match path {
+        Some(p) => check(p).map_err(|e| anyhow::anyhow!("{flag} {e}")),
         None => Ok(()),
     }
 }

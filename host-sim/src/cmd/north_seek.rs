@@ -117,7 +117,7 @@ pub fn run(args: Args) -> Result<()> {
                 latitude_deg: cfg.latitude_deg,
                 ..CampaignSpec::paper(cfg.seed)
             };
-            let campaign = simulate_checked(&params, &plan)?;
+            let campaign = simulate_checked(&params, &plan).map_err(super::with_plan_flag)?;
             let runs: Vec<_> = campaign.iter().map(|c| &c.run).collect();
             let trained = train_default(&runs, &crate::train::default_specs(), "sim")?;
             eprintln!(

@@ -49,7 +49,7 @@ pub fn options(
     threads: Option<usize>,
     plots: Option<PathBuf>,
 ) -> Result<ReproduceOptions> {
-    validate_plan(&campaign)?;
+    validate_plan(&campaign).map_err(|e| super::with_plan_flag(e.into()))?;
     if campaign.runs_per_ambient <= TRAIN_RUNS {
         bail!(
             "--runs {}: runs 1-{TRAIN_RUNS} of each temperature train, so at least {} are needed to hold some out",
@@ -100,7 +100,7 @@ pub fn run(args: Args) -> Result<()> {
         args.threads,
         args.outputs.plots.clone(),
     )?;
-    let report = reproduce(&GyroParams::paper_default(), &opts)?;
+    let report = reproduce(&GyroParams::paper_default(), &opts).map_err(super::with_plan_flag)?;
     print!("{}\n{}", validation_tables(&report), summary(&report));
     if let Some(p) = &args.outputs.json {
         write_json(p, &report)?;

@@ -55,15 +55,6 @@ pub struct Diagnosis {
     pub sim_terms: Vec<Vec<crate::sim::DriftTerm>>,
 }
 
-fn pooled_within_std(rows: &[std::ops::Range<usize>], v: &[f64]) -> f64 {
-    let mut ss = 0.0;
-    for r in rows {
-        let m = v[r.clone()].iter().sum::<f64>() / r.len() as f64;
-        ss += v[r.clone()].iter().map(|x| (x - m) * (x - m)).sum::<f64>();
-    }
-    (ss / v.len().max(1) as f64).sqrt()
-}
-
 /// Runs the whole diagnosis on a campaign.
 // Split along its sections is deferred (issue 12, second part); allowed until then.
 #[allow(clippy::too_many_lines)]
@@ -185,9 +176,12 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
             .collect(),
         parsimony_note: screening.parsimony_note.clone(),
         drift_std: DriftStd {
-            uncompensated_dph: pooled_within_std(&folds.run_rows, &st.y),
-            baseline_heldout_dph: pooled_within_std(&folds.run_rows, &base.cv.residual),
-            extended_heldout_dph: pooled_within_std(&folds.run_rows, &ext_resid),
+            uncompensated_dph: crate::stats::pooled_std_of_rows(&folds.run_rows, &st.y),
+            baseline_heldout_dph: crate::stats::pooled_std_of_rows(
+                &folds.run_rows,
+                &base.cv.residual,
+            ),
+            extended_heldout_dph: crate::stats::pooled_std_of_rows(&folds.run_rows, &ext_resid),
         },
         extended,
         azimuth,

@@ -43,12 +43,9 @@ pub struct Cause {
 }
 
 impl Cause {
-    /// `column:transform[(tau)]`.
+    /// The report name, e.g. `temp_c:lag(tau_s=240)` (see `crate::report::feature_label`).
     pub fn label(&self) -> String {
-        match self.tau_s {
-            Some(t) => format!("{}:{}({t:.0}s)", self.column, self.transform.name()),
-            None => format!("{}:{}", self.column, self.transform.name()),
-        }
+        crate::report::feature_label(&self.column, self.transform.name(), self.tau_s)
     }
 }
 

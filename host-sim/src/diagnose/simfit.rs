@@ -11,7 +11,7 @@
 use super::error::DiagnoseError;
 use super::input::Campaign;
 use super::linalg::solve_spd;
-use crate::metrics::rms;
+use crate::stats::rms;
 use serde::Serialize;
 
 /// Thermal time constants tried, s (pairs tau_fast < tau_slow).

@@ -64,12 +64,9 @@ pub struct Candidate {
 }
 
 impl Candidate {
-    /// `column:transform[tau]`, e.g. `temp_c:lag(240s)`.
+    /// The report name, e.g. `temp_c:lag(tau_s=240)` (see `crate::report::feature_label`).
     pub fn label(&self) -> String {
-        match self.tau_s {
-            Some(t) => format!("{}:{}({t:.0}s)", self.column, self.transform.name()),
-            None => format!("{}:{}", self.column, self.transform.name()),
-        }
+        crate::report::feature_label(&self.column, self.transform.name(), self.tau_s)
     }
 
     /// Parsimony rank within a column (see `Transform::complexity`), except that for an

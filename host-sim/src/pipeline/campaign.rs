@@ -49,7 +49,7 @@ impl CampaignSpec {
             raw_rate_hz: self.raw_rate_hz,
             ..RunSpec::paper(
                 self.ambients_c[amb],
-                derive_seed(self.seed, amb as u64, run as u64),
+                crate::seed::derive_seed(self.seed, amb as u64, run as u64),
             )
         }
     }
@@ -64,15 +64,6 @@ impl CampaignSpec {
             run + 1
         )
     }
-}
-
-/// A per-run seed from the campaign seed (SplitMix64 finaliser over the indices).
-pub fn derive_seed(seed: u64, a: u64, b: u64) -> u64 {
-    let mut z =
-        seed ^ a.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ b.wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
 }
 
 /// One simulated power-on of a campaign (`run.path` is its file name).
@@ -125,32 +116,14 @@ pub fn simulate_campaign(
         .collect();
     // Fail fast on a bad spec before spawning anything.
     spec.run_spec(0, 0).validate().map_err(CampaignError::Sim)?;
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(jobs.len());
-    let mut results: Vec<Option<Result<Run, SimError>>> = (0..jobs.len()).map(|_| None).collect();
-    std::thread::scope(|s| {
-        let chunks: Vec<_> = results
-            .chunks_mut(jobs.len().div_ceil(threads))
-            .enumerate()
-            .collect();
-        let size = jobs.len().div_ceil(threads);
-        for (c, chunk) in chunks {
-            let jobs = &jobs;
-            s.spawn(move || {
-                for (k, slot) in chunk.iter_mut().enumerate() {
-                    let (a, r) = jobs[c * size + k];
-                    *slot = Some(simulate_run(params, &spec.run_spec(a, r)));
-                }
-            });
-        }
+    let results = crate::fanout::map_in_order(jobs.len(), crate::fanout::thread_count(None), |j| {
+        let (a, r) = jobs[j];
+        simulate_run(params, &spec.run_spec(a, r))
     });
     jobs.iter()
         .zip(results)
         .map(|(&(a, r), res)| {
-            let mut run = res
-                .expect("every slot is filled by its thread")
-                .map_err(CampaignError::Sim)?;
+            let mut run = res.map_err(CampaignError::Sim)?;
             run.path = PathBuf::from(spec.file_name(a, r));
             run.set_meta("run", r + 1);
             Ok(CampaignRun {
@@ -185,7 +158,7 @@ pub fn write_campaign(dir: &Path, runs: &[CampaignRun]) -> Result<Vec<PathBuf>, 
                 .into_owned();
             if name.to_ascii_lowercase().ends_with(".csv") && !ours.contains(&name) {
                 return Err(CampaignError::Spec(format!(
-                    "--out {}: holds {name}, which is not part of this campaign and would mix with it; use an empty directory",
+                    "output directory {}: holds {name}, which is not part of this campaign and would mix with it; use an empty directory",
                     dir.display()
                 )));
             }

@@ -3,7 +3,7 @@
 //! default model on it, and splitting a campaign into training runs (1-3 of each
 //! temperature) and held-out runs (4-5).
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, Context, Result};
 use fog_core::model::FeatureSpec;
 
 use crate::io::runs::Run;
@@ -11,26 +11,84 @@ pub use crate::pipeline::campaign::{CampaignRun, CampaignSpec};
 use crate::sim::GyroParams;
 use crate::train::{dataset_from_runs, train_model, TrainConfig, TrainOutcome};
 
-/// Checks a campaign plan, naming the option at fault.
-pub fn validate_plan(plan: &CampaignSpec) -> Result<()> {
-    if plan.ambients_c.is_empty() {
-        bail!("--ambient: at least one temperature is needed");
+/// The campaign setting a [`PlanError`] is about (`cmd` maps it to its flag).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PlanSetting {
+    Ambients,
+    Minutes,
+    RunsPerAmbient,
+}
+
+/// What is wrong with a campaign plan, and with which value.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PlanError {
+    NoAmbients,
+    AmbientOutOfRange {
+        ambient_c: f64,
+    },
+    BadMinutes {
+        minutes: f64,
+    },
+    NoRuns,
+    /// Too few runs per temperature to hold any out after the `train_runs` training runs.
+    NoHeldOutRuns {
+        runs: usize,
+        train_runs: usize,
+    },
+}
+
+impl PlanError {
+    /// The setting at fault.
+    pub fn setting(&self) -> PlanSetting {
+        match self {
+            PlanError::NoAmbients | PlanError::AmbientOutOfRange { .. } => PlanSetting::Ambients,
+            PlanError::BadMinutes { .. } => PlanSetting::Minutes,
+            PlanError::NoRuns | PlanError::NoHeldOutRuns { .. } => PlanSetting::RunsPerAmbient,
+        }
     }
-    if let Some(a) = plan
+}
+
+impl std::fmt::Display for PlanError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            PlanError::NoAmbients => write!(f, "no ambient temperature: at least one is needed"),
+            PlanError::AmbientOutOfRange { ambient_c } => {
+                write!(f, "ambient {ambient_c} degC: must be within -60..=100 degC")
+            }
+            PlanError::BadMinutes { minutes } => write!(
+                f,
+                "record length {minutes} min: must be a positive number of minutes"
+            ),
+            PlanError::NoRuns => write!(f, "0 runs per temperature: must be at least 1"),
+            PlanError::NoHeldOutRuns { runs, train_runs } => write!(
+                f,
+                "{runs} runs per temperature: need more than the {train_runs} training runs, so that some are held out"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for PlanError {}
+
+/// Checks a campaign plan, naming the value at fault.
+pub fn validate_plan(plan: &CampaignSpec) -> Result<(), PlanError> {
+    if plan.ambients_c.is_empty() {
+        return Err(PlanError::NoAmbients);
+    }
+    if let Some(&a) = plan
         .ambients_c
         .iter()
         .find(|a| !(a.is_finite() && (-60.0..=100.0).contains(*a)))
     {
-        bail!("--ambient {a}: must be within -60..=100 degC");
+        return Err(PlanError::AmbientOutOfRange { ambient_c: a });
     }
     if !(plan.minutes.is_finite() && plan.minutes > 0.0) {
-        bail!(
-            "--minutes {}: must be a positive number of minutes",
-            plan.minutes
-        );
+        return Err(PlanError::BadMinutes {
+            minutes: plan.minutes,
+        });
     }
     if plan.runs_per_ambient == 0 {
-        bail!("--runs: must be at least 1");
+        return Err(PlanError::NoRuns);
     }
     Ok(())
 }

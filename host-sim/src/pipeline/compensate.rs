@@ -7,12 +7,12 @@ use std::path::Path;
 use anyhow::{bail, Result};
 
 use crate::io::runs::Run;
-use crate::metrics::SPEC_DPH;
 use crate::pipeline::compensation_replay::{
     compensate_run, drift_stats, pooled_stats, CompensatedSeries,
 };
 use crate::plots::{startup_chart, write_svg, StartupCurve};
 use crate::report::{BeforeAfter, CompensateReport, CompensatedRun, Table};
+use crate::stats::SPEC_DPH;
 
 /// Compensates every run and builds the report (series kept for plots).
 pub fn compensate_all(
@@ -107,7 +107,7 @@ pub fn write_startup_plots(
                 } else {
                     (&s.t_s, &s.before_dph)
                 };
-                let settled = crate::metrics::settled_mean(t, y);
+                let settled = crate::stats::settled_mean(t, y);
                 StartupCurve {
                     label: run.name(),
                     t_s: t.clone(),

@@ -17,8 +17,8 @@ use fog_core::hal::{GyroSample, TempSample};
 use fog_core::model::RbfModel;
 
 use crate::io::runs::Run;
-use crate::metrics;
 use crate::report::DriftStats;
+use crate::stats;
 
 /// One record's drift series before and after compensation (10 s windows).
 #[derive(Clone, Debug, Default)]
@@ -42,13 +42,13 @@ pub struct CompensatedSeries {
 /// The figures of one drift series (10 s means).
 pub fn drift_stats(t_s: &[f64], drift_dph: &[f64]) -> DriftStats {
     DriftStats {
-        std_dph: metrics::std_dev(drift_dph),
+        std_dph: stats::std_dev(drift_dph),
         max_dev_dph: if drift_dph.is_empty() {
             0.0
         } else {
-            metrics::max_deviation(t_s, drift_dph)
+            stats::max_deviation(t_s, drift_dph)
         },
-        time_to_spec_s: metrics::time_to_spec_s(t_s, drift_dph, metrics::SPEC_DPH),
+        time_to_spec_s: stats::time_to_spec_s(t_s, drift_dph, stats::SPEC_DPH),
     }
 }
 
@@ -61,7 +61,7 @@ pub fn pooled_stats(series: &[(&[f64], &[f64])]) -> DriftStats {
         .iter()
         .try_fold(0.0f64, |acc, s| s.time_to_spec_s.map(|t| acc.max(t)));
     DriftStats {
-        std_dph: metrics::pooled_std(&groups),
+        std_dph: stats::pooled_std(&groups),
         max_dev_dph: each.iter().map(|s| s.max_dev_dph).fold(0.0, f64::max),
         time_to_spec_s: worst_time,
     }

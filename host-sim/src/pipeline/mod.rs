@@ -1,6 +1,6 @@
 //! Pipelines: one per user-facing job (reproduce the paper, compensate recorded runs,
 //! the north-seek Monte Carlo, the simulated campaign), built from the engines (`sim`,
-//! `train`, `diagnose`) over `io` and `metrics`. They never print and never name flags.
+//! `train`, `diagnose`) over `io` and `stats`. They never print and never name flags.
 
 pub mod campaign;
 pub mod campaign_steps;

@@ -6,7 +6,7 @@
 //! code path, while the gyro keeps warming up and the table turns. Every start is run twice
 //! with the same seed (same gyro, same noise, same table errors): once without a model
 //! (uncompensated) and once with the drift model (compensated), so the two arms differ only
-//! by the compensation. Starts are spread over threads with `std::thread::scope`; each has
+//! by the compensation. Starts are spread over threads by `crate::fanout`; each has
 //! its own seed derived from the campaign seed and its index, so the result does not depend
 //! on the thread count or scheduling.
 //!
@@ -18,9 +18,6 @@
 //! azimuth (`fog_core::heading_cal`), applied in the compensated arm, and a fourth arm runs
 //! without it (`heading_uncalibrated`).
 
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
-
 use anyhow::{anyhow, bail, Context, Result};
 use fog_core::compensator::{Compensator, CompensatorConfig};
 use fog_core::consts::earth_rate_horizontal_dph;
@@ -31,12 +28,12 @@ use fog_core::northfinder::{NorthFinder, SeekConfig, SeekMode, SeekStatus};
 use fog_core::tilt::Tilt;
 use serde::Serialize;
 
-use crate::metrics::{rms, std_dev};
 use crate::report::{NorthSeekReport, SeekStats, Table};
 use crate::sim::{
     rig, AuxSource, AuxTransform, BaseMotion, DriftTerm, GyroParams, RunSpec, StartState,
     TurntableParams,
 };
+use crate::stats::{rms, std_dev};
 
 /// The paper's seek time, 4 min 56 s.
 pub const PAPER_SEEK_DURATION_S: f64 = 296.0;
@@ -167,22 +164,13 @@ impl MonteCarloConfig {
 
     /// Seed of start `index`: a SplitMix64 mix of the campaign seed and the index.
     pub fn start_seed(&self, index: usize) -> u64 {
-        let mut z = self.seed
-            ^ (index as u64)
-                .wrapping_add(1)
-                .wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        crate::seed::derive_seed(self.seed, index as u64 + 1, 0)
     }
 }
 
 /// Both cores by default, as the machine the demo targets has two.
 pub fn default_threads() -> usize {
-    std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1)
-        .min(8)
+    crate::fanout::thread_count(None).min(8)
 }
 
 /// One finished seek.
@@ -391,78 +379,49 @@ pub fn run_monte_carlo_with_calibration(
         feed_tilt: true,
         heading,
     };
-    let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<Result<StartOutcome>>>> =
-        Mutex::new((0..cfg.starts).map(|_| None).collect());
-    std::thread::scope(|scope| {
-        for _ in 0..cfg.threads.min(cfg.starts) {
-            scope.spawn(|| loop {
-                let i = next.fetch_add(1, Ordering::Relaxed);
-                if i >= cfg.starts {
-                    break;
-                }
-                let seed = cfg.start_seed(i);
-                let arm = |name: &str, a: Arm<'_>| {
-                    run_seeks(params, cfg, a, seed)
-                        .with_context(|| format!("start {} (seed {seed}), {name}", i + 1))
-                };
-                let r = (|| -> Result<StartOutcome> {
-                    Ok(StartOutcome {
-                        seed,
-                        uncompensated: arm(
-                            "uncompensated",
-                            Arm {
-                                model: None,
-                                ..full
-                            },
-                        )?,
-                        compensated: arm("compensated", full)?,
-                        tilt_uncompensated: if cfg.tilt_deg > 0.0 {
-                            arm(
-                                "tilt uncompensated",
-                                Arm {
-                                    feed_tilt: false,
-                                    ..full
-                                },
-                            )?
-                        } else {
-                            Vec::new()
-                        },
-                        heading_uncalibrated: if heading.is_some() {
-                            arm(
-                                "heading uncalibrated",
-                                Arm {
-                                    heading: None,
-                                    ..full
-                                },
-                            )?
-                        } else {
-                            Vec::new()
-                        },
-                    })
-                })();
-                let failed = r.is_err();
-                results.lock().expect("no panics while holding the lock")[i] = Some(r);
-                on_start_done();
-                if failed {
-                    // Stop handing out work: the first error is reported.
-                    next.store(cfg.starts, Ordering::Relaxed);
-                    break;
-                }
-            });
-        }
-    });
-    let results = results
-        .into_inner()
-        .expect("no panics while holding the lock");
-    let mut out = Vec::with_capacity(cfg.starts);
-    for r in results {
-        match r {
-            Some(r) => out.push(r?),
-            None => bail!("north-seek Monte Carlo stopped early"),
-        }
-    }
-    Ok((out, heading))
+    let outcomes = crate::fanout::try_map_in_order(cfg.starts, cfg.threads, |i| {
+        let seed = cfg.start_seed(i);
+        let arm = |name: &str, a: Arm<'_>| {
+            run_seeks(params, cfg, a, seed)
+                .with_context(|| format!("start {} (seed {seed}), {name}", i + 1))
+        };
+        let outcome = StartOutcome {
+            seed,
+            uncompensated: arm(
+                "uncompensated",
+                Arm {
+                    model: None,
+                    ..full
+                },
+            )?,
+            compensated: arm("compensated", full)?,
+            tilt_uncompensated: if cfg.tilt_deg > 0.0 {
+                arm(
+                    "tilt uncompensated",
+                    Arm {
+                        feed_tilt: false,
+                        ..full
+                    },
+                )?
+            } else {
+                Vec::new()
+            },
+            heading_uncalibrated: if heading.is_some() {
+                arm(
+                    "heading uncalibrated",
+                    Arm {
+                        heading: None,
+                        ..full
+                    },
+                )?
+            } else {
+                Vec::new()
+            },
+        };
+        on_start_done();
+        Ok::<_, anyhow::Error>(outcome)
+    })?;
+    Ok((outcomes, heading))
 }
 
 /// Headings of the heading calibration, deg.

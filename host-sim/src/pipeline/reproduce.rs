@@ -9,7 +9,6 @@ use anyhow::{anyhow, Result};
 use serde::Serialize;
 
 use crate::io::runs::Run;
-use crate::metrics::{self, SPEC_DPH};
 use crate::pipeline::campaign_steps::{
     simulate_checked, split_train_validate, train_default, CampaignRun, CampaignSpec,
 };
@@ -24,6 +23,7 @@ use crate::report::{
     DRIFT_COLUMNS,
 };
 use crate::sim::{GyroParams, RunSpec, SimGyro, StartState};
+use crate::stats::{self, SPEC_DPH};
 use crate::train::{default_specs, TrainReport};
 use fog_core::model::{FeatureKind, FeatureSpec};
 
@@ -113,11 +113,11 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
     steps.inc(1);
     let (train, heldout) = split_train_validate(&campaign, opts.n_train);
     if train.is_empty() || heldout.is_empty() {
-        return Err(anyhow!(
-            "--runs {}: need more runs per temperature than the {} training runs, so that some are held out",
-            plan.runs_per_ambient,
-            opts.n_train
-        ));
+        return Err(crate::pipeline::campaign_steps::PlanError::NoHeldOutRuns {
+            runs: plan.runs_per_ambient,
+            train_runs: opts.n_train,
+        }
+        .into());
     }
     let train_runs: Vec<&Run> = train.iter().map(|c| &c.run).collect();
     let heldout_runs: Vec<Run> = heldout.iter().map(|c| c.run.clone()).collect();
@@ -427,8 +427,8 @@ fn steady_allan(params: &GyroParams, seed: u64) -> Result<(Vec<f64>, Vec<f64>, O
             s.rate_dph - s.earth_dph
         })
         .collect();
-    let adev = metrics::allan_deviation(&y, 1.0 / spec.raw_rate_hz);
-    let arw = metrics::arw_dpsh(&adev);
+    let adev = stats::allan_deviation(&y, 1.0 / spec.raw_rate_hz);
+    let arw = stats::arw_dpsh(&adev);
     Ok((
         adev.iter().map(|p| p.tau_s).collect(),
         adev.iter().map(|p| p.adev_dph).collect(),

@@ -6,8 +6,6 @@
 //! through `dot_columns` (all candidates against one vector), which is what each
 //! forward-selection step needs.
 
-use std::num::NonZeroUsize;
-
 /// exp() arguments below this give values under 2e-35: stored as exact zeros, which
 /// also keeps f32 denormals (slow on x86) out of the matrix.
 const MIN_EXP_ARG: f32 = -80.0;
@@ -23,12 +21,7 @@ pub struct GaussianDesign {
     threads: usize,
 }
 
-/// Worker threads to use: the machine's parallelism unless `requested` is set.
-pub fn thread_count(requested: Option<usize>) -> usize {
-    requested
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, NonZeroUsize::get))
-        .max(1)
-}
+pub use crate::fanout::thread_count;
 
 impl GaussianDesign {
     /// Builds phi[i][k] = exp(-||x_i - x_{c_k}||^2 / (2 width^2)) over the first `dims`

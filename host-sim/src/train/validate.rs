@@ -11,7 +11,7 @@ use super::config::{Method, TrainConfig};
 use super::dataset::Dataset;
 use super::error::{Result, TrainError};
 use super::fit::{fit_path, PathFit, Shape};
-pub use crate::metrics::rms;
+pub use crate::stats::rms;
 use fog_core::model::WIDTH_RANGE;
 use serde::Serialize;
 

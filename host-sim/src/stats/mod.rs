@@ -29,8 +29,13 @@ pub fn rms(x: &[f64]) -> f64 {
     (x.iter().map(|v| v * v).sum::<f64>() / x.len().max(1) as f64).sqrt()
 }
 
-/// Pooled standard deviation of several groups (runs): each about its own mean,
-/// sqrt(sum of squared deviations / (N - groups)). 0 when there are no degrees of freedom.
+/// The pooled within-run standard deviation: the one "drift std" of several runs.
+///
+/// Definition: each run's values are taken about that run's own mean (so constant
+/// run-to-run offsets do not count), the squared deviations are pooled over all runs and
+/// divided by the degrees of freedom left, sum over runs of (n_i - 1):
+/// sqrt( sum_i sum_j (y_ij - mean_i)^2 / sum_i (n_i - 1) ). With one run this is
+/// `std_dev`. Empty runs are skipped; 0 when there are no degrees of freedom.
 pub fn pooled_std(groups: &[&[f64]]) -> f64 {
     let (mut ss, mut n, mut k) = (0.0, 0usize, 0usize);
     for g in groups.iter().filter(|g| !g.is_empty()) {
@@ -44,6 +49,12 @@ pub fn pooled_std(groups: &[&[f64]]) -> f64 {
     } else {
         0.0
     }
+}
+
+/// `pooled_std` of runs stacked in one slice, run `i` being `values[rows[i]]`.
+pub fn pooled_std_of_rows(rows: &[std::ops::Range<usize>], values: &[f64]) -> f64 {
+    let groups: Vec<&[f64]> = rows.iter().map(|r| &values[r.clone()]).collect();
+    pooled_std(&groups)
 }
 
 /// Means over consecutive windows of `window_s` (window i holds the samples with
@@ -236,6 +247,10 @@ mod tests {
         let b = [101.0, 102.0, 103.0];
         assert!((pooled_std(&[&a, &b]) - 1.0).abs() < 1e-12);
         assert!((std_dev(&a) - 1.0).abs() < 1e-12);
+        // Divisor sum(n_i - 1): 4 squared deviations of 1 over 2 + 1 degrees of freedom.
+        let stacked = [0.0, 2.0, 10.0, 11.0, 12.0];
+        let got = pooled_std_of_rows(&[0..2, 2..5], &stacked);
+        assert!((got - (4.0f64 / 3.0).sqrt()).abs() < 1e-12, "{got}");
     }
 
     #[test]
