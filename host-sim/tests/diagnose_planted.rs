@@ -45,7 +45,7 @@ fn check(effect: Effect) {
                         .collect();
                     let line = format!(
                         "{effect:?} seed {seed}: expected {expected:?}, named {named:?}, gain {:+.2}%, base {:.4} -> {:.4}; top {top:?}",
-                        r.extended.gain_pct, r.baseline.heldout_rms_dph, r.extended.heldout_rms_dph
+                        r.extended.gain_pct, r.base.heldout_rms_dph, r.extended.heldout_rms_dph
                     );
                     (ok, line)
                 })

@@ -25,7 +25,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let d = diagnose(&runs).context("diagnose")?;
     print!("{}", report::render_text(&d.report));
     let check = if runs.len() >= 4 {
-        match olscheck::ols_check(&runs, d.report.named_cause.as_ref()) {
+        let binned: Vec<_> = runs
+            .iter()
+            .map(crate::diagnose::input::as_10s_run)
+            .collect();
+        match olscheck::ols_check(&binned, d.report.named_cause.as_ref()) {
             Ok(c) => {
                 println!(
                     "  cross-check, project's OLS trainer ({} folds, fog-core features): paper's model held-out std {:.4} deg/h{}",

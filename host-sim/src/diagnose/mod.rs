@@ -9,6 +9,7 @@
 //! draws it, [`azimuth`] translates it into north-seeking error.
 
 pub mod azimuth;
+pub mod bases;
 pub mod basis;
 pub mod cv;
 pub mod error;
@@ -69,14 +70,15 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
     let campaign = input::prepare(runs)?;
     let st = Stacked::new(&campaign);
     let folds = Folds::new(&st.run_lengths)?;
-    let base = models::fit_baseline(&folds, &st)?;
+    let choice = bases::choose(&folds, &st)?;
+    let base = &choice.chosen;
     let base_rms = base.cv.rms();
     let structure = residuals::structure(&campaign, &folds, &st, &base.cv.residual);
     let screening = screen::screen(
         &campaign,
         &folds,
         &st,
-        &base,
+        base,
         transforms::enumerate(&campaign),
     )?;
 
@@ -92,7 +94,7 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
         &st.y,
         named.map(|s| s.cols.as_slice()),
     )?;
-    let base_inputs = vec!["temp_c:value".to_owned(), "temp_c:rate".to_owned()];
+    let base_inputs = base.spec.inputs();
     let (extended, ext_resid) = match named {
         Some(s) => {
             let mut inputs = base_inputs.clone();
@@ -148,12 +150,17 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
             skipped_candidates: screening.skipped.iter().map(to_excl).collect(),
             smallest_attainable_p: signflip::smallest_p(folds.unit_rows.len()),
         },
-        baseline: ModelSummary {
+        base: ModelSummary {
+            name: base.spec.name.clone(),
+            poly_degree_t: base.spec.poly_degree_t,
+            uses_rate: base.spec.uses_rate,
             inputs: base_inputs,
             heldout_rms_dph: base_rms,
             centres: base.centres,
             width_factor: base.width_factor,
             ridge: base.ridge,
+            tried: choice.scores.clone(),
+            collinearity_warning: choice.collinearity_warning.clone(),
         },
         residual_structure: structure,
         candidates: screening

@@ -10,14 +10,22 @@ use super::transforms::Transform;
 use serde::Serialize;
 use std::fmt::Write as _;
 
-/// A model's held-out performance.
+/// The chosen base model and its held-out performance.
 #[derive(Clone, Debug, Serialize)]
 pub struct ModelSummary {
+    /// `constant`, `poly_t2_rate`, `rbf_t_rate`, ... (see `bases`).
+    pub name: String,
+    pub poly_degree_t: Option<u8>,
+    pub uses_rate: bool,
     pub inputs: Vec<String>,
     pub heldout_rms_dph: f64,
     pub centres: usize,
     pub width_factor: f64,
     pub ridge: f64,
+    /// Every base tried with its held-out rms (the lowest is chosen).
+    pub tried: Vec<super::bases::BaseScore>,
+    /// Set when T, time and lags of T are nearly collinear.
+    pub collinearity_warning: Option<String>,
 }
 
 /// One ranked candidate.
@@ -112,7 +120,7 @@ pub struct CampaignSummary {
 #[derive(Clone, Debug, Serialize)]
 pub struct Report {
     pub campaign: CampaignSummary,
-    pub baseline: ModelSummary,
+    pub base: ModelSummary,
     pub residual_structure: Structure,
     pub candidates: Vec<CandidateRow>,
     pub named_cause: Option<Cause>,
@@ -128,7 +136,7 @@ pub struct Report {
 /// The cause in words (physics reading of a column and transform).
 pub fn cause_in_words(c: Option<&Cause>, coef: &[f64]) -> String {
     let Some(c) = c else {
-        return "no significant cause: the residual of the paper's T, dT/dt model shows no structure that any \
+        return "no significant cause: the residual of the chosen base shows no structure that any \
                 candidate explains better than chance on held-out data"
             .into();
     };
@@ -207,14 +215,28 @@ pub fn render_text(r: &Report) -> String {
         "  simulation vs measured drift: rms {:.4} deg/h (run offsets removed)",
         r.simulation.before_rms_dph
     );
+    let tried: Vec<String> = r
+        .base
+        .tried
+        .iter()
+        .map(|b| format!("{} {:.4}", b.spec.name, b.heldout_rms_dph))
+        .collect();
     let _ = writeln!(
         s,
-        "  paper's model RBF({}): held-out rms {:.4} deg/h ({} centres); uncompensated drift std {:.4} deg/h",
-        r.baseline.inputs.join(", "),
-        r.baseline.heldout_rms_dph,
-        r.baseline.centres,
+        "  bases tried (held-out rms, deg/h; run offsets free): {}",
+        tried.join(", ")
+    );
+    let _ = writeln!(
+        s,
+        "  chosen base {} ({}): held-out rms {:.4} deg/h; uncompensated drift std {:.4} deg/h; candidates are screened against it",
+        r.base.name,
+        r.base.inputs.join(", "),
+        r.base.heldout_rms_dph,
         r.drift_std.uncompensated_dph
     );
+    if let Some(w) = &r.base.collinearity_warning {
+        let _ = writeln!(s, "  warning: {w}");
+    }
     let _ = writeln!(s, "\n2. What the model gets wrong (held-out residual)");
     for b in &r.residual_structure.by_time {
         let _ = writeln!(
@@ -285,7 +307,7 @@ pub fn render_text(r: &Report) -> String {
     let e = &r.extended;
     let _ = writeln!(
         s,
-        "  extended model RBF({}): held-out rms {:.4} deg/h, gain {:+.2}% ; drift std {:.4} -> {:.4} -> {:.4} deg/h (raw -> paper -> extended)",
+        "  extended model ({}): held-out rms {:.4} deg/h, gain {:+.2}% ; drift std {:.4} -> {:.4} -> {:.4} deg/h (raw -> base -> extended)",
         e.inputs.join(", "),
         e.heldout_rms_dph,
         e.gain_pct,

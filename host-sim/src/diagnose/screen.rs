@@ -13,10 +13,11 @@
 //!    imitate its column's value or derivatives). Significant candidates that lose their
 //!    gain once the named one is in the model are reported as competing with it.
 
+use super::bases::BaseFit;
 use super::cv::{CvResult, Folds};
 use super::error::DiagnoseError;
 use super::input::Campaign;
-use super::models::{fit_rbf_input, RbfFit, Stacked};
+use super::models::{fit_rbf_input, Stacked};
 use super::signflip::{max_t_pvalues, paired_pvalue};
 use super::transforms::Candidate;
 
@@ -93,7 +94,7 @@ pub fn screen(
     campaign: &Campaign,
     folds: &Folds,
     st: &Stacked,
-    base: &RbfFit,
+    base: &BaseFit,
     cands: Vec<Candidate>,
 ) -> Result<Screening, DiagnoseError> {
     let base_rms = base.cv.rms();
@@ -146,7 +147,7 @@ pub fn screen(
         .take(REFIT_TOP)
         .filter(|s| s.gain_pct > 0.0)
     {
-        if let Ok(fit) = fit_rbf_input(folds, st, &s.cols) {
+        if let Ok(fit) = fit_rbf_input(folds, st, &base.spec, &s.cols) {
             if fit.cv.rms() < s.heldout_rms_dph {
                 s.mode = Mode::RbfInput;
                 s.heldout_rms_dph = fit.cv.rms();
@@ -215,7 +216,7 @@ pub fn unit_gains(from: &CvResult, to: &CvResult) -> Vec<f64> {
 /// vanishes once the named cause is in the model: they explain the same thing.
 fn competitors(
     folds: &Folds,
-    base: &RbfFit,
+    base: &BaseFit,
     scored: &[Scored],
     named: usize,
 ) -> Result<Vec<(String, f64)>, DiagnoseError> {
