@@ -129,7 +129,9 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
         baseline: azimuth::azimuth_effect(&folds, &st.t_s, &base.cv.residual, latitude),
         extended: azimuth::azimuth_effect(&folds, &st.t_s, &ext_resid, latitude),
     });
-    let words = report::cause_in_words(cause.as_ref(), &sim.effect_coef);
+    let smallest_attainable_p = signflip::smallest_p(folds.unit_rows.len());
+    let words = report::cause_in_words(cause.as_ref(), &sim.effect_coef)
+        .unwrap_or_else(|| report::nothing_named(smallest_attainable_p));
     let sim_terms = simterm::terms_per_run(runs, cause.as_ref(), &sim.effect_coef);
     let term_summaries: Vec<simterm::TermSummary> = sim_terms
         .first()
@@ -148,7 +150,7 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
             validation: folds.describe(),
             excluded_columns: campaign.exclusions.clone(),
             skipped_candidates: screening.skipped.iter().map(to_excl).collect(),
-            smallest_attainable_p: signflip::smallest_p(folds.unit_rows.len()),
+            smallest_attainable_p,
         },
         base: ModelSummary {
             name: base.spec.name.clone(),

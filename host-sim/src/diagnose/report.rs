@@ -133,16 +133,28 @@ pub struct Report {
     pub simulation: Simulation,
 }
 
-/// The cause in words (physics reading of a column and transform).
-pub fn cause_in_words(c: Option<&Cause>, coef: &[f64]) -> String {
-    let Some(c) = c else {
-        return "no significant cause: the residual of the chosen base shows no structure that any \
-                candidate explains better than chance on held-out data"
-            .into();
-    };
+/// What "nothing named" means: no structure found, or no test power to find any.
+pub fn nothing_named(smallest_attainable_p: f64) -> String {
+    if smallest_attainable_p >= super::screen::ALPHA {
+        format!(
+            "cannot decide: no test power (smallest reachable p {smallest_attainable_p:.4} >= alpha {} with this \
+             few validation units); absence of a named cause says nothing about the drift",
+            super::screen::ALPHA
+        )
+    } else {
+        "no significant cause: the residual of the chosen base shows no structure that any \
+         candidate explains better than chance on held-out data"
+            .into()
+    }
+}
+
+/// The cause in words (physics reading of a column and transform); `None` when nothing
+/// is named (see `nothing_named`).
+pub fn cause_in_words(c: Option<&Cause>, coef: &[f64]) -> Option<String> {
+    let c = c?;
     let tau = c.tau_s.unwrap_or(0.0);
     let k = coef.first().copied().unwrap_or(0.0);
-    match (c.column.as_str(), c.transform) {
+    Some(match (c.column.as_str(), c.transform) {
         ("temp_c", Transform::Accel) => format!(
             "drift follows d2T/dt2 ({k:.3e} deg/h per degC/s^2): the Shupe gradient term (the rate of the temperature \
              gradient along the coil), which the T, dT/dt model cannot express"
@@ -174,7 +186,7 @@ pub fn cause_in_words(c: Option<&Cause>, coef: &[f64]) -> String {
         (col, Transform::Accel) => format!("drift follows the second derivative of `{col}` ({k:.4e} deg/h per unit/s^2)"),
         (col, Transform::Lag) => format!("drift follows `{col}` through a first-order lag of {tau:.0} s ({k:.4e} deg/h per unit)"),
         (col, Transform::Decay) => format!("drift decays as exp(-{col}/{tau:.0} s)"),
-    }
+    })
 }
 
 /// Human-readable report.
