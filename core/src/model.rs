@@ -279,10 +279,8 @@ struct WireModel<'a> {
     crc32: u32,
 }
 
-/// CRC-32 (IEEE 802.3, as zlib/PNG) used for the model body.
-pub fn crc32(bytes: &[u8]) -> u32 {
-    crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC).checksum(bytes)
-}
+/// CRC-32 (IEEE 802.3, as zlib/PNG) used for the model body: the protocol's, one copy.
+pub use crate::protocol::crc32;
 
 fn check_finite(field: ModelField, values: &[f32]) -> Result<(), ModelError> {
     match values.iter().position(|v| !v.is_finite()) {

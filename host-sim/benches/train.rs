@@ -4,7 +4,7 @@
 //! `cargo bench -p fog-sim --bench train`
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use fog_sim::campaign::{simulate_campaign, CampaignSpec};
+use fog_sim::pipeline::campaign::{simulate_campaign, CampaignSpec};
 use fog_sim::sim::GyroParams;
 use fog_sim::train::{
     dataset_from_runs, default_specs, fit_width, Dataset, GaussianDesign, Method, Normalizer,
@@ -21,7 +21,7 @@ fn paper_training_set() -> Dataset {
     let runs: Vec<_> = simulate_campaign(&GyroParams::paper_default(), &spec)
         .expect("campaign")
         .into_iter()
-        .map(|(_, r)| r)
+        .map(|c| c.run)
         .collect();
     dataset_from_runs(&runs, &default_specs()).expect("dataset")
 }

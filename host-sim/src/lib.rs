@@ -3,19 +3,32 @@
 //! It runs the same `fog-core` code as the firmware against a simulated gyro,
 //! thermal model and turntable, trains the RBF drift model by orthogonal least
 //! squares, and analyses measured records.
+//!
+//! # Layers
+//!
+//! Each layer uses only the layers below it; nothing imports `cmd`.
+//!
+//! ```text
+//! cmd/        arguments, flag checks (outputs checked before any computation), printing
+//!   |         (main.rs dispatches; one module per subcommand)
+//! pipeline/   one job each: reproduce, compensate, north-seek Monte Carlo (northseek),
+//!   |         the simulated campaign; plus diagnose/ and train/ as their own pipelines
+//! engines     sim/ (gyro, thermal, turntable physics), train/ (OLS/ORR fitting),
+//!   |         diagnose/ (residual screening and fits), pipeline/compensation_replay
+//!   |         (runs replayed through fog-core's compensator)
+//! report/     JSON report structures and terminal tables; plots/ the SVG charts
+//! io/         fog-runs reader (streaming, csv crate) and writer, 10 s binning, model
+//!   |         files, import, the one atomic writer, the output guard
+//! metrics     statistics: std/rms, pooled within-run std, drift metrics, windows
+//! ```
 
-pub mod campaign;
 pub mod cmd;
 pub mod diagnose;
-pub mod import;
+pub mod io;
 pub mod metrics;
-pub mod northseek;
+pub mod pipeline;
 pub mod plots;
 pub mod report;
-pub mod report_compensation;
-pub mod report_pipeline;
-pub mod report_reproduce;
-pub mod runs;
 pub mod sim;
 pub mod train;
 pub mod upload;

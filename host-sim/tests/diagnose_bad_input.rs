@@ -4,7 +4,7 @@
 #[path = "common/planted.rs"]
 mod planted;
 use fog_sim::diagnose::{diagnose, DiagnoseError};
-use fog_sim::runs::Run;
+use fog_sim::io::runs::Run;
 use planted::{campaign, Effect, Shape};
 
 fn small() -> Vec<Run> {

@@ -22,14 +22,16 @@ fn json_has_the_issue_schema_and_plots_are_written() {
         },
     );
     for r in &runs {
-        fog_sim::runs::write_run(runs_dir.join(r.name()), r).unwrap();
+        fog_sim::io::runs::write_run(runs_dir.join(r.name()), r).unwrap();
     }
     let json = dir.join("d.json");
     let plots = dir.join("plots");
     run(Args {
         runs: vec![runs_dir.clone()],
-        json: Some(json.clone()),
-        plots: Some(plots.clone()),
+        outputs: fog_sim::cmd::ReportOutputs {
+            json: Some(json.clone()),
+            plots: Some(plots.clone()),
+        },
     })
     .unwrap();
     let v: serde_json::Value =

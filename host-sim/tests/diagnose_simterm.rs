@@ -6,7 +6,7 @@
 //! seeds) must bring the simulator closer to the "measured" campaign than without it.
 
 use fog_sim::diagnose::{diagnose, transforms::Transform};
-use fog_sim::runs::Run;
+use fog_sim::io::runs::Run;
 use fog_sim::sim::{
     simulate_run, AuxSource, AuxTransform, DriftTerm, GyroParams, RunSpec, StartState,
 };

@@ -1,7 +1,7 @@
 //! `fogsim import` of the PAN thermal-vacuum MEMS log: burst means, LSM6DSM temperature
 //! conversion, rad/s -> deg/h, outlier removal, and rejection of malformed files.
 
-use fog_sim::import::{import_pan, lsm6dsm_temp_c, PAN_HEADER};
+use fog_sim::io::import::{import_pan, lsm6dsm_temp_c, PAN_HEADER};
 use std::path::PathBuf;
 
 const RADS_TO_DPH: f64 = 180.0 / std::f64::consts::PI * 3600.0;

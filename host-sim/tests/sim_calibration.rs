@@ -3,13 +3,13 @@
 //! determinism, the dependence on the ambient, and that the drift is largely (not
 //! perfectly) explainable by the sensor's T and dT/dt.
 
-use fog_sim::campaign::{simulate_campaign, CampaignSpec};
+use fog_sim::io::runs::{format_run, Run};
 use fog_sim::metrics::{
     allan_deviation, arw_dpsh, bias_instability_dph, max_deviation, mean, settled_mean, std_dev,
     time_to_spec_s, SPEC_DPH,
 };
+use fog_sim::pipeline::campaign::{simulate_campaign, CampaignSpec};
 use fog_sim::plots::{allan_chart, startup_chart, write_svg, Series, StartupCurve};
-use fog_sim::runs::{format_run, Run};
 use fog_sim::sim::{simulate_run, GyroParams, RunSpec, SimGyro, StartState};
 use std::path::Path;
 
@@ -43,12 +43,12 @@ fn same_seed_same_bytes() {
     let x: Vec<String> = simulate_campaign(&p, &cs)
         .unwrap()
         .iter()
-        .map(|(n, r)| n.clone() + &format_run(r))
+        .map(|c| c.run.name() + &format_run(&c.run))
         .collect();
     let y: Vec<String> = simulate_campaign(&p, &cs)
         .unwrap()
         .iter()
-        .map(|(n, r)| n.clone() + &format_run(r))
+        .map(|c| c.run.name() + &format_run(&c.run))
         .collect();
     assert_eq!(x, y);
     assert_ne!(x[0], x[1], "runs of one ambient differ");
@@ -290,7 +290,7 @@ fn startup_over_the_paper_ambients() {
     );
     println!("|---:|---:|---:|---:|");
     let mut devs = Vec::new();
-    for ambient in fog_sim::campaign::PAPER_AMBIENTS_C {
+    for ambient in fog_sim::pipeline::campaign::PAPER_AMBIENTS_C {
         let runs: Vec<Run> = (0..5).map(|s| paper_run(ambient, 7000 + s)).collect();
         let dev = mean(
             &runs

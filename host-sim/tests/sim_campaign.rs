@@ -3,7 +3,7 @@
 
 mod app_support;
 
-use fog_sim::runs::read_runs;
+use fog_sim::io::runs::read_runs;
 use std::path::PathBuf;
 
 fn scratch(tag: &str) -> PathBuf {

@@ -1,7 +1,7 @@
 //! fog-runs v1 reader/writer: round trip, accessors, and every rejection case
 //! (each must name the file, the line and, where one applies, the column).
 
-use fog_sim::runs::{parse_run, read_run, read_runs, write_run, Run, RunErrorKind};
+use fog_sim::io::runs::{parse_run, read_run, read_runs, write_run, Run, RunErrorKind};
 use std::path::{Path, PathBuf};
 
 const GOOD: &str = "# fog-runs v1
@@ -20,7 +20,7 @@ fn scratch_dir(tag: &str) -> PathBuf {
     d
 }
 
-fn reject(text: &str) -> fog_sim::runs::RunError {
+fn reject(text: &str) -> fog_sim::io::runs::RunError {
     parse_run(Path::new("bad.csv"), text).expect_err("must be rejected")
 }
 

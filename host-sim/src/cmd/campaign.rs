@@ -1,7 +1,7 @@
 //! `fogsim campaign`: simulate the paper's test campaign into a directory of fog-runs
 //! v1 files (one per power-on, 10 s means, Earth rate in `earth_dph`).
 
-use crate::campaign::{
+use crate::pipeline::campaign::{
     simulate_campaign, write_campaign, CampaignSpec, PAPER_AMBIENTS_C, PAPER_MINUTES, PAPER_RUNS,
 };
 use crate::sim::{GyroParams, DEFAULT_LATITUDE_DEG};

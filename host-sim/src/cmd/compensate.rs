@@ -2,20 +2,16 @@
 //! the settled mean and time to spec, before and after the model (replayed through
 //! fog-core's compensator), plus the pooled figures; optional JSON and SVG plots.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 
-use crate::metrics::SPEC_DPH;
-use crate::plots::{startup_chart, write_svg, StartupCurve};
-use crate::report::{
-    check_output_path, ensure_dir, write_json, BeforeAfter, CompensateReport, CompensatedRun, Table,
-};
-use crate::report_compensation::{
-    check_model_inputs, compensate_run, drift_stats, pooled_stats, CompensatedSeries,
-};
-use crate::report_pipeline::read_model;
-use crate::runs::{read_runs, Run};
+use crate::io::model::read_model;
+use crate::io::runs::read_runs;
+use crate::io::OutputGuard;
+use crate::pipeline::compensate::{compensate_all, compensate_table, write_startup_plots};
+use crate::pipeline::compensation_replay::check_model_inputs;
+use crate::report::write_json;
 
 /// Options of `fogsim compensate`.
 #[derive(clap::Args, Debug)]
@@ -26,146 +22,26 @@ pub struct Args {
     /// Drift model (fog-core postcard, from `fogsim train`).
     #[arg(long)]
     pub model: PathBuf,
-    /// Write the JSON report here.
-    #[arg(long)]
-    pub json: Option<PathBuf>,
-    /// Write startup plots (SVG) into this directory.
-    #[arg(long)]
-    pub plots: Option<PathBuf>,
-}
-
-/// Compensates every run and builds the report (series kept for plots).
-pub fn compensate_all(
-    runs: &[Run],
-    model: &fog_core::model::RbfModel,
-) -> Result<(CompensateReport, Vec<CompensatedSeries>)> {
-    let mut series = Vec::with_capacity(runs.len());
-    let mut rows = Vec::with_capacity(runs.len());
-    for run in runs {
-        let s = compensate_run(run, Some(model))?;
-        if s.after_dph.len() < 2 {
-            bail!(
-                "{}: the model compensated fewer than two 10 s windows",
-                run.path.display()
-            );
-        }
-        rows.push(CompensatedRun {
-            file: run.path.display().to_string(),
-            ambient_c: run.ambient_c(),
-            before: drift_stats(&s.t_s, &s.before_dph),
-            after: drift_stats(&s.after_t_s, &s.after_dph),
-            out_of_range_windows: s.out_of_range_windows,
-        });
-        series.push(s);
-    }
-    let before: Vec<(&[f64], &[f64])> = series
-        .iter()
-        .map(|s| (s.t_s.as_slice(), s.before_dph.as_slice()))
-        .collect();
-    let after: Vec<(&[f64], &[f64])> = series
-        .iter()
-        .map(|s| (s.after_t_s.as_slice(), s.after_dph.as_slice()))
-        .collect();
-    let overall = BeforeAfter {
-        before: pooled_stats(&before),
-        after: pooled_stats(&after),
-    };
-    Ok((
-        CompensateReport {
-            runs: rows,
-            overall,
-            spec_dph: SPEC_DPH,
-        },
-        series,
-    ))
-}
-
-/// The per-run table printed to the terminal.
-pub fn compensate_table(report: &CompensateReport) -> String {
-    let mut t = Table::new(&[&["run", "ambient"][..], &crate::report::DRIFT_COLUMNS].concat());
-    let amb = |a: Option<f64>| a.map_or("-".to_string(), |a| format!("{a:+.0} degC"));
-    let name = |f: &str| {
-        Path::new(f)
-            .file_name()
-            .map_or(f.to_string(), |n| n.to_string_lossy().into_owned())
-    };
-    let mut add = |label: String,
-                   ambient: String,
-                   b: &crate::report::DriftStats,
-                   a: &crate::report::DriftStats| {
-        t.row(&[&[label, ambient][..], &crate::report::drift_cells(b, a)].concat());
-    };
-    for r in &report.runs {
-        add(name(&r.file), amb(r.ambient_c), &r.before, &r.after);
-    }
-    add(
-        "overall (pooled)".into(),
-        String::new(),
-        &report.overall.before,
-        &report.overall.after,
-    );
-    format!(
-        "drift of 10 s means, deg/h (spec {} deg/h, 1 sigma)\n{}",
-        report.spec_dph,
-        t.render()
-    )
-}
-
-/// Fig. 4/5-style startup curves (deviation from each run's settled mean) before and after.
-pub fn write_startup_plots(
-    dir: &Path,
-    runs: &[Run],
-    series: &[CompensatedSeries],
-    tag: &str,
-) -> Result<()> {
-    let curves = |after: bool| -> Vec<StartupCurve> {
-        runs.iter()
-            .zip(series)
-            .map(|(run, s)| {
-                let (t, y) = if after {
-                    (&s.after_t_s, &s.after_dph)
-                } else {
-                    (&s.t_s, &s.before_dph)
-                };
-                let settled = crate::metrics::settled_mean(t, y);
-                StartupCurve {
-                    label: run.name(),
-                    t_s: t.clone(),
-                    drift_dph: y.iter().map(|v| v - settled).collect(),
-                }
-            })
-            .collect()
-    };
-    let title = |what: &str| format!("startup drift {what} compensation{tag}");
-    write_svg(
-        &dir.join("startup_before.svg"),
-        &startup_chart(&title("before"), &curves(false), Some(SPEC_DPH)),
-    )?;
-    write_svg(
-        &dir.join("startup_after.svg"),
-        &startup_chart(&title("after"), &curves(true), Some(SPEC_DPH)),
-    )?;
-    Ok(())
+    #[command(flatten)]
+    pub outputs: super::ReportOutputs,
 }
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
-    if let Some(p) = &args.json {
-        check_output_path(p, "--json")?;
-    }
+    let guard = OutputGuard::new(&args.runs).with_input(&args.model);
+    args.outputs.check(&guard)?;
     let runs = read_runs(&args.runs).map_err(|e| anyhow::anyhow!("{e}"))?;
     if runs.is_empty() {
         bail!("no fog-runs files found in {:?}", args.runs);
     }
-    let model = read_model(&args.model)?;
+    let model = read_model(&args.model).map_err(|e| anyhow::anyhow!("--model {e}"))?;
     check_model_inputs(&model, &format!("--model {}", args.model.display()))?;
     let (report, series) = compensate_all(&runs, &model)?;
     print!("{}", compensate_table(&report));
-    if let Some(dir) = &args.plots {
-        ensure_dir(dir, "--plots")?;
+    if let Some(dir) = &args.outputs.plots {
         write_startup_plots(dir, &runs, &series, "")?;
     }
-    if let Some(p) = &args.json {
+    if let Some(p) = &args.outputs.json {
         write_json(p, &report)?;
     }
     Ok(())

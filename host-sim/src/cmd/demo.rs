@@ -6,10 +6,12 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 
+use super::prepare_output_dir;
 use crate::cmd::reproduce::options;
-use crate::report::{ensure_dir, write_json};
-use crate::report_pipeline::CampaignSpec;
-use crate::report_reproduce::{reproduce, summary};
+use crate::io::OutputGuard;
+use crate::pipeline::campaign_steps::CampaignSpec;
+use crate::pipeline::reproduce::{reproduce, summary};
+use crate::report::write_json;
 use crate::sim::GyroParams;
 
 /// Options of `fogsim demo`.
@@ -43,7 +45,7 @@ pub fn run(args: Args) -> Result<()> {
         None,
         Some(args.out.clone()),
     )?;
-    ensure_dir(&args.out, "--out")?;
+    prepare_output_dir(&OutputGuard::default(), Some(&args.out), "--out")?;
     let started = std::time::Instant::now();
     let report = reproduce(&GyroParams::paper_default(), &opts)?;
     print!("{}", summary(&report));

@@ -2,6 +2,7 @@
 //! paper's model get wrong on a measured campaign, the cause, the extension and its gain.
 
 use crate::diagnose::{diagnose, olscheck, plots, report};
+use crate::io::{write_atomic, OutputGuard};
 use anyhow::Context;
 use std::path::PathBuf;
 
@@ -11,17 +12,15 @@ pub struct Args {
     /// fog-runs v1 files or directories (read in name order).
     #[arg(required = true)]
     pub runs: Vec<PathBuf>,
-    /// Write the diagnosis as JSON here.
-    #[arg(long)]
-    pub json: Option<PathBuf>,
-    /// Write SVG plots into this directory.
-    #[arg(long)]
-    pub plots: Option<PathBuf>,
+    #[command(flatten)]
+    pub outputs: super::ReportOutputs,
 }
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let runs = crate::runs::read_runs(&args.runs)?;
+    let guard = OutputGuard::new(&args.runs);
+    args.outputs.check(&guard)?;
+    let runs = crate::io::runs::read_runs(&args.runs)?;
     let d = diagnose(&runs).context("diagnose")?;
     print!("{}", report::render_text(&d.report));
     let check = if runs.len() >= 4 {
@@ -50,7 +49,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     } else {
         None
     };
-    if let Some(path) = &args.json {
+    if let Some(path) = &args.outputs.json {
         let mut value = serde_json::to_value(&d.report)?;
         value["ols_trainer_check"] = serde_json::to_value(&check)?;
         let text = serde_json::to_string_pretty(&value)?;
@@ -58,7 +57,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             .with_context(|| format!("writing {}", path.display()))?;
         println!("JSON written to {}", path.display());
     }
-    if let Some(dir) = &args.plots {
+    if let Some(dir) = &args.outputs.plots {
         for p in
             plots::write_plots(dir, &d).with_context(|| format!("plots in {}", dir.display()))?
         {
@@ -66,11 +65,4 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
     }
     Ok(())
-}
-
-/// Writes a file via a temporary sibling and a rename, so no partial file is left.
-pub fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
-    let tmp = path.with_extension("tmp-fogsim");
-    std::fs::write(&tmp, bytes)?;
-    std::fs::rename(&tmp, path)
 }

@@ -1,7 +1,9 @@
 //! `fogsim import FILE --out DIR [--axis x|y|z|all]`: a foreign recording to fog-runs v1
-//! (currently the PAN thermal-vacuum MEMS log; see `fog_sim::import`).
+//! (currently the PAN thermal-vacuum MEMS log; see `fog_sim::io::import`).
 
-use crate::import::import_pan;
+use super::{check_output_file, prepare_output_dir};
+use crate::io::import::import_pan;
+use crate::io::OutputGuard;
 use std::path::PathBuf;
 
 /// Options of `fogsim import`.
@@ -31,11 +33,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     } else {
         args.input.clone()
     };
+    let guard = OutputGuard::new(&[&args.input, &file]);
+    prepare_output_dir(&guard, Some(&args.out), "--out")?;
     let imp = import_pan(&file, &axes)?;
-    std::fs::create_dir_all(&args.out)?;
     for run in &imp.runs {
         let path = args.out.join(run.name());
-        crate::runs::write_run(&path, run)?;
+        check_output_file(&guard, Some(&path), "--out")?;
+        crate::io::runs::write_run(&path, run)?;
         println!("wrote {} ({} rows)", path.display(), run.len());
     }
     println!(

@@ -1,4 +1,5 @@
-//! One module per `fogsim` subcommand: each has clap `Args` and a `run` function.
+//! One module per `fogsim` subcommand: each has clap `Args` and a `run` function that
+//! checks flags and outputs, calls a pipeline and prints. Nothing outside `cmd` imports it.
 
 pub mod campaign;
 pub mod compensate;
@@ -9,3 +10,53 @@ pub mod north_seek;
 pub mod reproduce;
 pub mod train;
 pub mod upload;
+
+use crate::io::OutputGuard;
+use std::path::{Path, PathBuf};
+
+/// Checks an output file before any computation, naming the flag in the error.
+pub(crate) fn check_output_file(
+    guard: &OutputGuard,
+    path: Option<&Path>,
+    flag: &str,
+) -> anyhow::Result<()> {
+    match path {
+        Some(p) => guard
+            .check_file(p)
+            .map_err(|e| anyhow::anyhow!("{flag} {e}")),
+        None => Ok(()),
+    }
+}
+
+/// Creates an output directory before any computation, naming the flag in the error.
+pub(crate) fn prepare_output_dir(
+    guard: &OutputGuard,
+    dir: Option<&Path>,
+    flag: &str,
+) -> anyhow::Result<()> {
+    match dir {
+        Some(d) => guard
+            .prepare_dir(d)
+            .map_err(|e| anyhow::anyhow!("{flag} {e}")),
+        None => Ok(()),
+    }
+}
+
+/// The report outputs shared by `compensate`, `diagnose` and `reproduce`.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct ReportOutputs {
+    /// Write the JSON report here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Write the SVG plots into this directory (created if missing).
+    #[arg(long)]
+    pub plots: Option<PathBuf>,
+}
+
+impl ReportOutputs {
+    /// Checks the JSON path and creates the plot directory, before any computation.
+    pub(crate) fn check(&self, guard: &OutputGuard) -> anyhow::Result<()> {
+        check_output_file(guard, self.json.as_deref(), "--json")?;
+        prepare_output_dir(guard, self.plots.as_deref(), "--plots")
+    }
+}

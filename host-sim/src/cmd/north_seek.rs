@@ -7,11 +7,14 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use fog_core::northfinder::SeekMode;
 
-use crate::northseek::{
+use super::check_output_file;
+use crate::io::model::read_model;
+use crate::io::OutputGuard;
+use crate::pipeline::campaign_steps::{simulate_checked, train_default, CampaignSpec};
+use crate::pipeline::northseek::{
     build_report, default_threads, run_monte_carlo, seek_table, MonteCarloConfig,
 };
-use crate::report::{check_output_path, progress_bar, write_json};
-use crate::report_pipeline::{read_model, simulate_campaign, train_default, CampaignSpec};
+use crate::report::{progress_bar, write_json};
 use crate::sim::GyroParams;
 
 /// Options of `fogsim north-seek`.
@@ -36,7 +39,7 @@ pub struct Args {
     #[arg(long, default_value_t = 20.0, allow_negative_numbers = true)]
     pub ambient: f64,
     /// True azimuth of the table's zero, deg (the paper's was about 108.4).
-    #[arg(long, default_value_t = crate::northseek::PAPER_AZIMUTH_DEG, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = crate::pipeline::northseek::PAPER_AZIMUTH_DEG, allow_negative_numbers = true)]
     pub azimuth: f64,
     /// Measuring time per main position, s (default: 110 for two positions, 60 for four,
     /// so that one seek fits the paper's 4 min 56 s).
@@ -85,12 +88,17 @@ pub fn config_from_args(a: &Args) -> Result<MonteCarloConfig> {
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
     let cfg = config_from_args(&args)?;
-    if let Some(p) = &args.json {
-        check_output_path(p, "--json")?;
-    }
+    let guard = match &args.model {
+        Some(m) => OutputGuard::new(&[m]),
+        None => OutputGuard::default(),
+    };
+    check_output_file(&guard, args.json.as_deref(), "--json")?;
     let params = GyroParams::paper_default();
     let (model, source) = match &args.model {
-        Some(p) => (read_model(p)?, p.display().to_string()),
+        Some(p) => (
+            read_model(p).map_err(|e| anyhow::anyhow!("--model {e}"))?,
+            p.display().to_string(),
+        ),
         None => {
             let plan = CampaignSpec {
                 ambients_c: vec![cfg.ambient_c],
@@ -98,7 +106,7 @@ pub fn run(args: Args) -> Result<()> {
                 latitude_deg: cfg.latitude_deg,
                 ..CampaignSpec::paper(cfg.seed)
             };
-            let campaign = simulate_campaign(&params, &plan)?;
+            let campaign = simulate_checked(&params, &plan)?;
             let runs: Vec<_> = campaign.iter().map(|c| &c.run).collect();
             let trained = train_default(&runs, &crate::train::default_specs(), "sim")?;
             eprintln!(

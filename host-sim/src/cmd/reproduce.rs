@@ -6,10 +6,11 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 
-use crate::northseek::{default_threads, MonteCarloConfig};
-use crate::report::{check_output_path, ensure_dir, write_json};
-use crate::report_pipeline::{validate_plan, CampaignSpec};
-use crate::report_reproduce::{reproduce, summary, validation_tables, ReproduceOptions};
+use crate::io::OutputGuard;
+use crate::pipeline::campaign_steps::{validate_plan, CampaignSpec};
+use crate::pipeline::northseek::{default_threads, MonteCarloConfig};
+use crate::pipeline::reproduce::{reproduce, summary, validation_tables, ReproduceOptions};
+use crate::report::write_json;
 use crate::sim::GyroParams;
 
 /// Training runs per temperature (the paper's protocol).
@@ -18,18 +19,14 @@ pub const TRAIN_RUNS: usize = 3;
 /// Options of `fogsim reproduce`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Write the JSON report here.
-    #[arg(long)]
-    pub json: Option<PathBuf>,
-    /// Write the SVG plots into this directory.
-    #[arg(long)]
-    pub plots: Option<PathBuf>,
+    #[command(flatten)]
+    pub outputs: super::ReportOutputs,
     /// Seed of the campaign and of the Monte Carlo.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Ambient temperatures, degC (comma separated).
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true,
-          default_values_t = crate::campaign::PAPER_AMBIENTS_C.to_vec())]
+          default_values_t = crate::pipeline::campaign::PAPER_AMBIENTS_C.to_vec())]
     pub ambient: Vec<f64>,
     /// Runs per temperature (runs 1-3 train, the rest validate).
     #[arg(long, default_value_t = 5)]
@@ -89,22 +86,23 @@ pub fn options(
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
-    if let Some(p) = &args.json {
-        check_output_path(p, "--json")?;
-    }
+    let guard = OutputGuard::default();
+    args.outputs.check(&guard)?;
     let campaign = CampaignSpec {
         ambients_c: args.ambient.clone(),
         runs_per_ambient: args.runs,
         minutes: args.minutes,
         ..CampaignSpec::paper(args.seed)
     };
-    let opts = options(campaign, args.starts, args.threads, args.plots.clone())?;
-    if let Some(dir) = &args.plots {
-        ensure_dir(dir, "--plots")?;
-    }
+    let opts = options(
+        campaign,
+        args.starts,
+        args.threads,
+        args.outputs.plots.clone(),
+    )?;
     let report = reproduce(&GyroParams::paper_default(), &opts)?;
     print!("{}\n{}", validation_tables(&report), summary(&report));
-    if let Some(p) = &args.json {
+    if let Some(p) = &args.outputs.json {
         write_json(p, &report)?;
     }
     Ok(())

@@ -3,8 +3,9 @@
 //! an optional JSON report. Everything is checked and encoded before any file is
 //! written, and files are written atomically, so a failure leaves no partial output.
 
-use crate::report::write_atomic;
-use crate::runs::read_runs;
+use super::check_output_file;
+use crate::io::runs::read_runs;
+use crate::io::{write_atomic, OutputGuard};
 use crate::train::{
     dataset_from_runs, default_specs, train_model, Method, TrainConfig, TrainOutcome,
 };
@@ -78,6 +79,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let specs = default_specs();
     // Options first: a bad option is reported before any file is read.
     cfg.check(specs.len()).context("fogsim train")?;
+    // Outputs next: a bad or input-destroying output is refused before any training.
+    let guard = OutputGuard::new(&args.runs);
+    check_output_file(&guard, Some(&args.out), "--out")?;
+    check_output_file(&guard, args.json.as_deref(), "--json")?;
+    if args.json.as_deref() == Some(args.out.as_path()) {
+        anyhow::bail!("--json and --out name the same file {}", args.out.display());
+    }
     let runs = read_runs(&args.runs)?;
     let ds = dataset_from_runs(&runs, &specs)?;
     let outcome = train_model(&ds, &cfg)?;

@@ -9,8 +9,8 @@ use serde::Serialize;
 
 /// Dwell per position, s (the paper's 4 min 56 s seek holds two of about this length).
 pub const DWELL_S: f64 = 148.0;
-/// Latitude used when the runs do not state one, deg.
-pub const DEFAULT_LATITUDE_DEG: f64 = 40.0;
+/// Latitude used when the runs do not state one, deg (the simulator's, one value for all).
+pub use crate::sim::DEFAULT_LATITUDE_DEG;
 
 /// Azimuth effect of a residual.
 #[derive(Clone, Debug, Serialize)]

@@ -8,7 +8,7 @@
 //! records (e.g. one mean per burst) are kept as they are.
 
 use super::error::DiagnoseError;
-use crate::runs::Run;
+use crate::io::runs::Run;
 
 /// Window length the model works on, s.
 pub const WINDOW_S: f64 = 10.0;

@@ -29,7 +29,7 @@ pub mod transforms;
 pub use error::DiagnoseError;
 pub use report::{Cause, Report};
 
-use crate::runs::Run;
+use crate::io::runs::Run;
 use cv::Folds;
 use input::Exclusion;
 use models::Stacked;
@@ -66,6 +66,8 @@ fn pooled_within_std(rows: &[std::ops::Range<usize>], v: &[f64]) -> f64 {
 }
 
 /// Runs the whole diagnosis on a campaign.
+// Split along its sections is deferred (issue 12, second part); allowed until then.
+#[allow(clippy::too_many_lines)]
 pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
     let campaign = input::prepare(runs)?;
     let st = Stacked::new(&campaign);

@@ -6,7 +6,7 @@
 
 use super::report::Cause;
 use super::transforms::Transform;
-use crate::runs::Run;
+use crate::io::runs::Run;
 use crate::train::{cross_validate, dataset_from_runs_with_aux, TrainConfig};
 use fog_core::model::{FeatureKind, FeatureSpec};
 use serde::Serialize;

@@ -90,6 +90,8 @@ fn gain_pct(base: f64, ext: f64) -> f64 {
 }
 
 /// Screens, refits and names (see the module header).
+// Split along its sections is deferred (issue 12, second part); allowed until then.
+#[allow(clippy::too_many_lines)]
 pub fn screen(
     campaign: &Campaign,
     folds: &Folds,

@@ -19,7 +19,7 @@
 
 use super::report::Cause;
 use super::transforms::Transform;
-use crate::runs::Run;
+use crate::io::runs::Run;
 use crate::sim::{AuxSource, AuxTransform, DriftTerm};
 use serde::Serialize;
 

@@ -4,7 +4,7 @@
 
 use super::dataset::Dataset;
 use super::error::{Result, TrainError};
-use crate::runs::Run;
+use crate::io::runs::Run;
 use fog_core::features::{features_for_series, FeatureVector};
 use fog_core::model::{FeatureKind, FeatureSpec, MAX_INPUTS};
 

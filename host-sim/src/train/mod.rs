@@ -26,7 +26,6 @@ mod predict;
 mod select;
 mod validate;
 
-pub mod export;
 pub mod features;
 
 pub use config::{Method, TrainConfig};

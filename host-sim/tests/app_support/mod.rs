@@ -6,8 +6,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use fog_sim::report_pipeline::{simulate_campaign, train_default, CampaignSpec};
-use fog_sim::runs::write_run;
+use fog_sim::io::runs::write_run;
+use fog_sim::pipeline::campaign_steps::{simulate_checked, train_default, CampaignSpec};
 use fog_sim::sim::GyroParams;
 
 /// Runs `fogsim` with `args` in `dir`.
@@ -41,7 +41,7 @@ pub fn campaign_and_model(dir: &Path, runs: usize) -> Vec<PathBuf> {
         runs_per_ambient: runs,
         ..CampaignSpec::paper(11)
     };
-    let campaign = simulate_campaign(&params, &plan).unwrap();
+    let campaign = simulate_checked(&params, &plan).unwrap();
     let train: Vec<_> = campaign
         .iter()
         .filter(|c| c.index <= 3)

@@ -4,17 +4,33 @@
 //! metadata lines (the first is `# fog-runs v1`), one header line, then numeric rows.
 //! Required columns are `t_s`, `rate_dph`, `temp_c`; every other numeric column is kept.
 //! Bad input is rejected whole with the file, line and column named ([`RunError`]);
-//! writing is atomic (temporary file in the same directory, then rename).
+//! reading streams (see [`super::reader`]), writing is atomic ([`super::atomic`]).
 
 use std::fmt;
 use std::fs;
-use std::io::Write as _;
+use std::io::Write;
 use std::path::{Path, PathBuf};
+
+use super::reader::{excerpt, RunReader};
 
 /// The first line of every fog-runs v1 file.
 pub const FORMAT_LINE: &str = "# fog-runs v1";
 /// Column names every run must have.
 pub const REQUIRED_COLUMNS: [&str; 3] = ["t_s", "rate_dph", "temp_c"];
+
+/// Largest |rate| accepted in `rate_dph` and `earth_dph`, deg/h: 1e7 deg/h = 2 778 deg/s,
+/// beyond the +-2 000 deg/s full scale of the widest-range MEMS gyros and four orders
+/// above any FOG north finder's range; the measured MEMS log peaks near 1.4e4 deg/h.
+pub const MAX_ABS_RATE_DPH: f64 = 1.0e7;
+/// Coldest temperature accepted in `temp_c`, degC (absolute zero).
+pub const MIN_TEMP_C: f64 = -273.15;
+/// Hottest temperature accepted in `temp_c`, degC (far above any gyro's survival limit).
+pub const MAX_TEMP_C: f64 = 1000.0;
+/// Largest |t_s| accepted, s (about 32 years since power-on).
+pub const MAX_ABS_TIME_S: f64 = 1.0e9;
+/// Largest magnitude accepted in any other column: no sensor channel in SI-derived units
+/// reaches it, while 1e300-style corruption does.
+pub const MAX_ABS_VALUE: f64 = 1.0e15;
 
 /// One power-on record: ordered metadata and named numeric columns of equal length.
 #[derive(Clone, Debug, PartialEq)]
@@ -52,10 +68,16 @@ pub enum RunErrorKind {
     DuplicateColumn,
     /// A required column is absent.
     MissingColumn,
-    /// A cell is not a number.
+    /// A cell is not a number (the cell's text, cut to one short line).
     NotNumeric(String),
     /// A cell is NaN or infinite.
     NotFinite,
+    /// A finite value outside the column's physical range `[low, high]`.
+    OutOfBounds { value: f64, low: f64, high: f64 },
+    /// A line or cell is not valid UTF-8.
+    NotUtf8,
+    /// A line is longer than [`super::reader::MAX_LINE_BYTES`].
+    LineTooLong,
     /// A row has a different number of cells than the header.
     RaggedRow { expected: usize, found: usize },
     /// `t_s` does not strictly increase.
@@ -75,16 +97,25 @@ pub enum RunErrorKind {
 pub struct RunError {
     pub path: PathBuf,
     pub line: Option<usize>,
+    /// Column name.
     pub column: Option<String>,
+    /// Column position in the row, 1-based (known for a bad cell).
+    pub column_number: Option<usize>,
     pub kind: RunErrorKind,
 }
 
 impl RunError {
-    fn new(path: &Path, line: Option<usize>, column: Option<&str>, kind: RunErrorKind) -> Self {
+    pub(crate) fn new(
+        path: &Path,
+        line: Option<usize>,
+        column: Option<&str>,
+        kind: RunErrorKind,
+    ) -> Self {
         Self {
             path: path.to_path_buf(),
             line,
-            column: column.map(str::to_owned),
+            column: column.map(excerpt),
+            column_number: None,
             kind,
         }
     }
@@ -109,6 +140,16 @@ impl fmt::Display for RunErrorKind {
             MissingColumn => write!(f, "required column missing (need t_s, rate_dph, temp_c)"),
             NotNumeric(cell) => write!(f, "`{cell}` is not a number"),
             NotFinite => write!(f, "value is NaN or infinite"),
+            OutOfBounds { value, low, high } => write!(
+                f,
+                "value {value:e} is outside the physical range [{low:e}, {high:e}]"
+            ),
+            NotUtf8 => write!(f, "bytes that are not valid UTF-8"),
+            LineTooLong => write!(
+                f,
+                "line longer than {} bytes",
+                super::reader::MAX_LINE_BYTES
+            ),
             RaggedRow { expected, found } => {
                 write!(f, "row has {found} cells, header has {expected}")
             }
@@ -131,6 +172,9 @@ impl fmt::Display for RunError {
         write!(f, "{}", self.path.display())?;
         if let Some(line) = self.line {
             write!(f, ":{line}")?;
+            if let Some(col) = self.column_number {
+                write!(f, ":{col}")?;
+            }
         }
         if let Some(col) = &self.column {
             write!(f, ": column `{col}`")?;
@@ -182,8 +226,8 @@ impl Run {
                     RunErrorKind::ShapeMismatch,
                 ));
             }
-            if values.iter().any(|v| !v.is_finite()) {
-                return Err(RunError::new(p, None, Some(name), RunErrorKind::NotFinite));
+            if let Some(kind) = values.iter().find_map(|&v| check_value(name, v).err()) {
+                return Err(RunError::new(p, None, Some(name), kind));
             }
         }
         check_time(p, self.t_s(), |_| None)
@@ -311,7 +355,11 @@ impl Run {
     }
 }
 
-fn check_header(path: &Path, line: Option<usize>, names: &[String]) -> Result<(), RunError> {
+pub(super) fn check_header(
+    path: &Path,
+    line: Option<usize>,
+    names: &[String],
+) -> Result<(), RunError> {
     for (i, name) in names.iter().enumerate() {
         if name.is_empty() {
             return Err(RunError::new(
@@ -344,7 +392,7 @@ fn check_header(path: &Path, line: Option<usize>, names: &[String]) -> Result<()
 }
 
 /// Numeric metadata keys that the readers interpret; they must parse when present.
-const NUMERIC_META: [&str; 3] = ["earth_dph", "latitude_deg", "ambient_c"];
+pub(super) const NUMERIC_META: [&str; 3] = ["earth_dph", "latitude_deg", "ambient_c"];
 
 fn check_metadata(path: &Path, meta: &[(String, String)]) -> Result<(), RunError> {
     for (i, (k, v)) in meta.iter().enumerate() {
@@ -377,6 +425,28 @@ fn check_metadata(path: &Path, meta: &[(String, String)]) -> Result<(), RunError
     Ok(())
 }
 
+/// A cell value's check: finite and inside its column's physical range.
+pub(super) fn check_value(column: &str, v: f64) -> Result<(), RunErrorKind> {
+    if !v.is_finite() {
+        return Err(RunErrorKind::NotFinite);
+    }
+    let (low, high) = match column {
+        "rate_dph" | "earth_dph" => (-MAX_ABS_RATE_DPH, MAX_ABS_RATE_DPH),
+        "temp_c" => (MIN_TEMP_C, MAX_TEMP_C),
+        "t_s" => (-MAX_ABS_TIME_S, MAX_ABS_TIME_S),
+        _ => (-MAX_ABS_VALUE, MAX_ABS_VALUE),
+    };
+    if (low..=high).contains(&v) {
+        Ok(())
+    } else {
+        Err(RunErrorKind::OutOfBounds {
+            value: v,
+            low,
+            high,
+        })
+    }
+}
+
 /// `line_of(row)` gives the file line of a data row, if known.
 fn check_time(
     path: &Path,
@@ -397,105 +467,29 @@ fn check_time(
 
 /// Parses fog-runs v1 text; `path` is only used in errors and stored in the run.
 pub fn parse_run(path: &Path, text: &str) -> Result<Run, RunError> {
-    let err = |line: usize, col: Option<&str>, kind| RunError::new(path, Some(line), col, kind);
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim_end_matches('\r')));
-
-    match lines.next() {
-        Some((_, l)) if l.trim() == FORMAT_LINE => {}
-        Some((n, l)) if l.trim_start().starts_with("# fog-runs") => {
-            let v = l.trim_start_matches('#').trim().to_owned();
-            return Err(err(n, None, RunErrorKind::UnsupportedVersion(v)));
-        }
-        Some((n, _)) => return Err(err(n, None, RunErrorKind::NotFogRuns)),
-        None => return Err(err(1, None, RunErrorKind::NotFogRuns)),
-    }
-
-    let mut meta: Vec<(String, String)> = Vec::new();
-    let mut header: Option<(usize, Vec<String>)> = None;
-    for (n, l) in lines.by_ref() {
-        if l.trim().is_empty() {
-            continue;
-        }
-        if let Some(body) = l.strip_prefix('#') {
-            let (k, v) = body
-                .split_once(':')
-                .ok_or_else(|| err(n, None, RunErrorKind::BadMetadata))?;
-            let (k, v) = (k.trim(), v.trim());
-            if k.is_empty() {
-                return Err(err(n, None, RunErrorKind::BadMetadata));
-            }
-            if meta.iter().any(|(k2, _)| k2 == k) {
-                return Err(err(n, None, RunErrorKind::DuplicateMetadata(k.to_owned())));
-            }
-            if NUMERIC_META.contains(&k) && !v.parse::<f64>().is_ok_and(f64::is_finite) {
-                return Err(err(n, None, RunErrorKind::BadMetadataValue(v.to_owned())));
-            }
-            meta.push((k.to_owned(), v.to_owned()));
-        } else {
-            header = Some((n, l.split(',').map(|c| c.trim().to_owned()).collect()));
-            break;
-        }
-    }
-    let (header_line, columns) = header.ok_or_else(|| {
-        err(
-            text.lines().count().max(1),
-            None,
-            RunErrorKind::MissingHeader,
-        )
-    })?;
-    check_header(path, Some(header_line), &columns)?;
-
-    let mut data: Vec<Vec<f64>> = vec![Vec::new(); columns.len()];
-    let mut row_lines: Vec<usize> = Vec::new();
-    for (n, l) in lines {
-        if l.trim().is_empty() {
-            continue;
-        }
-        if l.starts_with('#') {
-            return Err(err(n, None, RunErrorKind::CommentAfterHeader));
-        }
-        let cells: Vec<&str> = l.split(',').collect();
-        if cells.len() != columns.len() {
-            let kind = RunErrorKind::RaggedRow {
-                expected: columns.len(),
-                found: cells.len(),
-            };
-            return Err(err(n, None, kind));
-        }
-        for ((cell, name), col) in cells.iter().zip(&columns).zip(data.iter_mut()) {
-            let cell = cell.trim();
-            let v: f64 = cell
-                .parse()
-                .map_err(|_| err(n, Some(name), RunErrorKind::NotNumeric(cell.to_owned())))?;
-            if !v.is_finite() {
-                return Err(err(n, Some(name), RunErrorKind::NotFinite));
-            }
-            col.push(v);
-        }
-        row_lines.push(n);
-    }
-    if row_lines.is_empty() {
-        return Err(err(header_line, None, RunErrorKind::NoRows));
-    }
-    let run = Run {
-        path: path.to_path_buf(),
-        meta,
-        columns,
-        data,
-    };
-    check_time(path, run.t_s(), |row| row_lines.get(row).copied())?;
-    Ok(run)
+    collect_run(RunReader::from_reader(path, text.as_bytes())?)
 }
 
-/// Reads one fog-runs v1 file.
+/// Reads one fog-runs v1 file whole (streamed; see [`super::bin`] for 10 s windows).
 pub fn read_run(path: impl AsRef<Path>) -> Result<Run, RunError> {
-    let path = path.as_ref();
-    let text = fs::read_to_string(path)
-        .map_err(|e| RunError::new(path, None, None, RunErrorKind::Io(e.to_string())))?;
-    parse_run(path, &text)
+    collect_run(RunReader::open(path)?)
+}
+
+fn collect_run<R: std::io::Read>(mut reader: RunReader<R>) -> Result<Run, RunError> {
+    let mut data: Vec<Vec<f64>> = vec![Vec::new(); reader.header().columns.len()];
+    let mut values = Vec::new();
+    while reader.next_row_into(&mut values)?.is_some() {
+        for (col, &v) in data.iter_mut().zip(&values) {
+            col.push(v);
+        }
+    }
+    let header = reader.header().clone();
+    Ok(Run {
+        path: header.path,
+        meta: header.meta,
+        columns: header.columns,
+        data,
+    })
 }
 
 /// The `.csv` files of a directory in name order (hidden files skipped).
@@ -521,67 +515,58 @@ pub fn list_run_files(dir: &Path) -> Result<Vec<PathBuf>, RunError> {
 /// Reads files and directories (a directory's `.csv` files in name order), in argument
 /// order. The first bad file rejects the whole call.
 pub fn read_runs<P: AsRef<Path>>(paths: &[P]) -> Result<Vec<Run>, RunError> {
-    let mut runs = Vec::new();
+    run_files(paths)?.iter().map(read_run).collect()
+}
+
+/// The run files named by files and directories (a directory's `.csv` files in name
+/// order), in argument order.
+pub fn run_files<P: AsRef<Path>>(paths: &[P]) -> Result<Vec<PathBuf>, RunError> {
+    let mut files = Vec::new();
     for p in paths {
         let p = p.as_ref();
         if p.is_dir() {
-            for f in list_run_files(p)? {
-                runs.push(read_run(&f)?);
-            }
+            files.extend(list_run_files(p)?);
         } else {
-            runs.push(read_run(p)?);
+            files.push(p.to_path_buf());
         }
     }
-    Ok(runs)
+    Ok(files)
 }
 
-/// The fog-runs v1 text of a run (numbers in shortest round-trip form).
-pub fn format_run(run: &Run) -> String {
-    let mut s = String::with_capacity(64 + run.len() * run.columns.len() * 12);
-    s.push_str(FORMAT_LINE);
-    s.push('\n');
+/// Writes the fog-runs v1 text of a run (numbers in shortest round-trip form).
+pub fn write_run_text(run: &Run, w: &mut dyn Write) -> std::io::Result<()> {
+    writeln!(w, "{FORMAT_LINE}")?;
     for (k, v) in &run.meta {
-        s.push_str(&format!("# {k}: {v}\n"));
+        writeln!(w, "# {k}: {v}")?;
     }
-    s.push_str(&run.columns.join(","));
-    s.push('\n');
+    writeln!(w, "{}", run.columns.join(","))?;
     for row in 0..run.len() {
         for (i, col) in run.data.iter().enumerate() {
             if i > 0 {
-                s.push(',');
+                w.write_all(b",")?;
             }
-            s.push_str(&format!("{}", col[row]));
+            write!(w, "{}", col[row])?;
         }
-        s.push('\n');
+        w.write_all(b"\n")?;
     }
-    s
+    Ok(())
 }
 
-/// Writes a run atomically: validated first, written to a hidden temporary file in the
-/// same directory, then renamed over `path`. On error nothing is left at `path`.
+/// The fog-runs v1 text of a run (see [`write_run_text`]).
+pub fn format_run(run: &Run) -> String {
+    let mut bytes = Vec::with_capacity(64 + run.len() * run.columns.len() * 12);
+    write_run_text(run, &mut bytes).expect("writing to memory cannot fail");
+    String::from_utf8(bytes).expect("formatted numbers and validated text are UTF-8")
+}
+
+/// Writes a run atomically: validated first, then streamed through
+/// [`super::atomic::write_atomic_with`]. On error nothing is left at `path`.
 pub fn write_run(path: impl AsRef<Path>, run: &Run) -> Result<(), RunError> {
     let path = path.as_ref();
     run.validate().map_err(|e| RunError {
         path: path.to_path_buf(),
         ..e
     })?;
-    let io = |e: std::io::Error| RunError::new(path, None, None, RunErrorKind::Io(e.to_string()));
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .map_or_else(|| "run".into(), |n| n.to_string_lossy().into_owned());
-    let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
-    let result = (|| {
-        let mut f = fs::File::create(&tmp)?;
-        f.write_all(format_run(run).as_bytes())?;
-        f.sync_all()?;
-        fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
-    }
-    result.map_err(io)
+    super::atomic::write_atomic_with(path, |w| write_run_text(run, w))
+        .map_err(|e| RunError::new(path, None, None, RunErrorKind::Io(e.to_string())))
 }

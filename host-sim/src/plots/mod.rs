@@ -288,7 +288,7 @@ where
 /// Renders `chart` and writes it to `path` atomically (temp file in the same directory, then rename).
 pub fn write_svg(path: &Path, chart: &Chart) -> Result<(), PlotError> {
     let svg = render_svg(chart)?;
-    crate::report::write_atomic(path, svg.as_bytes()).map_err(|source| PlotError::Io {
+    crate::io::write_atomic(path, svg.as_bytes()).map_err(|source| PlotError::Io {
         path: path.to_path_buf(),
         source,
     })

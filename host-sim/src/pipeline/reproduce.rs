@@ -8,9 +8,14 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, Result};
 use serde::Serialize;
 
-use crate::cmd::compensate::{compensate_all, compensate_table, write_startup_plots};
+use crate::io::runs::Run;
 use crate::metrics::{self, SPEC_DPH};
-use crate::northseek::{
+use crate::pipeline::campaign_steps::{
+    simulate_checked, split_train_validate, train_default, CampaignRun, CampaignSpec,
+};
+use crate::pipeline::compensate::{compensate_all, compensate_table, write_startup_plots};
+use crate::pipeline::compensation_replay::{pooled_stats, CompensatedSeries};
+use crate::pipeline::northseek::{
     build_report, run_monte_carlo, seek_table, MonteCarloConfig, PAPER_SEEK_DURATION_S,
 };
 use crate::plots::{allan_chart, azimuth_scatter_chart, temperature_chart, write_svg, Series};
@@ -18,11 +23,6 @@ use crate::report::{
     drift_cells, fmt_minutes, progress_bar, CompensateReport, DriftStats, NorthSeekReport, Table,
     DRIFT_COLUMNS,
 };
-use crate::report_compensation::{pooled_stats, CompensatedSeries};
-use crate::report_pipeline::{
-    simulate_campaign, split_train_validate, train_default, CampaignRun, CampaignSpec,
-};
-use crate::runs::Run;
 use crate::sim::{GyroParams, RunSpec, SimGyro, StartState};
 use crate::train::{default_specs, TrainReport};
 use fog_core::model::{FeatureKind, FeatureSpec};
@@ -109,7 +109,7 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
     let plan = &opts.campaign;
     let variants = input_variants();
     let steps = progress_bar(1 + 2 * variants.len(), "campaign, training, validation");
-    let campaign = simulate_campaign(params, plan)?;
+    let campaign = simulate_checked(params, plan)?;
     steps.inc(1);
     let (train, heldout) = split_train_validate(&campaign, opts.n_train);
     if train.is_empty() || heldout.is_empty() {
@@ -452,7 +452,7 @@ fn write_model_plots(
     } else {
         sub
     };
-    crate::report::ensure_dir(&target, "--plots")?;
+    crate::io::guard::create_dir(&target)?;
     let (room_runs, room_series): (Vec<Run>, Vec<_>) = heldout
         .iter()
         .zip(series)
@@ -487,7 +487,7 @@ fn write_model_plots(
 
 /// Plots of the campaign itself: coil temperature after power-on, Allan deviation.
 fn write_campaign_plots(dir: &Path, params: &GyroParams, campaign: &[CampaignRun]) -> Result<()> {
-    crate::report::ensure_dir(dir, "--plots")?;
+    crate::io::guard::create_dir(dir)?;
     let temps: Vec<(String, Vec<f64>, Vec<f64>)> = campaign
         .iter()
         .filter(|c| c.index == 1)

@@ -3,7 +3,7 @@
 //! simulated in parallel (each from its own derived seed, so the bytes never depend
 //! on the thread schedule) and written only when all succeeded.
 
-use crate::runs::{write_run, Run, RunError};
+use crate::io::runs::{write_run, Run, RunError};
 use crate::sim::{simulate_run, GyroParams, RunSpec, SimError, DEFAULT_LATITUDE_DEG};
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -75,6 +75,15 @@ pub fn derive_seed(seed: u64, a: u64, b: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// One simulated power-on of a campaign (`run.path` is its file name).
+#[derive(Clone, Debug)]
+pub struct CampaignRun {
+    pub ambient_c: f64,
+    /// 1-based index of the run at its temperature (the paper trains on 1-3).
+    pub index: usize,
+    pub run: Run,
+}
+
 /// Why a campaign failed.
 #[derive(Debug)]
 pub enum CampaignError {
@@ -95,12 +104,12 @@ impl fmt::Display for CampaignError {
 
 impl std::error::Error for CampaignError {}
 
-/// Simulates every run (in parallel over the available cores); the result is in file
-/// order: (file name, run).
+/// Simulates every run (in parallel over the available cores), in file order, each
+/// tagged with its ambient and 1-based index.
 pub fn simulate_campaign(
     params: &GyroParams,
     spec: &CampaignSpec,
-) -> Result<Vec<(String, Run)>, CampaignError> {
+) -> Result<Vec<CampaignRun>, CampaignError> {
     if spec.ambients_c.is_empty() {
         return Err(CampaignError::Spec(
             "campaign: no ambient temperatures".into(),
@@ -142,36 +151,39 @@ pub fn simulate_campaign(
             let mut run = res
                 .expect("every slot is filled by its thread")
                 .map_err(CampaignError::Sim)?;
-            let name = spec.file_name(a, r);
-            run.path = PathBuf::from(&name);
+            run.path = PathBuf::from(spec.file_name(a, r));
             run.set_meta("run", r + 1);
-            Ok((name, run))
+            Ok(CampaignRun {
+                ambient_c: spec.ambients_c[a],
+                index: r + 1,
+                run,
+            })
         })
         .collect()
 }
 
 /// Writes a simulated campaign into `dir` (created if missing). If any file fails, the
 /// files written by this call are removed again: no partial campaign is left.
-pub fn write_campaign(dir: &Path, runs: &[(String, Run)]) -> Result<Vec<PathBuf>, CampaignError> {
+pub fn write_campaign(dir: &Path, runs: &[CampaignRun]) -> Result<Vec<PathBuf>, CampaignError> {
     let io = |e: std::io::Error| {
-        CampaignError::Write(RunError {
-            path: dir.to_path_buf(),
-            line: None,
-            column: None,
-            kind: crate::runs::RunErrorKind::Io(e.to_string()),
-        })
+        CampaignError::Write(RunError::new(
+            dir,
+            None,
+            None,
+            crate::io::runs::RunErrorKind::Io(e.to_string()),
+        ))
     };
     if dir.is_dir() {
         // Stale runs of another campaign would silently join this one when the directory
         // is read back (e.g. by `fogsim train DIR`): refuse before writing anything.
-        let ours: Vec<&str> = runs.iter().map(|(n, _)| n.as_str()).collect();
+        let ours: Vec<String> = runs.iter().map(|c| c.run.name()).collect();
         for entry in std::fs::read_dir(dir).map_err(io)? {
             let name = entry
                 .map_err(io)?
                 .file_name()
                 .to_string_lossy()
                 .into_owned();
-            if name.to_ascii_lowercase().ends_with(".csv") && !ours.contains(&name.as_str()) {
+            if name.to_ascii_lowercase().ends_with(".csv") && !ours.contains(&name) {
                 return Err(CampaignError::Spec(format!(
                     "--out {}: holds {name}, which is not part of this campaign and would mix with it; use an empty directory",
                     dir.display()
@@ -182,9 +194,9 @@ pub fn write_campaign(dir: &Path, runs: &[(String, Run)]) -> Result<Vec<PathBuf>
     let created_dir = !dir.exists();
     std::fs::create_dir_all(dir).map_err(io)?;
     let mut written = Vec::new();
-    for (name, run) in runs {
-        let path = dir.join(name);
-        if let Err(e) = write_run(&path, run) {
+    for c in runs {
+        let path = dir.join(c.run.name());
+        if let Err(e) = write_run(&path, &c.run) {
             for p in &written {
                 let _ = std::fs::remove_file(p);
             }

@@ -16,9 +16,9 @@ use fog_core::consts::WINDOW_S;
 use fog_core::hal::{GyroSample, TempSample};
 use fog_core::model::RbfModel;
 
+use crate::io::runs::Run;
 use crate::metrics;
 use crate::report::DriftStats;
-use crate::runs::Run;
 
 /// One record's drift series before and after compensation (10 s windows).
 #[derive(Clone, Debug, Default)]

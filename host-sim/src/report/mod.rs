@@ -1,71 +1,18 @@
 //! Report plumbing shared by `compensate`, `north-seek`, `reproduce` and `demo`:
-//! the JSON report structures (their shape is the contract of issue 3), atomic file output
-//! (nothing half-written on error) and a plain-text table for the terminal.
+//! the JSON report structures (their shape is the contract of issue 3), JSON output through
+//! the one atomic writer ([`crate::io::atomic`]) and a plain-text table for the terminal.
 
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::Path;
 
 use serde::Serialize;
-
-/// Writes `bytes` to `path` via a temporary file in the same directory and a rename, so
-/// readers never see a partial file and a failure leaves no file behind.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
-    let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
-}
 
 /// Serialises `value` as pretty JSON and writes it atomically to `path`.
 pub fn write_json<T: Serialize>(path: &Path, value: &T) -> anyhow::Result<()> {
     let mut text = serde_json::to_string_pretty(value)?;
     text.push('\n');
-    write_atomic(path, text.as_bytes())
+    crate::io::write_atomic(path, text.as_bytes())
         .map_err(|e| anyhow::anyhow!("{}: cannot write JSON report: {e}", path.display()))
-}
-
-/// Fails early (before any long computation) if `path` cannot be created: its directory must exist.
-pub fn check_output_path(path: &Path, option: &str) -> anyhow::Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    if !dir.is_dir() {
-        anyhow::bail!(
-            "{option} {}: directory {} does not exist",
-            path.display(),
-            dir.display()
-        );
-    }
-    if path.is_dir() {
-        anyhow::bail!(
-            "{option} {}: is a directory, expected a file name",
-            path.display()
-        );
-    }
-    Ok(())
-}
-
-/// Creates a plot directory (and parents) up front, with the option name in the error.
-pub fn ensure_dir(dir: &Path, option: &str) -> anyhow::Result<()> {
-    std::fs::create_dir_all(dir)
-        .map_err(|e| anyhow::anyhow!("{option} {}: cannot create directory: {e}", dir.display()))
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -291,17 +238,5 @@ mod tests {
         assert_eq!(lines.len(), 4);
         assert_eq!(lines[2], "std       0.034    0.1");
         assert_eq!(lines[3], "x             1  22.25");
-    }
-
-    #[test]
-    fn atomic_write_replaces_whole_file() {
-        let dir = std::env::temp_dir().join(format!("fogsim-report-test-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let p = dir.join("a.json");
-        write_atomic(&p, b"first").unwrap();
-        write_atomic(&p, b"second").unwrap();
-        assert_eq!(std::fs::read(&p).unwrap(), b"second");
-        assert!(write_atomic(&dir.join("missing/x.json"), b"x").is_err());
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

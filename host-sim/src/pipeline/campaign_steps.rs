@@ -1,40 +1,15 @@
-//! The steps `north-seek`, `reproduce` and `demo` share: reading a model file, simulating
-//! a campaign in memory (`fog_sim::campaign`, the paper's protocol, seeded), training the
+//! The steps `north-seek`, `reproduce` and `demo` share: checking and simulating
+//! a campaign in memory (`fog_sim::pipeline::campaign`, the paper's protocol, seeded), training the
 //! default model on it, and splitting a campaign into training runs (1-3 of each
 //! temperature) and held-out runs (4-5).
 
-use std::path::Path;
-
 use anyhow::{anyhow, bail, Context, Result};
-use fog_core::model::{FeatureSpec, RbfModel, MAX_ENCODED_LEN};
+use fog_core::model::FeatureSpec;
 
-pub use crate::campaign::CampaignSpec;
-use crate::runs::Run;
+use crate::io::runs::Run;
+pub use crate::pipeline::campaign::{CampaignRun, CampaignSpec};
 use crate::sim::GyroParams;
 use crate::train::{dataset_from_runs, train_model, TrainConfig, TrainOutcome};
-
-/// Reads and validates a fog-core model file (postcard, as written by `fogsim train`).
-pub fn read_model(path: &Path) -> Result<RbfModel> {
-    let bytes =
-        std::fs::read(path).map_err(|e| anyhow!("--model {}: cannot read: {e}", path.display()))?;
-    if bytes.len() > MAX_ENCODED_LEN {
-        bail!(
-            "--model {}: {} bytes, a model is at most {MAX_ENCODED_LEN} bytes",
-            path.display(),
-            bytes.len()
-        );
-    }
-    RbfModel::decode(&bytes).map_err(|e| anyhow!("--model {}: {e}", path.display()))
-}
-
-/// One simulated power-on of a campaign.
-#[derive(Clone, Debug)]
-pub struct CampaignRun {
-    pub ambient_c: f64,
-    /// 1-based index of the run at its temperature (the paper trains on 1-3).
-    pub index: usize,
-    pub run: Run,
-}
 
 /// Checks a campaign plan, naming the option at fault.
 pub fn validate_plan(plan: &CampaignSpec) -> Result<()> {
@@ -60,22 +35,11 @@ pub fn validate_plan(plan: &CampaignSpec) -> Result<()> {
     Ok(())
 }
 
-/// Simulates the campaign in memory with `fog_sim::campaign` (same seeds and files as
-/// `fogsim campaign --seed`), tagging each run with its ambient and 1-based index.
-pub fn simulate_campaign(params: &GyroParams, plan: &CampaignSpec) -> Result<Vec<CampaignRun>> {
+/// Simulates the campaign in memory after checking the plan ([`validate_plan`]); same
+/// seeds and files as `fogsim campaign --seed` ([`crate::pipeline::campaign::simulate_campaign`]).
+pub fn simulate_checked(params: &GyroParams, plan: &CampaignSpec) -> Result<Vec<CampaignRun>> {
     validate_plan(plan)?;
-    let runs =
-        crate::campaign::simulate_campaign(params, plan).map_err(|e| anyhow!("campaign: {e}"))?;
-    let per = plan.runs_per_ambient;
-    Ok(runs
-        .into_iter()
-        .enumerate()
-        .map(|(k, (_, run))| CampaignRun {
-            ambient_c: plan.ambients_c[k / per],
-            index: k % per + 1,
-            run,
-        })
-        .collect())
+    crate::pipeline::campaign::simulate_campaign(params, plan).map_err(|e| anyhow!("campaign: {e}"))
 }
 
 /// Splits a campaign: runs 1..=`n_train` of each temperature train, the others validate.

@@ -10,7 +10,7 @@
 //!   y_train.f64, y_test.f64   target drift, deg/h
 //!   meta.json      sizes, width, and our timings / held-out rms / centre count.
 
-use fog_sim::runs::{read_runs, Run};
+use fog_sim::io::runs::{read_runs, Run};
 use fog_sim::train::{
     dataset_from_runs, default_specs, predict_batch, rms, train_model, TrainConfig,
 };

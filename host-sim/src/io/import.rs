@@ -16,8 +16,10 @@
 //! Bad input (wrong header, non-numeric cell, ragged row, time going backwards) is
 //! rejected with the line named; nothing is written then.
 
-use crate::runs::Run;
+use super::reader::{excerpt, MAX_LINE_BYTES};
+use crate::io::runs::Run;
 use std::fmt;
+use std::io::{BufRead, Read};
 use std::path::Path;
 
 /// The header the PAN file must have.
@@ -74,26 +76,57 @@ pub fn lsm6dsm_temp_c(raw: f64) -> f64 {
     25.0 + s as f64 / 256.0
 }
 
-fn parse(file: &str, text: &str) -> Result<Vec<Sample>, ImportError> {
+/// Streams the samples of a PAN log to `each` in file order, checking every row; lines
+/// are bounded ([`MAX_LINE_BYTES`]) and quoted text cut ([`excerpt`]), so a huge or
+/// wrong file is neither read whole nor echoed whole.
+fn parse_stream(
+    file: &str,
+    mut input: impl BufRead,
+    mut each: impl FnMut(Sample),
+) -> Result<usize, ImportError> {
     let err = |line: Option<usize>, what: String| ImportError {
         file: file.to_owned(),
         line,
         what,
     };
-    let mut lines = text.lines().enumerate();
-    match lines.next() {
-        Some((_, h)) if h.trim() == PAN_HEADER => {}
-        Some((_, h)) => {
+    let mut buf = Vec::new();
+    let mut next_line = |n: usize| -> Result<Option<String>, ImportError> {
+        buf.clear();
+        let got = (&mut input)
+            .take(MAX_LINE_BYTES as u64 + 1)
+            .read_until(b'\n', &mut buf)
+            .map_err(|e| err(Some(n), e.to_string()))?;
+        if got == 0 {
+            return Ok(None);
+        }
+        if buf.len() > MAX_LINE_BYTES && !buf.ends_with(b"\n") {
+            return Err(err(
+                Some(n),
+                format!("line longer than {MAX_LINE_BYTES} bytes"),
+            ));
+        }
+        let text = std::str::from_utf8(&buf)
+            .map_err(|_| err(Some(n), "bytes that are not valid UTF-8".into()))?;
+        Ok(Some(text.trim_end_matches(['\n', '\r']).to_owned()))
+    };
+    match next_line(1)? {
+        Some(h) if h.trim() == PAN_HEADER => {}
+        Some(h) => {
             return Err(err(
                 Some(1),
-                format!("unexpected header `{}` (want `{PAN_HEADER}`)", h.trim()),
+                format!(
+                    "unexpected header `{}` (want `{PAN_HEADER}`)",
+                    excerpt(h.trim())
+                ),
             ))
         }
         None => return Err(err(None, "empty file".into())),
     }
-    let mut out: Vec<Sample> = Vec::new();
-    for (i, l) in lines {
-        let n = i + 1;
+    let mut count = 0;
+    let mut last_t_s: Option<f64> = None;
+    let mut n = 1;
+    while let Some(l) = next_line(n + 1)? {
+        n += 1;
         if l.trim().is_empty() {
             continue;
         }
@@ -110,25 +143,54 @@ fn parse(file: &str, text: &str) -> Result<Vec<Sample>, ImportError> {
                 .ok_or_else(|| {
                     err(
                         Some(n),
-                        format!("column {} is not a finite number: `{c}`", k + 1),
+                        format!("column {} is not a finite number: `{}`", k + 1, excerpt(c)),
                     )
                 })?;
         }
         let t_s = v[0] / 1000.0;
-        if out.last().is_some_and(|p| t_s <= p.t_s) {
+        if last_t_s.is_some_and(|p| t_s <= p) {
             return Err(err(Some(n), "time is not strictly increasing".into()));
         }
-        out.push(Sample {
+        last_t_s = Some(t_s);
+        count += 1;
+        each(Sample {
             t_s,
             mag_t: [v[1], v[2], v[3]],
             gyro_rads: [v[4], v[5], v[6]],
             temp_c: lsm6dsm_temp_c(v[7]),
         });
     }
-    if out.is_empty() {
+    if count == 0 {
         return Err(err(None, "no data rows".into()));
     }
-    Ok(out)
+    Ok(count)
+}
+
+#[cfg(test)]
+fn parse(file: &str, text: &str) -> Result<Vec<Sample>, ImportError> {
+    let mut samples = Vec::new();
+    parse_stream(file, text.as_bytes(), |s| samples.push(s))?;
+    Ok(samples)
+}
+
+/// One burst after outlier removal, reduced to its means as the run columns need them.
+struct BurstMean {
+    t_s: f64,
+    rate_dph: [f64; 3],
+    temp_c: f64,
+    mag_ut: [f64; 3],
+}
+
+impl BurstMean {
+    fn of(b: &[Sample]) -> Self {
+        let mean = |f: &dyn Fn(&Sample) -> f64| b.iter().map(f).sum::<f64>() / b.len() as f64;
+        BurstMean {
+            t_s: mean(&|s| s.t_s),
+            rate_dph: [0, 1, 2].map(|a| mean(&|s| s.gyro_rads[a] * RADS_TO_DPH)),
+            temp_c: mean(&|s| s.temp_c),
+            mag_ut: [0, 1, 2].map(|a| mean(&|s| s.mag_t[a] * 1e6)),
+        }
+    }
 }
 
 fn median(v: &mut [f64]) -> f64 {
@@ -160,23 +222,28 @@ fn clean_burst(b: &[Sample]) -> Vec<Sample> {
 /// Imports the PAN TVAC file; `axes` are 0 = x, 1 = y, 2 = z.
 pub fn import_pan(path: &Path, axes: &[usize]) -> Result<PanImport, ImportError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| ImportError {
+    let input = std::fs::File::open(path).map_err(|e| ImportError {
         file: file.clone(),
         line: None,
         what: e.to_string(),
     })?;
-    let samples = parse(&file, &text)?;
-    let mut bursts: Vec<Vec<Sample>> = Vec::new();
-    for s in &samples {
-        match bursts.last_mut() {
-            Some(b) if s.t_s - b.last().map_or(s.t_s, |p| p.t_s) <= BURST_GAP_S => b.push(*s),
-            _ => bursts.push(vec![*s]),
+    // Streamed burst by burst: memory holds one burst and one mean per burst.
+    let mut means: Vec<BurstMean> = Vec::new();
+    let mut burst: Vec<Sample> = Vec::new();
+    let mut kept = 0;
+    let mut close = |burst: &mut Vec<Sample>, means: &mut Vec<BurstMean>| {
+        let cleaned = clean_burst(burst);
+        kept += cleaned.len();
+        means.push(BurstMean::of(&cleaned));
+        burst.clear();
+    };
+    let samples = parse_stream(&file, std::io::BufReader::new(input), |s| {
+        if burst.last().is_some_and(|p| s.t_s - p.t_s > BURST_GAP_S) {
+            close(&mut burst, &mut means);
         }
-    }
-    let cleaned: Vec<Vec<Sample>> = bursts.iter().map(|b| clean_burst(b)).collect();
-    let kept: usize = cleaned.iter().map(Vec::len).sum();
-    let mean =
-        |b: &[Sample], f: &dyn Fn(&Sample) -> f64| b.iter().map(f).sum::<f64>() / b.len() as f64;
+        burst.push(s);
+    })?;
+    close(&mut burst, &mut means);
     let stem = path
         .file_stem()
         .map_or_else(|| "pan".into(), |s| s.to_string_lossy().into_owned());
@@ -184,41 +251,26 @@ pub fn import_pan(path: &Path, axes: &[usize]) -> Result<PanImport, ImportError>
     for &axis in axes {
         let name = ["x", "y", "z"][axis.min(2)];
         let cols = vec![
-            (
-                "t_s".to_owned(),
-                cleaned.iter().map(|b| mean(b, &|s| s.t_s)).collect(),
-            ),
+            ("t_s".to_owned(), means.iter().map(|m| m.t_s).collect()),
             (
                 "rate_dph".to_owned(),
-                cleaned
-                    .iter()
-                    .map(|b| mean(b, &|s| s.gyro_rads[axis] * RADS_TO_DPH))
-                    .collect(),
+                means.iter().map(|m| m.rate_dph[axis]).collect(),
             ),
             (
                 "temp_c".to_owned(),
-                cleaned.iter().map(|b| mean(b, &|s| s.temp_c)).collect(),
+                means.iter().map(|m| m.temp_c).collect(),
             ),
             (
                 "mag_x_ut".to_owned(),
-                cleaned
-                    .iter()
-                    .map(|b| mean(b, &|s| s.mag_t[0] * 1e6))
-                    .collect(),
+                means.iter().map(|m| m.mag_ut[0]).collect(),
             ),
             (
                 "mag_y_ut".to_owned(),
-                cleaned
-                    .iter()
-                    .map(|b| mean(b, &|s| s.mag_t[1] * 1e6))
-                    .collect(),
+                means.iter().map(|m| m.mag_ut[1]).collect(),
             ),
             (
                 "mag_z_ut".to_owned(),
-                cleaned
-                    .iter()
-                    .map(|b| mean(b, &|s| s.mag_t[2] * 1e6))
-                    .collect(),
+                means.iter().map(|m| m.mag_ut[2]).collect(),
             ),
         ];
         let meta = vec![
@@ -226,7 +278,7 @@ pub fn import_pan(path: &Path, axes: &[usize]) -> Result<PanImport, ImportError>
             ("earth_dph".to_owned(), "0".to_owned()),
             ("source".to_owned(), format!("{stem}.csv (pathfinder-for-autonomous-navigation/psim 91d70ad), gyro axis {name}")),
             ("license".to_owned(), "MIT, Copyright (c) 2020 Pathfinder for Autonomous Navigation (PAN)".to_owned()),
-            ("conversion".to_owned(), format!("one row per 5 s burst (mean); T = 25 + int16(raw)/256 degC; rad/s -> deg/h; {} outlier samples dropped", samples.len() - kept)),
+            ("conversion".to_owned(), format!("one row per 5 s burst (mean); T = 25 + int16(raw)/256 degC; rad/s -> deg/h; {} outlier samples dropped", samples - kept)),
             ("note".to_owned(), "cooling in a thermal-vacuum chamber, not a power-on warm-up; t_s is time since flight-computer boot".to_owned()),
         ];
         let path = format!("{stem}_gyro_{name}.csv");
@@ -238,9 +290,9 @@ pub fn import_pan(path: &Path, axes: &[usize]) -> Result<PanImport, ImportError>
     }
     Ok(PanImport {
         runs,
-        samples: samples.len(),
-        bursts: bursts.len(),
-        outliers_dropped: samples.len() - kept,
+        samples,
+        bursts: means.len(),
+        outliers_dropped: samples - kept,
     })
 }
 

@@ -1,0 +1,10 @@
+//! Pipelines: one per user-facing job (reproduce the paper, compensate recorded runs,
+//! the north-seek Monte Carlo, the simulated campaign), built from the engines (`sim`,
+//! `train`, `diagnose`) over `io` and `metrics`. They never print and never name flags.
+
+pub mod campaign;
+pub mod campaign_steps;
+pub mod compensate;
+pub mod compensation_replay;
+pub mod northseek;
+pub mod reproduce;
