@@ -20,15 +20,12 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<()> {
     let guard = OutputGuard::new(&args.runs);
     args.outputs.check(&guard)?;
-    let runs = crate::io::runs::read_runs(&args.runs)?;
+    // Streamed into 10 s windows: memory grows with windows, not rows, at any row rate.
+    let runs = crate::io::bin::read_runs_binned(&args.runs)?;
     let d = diagnose(&runs).context("diagnose")?;
     print!("{}", report::render_text(&d.report));
     let check = if runs.len() >= 4 {
-        let binned: Vec<_> = runs
-            .iter()
-            .map(crate::diagnose::input::as_10s_run)
-            .collect();
-        match olscheck::ols_check(&binned, d.report.named_cause.as_ref()) {
+        match olscheck::ols_check(&runs, d.report.named_cause.as_ref()) {
             Ok(c) => {
                 println!(
                     "  cross-check, project's OLS trainer ({} folds, fog-core features): paper's model held-out std {:.4} deg/h{}",

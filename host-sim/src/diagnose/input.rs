@@ -233,27 +233,6 @@ fn to_series(run: &Run, extra_names: &[String]) -> Series {
     }
 }
 
-/// The run as 10 s means of every column (metadata kept), for tools that take each row
-/// as one 10 s point (the project's trainer): a 1 Hz or raw-rate record would otherwise
-/// be ten or more times as many "points", with serially correlated noise.
-pub fn as_10s_run(run: &Run) -> Run {
-    let bins = window_bins(run.t_s());
-    Run {
-        path: run.path.clone(),
-        meta: run.meta.clone(),
-        columns: run.columns.clone(),
-        data: run
-            .data
-            .iter()
-            .map(|v| {
-                bins.iter()
-                    .map(|b| v[b.0..b.1].iter().sum::<f64>() / (b.1 - b.0) as f64)
-                    .collect()
-            })
-            .collect(),
-    }
-}
-
 /// Row ranges `[start, end)` forming the 10 s windows; one row per window when the
 /// record is already at 10 s or slower.
 fn window_bins(t: &[f64]) -> Vec<(usize, usize)> {
@@ -299,13 +278,9 @@ mod tests {
                 ("temp_c", t.iter().map(|x| x * 0.1).collect()),
             ],
         );
-        let r_clone = r.clone();
         let c = prepare(&[r]).unwrap();
         assert_eq!(c.runs[0].t_s.len(), 10);
         assert!((c.runs[0].drift_dph[0] - 5.0).abs() < 1e-12);
-        let binned = as_10s_run(&r_clone);
-        assert_eq!(binned.t_s().len(), 10);
-        assert!((binned.t_s()[0] - 5.0).abs() < 1e-12);
     }
 
     #[test]

@@ -17,6 +17,7 @@ pub mod input;
 pub mod linalg;
 pub mod models;
 pub mod olscheck;
+pub mod outliers;
 pub mod plots;
 pub mod report;
 pub mod residuals;
@@ -76,6 +77,8 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
     let base = &choice.chosen;
     let base_rms = base.cv.rms();
     let structure = residuals::structure(&campaign, &folds, &st, &base.cv.residual);
+    let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
+    let outliers = outliers::locate(&folds, &run_names, &st.t_s, &st.y, &base.cv.residual);
     let screening = screen::screen(
         &campaign,
         &folds,
@@ -167,6 +170,7 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
             collinearity_warning: choice.collinearity_warning.clone(),
         },
         residual_structure: structure,
+        outliers,
         candidates: screening
             .scored
             .iter()
@@ -210,7 +214,7 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
     };
     Ok(Diagnosis {
         report,
-        run_names: campaign.runs.iter().map(|s| s.name.clone()).collect(),
+        run_names,
         run_rows: folds.run_rows.clone(),
         t_s: st.t_s.clone(),
         drift_dph: base.prepared.target().to_vec(),

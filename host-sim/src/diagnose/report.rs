@@ -122,6 +122,7 @@ pub struct Report {
     pub campaign: CampaignSummary,
     pub base: ModelSummary,
     pub residual_structure: Structure,
+    pub outliers: super::outliers::Outliers,
     pub candidates: Vec<CandidateRow>,
     pub named_cause: Option<Cause>,
     pub cause_in_words: String,
@@ -278,6 +279,21 @@ pub fn render_text(r: &Report) -> String {
         "  within-run correlation with signals: {}",
         top.join(", ")
     );
+    let o = &r.outliers;
+    let _ = writeln!(
+        s,
+        "  outliers: {} (beyond {:.2} robust sigma = {:.4} deg/h, or a repeated identical rate)",
+        o.count,
+        o.threshold_sigma,
+        o.threshold_sigma * o.robust_sigma_dph
+    );
+    for x in o.listed.iter().take(10) {
+        let _ = writeln!(
+            s,
+            "    run {} row {} (t {:.0} s) {}: {:+.1} sigma, value {:.5}; {}",
+            x.run, x.row, x.t_s, x.column, x.sigma, x.value, x.pattern
+        );
+    }
     let _ = writeln!(s, "\n3. Candidate causes (ranked by held-out rms; p = family-wise sign-flip test over whole validation units)");
     for row in r.candidates.iter().take(8) {
         let label = Cause {
