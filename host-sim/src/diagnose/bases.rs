@@ -53,6 +53,22 @@ pub struct BaseFit {
     pub centres: usize,
     pub width_factor: f64,
     pub ridge: f64,
+    /// The RBF basis (None for polynomial and constant bases).
+    pub basis: Option<super::basis::RbfBasis>,
+}
+
+impl BaseFit {
+    /// The base's design columns before run offsets are removed.
+    pub fn raw_columns(&self, st: &Stacked) -> Vec<Vec<f64>> {
+        match &self.basis {
+            Some(b) => b.columns(&[st.temp_c.clone(), st.temp_rate_cps.clone()]),
+            None => poly_columns(
+                st,
+                self.spec.poly_degree_t.unwrap_or(0),
+                self.spec.uses_rate,
+            ),
+        }
+    }
 }
 
 /// One base's held-out score, for the report.
@@ -118,6 +134,7 @@ fn fit_linear(
         centres: 0,
         width_factor: 0.0,
         ridge,
+        basis: None,
     })
 }
 
@@ -164,6 +181,7 @@ pub fn fit(folds: &Folds, st: &Stacked, spec: &BaseSpec) -> Result<BaseFit, Diag
             centres: r.centres,
             width_factor: r.width_factor,
             ridge: r.ridge,
+            basis: Some(r.basis),
         });
     }
     let cols = poly_columns(st, spec.poly_degree_t.unwrap_or(0), spec.uses_rate);

@@ -11,6 +11,7 @@
 pub mod azimuth;
 pub mod bases;
 pub mod basis;
+pub mod between;
 pub mod cv;
 pub mod error;
 pub mod input;
@@ -79,13 +80,31 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
     let structure = residuals::structure(&campaign, &folds, &st, &base.cv.residual);
     let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
     let outliers = outliers::locate(&folds, &run_names, &st.t_s, &st.y, &base.cv.residual);
+    let run_level = between::prepare(&campaign, &folds, &st, base);
+    let no_gains = Vec::new();
     let screening = screen::screen(
         &campaign,
         &folds,
         &st,
         base,
         transforms::enumerate(&campaign),
+        run_level.as_ref().map_or(&no_gains, |p| &p.gains),
     )?;
+    let latitude = campaign
+        .runs
+        .iter()
+        .find_map(|s| s.latitude_deg)
+        .unwrap_or(azimuth::DEFAULT_LATITUDE_DEG);
+    let between_run = match run_level {
+        Ok(p) => between::finish(p, &screening.between_p, latitude),
+        Err(note) => between::BetweenRun {
+            turn_on_repeatability_dph: f64::NAN,
+            rows: vec![],
+            named: None,
+            heading: None,
+            note: Some(note),
+        },
+    };
 
     let named = screening.named.map(|i| &screening.scored[i]);
     let cause = named.map(|s| Cause {
@@ -125,18 +144,19 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
         ),
     };
     let has_heading = campaign.extra_names.iter().any(|n| n.contains("heading"));
-    let latitude = campaign
-        .runs
-        .iter()
-        .find_map(|s| s.latitude_deg)
-        .unwrap_or(azimuth::DEFAULT_LATITUDE_DEG);
     let azimuth = has_heading.then(|| Azimuth {
         baseline: azimuth::azimuth_effect(&folds, &st.t_s, &base.cv.residual, latitude),
         extended: azimuth::azimuth_effect(&folds, &st.t_s, &ext_resid, latitude),
     });
     let smallest_attainable_p = signflip::smallest_p(folds.unit_rows.len());
-    let words = report::cause_in_words(cause.as_ref(), &sim.effect_coef)
-        .unwrap_or_else(|| report::nothing_named(smallest_attainable_p));
+    let words = report::cause_in_words(cause.as_ref(), &sim.effect_coef).unwrap_or_else(|| {
+        match &between_run.named {
+            Some(b) => format!(
+                "no within-run cause; between runs: {b} (see the heading / run-level lines)"
+            ),
+            None => report::nothing_named(smallest_attainable_p),
+        }
+    });
     let sim_terms = simterm::terms_per_run(runs, cause.as_ref(), &sim.effect_coef);
     let term_summaries: Vec<simterm::TermSummary> = sim_terms
         .first()
@@ -171,6 +191,7 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
         },
         residual_structure: structure,
         outliers,
+        between_run,
         candidates: screening
             .scored
             .iter()

@@ -123,6 +123,7 @@ pub struct Report {
     pub base: ModelSummary,
     pub residual_structure: Structure,
     pub outliers: super::outliers::Outliers,
+    pub between_run: super::between::BetweenRun,
     pub candidates: Vec<CandidateRow>,
     pub named_cause: Option<Cause>,
     pub cause_in_words: String,
@@ -314,6 +315,31 @@ pub fn render_text(r: &Report) -> String {
             if row.significant { "  *" } else { "" }
         );
     }
+    let b = &r.between_run;
+    match &b.note {
+        Some(n) => {
+            let _ = writeln!(s, "  between runs: not tested ({n})");
+        }
+        None => {
+            let _ = writeln!(
+                s,
+                "  between runs (run offsets left by the base; turn-on repeatability {:.4} deg/h, leave one run out; p in the same family):",
+                b.turn_on_repeatability_dph
+            );
+            for row in b.rows.iter().take(4) {
+                let _ = writeln!(
+                    s,
+                    "  {:<28} offset rms {:.4}  gain {:+6.2}%  p {:.4}  (run permutation p {:.4}){}",
+                    row.label,
+                    row.heldout_offset_rms_dph,
+                    row.gain_pct,
+                    row.p_value,
+                    row.permutation_p,
+                    if row.significant { "  *" } else { "" }
+                );
+            }
+        }
+    }
     let _ = writeln!(s, "\n4. Cause");
     match &r.named_cause {
         Some(cause) => {
@@ -332,6 +358,16 @@ pub fn render_text(r: &Report) -> String {
             s,
             "  competes: {} explains the same thing (its gain drops to {:+.2}% once the named cause is in)",
             comp.candidate, comp.conditional_gain_pct
+        );
+    }
+    if let Some(n) = &b.named {
+        let _ = writeln!(s, "  named between runs: {n}");
+    }
+    if let Some(h) = &b.heading {
+        let _ = writeln!(
+            s,
+            "  heading-dependent bias: amplitude {:.4} deg/h, maximum at {} = {:.0} deg; two-position seek azimuth error {:+.3} deg at psi 90 deg (up to {:.3} deg where |sin psi| >= 0.5, lat {:.1})",
+            h.amplitude_dph, h.column, h.phase_deg, h.azimuth_error_at_90_deg, h.azimuth_error_bound_deg, h.latitude_deg
         );
     }
     let e = &r.extended;

@@ -67,6 +67,8 @@ pub struct Screening {
     pub competing: Vec<(String, f64)>,
     /// When the named cause displaced a higher-gain candidate of the same column.
     pub parsimony_note: Option<String>,
+    /// Family-wise p-values of the between-run candidates (same max-T family).
+    pub between_p: Vec<f64>,
 }
 
 fn has_within_unit_variation(folds: &Folds, col: &[f64]) -> bool {
@@ -98,6 +100,7 @@ pub fn screen(
     st: &Stacked,
     base: &BaseFit,
     cands: Vec<Candidate>,
+    between_gains: &[Vec<f64>],
 ) -> Result<Screening, DiagnoseError> {
     let base_rms = base.cv.rms();
     let mut skipped = Vec::new();
@@ -120,7 +123,8 @@ pub fn screen(
         {
             skipped.push((
                 cand.label(),
-                "no variation within runs: cannot be told from run offsets".to_owned(),
+                "no variation within runs: tested between runs instead (run-level means)"
+                    .to_owned(),
             ));
             continue;
         }
@@ -138,8 +142,12 @@ pub fn screen(
             units_improved: 0.0,
         });
     }
-    let gains: Vec<Vec<f64>> = scored.iter().map(|s| unit_gains(&base.cv, &s.cv)).collect();
-    let pv = max_t_pvalues(&gains, FLIP_SEED);
+    // One family: within-run candidates and between-run ones (per-run gains in the same
+    // squared-error currency, see `between`) share the sign-flip max-T null.
+    let mut gains: Vec<Vec<f64>> = scored.iter().map(|s| unit_gains(&base.cv, &s.cv)).collect();
+    gains.extend(between_gains.iter().cloned());
+    let mut pv = max_t_pvalues(&gains, FLIP_SEED);
+    let between_p = pv.split_off(scored.len());
     for (s, p) in scored.iter_mut().zip(pv) {
         s.p_value = p;
     }
@@ -202,6 +210,7 @@ pub fn screen(
         named,
         competing,
         parsimony_note,
+        between_p,
     })
 }
 
