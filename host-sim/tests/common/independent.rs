@@ -58,7 +58,7 @@ pub fn campaign(hidden: Hidden, seed: u64) -> (Vec<Run>, Option<&'static str>) {
         };
         let offset = REPEATABILITY_DPH * g.sample(&mut rng);
         let mut supply = 24.0;
-        let mut cols: Vec<Vec<f64>> = vec![Vec::with_capacity(rows); 6];
+        let mut cols: Vec<Vec<f64>> = (0..6).map(|_| Vec::with_capacity(rows)).collect();
         for k in 0..rows {
             let t = (k + 1) as f64;
             let x = t / tau;
