@@ -9,15 +9,20 @@
 #![forbid(unsafe_code)]
 
 pub mod accuracy;
+pub mod bit;
 pub mod compensator;
 pub mod consts;
 pub mod features;
 pub mod fixed;
 pub mod hal;
+pub mod heading_cal;
+pub mod link;
 pub mod model;
 mod model_in_place;
 pub mod northfinder;
 pub mod numeric;
 pub mod protocol;
 pub mod rbf;
+pub mod seek_quality;
 pub mod synthetic;
+pub mod tilt;

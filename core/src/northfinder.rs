@@ -13,6 +13,16 @@
 //!   +90 dwell's sine enters directly: psi = atan2(s, c).
 //! - Four positions (h0 + 0/90/180/270): psi = atan2(w4 - w2, w1 - w3); bias and scale factor cancel.
 //!
+//! Tilt (see `tilt`): with the base pitched/rolled the reading is
+//! w(h) = Omega_H (cos A P(h) + sin A Q(h)) + V(h) + bias; both modes solve the two bias-free
+//! combinations (opposite dwells, quadrature dwells), linear in Omega_H (cos A, sin A), with
+//! the seek's mean measured tilt (`on_window_tilted`). The magnitude of that solution is the
+//! observed horizontal Earth rate, reported for the latitude check (`seek_quality`).
+//! A heading-dependent bias a cos(alpha) + b sin(alpha) of the input axis azimuth alpha
+//! (`heading_cal`) is the same harmonic as Earth rate: with it the seek sees
+//! R cos(A - phi + h), R = |(Omega_H + a, b)|, phi = atan2(b, Omega_H + a), so a stored
+//! calibration is applied as that effective rate and azimuth offset.
+//!
 //! It is driven by the 10 s `WindowResult`s (compensated rates) and polls a `hal::Turntable`;
 //! it never blocks. Windows that overlap a move or the settle time are not used; invalid
 //! windows are skipped (too many abort the seek). The 1-sigma uncertainty comes from the
@@ -21,7 +31,9 @@
 use crate::compensator::WindowResult;
 use crate::consts::earth_rate_horizontal_dph;
 use crate::hal::{TableState, Turntable};
+use crate::heading_cal::HeadingHarmonic;
 use crate::numeric::wrap_360_deg as wrap_360;
+use crate::tilt::{axis_coefficients, AxisCoefficients, Tilt};
 
 /// Most table positions in one seek.
 pub const MAX_POSITIONS: usize = 4;
@@ -151,6 +163,12 @@ pub struct SeekResult {
     /// Per-position means, in the order measured; `n_positions` used.
     pub positions: [PositionMean; MAX_POSITIONS],
     pub n_positions: u8,
+    /// Mean base tilt over the windows used (level if none was given), deg.
+    pub tilt: Tilt,
+    /// Observed horizontal Earth rate |(X, Y)| after removing the tilt leak, deg/h, and its
+    /// 1-sigma: compared with Omega cos(latitude) by the latitude check.
+    pub horizontal_rate_dph: f64,
+    pub horizontal_rate_sigma_dph: f64,
 }
 
 /// Where the seek is.
@@ -195,6 +213,10 @@ pub struct NorthFinder {
     acc: [Accumulator; MAX_POSITIONS],
     t_start_s: f64,
     last: Option<SeekResult>,
+    /// Sums of the tilt of the windows used in this seek.
+    tilt_sum_deg: [f64; 2],
+    tilt_n: u32,
+    heading: Option<HeadingHarmonic>,
 }
 
 impl NorthFinder {
@@ -219,6 +241,9 @@ impl NorthFinder {
             acc: [Accumulator::default(); MAX_POSITIONS],
             t_start_s: 0.0,
             last: None,
+            tilt_sum_deg: [0.0; 2],
+            tilt_n: 0,
+            heading: None,
         })
     }
 
@@ -257,6 +282,18 @@ impl NorthFinder {
     pub fn direct_sine_below(&self) -> f64 {
         // f32 inputs, so f32 `sqrtf` loses nothing.
         (libm::sqrtf(self.cfg.ambiguity_dwell_s / (2.0 * self.cfg.dwell_s)) as f64).min(0.5)
+    }
+
+    /// 10 s windows position `k` needs (its dwell rounded up to whole windows).
+    pub fn windows_needed(&self, k: usize) -> u16 {
+        let n = self.dwell_of(k) / crate::consts::WINDOW_S as f64;
+        let whole = crate::numeric::floor_i64(n);
+        (if (whole as f64) < n - 1e-6 {
+            whole + 1
+        } else {
+            whole
+        })
+        .clamp(1, u16::MAX as i64) as u16
     }
 
     fn dwell_of(&self, k: usize) -> f64 {
@@ -304,6 +341,8 @@ impl NorthFinder {
             return Err(SeekError::BadConfig);
         }
         self.acc = [Accumulator::default(); MAX_POSITIONS];
+        self.tilt_sum_deg = [0.0; 2];
+        self.tilt_n = 0;
         self.t_start_s = t_now_s;
         self.go_to(table, 0, t_now_s)
     }
@@ -353,10 +392,60 @@ impl NorthFinder {
         Ok(self.status())
     }
 
-    /// Feed one 10 s result. Windows that started before the table settled are ignored.
+    /// Applies a heading-dependent bias calibration to the following seeks (None: none).
+    pub fn set_heading_correction(&mut self, h: Option<HeadingHarmonic>) {
+        self.heading = h;
+    }
+
+    /// The heading calibration in use.
+    pub fn heading_correction(&self) -> Option<&HeadingHarmonic> {
+        self.heading.as_ref()
+    }
+
+    /// Horizontal rate the solution scales by, deg/h, and the azimuth offset it adds, rad
+    /// (Omega_H and 0 without a heading calibration; see the module header).
+    fn effective_horizontal(&self) -> (f64, f64) {
+        match &self.heading {
+            None => (self.omega_h_dph, 0.0),
+            Some(h) => {
+                let a = self.omega_h_dph + h.cos_dph as f64;
+                let b = h.sin_dph as f64;
+                (
+                    libm::sqrtf((a * a + b * b) as f32) as f64,
+                    libm::atan2f(b as f32, a as f32) as f64,
+                )
+            }
+        }
+    }
+
+    /// Mean tilt of the windows used so far in this seek (level before any).
+    pub fn mean_tilt(&self) -> Tilt {
+        if self.tilt_n == 0 {
+            return Tilt::LEVEL;
+        }
+        let n = self.tilt_n as f64;
+        Tilt {
+            pitch_deg: (self.tilt_sum_deg[0] / n) as f32,
+            roll_deg: (self.tilt_sum_deg[1] / n) as f32,
+        }
+    }
+
+    /// Feed one 10 s result of a level base. Windows that started before the table settled
+    /// are ignored.
     pub fn on_window<T: Turntable>(
         &mut self,
         w: &WindowResult,
+        table: &mut T,
+    ) -> Result<SeekStatus, SeekError> {
+        self.on_window_tilted(w, Tilt::LEVEL, table)
+    }
+
+    /// Feed one 10 s result with the base tilt averaged over the same window (the range and
+    /// steadiness of the tilt are checked by `seek_quality::SeekSupervisor`).
+    pub fn on_window_tilted<T: Turntable>(
+        &mut self,
+        w: &WindowResult,
+        tilt: Tilt,
         table: &mut T,
     ) -> Result<SeekStatus, SeekError> {
         self.poll(table, w.t_end_s)?;
@@ -374,6 +463,11 @@ impl NorthFinder {
             a.sum_sq += v * v;
             a.n += 1;
             a.duration_s += w.t_end_s - w.t_start_s;
+            if tilt.within(90.0) {
+                self.tilt_sum_deg[0] += tilt.pitch_deg as f64;
+                self.tilt_sum_deg[1] += tilt.roll_deg as f64;
+                self.tilt_n += 1;
+            }
         } else {
             a.invalid += 1;
             if a.invalid > self.cfg.max_invalid_windows {
@@ -423,62 +517,72 @@ impl NorthFinder {
         for (k, p) in positions.iter_mut().enumerate().take(np) {
             *p = self.position_mean(k);
         }
-        let oh = self.omega_h_dph;
-        let (psi, sigma_rad, bias) = match self.cfg.mode {
+        let tilt = self.mean_tilt();
+        let lat = self.cfg.latitude_deg;
+        let (oh, offset_rad) = self.effective_horizontal();
+        let coeff = |k: usize| axis_coefficients(tilt, self.heading_of(k) as f64, lat);
+        let m: [f64; MAX_POSITIONS] = core::array::from_fn(|k| positions[k].mean_rate_dph);
+        let v: [f64; MAX_POSITIONS] =
+            core::array::from_fn(|k| positions[k].sigma_dph * positions[k].sigma_dph);
+        // Two equations, linear in (X, Y) = Omega_H (cos A, sin A) (see `tilt`):
+        // c = P0 X + Q0 Y + V0 from the two opposite main dwells, q = P90 X + Q90 Y + V90
+        // from the quadrature dwell(s); the bias cancels in both.
+        let (k_c, k_q, c, q, var_c, var_q, bias) = match self.cfg.mode {
             SeekMode::TwoPosition => {
-                let (p1, p2, p3) = (positions[0], positions[1], positions[2]);
-                let c = (p1.mean_rate_dph - p2.mean_rate_dph) / (2.0 * oh);
-                if libm::fabs(c) > 1.1 {
+                let bias = 0.5 * (m[0] + m[1]);
+                let var_c = (v[0] + v[1]) / 4.0;
+                (
+                    coeff(0),
+                    coeff(2),
+                    0.5 * (m[0] - m[1]),
+                    m[2] - bias,
+                    var_c,
+                    v[2] + var_c,
+                    bias,
+                )
+            }
+            SeekMode::FourPosition => (
+                coeff(0),
+                coeff(1),
+                0.5 * (m[0] - m[2]),
+                0.5 * (m[1] - m[3]),
+                (v[0] + v[2]) / 4.0,
+                (v[1] + v[3]) / 4.0,
+                0.25 * (m[0] + m[1] + m[2] + m[3]),
+            ),
+        };
+        let direct =
+            solve_pair(k_c, k_q, c, q, var_c, var_q).ok_or(SeekError::InconsistentRates)?;
+        let (az_rad, sigma_rad) = match self.cfg.mode {
+            SeekMode::FourPosition => (direct.azimuth_rad, direct.sigma_rad),
+            SeekMode::TwoPosition => {
+                // c - V0 = Omega_H R0 cos(A - d0): acos of the two long dwells, the sign (and,
+                // near A - d0 = 0/180 deg, where acos is ill-conditioned, the whole angle) from
+                // the quadrature dwell.
+                let r0 = libm::sqrtf((k_c.p * k_c.p + k_c.q * k_c.q) as f32) as f64;
+                let cos_arg = (c - k_c.v_dph) / (oh * r0);
+                if libm::fabs(cos_arg) > 1.1 {
                     return Err(SeekError::InconsistentRates);
                 }
-                // Angles in f32 (acosf/atan2f, ~1e-7 rad = 6e-6 deg, plus the rounding of c
-                // to f32, 6e-8 / |sin psi| rad <= 2e-7 rad for the default dwells' |sin psi| >= 0.29): far inside
-                // the 1e-4 deg noiseless tests and any gyro's noise, and the firmware then
-                // needs no f64 trigonometry. Sums and rates stay f64.
-                let c_in = c.clamp(-1.0, 1.0);
-                let psi0 = libm::acosf(c_in as f32) as f64;
-                let bias = 0.5 * (p1.mean_rate_dph + p2.mean_rate_dph);
-                // w3 = -Omega_H sin(psi) + bias.
-                let s = (bias - p3.mean_rate_dph) / oh;
-                let var_c =
-                    (p1.sigma_dph * p1.sigma_dph + p2.sigma_dph * p2.sigma_dph) / (4.0 * oh * oh);
-                let var_s = (p3.sigma_dph * p3.sigma_dph) / (oh * oh) + var_c;
+                // Angles in f32 (acosf/atan2f, ~1e-7 rad = 6e-6 deg): far inside the 1e-4 deg
+                // noiseless tests and any gyro's noise, and the firmware then needs no f64
+                // trigonometry. Sums and rates stay f64.
+                let c_in = cos_arg.clamp(-1.0, 1.0);
+                let half = libm::acosf(c_in as f32) as f64;
+                let d0 = libm::atan2f(k_c.q as f32, k_c.p as f32) as f64;
                 // sin(acos c) = sqrt((1 - c)(1 + c)): exact identity, no sine needed.
                 let sin0 = libm::sqrtf(((1.0 - c_in) * (1.0 + c_in)) as f32) as f64;
                 if sin0 >= self.direct_sine_below() {
-                    // Main branch: acos of the two main dwells, sign from the +90 dwell.
-                    let psi = if s >= 0.0 { psi0 } else { -psi0 };
-                    (psi, libm::sqrtf(var_c as f32) as f64 / sin0, bias)
+                    // The side of d0 the quadrature solution lies on: sign of sin(A_direct - d0).
+                    let side = direct.y_dph * k_c.p - direct.x_dph * k_c.q;
+                    let a = if side >= 0.0 { d0 + half } else { d0 - half };
+                    (a, libm::sqrtf(var_c as f32) as f64 / (oh * r0 * sin0))
                 } else {
-                    // Near psi = 0/180 acos is ill-conditioned (d psi = dc / |sin psi|): the
-                    // +90 dwell measures sin(psi) directly and is the better estimate there.
-                    let psi = libm::atan2f(s as f32, c as f32) as f64;
-                    let r2 = c * c + s * s;
-                    let var = (c * c * var_s + s * s * var_c) / (r2 * r2);
-                    (psi, libm::sqrtf(var as f32) as f64, bias)
+                    (direct.azimuth_rad, direct.sigma_rad)
                 }
-            }
-            SeekMode::FourPosition => {
-                let m: [f64; 4] = core::array::from_fn(|k| positions[k].mean_rate_dph);
-                let v: [f64; 4] =
-                    core::array::from_fn(|k| positions[k].sigma_dph * positions[k].sigma_dph);
-                // w_k = Omega_H cos(psi + 90 k) + b.
-                let dc = m[0] - m[2]; // 2 Omega_H cos psi
-                let ds = m[3] - m[1]; // 2 Omega_H sin psi
-                let r2 = dc * dc + ds * ds;
-                if r2 <= 0.0 {
-                    return Err(SeekError::InconsistentRates);
-                }
-                let psi = libm::atan2f(ds as f32, dc as f32) as f64;
-                let var = (dc * dc * (v[1] + v[3]) + ds * ds * (v[0] + v[2])) / (r2 * r2);
-                (
-                    psi,
-                    libm::sqrtf(var as f32) as f64,
-                    0.25 * (m[0] + m[1] + m[2] + m[3]),
-                )
             }
         };
-        let azimuth = wrap_360(psi.to_degrees() - self.cfg.start_heading_deg as f64);
+        let azimuth = wrap_360((az_rad + offset_rad).to_degrees());
         Ok(SeekResult {
             azimuth_deg: azimuth,
             sigma_deg: sigma_rad.to_degrees(),
@@ -489,6 +593,59 @@ impl NorthFinder {
             mode: self.cfg.mode,
             positions,
             n_positions: np as u8,
+            tilt,
+            horizontal_rate_dph: direct.magnitude_dph,
+            horizontal_rate_sigma_dph: direct.magnitude_sigma_dph,
         })
     }
+}
+
+/// (X, Y) = Omega_H (cos A, sin A) from the two equations c, q, with 1-sigmas.
+#[derive(Clone, Copy, Debug)]
+struct PairSolution {
+    x_dph: f64,
+    y_dph: f64,
+    azimuth_rad: f64,
+    sigma_rad: f64,
+    magnitude_dph: f64,
+    magnitude_sigma_dph: f64,
+}
+
+/// Solves `c = P_c X + Q_c Y + V_c`, `q = P_q X + Q_q Y + V_q`; `None` when singular or when
+/// the rates are all zero (no direction).
+fn solve_pair(
+    k_c: AxisCoefficients,
+    k_q: AxisCoefficients,
+    c: f64,
+    q: f64,
+    var_c: f64,
+    var_q: f64,
+) -> Option<PairSolution> {
+    let det = k_c.p * k_q.q - k_c.q * k_q.p;
+    if !det.is_finite() || libm::fabs(det) < 1e-6 {
+        return None;
+    }
+    // Inverse of [[P_c, Q_c], [P_q, Q_q]].
+    let inv = [[k_q.q / det, -k_c.q / det], [-k_q.p / det, k_c.p / det]];
+    let (rc, rq) = (c - k_c.v_dph, q - k_q.v_dph);
+    let x = inv[0][0] * rc + inv[0][1] * rq;
+    let y = inv[1][0] * rc + inv[1][1] * rq;
+    let r2 = x * x + y * y;
+    if r2.is_nan() || r2 <= 0.0 {
+        return None;
+    }
+    let r = libm::sqrtf(r2 as f32) as f64;
+    // d atan2(y, x) = (x dy - y dx) / r^2 and d r = (x dx + y dy) / r, through the inverse.
+    let da = |j: usize| (x * inv[1][j] - y * inv[0][j]) / r2;
+    let dr = |j: usize| (x * inv[0][j] + y * inv[1][j]) / r;
+    let var_a = da(0) * da(0) * var_c + da(1) * da(1) * var_q;
+    let var_r = dr(0) * dr(0) * var_c + dr(1) * dr(1) * var_q;
+    Some(PairSolution {
+        x_dph: x,
+        y_dph: y,
+        azimuth_rad: libm::atan2f(y as f32, x as f32) as f64,
+        sigma_rad: libm::sqrtf(var_a as f32) as f64,
+        magnitude_dph: r,
+        magnitude_sigma_dph: libm::sqrtf(var_r as f32) as f64,
+    })
 }

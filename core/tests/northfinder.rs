@@ -5,8 +5,10 @@
 use fog_core::compensator::{WindowResult, WindowStatus};
 use fog_core::consts::earth_rate_horizontal_dph;
 use fog_core::hal::{TableState, Turntable};
+use fog_core::heading_cal::HeadingHarmonic;
 use fog_core::northfinder::{NorthFinder, SeekConfig, SeekError, SeekMode, SeekResult, SeekStatus};
 use fog_core::synthetic::SplitMix64;
+use fog_core::tilt::{earth_rate_on_axis_dph, Tilt};
 
 const LAT_DEG: f64 = 39.9;
 
@@ -75,9 +77,18 @@ fn window(t_end_s: f64, rate_dph: f64, status: WindowStatus) -> WindowResult {
 fn run_seek(
     cfg: SeekConfig,
     t0_s: f64,
+    rate: impl FnMut(f64, f32) -> f64,
+) -> Result<SeekResult, SeekError> {
+    run_tilted_seek(NorthFinder::new(cfg)?, Tilt::LEVEL, t0_s, rate)
+}
+
+/// Run one seek on a base tilted by `tilt` (fed to the finder with every window).
+fn run_tilted_seek(
+    mut nf: NorthFinder,
+    tilt: Tilt,
+    t0_s: f64,
     mut rate: impl FnMut(f64, f32) -> f64,
 ) -> Result<SeekResult, SeekError> {
-    let mut nf = NorthFinder::new(cfg)?;
     let mut table = MockTable::new(7.0);
     table.now_s = t0_s;
     nf.start(&mut table, t0_s)?;
@@ -89,7 +100,7 @@ fn run_seek(
         t += 10.0;
         table.now_s = t;
         let w = window(t, rate(t, heading), WindowStatus::Valid);
-        if let SeekStatus::Done(r) = nf.on_window(&w, &mut table)? {
+        if let SeekStatus::Done(r) = nf.on_window_tilted(&w, tilt, &mut table)? {
             return Ok(r);
         }
     }
@@ -361,4 +372,86 @@ fn done_is_reported_once_then_idle() {
     assert_eq!(done, 1);
     assert_eq!(nf.status(), SeekStatus::Idle);
     assert!(ang_err(nf.last_result().unwrap().azimuth_deg, 10.0).abs() < 1e-4);
+}
+
+#[test]
+fn noiseless_tilted_seeks_all_around_the_circle_up_to_30_deg() {
+    let tilts = [
+        (1.0, 0.0),
+        (5.0, -5.0),
+        (-15.0, 10.0),
+        (0.0, 30.0),
+        (30.0, -30.0),
+    ];
+    for mode in [SeekMode::TwoPosition, SeekMode::FourPosition] {
+        for h0 in [0.0f32, 37.0] {
+            for &(p, r) in &tilts {
+                let tilt = Tilt {
+                    pitch_deg: p,
+                    roll_deg: r,
+                };
+                let mut worst_uncomp = 0.0f64;
+                for k in 0..72 {
+                    let az = 2.5 + k as f64 * 5.0;
+                    let read =
+                        |_: f64, h: f32| earth_rate_on_axis_dph(LAT_DEG, az, tilt, h as f64) + 0.3;
+                    let nf = NorthFinder::new(cfg(mode, h0)).unwrap();
+                    let res = run_tilted_seek(nf, tilt, 0.0, read).unwrap();
+                    let e = ang_err(res.azimuth_deg, az);
+                    assert!(
+                        e.abs() < 2e-4,
+                        "{mode:?} h0 {h0} tilt {tilt:?} az {az}: err {e}"
+                    );
+                    assert_eq!(res.tilt, tilt);
+                    let oh = earth_rate_horizontal_dph(LAT_DEG);
+                    assert!((res.horizontal_rate_dph - oh).abs() < 1e-3 * oh);
+                    // The same readings without the tilt: the error the tilt maths removes.
+                    let nf = NorthFinder::new(cfg(mode, h0)).unwrap();
+                    if let Ok(level) = run_tilted_seek(nf, Tilt::LEVEL, 0.0, read) {
+                        worst_uncomp = worst_uncomp.max(ang_err(level.azimuth_deg, az).abs());
+                    } else {
+                        worst_uncomp = f64::INFINITY;
+                    }
+                }
+                // At least a degree-level error uncompensated, even for 1 deg of pitch
+                // (tan(39.9 deg) x 1 deg of vertical leak).
+                assert!(worst_uncomp > 0.5, "{mode:?} tilt {tilt:?}: {worst_uncomp}");
+            }
+        }
+    }
+}
+
+#[test]
+fn heading_calibration_removes_the_magnetic_harmonic() {
+    let (a, b) = (0.04, -0.03); // deg/h, of the input axis azimuth
+    let harmonic = HeadingHarmonic {
+        cos_dph: a as f32,
+        sin_dph: b as f32,
+        cos_sigma_dph: 0.001,
+        sin_sigma_dph: 0.001,
+        correlation: 0.0,
+        n_headings: 8,
+    };
+    for mode in [SeekMode::TwoPosition, SeekMode::FourPosition] {
+        let mut worst_raw = 0.0f64;
+        for k in 0..36 {
+            let az = 3.0 + 10.0 * k as f64;
+            let read = |_: f64, h: f32| {
+                let alpha = (az + h as f64).to_radians();
+                earth(az, h) + 0.2 + a * alpha.cos() + b * alpha.sin()
+            };
+            let raw = run_seek(cfg(mode, 0.0), 0.0, read).unwrap();
+            let mut nf = NorthFinder::new(cfg(mode, 0.0)).unwrap();
+            nf.set_heading_correction(Some(harmonic));
+            let fixed = run_tilted_seek(nf, Tilt::LEVEL, 0.0, read).unwrap();
+            assert!(
+                ang_err(fixed.azimuth_deg, az).abs() < 2e-4,
+                "{mode:?} az {az}"
+            );
+            worst_raw = worst_raw.max(ang_err(raw.azimuth_deg, az).abs());
+        }
+        // Uncorrected: atan2(b, Omega_H + a) = 0.15 deg here (four positions everywhere;
+        // two positions, with the acos scaled by Omega_H, somewhere on the circle).
+        assert!(worst_raw > 0.1, "{mode:?}: {worst_raw}");
+    }
 }

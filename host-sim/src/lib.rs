@@ -26,6 +26,7 @@ pub mod cmd;
 pub mod diagnose;
 pub mod io;
 pub mod metrics;
+pub mod monitor;
 pub mod pipeline;
 pub mod plots;
 pub mod report;

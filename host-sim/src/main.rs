@@ -34,6 +34,8 @@ enum Command {
     Import(cmd::import::Args),
     /// Upload a signed model to the firmware over a serial link.
     Upload(cmd::upload::Args),
+    /// Live north-finder status with a progress bar; seek results appended to a CSV.
+    Monitor(cmd::monitor::Args),
 }
 
 fn main() {
@@ -48,6 +50,7 @@ fn main() {
         Command::Diagnose(a) => cmd::diagnose::run(a),
         Command::Import(a) => cmd::import::run(a),
         Command::Upload(a) => cmd::upload::run(a),
+        Command::Monitor(a) => cmd::monitor::run(a),
     };
     if let Err(e) = result {
         eprintln!("fogsim: error: {e:#}");

@@ -77,3 +77,44 @@ fn compensated_cold_start_seeks_beat_uncompensated_ones() {
     assert_eq!(a, b, "the Monte Carlo depends on the thread count");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn tilt_and_heading_arms_are_in_the_json_and_out_of_range_tilt_is_refused() {
+    let dir = scratch_dir("northseek-tilt");
+    let args = [
+        "north-seek",
+        "--starts",
+        "3",
+        "--seeks",
+        "2",
+        "--tilt-deg",
+        "5",
+        "--heading-bias-dph",
+        "0.05",
+        "--json",
+        "tilt.json",
+        "--threads",
+        "2",
+    ];
+    let out = fogsim(&dir, &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("tilt.json")).unwrap()).unwrap();
+    let comp = f(&json, &["compensated", "std_deg"]);
+    let floor = f(&json, &["noise_floor_deg"]);
+    let tilt_unc = f(&json, &["tilt_uncompensated", "std_deg"]);
+    assert!(comp < 3.0 * floor, "compensated {comp} vs floor {floor}");
+    assert!(tilt_unc > 10.0 * comp, "tilt not fed {tilt_unc} vs {comp}");
+    // The heading bias biases the two-position seek unless calibrated.
+    let cal = f(&json, &["compensated", "mean_error_deg"]).abs();
+    let uncal = f(&json, &["heading_uncalibrated", "mean_error_deg"]).abs();
+    assert!(
+        uncal > cal + 0.03,
+        "uncalibrated {uncal} vs calibrated {cal}"
+    );
+    assert!((f(&json, &["heading_calibration", "amplitude_dph"]) - 0.05).abs() < 0.01);
+
+    let out = fogsim(&dir, &["north-seek", "--starts", "1", "--tilt-deg", "31"]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("--tilt-deg 31"), "{}", stderr(&out));
+}

@@ -4,5 +4,6 @@
 
 pub mod fog_serial;
 pub mod gyro_frame;
+pub mod scl3300;
 pub mod tmp117;
 pub mod turntable;

@@ -6,6 +6,7 @@ pub mod compensate;
 pub mod demo;
 pub mod diagnose;
 pub mod import;
+pub mod monitor;
 pub mod north_seek;
 pub mod reproduce;
 pub mod train;

@@ -12,7 +12,8 @@ use crate::io::model::read_model;
 use crate::io::OutputGuard;
 use crate::pipeline::campaign_steps::{simulate_checked, train_default, CampaignSpec};
 use crate::pipeline::northseek::{
-    build_report, default_threads, run_monte_carlo, seek_table, MonteCarloConfig,
+    build_product_report, default_threads, run_monte_carlo_with_calibration, seek_table,
+    MonteCarloConfig,
 };
 use crate::report::{progress_bar, write_json};
 use crate::sim::GyroParams;
@@ -51,6 +52,14 @@ pub struct Args {
     /// Worker threads (default: available cores).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Base tilt, deg (0..=30): the table stands on a base tilted by this much towards a
+    /// direction drawn per start; adds the `tilt_uncompensated` arm.
+    #[arg(long, default_value_t = 0.0)]
+    pub tilt_deg: f64,
+    /// Heading-dependent bias A cos(input axis azimuth), deg/h: calibrated over 8 headings
+    /// first; adds the `heading_uncalibrated` arm.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub heading_bias_dph: f64,
     /// Write the JSON report here.
     #[arg(long)]
     pub json: Option<PathBuf>,
@@ -79,6 +88,8 @@ pub fn config_from_args(a: &Args) -> Result<MonteCarloConfig> {
         }),
         seed: a.seed,
         threads: a.threads.unwrap_or_else(default_threads),
+        tilt_deg: a.tilt_deg,
+        heading_bias_dph: a.heading_bias_dph,
         ..MonteCarloConfig::paper(a.seed)
     };
     cfg.validate()?;
@@ -129,16 +140,39 @@ pub fn run(args: Args) -> Result<()> {
         }
     };
     let bar = progress_bar(cfg.starts, "north-seek cold starts");
-    let outcomes = run_monte_carlo(&params, &cfg, &model, &|| bar.inc(1))?;
+    let (outcomes, heading) =
+        run_monte_carlo_with_calibration(&params, &cfg, &model, &|| bar.inc(1))?;
     bar.finish_and_clear();
-    let report = build_report(&params, &cfg, &outcomes, &source);
+    let product = build_product_report(&params, &cfg, &outcomes, heading, &source);
+    let report = &product.base;
     println!(
         "north-seek Monte Carlo: {} cold starts x {} seeks, {} positions, {} degC, latitude {} deg, true azimuth {} deg",
         report.starts, report.seeks_per_start, report.positions, report.ambient_c, report.latitude_deg, report.true_azimuth_deg
     );
-    print!("{}", seek_table(&report));
+    print!("{}", seek_table(report));
+    if let Some(t) = &product.tilt_uncompensated {
+        println!(
+            "tilt {} deg: compensated std {:.4} deg, tilt not compensated std {:.4} deg (mean error {:+.4} deg)",
+            product.tilt_deg, report.compensated.std_deg, t.std_deg, t.mean_error_deg
+        );
+    }
+    if let (Some(h), Some(c)) = (&product.heading_uncalibrated, &product.heading_calibration) {
+        println!(
+            "heading bias {} deg/h (calibrated {:.4} +- {:.4} deg/h at {:.1} +- {:.1} deg): \
+             with calibration std {:.4} / mean error {:+.4} deg, without std {:.4} / mean error {:+.4} deg",
+            product.heading_bias_dph,
+            c.amplitude_dph,
+            c.amplitude_sigma_dph,
+            c.phase_deg,
+            c.phase_sigma_deg,
+            report.compensated.std_deg,
+            report.compensated.mean_error_deg,
+            h.std_deg,
+            h.mean_error_deg
+        );
+    }
     if let Some(p) = &args.json {
-        write_json(p, &report)?;
+        write_json(p, &product)?;
     }
     Ok(())
 }

@@ -15,9 +15,9 @@ use crate::upload::{
     describe_model, load_signing_key, open_link, sign_model, test_key_path, UploadClient,
 };
 
-/// Options of `fogsim upload`.
+/// Where the device is: shared by `upload` and `monitor`.
 #[derive(clap::Args, Debug)]
-pub struct Args {
+pub struct LinkArgs {
     /// Link to the device: a serial port (`/dev/ttyUSB0`, `COM3`) or `tcp:127.0.0.1:PORT`
     /// (QEMU started with `-serial tcp:127.0.0.1:PORT,server`).
     #[arg(long)]
@@ -25,6 +25,20 @@ pub struct Args {
     /// Serial baud rate (ignored for tcp:).
     #[arg(long, default_value_t = 115_200)]
     pub baud: u32,
+}
+
+impl LinkArgs {
+    /// Opens the link (see `upload::open_link`).
+    pub fn open(&self) -> anyhow::Result<Box<dyn crate::upload::Link>> {
+        open_link(&self.port, self.baud)
+    }
+}
+
+/// Options of `fogsim upload`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    #[command(flatten)]
+    pub link: LinkArgs,
     /// Ed25519 signing seed (64 hex digits). Default: the repository's public TEST key.
     #[arg(long)]
     pub key: Option<PathBuf>,
@@ -52,7 +66,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Some(path) => Some(prepare(path, args.key.clone())?),
         None => None,
     };
-    let link = open_link(&args.port, args.baud)?;
+    let link = args.link.open()?;
     let mut client = UploadClient::new(link, Duration::from_secs_f64(args.timeout_s));
     let before = client.hello().context("handshake (Hello)")?;
     match &before.active {

@@ -9,6 +9,14 @@
 //! by the compensation. Starts are spread over threads with `std::thread::scope`; each has
 //! its own seed derived from the campaign seed and its index, so the result does not depend
 //! on the thread count or scheduling.
+//!
+//! With `tilt_deg` > 0 the table stands on a base tilted by that much (towards a direction
+//! drawn per start) and the finder gets the inclinometer's 10 s means; a third arm runs the
+//! same seeds with the model but without the tilt (`tilt_uncompensated`). With
+//! `heading_bias_dph` != 0 the gyro has a bias A cos(alpha) of its input axis azimuth; the
+//! heading harmonic is first calibrated over 8 headings on a warm, level gyro at the known
+//! azimuth (`fog_core::heading_cal`), applied in the compensated arm, and a fourth arm runs
+//! without it (`heading_uncalibrated`).
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -17,12 +25,18 @@ use anyhow::{anyhow, bail, Context, Result};
 use fog_core::compensator::{Compensator, CompensatorConfig};
 use fog_core::consts::earth_rate_horizontal_dph;
 use fog_core::hal::{GyroSample, TempSample};
+use fog_core::heading_cal::{calibrate, HeadingDwell, HeadingHarmonic};
 use fog_core::model::RbfModel;
 use fog_core::northfinder::{NorthFinder, SeekConfig, SeekMode, SeekStatus};
+use fog_core::tilt::Tilt;
+use serde::Serialize;
 
 use crate::metrics::{rms, std_dev};
 use crate::report::{NorthSeekReport, SeekStats, Table};
-use crate::sim::{rig, GyroParams, RunSpec, StartState, TurntableParams};
+use crate::sim::{
+    rig, AuxSource, AuxTransform, BaseMotion, DriftTerm, GyroParams, RunSpec, StartState,
+    TurntableParams,
+};
 
 /// The paper's seek time, 4 min 56 s.
 pub const PAPER_SEEK_DURATION_S: f64 = 296.0;
@@ -54,6 +68,10 @@ pub struct MonteCarloConfig {
     pub seed: u64,
     /// Worker threads (>= 1).
     pub threads: usize,
+    /// Base tilt magnitude, deg (0: level base, no tilt arm).
+    pub tilt_deg: f64,
+    /// Heading-dependent bias amplitude A of A cos(input axis azimuth), deg/h (0: none).
+    pub heading_bias_dph: f64,
 }
 
 impl MonteCarloConfig {
@@ -74,7 +92,23 @@ impl MonteCarloConfig {
             turntable: TurntableParams::default(),
             seed,
             threads: default_threads(),
+            tilt_deg: 0.0,
+            heading_bias_dph: 0.0,
         }
+    }
+
+    /// The simulated gyro of this Monte Carlo: `params` plus the heading bias term.
+    pub fn gyro_params(&self, params: &GyroParams) -> GyroParams {
+        if self.heading_bias_dph == 0.0 {
+            return params.clone();
+        }
+        params.clone().with_term(DriftTerm {
+            label: "heading_bias".to_string(),
+            source: AuxSource::HeadingCos,
+            transform: AuxTransform::Value,
+            coeff_dph: self.heading_bias_dph,
+            column: None,
+        })
     }
 
     /// Checks the options, naming the offending one.
@@ -102,6 +136,18 @@ impl MonteCarloConfig {
         }
         if self.threads == 0 {
             bail!("--threads: must be at least 1");
+        }
+        if !(self.tilt_deg.is_finite() && (0.0..=30.0).contains(&self.tilt_deg)) {
+            bail!(
+                "--tilt-deg {}: must be within 0..=30 deg (the north finder's tilt range)",
+                self.tilt_deg
+            );
+        }
+        if !(self.heading_bias_dph.is_finite() && self.heading_bias_dph.abs() <= 1.0) {
+            bail!(
+                "--heading-bias-dph {}: must be within -1..=1 deg/h",
+                self.heading_bias_dph
+            );
         }
         Ok(())
     }
@@ -151,22 +197,72 @@ pub struct SeekOutcome {
     pub main_dwell_s: f64,
 }
 
-/// Both arms of one cold start.
+/// The arms of one cold start (`tilt_uncompensated` and `heading_uncalibrated` are empty
+/// when the Monte Carlo has no tilt / no heading bias).
 #[derive(Clone, Debug, PartialEq)]
 pub struct StartOutcome {
     pub seed: u64,
     pub uncompensated: Vec<SeekOutcome>,
     pub compensated: Vec<SeekOutcome>,
+    pub tilt_uncompensated: Vec<SeekOutcome>,
+    pub heading_uncalibrated: Vec<SeekOutcome>,
 }
 
-/// Runs `cfg.seeks_per_start` seeks after one cold start with the given seed, with
-/// `model` applied by the compensator (None: uncompensated).
+/// What one arm applies.
+#[derive(Clone, Copy, Debug)]
+pub struct Arm<'a> {
+    /// Drift model (None: uncompensated drift).
+    pub model: Option<&'a RbfModel>,
+    /// Give the finder the measured tilt (false: it assumes a level base).
+    pub feed_tilt: bool,
+    /// Heading calibration applied by the finder.
+    pub heading: Option<HeadingHarmonic>,
+}
+
+/// Inclinometer readings (1 Hz) averaged over one 10 s window, as the firmware does.
+#[derive(Default)]
+struct TiltMean {
+    sum_deg: [f64; 2],
+    n: u32,
+}
+
+impl TiltMean {
+    fn add(&mut self, t: Tilt) {
+        self.sum_deg[0] += t.pitch_deg as f64;
+        self.sum_deg[1] += t.roll_deg as f64;
+        self.n += 1;
+    }
+
+    /// The window's mean (level when `feed` is false: a finder that ignores tilt), reset.
+    fn take(&mut self, feed: bool) -> Tilt {
+        let n = self.n.max(1) as f64;
+        let mean = Tilt {
+            pitch_deg: (self.sum_deg[0] / n) as f32,
+            roll_deg: (self.sum_deg[1] / n) as f32,
+        };
+        *self = Self::default();
+        if feed {
+            mean
+        } else {
+            Tilt::LEVEL
+        }
+    }
+}
+
+/// Direction of the base tilt of a start, deg (pitch = tilt cos, roll = tilt sin).
+fn tilt_direction_deg(seed: u64) -> f64 {
+    (seed % 3600) as f64 / 10.0
+}
+
+/// Runs `cfg.seeks_per_start` seeks after one cold start with the given seed, with the
+/// arm's model, tilt input and heading calibration. `params` is already `cfg.gyro_params`.
 pub fn run_seeks(
     params: &GyroParams,
     cfg: &MonteCarloConfig,
-    model: Option<&RbfModel>,
+    arm: Arm<'_>,
     seed: u64,
 ) -> Result<Vec<SeekOutcome>> {
+    let model = arm.model;
     let spec = RunSpec {
         ambient_c: cfg.ambient_c,
         minutes: cfg.seeks_per_start as f64 * 10.0,
@@ -179,6 +275,10 @@ pub fn run_seeks(
     };
     let (mut gyro, mut table) =
         rig(params, &spec, cfg.turntable.clone()).map_err(|e| anyhow!("simulator: {e}"))?;
+    if cfg.tilt_deg > 0.0 {
+        gyro.set_base(BaseMotion::tilted(cfg.tilt_deg, tilt_direction_deg(seed)))
+            .map_err(|e| anyhow!("simulator: {e}"))?;
+    }
     let dt_s = gyro.sample_period_s();
     let temp_period_s = params.sensor.sample_period_s;
     let comp_cfg = CompensatorConfig {
@@ -188,6 +288,8 @@ pub fn run_seeks(
     };
     let mut comp = Compensator::new(comp_cfg, model.cloned()).map_err(|e| anyhow!("{e}"))?;
     let mut finder = NorthFinder::new(cfg.seek_config()).map_err(|e| anyhow!("{e}"))?;
+    finder.set_heading_correction(arm.heading);
+    let mut inclinometer = TiltMean::default();
     let temp_every = ((temp_period_s / dt_s).round() as u64).max(1);
     let poll_every = ((1.0 / dt_s).round() as u64).max(1);
     // Generous bound: a seek that has not finished in 4x its nominal time never will.
@@ -216,10 +318,13 @@ pub fn run_seeks(
                 temp_c: gyro.read_sensor_c() as f32,
             });
         }
-        if started && step.is_multiple_of(poll_every) {
-            finder
-                .poll(&mut table, s.t_s)
-                .map_err(|e| anyhow!("seek {}: {e}", out.len() + 1))?;
+        if step.is_multiple_of(poll_every) {
+            inclinometer.add(gyro.read_inclinometer());
+            if started {
+                finder
+                    .poll(&mut table, s.t_s)
+                    .map_err(|e| anyhow!("seek {}: {e}", out.len() + 1))?;
+            }
         }
         // A raw sample is the mean over (t - dt, t]: time-stamp it at the interval's middle.
         let sample = GyroSample {
@@ -229,11 +334,12 @@ pub fn run_seeks(
         let Some(w) = comp.push_gyro(sample) else {
             continue;
         };
+        let tilt = inclinometer.take(arm.feed_tilt);
         if !started {
             continue;
         }
         let status = finder
-            .on_window(&w, &mut table)
+            .on_window_tilted(&w, tilt, &mut table)
             .map_err(|e| anyhow!("seek {}: {e}", out.len() + 1))?;
         if let SeekStatus::Done(r) = status {
             let n_main = r.positions[0].n_windows as f64;
@@ -262,7 +368,29 @@ pub fn run_monte_carlo(
     model: &RbfModel,
     on_start_done: &(dyn Fn() + Sync),
 ) -> Result<Vec<StartOutcome>> {
+    Ok(run_monte_carlo_with_calibration(params, cfg, model, on_start_done)?.0)
+}
+
+/// `run_monte_carlo`, also returning the heading calibration used (when there is a
+/// heading bias).
+pub fn run_monte_carlo_with_calibration(
+    params: &GyroParams,
+    cfg: &MonteCarloConfig,
+    model: &RbfModel,
+    on_start_done: &(dyn Fn() + Sync),
+) -> Result<(Vec<StartOutcome>, Option<HeadingHarmonic>)> {
     cfg.validate()?;
+    let params = &cfg.gyro_params(params);
+    let heading = if cfg.heading_bias_dph != 0.0 {
+        Some(calibrate_heading(params, cfg)?)
+    } else {
+        None
+    };
+    let full = Arm {
+        model: Some(model),
+        feed_tilt: true,
+        heading,
+    };
     let next = AtomicUsize::new(0);
     let results: Mutex<Vec<Option<Result<StartOutcome>>>> =
         Mutex::new((0..cfg.starts).map(|_| None).collect());
@@ -274,19 +402,45 @@ pub fn run_monte_carlo(
                     break;
                 }
                 let seed = cfg.start_seed(i);
-                let r = run_seeks(params, cfg, None, seed)
-                    .with_context(|| format!("start {} (seed {seed}), uncompensated", i + 1))
-                    .and_then(|unc| {
-                        let comp =
-                            run_seeks(params, cfg, Some(model), seed).with_context(|| {
-                                format!("start {} (seed {seed}), compensated", i + 1)
-                            })?;
-                        Ok(StartOutcome {
-                            seed,
-                            uncompensated: unc,
-                            compensated: comp,
-                        })
-                    });
+                let arm = |name: &str, a: Arm<'_>| {
+                    run_seeks(params, cfg, a, seed)
+                        .with_context(|| format!("start {} (seed {seed}), {name}", i + 1))
+                };
+                let r = (|| -> Result<StartOutcome> {
+                    Ok(StartOutcome {
+                        seed,
+                        uncompensated: arm(
+                            "uncompensated",
+                            Arm {
+                                model: None,
+                                ..full
+                            },
+                        )?,
+                        compensated: arm("compensated", full)?,
+                        tilt_uncompensated: if cfg.tilt_deg > 0.0 {
+                            arm(
+                                "tilt uncompensated",
+                                Arm {
+                                    feed_tilt: false,
+                                    ..full
+                                },
+                            )?
+                        } else {
+                            Vec::new()
+                        },
+                        heading_uncalibrated: if heading.is_some() {
+                            arm(
+                                "heading uncalibrated",
+                                Arm {
+                                    heading: None,
+                                    ..full
+                                },
+                            )?
+                        } else {
+                            Vec::new()
+                        },
+                    })
+                })();
                 let failed = r.is_err();
                 results.lock().expect("no panics while holding the lock")[i] = Some(r);
                 on_start_done();
@@ -308,7 +462,66 @@ pub fn run_monte_carlo(
             None => bail!("north-seek Monte Carlo stopped early"),
         }
     }
-    Ok(out)
+    Ok((out, heading))
+}
+
+/// Headings of the heading calibration, deg.
+pub const CALIBRATION_HEADINGS: usize = 8;
+
+/// Calibrates the heading harmonic as on a bench: warm gyro, level base, table zero at the
+/// known `true_azimuth_deg`, `CALIBRATION_HEADINGS` headings with 2 x `dwell_s` each (10 s
+/// window means after the table settled; sigma of each heading's mean from their scatter).
+pub fn calibrate_heading(params: &GyroParams, cfg: &MonteCarloConfig) -> Result<HeadingHarmonic> {
+    let seed = cfg.seed ^ 0x4845_4144_4341_4C31; // "HEADCAL1"
+    let spec = RunSpec {
+        ambient_c: cfg.ambient_c,
+        minutes: 120.0,
+        latitude_deg: cfg.latitude_deg,
+        heading_deg: cfg.true_azimuth_deg,
+        input_axis_vertical: false,
+        raw_rate_hz: cfg.raw_rate_hz,
+        seed,
+        start: StartState::Warm,
+    };
+    let (mut gyro, mut table) =
+        rig(params, &spec, cfg.turntable.clone()).map_err(|e| anyhow!("simulator: {e}"))?;
+    let per_window = (cfg.raw_rate_hz * fog_core::consts::WINDOW_S as f64).round() as usize;
+    let windows = ((2.0 * cfg.dwell_s as f64) / fog_core::consts::WINDOW_S as f64).ceil() as usize;
+    let mut dwells = Vec::with_capacity(CALIBRATION_HEADINGS);
+    for k in 0..CALIBRATION_HEADINGS {
+        let heading = 360.0 * k as f64 / CALIBRATION_HEADINGS as f64;
+        use fog_core::hal::{TableState, Turntable};
+        table
+            .command_heading(heading as f32)
+            .map_err(|e| anyhow!("calibration table: {e}"))?;
+        let mut guard = 0;
+        while !matches!(table.poll(), Ok(TableState::Settled { .. })) {
+            gyro.next_sample();
+            guard += 1;
+            if guard > per_window * 60 {
+                bail!("calibration: the table did not settle at {heading} deg");
+            }
+        }
+        // Skip the rest of the current window, then average whole windows.
+        let means: Vec<f64> = (0..=windows)
+            .map(|_| {
+                (0..per_window)
+                    .map(|_| gyro.next_sample().rate_dph)
+                    .sum::<f64>()
+                    / per_window as f64
+            })
+            .skip(1)
+            .collect();
+        let mean = means.iter().sum::<f64>() / means.len() as f64;
+        dwells.push(HeadingDwell {
+            heading_deg: heading as f32,
+            mean_rate_dph: mean,
+            sigma_dph: (std_dev(&means) / (means.len() as f64).sqrt()).max(1e-9),
+        });
+    }
+    let (h, _b0) = calibrate(&dwells, cfg.true_azimuth_deg, cfg.latitude_deg, Tilt::LEVEL)
+        .map_err(|e| anyhow!("{e}"))?;
+    Ok(h)
 }
 
 /// Signed azimuth difference a - b wrapped to [-180, 180), deg.
@@ -436,6 +649,64 @@ pub fn build_report(
     }
 }
 
+/// The heading calibration as reported.
+#[derive(Clone, Debug, Serialize)]
+pub struct HeadingCalibrationReport {
+    pub simulated_amplitude_dph: f64,
+    pub amplitude_dph: f64,
+    pub amplitude_sigma_dph: f64,
+    pub phase_deg: f64,
+    pub phase_sigma_deg: f64,
+    pub headings: usize,
+}
+
+/// `fogsim north-seek --json`: the base report plus the tilt and heading arms.
+#[derive(Clone, Debug, Serialize)]
+pub struct NorthSeekProductReport {
+    #[serde(flatten)]
+    pub base: NorthSeekReport,
+    pub tilt_deg: f64,
+    pub heading_bias_dph: f64,
+    /// Same seeds, model applied, tilt not given to the finder (None without tilt).
+    pub tilt_uncompensated: Option<SeekStats>,
+    /// Same seeds, model and tilt, no heading calibration (None without heading bias).
+    pub heading_uncalibrated: Option<SeekStats>,
+    pub heading_calibration: Option<HeadingCalibrationReport>,
+}
+
+/// The extended report of a Monte Carlo with tilt / heading bias.
+pub fn build_product_report(
+    params: &GyroParams,
+    cfg: &MonteCarloConfig,
+    outcomes: &[StartOutcome],
+    heading: Option<HeadingHarmonic>,
+    model_source: &str,
+) -> NorthSeekProductReport {
+    let stats = |f: fn(&StartOutcome) -> &Vec<SeekOutcome>| {
+        let v: Vec<Vec<SeekOutcome>> = outcomes.iter().map(|o| f(o).clone()).collect();
+        if v.iter().all(Vec::is_empty) {
+            None
+        } else {
+            Some(seek_stats(&v, cfg.true_azimuth_deg))
+        }
+    };
+    NorthSeekProductReport {
+        base: build_report(params, cfg, outcomes, model_source),
+        tilt_deg: cfg.tilt_deg,
+        heading_bias_dph: cfg.heading_bias_dph,
+        tilt_uncompensated: stats(|o| &o.tilt_uncompensated),
+        heading_uncalibrated: stats(|o| &o.heading_uncalibrated),
+        heading_calibration: heading.map(|h| HeadingCalibrationReport {
+            simulated_amplitude_dph: cfg.heading_bias_dph,
+            amplitude_dph: h.amplitude_dph() as f64,
+            amplitude_sigma_dph: h.amplitude_sigma_dph() as f64,
+            phase_deg: h.phase_deg() as f64,
+            phase_sigma_deg: h.phase_sigma_deg() as f64,
+            headings: h.n_headings as usize,
+        }),
+    }
+}
+
 /// The per-seek table printed by `north-seek`, `reproduce` and `demo`.
 pub fn seek_table(r: &NorthSeekReport) -> String {
     let mut t = Table::new(&[
@@ -510,6 +781,47 @@ mod tests {
         // Four positions (4 tau in total) do not depend on psi and equal two positions at psi = 90 deg.
         let f4 = noise_floor_deg(0.0011, SeekMode::FourPosition, 0.0, 10.0, 120.0);
         assert!((f4 - f).abs() < 1e-12);
+    }
+
+    #[test]
+    fn tilt_input_removes_the_tilt_error_and_runs_repeat() {
+        let cfg = MonteCarloConfig {
+            seeks_per_start: 1,
+            tilt_deg: 15.0,
+            ..MonteCarloConfig::paper(3)
+        };
+        let params = GyroParams::paper_default();
+        let arm = |feed_tilt| Arm {
+            model: None,
+            feed_tilt,
+            heading: None,
+        };
+        let err = |o: &[SeekOutcome]| azimuth_error_deg(o[0].azimuth_deg, cfg.true_azimuth_deg);
+        let fed = run_seeks(&params, &cfg, arm(true), 11).unwrap();
+        let level = run_seeks(&params, &cfg, arm(false), 11).unwrap();
+        // Uncompensated warm-up drift alone is ~0.1 deg on the first seek; 15 deg of tilt
+        // without the tilt maths is degrees.
+        assert!(err(&fed).abs() < 0.2, "{}", err(&fed));
+        assert!(err(&level).abs() > 1.0, "{}", err(&level));
+        assert_eq!(fed, run_seeks(&params, &cfg, arm(true), 11).unwrap());
+    }
+
+    #[test]
+    fn heading_calibration_finds_the_simulated_harmonic() {
+        let cfg = MonteCarloConfig {
+            heading_bias_dph: 0.05,
+            ..MonteCarloConfig::paper(5)
+        };
+        let h = calibrate_heading(&cfg.gyro_params(&GyroParams::paper_default()), &cfg).unwrap();
+        let a = h.amplitude_dph() as f64;
+        assert!(
+            (a - 0.05).abs() < 4.0 * h.amplitude_sigma_dph() as f64 + 1e-3,
+            "{h:?}"
+        );
+        assert!(
+            (h.phase_deg() as f64).abs() < 4.0 * h.phase_sigma_deg() as f64 + 1.0,
+            "{h:?}"
+        );
     }
 
     #[test]

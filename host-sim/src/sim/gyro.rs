@@ -8,6 +8,7 @@
 //!       + k_G d(T_h - T_c)/dt                                     gradient rate (~ d2T/dt2)
 //!       + turn-on bias + extra terms + noise
 
+use super::base::BaseMotion;
 use super::error::SimError;
 use super::noise::NoiseGen;
 use super::params::{GyroParams, SensorPlacement};
@@ -29,6 +30,8 @@ const STREAM_SENSOR: u64 = 1;
 const STREAM_RUN: u64 = 2;
 /// Stream of the turntable's indexing errors.
 pub(crate) const STREAM_TABLE: u64 = 3;
+/// Stream of the inclinometer noise.
+const STREAM_INCLINOMETER: u64 = 4;
 
 /// A seeded generator on one of the run's streams.
 pub(crate) fn stream_rng(seed: u64, stream: u64) -> ChaCha8Rng {
@@ -76,6 +79,9 @@ pub struct SimGyro {
     rng_sensor: ChaCha8Rng,
     last: Option<RawSample>,
     last_input_rate_dph: f64,
+    base: Option<BaseMotion>,
+    latitude_deg: f64,
+    rng_inclinometer: ChaCha8Rng,
 }
 
 impl SimGyro {
@@ -125,6 +131,9 @@ impl SimGyro {
             rng_sensor: stream_rng(spec.seed, STREAM_SENSOR),
             last: None,
             last_input_rate_dph: 0.0,
+            base: None,
+            latitude_deg: spec.latitude_deg,
+            rng_inclinometer: stream_rng(spec.seed, STREAM_INCLINOMETER),
         };
         gyro.sensor_c = gyro.sensor_node_c();
         Ok(gyro)
@@ -139,6 +148,22 @@ impl SimGyro {
         match self.params.sensor.placement {
             SensorPlacement::Coil => self.thermal.coil_c(),
             SensorPlacement::Housing => self.thermal.housing_c(),
+        }
+    }
+
+    /// Stands the (horizontal-axis) gyro's turntable on a tilted, possibly rocking base.
+    pub fn set_base(&mut self, base: BaseMotion) -> Result<(), SimError> {
+        base.validate()?;
+        self.base = Some(base);
+        Ok(())
+    }
+
+    /// One inclinometer reading of the base now (level and noiseless without a base).
+    pub fn read_inclinometer(&mut self) -> fog_core::tilt::Tilt {
+        let t = self.now_s();
+        match &self.base {
+            Some(b) => b.read_inclinometer(t, &mut self.rng_inclinometer),
+            None => fog_core::tilt::Tilt::LEVEL,
         }
     }
 
@@ -202,6 +227,12 @@ impl SimGyro {
         let (earth_dph, table_dph) = if self.vertical {
             // Heading increases clockwise seen from above: a negative rotation about "up".
             (self.earth_vertical_dph, -(a1 - a0) / self.dt_s * 3600.0)
+        } else if let Some(b) = &self.base {
+            let h = 0.5 * (a0 + a1);
+            (
+                b.input_rate_dph(self.latitude_deg, self.heading_deg, h, t1),
+                0.0,
+            )
         } else {
             (
                 self.earth_horizontal_dph * azimuth_deg.to_radians().cos(),

@@ -3,6 +3,7 @@
 //! gradient-rate term, turn-on bias, pluggable extra terms), IEEE Std 952 noise, and
 //! an indexing turntable. See `docs/simulator.md` for the calibration to the paper.
 
+pub mod base;
 pub mod error;
 pub mod gyro;
 pub mod noise;
@@ -13,6 +14,7 @@ pub mod terms;
 pub mod thermal;
 pub mod turntable;
 
+pub use base::{BaseMotion, Disturbance};
 pub use error::SimError;
 pub use gyro::{RawSample, SimGyro};
 pub use params::{

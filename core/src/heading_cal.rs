@@ -1,0 +1,445 @@
+//! Heading-dependent bias calibration: the first harmonic of the gyro bias in the azimuth of
+//! its input axis (e.g. a magnetic/Faraday bias from the Earth's field), estimated from N
+//! dwells at known headings and stored beside the drift model in its own small record.
+//!
+//! Exists because such a bias, a cos(alpha) + b sin(alpha) with alpha the input axis azimuth,
+//! is the same harmonic as Earth rate: no seek can separate it, so it has to be measured once
+//! against a reference azimuth (a surveyed mark) and then removed (see `northfinder`).
+//!
+//! Estimation: with the table zero at the known azimuth A_ref, dwell k at heading h_k reads
+//! `m_k = E(A_ref, h_k, tilt) + b0 + a cos(A_ref + h_k) + b sin(A_ref + h_k)`; the Earth
+//! term E comes from `tilt::earth_rate_on_axis_dph`, and (b0, a, b) from weighted least
+//! squares (weights 1 / sigma_k^2). The covariance is (J^T W J)^-1, scaled up by the reduced
+//! chi-square when the residuals scatter more than the dwell sigmas say.
+//!
+//! Record (postcard, then CRC-32/ISO-HDLC of those bytes, little-endian):
+//! `HeadingCalRecord { magic: u32 = HEADING_CAL_MAGIC, version: u16, harmonic }`.
+
+use serde::{Deserialize, Serialize};
+
+use crate::numeric::sin_cos_deg;
+use crate::protocol::crc32;
+use crate::tilt::{earth_rate_on_axis_dph, Tilt};
+
+/// "FHCL" little-endian: marks a heading calibration record.
+pub const HEADING_CAL_MAGIC: u32 = u32::from_le_bytes(*b"FHCL");
+/// Record format version written by this build.
+pub const HEADING_CAL_VERSION: u16 = 1;
+/// Largest encoded record, bytes (postcard varints + CRC).
+pub const MAX_RECORD_LEN: usize = 48;
+/// Fewest headings a calibration accepts (three unknowns plus one degree of freedom).
+pub const MIN_HEADINGS: usize = 4;
+
+/// The bias harmonic a cos(alpha) + b sin(alpha) of the input axis azimuth alpha.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct HeadingHarmonic {
+    /// a, deg/h.
+    pub cos_dph: f32,
+    /// b, deg/h.
+    pub sin_dph: f32,
+    /// 1-sigma of a and b and their correlation coefficient.
+    pub cos_sigma_dph: f32,
+    pub sin_sigma_dph: f32,
+    pub correlation: f32,
+    /// Headings the calibration used.
+    pub n_headings: u16,
+}
+
+impl HeadingHarmonic {
+    /// Bias at input axis azimuth `alpha_deg`, deg/h.
+    pub fn bias_dph(&self, alpha_deg: f64) -> f64 {
+        let (s, c) = sin_cos_deg(alpha_deg);
+        self.cos_dph as f64 * c + self.sin_dph as f64 * s
+    }
+
+    /// Amplitude sqrt(a^2 + b^2), deg/h.
+    pub fn amplitude_dph(&self) -> f32 {
+        libm::sqrtf(self.cos_dph * self.cos_dph + self.sin_dph * self.sin_dph)
+    }
+
+    /// Phase atan2(b, a): the azimuth of largest bias, deg.
+    pub fn phase_deg(&self) -> f32 {
+        libm::atan2f(self.sin_dph, self.cos_dph).to_degrees()
+    }
+
+    /// 1-sigma of the amplitude, deg/h (linearised).
+    pub fn amplitude_sigma_dph(&self) -> f32 {
+        let (a, b) = (self.cos_dph, self.sin_dph);
+        let amp2 = a * a + b * b;
+        if amp2 <= 0.0 {
+            return self.cos_sigma_dph.max(self.sin_sigma_dph);
+        }
+        let (sa, sb) = (self.cos_sigma_dph, self.sin_sigma_dph);
+        let var = a * a * sa * sa + b * b * sb * sb + 2.0 * a * b * self.correlation * sa * sb;
+        libm::sqrtf(var.max(0.0) / amp2)
+    }
+
+    /// 1-sigma of the phase, deg (linearised; large when the amplitude is near 0).
+    pub fn phase_sigma_deg(&self) -> f32 {
+        let (a, b) = (self.cos_dph, self.sin_dph);
+        let amp2 = a * a + b * b;
+        if amp2 <= 0.0 {
+            return 180.0;
+        }
+        let (sa, sb) = (self.cos_sigma_dph, self.sin_sigma_dph);
+        let var = b * b * sa * sa + a * a * sb * sb - 2.0 * a * b * self.correlation * sa * sb;
+        (libm::sqrtf(var.max(0.0)) / amp2).to_degrees().min(180.0)
+    }
+
+    fn is_valid(&self) -> bool {
+        let f = [
+            self.cos_dph,
+            self.sin_dph,
+            self.cos_sigma_dph,
+            self.sin_sigma_dph,
+            self.correlation,
+        ];
+        f.iter().all(|v| v.is_finite())
+            && self.cos_sigma_dph >= 0.0
+            && self.sin_sigma_dph >= 0.0
+            && libm::fabsf(self.correlation) <= 1.0
+            && self.n_headings as usize >= MIN_HEADINGS
+    }
+}
+
+/// One calibration dwell.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HeadingDwell {
+    /// Table heading, deg.
+    pub heading_deg: f32,
+    /// Mean compensated rate, deg/h.
+    pub mean_rate_dph: f64,
+    /// 1-sigma of that mean, deg/h (> 0).
+    pub sigma_dph: f64,
+}
+
+/// Why a calibration or a record was refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum HeadingCalError {
+    /// Fewer than `MIN_HEADINGS` dwells.
+    TooFewHeadings {
+        n: u16,
+    },
+    /// Dwell `index` has a non-finite value or a sigma <= 0.
+    BadDwell {
+        index: u16,
+    },
+    /// Reference azimuth or latitude not finite / |latitude| >= 90.
+    BadReference,
+    /// The headings do not span the circle (normal equations singular).
+    HeadingsDegenerate,
+    /// Output buffer too small.
+    BufferTooSmall,
+    /// Not postcard-decodable, truncated or with trailing bytes.
+    Malformed,
+    /// Magic is not `HEADING_CAL_MAGIC`.
+    BadMagic,
+    UnsupportedVersion {
+        version: u16,
+    },
+    CrcMismatch,
+    /// Non-finite or negative values.
+    InvalidContent,
+}
+
+impl core::fmt::Display for HeadingCalError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            Self::TooFewHeadings { n } => write!(
+                f,
+                "heading calibration: {n} headings, at least {MIN_HEADINGS} needed"
+            ),
+            Self::BadDwell { index } => write!(
+                f,
+                "heading calibration: dwell {index} has a non-finite value or sigma <= 0"
+            ),
+            Self::BadReference => write!(
+                f,
+                "heading calibration: reference azimuth or latitude not usable"
+            ),
+            Self::HeadingsDegenerate => write!(
+                f,
+                "heading calibration: headings do not span the circle (spread them evenly)"
+            ),
+            Self::BufferTooSmall => write!(f, "heading calibration record: buffer too small"),
+            Self::Malformed => write!(f, "heading calibration record: malformed or truncated"),
+            Self::BadMagic => write!(f, "heading calibration record: wrong magic"),
+            Self::UnsupportedVersion { version } => {
+                write!(
+                    f,
+                    "heading calibration record: version {version} not supported"
+                )
+            }
+            Self::CrcMismatch => write!(f, "heading calibration record: CRC-32 mismatch"),
+            Self::InvalidContent => write!(f, "heading calibration record: invalid values"),
+        }
+    }
+}
+
+impl core::error::Error for HeadingCalError {}
+
+/// Fits the bias harmonic to `dwells` taken with table zero at `reference_azimuth_deg`.
+/// Returns the harmonic and the constant bias b0 (deg/h).
+pub fn calibrate(
+    dwells: &[HeadingDwell],
+    reference_azimuth_deg: f64,
+    latitude_deg: f64,
+    tilt: Tilt,
+) -> Result<(HeadingHarmonic, f64), HeadingCalError> {
+    let n = dwells.len();
+    if n < MIN_HEADINGS {
+        return Err(HeadingCalError::TooFewHeadings {
+            n: n.min(u16::MAX as usize) as u16,
+        });
+    }
+    if !reference_azimuth_deg.is_finite()
+        || !latitude_deg.is_finite()
+        || libm::fabs(latitude_deg) >= 90.0
+    {
+        return Err(HeadingCalError::BadReference);
+    }
+    // Normal equations of (b0, a, b): N = J^T W J, g = J^T W r.
+    let mut nm = [[0.0f64; 3]; 3];
+    let mut g = [0.0f64; 3];
+    let row = |d: &HeadingDwell| -> ([f64; 3], f64) {
+        let (s, c) = sin_cos_deg(reference_azimuth_deg + d.heading_deg as f64);
+        let earth = earth_rate_on_axis_dph(
+            latitude_deg,
+            reference_azimuth_deg,
+            tilt,
+            d.heading_deg as f64,
+        );
+        ([1.0, c, s], d.mean_rate_dph - earth)
+    };
+    for (i, d) in dwells.iter().enumerate() {
+        let ok = d.heading_deg.is_finite()
+            && d.mean_rate_dph.is_finite()
+            && d.sigma_dph.is_finite()
+            && d.sigma_dph > 0.0;
+        if !ok {
+            return Err(HeadingCalError::BadDwell {
+                index: i.min(u16::MAX as usize) as u16,
+            });
+        }
+        let (j, r) = row(d);
+        let w = 1.0 / (d.sigma_dph * d.sigma_dph);
+        for a in 0..3 {
+            g[a] += w * j[a] * r;
+            for b in 0..3 {
+                nm[a][b] += w * j[a] * j[b];
+            }
+        }
+    }
+    let cov = invert3(&nm).ok_or(HeadingCalError::HeadingsDegenerate)?;
+    let x: [f64; 3] = core::array::from_fn(|a| (0..3).map(|b| cov[a][b] * g[b]).sum());
+    let chi2: f64 = dwells
+        .iter()
+        .map(|d| {
+            let (j, r) = row(d);
+            let e = r - (j[0] * x[0] + j[1] * x[1] + j[2] * x[2]);
+            e * e / (d.sigma_dph * d.sigma_dph)
+        })
+        .sum();
+    let reduced = (chi2 / (n - 3) as f64).max(1.0);
+    let sa = libm::sqrt(cov[1][1] * reduced);
+    let sb = libm::sqrt(cov[2][2] * reduced);
+    let corr = (cov[1][2] * reduced / (sa * sb)).clamp(-1.0, 1.0);
+    Ok((
+        HeadingHarmonic {
+            cos_dph: x[1] as f32,
+            sin_dph: x[2] as f32,
+            cos_sigma_dph: sa as f32,
+            sin_sigma_dph: sb as f32,
+            correlation: corr as f32,
+            n_headings: n.min(u16::MAX as usize) as u16,
+        },
+        x[0],
+    ))
+}
+
+/// Inverse of a symmetric 3x3 matrix by cofactors; `None` if (near) singular.
+fn invert3(m: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
+    let c =
+        |r0: usize, r1: usize, c0: usize, c1: usize| m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0];
+    let cof = [
+        [c(1, 2, 1, 2), -c(1, 2, 0, 2), c(1, 2, 0, 1)],
+        [-c(0, 2, 1, 2), c(0, 2, 0, 2), -c(0, 2, 0, 1)],
+        [c(0, 1, 1, 2), -c(0, 1, 0, 2), c(0, 1, 0, 1)],
+    ];
+    let det = m[0][0] * cof[0][0] + m[0][1] * cof[0][1] + m[0][2] * cof[0][2];
+    let scale = m[0][0].abs().max(m[1][1].abs()).max(m[2][2].abs());
+    if !det.is_finite() || det.abs() <= 1e-9 * scale * scale * scale {
+        return None;
+    }
+    // Inverse = adjugate / det; the adjugate is the transposed cofactor matrix.
+    Some(core::array::from_fn(|i| {
+        core::array::from_fn(|j| cof[j][i] / det)
+    }))
+}
+
+/// The stored record.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct HeadingCalRecord {
+    pub magic: u32,
+    pub version: u16,
+    pub harmonic: HeadingHarmonic,
+}
+
+impl HeadingCalRecord {
+    pub fn new(harmonic: HeadingHarmonic) -> Self {
+        Self {
+            magic: HEADING_CAL_MAGIC,
+            version: HEADING_CAL_VERSION,
+            harmonic,
+        }
+    }
+
+    /// Writes postcard + CRC-32 into `out`; returns the length.
+    pub fn encode(&self, out: &mut [u8]) -> Result<usize, HeadingCalError> {
+        if !self.harmonic.is_valid() {
+            return Err(HeadingCalError::InvalidContent);
+        }
+        let body = postcard::to_slice(self, out)
+            .map_err(|_| HeadingCalError::BufferTooSmall)?
+            .len();
+        let crc = crc32(&out[..body]).to_le_bytes();
+        out.get_mut(body..body + 4)
+            .ok_or(HeadingCalError::BufferTooSmall)?
+            .copy_from_slice(&crc);
+        Ok(body + 4)
+    }
+
+    /// Checks CRC, magic, version and values; a record is accepted whole or not at all.
+    pub fn decode(bytes: &[u8]) -> Result<Self, HeadingCalError> {
+        if bytes.len() < 5 {
+            return Err(HeadingCalError::Malformed);
+        }
+        let (body, crc) = bytes.split_at(bytes.len() - 4);
+        if crc32(body) != u32::from_le_bytes([crc[0], crc[1], crc[2], crc[3]]) {
+            return Err(HeadingCalError::CrcMismatch);
+        }
+        let rec: Self = match postcard::take_from_bytes(body) {
+            Ok((r, [])) => r,
+            _ => return Err(HeadingCalError::Malformed),
+        };
+        if rec.magic != HEADING_CAL_MAGIC {
+            return Err(HeadingCalError::BadMagic);
+        }
+        if rec.version != HEADING_CAL_VERSION {
+            return Err(HeadingCalError::UnsupportedVersion {
+                version: rec.version,
+            });
+        }
+        if !rec.harmonic.is_valid() {
+            return Err(HeadingCalError::InvalidContent);
+        }
+        Ok(rec)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dwells(az: f64, lat: f64, a: f64, b: f64, b0: f64, n: usize) -> Vec<HeadingDwell> {
+        (0..n)
+            .map(|k| {
+                let h = 360.0 * k as f64 / n as f64;
+                let alpha = (az + h).to_radians();
+                HeadingDwell {
+                    heading_deg: h as f32,
+                    mean_rate_dph: earth_rate_on_axis_dph(lat, az, Tilt::LEVEL, h)
+                        + b0
+                        + a * alpha.cos()
+                        + b * alpha.sin(),
+                    sigma_dph: 0.002,
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn recovers_a_known_harmonic_noiselessly() {
+        let d = dwells(108.4, 39.9, 0.03, -0.02, 0.5, 8);
+        let (h, b0) = calibrate(&d, 108.4, 39.9, Tilt::LEVEL).unwrap();
+        assert!((h.cos_dph - 0.03).abs() < 1e-5 && (h.sin_dph + 0.02).abs() < 1e-5);
+        assert!((b0 - 0.5).abs() < 1e-9);
+        assert!((h.amplitude_dph() - 0.036_055).abs() < 1e-4);
+        assert!((h.phase_deg() + 33.69).abs() < 0.01);
+        // Eight equal dwells: sigma of a and b = sigma sqrt(2 / n) (uncorrelated).
+        assert!(
+            (h.cos_sigma_dph - 0.001).abs() < 1e-6,
+            "{}",
+            h.cos_sigma_dph
+        );
+        assert!(h.correlation.abs() < 1e-6);
+    }
+
+    #[test]
+    fn rejects_degenerate_and_bad_inputs() {
+        let mut d = dwells(0.0, 39.9, 0.0, 0.0, 0.0, 8);
+        assert_eq!(
+            calibrate(&d[..3], 0.0, 39.9, Tilt::LEVEL).err(),
+            Some(HeadingCalError::TooFewHeadings { n: 3 })
+        );
+        for x in &mut d {
+            x.heading_deg = 10.0;
+        }
+        assert_eq!(
+            calibrate(&d, 0.0, 39.9, Tilt::LEVEL).err(),
+            Some(HeadingCalError::HeadingsDegenerate)
+        );
+        d[2].sigma_dph = 0.0;
+        assert_eq!(
+            calibrate(&d, 0.0, 39.9, Tilt::LEVEL).err(),
+            Some(HeadingCalError::BadDwell { index: 2 })
+        );
+    }
+
+    #[test]
+    fn record_roundtrips_and_every_flipped_bit_is_caught() {
+        let d = dwells(20.0, 45.0, -0.01, 0.04, 0.1, 8);
+        let (h, _) = calibrate(&d, 20.0, 45.0, Tilt::LEVEL).unwrap();
+        let mut buf = [0u8; MAX_RECORD_LEN];
+        let n = HeadingCalRecord::new(h).encode(&mut buf).unwrap();
+        assert_eq!(HeadingCalRecord::decode(&buf[..n]).unwrap().harmonic, h);
+        for bit in 0..n * 8 {
+            let mut c = buf;
+            c[bit / 8] ^= 1 << (bit % 8);
+            assert!(HeadingCalRecord::decode(&c[..n]).is_err(), "bit {bit}");
+        }
+        for len in 0..n {
+            assert!(HeadingCalRecord::decode(&buf[..len]).is_err(), "len {len}");
+        }
+    }
+
+    #[test]
+    fn wrong_version_and_magic_are_named() {
+        let h = HeadingHarmonic {
+            cos_dph: 0.01,
+            sin_dph: 0.0,
+            cos_sigma_dph: 0.001,
+            sin_sigma_dph: 0.001,
+            correlation: 0.0,
+            n_headings: 8,
+        };
+        let mut buf = [0u8; MAX_RECORD_LEN];
+        let mut rec = HeadingCalRecord::new(h);
+        rec.version = 9;
+        // encode does not check the version, so a future record can be simulated.
+        let n = rec.encode(&mut buf).unwrap();
+        assert_eq!(
+            HeadingCalRecord::decode(&buf[..n]).err(),
+            Some(HeadingCalError::UnsupportedVersion { version: 9 })
+        );
+        let mut rec = HeadingCalRecord::new(h);
+        rec.magic = 1;
+        let n = rec.encode(&mut buf).unwrap();
+        assert_eq!(
+            HeadingCalRecord::decode(&buf[..n]).err(),
+            Some(HeadingCalError::BadMagic)
+        );
+    }
+}

@@ -1,0 +1,244 @@
+//! Host-link messages of the north finder (device <-> PC over the host UART or RS-422):
+//! status, seek results and commands.
+//!
+//! Exists so that the firmware and `fogsim monitor` build against one set of types. Frames
+//! are exactly the upload's: `fog_core::protocol::encode_frame` / `decode_frame` /
+//! `FrameReceiver` (postcard, CRC-32, COBS, 0x00 delimiter); this module only adds the
+//! message types and two thin helpers that call those functions.
+
+use serde::{Deserialize, Serialize};
+
+use crate::bit::BitWord;
+use crate::protocol::{decode_message, encode_frame, FrameError};
+use crate::seek_quality::{MotionReason, QualityError, SeekState, Validity};
+use crate::tilt::Tilt;
+
+/// Version of these messages (in every `Status`).
+pub const LINK_VERSION: u16 = 1;
+
+/// Why the device last reset.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ResetReason {
+    PowerOn,
+    Watchdog,
+    Software,
+    Lockup,
+    Unknown,
+}
+
+/// PC -> device.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Command {
+    /// Start a seek with 2 or 4 positions; answered with `Accepted` or `Refused`.
+    StartSeek { positions: u8 },
+    /// Site latitude, deg; refused while seeking or outside |lat| < 85.
+    SetLatitude { latitude_deg: f32 },
+    /// Abandon the running seek.
+    Abort,
+    /// Ask for one `Status` now.
+    GetStatus,
+}
+
+/// Device -> PC.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum DeviceMessage {
+    Status(Status),
+    Result(SeekReport),
+    /// The last command was carried out.
+    Accepted,
+    /// The last command was refused, and why.
+    Refused(Refusal),
+}
+
+/// Why a command was refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Refusal {
+    Quality(QualityError),
+    /// `SetLatitude` out of range or while seeking.
+    BadLatitude,
+    /// `StartSeek` with a position count other than 2 or 4.
+    BadPositions,
+    /// `Abort` with no seek running.
+    NotSeeking,
+}
+
+/// Periodic status (about once per second and after every command).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Status {
+    pub link_version: u16,
+    /// Seconds since power-on.
+    pub t_s: f32,
+    pub state: SeekState,
+    /// 0..1 of the running seek.
+    pub progress: f32,
+    /// Predicted 1-sigma of the running seek from the noise seen so far, deg.
+    pub predicted_sigma_deg: f32,
+    /// Gyro temperature, degC.
+    pub temp_c: f32,
+    /// CRC-32 of the drift model in use (`None`: no model, compensation off).
+    pub model_crc32: Option<u32>,
+    pub bit: BitWord,
+    pub reset_reason: ResetReason,
+    pub latitude_deg: f32,
+    /// Latest 10 s mean base tilt.
+    pub tilt: Tilt,
+    /// Restarts of the running seek and the last reason.
+    pub restarts: u8,
+    pub last_restart: Option<MotionReason>,
+}
+
+/// One finished seek.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SeekReport {
+    /// Counts seeks since power-on.
+    pub sequence: u32,
+    /// Azimuth of table heading 0, deg in [0, 360).
+    pub azimuth_deg: f64,
+    pub sigma_deg: f32,
+    pub tilt: Tilt,
+    pub duration_s: f32,
+    /// End of the seek, s since power-on.
+    pub t_end_s: f64,
+    pub positions: u8,
+    pub validity: Validity,
+}
+
+/// Largest frame of any link message on the wire, bytes (checked by a test).
+pub const MAX_LINK_FRAME_LEN: usize = 96;
+
+/// Encodes one message as a wire frame (upload framing) into `out`.
+pub fn encode<T: Serialize>(msg: &T, out: &mut [u8]) -> Result<usize, FrameError> {
+    encode_frame(msg, out)
+}
+
+/// Decodes a checked frame payload (from `FrameReceiver` or `decode_frame`) as `T`.
+pub fn decode<'a, T: Deserialize<'a>>(payload: &'a [u8]) -> Result<T, FrameError> {
+    decode_message(payload)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bit::BitItem;
+    use crate::protocol::{FrameReceiver, MAX_WIRE_FRAME_LEN};
+    use crate::seek_quality::FinderFault;
+    use crate::synthetic::SplitMix64;
+
+    fn status(bit: u16) -> Status {
+        Status {
+            link_version: LINK_VERSION,
+            t_s: 1234.5,
+            state: SeekState::NotReady(BitItem::Inclinometer),
+            progress: 0.42,
+            predicted_sigma_deg: 0.031,
+            temp_c: 31.25,
+            model_crc32: Some(0xDEAD_BEEF),
+            bit: BitWord(bit),
+            reset_reason: ResetReason::Watchdog,
+            latitude_deg: 39.9,
+            tilt: Tilt {
+                pitch_deg: -12.5,
+                roll_deg: 3.25,
+            },
+            restarts: 2,
+            last_restart: Some(MotionReason::TiltChange { change_mdeg: 120 }),
+        }
+    }
+
+    fn all_messages() -> Vec<DeviceMessage> {
+        vec![
+            DeviceMessage::Status(status(0x0010)),
+            DeviceMessage::Status(Status {
+                model_crc32: None,
+                last_restart: None,
+                state: SeekState::Seeking,
+                ..status(u16::MAX)
+            }),
+            DeviceMessage::Result(SeekReport {
+                sequence: u32::MAX,
+                azimuth_deg: 359.999_999,
+                sigma_deg: 0.02,
+                tilt: Tilt::LEVEL,
+                duration_s: 290.0,
+                t_end_s: 1e6,
+                positions: 4,
+                validity: Validity::LatitudeMismatch {
+                    observed_latitude_deg: 12.0,
+                },
+            }),
+            DeviceMessage::Accepted,
+            DeviceMessage::Refused(Refusal::Quality(QualityError::TiltOutOfRange {
+                tilt_cdeg: u32::MAX,
+                max_cdeg: 3000,
+            })),
+            DeviceMessage::Refused(Refusal::Quality(QualityError::Finder(
+                FinderFault::TableTimeout { position: 3 },
+            ))),
+            DeviceMessage::Refused(Refusal::NotSeeking),
+        ]
+    }
+
+    #[test]
+    fn every_message_roundtrips_through_the_upload_framing() {
+        let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
+        let mut rx = FrameReceiver::new();
+        for m in all_messages() {
+            let n = encode(&m, &mut wire).unwrap();
+            assert!(n <= MAX_LINK_FRAME_LEN, "{m:?}: {n} bytes");
+            let mut got = None;
+            for &b in &wire[..n] {
+                if let Some(p) = rx.push(b) {
+                    got = Some(decode::<DeviceMessage>(p.unwrap()).unwrap());
+                }
+            }
+            assert_eq!(got, Some(m));
+        }
+        for c in [
+            Command::StartSeek { positions: 2 },
+            Command::SetLatitude {
+                latitude_deg: -33.9,
+            },
+            Command::Abort,
+            Command::GetStatus,
+        ] {
+            let n = encode(&c, &mut wire).unwrap();
+            let p = crate::protocol::decode_frame(&mut wire[..n - 1]).unwrap();
+            assert_eq!(decode::<Command>(p).unwrap(), c);
+        }
+    }
+
+    #[test]
+    fn random_bytes_and_corrupted_frames_never_panic_nor_decode_wrong() {
+        let mut rng = SplitMix64::new(10);
+        let mut rx = FrameReceiver::new();
+        let msgs = all_messages();
+        let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
+        let mut decoded_ok = 0;
+        for round in 0..2000 {
+            let m = &msgs[round % msgs.len()];
+            let n = encode(m, &mut wire).unwrap();
+            // Flip one random byte of the body in half of the rounds.
+            let flip = round % 2 == 1;
+            if flip {
+                let i = (rng.next_u64() % (n as u64 - 1)) as usize;
+                wire[i] ^= 1 + (rng.next_u64() % 255) as u8;
+            }
+            // Random garbage before the frame.
+            for _ in 0..(rng.next_u64() % 8) {
+                let _ = rx.push((rng.next_u64() % 256) as u8);
+            }
+            let _ = rx.push(0);
+            for &b in &wire[..n] {
+                if let Some(Ok(p)) = rx.push(b) {
+                    if let Ok(back) = decode::<DeviceMessage>(p) {
+                        // A CRC-32 collision is not expected in 1000 corrupted frames.
+                        assert_eq!(&back, m, "round {round}");
+                        decoded_ok += 1;
+                    }
+                }
+            }
+        }
+        assert!(decoded_ok >= 1000, "{decoded_ok}");
+    }
+}
