@@ -8,20 +8,9 @@ mod independent;
 use fog_sim::diagnose::diagnose;
 use independent::{campaign, Hidden};
 
-/// Seeds run by default; `DIAG_SEEDS=1,2,3` tries others (by hand).
-const SEEDS: [u64; 3] = [11, 22, 33];
-
-fn seeds() -> Vec<u64> {
-    std::env::var("DIAG_SEEDS")
-        .ok()
-        .map(|s| {
-            s.split(',')
-                .filter_map(|x| x.trim().parse().ok())
-                .collect::<Vec<u64>>()
-        })
-        .filter(|v| !v.is_empty())
-        .unwrap_or_else(|| SEEDS.to_vec())
-}
+#[path = "common/seeds.rs"]
+mod seeds;
+use seeds::seeds;
 
 /// `named_required`: the family-wise decision must name it; otherwise it must rank first
 /// among run-level candidates with run-permutation p < 0.01 and nothing wrong be named.
