@@ -20,6 +20,20 @@ fn small() -> Vec<Run> {
     .0
 }
 
+/// One 45 min record with nothing planted.
+fn one_record() -> Vec<Run> {
+    campaign(
+        Effect::Null,
+        9,
+        Shape {
+            runs: 1,
+            minutes: 45.0,
+            sigmas: 1.0,
+        },
+    )
+    .0
+}
+
 fn set_column(run: &mut Run, name: &str, values: Vec<f64>) {
     match run.columns.iter().position(|c| c == name) {
         Some(i) => run.data[i] = values,
@@ -124,16 +138,7 @@ fn constant_temperature_is_refused() {
 
 #[test]
 fn a_single_record_is_validated_on_time_blocks_and_says_so() {
-    let runs = campaign(
-        Effect::Null,
-        9,
-        Shape {
-            runs: 1,
-            minutes: 45.0,
-            sigmas: 1.0,
-        },
-    )
-    .0;
+    let runs = one_record();
     let d = diagnose(&runs).expect("one long record is enough for time blocks");
     assert!(
         d.report.campaign.validation.contains("time blocks"),
@@ -141,4 +146,24 @@ fn a_single_record_is_validated_on_time_blocks_and_says_so() {
         d.report.campaign.validation
     );
     assert!(d.report.named_cause.is_none());
+}
+
+#[test]
+fn a_record_too_short_for_test_power_says_cannot_decide() {
+    let long = one_record();
+    let d = diagnose(&long).unwrap();
+    assert!(d.report.campaign.smallest_attainable_p < 0.01);
+    assert!(d.report.cause_in_words.starts_with("no significant cause"));
+    let mut short = long;
+    for v in short[0].data.iter_mut() {
+        v.truncate(20);
+    }
+    let d = diagnose(&short).unwrap();
+    let p = d.report.campaign.smallest_attainable_p;
+    assert!(p >= 0.01, "20 points, 6 blocks: smallest p {p}");
+    assert!(
+        d.report.cause_in_words.contains("no test power"),
+        "{}",
+        d.report.cause_in_words
+    );
 }

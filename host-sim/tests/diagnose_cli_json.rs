@@ -36,11 +36,14 @@ fn json_has_the_issue_schema_and_plots_are_written() {
     .unwrap();
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    assert_eq!(
-        v["baseline"]["inputs"],
-        serde_json::json!(["temp_c:value", "temp_c:rate"])
-    );
-    assert!(v["baseline"]["heldout_rms_dph"].as_f64().unwrap() > 0.0);
+    let base = &v["base"];
+    let chosen = base["heldout_rms_dph"].as_f64().unwrap();
+    assert!(chosen > 0.0);
+    assert!(base["name"].is_string() && base["uses_rate"].is_boolean());
+    let tried = base["tried"].as_array().unwrap();
+    assert_eq!(tried.len(), 8, "constant, poly 1-3 with/without dT/dt, RBF");
+    let same = tried.iter().find(|b| b["name"] == base["name"]).unwrap();
+    assert_eq!(same["heldout_rms_dph"].as_f64().unwrap(), chosen);
     let c0 = &v["candidates"][0];
     for key in [
         "column",

@@ -7,20 +7,9 @@ mod planted;
 use fog_sim::diagnose::diagnose;
 use planted::{campaign, Effect, Shape};
 
-/// Seeds run by default; `DIAG_SEEDS=1,2,3` tries others (for robustness checks by hand).
-const SEEDS: [u64; 3] = [11, 22, 33];
-
-fn seeds() -> Vec<u64> {
-    std::env::var("DIAG_SEEDS")
-        .ok()
-        .map(|s| {
-            s.split(',')
-                .filter_map(|x| x.trim().parse().ok())
-                .collect::<Vec<u64>>()
-        })
-        .filter(|v| !v.is_empty())
-        .unwrap_or_else(|| SEEDS.to_vec())
-}
+#[path = "common/seeds.rs"]
+mod seeds;
+use seeds::seeds;
 
 fn check(effect: Effect) {
     let results: Vec<String> = std::thread::scope(|s| {
@@ -45,7 +34,7 @@ fn check(effect: Effect) {
                         .collect();
                     let line = format!(
                         "{effect:?} seed {seed}: expected {expected:?}, named {named:?}, gain {:+.2}%, base {:.4} -> {:.4}; top {top:?}",
-                        r.extended.gain_pct, r.baseline.heldout_rms_dph, r.extended.heldout_rms_dph
+                        r.extended.gain_pct, r.base.heldout_rms_dph, r.extended.heldout_rms_dph
                     );
                     (ok, line)
                 })

@@ -146,7 +146,12 @@ fn close_the_loop(planted: Planted, column: &str, expected: Transform, coeff_tol
     let measured = measured_campaign(planted);
     let d = diagnose(&measured).unwrap();
     let r = &d.report;
-    let cause = r.named_cause.as_ref().expect("a cause must be named");
+    let cause = r.named_cause.as_ref().unwrap_or_else(|| {
+        panic!(
+            "a cause must be named:\n{}",
+            fog_sim::diagnose::report::render_text(r)
+        )
+    });
     assert_eq!(cause.column, column, "named {}", cause.label());
     assert_eq!(cause.transform, expected, "named {}", cause.label());
 

@@ -12,8 +12,14 @@ use super::linalg::solve_spd;
 
 /// Fewest runs for validation grouped by run.
 pub const MIN_RUNS_GROUPED: usize = 4;
-/// Time blocks per run when the campaign has fewer runs than that.
+/// Fewest time blocks per run when the campaign has fewer runs than that.
 pub const BLOCKS_PER_RUN: usize = 5;
+/// Validation units wanted in total for time-block layouts: 2^-8 = 0.0039 is the
+/// smallest reachable sign-flip p, below the family-wise alpha 0.01 (five blocks of one
+/// record could never go below 1/32 = 0.031: "no test power" by construction).
+pub const MIN_BLOCK_UNITS: usize = 8;
+/// Fewest 10 s points in a time block.
+pub const MIN_POINTS_PER_BLOCK: usize = 3;
 /// Fewest 10 s points per run for time-block validation.
 pub const MIN_POINTS_PER_BLOCK_RUN: usize = 20;
 
@@ -66,11 +72,14 @@ impl Folds {
             });
         }
         let mut unit_rows = Vec::new();
+        let wanted = MIN_BLOCK_UNITS
+            .div_ceil(run_lengths.len())
+            .max(BLOCKS_PER_RUN);
         for r in &run_rows {
             let n = r.len();
-            for b in 0..BLOCKS_PER_RUN {
-                unit_rows
-                    .push(r.start + b * n / BLOCKS_PER_RUN..r.start + (b + 1) * n / BLOCKS_PER_RUN);
+            let blocks = wanted.min(n / MIN_POINTS_PER_BLOCK).max(BLOCKS_PER_RUN);
+            for b in 0..blocks {
+                unit_rows.push(r.start + b * n / blocks..r.start + (b + 1) * n / blocks);
             }
         }
         Ok(Self {
@@ -336,6 +345,8 @@ mod tests {
         let cv = p.validate(&folds).unwrap();
         assert!(cv.rms() < 1e-6, "rms {}", cv.rms());
         assert!(Folds::new(&[5, 5]).is_err());
-        assert_eq!(Folds::new(&[40]).unwrap().unit_rows.len(), BLOCKS_PER_RUN);
+        assert_eq!(Folds::new(&[40]).unwrap().unit_rows.len(), MIN_BLOCK_UNITS);
+        assert_eq!(Folds::new(&[20]).unwrap().unit_rows.len(), 6);
+        assert_eq!(Folds::new(&[40, 40]).unwrap().unit_rows.len(), 10);
     }
 }

@@ -9,13 +9,16 @@
 //! draws it, [`azimuth`] translates it into north-seeking error.
 
 pub mod azimuth;
+pub mod bases;
 pub mod basis;
+pub mod between;
 pub mod cv;
 pub mod error;
 pub mod input;
 pub mod linalg;
 pub mod models;
 pub mod olscheck;
+pub mod outliers;
 pub mod plots;
 pub mod report;
 pub mod residuals;
@@ -62,16 +65,37 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
     let campaign = input::prepare(runs)?;
     let st = Stacked::new(&campaign);
     let folds = Folds::new(&st.run_lengths)?;
-    let base = models::fit_baseline(&folds, &st)?;
+    let choice = bases::choose(&folds, &st)?;
+    let base = &choice.chosen;
     let base_rms = base.cv.rms();
     let structure = residuals::structure(&campaign, &folds, &st, &base.cv.residual);
+    let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
+    let outliers = outliers::locate(&folds, &run_names, &st.t_s, &st.y, &base.cv.residual);
+    let run_level = between::prepare(&campaign, &folds, &st, base);
+    let no_gains = Vec::new();
     let screening = screen::screen(
         &campaign,
         &folds,
         &st,
-        &base,
+        base,
         transforms::enumerate(&campaign),
+        run_level.as_ref().map_or(&no_gains, |p| &p.gains),
     )?;
+    let latitude = campaign
+        .runs
+        .iter()
+        .find_map(|s| s.latitude_deg)
+        .unwrap_or(azimuth::DEFAULT_LATITUDE_DEG);
+    let between_run = match run_level {
+        Ok(p) => between::finish(p, &screening.between_p, latitude),
+        Err(note) => between::BetweenRun {
+            turn_on_repeatability_dph: f64::NAN,
+            rows: vec![],
+            named: None,
+            heading: None,
+            note: Some(note),
+        },
+    };
 
     let named = screening.named.map(|i| &screening.scored[i]);
     let cause = named.map(|s| Cause {
@@ -85,7 +109,7 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
         &st.y,
         named.map(|s| s.cols.as_slice()),
     )?;
-    let base_inputs = vec!["temp_c:value".to_owned(), "temp_c:rate".to_owned()];
+    let base_inputs = base.spec.inputs();
     let (extended, ext_resid) = match named {
         Some(s) => {
             let mut inputs = base_inputs.clone();
@@ -111,16 +135,19 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
         ),
     };
     let has_heading = campaign.extra_names.iter().any(|n| n.contains("heading"));
-    let latitude = campaign
-        .runs
-        .iter()
-        .find_map(|s| s.latitude_deg)
-        .unwrap_or(azimuth::DEFAULT_LATITUDE_DEG);
     let azimuth = has_heading.then(|| Azimuth {
         baseline: azimuth::azimuth_effect(&folds, &st.t_s, &base.cv.residual, latitude),
         extended: azimuth::azimuth_effect(&folds, &st.t_s, &ext_resid, latitude),
     });
-    let words = report::cause_in_words(cause.as_ref(), &sim.effect_coef);
+    let smallest_attainable_p = signflip::smallest_p(folds.unit_rows.len());
+    let words = report::cause_in_words(cause.as_ref(), &sim.effect_coef).unwrap_or_else(|| {
+        match &between_run.named {
+            Some(b) => format!(
+                "no within-run cause; between runs: {b} (see the heading / run-level lines)"
+            ),
+            None => report::nothing_named(smallest_attainable_p),
+        }
+    });
     let sim_terms = simterm::terms_per_run(runs, cause.as_ref(), &sim.effect_coef);
     let term_summaries: Vec<simterm::TermSummary> = sim_terms
         .first()
@@ -139,16 +166,23 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
             validation: folds.describe(),
             excluded_columns: campaign.exclusions.clone(),
             skipped_candidates: screening.skipped.iter().map(to_excl).collect(),
-            smallest_attainable_p: signflip::smallest_p(folds.unit_rows.len()),
+            smallest_attainable_p,
         },
-        baseline: ModelSummary {
+        base: ModelSummary {
+            name: base.spec.name.clone(),
+            poly_degree_t: base.spec.poly_degree_t,
+            uses_rate: base.spec.uses_rate,
             inputs: base_inputs,
             heldout_rms_dph: base_rms,
             centres: base.centres,
             width_factor: base.width_factor,
             ridge: base.ridge,
+            tried: choice.scores.clone(),
+            collinearity_warning: choice.collinearity_warning.clone(),
         },
         residual_structure: structure,
+        outliers,
+        between_run,
         candidates: screening
             .scored
             .iter()
@@ -195,7 +229,7 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
     };
     Ok(Diagnosis {
         report,
-        run_names: campaign.runs.iter().map(|s| s.name.clone()).collect(),
+        run_names,
         run_rows: folds.run_rows.clone(),
         t_s: st.t_s.clone(),
         drift_dph: base.prepared.target().to_vec(),

@@ -95,23 +95,21 @@ pub fn fit_rbf(
     best.ok_or(DiagnoseError::Singular { what: "RBF fit" })
 }
 
-/// The paper's model: RBF on (T, dT/dt).
-pub fn fit_baseline(folds: &Folds, st: &Stacked) -> Result<RbfFit, DiagnoseError> {
-    fit_rbf(
-        folds,
-        &[st.temp_c.clone(), st.temp_rate_cps.clone()],
-        &[],
-        &st.y,
-    )
-}
-
-/// The candidate as a further RBF input (its columns also kept as linear terms).
+/// The candidate as a further RBF input next to the chosen base's inputs (T when the base
+/// uses it, dT/dt when it does; the candidate's columns also kept as linear terms).
 pub fn fit_rbf_input(
     folds: &Folds,
     st: &Stacked,
+    base: &super::bases::BaseSpec,
     cand: &[Vec<f64>],
 ) -> Result<RbfFit, DiagnoseError> {
-    let mut inputs = vec![st.temp_c.clone(), st.temp_rate_cps.clone()];
+    let mut inputs = Vec::new();
+    if base.rbf || base.poly_degree_t.is_some() {
+        inputs.push(st.temp_c.clone());
+    }
+    if base.uses_rate {
+        inputs.push(st.temp_rate_cps.clone());
+    }
     inputs.extend(cand.iter().cloned());
     fit_rbf(folds, &inputs, &[], &st.y)
 }

@@ -10,14 +10,22 @@ use super::transforms::Transform;
 use serde::Serialize;
 use std::fmt::Write as _;
 
-/// A model's held-out performance.
+/// The chosen base model and its held-out performance.
 #[derive(Clone, Debug, Serialize)]
 pub struct ModelSummary {
+    /// `constant`, `poly_t2_rate`, `rbf_t_rate`, ... (see `bases`).
+    pub name: String,
+    pub poly_degree_t: Option<u8>,
+    pub uses_rate: bool,
     pub inputs: Vec<String>,
     pub heldout_rms_dph: f64,
     pub centres: usize,
     pub width_factor: f64,
     pub ridge: f64,
+    /// Every base tried with its held-out rms (the lowest is chosen).
+    pub tried: Vec<super::bases::BaseScore>,
+    /// Set when T, time and lags of T are nearly collinear.
+    pub collinearity_warning: Option<String>,
 }
 
 /// One ranked candidate.
@@ -109,8 +117,10 @@ pub struct CampaignSummary {
 #[derive(Clone, Debug, Serialize)]
 pub struct Report {
     pub campaign: CampaignSummary,
-    pub baseline: ModelSummary,
+    pub base: ModelSummary,
     pub residual_structure: Structure,
+    pub outliers: super::outliers::Outliers,
+    pub between_run: super::between::BetweenRun,
     pub candidates: Vec<CandidateRow>,
     pub named_cause: Option<Cause>,
     pub cause_in_words: String,
@@ -122,16 +132,28 @@ pub struct Report {
     pub simulation: Simulation,
 }
 
-/// The cause in words (physics reading of a column and transform).
-pub fn cause_in_words(c: Option<&Cause>, coef: &[f64]) -> String {
-    let Some(c) = c else {
-        return "no significant cause: the residual of the paper's T, dT/dt model shows no structure that any \
-                candidate explains better than chance on held-out data"
-            .into();
-    };
+/// What "nothing named" means: no structure found, or no test power to find any.
+pub fn nothing_named(smallest_attainable_p: f64) -> String {
+    if smallest_attainable_p >= super::screen::ALPHA {
+        format!(
+            "cannot decide: no test power (smallest reachable p {smallest_attainable_p:.4} >= alpha {} with this \
+             few validation units); absence of a named cause says nothing about the drift",
+            super::screen::ALPHA
+        )
+    } else {
+        "no significant cause: the residual of the chosen base shows no structure that any \
+         candidate explains better than chance on held-out data"
+            .into()
+    }
+}
+
+/// The cause in words (physics reading of a column and transform); `None` when nothing
+/// is named (see `nothing_named`).
+pub fn cause_in_words(c: Option<&Cause>, coef: &[f64]) -> Option<String> {
+    let c = c?;
     let tau = c.tau_s.unwrap_or(0.0);
     let k = coef.first().copied().unwrap_or(0.0);
-    match (c.column.as_str(), c.transform) {
+    Some(match (c.column.as_str(), c.transform) {
         ("temp_c", Transform::Accel) => format!(
             "drift follows d2T/dt2 ({k:.3e} deg/h per degC/s^2): the Shupe gradient term (the rate of the temperature \
              gradient along the coil), which the T, dT/dt model cannot express"
@@ -163,7 +185,7 @@ pub fn cause_in_words(c: Option<&Cause>, coef: &[f64]) -> String {
         (col, Transform::Accel) => format!("drift follows the second derivative of `{col}` ({k:.4e} deg/h per unit/s^2)"),
         (col, Transform::Lag) => format!("drift follows `{col}` through a first-order lag of {tau:.0} s ({k:.4e} deg/h per unit)"),
         (col, Transform::Decay) => format!("drift decays as exp(-{col}/{tau:.0} s)"),
-    }
+    })
 }
 
 /// Human-readable report.
@@ -206,14 +228,28 @@ pub fn render_text(r: &Report) -> String {
         "  simulation vs measured drift: rms {:.4} deg/h (run offsets removed)",
         r.simulation.before_rms_dph
     );
+    let tried: Vec<String> = r
+        .base
+        .tried
+        .iter()
+        .map(|b| format!("{} {:.4}", b.spec.name, b.heldout_rms_dph))
+        .collect();
     let _ = writeln!(
         s,
-        "  paper's model RBF({}): held-out rms {:.4} deg/h ({} centres); uncompensated drift std {:.4} deg/h",
-        r.baseline.inputs.join(", "),
-        r.baseline.heldout_rms_dph,
-        r.baseline.centres,
+        "  bases tried (held-out rms, deg/h; run offsets free): {}",
+        tried.join(", ")
+    );
+    let _ = writeln!(
+        s,
+        "  chosen base {} ({}): held-out rms {:.4} deg/h; uncompensated drift std {:.4} deg/h; candidates are screened against it",
+        r.base.name,
+        r.base.inputs.join(", "),
+        r.base.heldout_rms_dph,
         r.drift_std.uncompensated_dph
     );
+    if let Some(w) = &r.base.collinearity_warning {
+        let _ = writeln!(s, "  warning: {w}");
+    }
     let _ = writeln!(s, "\n2. What the model gets wrong (held-out residual)");
     for b in &r.residual_structure.by_time {
         let _ = writeln!(
@@ -241,6 +277,21 @@ pub fn render_text(r: &Report) -> String {
         "  within-run correlation with signals: {}",
         top.join(", ")
     );
+    let o = &r.outliers;
+    let _ = writeln!(
+        s,
+        "  outliers: {} (beyond {:.2} robust sigma = {:.4} deg/h, or a repeated identical rate)",
+        o.count,
+        o.threshold_sigma,
+        o.threshold_sigma * o.robust_sigma_dph
+    );
+    for x in o.listed.iter().take(10) {
+        let _ = writeln!(
+            s,
+            "    run {} row {} (t {:.0} s) {}: {:+.1} sigma, value {:.5}; {}",
+            x.run, x.row, x.t_s, x.column, x.sigma, x.value, x.pattern
+        );
+    }
     let _ = writeln!(s, "\n3. Candidate causes (ranked by held-out rms; p = family-wise sign-flip test over whole validation units)");
     for row in r.candidates.iter().take(8) {
         let label = Cause {
@@ -260,6 +311,31 @@ pub fn render_text(r: &Report) -> String {
             100.0 * row.units_improved,
             if row.significant { "  *" } else { "" }
         );
+    }
+    let b = &r.between_run;
+    match &b.note {
+        Some(n) => {
+            let _ = writeln!(s, "  between runs: not tested ({n})");
+        }
+        None => {
+            let _ = writeln!(
+                s,
+                "  between runs (run offsets left by the base; turn-on repeatability {:.4} deg/h, leave one run out; p in the same family):",
+                b.turn_on_repeatability_dph
+            );
+            for row in b.rows.iter().take(4) {
+                let _ = writeln!(
+                    s,
+                    "  {:<28} offset rms {:.4}  gain {:+6.2}%  p {:.4}  (run permutation p {:.4}){}",
+                    row.label,
+                    row.heldout_offset_rms_dph,
+                    row.gain_pct,
+                    row.p_value,
+                    row.permutation_p,
+                    if row.significant { "  *" } else { "" }
+                );
+            }
+        }
     }
     let _ = writeln!(s, "\n4. Cause");
     match &r.named_cause {
@@ -281,10 +357,20 @@ pub fn render_text(r: &Report) -> String {
             comp.candidate, comp.conditional_gain_pct
         );
     }
+    if let Some(n) = &b.named {
+        let _ = writeln!(s, "  named between runs: {n}");
+    }
+    if let Some(h) = &b.heading {
+        let _ = writeln!(
+            s,
+            "  heading-dependent bias: amplitude {:.4} deg/h, maximum at {} = {:.0} deg; two-position seek azimuth error {:+.3} deg at psi 90 deg (up to {:.3} deg where |sin psi| >= 0.5, lat {:.1})",
+            h.amplitude_dph, h.column, h.phase_deg, h.azimuth_error_at_90_deg, h.azimuth_error_bound_deg, h.latitude_deg
+        );
+    }
     let e = &r.extended;
     let _ = writeln!(
         s,
-        "  extended model RBF({}): held-out rms {:.4} deg/h, gain {:+.2}% ; drift std {:.4} -> {:.4} -> {:.4} deg/h (raw -> paper -> extended)",
+        "  extended model ({}): held-out rms {:.4} deg/h, gain {:+.2}% ; drift std {:.4} -> {:.4} -> {:.4} deg/h (raw -> base -> extended)",
         e.inputs.join(", "),
         e.heldout_rms_dph,
         e.gain_pct,

@@ -13,10 +13,11 @@
 //!    imitate its column's value or derivatives). Significant candidates that lose their
 //!    gain once the named one is in the model are reported as competing with it.
 
+use super::bases::BaseFit;
 use super::cv::{CvResult, Folds};
 use super::error::DiagnoseError;
 use super::input::Campaign;
-use super::models::{fit_rbf_input, RbfFit, Stacked};
+use super::models::{fit_rbf_input, Stacked};
 use super::signflip::{max_t_pvalues, paired_pvalue};
 use super::transforms::Candidate;
 
@@ -66,6 +67,8 @@ pub struct Screening {
     pub competing: Vec<(String, f64)>,
     /// When the named cause displaced a higher-gain candidate of the same column.
     pub parsimony_note: Option<String>,
+    /// Family-wise p-values of the between-run candidates (same max-T family).
+    pub between_p: Vec<f64>,
 }
 
 fn has_within_unit_variation(folds: &Folds, col: &[f64]) -> bool {
@@ -95,8 +98,9 @@ pub fn screen(
     campaign: &Campaign,
     folds: &Folds,
     st: &Stacked,
-    base: &RbfFit,
+    base: &BaseFit,
     cands: Vec<Candidate>,
+    between_gains: &[Vec<f64>],
 ) -> Result<Screening, DiagnoseError> {
     let base_rms = base.cv.rms();
     let mut skipped = Vec::new();
@@ -119,7 +123,8 @@ pub fn screen(
         {
             skipped.push((
                 cand.label(),
-                "no variation within runs: cannot be told from run offsets".to_owned(),
+                "no variation within runs: tested between runs instead (run-level means)"
+                    .to_owned(),
             ));
             continue;
         }
@@ -137,8 +142,16 @@ pub fn screen(
             units_improved: 0.0,
         });
     }
+    // One family-wise decision over within-run and between-run candidates: max-T sign
+    // flips inside each group, Bonferroni over the two groups. (One max-T over both was
+    // measured to drown within-run effects: run-offset gains are far larger, so they
+    // dominate the null maximum.)
     let gains: Vec<Vec<f64>> = scored.iter().map(|s| unit_gains(&base.cv, &s.cv)).collect();
-    let pv = max_t_pvalues(&gains, FLIP_SEED);
+    let groups = if between_gains.is_empty() { 1.0 } else { 2.0 };
+    let adjust =
+        |p: Vec<f64>| -> Vec<f64> { p.into_iter().map(|x| (groups * x).min(1.0)).collect() };
+    let pv = adjust(max_t_pvalues(&gains, FLIP_SEED));
+    let between_p = adjust(max_t_pvalues(between_gains, FLIP_SEED));
     for (s, p) in scored.iter_mut().zip(pv) {
         s.p_value = p;
     }
@@ -148,7 +161,7 @@ pub fn screen(
         .take(REFIT_TOP)
         .filter(|s| s.gain_pct > 0.0)
     {
-        if let Ok(fit) = fit_rbf_input(folds, st, &s.cols) {
+        if let Ok(fit) = fit_rbf_input(folds, st, &base.spec, &s.cols) {
             if fit.cv.rms() < s.heldout_rms_dph {
                 s.mode = Mode::RbfInput;
                 s.heldout_rms_dph = fit.cv.rms();
@@ -201,6 +214,7 @@ pub fn screen(
         named,
         competing,
         parsimony_note,
+        between_p,
     })
 }
 
@@ -217,7 +231,7 @@ pub fn unit_gains(from: &CvResult, to: &CvResult) -> Vec<f64> {
 /// vanishes once the named cause is in the model: they explain the same thing.
 fn competitors(
     folds: &Folds,
-    base: &RbfFit,
+    base: &BaseFit,
     scored: &[Scored],
     named: usize,
 ) -> Result<Vec<(String, f64)>, DiagnoseError> {

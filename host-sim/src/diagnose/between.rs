@@ -1,0 +1,372 @@
+//! Effects that live between runs: a bias constant within a run but different from run to
+//! run (a heading-dependent magnetic bias when each run has its own heading; a
+//! dependence on the chamber ambient or on a column's run mean). Within-run screening
+//! cannot see them: the free run offset absorbs them. Here the run offsets left by the
+//! chosen base (the turn-on biases) are the data: each candidate (run-level features) is
+//! validated leaving one run out against the offsets' own mean (the turn-on
+//! repeatability), and its per-run held-out gains are scaled by the run's point count so
+//! they are drops in held-out squared error like the within-run gains. They then enter
+//! the same Westfall-Young sign-flip family as the within-run candidates (one
+//! family-wise decision); a run-level permutation test (features shuffled across runs)
+//! is reported next to it as a check.
+
+use super::bases::BaseFit;
+use super::cv::Folds;
+use super::input::Campaign;
+use super::linalg::solve_spd;
+use super::models::Stacked;
+use fog_core::consts::EARTH_RATE_DPH;
+use rand::seq::SliceRandom;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use serde::Serialize;
+
+/// Run-level permutations for the check p-value.
+pub const PERMUTATIONS: usize = 4_000;
+/// Seed of the permutations (results are deterministic).
+pub const PERM_SEED: u64 = 0xBE7_3EE2;
+
+/// One run-level candidate: `features[r]` holds run r's feature values.
+#[derive(Clone, Debug)]
+pub struct RunCandidate {
+    pub label: String,
+    pub column: String,
+    pub harmonic: bool,
+    pub features: Vec<Vec<f64>>,
+}
+
+/// One scored run-level candidate, for the report.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunRow {
+    pub label: String,
+    /// Leave-one-run-out rms of the run offsets with the candidate, deg/h.
+    pub heldout_offset_rms_dph: f64,
+    /// Gain on the turn-on repeatability, %.
+    pub gain_pct: f64,
+    /// Family-wise p (shared with the within-run candidates).
+    pub p_value: f64,
+    /// Run-level permutation p (candidate alone).
+    pub permutation_p: f64,
+    pub significant: bool,
+    /// Fitted coefficients on all runs (intercept first), deg/h per unit.
+    pub coef: Vec<f64>,
+}
+
+/// A named heading harmonic in north-seeking terms.
+#[derive(Clone, Debug, Serialize)]
+pub struct HeadingEffect {
+    pub column: String,
+    pub amplitude_dph: f64,
+    /// Heading of maximum bias, deg.
+    pub phase_deg: f64,
+    pub latitude_deg: f64,
+    /// Two-position seek at psi = 90 deg: bias difference 2 A cos(psi - phase) over
+    /// 2 Omega_H sin psi, deg.
+    pub azimuth_error_at_90_deg: f64,
+    /// Largest over the seek headings where |sin psi| >= 0.5 (A / (Omega_H / 2)), deg.
+    pub azimuth_error_bound_deg: f64,
+}
+
+/// The between-run analysis.
+#[derive(Clone, Debug, Serialize)]
+pub struct BetweenRun {
+    /// rms of the run offsets about their leave-one-out mean, deg/h.
+    pub turn_on_repeatability_dph: f64,
+    pub rows: Vec<RunRow>,
+    /// Label of the named run-level effect, if any.
+    pub named: Option<String>,
+    pub heading: Option<HeadingEffect>,
+    /// Why the analysis was not run, if it was not.
+    pub note: Option<String>,
+}
+
+fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len().max(1) as f64
+}
+
+/// Run offsets left by the base fitted on every run: mean over the run of drift minus
+/// the base's prediction (the base itself carries no offset).
+pub fn run_offsets(folds: &Folds, st: &Stacked, base: &BaseFit) -> Vec<f64> {
+    let cols = base.raw_columns(st);
+    let w = base
+        .prepared
+        .fit_all(folds, &[])
+        .map(|(w, _)| w)
+        .unwrap_or_default();
+    folds
+        .run_rows
+        .iter()
+        .map(|r| {
+            let resid: Vec<f64> = r
+                .clone()
+                .map(|i| st.y[i] - cols.iter().zip(&w).map(|(c, wj)| c[i] * wj).sum::<f64>())
+                .collect();
+            mean(&resid)
+        })
+        .collect()
+}
+
+/// Run-level candidates: the harmonic (cos, sin of the run's circular mean) of every
+/// `*_deg` column, the run mean of every other extra column, and the ambient.
+pub fn enumerate(c: &Campaign) -> Vec<RunCandidate> {
+    let mut out = Vec::new();
+    for (j, name) in c.extra_names.iter().enumerate() {
+        if name.ends_with("_deg") {
+            let f = c
+                .runs
+                .iter()
+                .map(|s| {
+                    let cs = mean(
+                        &s.extras[j]
+                            .iter()
+                            .map(|a| a.to_radians().cos())
+                            .collect::<Vec<_>>(),
+                    );
+                    let sn = mean(
+                        &s.extras[j]
+                            .iter()
+                            .map(|a| a.to_radians().sin())
+                            .collect::<Vec<_>>(),
+                    );
+                    let ang = sn.atan2(cs);
+                    vec![ang.cos(), ang.sin()]
+                })
+                .collect();
+            out.push(RunCandidate {
+                label: format!("{name}:run_harmonic"),
+                column: name.clone(),
+                harmonic: true,
+                features: f,
+            });
+        } else {
+            out.push(RunCandidate {
+                label: format!("{name}:run_mean"),
+                column: name.clone(),
+                harmonic: false,
+                features: c.runs.iter().map(|s| vec![mean(&s.extras[j])]).collect(),
+            });
+        }
+    }
+    if c.runs.iter().all(|s| s.ambient_c.is_some()) {
+        out.push(RunCandidate {
+            label: "ambient_c:run_value".into(),
+            column: "ambient_c".into(),
+            harmonic: false,
+            features: c
+                .runs
+                .iter()
+                .map(|s| vec![s.ambient_c.unwrap_or(0.0)])
+                .collect(),
+        });
+    }
+    out.retain(|c| varies(&c.features));
+    out
+}
+
+fn varies(f: &[Vec<f64>]) -> bool {
+    let k = f.first().map_or(0, Vec::len);
+    (0..k).any(|j| {
+        let v: Vec<f64> = f.iter().map(|x| x[j]).collect();
+        let m = mean(&v);
+        v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() > 1e-12 * (1.0 + m * m) * v.len() as f64
+    })
+}
+
+/// Least squares o = a + b . f over `rows` (small ridge for stability).
+fn fit(o: &[f64], f: &[Vec<f64>], rows: &[usize]) -> Option<Vec<f64>> {
+    let q = 1 + f.first().map_or(0, Vec::len);
+    let mut a = vec![0.0; q * q];
+    let mut b = vec![0.0; q];
+    for &r in rows {
+        let x: Vec<f64> = std::iter::once(1.0).chain(f[r].iter().copied()).collect();
+        for i in 0..q {
+            b[i] += x[i] * o[r];
+            for j in 0..q {
+                a[i * q + j] += x[i] * x[j];
+            }
+        }
+    }
+    for i in 0..q {
+        a[i * q + i] += 1e-9 * (1.0 + a[i * q + i]);
+    }
+    solve_spd(&mut a, &mut b, q).ok()?;
+    Some(b)
+}
+
+fn predict(coef: &[f64], f: &[f64]) -> f64 {
+    coef[0] + coef[1..].iter().zip(f).map(|(c, x)| c * x).sum::<f64>()
+}
+
+/// Per-run held-out gains (run's points x drop in squared offset error, leave one run
+/// out), the leave-one-out rms without and with the candidate.
+pub fn loo_gains(o: &[f64], lens: &[usize], f: &[Vec<f64>]) -> Option<(Vec<f64>, f64, f64)> {
+    let n = o.len();
+    let mut gains = Vec::with_capacity(n);
+    let (mut ss0, mut ss1) = (0.0, 0.0);
+    for r in 0..n {
+        let rows: Vec<usize> = (0..n).filter(|&i| i != r).collect();
+        let m = rows.iter().map(|&i| o[i]).sum::<f64>() / rows.len() as f64;
+        let coef = fit(o, f, &rows)?;
+        let e0 = o[r] - m;
+        let e1 = o[r] - predict(&coef, &f[r]);
+        ss0 += e0 * e0;
+        ss1 += e1 * e1;
+        gains.push(lens[r] as f64 * (e0 * e0 - e1 * e1));
+    }
+    Some((gains, (ss0 / n as f64).sqrt(), (ss1 / n as f64).sqrt()))
+}
+
+/// Run-level permutation p of the total gain (features shuffled across runs).
+pub fn permutation_p(o: &[f64], lens: &[usize], f: &[Vec<f64>]) -> f64 {
+    let Some((g, _, _)) = loo_gains(o, lens, f) else {
+        return 1.0;
+    };
+    let obs: f64 = g.iter().sum();
+    let mut rng = ChaCha8Rng::seed_from_u64(PERM_SEED);
+    let mut perm: Vec<Vec<f64>> = f.to_vec();
+    let mut hits = 1usize;
+    for _ in 0..PERMUTATIONS {
+        perm.shuffle(&mut rng);
+        if let Some((gp, _, _)) = loo_gains(o, lens, &perm) {
+            if gp.iter().sum::<f64>() >= obs - 1e-12 * obs.abs() {
+                hits += 1;
+            }
+        }
+    }
+    hits as f64 / (PERMUTATIONS + 1) as f64
+}
+
+/// A heading harmonic's amplitude, phase and two-position azimuth error.
+pub fn heading_effect(column: &str, coef: &[f64], latitude_deg: f64) -> HeadingEffect {
+    let (a, b) = (
+        coef.get(1).copied().unwrap_or(0.0),
+        coef.get(2).copied().unwrap_or(0.0),
+    );
+    let amp = a.hypot(b);
+    let phase = b.atan2(a);
+    let omega_h = (EARTH_RATE_DPH * latitude_deg.to_radians().cos())
+        .abs()
+        .max(1e-9);
+    // at psi = 90 deg: 2 A cos(90 deg - phase) / (2 Omega_H sin 90 deg)
+    let at_90 = (amp * phase.sin() / omega_h).atan().to_degrees();
+    HeadingEffect {
+        column: column.to_owned(),
+        amplitude_dph: amp,
+        phase_deg: phase.to_degrees().rem_euclid(360.0),
+        latitude_deg,
+        azimuth_error_at_90_deg: at_90,
+        azimuth_error_bound_deg: (amp / (0.5 * omega_h)).atan().to_degrees(),
+    }
+}
+
+/// Candidates with their per-run gains (for the shared family) and the scored rows
+/// (p-values filled in later by `finish`).
+pub struct Prepared {
+    pub offsets: Vec<f64>,
+    pub cands: Vec<RunCandidate>,
+    pub gains: Vec<Vec<f64>>,
+    pub rows: Vec<RunRow>,
+    pub repeatability_dph: f64,
+}
+
+/// Offsets, candidates and gains; `None` (with the reason) when runs are too few.
+pub fn prepare(
+    c: &Campaign,
+    folds: &Folds,
+    st: &Stacked,
+    base: &BaseFit,
+) -> Result<Prepared, String> {
+    if folds.offsets != super::cv::Offsets::PerUnit {
+        return Err("between-run effects need >= 4 runs held out whole".into());
+    }
+    let offsets = run_offsets(folds, st, base);
+    let lens: Vec<usize> = folds.run_rows.iter().map(|r| r.len()).collect();
+    let mut out = Prepared {
+        repeatability_dph: 0.0,
+        offsets,
+        cands: vec![],
+        gains: vec![],
+        rows: vec![],
+    };
+    for cand in enumerate(c) {
+        if cand.features[0].len() + 2 >= out.offsets.len() {
+            continue;
+        }
+        let Some((g, rms0, rms1)) = loo_gains(&out.offsets, &lens, &cand.features) else {
+            continue;
+        };
+        let all: Vec<usize> = (0..out.offsets.len()).collect();
+        out.repeatability_dph = rms0;
+        out.rows.push(RunRow {
+            label: cand.label.clone(),
+            heldout_offset_rms_dph: rms1,
+            gain_pct: 100.0 * (1.0 - rms1 / rms0.max(1e-300)),
+            p_value: 1.0,
+            permutation_p: permutation_p(&out.offsets, &lens, &cand.features),
+            significant: false,
+            coef: fit(&out.offsets, &cand.features, &all).unwrap_or_default(),
+        });
+        out.gains.push(g);
+        out.cands.push(cand);
+    }
+    Ok(out)
+}
+
+/// Fills in the family-wise p-values and names the best significant run-level effect.
+pub fn finish(p: Prepared, family_p: &[f64], latitude_deg: f64) -> BetweenRun {
+    let mut rows = p.rows;
+    for (r, fp) in rows.iter_mut().zip(family_p) {
+        r.p_value = *fp;
+        r.significant = *fp < super::screen::ALPHA && r.gain_pct > super::screen::MIN_GAIN_PCT;
+    }
+    let best = rows
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.significant)
+        .max_by(|a, b| a.1.gain_pct.total_cmp(&b.1.gain_pct))
+        .map(|(i, _)| i);
+    let heading = best
+        .filter(|&i| p.cands[i].harmonic)
+        .map(|i| heading_effect(&p.cands[i].column, &rows[i].coef, latitude_deg));
+    let named = best.map(|i| rows[i].label.clone());
+    rows.sort_by(|a, b| b.gain_pct.total_cmp(&a.gain_pct));
+    BetweenRun {
+        turn_on_repeatability_dph: p.repeatability_dph,
+        rows,
+        named,
+        heading,
+        note: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_heading_harmonic_in_the_offsets_is_recovered() {
+        let n = 12;
+        let lens = vec![100; n];
+        let f: Vec<Vec<f64>> = (0..n)
+            .map(|r| {
+                let h = (r as f64 * 97.0).to_radians();
+                vec![h.cos(), h.sin()]
+            })
+            .collect();
+        let jitter = |r: usize| 0.002 * ((r as f64 * 12.9898).sin() * 43_758.5).fract();
+        let o: Vec<f64> = (0..n)
+            .map(|r| 0.5 + 0.03 * f[r][0] - 0.01 * f[r][1] + jitter(r))
+            .collect();
+        let (g, rms0, rms1) = loo_gains(&o, &lens, &f).unwrap();
+        assert!(rms1 < 0.2 * rms0, "{rms0} -> {rms1}");
+        assert!(g.iter().sum::<f64>() > 0.0);
+        assert!(permutation_p(&o, &lens, &f) < 0.01);
+        let all: Vec<usize> = (0..n).collect();
+        let e = heading_effect("heading_deg", &fit(&o, &f, &all).unwrap(), 40.0);
+        assert!((e.amplitude_dph - 0.0316).abs() < 0.002, "{e:?}");
+        assert!((e.phase_deg - 341.6).abs() < 3.0, "{e:?}");
+        let unrelated: Vec<Vec<f64>> = (0..n).map(|r| vec![((r * 5) % 7) as f64]).collect();
+        let flat: Vec<f64> = (0..n).map(jitter).collect();
+        assert!(permutation_p(&flat, &lens, &unrelated) > 0.01);
+    }
+}

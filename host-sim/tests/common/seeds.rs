@@ -1,0 +1,17 @@
+//! Seeds for the diagnose generator tests: a fast default set, others via `DIAG_SEEDS=1,2,3`.
+
+/// Seeds run by default.
+pub const SEEDS: [u64; 3] = [11, 22, 33];
+
+/// `DIAG_SEEDS` if set (comma separated), else [`SEEDS`].
+pub fn seeds() -> Vec<u64> {
+    std::env::var("DIAG_SEEDS")
+        .ok()
+        .map(|s| {
+            s.split(',')
+                .filter_map(|x| x.trim().parse().ok())
+                .collect::<Vec<u64>>()
+        })
+        .filter(|v| !v.is_empty())
+        .unwrap_or_else(|| SEEDS.to_vec())
+}
