@@ -12,6 +12,7 @@ pub mod accuracy;
 pub mod bit;
 pub mod compensator;
 pub mod consts;
+pub mod exp_neg;
 pub mod features;
 pub mod fixed;
 pub mod hal;

@@ -1,6 +1,6 @@
-//! Gaussian RBF evaluation in f32 (with `exp_neg_f32`, a range-reduced polynomial
-//! exponential that is about twice as cheap as `libm::expf` on the Cortex-M4F), plus the
-//! f64 reference (`libm::exp`) the other evaluation paths are measured against.
+//! Gaussian RBF evaluation in f32 (with `exp_neg::exp_neg_table_f32`, a table-based
+//! exponential made for the Cortex-M4F's instruction count), plus the f64 reference
+//! (`libm::exp`) the other evaluation paths are measured against.
 //!
 //! drift_dph = bias + sum_j linear[j] * xn_j + sum_k poly[k-1] t^k
 //!             + sum_i w_i * exp(-||xn - c_i||^2 / (2 s_i^2)),
@@ -9,6 +9,8 @@
 //! the Gaussian distance (see `model`).
 //! No range check happens here: the compensator flags inputs outside the trained range.
 
+pub use crate::exp_neg::exp_neg_f32;
+use crate::exp_neg::{twice_exp_neg_half, GAUSS_MAX_V};
 use crate::model::{RbfModel, MAX_INPUTS, XN_CLAMP};
 
 /// Why an RBF evaluation was refused.
@@ -82,64 +84,75 @@ pub fn normalise_f32(model: &RbfModel, x_raw: &[f32]) -> Result<[f32; MAX_INPUTS
     Ok(xn)
 }
 
-/// exp(-u) for u >= 0 in f32: u log2(e) = n + f with n an integer, exp(-u) =
-/// 2^-n exp(-r), r = u - n ln 2 in [-ln2/2, ln2/2] (Cody-Waite two-part ln 2), exp(-r)
-/// by a degree-6 polynomial (Cephes expf coefficients). Measured relative error against
-/// f64 `exp` < 2e-7 over the whole range (test `exp_neg_f32_relative_error`); exactly 0
-/// for u > 87 (below f32's normal range) and for NaN-free but huge u. Branch-free apart
-/// from the cut-off, so the host trainer's loops vectorise it as well.
-#[inline]
-pub fn exp_neg_f32(u: f32) -> f32 {
-    const LOG2E: f32 = core::f32::consts::LOG2_E;
-    const LN2_HI: f32 = 0.693_359_4;
-    const LN2_LO: f32 = -2.121_944_4e-4;
-    const ROUND: f32 = 12_582_912.0; // 1.5 * 2^23: adding it rounds to an integer.
-    const MAX_U: f32 = 87.0;
-    // A compare and select, not `f32::min` (a libm call with NaN handling on the M4F).
-    let x = if u < MAX_U { -u } else { -MAX_U };
-    let n = (x * LOG2E + ROUND) - ROUND;
-    let r = x - n * LN2_HI - n * LN2_LO;
-    let p = 1.987_569_1e-4f32;
-    let p = p * r + 1.398_199_9e-3;
-    let p = p * r + 8.333_452e-3;
-    let p = p * r + 4.166_579_6e-2;
-    let p = p * r + 1.666_666_5e-1;
-    let p = p * r + 0.5;
-    let p = (p * r * r + r) + 1.0;
-    let scale = f32::from_bits(((n as i32 + 127) as u32) << 23);
-    // All-ones mask while u <= MAX_U (also drops NaN): a select, not a branch.
-    let keep = u32::from(u <= MAX_U).wrapping_neg();
-    f32::from_bits((p * scale).to_bits() & keep)
-}
-
-/// The polynomial base sum_k poly[k-1] t^k, t = xn0 held to `domain` (Horner).
-fn poly_f32(poly: &[f32], domain: (f32, f32), xn0: f32) -> f32 {
-    // max/min, not clamp: an unvalidated model's bounds may be NaN or reversed.
-    let t = xn0.max(domain.0).min(domain.1);
-    poly.iter().rev().fold(0.0f32, |acc, &p| (acc + p) * t)
-}
-
-/// Predicted drift, deg/h, in f32 with `libm::expf`. `x_raw` is in the order of `model.inputs`.
-pub fn predict_f32(model: &RbfModel, x_raw: &[f32]) -> Result<f32, RbfError> {
-    let xn = normalise_f32(model, x_raw)?;
-    let n = model.inputs.len();
-    let nr = model.n_rbf_inputs as usize;
-    let mut acc = model.bias_dph + poly_f32(&model.poly, model.poly_domain(), xn[0]);
-    for (&l, &x) in model.linear.iter().zip(xn.iter()).take(n) {
-        acc += l * x;
+/// The polynomial base sum_k poly[k-1] t^k, t = xn0 held to the trained range of input 0
+/// (Horner); 0 without a polynomial, which skips computing the range.
+fn poly_f32(model: &RbfModel, xn0: f32) -> f32 {
+    if model.poly.is_empty() {
+        return 0.0;
     }
-    // Sliced once, outside the loop: no bounds check or index call per centre.
-    let xr = xn.get(..nr).unwrap_or(&[]);
+    let (lo, hi) = model.poly_domain();
+    // Compare and select as `f32::max` then `f32::min` would (a NaN bound is ignored, a
+    // reversed pair gives `hi`), without their libm calls on the M4F.
+    let t = if xn0 < lo { lo } else { xn0 };
+    let t = if t > hi { hi } else { t };
+    model
+        .poly
+        .iter()
+        .rev()
+        .fold(0.0f32, |acc, &p| (acc + p) * t)
+}
+
+/// The square of `d`.
+#[inline(always)]
+fn sq(d: f32) -> f32 {
+    d * d
+}
+
+/// acc + sum_i w_i exp(-d2(c_i) / (2 s_i^2)) over the model's centres, with the squared
+/// distance `d2` written out for the model's number of RBF inputs (no inner loop per
+/// centre). Each term is computed as w_i 2 exp(-v/2), v = d2 / s^2, and summed doubled
+/// (exact scalings by 2: the result has the bits of the plain sum); a centre whose v
+/// is beyond the f32 underflow threshold costs a compare and a branch.
+#[inline(always)]
+fn add_gaussians(model: &RbfModel, acc: f32, d2: impl Fn(&[f32; MAX_INPUTS]) -> f32) -> f32 {
+    let mut twice_acc = 2.0 * acc;
     for ((c, &s), &w) in model
         .centers
         .iter()
         .zip(model.widths.iter())
         .zip(model.weights.iter())
     {
-        let d2: f32 = xr.iter().zip(c).map(|(x, c)| (x - c) * (x - c)).sum();
-        acc += w * exp_neg_f32(d2 / (2.0 * s * s));
+        let v = d2(c) / (s * s);
+        if v <= GAUSS_MAX_V {
+            twice_acc += w * twice_exp_neg_half(v);
+        }
     }
-    Ok(acc)
+    0.5 * twice_acc
+}
+
+/// Predicted drift, deg/h, in f32 (`exp_neg::exp_neg_table_f32`'s arithmetic). `x_raw` is in the order of
+/// `model.inputs`.
+pub fn predict_f32(model: &RbfModel, x_raw: &[f32]) -> Result<f32, RbfError> {
+    let xn = normalise_f32(model, x_raw)?;
+    let n = model.inputs.len();
+    let mut acc = model.bias_dph + poly_f32(model, xn[0]);
+    for (&l, &x) in model.linear.iter().zip(xn.iter()).take(n) {
+        acc += l * x;
+    }
+    // Summed in input order as a loop over the inputs would, so the result does not
+    // depend on which arm runs; `check_inputs` bounds n_rbf_inputs by the input count.
+    let [x0, x1, x2, x3] = xn;
+    Ok(match model.n_rbf_inputs {
+        0 => add_gaussians(model, acc, |_| 0.0),
+        1 => add_gaussians(model, acc, |c| sq(x0 - c[0])),
+        2 => add_gaussians(model, acc, |c| sq(x0 - c[0]) + sq(x1 - c[1])),
+        3 => add_gaussians(model, acc, |c| {
+            sq(x0 - c[0]) + sq(x1 - c[1]) + sq(x2 - c[2])
+        }),
+        _ => add_gaussians(model, acc, |c| {
+            sq(x0 - c[0]) + sq(x1 - c[1]) + sq(x2 - c[2]) + sq(x3 - c[3])
+        }),
+    })
 }
 
 /// Reference drift, deg/h, in f64 (`libm::exp`) from the same f32 parameters.
