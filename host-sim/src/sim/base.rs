@@ -12,8 +12,8 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 
+use super::checks::{finite, non_negative, positive};
 use super::error::SimError;
-use super::params::{finite, non_negative, positive};
 use fog_core::consts::EARTH_RATE_DPH;
 use fog_core::tilt::Tilt;
 

@@ -4,6 +4,7 @@
 //! an indexing turntable. See `docs/simulator.md` for the calibration to the paper.
 
 pub mod base;
+mod checks;
 pub mod error;
 pub mod gyro;
 pub mod noise;

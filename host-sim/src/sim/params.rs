@@ -2,6 +2,7 @@
 //! drift physics, IEEE Std 952 noise terms, run-to-run variation, and the default
 //! gyro calibrated to the paper at 20 degC (`GyroParams::paper_default`).
 
+use super::checks::{finite, fraction, non_negative, positive};
 use super::error::SimError;
 use super::terms::DriftTerm;
 
@@ -221,53 +222,5 @@ impl GyroParams {
     pub fn with_term(mut self, term: DriftTerm) -> Self {
         self.extra_terms.push(term);
         self
-    }
-}
-
-pub(crate) fn finite(name: &'static str, v: f64) -> Result<(), SimError> {
-    if v.is_finite() {
-        Ok(())
-    } else {
-        Err(SimError::BadParameter {
-            name,
-            value: v,
-            why: "must be finite",
-        })
-    }
-}
-
-pub(crate) fn positive(name: &'static str, v: f64) -> Result<(), SimError> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(SimError::BadParameter {
-            name,
-            value: v,
-            why: "must be > 0",
-        })
-    }
-}
-
-pub(crate) fn non_negative(name: &'static str, v: f64) -> Result<(), SimError> {
-    if v.is_finite() && v >= 0.0 {
-        Ok(())
-    } else {
-        Err(SimError::BadParameter {
-            name,
-            value: v,
-            why: "must be >= 0",
-        })
-    }
-}
-
-fn fraction(name: &'static str, v: f64) -> Result<(), SimError> {
-    if (0.0..=1.0).contains(&v) {
-        Ok(())
-    } else {
-        Err(SimError::BadParameter {
-            name,
-            value: v,
-            why: "must be within 0..=1",
-        })
     }
 }

@@ -1,8 +1,8 @@
 //! What one simulated power-on looks like from outside: ambient, duration, site,
 //! mounting, raw sample rate, seed and start condition.
 
+use super::checks::{finite, positive};
 use super::error::SimError;
-use super::params::{finite, positive};
 
 /// Thermal condition at power-on.
 #[derive(Clone, Copy, Debug, PartialEq)]

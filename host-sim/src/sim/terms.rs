@@ -3,8 +3,8 @@
 //! fitted coefficient (e.g. drift proportional to a supply-voltage column, to d2T/dt2,
 //! to a power-on decay, or a heading-dependent magnetic bias).
 
+use super::checks::{finite, positive};
 use super::error::SimError;
-use super::params::{finite, positive};
 
 /// The signal a term acts on.
 #[derive(Clone, Debug, PartialEq)]

@@ -6,8 +6,8 @@
 //! lands with a random indexing error and reports `Settled` after `settle_s`; while it
 //! turns, the gyro senses the table rate.
 
+use super::checks::{non_negative, positive};
 use super::error::SimError;
-use super::params::{non_negative, positive};
 use fog_core::hal::{TableState, Turntable};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
