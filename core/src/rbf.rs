@@ -76,12 +76,21 @@ pub(crate) fn check_inputs<T: Copy>(
 
 /// Raw inputs -> normalised inputs (f32), as the f32 evaluator sees them.
 pub fn normalise_f32(model: &RbfModel, x_raw: &[f32]) -> Result<[f32; MAX_INPUTS], RbfError> {
-    let n = check_inputs(model, x_raw, f32::is_finite)?;
-    let mut xn = [0.0f32; MAX_INPUTS];
-    for (j, (out, &x)) in xn.iter_mut().zip(x_raw.iter()).enumerate().take(n) {
-        *out = ((x - model.input_offset[j]) / model.input_scale[j]).clamp(-XN_CLAMP, XN_CLAMP);
-    }
-    Ok(xn)
+    check_inputs(model, x_raw, f32::is_finite)?;
+    // Written element by element (no zero-fill loop, no bounds checks): inputs beyond
+    // the model's count stay 0.
+    Ok(core::array::from_fn(|j| {
+        match (
+            x_raw.get(j),
+            model.input_offset.get(j),
+            model.input_scale.get(j),
+        ) {
+            (Some(&x), Some(&offset), Some(&scale)) => {
+                ((x - offset) / scale).clamp(-XN_CLAMP, XN_CLAMP)
+            }
+            _ => 0.0,
+        }
+    }))
 }
 
 /// The polynomial base sum_k poly[k-1] t^k, t = xn0 held to the trained range of input 0
