@@ -58,7 +58,7 @@ impl Default for TrainConfig {
             rho: 0.0,
             target_dph: None,
             poly_degrees: vec![0, 1, 2, 3],
-            max_candidates: 1000,
+            max_candidates: 500,
             max_design_bytes: 2 << 30,
             max_centers: MAX_CENTERS,
             width_candidates: vec![0.2, 0.35, 0.6, 1.0, 1.6],
