@@ -14,7 +14,7 @@ use super::dataset::Dataset;
 use super::error::{Result, TrainError};
 use super::fit::{select_path, SelectedPath, Shape, WidthDesign};
 use super::normalize::Normalizer;
-use crate::fanout::thread_count;
+use crate::fanout::{map_in_order, thread_count};
 pub use crate::stats::rms;
 use fog_core::model::WIDTH_RANGE;
 use serde::Serialize;
@@ -179,6 +179,7 @@ impl<'a> FoldContext<'a> {
 /// Scores every configured degree at one width: one Gram per fold, one selection path
 /// per (degree, fold) on the fold's training Gram, every prefix scored on the fold's
 /// held-out Gram; the best prefix's held-out residuals are then computed row by row.
+/// Degrees are scored in parallel (`fanout`), results in degree order.
 fn score_width(
     ctx: &FoldContext<'_>,
     cfg: &TrainConfig,
@@ -189,67 +190,65 @@ fn score_width(
     let clock = Instant::now();
     let design = WidthDesign::new(ds, cfg, ctx.points, width, max_degree);
     let grid_s = clock.elapsed().as_secs_f64();
-    let grams = design.grams_of(ds, ctx.points, ctx.fold, folds, thread_count(cfg.threads));
+    let threads = thread_count(cfg.threads);
+    let grams = design.grams_of(ds, ctx.points, ctx.fold, folds, threads);
     let gram_s = clock.elapsed().as_secs_f64() - grid_s;
     let max_m = cfg.max_centers;
-    let scores = cfg
-        .poly_degrees
-        .iter()
-        .map(|&degree| {
-            let shape = Shape {
-                width,
-                degree,
-                centers: None,
-            };
-            let paths: Vec<SelectedPath> = (0..folds)
-                .map(|f| select_path(grams.without_fold(f), &design, cfg, &shape))
-                .collect();
-            // sse[m]: held-out residual energy over all folds with m centres (a path
-            // that stopped early keeps its last prefix).
-            let mut sse = vec![0.0; max_m + 1];
-            for (f, path) in paths.iter().enumerate() {
-                let held = grams.fold(f);
-                let nf = path.forced.len();
-                let mut last = f64::NAN;
-                for (m, e) in sse.iter_mut().enumerate() {
-                    if let Some(Some(theta)) = path.thetas.get(m) {
-                        last = held.residual_energy(&path.columns[..nf + m], theta);
-                    }
-                    *e += last;
+    let scores = map_in_order(cfg.poly_degrees.len(), threads, |di| {
+        let degree = cfg.poly_degrees[di];
+        let shape = Shape {
+            width,
+            degree,
+            centers: None,
+        };
+        let paths: Vec<SelectedPath> = (0..folds)
+            .map(|f| select_path(grams.without_fold(f), &design, cfg, &shape))
+            .collect();
+        // sse[m]: held-out residual energy over all folds with m centres (a path
+        // that stopped early keeps its last prefix).
+        let mut sse = vec![0.0; max_m + 1];
+        for (f, path) in paths.iter().enumerate() {
+            let held = grams.fold(f);
+            let nf = path.forced.len();
+            let mut last = f64::NAN;
+            for (m, e) in sse.iter_mut().enumerate() {
+                if let Some(Some(theta)) = path.thetas.get(m) {
+                    last = held.residual_energy(&path.columns[..nf + m], theta);
                 }
+                *e += last;
             }
-            let pick = |path: &SelectedPath, m_best: Option<usize>| {
-                let own = path.thetas.iter().rposition(Option::is_some).unwrap_or(0);
-                m_best.map_or(own, |m| m.min(own))
-            };
-            let m_best = (cfg.method == Method::Ols).then(|| {
-                sse.iter()
-                    .enumerate()
-                    .filter(|(_, v)| v.is_finite())
-                    .fold(
-                        (0, f64::INFINITY),
-                        |a, (m, &v)| if v < a.1 { (m, v) } else { a },
-                    )
-                    .0
-            });
-            let mut res = vec![0.0; ds.len()];
-            let mut centers = 0usize;
-            for (f, path) in paths.iter().enumerate() {
-                centers += path.selected.len();
-                heldout_residuals(ctx, &design, path, f, pick(path, m_best), &mut res);
-            }
-            let score = WidthScore {
-                width,
-                degree,
-                centers: m_best,
-                heldout_rms_dph: rms(&res),
-                heldout_std_dph: std_within_groups(&res, &ds.groups),
-                mean_centers: m_best.map_or(centers as f64 / folds as f64, |m| m as f64),
-                candidates: design.candidates.len(),
-            };
-            (score, res)
-        })
-        .collect();
+        }
+        let pick = |path: &SelectedPath, m_best: Option<usize>| {
+            let own = path.thetas.iter().rposition(Option::is_some).unwrap_or(0);
+            m_best.map_or(own, |m| m.min(own))
+        };
+        let m_best = (cfg.method == Method::Ols).then(|| {
+            sse.iter()
+                .enumerate()
+                .filter(|(_, v)| v.is_finite())
+                .fold(
+                    (0, f64::INFINITY),
+                    |a, (m, &v)| if v < a.1 { (m, v) } else { a },
+                )
+                .0
+        });
+        let mut res = vec![0.0; ds.len()];
+        let mut centers = 0usize;
+        for (f, path) in paths.iter().enumerate() {
+            centers += path.selected.len();
+            heldout_residuals(ctx, &design, path, f, pick(path, m_best), &mut res);
+        }
+        let score = WidthScore {
+            width,
+            degree,
+            centers: m_best,
+            heldout_rms_dph: rms(&res),
+            heldout_std_dph: std_within_groups(&res, &ds.groups),
+            mean_centers: m_best.map_or(centers as f64 / folds as f64, |m| m as f64),
+            candidates: design.candidates.len(),
+        };
+        (score, res)
+    });
     if profiling() {
         eprintln!(
             "profile: width {width}: {} candidates, grid {grid_s:.3} s, Gram {gram_s:.3} s, \
