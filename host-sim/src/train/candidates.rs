@@ -9,7 +9,10 @@
 
 use std::collections::HashMap;
 
-/// Cell edge as a fraction of the Gaussian width at the start of the search.
+/// Cell edge as a fraction of the Gaussian width at the start of the search. Training
+/// time is quadratic in the candidates (the Gram matrix); a coarser grid (0.5) kept the
+/// simulated campaign's held-out rms (0.01815 against 0.01812 deg/h) at 2.5x less CPU,
+/// but no longer recovers a function built on sample centres to 2e-4 (`train_ols`).
 const CELL_OF_WIDTH: f64 = 0.25;
 /// Growth of the cell per round when too many cells are occupied.
 const CELL_GROWTH: f64 = 1.25;

@@ -26,10 +26,11 @@ pub struct TrainConfig {
     pub target_dph: Option<f64>,
     /// Polynomial degrees in the first input (T) tried by grouped validation (0..=3).
     pub poly_degrees: Vec<usize>,
-    /// Most candidate centres (grid over the normalised inputs); bounds the design to
-    /// n x max_candidates.
+    /// Most candidate centres (grid over the normalised inputs); bounds each Gram
+    /// matrix to (max_candidates + forced + 1)^2 values.
     pub max_candidates: usize,
-    /// Largest design matrix allowed, bytes; bigger training sets are refused up front.
+    /// Largest working memory allowed (`train::working_bytes`: Gram matrices and
+    /// per-row arrays), bytes; bigger training sets are refused up front.
     pub max_design_bytes: usize,
     /// Most RBF centres (1..=64, fog-core's MAX_CENTERS).
     pub max_centers: usize,
@@ -57,7 +58,7 @@ impl Default for TrainConfig {
             rho: 0.0,
             target_dph: None,
             poly_degrees: vec![0, 1, 2, 3],
-            max_candidates: 1000,
+            max_candidates: 500,
             max_design_bytes: 2 << 30,
             max_centers: MAX_CENTERS,
             width_candidates: vec![0.2, 0.35, 0.6, 1.0, 1.6],

@@ -21,8 +21,6 @@ pub struct GaussianDesign {
     threads: usize,
 }
 
-pub use crate::fanout::thread_count;
-
 impl GaussianDesign {
     /// Builds phi[i][k] = exp(-||x_i - x_{c_k}||^2 / (2 width^2)) over the first `dims`
     /// coordinates of `points` (row-major, `stride` values per point, normalised units),

@@ -42,7 +42,7 @@ pub enum TrainError {
     Model { why: String },
     /// fog-core's RBF evaluation rejected an input row.
     Predict { row: usize, why: String },
-    /// The training set would need a design matrix above the memory limit.
+    /// The training set would need working memory above the limit.
     TooLarge {
         rows: usize,
         bytes: usize,
@@ -98,8 +98,9 @@ impl fmt::Display for TrainError {
             Self::Predict { row, why } => write!(f, "RBF evaluation failed at row {row}: {why}"),
             Self::TooLarge { rows, bytes, limit } => write!(
                 f,
-                "{rows} training points need a {} MiB design matrix, above the {} MiB limit: \
-                 train on fewer runs or average to 10 s rows first",
+                "{rows} training points need {} MiB of working memory (Gram matrices and \
+                 per-row arrays), above the {} MiB limit: train on fewer runs, lower \
+                 --max-candidates or average to 10 s rows first",
                 bytes >> 20,
                 limit >> 20
             ),

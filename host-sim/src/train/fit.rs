@@ -1,20 +1,23 @@
 //! One training at a fixed Gaussian width and polynomial degree: normalise, pick the
-//! candidate centres, build the design, add the forced terms (bias, polynomial in the
-//! first input, linear inputs), run OLS or Orr selection, and keep the weights of every
-//! prefix of the selection path, so validation can score each number of centres from
-//! one run. Width, degree and size selection sit on top of this (`validate`).
+//! candidate centres, accumulate the Gram matrix of the extended design (`gram`), add
+//! the forced terms (bias, polynomial in the first input, linear inputs), run OLS or Orr
+//! selection on it, and keep the weights of every prefix of the selection path, so
+//! validation can score each number of centres from one run. `WidthDesign` and
+//! `select_path` are shared with validation (`validate`), which runs them per fold.
 
 use super::assemble::{assemble, ForcedTerm, ModelParts};
 use super::candidates::grid_candidates;
 use super::config::{Method, TrainConfig};
 use super::dataset::Dataset;
-use super::design::{thread_count, GaussianDesign};
+use super::design::GaussianDesign;
 use super::error::Result;
+use super::gram::{FoldGrams, ForcedColumn, GramView, Layout};
 use super::normalize::Normalizer;
 use super::ols::select_ols;
 use super::orr::select_orr;
 use super::path::PathSummary;
 use super::select::{Added, Selection};
+use crate::fanout::thread_count;
 use fog_core::model::RbfModel;
 
 /// A model trained at one width, with what its selection did.
@@ -23,8 +26,10 @@ pub struct Fit {
     pub model: RbfModel,
     pub width: f64,
     pub path: PathSummary,
-    /// Size of the design matrix this fit held, bytes.
+    /// Size this fit's n x K design would have as f32, bytes (streamed, never held).
     pub design_bytes: usize,
+    /// Bytes of the Gram matrices this fit held.
+    pub gram_bytes: usize,
 }
 
 /// What one model shape is: Gaussian width, polynomial degree in input 0, and the
@@ -48,7 +53,10 @@ pub struct PathFit {
     pub centers: Vec<usize>,
     pub thetas: Vec<Option<Vec<f64>>>,
     pub path: PathSummary,
+    /// Size of the n x K design as f32, bytes (streamed into the Gram, never held).
     pub design_bytes: usize,
+    /// Bytes of the Gram matrices the fit held.
+    pub gram_bytes: usize,
     pub n_candidates: usize,
     /// Inputs entering the Gaussian distance (the leading ones).
     pub n_rbf_inputs: usize,
@@ -58,79 +66,174 @@ pub struct PathFit {
 pub fn fit_path(ds: &Dataset, cfg: &TrainConfig, shape: &Shape) -> Result<PathFit> {
     cfg.check(ds.n_inputs())?;
     let normalizer = Normalizer::fit(ds)?;
-    let d = ds.n_inputs();
-    let n_rbf = d - cfg.linear_only_inputs;
     let points = normalizer.normalized_rows(ds);
-    let candidates = grid_candidates(&points, d, n_rbf, shape.width, cfg.max_candidates);
-    let design = GaussianDesign::build(
+    let width_design = WidthDesign::new(ds, cfg, &points, shape.width, shape.degree);
+    let grams = width_design.grams_of(
+        ds,
         &points,
-        d,
-        n_rbf,
-        &candidates,
-        shape.width,
+        &vec![0; ds.len()],
+        1,
         thread_count(cfg.threads),
     );
-    let mut sel = Selection::new(&design, &ds.targets_dph, cfg.collinearity_tol);
-
-    let mut forced = Vec::new();
-    if sel.add_forced(&vec![1.0; ds.len()]) == Added::Yes {
-        forced.push(ForcedTerm::Bias);
-    }
-    for k in 1..=shape.degree {
-        let column: Vec<f64> = points
-            .chunks_exact(d)
-            .map(|p| f64::from(p[0]).powi(k as i32))
-            .collect();
-        if sel.add_forced(&column) == Added::Yes {
-            forced.push(ForcedTerm::Poly(k));
-        }
-    }
-    let first_linear = if cfg.linear_on_rbf_inputs { 0 } else { n_rbf };
-    for j in first_linear..d {
-        if j == 0 && shape.degree >= 1 {
-            continue; // already the polynomial's first power
-        }
-        let column: Vec<f64> = points.chunks_exact(d).map(|p| f64::from(p[j])).collect();
-        if sel.add_forced(&column) == Added::Yes {
-            forced.push(ForcedTerm::Linear(j));
-        }
-    }
-
-    let max_centers = shape
-        .centers
-        .unwrap_or(cfg.max_centers)
-        .min(cfg.max_centers);
-    let path = match cfg.method {
-        Method::Ols => select_ols(&mut sel, cfg.rho, cfg.target_dph, max_centers),
-        Method::OrrGcv => select_orr(&mut sel, max_centers),
-    };
-    let nf = forced.len();
-    let n_centers = path.terms - nf;
-    let thetas = match cfg.method {
-        Method::Ols => (0..=n_centers)
-            .map(|m| Some(sel.solve(nf + m, &path.shrink)))
-            .collect(),
-        Method::OrrGcv => {
-            let mut t = vec![None; n_centers + 1];
-            t[n_centers] = Some(sel.solve(path.terms, &path.shrink));
-            t
-        }
-    };
-    let centers = sel.selected()[..n_centers]
+    let path = select_path(grams.all(), &width_design, cfg, shape);
+    let centers = path
+        .selected
         .iter()
-        .map(|&k| candidates[k])
+        .map(|&k| width_design.candidates[k])
         .collect();
     Ok(PathFit {
         normalizer,
         points,
-        forced,
+        forced: path.forced,
         centers,
-        thetas,
-        path,
-        design_bytes: design.bytes(),
-        n_candidates: candidates.len(),
-        n_rbf_inputs: n_rbf,
+        thetas: path.thetas,
+        path: path.summary,
+        design_bytes: GaussianDesign::bytes_for(ds.len(), width_design.candidates.len()),
+        gram_bytes: grams.bytes(),
+        n_candidates: width_design.candidates.len(),
+        n_rbf_inputs: width_design.n_rbf,
     })
+}
+
+/// The extended design of one width: candidate centres and the forced columns of every
+/// polynomial degree up to the largest asked for.
+pub(super) struct WidthDesign {
+    pub width: f64,
+    pub candidates: Vec<usize>,
+    pub columns: Vec<ForcedColumn>,
+    pub n_rbf: usize,
+    first_linear: usize,
+}
+
+impl WidthDesign {
+    /// Candidates by the grid over `points` (normalised rows of `ds`), forced columns
+    /// for degrees up to `max_degree`.
+    pub fn new(
+        ds: &Dataset,
+        cfg: &TrainConfig,
+        points: &[f32],
+        width: f64,
+        max_degree: usize,
+    ) -> Self {
+        let d = ds.n_inputs();
+        let n_rbf = d - cfg.linear_only_inputs;
+        let candidates = grid_candidates(points, d, n_rbf, width, cfg.max_candidates);
+        let first_linear = if cfg.linear_on_rbf_inputs { 0 } else { n_rbf };
+        let powers = max_degree.max(usize::from(first_linear == 0));
+        let mut columns = vec![ForcedColumn::Bias];
+        columns.extend((1..=powers).map(ForcedColumn::Power));
+        columns.extend((first_linear.max(1)..d).map(ForcedColumn::Input));
+        Self {
+            width,
+            candidates,
+            columns,
+            n_rbf,
+            first_linear,
+        }
+    }
+
+    /// Per-fold Gram matrices of this design over the rows of `ds` (normalised `points`).
+    pub fn grams_of(
+        &self,
+        ds: &Dataset,
+        points: &[f32],
+        fold: &[usize],
+        folds: usize,
+        threads: usize,
+    ) -> FoldGrams {
+        FoldGrams::build(
+            &Layout {
+                points,
+                stride: ds.n_inputs(),
+                rbf_dims: self.n_rbf,
+                candidates: &self.candidates,
+                width: self.width,
+                forced: &self.columns,
+                targets: &ds.targets_dph,
+            },
+            fold,
+            folds,
+            threads,
+        )
+    }
+
+    /// The forced terms of a model of polynomial `degree`, each with its Gram column:
+    /// bias, T^1..T^degree, then the linear inputs (input 0's linear term is T^1).
+    pub fn forced_terms(&self, degree: usize, n_inputs: usize) -> Vec<(ForcedTerm, usize)> {
+        let col = |c: ForcedColumn| self.columns.iter().position(|&x| x == c);
+        let mut terms = vec![(ForcedTerm::Bias, 0)];
+        for k in 1..=degree {
+            terms.extend(col(ForcedColumn::Power(k)).map(|c| (ForcedTerm::Poly(k), c)));
+        }
+        for j in self.first_linear..n_inputs {
+            if j == 0 && degree >= 1 {
+                continue; // already the polynomial's first power
+            }
+            let c = if j == 0 {
+                ForcedColumn::Power(1)
+            } else {
+                ForcedColumn::Input(j)
+            };
+            terms.extend(col(c).map(|c| (ForcedTerm::Linear(j), c)));
+        }
+        terms
+    }
+}
+
+/// One selection path on a Gram matrix.
+pub(super) struct SelectedPath {
+    pub forced: Vec<ForcedTerm>,
+    /// Gram column of every kept term (forced terms, then centres in order).
+    pub columns: Vec<usize>,
+    /// Candidate number of each selected centre.
+    pub selected: Vec<usize>,
+    pub thetas: Vec<Option<Vec<f64>>>,
+    pub summary: PathSummary,
+}
+
+/// Adds the forced terms of `shape.degree`, then selects centres by `cfg.method`, and
+/// solves for the coefficients of every prefix (Orr: of its GCV-chosen prefix only).
+pub(super) fn select_path(
+    gram: GramView<'_>,
+    design: &WidthDesign,
+    cfg: &TrainConfig,
+    shape: &Shape,
+) -> SelectedPath {
+    let mut sel = Selection::new(gram, cfg.collinearity_tol);
+    let n_inputs = design.n_rbf + cfg.linear_only_inputs;
+    let mut forced = Vec::new();
+    for (term, column) in design.forced_terms(shape.degree, n_inputs) {
+        if sel.add_forced(column) == Added::Yes {
+            forced.push(term);
+        }
+    }
+    let max_centers = shape
+        .centers
+        .unwrap_or(cfg.max_centers)
+        .min(cfg.max_centers);
+    let summary = match cfg.method {
+        Method::Ols => select_ols(&mut sel, cfg.rho, cfg.target_dph, max_centers),
+        Method::OrrGcv => select_orr(&mut sel, max_centers),
+    };
+    let nf = forced.len();
+    let n_centers = summary.terms - nf;
+    let thetas = match cfg.method {
+        Method::Ols => (0..=n_centers)
+            .map(|m| Some(sel.solve(nf + m, &summary.shrink)))
+            .collect(),
+        Method::OrrGcv => {
+            let mut t = vec![None; n_centers + 1];
+            t[n_centers] = Some(sel.solve(summary.terms, &summary.shrink));
+            t
+        }
+    };
+    SelectedPath {
+        forced,
+        columns: sel.columns()[..summary.terms].to_vec(),
+        selected: sel.selected()[..n_centers].to_vec(),
+        thetas,
+        summary,
+    }
 }
 
 impl PathFit {
@@ -180,6 +283,7 @@ pub fn fit_shape(ds: &Dataset, cfg: &TrainConfig, shape: &Shape) -> Result<Fit> 
         width: shape.width,
         path,
         design_bytes: pf.design_bytes,
+        gram_bytes: pf.gram_bytes,
     })
 }
 

@@ -1,12 +1,13 @@
 //! The OLS trainer: fits fog-core's Gaussian RBF drift model to 10 s drift data.
 //!
-//! Pipeline (`train_model`): normalise the inputs (mean/std), then for each candidate
-//! Gaussian width run grouped cross-validation (whole runs held out) to pick the width,
-//! then train on all data at that width. Each training treats every sample as a
-//! candidate centre and selects centres forward, by Chen-Cowan-Grant OLS (error-reduction
-//! ratio, stop at 1 - sum(err) < rho or `max_centers`) or by Orr's regularised selection
-//! with a GCV stop; a bias and optional linear terms are fitted jointly as forced
-//! regressors. Predictions and every reported rms use fog-core's deployed RBF maths.
+//! Pipeline (`train_model`): normalise the inputs (mean/std); for each candidate
+//! Gaussian width pick candidate centres on a grid over the normalised inputs and
+//! accumulate, per fold of whole runs, the Gram matrix of the design (bias, polynomial
+//! in T, linear terms, candidate Gaussians, target); then score every polynomial degree
+//! and number of centres by grouped cross-validation, selecting centres forward on each
+//! fold's training Gram (Chen-Cowan-Grant OLS by error-reduction ratio, or Orr's
+//! regularised selection with a GCV stop); finally train on all data at the best shape.
+//! Predictions and every reported rms use fog-core's deployed RBF maths.
 //!
 //! Public API for `fogsim train`, `diagnose` and the other commands: [`Dataset`],
 //! [`dataset_from_runs`], [`TrainConfig`], [`train_model`], [`predict_batch`],
@@ -19,6 +20,7 @@ mod dataset;
 mod design;
 mod error;
 mod fit;
+mod gram;
 mod normalize;
 mod ols;
 mod orr;
@@ -39,6 +41,7 @@ pub use features::{
     feature_name_with_aux,
 };
 pub use fit::{fit_path, fit_shape, fit_width, Fit, PathFit, Shape};
+pub use gram::gram_bytes;
 pub use normalize::Normalizer;
 pub use path::StopReason;
 pub use predict::predict_batch;
@@ -85,11 +88,29 @@ pub struct TrainReport {
     pub cross_validation: CvReport,
     /// Largest |weight| of the final model, deg/h (conditioning indicator).
     pub max_abs_weight_dph: f64,
-    /// Size of the final fit's design matrix, bytes.
+    /// Size the final fit's n x K design would have as f32, bytes (it is streamed in
+    /// row blocks into the Gram, never held).
     pub design_bytes: usize,
+    /// Bytes of the final fit's Gram matrices (what it holds).
+    pub gram_bytes: usize,
     /// Wall time of width selection and of the final fit, s.
     pub validation_s: f64,
     pub final_fit_s: f64,
+}
+
+/// Upper bound of the memory training takes besides the dataset itself: the Gram
+/// matrices of one width (per fold, their total, one partial per fold and thread; at
+/// most `max_candidates` candidates) and the per-row arrays of validation (normalised
+/// points, fold ids, held-out residuals of every degree). Linear in the rows, never
+/// rows x candidates.
+pub fn working_bytes(ds: &Dataset, cfg: &TrainConfig) -> usize {
+    let columns = cfg.max_candidates.min(ds.len()) + ds.n_inputs() + 5;
+    let folds = cfg.folds.max(1);
+    let grams = folds * (crate::fanout::thread_count(cfg.threads) + 1) + 1;
+    let per_row = 4 * ds.n_inputs() + 8 * (cfg.poly_degrees.len() + 3);
+    gram_bytes(columns)
+        .saturating_mul(grams)
+        .saturating_add(ds.len().saturating_mul(per_row))
 }
 
 /// Held-out compensated std must be below this fraction of the raw std to count as
@@ -113,14 +134,14 @@ pub struct TrainOutcome {
 
 /// Full training: grouped cross-validation over widths, polynomial degrees and numbers
 /// of centres (cfg.folds folds), then the final fit on all rows at the best shape.
-/// Needs at least `cfg.folds` runs. A training set whose design would exceed
-/// `cfg.max_design_bytes` is refused before any fit.
+/// Needs at least `cfg.folds` runs. A training set whose working memory
+/// (`working_bytes`) would exceed `cfg.max_design_bytes` is refused before any fit.
 pub fn train_model(ds: &Dataset, cfg: &TrainConfig) -> Result<TrainOutcome> {
-    let design = GaussianDesign::bytes_for(ds.len(), cfg.max_candidates.min(ds.len()));
-    if design > cfg.max_design_bytes {
+    let need = working_bytes(ds, cfg);
+    if need > cfg.max_design_bytes {
         return Err(TrainError::TooLarge {
             rows: ds.len(),
-            bytes: design,
+            bytes: need,
             limit: cfg.max_design_bytes,
         });
     }
@@ -174,6 +195,7 @@ pub fn train_model(ds: &Dataset, cfg: &TrainConfig) -> Result<TrainOutcome> {
             .iter()
             .fold(0.0f64, |m, w| m.max(f64::from(w.abs()))),
         design_bytes: fit.design_bytes,
+        gram_bytes: fit.gram_bytes,
         cross_validation: cv,
         validation_s,
         final_fit_s,

@@ -1,19 +1,24 @@
 //! Grouped cross-validation: whole runs are held out (a run is never split between
-//! training and validation). For every Gaussian width and polynomial degree, each fold
-//! runs one selection path to `max_centers` and scores every prefix (0..=M centres) on
-//! its held-out runs, so the number of centres, the width and the degree are all chosen
-//! by held-out error, never by a fit-energy ratio. The width grid widens itself while
-//! the best width sits at its edge. `cross_validate` is public so `diagnose` can score
+//! training and validation). For every Gaussian width the Gram matrix of the design is
+//! accumulated once per fold (`gram`); for every polynomial degree each fold then runs
+//! one selection path to `max_centers` on its training Gram (total minus the fold) and
+//! scores every prefix (0..=M centres) on its held-out Gram, so the number of centres,
+//! the width and the degree are all chosen by held-out error, never by a fit-energy
+//! ratio, without a pass over the rows per fit. The width grid widens itself while the
+//! best width sits at its edge. `cross_validate` is public so `diagnose` can score
 //! candidate inputs the same way.
 
 use super::assemble::ForcedTerm;
 use super::config::{Method, TrainConfig};
 use super::dataset::Dataset;
 use super::error::{Result, TrainError};
-use super::fit::{fit_path, PathFit, Shape};
+use super::fit::{select_path, SelectedPath, Shape, WidthDesign};
+use super::normalize::Normalizer;
+use crate::fanout::{map_in_order, thread_count};
 pub use crate::stats::rms;
 use fog_core::model::WIDTH_RANGE;
 use serde::Serialize;
+use std::time::Instant;
 
 /// Held-out score of one (width, degree) pair at its best number of centres.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -30,6 +35,8 @@ pub struct WidthScore {
     pub heldout_std_dph: f64,
     /// Mean number of centres over the folds.
     pub mean_centers: f64,
+    /// Candidate centres at this width (grid over the normalised inputs).
+    pub candidates: usize,
 }
 
 /// Result of grouped cross-validation over widths, degrees and sizes.
@@ -83,10 +90,12 @@ pub fn cross_validate(ds: &Dataset, cfg: &TrainConfig, folds: usize) -> Result<C
     let mut queue = widths.clone();
     const MAX_WIDENING: usize = 4;
     const WIDEN: f64 = 1.6;
+    let normalizer = Normalizer::fit(ds)?;
+    let points = normalizer.normalized_rows(ds);
+    let ctx = FoldContext::new(ds, &points, &fold, folds);
     for round in 0..=MAX_WIDENING {
         for &width in &queue {
-            for &degree in &cfg.poly_degrees {
-                let (score, residuals) = score_shape(ds, cfg, &fold, folds, width, degree)?;
+            for (score, residuals) in score_width(&ctx, cfg, width) {
                 let better = best
                     .as_ref()
                     .is_none_or(|(b, _)| score.heldout_rms_dph < scan[*b].heldout_rms_dph);
@@ -130,126 +139,183 @@ pub fn pooled_std(v: &[f64]) -> f64 {
     rms(&centred)
 }
 
-/// Held-out residuals of every prefix for one (width, degree); returns the best prefix's
-/// score and residuals.
-fn score_shape(
-    ds: &Dataset,
-    cfg: &TrainConfig,
-    fold: &[usize],
+/// The data of a cross-validation, shared by every width: normalised points (one
+/// normalisation and one candidate grid for all folds, from the inputs only; held-out
+/// targets never enter a fold's fit), fold of each row, and each fold's T range (the
+/// deployed polynomial clamps T to the range it was trained on).
+struct FoldContext<'a> {
+    ds: &'a Dataset,
+    points: &'a [f32],
+    fold: &'a [usize],
     folds: usize,
-    width: f64,
-    degree: usize,
-) -> Result<(WidthScore, Vec<f64>)> {
-    let shape = Shape {
-        width,
-        degree,
-        centers: None,
-    };
-    let max_m = cfg.max_centers;
-    // residuals[m][i]: held-out residual of row i with m centres (NaN: no such prefix).
-    let mut residuals = vec![vec![f64::NAN; ds.len()]; max_m + 1];
-    let mut own_stop = vec![0.0; ds.len()];
-    let mut centers = 0usize;
-    for f in 0..folds {
-        let train_idx: Vec<usize> = (0..ds.len()).filter(|&i| fold[i] != f).collect();
-        let test_idx: Vec<usize> = (0..ds.len()).filter(|&i| fold[i] == f).collect();
-        let train = ds.subset(&train_idx);
-        let pf = fit_path(&train, cfg, &shape)?;
-        centers += pf.full_len();
-        let preds = prefix_predictions(&pf, ds, &test_idx, width);
-        for (m, pred) in preds.iter().enumerate() {
-            if let Some(pred) = pred {
-                for (&i, p) in test_idx.iter().zip(pred) {
-                    residuals[m][i] = ds.targets_dph[i] - p;
-                }
-                // The deepest prefix with weights is the selection's own stop.
-                for (&i, p) in test_idx.iter().zip(pred) {
-                    own_stop[i] = ds.targets_dph[i] - p;
-                }
-            }
-        }
-        // Prefixes a shorter path never reached keep the path's last prediction.
-        let last = preds.iter().rposition(Option::is_some).unwrap_or(0);
-        for row in residuals.iter_mut().skip(last + 1) {
-            for &i in &test_idx {
-                row[i] = own_stop[i];
-            }
-        }
-    }
-    let (m_best, res) = if cfg.method == Method::OrrGcv {
-        (None, own_stop)
-    } else {
-        let (m, _) = residuals
-            .iter()
-            .enumerate()
-            .map(|(m, r)| (m, rms(r)))
-            .filter(|(_, v)| v.is_finite())
-            .fold((0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
-        (Some(m), residuals.swap_remove(m))
-    };
-    let score = WidthScore {
-        width,
-        degree,
-        centers: m_best,
-        heldout_rms_dph: rms(&res),
-        heldout_std_dph: std_within_groups(&res, &ds.groups),
-        mean_centers: m_best.map_or(centers as f64 / folds as f64, |m| m as f64),
-    };
-    Ok((score, res))
+    /// (min, max) of normalised T over each fold's training rows.
+    t_range: Vec<(f64, f64)>,
 }
 
-/// Predictions on rows `test_idx` of `ds` for every prefix of the path (None where the
-/// path has no weights), in f64 from the model's f32 parameters, with the deployed
-/// clamping of the polynomial's input to the trained range.
-fn prefix_predictions(
-    pf: &PathFit,
-    ds: &Dataset,
-    test_idx: &[usize],
+impl<'a> FoldContext<'a> {
+    fn new(ds: &'a Dataset, points: &'a [f32], fold: &'a [usize], folds: usize) -> Self {
+        let d = ds.n_inputs();
+        let t_range = (0..folds)
+            .map(|f| {
+                points
+                    .chunks_exact(d)
+                    .zip(fold)
+                    .filter(|(_, &g)| g != f)
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (p, _)| {
+                        (lo.min(f64::from(p[0])), hi.max(f64::from(p[0])))
+                    })
+            })
+            .collect();
+        Self {
+            ds,
+            points,
+            fold,
+            folds,
+            t_range,
+        }
+    }
+}
+
+/// Scores every configured degree at one width: one Gram per fold, one selection path
+/// per (degree, fold) on the fold's training Gram, every prefix scored on the fold's
+/// held-out Gram; the best prefix's held-out residuals are then computed row by row.
+/// Degrees are scored in parallel (`fanout`), results in degree order.
+fn score_width(
+    ctx: &FoldContext<'_>,
+    cfg: &TrainConfig,
     width: f64,
-) -> Vec<Option<Vec<f64>>> {
-    let d = ds.n_inputs();
-    let norm = &pf.normalizer;
-    let n_rbf = pf.n_rbf_inputs;
-    let t_lo = (f64::from(norm.min[0]) - f64::from(norm.offset[0])) / f64::from(norm.scale[0]);
-    let t_hi = (f64::from(norm.max[0]) - f64::from(norm.offset[0])) / f64::from(norm.scale[0]);
-    let neg_inv_2s2 = -0.5 / (width * width);
-    let cols: Vec<Vec<f64>> = test_idx
+) -> Vec<(WidthScore, Vec<f64>)> {
+    let (ds, folds) = (ctx.ds, ctx.folds);
+    let max_degree = cfg.poly_degrees.iter().copied().max().unwrap_or(0);
+    let clock = Instant::now();
+    let design = WidthDesign::new(ds, cfg, ctx.points, width, max_degree);
+    let grid_s = clock.elapsed().as_secs_f64();
+    let threads = thread_count(cfg.threads);
+    let grams = design.grams_of(ds, ctx.points, ctx.fold, folds, threads);
+    let gram_s = clock.elapsed().as_secs_f64() - grid_s;
+    let max_m = cfg.max_centers;
+    let scores = map_in_order(cfg.poly_degrees.len(), threads, |di| {
+        let degree = cfg.poly_degrees[di];
+        let shape = Shape {
+            width,
+            degree,
+            centers: None,
+        };
+        let paths: Vec<SelectedPath> = (0..folds)
+            .map(|f| select_path(grams.without_fold(f), &design, cfg, &shape))
+            .collect();
+        // sse[m]: held-out residual energy over all folds with m centres (a path
+        // that stopped early keeps its last prefix).
+        let mut sse = vec![0.0; max_m + 1];
+        for (f, path) in paths.iter().enumerate() {
+            let held = grams.fold(f);
+            let nf = path.forced.len();
+            let mut last = f64::NAN;
+            for (m, e) in sse.iter_mut().enumerate() {
+                if let Some(Some(theta)) = path.thetas.get(m) {
+                    last = held.residual_energy(&path.columns[..nf + m], theta);
+                }
+                *e += last;
+            }
+        }
+        let pick = |path: &SelectedPath, m_best: Option<usize>| {
+            let own = path.thetas.iter().rposition(Option::is_some).unwrap_or(0);
+            m_best.map_or(own, |m| m.min(own))
+        };
+        let m_best = (cfg.method == Method::Ols).then(|| {
+            sse.iter()
+                .enumerate()
+                .filter(|(_, v)| v.is_finite())
+                .fold(
+                    (0, f64::INFINITY),
+                    |a, (m, &v)| if v < a.1 { (m, v) } else { a },
+                )
+                .0
+        });
+        let mut res = vec![0.0; ds.len()];
+        let mut centers = 0usize;
+        for (f, path) in paths.iter().enumerate() {
+            centers += path.selected.len();
+            heldout_residuals(ctx, &design, path, f, pick(path, m_best), &mut res);
+        }
+        let score = WidthScore {
+            width,
+            degree,
+            centers: m_best,
+            heldout_rms_dph: rms(&res),
+            heldout_std_dph: std_within_groups(&res, &ds.groups),
+            mean_centers: m_best.map_or(centers as f64 / folds as f64, |m| m as f64),
+            candidates: design.candidates.len(),
+        };
+        (score, res)
+    });
+    if profiling() {
+        eprintln!(
+            "profile: width {width}: {} candidates, grid {grid_s:.3} s, Gram {gram_s:.3} s, \
+             paths and held-out scores {:.3} s",
+            design.candidates.len(),
+            clock.elapsed().as_secs_f64() - gram_s - grid_s
+        );
+    }
+    scores
+}
+
+/// `FOG_TRAIN_PROFILE=1`: print where cross-validation spends its time, per width.
+fn profiling() -> bool {
+    std::env::var_os("FOG_TRAIN_PROFILE").is_some_and(|v| v == "1")
+}
+
+/// Writes target - prediction of the path's first `m` centres into `res` for every row
+/// of fold `f`, in f64 from the model's f32 centres, with the deployed clamping of the
+/// polynomial's input to the fold's trained range.
+fn heldout_residuals(
+    ctx: &FoldContext<'_>,
+    design: &WidthDesign,
+    path: &SelectedPath,
+    f: usize,
+    m: usize,
+    res: &mut [f64],
+) {
+    let d = ctx.ds.n_inputs();
+    let Some(Some(theta)) = path.thetas.get(m) else {
+        return;
+    };
+    let (t_lo, t_hi) = ctx.t_range[f];
+    let neg_inv_2s2 = -0.5 / (design.width * design.width);
+    let nf = path.forced.len();
+    let centres: Vec<&[f32]> = path.selected[..m]
         .iter()
-        .map(|&i| {
-            let row = ds.row(i);
-            let xn: Vec<f64> = (0..d)
-                .map(|j| ((row[j] as f32 - norm.offset[j]) / norm.scale[j]) as f64)
-                .collect();
-            let t = xn[0].clamp(t_lo.min(t_hi), t_hi.max(t_lo));
-            let mut c: Vec<f64> = pf
-                .forced
-                .iter()
-                .map(|term| match *term {
+        .map(|&k| &ctx.points[design.candidates[k] * d..design.candidates[k] * d + d])
+        .collect();
+    for (i, x) in ctx.points.chunks_exact(d).enumerate() {
+        if ctx.fold[i] != f {
+            continue;
+        }
+        let t = f64::from(x[0]).clamp(t_lo.min(t_hi), t_hi.max(t_lo));
+        let forced: f64 = path
+            .forced
+            .iter()
+            .zip(theta)
+            .map(|(term, th)| {
+                th * match *term {
                     ForcedTerm::Bias => 1.0,
                     ForcedTerm::Poly(k) => t.powi(k as i32),
-                    ForcedTerm::Linear(j) => xn[j],
-                })
-                .collect();
-            for &k in &pf.centers {
-                let centre = &pf.points[k * d..k * d + d];
-                let d2: f64 = (0..n_rbf)
-                    .map(|j| (xn[j] - f64::from(centre[j])).powi(2))
-                    .sum();
-                c.push((d2 * neg_inv_2s2).exp());
-            }
-            c
-        })
-        .collect();
-    pf.thetas
-        .iter()
-        .map(|theta| {
-            theta.as_ref().map(|th| {
-                cols.iter()
-                    .map(|c| c.iter().zip(th).map(|(a, b)| a * b).sum())
-                    .collect()
+                    ForcedTerm::Linear(j) => f64::from(x[j]),
+                }
             })
-        })
-        .collect()
+            .sum();
+        let rbf: f64 = centres
+            .iter()
+            .zip(&theta[nf..])
+            .map(|(c, th)| {
+                let d2: f64 = (0..design.n_rbf)
+                    .map(|j| (f64::from(x[j]) - f64::from(c[j])).powi(2))
+                    .sum();
+                th * (d2 * neg_inv_2s2).exp()
+            })
+            .sum();
+        res[i] = ctx.ds.targets_dph[i] - forced - rbf;
+    }
 }
 
 /// Pooled rms after removing each group's mean: the within-run scatter.
