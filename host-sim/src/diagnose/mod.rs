@@ -12,6 +12,7 @@ pub mod azimuth;
 pub mod bases;
 pub mod basis;
 pub mod between;
+pub mod bootstrap;
 pub mod cause;
 pub mod cv;
 pub mod error;
@@ -28,6 +29,7 @@ pub mod signflip;
 pub mod simfit;
 pub mod simterm;
 pub mod transforms;
+pub mod uncertainty;
 
 pub use cause::Cause;
 pub use error::DiagnoseError;
@@ -84,26 +86,33 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
         named.map(|s| s.cols.as_slice()),
     )?;
     let (extended, ext_resid) = extended_model(base, named, cause.as_ref());
+    let uncertainty = uncertainty::estimate(
+        &campaign,
+        &folds,
+        &st,
+        base,
+        named
+            .zip(cause.as_ref())
+            .map(|(s, c)| uncertainty::NamedFeature {
+                label: c.label(),
+                cols: &s.cols,
+            })
+            .as_ref(),
+    );
     let has_heading = campaign.extra_names.iter().any(|n| n.contains("heading"));
     let azimuth = has_heading.then(|| Azimuth {
         baseline: azimuth::azimuth_effect(&folds, &st.t_s, &base.cv.residual, latitude),
         extended: azimuth::azimuth_effect(&folds, &st.t_s, &ext_resid, latitude),
     });
     let smallest_attainable_p = signflip::smallest_p(folds.unit_rows.len());
-    let words = match (&cause, &between_run.named) {
-        (Some(c), _) => c.in_words(&sim.effect_coef),
-        (None, Some(b)) => {
-            format!("no within-run cause; between runs: {b} (see the heading / run-level lines)")
-        }
-        (None, None) => report::nothing_named(smallest_attainable_p),
-    };
+    let words = cause_in_words(
+        cause.as_ref(),
+        &between_run,
+        &sim.effect_coef,
+        smallest_attainable_p,
+    );
     let sim_terms = simterm::terms_per_run(runs, cause.as_ref(), &sim.effect_coef);
-    let term_summaries: Vec<simterm::TermSummary> = sim_terms
-        .first()
-        .into_iter()
-        .flatten()
-        .map(|t| simterm::summarize(t, cause.as_ref().map_or("", |c| c.column.as_str())))
-        .collect();
+    let cause_column = cause.as_ref().map(|c| c.column.clone());
     let report = Report {
         campaign: CampaignSummary {
             runs: campaign.runs.len(),
@@ -132,13 +141,8 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
         drift_std: drift_std(&folds, &st.y, &base.cv.residual, &ext_resid),
         extended,
         azimuth,
-        simulation: Simulation {
-            before_rms_dph: sim.before_rms_dph,
-            after_rms_dph: sim.after_rms_dph.unwrap_or(sim.before_rms_dph),
-            term: term_summaries.first().cloned(),
-            terms: term_summaries,
-            calibration: sim,
-        },
+        uncertainty,
+        simulation: simulation_summary(sim, &sim_terms, cause_column.as_deref()),
     };
     Ok(Diagnosis {
         report,
@@ -263,5 +267,42 @@ fn to_exclusion((column, reason): &screen::Skipped) -> Exclusion {
     Exclusion {
         column: column.clone(),
         reason: reason.clone(),
+    }
+}
+
+/// The within-run cause in words, else the between-run one, else why nothing is named.
+fn cause_in_words(
+    cause: Option<&Cause>,
+    between_run: &between::BetweenRun,
+    coef: &[f64],
+    smallest_attainable_p: f64,
+) -> String {
+    match (cause, &between_run.named) {
+        (Some(c), _) => c.in_words(coef),
+        (None, Some(b)) => {
+            format!("no within-run cause; between runs: {b} (see the heading / run-level lines)")
+        }
+        (None, None) => report::nothing_named(smallest_attainable_p),
+    }
+}
+
+/// The simulator before/after and the terms added (listed for the first run).
+fn simulation_summary(
+    sim: simfit::SimCalibration,
+    sim_terms: &[Vec<crate::sim::DriftTerm>],
+    cause_column: Option<&str>,
+) -> Simulation {
+    let terms: Vec<simterm::TermSummary> = sim_terms
+        .first()
+        .into_iter()
+        .flatten()
+        .map(|t| simterm::summarize(t, cause_column.unwrap_or("")))
+        .collect();
+    Simulation {
+        before_rms_dph: sim.before_rms_dph,
+        after_rms_dph: sim.after_rms_dph.unwrap_or(sim.before_rms_dph),
+        term: terms.first().cloned(),
+        terms,
+        calibration: sim,
     }
 }

@@ -115,6 +115,8 @@ pub struct Report {
     pub extended: Extended,
     pub drift_std: DriftStd,
     pub azimuth: Option<Azimuth>,
+    /// +/- (block bootstrap) on every fitted coefficient, ratios to the simulator.
+    pub uncertainty: super::uncertainty::Uncertainty,
     pub simulation: Simulation,
 }
 
@@ -142,6 +144,7 @@ pub fn render_text(r: &Report) -> String {
     write_candidates(&mut s, r);
     write_cause(&mut s, r);
     write_simulator(&mut s, r);
+    write_uncertainty(&mut s, &r.uncertainty);
     s
 }
 
@@ -367,6 +370,38 @@ fn write_simulator(s: &mut String, r: &Report) {
             s,
             "  simulator extended with: {} = {:.4e} deg/h x {}({}{tau}) (fog_sim::sim::DriftTerm)",
             t.label, t.coeff_dph, t.transform, t.source
+        );
+    }
+}
+
+/// Section 6: every fitted coefficient with its bootstrap range, ratios to the simulator.
+fn write_uncertainty(s: &mut String, u: &super::uncertainty::Uncertainty) {
+    let _ = writeln!(s, "\n6. Coefficients with +/- ({})", u.method);
+    let groups = [
+        ("base", &u.base),
+        ("extension", &u.extension),
+        ("calibrated simulator", &u.simulator),
+    ];
+    for (what, list) in groups {
+        for e in list {
+            let _ = writeln!(
+                s,
+                "  {what}: {} = {:.4e} +/- {:.2e} {} (95 %: {:.4e} .. {:.4e})",
+                e.name, e.value, e.plus_minus, e.unit, e.ci95[0], e.ci95[1]
+            );
+        }
+    }
+    for r in &u.ratios {
+        let _ = writeln!(
+            s,
+            "  measured / simulator, {}: {:.4e} +/- {:.2e} vs {:.4e} {} -> ratio {:.3} +/- {:.3}",
+            r.name,
+            r.measured,
+            r.measured_plus_minus,
+            r.simulator,
+            r.unit,
+            r.ratio.value,
+            r.ratio.plus_minus
         );
     }
 }

@@ -144,13 +144,9 @@ fn fit_thermal(c: &Campaign) -> Thermal {
     })
 }
 
-/// Calibrates (see the module header); `effect` are the named cause's stacked columns.
-pub fn calibrate(
-    c: &Campaign,
-    run_rows: &[std::ops::Range<usize>],
-    y: &[f64],
-    effect: Option<&[Vec<f64>]>,
-) -> Result<SimCalibration, DiagnoseError> {
+/// The calibration's drift design from the fitted thermal response: T - mean T,
+/// (T - mean T)^2, dT/dt (in that order: bias slope, curvature, Shupe), stacked.
+fn design(c: &Campaign) -> (Thermal, Vec<Vec<f64>>) {
     let th = fit_thermal(c);
     let t_mean = th.temp.iter().sum::<f64>() / th.temp.len().max(1) as f64;
     let dt: Vec<f64> = th.temp.iter().map(|t| t - t_mean).collect();
@@ -159,6 +155,25 @@ pub fn calibrate(
         dt.iter().map(|d| d * d).collect(),
         th.rate.clone(),
     ];
+    (th, cols)
+}
+
+/// The calibration's drift design columns (see `design`) and the mean fitted temperature,
+/// degC (where `bias_dph_per_c` applies).
+pub fn design_columns(c: &Campaign) -> (Vec<Vec<f64>>, f64) {
+    let (th, cols) = design(c);
+    let t_mean = th.temp.iter().sum::<f64>() / th.temp.len().max(1) as f64;
+    (cols, t_mean)
+}
+
+/// Calibrates (see the module header); `effect` are the named cause's stacked columns.
+pub fn calibrate(
+    c: &Campaign,
+    run_rows: &[std::ops::Range<usize>],
+    y: &[f64],
+    effect: Option<&[Vec<f64>]>,
+) -> Result<SimCalibration, DiagnoseError> {
+    let (th, cols) = design(c);
     let (coef, resid) = fit_with_offsets(run_rows, &cols, y)?;
     let mut out = SimCalibration {
         tau_fast_s: th.tau.0,
