@@ -22,6 +22,7 @@ pub mod models;
 pub mod olscheck;
 pub mod outliers;
 pub mod plots;
+pub mod rawrows;
 pub mod report;
 pub mod residuals;
 pub mod screen;
@@ -142,6 +143,7 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
         extended,
         azimuth,
         uncertainty,
+        raw_rows: None,
         simulation: simulation_summary(sim, &sim_terms, cause_column.as_deref()),
     };
     Ok(Diagnosis {

@@ -117,6 +117,8 @@ pub struct Report {
     pub azimuth: Option<Azimuth>,
     /// +/- (block bootstrap) on every fitted coefficient, ratios to the simulator.
     pub uncertainty: super::uncertainty::Uncertainty,
+    /// The raw rows before averaging (set by the command that streamed them).
+    pub raw_rows: Option<super::rawrows::RawRows>,
     pub simulation: Simulation,
 }
 
@@ -145,6 +147,9 @@ pub fn render_text(r: &Report) -> String {
     write_cause(&mut s, r);
     write_simulator(&mut s, r);
     write_uncertainty(&mut s, &r.uncertainty);
+    if let Some(raw) = &r.raw_rows {
+        write_raw_rows(&mut s, raw);
+    }
     s
 }
 
@@ -403,5 +408,71 @@ fn write_uncertainty(s: &mut String, u: &super::uncertainty::Uncertainty) {
             r.ratio.value,
             r.ratio.plus_minus
         );
+    }
+}
+
+/// Section 7: Allan deviation, quantisation and steps of the raw rows.
+fn write_raw_rows(s: &mut String, raw: &super::rawrows::RawRows) {
+    let _ = writeln!(
+        s,
+        "\n7. Raw rows ({} rows, period {:.4} s; drift = rate_dph - earth_dph, runs pooled, never across a gap)",
+        raw.rows, raw.sample_period_s
+    );
+    let pts: Vec<String> = raw
+        .allan
+        .iter()
+        .map(|p| format!("{:.4}s {:.3e}", p.tau_s, p.adev_dph))
+        .collect();
+    let _ = writeln!(s, "  Allan deviation, deg/h: {}", pts.join(", "));
+    match (raw.arw_dpsh, raw.arw_plus_minus_dpsh) {
+        (Some(n), Some(pm)) => {
+            let sim = crate::sim::GyroParams::paper_default().noise.arw_dpsh;
+            let _ = writeln!(
+                s,
+                "  ARW (IEEE 952 N, -1/2 slope over tau {:?} s): {n:.3e} +/- {pm:.1e} deg/sqrt(h); simulator {sim:.1e}: ratio {:.3} +/- {:.3}",
+                raw.arw_fit_taus_s,
+                n / sim,
+                pm / sim
+            );
+        }
+        _ => {
+            let _ = writeln!(s, "  ARW: no -1/2 slope in the Allan deviation (white rate noise not dominant at any tau measured)");
+        }
+    }
+    if let (Some(b), Some(t)) = (raw.bias_instability_dph, raw.bias_instability_tau_s) {
+        let _ = writeln!(
+            s,
+            "  bias instability (IEEE 952 B = sigma_min / 0.664): {b:.3e} deg/h at tau {t:.4} s; {}",
+            raw.bias_instability_note
+        );
+    }
+    for q in &raw.quantisation {
+        let _ = writeln!(
+            s,
+            "  {}: smallest step {:.6e}; {}",
+            q.column,
+            q.smallest_step,
+            if q.quantised {
+                "quantised (every step a multiple of it)"
+            } else {
+                "not quantised at this step"
+            }
+        );
+    }
+    let st = &raw.steps;
+    let _ = writeln!(
+        s,
+        "  steps of the drift (two {}-row windows, > {} sigma): {}",
+        st.window_rows, st.threshold_sigma, st.count
+    );
+    for x in &st.listed {
+        let _ = writeln!(
+            s,
+            "    {} t {:.1} s: {:+.4e} deg/h ({:+.1} sigma)",
+            x.run, x.t_s, x.size_dph, x.sigma
+        );
+    }
+    for n in &raw.notes {
+        let _ = writeln!(s, "  note: {n}");
     }
 }
