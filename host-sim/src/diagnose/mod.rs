@@ -52,7 +52,12 @@ pub struct Diagnosis {
     pub report: Report,
     pub run_names: Vec<String>,
     pub run_rows: Vec<std::ops::Range<usize>>,
+    /// Validation units (runs, or time blocks of a few long records).
+    pub unit_rows: Vec<std::ops::Range<usize>>,
     pub t_s: Vec<f64>,
+    /// What `t_s` is, for axis labels: since power-on, or since the record's start.
+    pub time_axis: String,
+    pub temp_c: Vec<f64>,
     /// Drift with run offsets removed as the fits see it, deg/h.
     pub drift_dph: Vec<f64>,
     pub baseline_residual: Vec<f64>,
@@ -150,7 +155,10 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
         report,
         run_names,
         run_rows: folds.run_rows.clone(),
+        unit_rows: folds.unit_rows.clone(),
         t_s: st.t_s.clone(),
+        time_axis: time_axis(runs),
+        temp_c: st.temp_c.clone(),
         drift_dph: base.prepared.target().to_vec(),
         baseline_residual: base.cv.residual.clone(),
         extended_residual: ext_resid,
@@ -306,5 +314,20 @@ fn simulation_summary(
         term: terms.first().cloned(),
         terms,
         calibration: sim,
+    }
+}
+
+/// "time since power-on" when every run says how it was powered on (`start` metadata)
+/// and none says it is not a power-on record; else the record's own time.
+fn time_axis(runs: &[Run]) -> String {
+    let power_on = runs.iter().all(|r| r.meta_value("start").is_some())
+        && !runs.iter().any(|r| {
+            r.meta_value("note")
+                .is_some_and(|n| n.contains("not a power-on"))
+        });
+    if power_on {
+        "time since power-on".into()
+    } else {
+        "t_s (time since the record's start)".into()
     }
 }
