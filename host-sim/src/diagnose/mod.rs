@@ -1,11 +1,14 @@
 //! `diagnose`: from a measured campaign to what the simulation and the paper's model get
-//! wrong, the cause, the extended model and its held-out gain (issue 4).
+//! wrong, the cause, the extended model and its held-out gain (issues 4 and 9).
 //!
-//! Pipeline: [`input`] checks and averages the runs; [`models`] fits the paper's RBF on
-//! (T, dT/dt) with run offsets and validates it on held-out runs ([`cv`]); [`simfit`]
-//! calibrates the simulator's physics; [`residuals`] describes what is left; [`transforms`]
-//! builds every candidate feature; [`screen`] ranks them by held-out gain with the
-//! family-wise sign-flip test of [`signflip`]; [`report`] states the result, [`plots`]
+//! Pipeline: [`input`] checks and averages the runs ([`rawrows`] streams the files and
+//! analyses the raw rows on the way); [`bases`] chooses the base model on held-out data
+//! ([`cv`], [`models`]); [`simfit`] calibrates the simulator's physics; [`residuals`]
+//! and [`outliers`] describe what is left; [`transforms`] builds every candidate feature;
+//! [`screen`] ranks them by held-out gain with the family-wise sign-flip test of
+//! [`signflip`], [`between`] does the same for run-level effects; the named [`cause`] is
+//! mapped onto the simulator by [`simterm`]; [`uncertainty`] puts block-bootstrap
+//! ([`bootstrap`]) ranges on every coefficient; [`report`] states the result, [`plots`]
 //! draws it, [`azimuth`] translates it into north-seeking error.
 
 pub mod azimuth;

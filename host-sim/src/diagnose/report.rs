@@ -429,8 +429,8 @@ fn write_raw_rows(s: &mut String, raw: &super::rawrows::RawRows) {
             let sim = crate::sim::GyroParams::paper_default().noise.arw_dpsh;
             let _ = writeln!(
                 s,
-                "  ARW (IEEE 952 N, -1/2 slope over tau {:?} s): {n:.3e} +/- {pm:.1e} deg/sqrt(h); simulator {sim:.1e}: ratio {:.3} +/- {:.3}",
-                raw.arw_fit_taus_s,
+                "  ARW (IEEE 952 N, -1/2 slope over tau {} s): {n:.3e} +/- {pm:.1e} deg/sqrt(h); simulator {sim:.1e}: ratio {:.3} +/- {:.3}",
+                raw.arw_fit_taus_s.iter().map(|t| format!("{t:.4}")).collect::<Vec<_>>().join(", "),
                 n / sim,
                 pm / sim
             );

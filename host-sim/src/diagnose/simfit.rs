@@ -200,14 +200,13 @@ pub fn calibrate(
 
 /// sigma of white noise from first differences within runs (slow structure cancels).
 fn white_noise(run_rows: &[std::ops::Range<usize>], r: &[f64]) -> f64 {
-    let d: Vec<f64> = run_rows
+    rms(&within_run_differences(run_rows, r)) / std::f64::consts::SQRT_2
+}
+
+/// First differences of `v` inside each run (never across a run boundary).
+pub fn within_run_differences(run_rows: &[std::ops::Range<usize>], v: &[f64]) -> Vec<f64> {
+    run_rows
         .iter()
-        .flat_map(|rr| {
-            r[rr.clone()]
-                .windows(2)
-                .map(|w| w[1] - w[0])
-                .collect::<Vec<_>>()
-        })
-        .collect();
-    rms(&d) / std::f64::consts::SQRT_2
+        .flat_map(|rr| v[rr.clone()].windows(2).map(|w| w[1] - w[0]))
+        .collect()
 }

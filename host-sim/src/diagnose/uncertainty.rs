@@ -231,16 +231,7 @@ fn extension_estimates(
 
 /// Median row spacing within runs, s.
 fn row_spacing_s(folds: &Folds, t_s: &[f64]) -> f64 {
-    let mut d: Vec<f64> = folds
-        .run_rows
-        .iter()
-        .flat_map(|r| {
-            t_s[r.clone()]
-                .windows(2)
-                .map(|w| w[1] - w[0])
-                .collect::<Vec<_>>()
-        })
-        .collect();
+    let mut d = super::simfit::within_run_differences(&folds.run_rows, t_s);
     d.sort_by(f64::total_cmp);
     d.get(d.len() / 2).copied().unwrap_or(f64::NAN)
 }
