@@ -66,6 +66,27 @@ fn json_has_the_issue_schema_and_plots_are_written() {
             "simulation lacks {key}"
         );
     }
+    let u = &v["uncertainty"];
+    let sim = u["simulator"].as_array().expect("uncertainty.simulator");
+    for e in sim {
+        for key in ["name", "unit", "value", "plus_minus", "ci95"] {
+            assert!(e.get(key).is_some(), "estimate lacks {key}: {e}");
+        }
+    }
+    let ratios: Vec<&str> = u["ratios"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|q| q["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(ratios.len(), 3, "{ratios:?}");
+    assert!(u["base"].is_array() && u["extension"].is_array());
+    let raw = &v["raw_rows"];
+    assert!(raw["rows"].as_u64().unwrap() > 0, "raw_rows: {raw}");
+    assert!(!raw["allan"].as_array().unwrap().is_empty());
+    for key in ["arw_dpsh", "bias_instability_dph", "quantisation", "steps"] {
+        assert!(raw.get(key).is_some(), "raw_rows lacks {key}");
+    }
     assert!(
         v["ols_trainer_check"]["baseline"]["heldout_std_dph"]
             .as_f64()

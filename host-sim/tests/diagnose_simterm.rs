@@ -142,7 +142,12 @@ fn sim_vs_measured_rms(measured: &[Run], terms: &[Vec<DriftTerm>]) -> f64 {
 /// Diagnoses the campaign with `planted` and checks the cause (`expected` transform), the
 /// emitted terms and the before/after of the real simulator against the "measured" runs.
 /// `coeff_tol` is the accepted relative error of the emitted coefficient.
-fn close_the_loop(planted: Planted, column: &str, expected: Transform, coeff_tol: f64) {
+fn close_the_loop(
+    planted: Planted,
+    column: &str,
+    expected: Transform,
+    coeff_tol: f64,
+) -> fog_sim::diagnose::Report {
     let measured = measured_campaign(planted);
     let d = diagnose(&measured).unwrap();
     let r = &d.report;
@@ -223,11 +228,48 @@ fn close_the_loop(planted: Planted, column: &str, expected: Transform, coeff_tol
         after < 0.5 * before,
         "re-simulation with the emitted term: {before:.5} -> {after:.5} deg/h"
     );
+    let u = &r.uncertainty;
+    for e in u.extension.iter().chain(&u.simulator) {
+        println!(
+            "  {} = {:.4e} +/- {:.2e} {} (95 %: {:.4e} .. {:.4e})",
+            e.name, e.value, e.plus_minus, e.unit, e.ci95[0], e.ci95[1]
+        );
+        assert!(e.plus_minus > 0.0 && e.plus_minus.is_finite(), "{e:?}");
+    }
+    for q in &u.ratios {
+        println!(
+            "  {}: ratio {:.3} +/- {:.3}",
+            q.name, q.ratio.value, q.ratio.plus_minus
+        );
+    }
+    r.clone()
+}
+
+/// The block-bootstrap range of the named coefficient covers the planted value and is
+/// tight enough to mean something; the ARW of the real simulator's noise comes back at
+/// its own value (ratio 1 within 3 sigma).
+fn check_ranges(r: &fog_sim::diagnose::Report, planted_coeff: f64) {
+    let e = &r.uncertainty.extension[0];
+    assert!(
+        e.ci95[0] <= planted_coeff && planted_coeff <= e.ci95[1],
+        "planted {planted_coeff} outside the 95 % range of {e:?}"
+    );
+    assert!(e.plus_minus < 0.3 * e.value.abs(), "{e:?}");
+    let arw = r
+        .uncertainty
+        .ratios
+        .iter()
+        .find(|q| q.name.starts_with("ARW"))
+        .expect("ARW ratio");
+    assert!(
+        (arw.ratio.value - 1.0).abs() < 3.0 * arw.ratio.plus_minus + 0.1,
+        "{arw:?}"
+    );
 }
 
 #[test]
 fn planted_supply_value_term_closes_the_loop_on_the_real_simulator() {
-    close_the_loop(
+    let r = close_the_loop(
         Planted {
             signal: Signal::Supply { smooth_s: 0.0 },
             transform: AuxTransform::Value,
@@ -237,6 +279,7 @@ fn planted_supply_value_term_closes_the_loop_on_the_real_simulator() {
         Transform::Value,
         0.25,
     );
+    check_ranges(&r, 0.03);
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! `fogsim diagnose RUNS... [--json FILE] [--plots DIR]`: what the simulation and the
 //! paper's model get wrong on a measured campaign, the cause, the extension and its gain.
 
-use crate::diagnose::{diagnose, olscheck, plots, report};
+use crate::diagnose::{diagnose, olscheck, plots, rawrows, report};
 use crate::io::{write_atomic, OutputGuard};
 use anyhow::Context;
 use std::path::PathBuf;
@@ -20,9 +20,11 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<()> {
     let guard = OutputGuard::new(&args.runs);
     args.outputs.check(&guard)?;
-    // Streamed into 10 s windows: memory grows with windows, not rows, at any row rate.
-    let runs = crate::io::bin::read_runs_binned(&args.runs)?;
-    let d = diagnose(&runs).context("diagnose")?;
+    // Streamed into 10 s windows (memory grows with windows, not rows, at any row rate);
+    // the raw rows are analysed on the way (Allan deviation, quantisation, steps).
+    let (runs, raw) = rawrows::read_runs(&args.runs)?;
+    let mut d = diagnose(&runs).context("diagnose")?;
+    d.report.raw_rows = Some(raw);
     print!("{}", report::render_text(&d.report));
     let check = if runs.len() >= 4 {
         match olscheck::ols_check(&runs, d.report.named_cause.as_ref()) {

@@ -87,11 +87,16 @@ pub struct BaseChoice {
     pub collinearity_warning: Option<String>,
 }
 
-fn zscore(v: &[f64]) -> Vec<f64> {
+/// Mean and (population) standard deviation used to normalise a column (1 when constant).
+pub fn zscore_params(v: &[f64]) -> (f64, f64) {
     let n = v.len().max(1) as f64;
     let m = v.iter().sum::<f64>() / n;
     let sd = (v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / n).sqrt();
-    let sd = if sd > 1e-300 { sd } else { 1.0 };
+    (m, if sd > 1e-300 { sd } else { 1.0 })
+}
+
+fn zscore(v: &[f64]) -> Vec<f64> {
+    let (m, sd) = zscore_params(v);
     v.iter().map(|x| (x - m) / sd).collect()
 }
 

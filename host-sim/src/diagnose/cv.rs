@@ -220,7 +220,7 @@ impl Prepared {
         for (u, r) in folds.unit_rows.iter().enumerate() {
             let mut a: Vec<f64> = total_g.iter().zip(&grams[u]).map(|(t, g)| t - g).collect();
             let mut b: Vec<f64> = total_c.iter().zip(&xty[u]).map(|(t, g)| t - g).collect();
-            self.regularise(&mut a, &diag_scale, q);
+            add_ridge(&mut a, &diag_scale, q, self.ridge);
             solve_spd(&mut a, &mut b, q).map_err(|_| DiagnoseError::Singular {
                 what: "held-out fit",
             })?;
@@ -242,29 +242,31 @@ impl Prepared {
         folds: &Folds,
         extra: &[Vec<f64>],
     ) -> Result<(Vec<f64>, Vec<f64>), DiagnoseError> {
-        let (grams, xty, cols) = self.augmented(folds, extra);
-        let q = cols.len();
-        let mut a = sum_all(&grams);
-        let mut b = sum_all(&xty);
-        let diag_scale: Vec<f64> = (0..q).map(|i| a[i * q + i]).collect();
-        self.regularise(&mut a, &diag_scale, q);
-        solve_spd(&mut a, &mut b, q).map_err(|_| DiagnoseError::Singular { what: "full fit" })?;
+        let systems = self.unit_systems(folds, extra);
+        let b = systems
+            .solve(&vec![1.0; folds.unit_rows.len()])
+            .map_err(|_| DiagnoseError::Singular { what: "full fit" })?;
         let fitted = (0..folds.rows())
-            .map(|row| cols.iter().zip(&b).map(|(c, w)| c[row] * w).sum())
+            .map(|row| systems.cols.iter().zip(&b).map(|(c, w)| c[row] * w).sum())
             .collect();
         Ok((b, fitted))
+    }
+
+    /// The per-unit normal equations of this design plus `extra`, ready to be solved with
+    /// any unit multiplicities (all ones: the full fit; a bootstrap draw: resampled units).
+    pub fn unit_systems<'a>(&'a self, folds: &Folds, extra: &[Vec<f64>]) -> UnitSystems<'a> {
+        let (grams, xty, cols) = self.augmented(folds, extra);
+        UnitSystems {
+            grams,
+            xty,
+            cols,
+            ridge: self.ridge,
+        }
     }
 
     /// The adjusted target (demeaned per run in run-grouped layouts).
     pub fn target(&self) -> &[f64] {
         &self.y
-    }
-
-    fn regularise(&self, a: &mut [f64], diag_scale: &[f64], q: usize) {
-        let mean_diag = diag_scale.iter().sum::<f64>() / q.max(1) as f64;
-        for i in 0..q {
-            a[i * q + i] += self.ridge * diag_scale[i] + 1e-12 * mean_diag + 1e-300;
-        }
     }
 
     /// Per-unit Grams of the design augmented by `extra` columns (cross terms only).
@@ -319,6 +321,48 @@ type Augmented<'a> = (
     Vec<Vec<f64>>,
     Vec<std::borrow::Cow<'a, [f64]>>,
 );
+
+/// Per-unit normal equations (see `Prepared::unit_systems`).
+pub struct UnitSystems<'a> {
+    grams: Vec<Vec<f64>>,
+    xty: Vec<Vec<f64>>,
+    /// The design columns (adjusted), base first, run dummies, then the extra columns.
+    pub cols: Vec<std::borrow::Cow<'a, [f64]>>,
+    ridge: f64,
+}
+
+impl UnitSystems<'_> {
+    /// Weights of the ridge fit with unit u's data counted `counts[u]` times.
+    pub fn solve(&self, counts: &[f64]) -> Result<Vec<f64>, super::linalg::NotPositiveDefinite> {
+        let q = self.cols.len();
+        let mut a = counted_sum(&self.grams, counts);
+        let mut b = counted_sum(&self.xty, counts);
+        let diag_scale: Vec<f64> = (0..q).map(|i| a[i * q + i]).collect();
+        add_ridge(&mut a, &diag_scale, q, self.ridge);
+        solve_spd(&mut a, &mut b, q)?;
+        Ok(b)
+    }
+}
+
+/// Ridge relative to each column's energy (`diag_scale`), plus a tiny absolute floor.
+fn add_ridge(a: &mut [f64], diag_scale: &[f64], q: usize, ridge: f64) {
+    let mean_diag = diag_scale.iter().sum::<f64>() / q.max(1) as f64;
+    for i in 0..q {
+        a[i * q + i] += ridge * diag_scale[i] + 1e-12 * mean_diag + 1e-300;
+    }
+}
+
+fn counted_sum(v: &[Vec<f64>], counts: &[f64]) -> Vec<f64> {
+    let mut out = vec![0.0; v.first().map_or(0, Vec::len)];
+    for (x, &c) in v.iter().zip(counts) {
+        if c == 1.0 {
+            out.iter_mut().zip(x).for_each(|(o, a)| *o += a);
+        } else if c != 0.0 {
+            out.iter_mut().zip(x).for_each(|(o, a)| *o += c * a);
+        }
+    }
+    out
+}
 
 fn sum_all(v: &[Vec<f64>]) -> Vec<f64> {
     let mut out = vec![0.0; v.first().map_or(0, Vec::len)];

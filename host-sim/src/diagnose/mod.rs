@@ -1,17 +1,22 @@
 //! `diagnose`: from a measured campaign to what the simulation and the paper's model get
-//! wrong, the cause, the extended model and its held-out gain (issue 4).
+//! wrong, the cause, the extended model and its held-out gain (issues 4 and 9).
 //!
-//! Pipeline: [`input`] checks and averages the runs; [`models`] fits the paper's RBF on
-//! (T, dT/dt) with run offsets and validates it on held-out runs ([`cv`]); [`simfit`]
-//! calibrates the simulator's physics; [`residuals`] describes what is left; [`transforms`]
-//! builds every candidate feature; [`screen`] ranks them by held-out gain with the
-//! family-wise sign-flip test of [`signflip`]; [`report`] states the result, [`plots`]
+//! Pipeline: [`input`] checks and averages the runs ([`rawrows`] streams the files and
+//! analyses the raw rows on the way); [`bases`] chooses the base model on held-out data
+//! ([`cv`], [`models`]); [`simfit`] calibrates the simulator's physics; [`residuals`]
+//! and [`outliers`] describe what is left; [`transforms`] builds every candidate feature;
+//! [`screen`] ranks them by held-out gain with the family-wise sign-flip test of
+//! [`signflip`], [`between`] does the same for run-level effects; the named [`cause`] is
+//! mapped onto the simulator by [`simterm`]; [`uncertainty`] puts block-bootstrap
+//! ([`bootstrap`]) ranges on every coefficient; [`report`] states the result, [`plots`]
 //! draws it, [`azimuth`] translates it into north-seeking error.
 
 pub mod azimuth;
 pub mod bases;
 pub mod basis;
 pub mod between;
+pub mod bootstrap;
+pub mod cause;
 pub mod cv;
 pub mod error;
 pub mod input;
@@ -20,6 +25,7 @@ pub mod models;
 pub mod olscheck;
 pub mod outliers;
 pub mod plots;
+pub mod rawrows;
 pub mod report;
 pub mod residuals;
 pub mod screen;
@@ -27,9 +33,11 @@ pub mod signflip;
 pub mod simfit;
 pub mod simterm;
 pub mod transforms;
+pub mod uncertainty;
 
+pub use cause::Cause;
 pub use error::DiagnoseError;
-pub use report::{Cause, Report};
+pub use report::Report;
 
 use crate::io::runs::Run;
 use cv::Folds;
@@ -39,6 +47,7 @@ use report::{
     Azimuth, CampaignSummary, CandidateRow, Competitor, DriftStd, Extended, ModelSummary,
     Simulation,
 };
+use screen::{Scored, Screening};
 
 /// Everything the diagnosis computed: the report plus the series the plots need.
 #[derive(Clone, Debug)]
@@ -46,7 +55,12 @@ pub struct Diagnosis {
     pub report: Report,
     pub run_names: Vec<String>,
     pub run_rows: Vec<std::ops::Range<usize>>,
+    /// Validation units (runs, or time blocks of a few long records).
+    pub unit_rows: Vec<std::ops::Range<usize>>,
     pub t_s: Vec<f64>,
+    /// What `t_s` is, for axis labels: since power-on, or since the record's start.
+    pub time_axis: String,
+    pub temp_c: Vec<f64>,
     /// Drift with run offsets removed as the fits see it, deg/h.
     pub drift_dph: Vec<f64>,
     pub baseline_residual: Vec<f64>,
@@ -59,145 +73,69 @@ pub struct Diagnosis {
 }
 
 /// Runs the whole diagnosis on a campaign.
-// Split along its sections is deferred (issue 12, second part); allowed until then.
-#[allow(clippy::too_many_lines)]
 pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
     let campaign = input::prepare(runs)?;
     let st = Stacked::new(&campaign);
     let folds = Folds::new(&st.run_lengths)?;
     let choice = bases::choose(&folds, &st)?;
     let base = &choice.chosen;
-    let base_rms = base.cv.rms();
-    let structure = residuals::structure(&campaign, &folds, &st, &base.cv.residual);
     let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
-    let outliers = outliers::locate(&folds, &run_names, &st.t_s, &st.y, &base.cv.residual);
-    let run_level = between::prepare(&campaign, &folds, &st, base);
-    let no_gains = Vec::new();
-    let screening = screen::screen(
-        &campaign,
-        &folds,
-        &st,
-        base,
-        transforms::enumerate(&campaign),
-        run_level.as_ref().map_or(&no_gains, |p| &p.gains),
-    )?;
     let latitude = campaign
         .runs
         .iter()
         .find_map(|s| s.latitude_deg)
         .unwrap_or(azimuth::DEFAULT_LATITUDE_DEG);
-    let between_run = match run_level {
-        Ok(p) => between::finish(p, &screening.between_p, latitude),
-        Err(note) => between::BetweenRun {
-            turn_on_repeatability_dph: f64::NAN,
-            rows: vec![],
-            named: None,
-            heading: None,
-            note: Some(note),
-        },
-    };
-
+    let (screening, between_run) = screen_both(&campaign, &folds, &st, base, latitude)?;
     let named = screening.named.map(|i| &screening.scored[i]);
-    let cause = named.map(|s| Cause {
-        column: s.cand.column.clone(),
-        transform: s.cand.transform,
-        tau_s: s.cand.tau_s,
-    });
+    let cause = named.map(|s| Cause::from(&s.cand));
     let sim = simfit::calibrate(
         &campaign,
         &folds.run_rows,
         &st.y,
         named.map(|s| s.cols.as_slice()),
     )?;
-    let base_inputs = base.spec.inputs();
-    let (extended, ext_resid) = match named {
-        Some(s) => {
-            let mut inputs = base_inputs.clone();
-            inputs.push(cause.as_ref().map(Cause::label).unwrap_or_default());
-            (
-                Extended {
-                    inputs,
-                    mode: Some(s.mode),
-                    heldout_rms_dph: s.heldout_rms_dph,
-                    gain_pct: s.gain_pct,
-                },
-                s.cv.residual.clone(),
-            )
-        }
-        None => (
-            Extended {
-                inputs: base_inputs.clone(),
-                mode: None,
-                heldout_rms_dph: base_rms,
-                gain_pct: 0.0,
-            },
-            base.cv.residual.clone(),
-        ),
-    };
+    let (extended, ext_resid) = extended_model(base, named, cause.as_ref());
+    let uncertainty = uncertainty::estimate(
+        &campaign,
+        &folds,
+        &st,
+        base,
+        named
+            .zip(cause.as_ref())
+            .map(|(s, c)| uncertainty::NamedFeature {
+                label: c.label(),
+                cols: &s.cols,
+            })
+            .as_ref(),
+    );
     let has_heading = campaign.extra_names.iter().any(|n| n.contains("heading"));
     let azimuth = has_heading.then(|| Azimuth {
         baseline: azimuth::azimuth_effect(&folds, &st.t_s, &base.cv.residual, latitude),
         extended: azimuth::azimuth_effect(&folds, &st.t_s, &ext_resid, latitude),
     });
     let smallest_attainable_p = signflip::smallest_p(folds.unit_rows.len());
-    let words = report::cause_in_words(cause.as_ref(), &sim.effect_coef).unwrap_or_else(|| {
-        match &between_run.named {
-            Some(b) => format!(
-                "no within-run cause; between runs: {b} (see the heading / run-level lines)"
-            ),
-            None => report::nothing_named(smallest_attainable_p),
-        }
-    });
+    let words = cause_in_words(
+        cause.as_ref(),
+        &between_run,
+        &sim.effect_coef,
+        smallest_attainable_p,
+    );
     let sim_terms = simterm::terms_per_run(runs, cause.as_ref(), &sim.effect_coef);
-    let term_summaries: Vec<simterm::TermSummary> = sim_terms
-        .first()
-        .into_iter()
-        .flatten()
-        .map(|t| simterm::summarize(t, cause.as_ref().map_or("", |c| c.column.as_str())))
-        .collect();
-    let to_excl = |(c, r): &(String, String)| Exclusion {
-        column: c.clone(),
-        reason: r.clone(),
-    };
+    let cause_column = cause.as_ref().map(|c| c.column.clone());
     let report = Report {
         campaign: CampaignSummary {
             runs: campaign.runs.len(),
             points: campaign.points(),
             validation: folds.describe(),
             excluded_columns: campaign.exclusions.clone(),
-            skipped_candidates: screening.skipped.iter().map(to_excl).collect(),
+            skipped_candidates: screening.skipped.iter().map(to_exclusion).collect(),
             smallest_attainable_p,
         },
-        base: ModelSummary {
-            name: base.spec.name.clone(),
-            poly_degree_t: base.spec.poly_degree_t,
-            uses_rate: base.spec.uses_rate,
-            inputs: base_inputs,
-            heldout_rms_dph: base_rms,
-            centres: base.centres,
-            width_factor: base.width_factor,
-            ridge: base.ridge,
-            tried: choice.scores.clone(),
-            collinearity_warning: choice.collinearity_warning.clone(),
-        },
-        residual_structure: structure,
-        outliers,
+        base: base_summary(&choice),
+        residual_structure: residuals::structure(&campaign, &folds, &st, &base.cv.residual),
+        outliers: outliers::locate(&folds, &run_names, &st.t_s, &st.y, &base.cv.residual),
         between_run,
-        candidates: screening
-            .scored
-            .iter()
-            .map(|s| CandidateRow {
-                column: s.cand.column.clone(),
-                transform: s.cand.transform,
-                tau_s: s.cand.tau_s,
-                mode: s.mode,
-                heldout_rms_dph: s.heldout_rms_dph,
-                gain_pct: s.gain_pct,
-                p_value: s.p_value,
-                significant: s.significant,
-                units_improved: s.units_improved,
-            })
-            .collect(),
+        candidates: screening.scored.iter().map(candidate_row).collect(),
         named_cause: cause,
         cause_in_words: words,
         competing: screening
@@ -209,33 +147,190 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
             })
             .collect(),
         parsimony_note: screening.parsimony_note.clone(),
-        drift_std: DriftStd {
-            uncompensated_dph: crate::stats::pooled_std_of_rows(&folds.run_rows, &st.y),
-            baseline_heldout_dph: crate::stats::pooled_std_of_rows(
-                &folds.run_rows,
-                &base.cv.residual,
-            ),
-            extended_heldout_dph: crate::stats::pooled_std_of_rows(&folds.run_rows, &ext_resid),
-        },
+        drift_std: drift_std(&folds, &st.y, &base.cv.residual, &ext_resid),
         extended,
         azimuth,
-        simulation: Simulation {
-            before_rms_dph: sim.before_rms_dph,
-            after_rms_dph: sim.after_rms_dph.unwrap_or(sim.before_rms_dph),
-            term: term_summaries.first().cloned(),
-            terms: term_summaries,
-            calibration: sim,
-        },
+        uncertainty,
+        raw_rows: None,
+        simulation: simulation_summary(sim, &sim_terms, cause_column.as_deref()),
     };
     Ok(Diagnosis {
         report,
         run_names,
         run_rows: folds.run_rows.clone(),
+        unit_rows: folds.unit_rows.clone(),
         t_s: st.t_s.clone(),
+        time_axis: time_axis(runs),
+        temp_c: st.temp_c.clone(),
         drift_dph: base.prepared.target().to_vec(),
         baseline_residual: base.cv.residual.clone(),
         extended_residual: ext_resid,
         cause_feature: named.and_then(|s| s.cols.first().cloned()),
         sim_terms,
     })
+}
+
+/// Within-run screening and the between-run analysis, decided as one family.
+fn screen_both(
+    campaign: &input::Campaign,
+    folds: &Folds,
+    st: &Stacked,
+    base: &bases::BaseFit,
+    latitude_deg: f64,
+) -> Result<(Screening, between::BetweenRun), DiagnoseError> {
+    let run_level = between::prepare(campaign, folds, st, base);
+    let no_gains = Vec::new();
+    let screening = screen::screen(
+        campaign,
+        folds,
+        st,
+        base,
+        transforms::enumerate(campaign),
+        run_level.as_ref().map_or(&no_gains, |p| &p.gains),
+    )?;
+    let between_run = match run_level {
+        Ok(p) => between::finish(p, &screening.between_p, latitude_deg),
+        Err(note) => between::BetweenRun {
+            turn_on_repeatability_dph: f64::NAN,
+            rows: vec![],
+            named: None,
+            heading: None,
+            note: Some(note),
+        },
+    };
+    Ok((screening, between_run))
+}
+
+/// The base extended by the named cause (the base itself when nothing is named), and its
+/// held-out residual.
+fn extended_model(
+    base: &bases::BaseFit,
+    named: Option<&Scored>,
+    cause: Option<&Cause>,
+) -> (Extended, Vec<f64>) {
+    let mut inputs = base.spec.inputs();
+    match (named, cause) {
+        (Some(s), Some(c)) => {
+            inputs.push(c.label());
+            (
+                Extended {
+                    inputs,
+                    mode: Some(s.mode),
+                    heldout_rms_dph: s.heldout_rms_dph,
+                    gain_pct: s.gain_pct,
+                },
+                s.cv.residual.clone(),
+            )
+        }
+        _ => (
+            Extended {
+                inputs,
+                mode: None,
+                heldout_rms_dph: base.cv.rms(),
+                gain_pct: 0.0,
+            },
+            base.cv.residual.clone(),
+        ),
+    }
+}
+
+/// The chosen base and every base tried, for the report.
+fn base_summary(choice: &bases::BaseChoice) -> ModelSummary {
+    let base = &choice.chosen;
+    ModelSummary {
+        name: base.spec.name.clone(),
+        poly_degree_t: base.spec.poly_degree_t,
+        uses_rate: base.spec.uses_rate,
+        inputs: base.spec.inputs(),
+        heldout_rms_dph: base.cv.rms(),
+        centres: base.centres,
+        width_factor: base.width_factor,
+        ridge: base.ridge,
+        tried: choice.scores.clone(),
+        collinearity_warning: choice.collinearity_warning.clone(),
+    }
+}
+
+fn candidate_row(s: &Scored) -> CandidateRow {
+    CandidateRow {
+        column: s.cand.column.clone(),
+        transform: s.cand.transform,
+        tau_s: s.cand.tau_s,
+        mode: s.mode,
+        heldout_rms_dph: s.heldout_rms_dph,
+        gain_pct: s.gain_pct,
+        p_value: s.p_value,
+        significant: s.significant,
+        units_improved: s.units_improved,
+    }
+}
+
+/// Pooled within-run drift std of the raw drift, the base's and the extension's held-out
+/// residuals.
+fn drift_std(folds: &Folds, y: &[f64], base_resid: &[f64], ext_resid: &[f64]) -> DriftStd {
+    let pooled = |v: &[f64]| crate::stats::pooled_std_of_rows(&folds.run_rows, v);
+    DriftStd {
+        uncompensated_dph: pooled(y),
+        baseline_heldout_dph: pooled(base_resid),
+        extended_heldout_dph: pooled(ext_resid),
+    }
+}
+
+fn to_exclusion((column, reason): &screen::Skipped) -> Exclusion {
+    Exclusion {
+        column: column.clone(),
+        reason: reason.clone(),
+    }
+}
+
+/// The within-run cause in words, else the between-run one, else why nothing is named.
+fn cause_in_words(
+    cause: Option<&Cause>,
+    between_run: &between::BetweenRun,
+    coef: &[f64],
+    smallest_attainable_p: f64,
+) -> String {
+    match (cause, &between_run.named) {
+        (Some(c), _) => c.in_words(coef),
+        (None, Some(b)) => {
+            format!("no within-run cause; between runs: {b} (see the heading / run-level lines)")
+        }
+        (None, None) => report::nothing_named(smallest_attainable_p),
+    }
+}
+
+/// The simulator before/after and the terms added (listed for the first run).
+fn simulation_summary(
+    sim: simfit::SimCalibration,
+    sim_terms: &[Vec<crate::sim::DriftTerm>],
+    cause_column: Option<&str>,
+) -> Simulation {
+    let terms: Vec<simterm::TermSummary> = sim_terms
+        .first()
+        .into_iter()
+        .flatten()
+        .map(|t| simterm::summarize(t, cause_column.unwrap_or("")))
+        .collect();
+    Simulation {
+        before_rms_dph: sim.before_rms_dph,
+        after_rms_dph: sim.after_rms_dph.unwrap_or(sim.before_rms_dph),
+        term: terms.first().cloned(),
+        terms,
+        calibration: sim,
+    }
+}
+
+/// "time since power-on" when every run says how it was powered on (`start` metadata)
+/// and none says it is not a power-on record; else the record's own time.
+fn time_axis(runs: &[Run]) -> String {
+    let power_on = runs.iter().all(|r| r.meta_value("start").is_some())
+        && !runs.iter().any(|r| {
+            r.meta_value("note")
+                .is_some_and(|n| n.contains("not a power-on"))
+        });
+    if power_on {
+        "time since power-on".into()
+    } else {
+        "t_s (time since the record's start)".into()
+    }
 }

@@ -1,6 +1,7 @@
 //! The diagnosis as data (JSON, the issue's schema and more) and as words (stdout).
 
 use super::azimuth::AzimuthEffect;
+use super::cause::Cause;
 use super::input::Exclusion;
 use super::residuals::Structure;
 use super::screen::Mode;
@@ -40,21 +41,6 @@ pub struct CandidateRow {
     pub p_value: f64,
     pub significant: bool,
     pub units_improved: f64,
-}
-
-/// The named cause.
-#[derive(Clone, Debug, Serialize, PartialEq)]
-pub struct Cause {
-    pub column: String,
-    pub transform: Transform,
-    pub tau_s: Option<f64>,
-}
-
-impl Cause {
-    /// The report name, e.g. `temp_c:lag(tau_s=240)` (see `crate::report::feature_label`).
-    pub fn label(&self) -> String {
-        crate::report::feature_label(&self.column, self.transform.name(), self.tau_s)
-    }
 }
 
 /// A candidate that explains the same thing as the named cause.
@@ -129,6 +115,10 @@ pub struct Report {
     pub extended: Extended,
     pub drift_std: DriftStd,
     pub azimuth: Option<Azimuth>,
+    /// +/- (block bootstrap) on every fitted coefficient, ratios to the simulator.
+    pub uncertainty: super::uncertainty::Uncertainty,
+    /// The raw rows before averaging (set by the command that streamed them).
+    pub raw_rows: Option<super::rawrows::RawRows>,
     pub simulation: Simulation,
 }
 
@@ -147,53 +137,24 @@ pub fn nothing_named(smallest_attainable_p: f64) -> String {
     }
 }
 
-/// The cause in words (physics reading of a column and transform); `None` when nothing
-/// is named (see `nothing_named`).
-pub fn cause_in_words(c: Option<&Cause>, coef: &[f64]) -> Option<String> {
-    let c = c?;
-    let tau = c.tau_s.unwrap_or(0.0);
-    let k = coef.first().copied().unwrap_or(0.0);
-    Some(match (c.column.as_str(), c.transform) {
-        ("temp_c", Transform::Accel) => format!(
-            "drift follows d2T/dt2 ({k:.3e} deg/h per degC/s^2): the Shupe gradient term (the rate of the temperature \
-             gradient along the coil), which the T, dT/dt model cannot express"
-        ),
-        ("temp_c", Transform::Lag) => format!(
-            "drift follows the temperature through a {tau:.0} s lag: the sensor does not sit where the drift is \
-             generated (sensor lag / placement), which T, dT/dt of the sensor cannot express"
-        ),
-        ("t_s", Transform::Decay) => format!(
-            "a power-on transient exp(-t/{tau:.0} s) independent of temperature (start-up amplitude {k:.4} deg/h): \
-             e.g. light-source or electronics settling, which no function of T, dT/dt can express in warm restarts"
-        ),
-        ("earth_dph", Transform::Value) => format!(
-            "drift proportional to the Earth-rate input ({:.1} ppm): a scale-factor error",
-            k * 1e6
-        ),
-        (col, Transform::Harmonic) => {
-            let a = coef.first().copied().unwrap_or(0.0);
-            let b = coef.get(1).copied().unwrap_or(0.0);
-            format!(
-                "drift depends on {col} as a sinusoid (amplitude {:.4} deg/h, maximum at {:.0} deg): a heading-dependent \
-                 bias such as magnetic (Faraday) sensitivity; it flips with the 180 deg turn and does not cancel in a seek",
-                a.hypot(b),
-                b.atan2(a).to_degrees().rem_euclid(360.0)
-            )
-        }
-        (col, Transform::Value) => format!("drift follows `{col}` itself ({k:.4e} deg/h per unit)"),
-        (col, Transform::Rate) => format!("drift follows the rate of change of `{col}` ({k:.4e} deg/h per unit/s)"),
-        (col, Transform::Accel) => format!("drift follows the second derivative of `{col}` ({k:.4e} deg/h per unit/s^2)"),
-        (col, Transform::Lag) => format!("drift follows `{col}` through a first-order lag of {tau:.0} s ({k:.4e} deg/h per unit)"),
-        (col, Transform::Decay) => format!("drift decays as exp(-{col}/{tau:.0} s)"),
-    })
-}
-
-/// Human-readable report.
-// Split along its sections is deferred (issue 12, second part); allowed until then.
-#[allow(clippy::too_many_lines)]
+/// Human-readable report, one section after another.
 pub fn render_text(r: &Report) -> String {
     let mut s = String::new();
-    let c = &r.campaign;
+    write_campaign(&mut s, &r.campaign);
+    write_baseline(&mut s, r);
+    write_residual(&mut s, r);
+    write_candidates(&mut s, r);
+    write_cause(&mut s, r);
+    write_simulator(&mut s, r);
+    write_uncertainty(&mut s, &r.uncertainty);
+    if let Some(raw) = &r.raw_rows {
+        write_raw_rows(&mut s, raw);
+    }
+    s
+}
+
+/// Header: campaign size, validation layout, test power, exclusions.
+fn write_campaign(s: &mut String, c: &CampaignSummary) {
     let _ = writeln!(s, "fogsim diagnose: {} runs, {} points (10 s means, or one row per slower sample); validation: {}", c.runs, c.points, c.validation);
     if c.smallest_attainable_p >= super::screen::ALPHA {
         let _ = writeln!(
@@ -215,6 +176,10 @@ pub fn render_text(r: &Report) -> String {
             c.skipped_candidates[0].reason
         );
     }
+}
+
+/// Section 1: calibrated simulator and the base chosen on held-out data.
+fn write_baseline(s: &mut String, r: &Report) {
     let sim = &r.simulation.calibration;
     let _ = writeln!(s, "\n1. Baseline");
     let _ = writeln!(
@@ -250,6 +215,10 @@ pub fn render_text(r: &Report) -> String {
     if let Some(w) = &r.base.collinearity_warning {
         let _ = writeln!(s, "  warning: {w}");
     }
+}
+
+/// Section 2: the base's held-out residual by time, ambient, signal; the outliers.
+fn write_residual(s: &mut String, r: &Report) {
     let _ = writeln!(s, "\n2. What the model gets wrong (held-out residual)");
     for b in &r.residual_structure.by_time {
         let _ = writeln!(
@@ -292,14 +261,13 @@ pub fn render_text(r: &Report) -> String {
             x.run, x.row, x.t_s, x.column, x.sigma, x.value, x.pattern
         );
     }
+}
+
+/// Section 3: ranked within-run candidates, then the between-run ones.
+fn write_candidates(s: &mut String, r: &Report) {
     let _ = writeln!(s, "\n3. Candidate causes (ranked by held-out rms; p = family-wise sign-flip test over whole validation units)");
     for row in r.candidates.iter().take(8) {
-        let label = Cause {
-            column: row.column.clone(),
-            transform: row.transform,
-            tau_s: row.tau_s,
-        }
-        .label();
+        let label = crate::report::feature_label(&row.column, row.transform.name(), row.tau_s);
         let _ = writeln!(
             s,
             "  {:<28} {:>9} rms {:.4}  gain {:+6.2}%  p {:.4}  units improved {:>3.0}%{}",
@@ -313,39 +281,34 @@ pub fn render_text(r: &Report) -> String {
         );
     }
     let b = &r.between_run;
-    match &b.note {
-        Some(n) => {
-            let _ = writeln!(s, "  between runs: not tested ({n})");
-        }
-        None => {
-            let _ = writeln!(
-                s,
-                "  between runs (run offsets left by the base; turn-on repeatability {:.4} deg/h, leave one run out; p in the same family):",
-                b.turn_on_repeatability_dph
-            );
-            for row in b.rows.iter().take(4) {
-                let _ = writeln!(
-                    s,
-                    "  {:<28} offset rms {:.4}  gain {:+6.2}%  p {:.4}  (run permutation p {:.4}){}",
-                    row.label,
-                    row.heldout_offset_rms_dph,
-                    row.gain_pct,
-                    row.p_value,
-                    row.permutation_p,
-                    if row.significant { "  *" } else { "" }
-                );
-            }
-        }
+    if let Some(n) = &b.note {
+        let _ = writeln!(s, "  between runs: not tested ({n})");
+        return;
     }
+    let _ = writeln!(
+        s,
+        "  between runs (run offsets left by the base; turn-on repeatability {:.4} deg/h, leave one run out; p in the same family):",
+        b.turn_on_repeatability_dph
+    );
+    for row in b.rows.iter().take(4) {
+        let _ = writeln!(
+            s,
+            "  {:<28} offset rms {:.4}  gain {:+6.2}%  p {:.4}  (run permutation p {:.4}){}",
+            row.label,
+            row.heldout_offset_rms_dph,
+            row.gain_pct,
+            row.p_value,
+            row.permutation_p,
+            if row.significant { "  *" } else { "" }
+        );
+    }
+}
+
+/// Section 4: the named cause, competitors, heading effect, extended model, azimuth.
+fn write_cause(s: &mut String, r: &Report) {
     let _ = writeln!(s, "\n4. Cause");
-    match &r.named_cause {
-        Some(cause) => {
-            let _ = writeln!(s, "  named: {}", cause.label());
-        }
-        None => {
-            let _ = writeln!(s, "  named: none");
-        }
-    }
+    let named = r.named_cause.as_ref().map_or("none".into(), Cause::label);
+    let _ = writeln!(s, "  named: {named}");
     let _ = writeln!(s, "  {}", r.cause_in_words);
     if let Some(n) = &r.parsimony_note {
         let _ = writeln!(s, "  {n}");
@@ -357,6 +320,7 @@ pub fn render_text(r: &Report) -> String {
             comp.candidate, comp.conditional_gain_pct
         );
     }
+    let b = &r.between_run;
     if let Some(n) = &b.named {
         let _ = writeln!(s, "  named between runs: {n}");
     }
@@ -385,27 +349,130 @@ pub fn render_text(r: &Report) -> String {
             a.baseline.dwell_s, a.baseline.latitude_deg, a.baseline.azimuth_sigma_deg, a.extended.azimuth_sigma_deg
         );
     }
+}
+
+/// Section 5: the simulator extended with the named effect.
+fn write_simulator(s: &mut String, r: &Report) {
     let _ = writeln!(s, "\n5. Simulator extended with the named effect");
-    if r.named_cause.is_some() {
-        let _ = writeln!(
-            s,
-            "  sim vs measured rms: {:.4} -> {:.4} deg/h (fitted coefficient(s) of the new term: {:?})",
-            r.simulation.before_rms_dph, r.simulation.after_rms_dph, sim.effect_coef
-        );
-        for t in &r.simulation.terms {
-            let tau = t.tau_s.map_or(String::new(), |v| format!(", tau {v:.0} s"));
-            let _ = writeln!(
-                s,
-                "  simulator extended with: {} = {:.4e} deg/h x {}({}{tau}) (fog_sim::sim::DriftTerm)",
-                t.label, t.coeff_dph, t.transform, t.source
-            );
-        }
-    } else {
+    if r.named_cause.is_none() {
         let _ = writeln!(
             s,
             "  no named effect: the simulator is left as calibrated (rms {:.4} deg/h)",
             r.simulation.before_rms_dph
         );
+        return;
     }
-    s
+    let _ = writeln!(
+        s,
+        "  sim vs measured rms: {:.4} -> {:.4} deg/h (fitted coefficient(s) of the new term: {:?})",
+        r.simulation.before_rms_dph,
+        r.simulation.after_rms_dph,
+        r.simulation.calibration.effect_coef
+    );
+    for t in &r.simulation.terms {
+        let tau = t.tau_s.map_or(String::new(), |v| format!(", tau {v:.0} s"));
+        let _ = writeln!(
+            s,
+            "  simulator extended with: {} = {:.4e} deg/h x {}({}{tau}) (fog_sim::sim::DriftTerm)",
+            t.label, t.coeff_dph, t.transform, t.source
+        );
+    }
+}
+
+/// Section 6: every fitted coefficient with its bootstrap range, ratios to the simulator.
+fn write_uncertainty(s: &mut String, u: &super::uncertainty::Uncertainty) {
+    let _ = writeln!(s, "\n6. Coefficients with +/- ({})", u.method);
+    let groups = [
+        ("base", &u.base),
+        ("extension", &u.extension),
+        ("calibrated simulator", &u.simulator),
+    ];
+    for (what, list) in groups {
+        for e in list {
+            let _ = writeln!(
+                s,
+                "  {what}: {} = {:.4e} +/- {:.2e} {} (95 %: {:.4e} .. {:.4e})",
+                e.name, e.value, e.plus_minus, e.unit, e.ci95[0], e.ci95[1]
+            );
+        }
+    }
+    for r in &u.ratios {
+        let _ = writeln!(
+            s,
+            "  measured / simulator, {}: {:.4e} +/- {:.2e} vs {:.4e} {} -> ratio {:.3} +/- {:.3}",
+            r.name,
+            r.measured,
+            r.measured_plus_minus,
+            r.simulator,
+            r.unit,
+            r.ratio.value,
+            r.ratio.plus_minus
+        );
+    }
+}
+
+/// Section 7: Allan deviation, quantisation and steps of the raw rows.
+fn write_raw_rows(s: &mut String, raw: &super::rawrows::RawRows) {
+    let _ = writeln!(
+        s,
+        "\n7. Raw rows ({} rows, period {:.4} s; drift = rate_dph - earth_dph, runs pooled, never across a gap)",
+        raw.rows, raw.sample_period_s
+    );
+    let pts: Vec<String> = raw
+        .allan
+        .iter()
+        .map(|p| format!("{:.4}s {:.3e}", p.tau_s, p.adev_dph))
+        .collect();
+    let _ = writeln!(s, "  Allan deviation, deg/h: {}", pts.join(", "));
+    match (raw.arw_dpsh, raw.arw_plus_minus_dpsh) {
+        (Some(n), Some(pm)) => {
+            let sim = crate::sim::GyroParams::paper_default().noise.arw_dpsh;
+            let _ = writeln!(
+                s,
+                "  ARW (IEEE 952 N, -1/2 slope over tau {} s): {n:.3e} +/- {pm:.1e} deg/sqrt(h); simulator {sim:.1e}: ratio {:.3} +/- {:.3}",
+                raw.arw_fit_taus_s.iter().map(|t| format!("{t:.4}")).collect::<Vec<_>>().join(", "),
+                n / sim,
+                pm / sim
+            );
+        }
+        _ => {
+            let _ = writeln!(s, "  ARW: no -1/2 slope in the Allan deviation (white rate noise not dominant at any tau measured)");
+        }
+    }
+    if let (Some(b), Some(t)) = (raw.bias_instability_dph, raw.bias_instability_tau_s) {
+        let _ = writeln!(
+            s,
+            "  bias instability (IEEE 952 B = sigma_min / 0.664): {b:.3e} deg/h at tau {t:.4} s; {}",
+            raw.bias_instability_note
+        );
+    }
+    for q in &raw.quantisation {
+        let _ = writeln!(
+            s,
+            "  {}: smallest step {:.6e}; {}",
+            q.column,
+            q.smallest_step,
+            if q.quantised {
+                "quantised (every step a multiple of it)"
+            } else {
+                "not quantised at this step"
+            }
+        );
+    }
+    let st = &raw.steps;
+    let _ = writeln!(
+        s,
+        "  steps of the drift (two {}-row windows, > {} sigma): {}",
+        st.window_rows, st.threshold_sigma, st.count
+    );
+    for x in &st.listed {
+        let _ = writeln!(
+            s,
+            "    {} t {:.1} s: {:+.4e} deg/h ({:+.1} sigma)",
+            x.run, x.t_s, x.size_dph, x.sigma
+        );
+    }
+    for n in &raw.notes {
+        let _ = writeln!(s, "  note: {n}");
+    }
 }

@@ -54,13 +54,16 @@ pub struct Scored {
     pub units_improved: f64,
 }
 
+/// A skipped candidate's label and the reason.
+pub type Skipped = (String, String);
+
 /// The outcome of screening.
 #[derive(Clone, Debug)]
 pub struct Screening {
     /// Sorted by held-out rms, best first.
     pub scored: Vec<Scored>,
     /// Candidates skipped and why.
-    pub skipped: Vec<(String, String)>,
+    pub skipped: Vec<Skipped>,
     /// Index into `scored` of the named cause.
     pub named: Option<usize>,
     /// Labels of candidates competing with the named cause, with their conditional gain %.
@@ -92,8 +95,6 @@ fn gain_pct(base: f64, ext: f64) -> f64 {
 }
 
 /// Screens, refits and names (see the module header).
-// Split along its sections is deferred (issue 12, second part); allowed until then.
-#[allow(clippy::too_many_lines)]
 pub fn screen(
     campaign: &Campaign,
     folds: &Folds,
@@ -102,18 +103,39 @@ pub fn screen(
     cands: Vec<Candidate>,
     between_gains: &[Vec<f64>],
 ) -> Result<Screening, DiagnoseError> {
+    let (mut scored, skipped) = score_linear(campaign, folds, base, cands)?;
+    let between_p = family_pvalues(base, &mut scored, between_gains);
+    scored.sort_by(|a, b| a.heldout_rms_dph.total_cmp(&b.heldout_rms_dph));
+    refit_best_as_rbf_inputs(folds, st, base, &mut scored);
+    scored.sort_by(|a, b| a.heldout_rms_dph.total_cmp(&b.heldout_rms_dph));
+    let (named, parsimony_note) = name_cause(&scored);
+    let competing = match named {
+        Some(i) => competitors(folds, base, &scored, i)?,
+        None => vec![],
+    };
+    Ok(Screening {
+        scored,
+        skipped,
+        named,
+        competing,
+        parsimony_note,
+        between_p,
+    })
+}
+
+/// Step 1: every candidate as one more linear term of the base, validated held out.
+/// Returns the scored candidates and the skipped ones with the reason.
+fn score_linear(
+    campaign: &Campaign,
+    folds: &Folds,
+    base: &BaseFit,
+    cands: Vec<Candidate>,
+) -> Result<(Vec<Scored>, Vec<Skipped>), DiagnoseError> {
     let base_rms = base.cv.rms();
     let mut skipped = Vec::new();
     let mut scored = Vec::new();
     for cand in cands {
-        let cols: Vec<Vec<f64>> = {
-            let per_run: Vec<Vec<Vec<f64>>> =
-                campaign.runs.iter().map(|s| cand.compute(s)).collect();
-            let m = per_run.first().map_or(0, Vec::len);
-            (0..m)
-                .map(|j| per_run.iter().flat_map(|r| r[j].iter().copied()).collect())
-                .collect()
-        };
+        let cols = stacked_columns(campaign, &cand);
         if cols.iter().any(|c| c.iter().any(|v| !v.is_finite())) {
             skipped.push((cand.label(), "not finite".to_owned()));
             continue;
@@ -142,20 +164,38 @@ pub fn screen(
             units_improved: 0.0,
         });
     }
-    // One family-wise decision over within-run and between-run candidates: max-T sign
-    // flips inside each group, Bonferroni over the two groups. (One max-T over both was
-    // measured to drown within-run effects: run-offset gains are far larger, so they
-    // dominate the null maximum.)
+    Ok((scored, skipped))
+}
+
+/// The candidate's columns for every run, stacked run after run.
+fn stacked_columns(campaign: &Campaign, cand: &Candidate) -> Vec<Vec<f64>> {
+    let per_run: Vec<Vec<Vec<f64>>> = campaign.runs.iter().map(|s| cand.compute(s)).collect();
+    let m = per_run.first().map_or(0, Vec::len);
+    (0..m)
+        .map(|j| per_run.iter().flat_map(|r| r[j].iter().copied()).collect())
+        .collect()
+}
+
+/// One family-wise decision over within-run and between-run candidates: max-T sign
+/// flips inside each group, Bonferroni over the two groups. (One max-T over both was
+/// measured to drown within-run effects: run-offset gains are far larger, so they
+/// dominate the null maximum.) Sets the within-run p-values; returns the between-run ones.
+fn family_pvalues(base: &BaseFit, scored: &mut [Scored], between_gains: &[Vec<f64>]) -> Vec<f64> {
     let gains: Vec<Vec<f64>> = scored.iter().map(|s| unit_gains(&base.cv, &s.cv)).collect();
     let groups = if between_gains.is_empty() { 1.0 } else { 2.0 };
     let adjust =
         |p: Vec<f64>| -> Vec<f64> { p.into_iter().map(|x| (groups * x).min(1.0)).collect() };
     let pv = adjust(max_t_pvalues(&gains, FLIP_SEED));
-    let between_p = adjust(max_t_pvalues(between_gains, FLIP_SEED));
     for (s, p) in scored.iter_mut().zip(pv) {
         s.p_value = p;
     }
-    scored.sort_by(|a, b| a.heldout_rms_dph.total_cmp(&b.heldout_rms_dph));
+    adjust(max_t_pvalues(between_gains, FLIP_SEED))
+}
+
+/// Step 2: the best few (sorted) also tried as a further RBF input, keeping the better
+/// held-out form; then every candidate's improved-unit share and significance.
+fn refit_best_as_rbf_inputs(folds: &Folds, st: &Stacked, base: &BaseFit, scored: &mut [Scored]) {
+    let base_rms = base.cv.rms();
     for s in scored
         .iter_mut()
         .take(REFIT_TOP)
@@ -175,47 +215,41 @@ pub fn screen(
         s.units_improved = g.iter().filter(|v| **v > 0.0).count() as f64 / g.len().max(1) as f64;
         s.significant = s.p_value < ALPHA && s.gain_pct > MIN_GAIN_PCT;
     }
-    scored.sort_by(|a, b| a.heldout_rms_dph.total_cmp(&b.heldout_rms_dph));
-    let mut named = scored.iter().position(|s| s.significant);
-    let mut parsimony_note = None;
-    if let Some(top) = named {
-        let simpler = scored
-            .iter()
-            .enumerate()
-            .filter(|(i, s)| {
-                *i != top
-                    && s.significant
-                    && s.cand.column == scored[top].cand.column
-                    && s.cand.complexity() < scored[top].cand.complexity()
-            })
-            .filter(|(_, s)| paired_pvalue(&unit_gains(&s.cv, &scored[top].cv), FLIP_SEED) >= 0.05)
-            .min_by(|a, b| {
-                (a.1.cand.complexity(), a.1.heldout_rms_dph)
-                    .partial_cmp(&(b.1.cand.complexity(), b.1.heldout_rms_dph))
-                    .unwrap_or(std::cmp::Ordering::Equal)
-            })
-            .map(|(i, _)| i);
-        if let Some(i) = simpler {
-            parsimony_note = Some(format!(
+}
+
+/// Step 3: the best significant candidate (sorted), or a simpler transform of the same
+/// column that is not significantly worse (with the note saying so).
+fn name_cause(scored: &[Scored]) -> (Option<usize>, Option<String>) {
+    let Some(top) = scored.iter().position(|s| s.significant) else {
+        return (None, None);
+    };
+    let simpler = scored
+        .iter()
+        .enumerate()
+        .filter(|(i, s)| {
+            *i != top
+                && s.significant
+                && s.cand.column == scored[top].cand.column
+                && s.cand.complexity() < scored[top].cand.complexity()
+        })
+        .filter(|(_, s)| paired_pvalue(&unit_gains(&s.cv, &scored[top].cv), FLIP_SEED) >= 0.05)
+        .min_by(|a, b| {
+            (a.1.cand.complexity(), a.1.heldout_rms_dph)
+                .partial_cmp(&(b.1.cand.complexity(), b.1.heldout_rms_dph))
+                .unwrap_or(std::cmp::Ordering::Equal)
+        })
+        .map(|(i, _)| i);
+    match simpler {
+        Some(i) => (
+            Some(i),
+            Some(format!(
                 "{} chosen over {} (same column, simpler, not significantly worse on held-out data)",
                 scored[i].cand.label(),
                 scored[top].cand.label()
-            ));
-            named = Some(i);
-        }
+            )),
+        ),
+        None => (Some(top), None),
     }
-    let competing = match named {
-        Some(i) => competitors(folds, base, &scored, i)?,
-        None => vec![],
-    };
-    Ok(Screening {
-        scored,
-        skipped,
-        named,
-        competing,
-        parsimony_note,
-        between_p,
-    })
 }
 
 /// Per-unit drop in held-out squared error from `from` to `to`.

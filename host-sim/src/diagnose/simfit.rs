@@ -144,13 +144,9 @@ fn fit_thermal(c: &Campaign) -> Thermal {
     })
 }
 
-/// Calibrates (see the module header); `effect` are the named cause's stacked columns.
-pub fn calibrate(
-    c: &Campaign,
-    run_rows: &[std::ops::Range<usize>],
-    y: &[f64],
-    effect: Option<&[Vec<f64>]>,
-) -> Result<SimCalibration, DiagnoseError> {
+/// The calibration's drift design from the fitted thermal response: T - mean T,
+/// (T - mean T)^2, dT/dt (in that order: bias slope, curvature, Shupe), stacked.
+fn design(c: &Campaign) -> (Thermal, Vec<Vec<f64>>) {
     let th = fit_thermal(c);
     let t_mean = th.temp.iter().sum::<f64>() / th.temp.len().max(1) as f64;
     let dt: Vec<f64> = th.temp.iter().map(|t| t - t_mean).collect();
@@ -159,6 +155,25 @@ pub fn calibrate(
         dt.iter().map(|d| d * d).collect(),
         th.rate.clone(),
     ];
+    (th, cols)
+}
+
+/// The calibration's drift design columns (see `design`) and the mean fitted temperature,
+/// degC (where `bias_dph_per_c` applies).
+pub fn design_columns(c: &Campaign) -> (Vec<Vec<f64>>, f64) {
+    let (th, cols) = design(c);
+    let t_mean = th.temp.iter().sum::<f64>() / th.temp.len().max(1) as f64;
+    (cols, t_mean)
+}
+
+/// Calibrates (see the module header); `effect` are the named cause's stacked columns.
+pub fn calibrate(
+    c: &Campaign,
+    run_rows: &[std::ops::Range<usize>],
+    y: &[f64],
+    effect: Option<&[Vec<f64>]>,
+) -> Result<SimCalibration, DiagnoseError> {
+    let (th, cols) = design(c);
     let (coef, resid) = fit_with_offsets(run_rows, &cols, y)?;
     let mut out = SimCalibration {
         tau_fast_s: th.tau.0,
@@ -185,14 +200,13 @@ pub fn calibrate(
 
 /// sigma of white noise from first differences within runs (slow structure cancels).
 fn white_noise(run_rows: &[std::ops::Range<usize>], r: &[f64]) -> f64 {
-    let d: Vec<f64> = run_rows
+    rms(&within_run_differences(run_rows, r)) / std::f64::consts::SQRT_2
+}
+
+/// First differences of `v` inside each run (never across a run boundary).
+pub fn within_run_differences(run_rows: &[std::ops::Range<usize>], v: &[f64]) -> Vec<f64> {
+    run_rows
         .iter()
-        .flat_map(|rr| {
-            r[rr.clone()]
-                .windows(2)
-                .map(|w| w[1] - w[0])
-                .collect::<Vec<_>>()
-        })
-        .collect();
-    rms(&d) / std::f64::consts::SQRT_2
+        .flat_map(|rr| v[rr.clone()].windows(2).map(|w| w[1] - w[0]))
+        .collect()
 }

@@ -17,7 +17,7 @@
 //!   other `*_deg:harmonic` -> two series, cos and sin of the run's column;
 //! - `earth_dph:*` -> the true input rate with the same transform (a scale-factor error).
 
-use super::report::Cause;
+use super::cause::Cause;
 use super::transforms::Transform;
 use crate::io::runs::Run;
 use crate::sim::{AuxSource, AuxTransform, DriftTerm};

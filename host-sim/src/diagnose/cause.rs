@@ -1,0 +1,93 @@
+//! The named cause: which column, under which transform, drives the drift, and what that
+//! means physically. A domain type of its own so that the report, the simulator mapping
+//! (`simterm`) and the OLS cross-check (`olscheck`) share it without depending on each
+//! other.
+
+use super::transforms::{Candidate, Transform};
+use serde::Serialize;
+
+/// The named cause.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct Cause {
+    pub column: String,
+    pub transform: Transform,
+    pub tau_s: Option<f64>,
+}
+
+impl From<&Candidate> for Cause {
+    fn from(c: &Candidate) -> Self {
+        Self {
+            column: c.column.clone(),
+            transform: c.transform,
+            tau_s: c.tau_s,
+        }
+    }
+}
+
+impl Cause {
+    /// The report name, e.g. `temp_c:lag(tau_s=240)` (the one label format,
+    /// `crate::report::feature_label`, also used by `Candidate::label`).
+    pub fn label(&self) -> String {
+        crate::report::feature_label(&self.column, self.transform.name(), self.tau_s)
+    }
+
+    /// The cause in words (physics reading of the column and transform); `coef` are the
+    /// fitted coefficients of its term in the calibrated simulator.
+    pub fn in_words(&self, coef: &[f64]) -> String {
+        let tau = self.tau_s.unwrap_or(0.0);
+        let k = coef.first().copied().unwrap_or(0.0);
+        match (self.column.as_str(), self.transform) {
+            ("temp_c", Transform::Accel) => format!(
+                "drift follows d2T/dt2 ({k:.3e} deg/h per degC/s^2): the Shupe gradient term (the rate of the temperature \
+                 gradient along the coil), which the T, dT/dt model cannot express"
+            ),
+            ("temp_c", Transform::Lag) => format!(
+                "drift follows the temperature through a {tau:.0} s lag: the sensor does not sit where the drift is \
+                 generated (sensor lag / placement), which T, dT/dt of the sensor cannot express"
+            ),
+            ("t_s", Transform::Decay) => format!(
+                "a power-on transient exp(-t/{tau:.0} s) independent of temperature (start-up amplitude {k:.4} deg/h): \
+                 e.g. light-source or electronics settling, which no function of T, dT/dt can express in warm restarts"
+            ),
+            ("earth_dph", Transform::Value) => format!(
+                "drift proportional to the Earth-rate input ({:.1} ppm): a scale-factor error",
+                k * 1e6
+            ),
+            (col, Transform::Harmonic) => {
+                let a = coef.first().copied().unwrap_or(0.0);
+                let b = coef.get(1).copied().unwrap_or(0.0);
+                format!(
+                    "drift depends on {col} as a sinusoid (amplitude {:.4} deg/h, maximum at {:.0} deg): a heading-dependent \
+                     bias such as magnetic (Faraday) sensitivity; it flips with the 180 deg turn and does not cancel in a seek",
+                    a.hypot(b),
+                    b.atan2(a).to_degrees().rem_euclid(360.0)
+                )
+            }
+            (col, Transform::Value) => format!("drift follows `{col}` itself ({k:.4e} deg/h per unit)"),
+            (col, Transform::Rate) => format!("drift follows the rate of change of `{col}` ({k:.4e} deg/h per unit/s)"),
+            (col, Transform::Accel) => format!("drift follows the second derivative of `{col}` ({k:.4e} deg/h per unit/s^2)"),
+            (col, Transform::Lag) => format!("drift follows `{col}` through a first-order lag of {tau:.0} s ({k:.4e} deg/h per unit)"),
+            (col, Transform::Decay) => format!("drift decays as exp(-{col}/{tau:.0} s)"),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnose::transforms::Source;
+
+    #[test]
+    fn a_cause_is_labelled_like_the_candidate_it_comes_from() {
+        let cand = Candidate {
+            column: "temp_c".into(),
+            source: Source::Temp,
+            transform: Transform::Lag,
+            tau_s: Some(240.0),
+        };
+        let cause = Cause::from(&cand);
+        assert_eq!(cause.label(), cand.label());
+        assert_eq!(cause.label(), "temp_c:lag(tau_s=240)");
+        assert!(cause.in_words(&[0.1]).contains("240 s lag"));
+    }
+}

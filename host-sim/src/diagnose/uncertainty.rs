@@ -1,0 +1,359 @@
+//! +/- on every coefficient the report states (item 5 of issue 9): the chosen base's
+//! temperature sensitivity and rate coefficient (and, for a polynomial base, its
+//! coefficients in physical units), the named extension's coefficient(s), the calibrated
+//! simulator's bias slope, curvature, Shupe coefficient and noise, and the
+//! measured-vs-simulator ratios (temperature sensitivity, Shupe coefficient, ARW) against
+//! the project's simulator (`GyroParams::paper_default`). Ranges come from the block
+//! bootstrap of `bootstrap` (whole runs or time blocks resampled). The simulator stage is
+//! conditional on its fitted thermal response (the thermal time constants are not redrawn).
+
+use super::bases::{zscore_params, BaseFit};
+use super::bootstrap::{draws, Estimate, REPLICATES};
+use super::cv::{Folds, Offsets, Prepared, UnitSystems};
+use super::input::Campaign;
+use super::models::Stacked;
+use serde::Serialize;
+
+/// A measured coefficient against the simulator's value.
+#[derive(Clone, Debug, Serialize)]
+pub struct Ratio {
+    pub name: String,
+    pub unit: String,
+    pub measured: f64,
+    pub measured_plus_minus: f64,
+    pub simulator: f64,
+    /// measured / simulator, with its bootstrap spread.
+    pub ratio: Estimate,
+}
+
+/// Every coefficient with its range.
+#[derive(Clone, Debug, Serialize)]
+pub struct Uncertainty {
+    pub method: String,
+    pub replicates: usize,
+    pub base: Vec<Estimate>,
+    pub extension: Vec<Estimate>,
+    pub simulator: Vec<Estimate>,
+    pub ratios: Vec<Ratio>,
+}
+
+/// The named extension: its label and stacked feature columns.
+pub struct NamedFeature<'a> {
+    pub label: String,
+    pub cols: &'a [Vec<f64>],
+}
+
+/// Computes every range (see the module header).
+pub fn estimate(
+    campaign: &Campaign,
+    folds: &Folds,
+    st: &Stacked,
+    base: &BaseFit,
+    named: Option<&NamedFeature<'_>>,
+) -> Uncertainty {
+    let counts = draws(folds.unit_rows.len());
+    let blocks = match folds.offsets {
+        Offsets::PerUnit => "whole runs",
+        Offsets::RunDummies => "contiguous time blocks",
+    };
+    let (simulator, ratios) = simulator_estimates(campaign, folds, st, named, &counts);
+    Uncertainty {
+        method: format!(
+            "block bootstrap: {REPLICATES} replicates, {} {blocks} drawn with replacement; +/- is the bootstrap \
+             standard deviation (1 sigma), ci95 the 2.5-97.5 % percentiles",
+            folds.unit_rows.len()
+        ),
+        replicates: REPLICATES,
+        base: base_estimates(folds, st, base, &counts),
+        extension: named.map_or_else(Vec::new, |n| extension_estimates(folds, base, n, &counts)),
+        simulator,
+        ratios,
+    }
+}
+
+/// Applies `summary` to the full fit and to every replicate: one Estimate per output.
+fn bootstrap(
+    sys: &UnitSystems<'_>,
+    counts: &[Vec<f64>],
+    names: &[(String, &str)],
+    summary: &dyn Fn(&[f64]) -> Vec<f64>,
+) -> Vec<Estimate> {
+    let ones = vec![1.0; counts.first().map_or(0, Vec::len)];
+    let Ok(full) = sys.solve(&ones) else {
+        return vec![];
+    };
+    let value = summary(&full);
+    let reps: Vec<Vec<f64>> = counts
+        .iter()
+        .filter_map(|c| sys.solve(c).ok())
+        .map(|w| summary(&w))
+        .collect();
+    names
+        .iter()
+        .enumerate()
+        .map(|(k, (name, unit))| {
+            let r: Vec<f64> = reps.iter().map(|v| v[k]).collect();
+            Estimate::new(name.clone(), unit, value[k], &r)
+        })
+        .collect()
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len().max(1) as f64
+}
+
+/// Mean partial derivatives of each base column over the rows, w.r.t. T and dT/dt.
+fn mean_partials(base: &BaseFit, st: &Stacked) -> (Vec<f64>, Vec<f64>) {
+    if let Some(b) = &base.basis {
+        let diff = |which: usize| -> Vec<f64> {
+            let (_, sd) = zscore_params(if which == 0 {
+                &st.temp_c
+            } else {
+                &st.temp_rate_cps
+            });
+            let h = 1e-3 * sd;
+            let shifted = |d: f64| {
+                let mut inputs = [st.temp_c.clone(), st.temp_rate_cps.clone()];
+                inputs[which].iter_mut().for_each(|v| *v += d);
+                b.columns(&inputs)
+            };
+            let (p, m) = (shifted(h), shifted(-h));
+            p.iter()
+                .zip(&m)
+                .map(|(p, m)| {
+                    mean(
+                        &p.iter()
+                            .zip(m)
+                            .map(|(a, b)| (a - b) / (2.0 * h))
+                            .collect::<Vec<_>>(),
+                    )
+                })
+                .collect()
+        };
+        return (diff(0), diff(1));
+    }
+    let degree = usize::from(base.spec.poly_degree_t.unwrap_or(0));
+    let (m, sd) = zscore_params(&st.temp_c);
+    let z: Vec<f64> = st.temp_c.iter().map(|t| (t - m) / sd).collect();
+    let mut d_t: Vec<f64> = (1..=degree)
+        .map(|k| {
+            mean(
+                &z.iter()
+                    .map(|x| k as f64 * x.powi(k as i32 - 1) / sd)
+                    .collect::<Vec<_>>(),
+            )
+        })
+        .collect();
+    let mut d_r = vec![0.0; degree];
+    if base.spec.uses_rate {
+        d_t.push(0.0);
+        d_r.push(1.0 / zscore_params(&st.temp_rate_cps).1);
+    }
+    (d_t, d_r)
+}
+
+/// The base: mean temperature sensitivity, the dT/dt coefficient, and for a polynomial
+/// its coefficients in degC units about the mean T.
+fn base_estimates(
+    folds: &Folds,
+    st: &Stacked,
+    base: &BaseFit,
+    counts: &[Vec<f64>],
+) -> Vec<Estimate> {
+    let (d_t, d_r) = mean_partials(base, st);
+    let nb = d_t.len();
+    if nb == 0 {
+        return vec![];
+    }
+    let (t_mean, t_sd) = zscore_params(&st.temp_c);
+    let degree = if base.basis.is_some() {
+        0
+    } else {
+        usize::from(base.spec.poly_degree_t.unwrap_or(0))
+    };
+    let mut names = vec![("temp_sensitivity_mean".to_owned(), "deg/h per degC")];
+    if base.spec.uses_rate {
+        names.push(("temp_rate_coefficient_mean".to_owned(), "deg/h per degC/s"));
+    }
+    for k in 1..=degree {
+        names.push((format!("T^{k} about {t_mean:.2} degC"), "deg/h per degC^k"));
+    }
+    let uses_rate = base.spec.uses_rate;
+    let summary = move |w: &[f64]| -> Vec<f64> {
+        let w = &w[..nb];
+        let mut v = vec![dot(&d_t, w)];
+        if uses_rate {
+            v.push(dot(&d_r, w));
+        }
+        v.extend((1..=degree).map(|k| w[k - 1] / t_sd.powi(k as i32)));
+        v
+    };
+    bootstrap(
+        &base.prepared.unit_systems(folds, &[]),
+        counts,
+        &names,
+        &summary,
+    )
+}
+
+/// The named feature's coefficient(s) next to the base (deg/h per feature unit).
+fn extension_estimates(
+    folds: &Folds,
+    base: &BaseFit,
+    named: &NamedFeature<'_>,
+    counts: &[Vec<f64>],
+) -> Vec<Estimate> {
+    let p = base.prepared.width();
+    let m = named.cols.len();
+    let names: Vec<(String, &str)> = (0..m)
+        .map(|k| {
+            let part = match (m, k) {
+                (1, _) => String::new(),
+                (_, 0) => "[cos]".to_owned(),
+                (_, 1) => "[sin]".to_owned(),
+                _ => format!("[{k}]"),
+            };
+            (format!("{}{part}", named.label), "deg/h per feature unit")
+        })
+        .collect();
+    let summary = move |w: &[f64]| w[p..p + m].to_vec();
+    bootstrap(
+        &base.prepared.unit_systems(folds, named.cols),
+        counts,
+        &names,
+        &summary,
+    )
+}
+
+/// Median row spacing within runs, s.
+fn row_spacing_s(folds: &Folds, t_s: &[f64]) -> f64 {
+    let mut d = super::simfit::within_run_differences(&folds.run_rows, t_s);
+    d.sort_by(f64::total_cmp);
+    d.get(d.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// The calibrated simulator's linear stage with ranges, and the ratios to the simulator.
+fn simulator_estimates(
+    campaign: &Campaign,
+    folds: &Folds,
+    st: &Stacked,
+    named: Option<&NamedFeature<'_>>,
+    counts: &[Vec<f64>],
+) -> (Vec<Estimate>, Vec<Ratio>) {
+    let (cols, t_mean) = super::simfit::design_columns(campaign);
+    let prepared = Prepared::new(folds, &cols, &st.y, 0.0);
+    let extra: &[Vec<f64>] = named.map_or(&[], |n| n.cols);
+    let sys = prepared.unit_systems(folds, extra);
+    let p = prepared.width();
+    let mut names = vec![
+        ("bias_dph_per_c".to_owned(), "deg/h per degC"),
+        ("bias_dph_per_c2".to_owned(), "deg/h per degC^2"),
+        ("shupe_dph_per_cps".to_owned(), "deg/h per degC/s"),
+    ];
+    if let Some(n) = named {
+        names.extend(
+            (0..extra.len()).map(|k| (format!("{}[{k}]", n.label), "deg/h per feature unit")),
+        );
+    }
+    let summary = |w: &[f64]| -> Vec<f64> {
+        let mut v = w[..3].to_vec();
+        v.extend_from_slice(&w[p..]);
+        v
+    };
+    let mut out = bootstrap(&sys, counts, &names, &summary);
+    if let Some(arw) = arw_estimate(folds, st, &prepared, &sys, counts) {
+        out.push(arw);
+    }
+    let ratios = ratios_to_simulator(&out, t_mean);
+    (out, ratios)
+}
+
+/// ARW from the noise of the rows: first differences of the full fit's residual, per
+/// unit, sigma of one row scaled by sqrt(row spacing / 1 h).
+fn arw_estimate(
+    folds: &Folds,
+    st: &Stacked,
+    prepared: &Prepared,
+    sys: &UnitSystems<'_>,
+    counts: &[Vec<f64>],
+) -> Option<Estimate> {
+    let ones = vec![1.0; folds.unit_rows.len()];
+    let w = sys.solve(&ones).ok()?;
+    let target = prepared.target();
+    let resid: Vec<f64> = (0..folds.rows())
+        .map(|row| {
+            target[row]
+                - sys
+                    .cols
+                    .iter()
+                    .zip(&w)
+                    .map(|(c, w)| c[row] * w)
+                    .sum::<f64>()
+        })
+        .collect();
+    let per_unit: Vec<(f64, f64)> = folds
+        .unit_rows
+        .iter()
+        .map(|r| {
+            let d2: f64 = resid[r.clone()]
+                .windows(2)
+                .map(|w| (w[1] - w[0]).powi(2))
+                .sum();
+            (d2, r.len().saturating_sub(1) as f64)
+        })
+        .collect();
+    let to_arw = (row_spacing_s(folds, &st.t_s) / 3600.0).sqrt();
+    let arw = |c: &[f64]| {
+        let (d2, n) = per_unit
+            .iter()
+            .zip(c)
+            .fold((0.0, 0.0), |(a, b), ((d, m), k)| (a + k * d, b + k * m));
+        (d2 / n.max(1.0) / 2.0).sqrt() * to_arw
+    };
+    let reps: Vec<f64> = counts.iter().map(|c| arw(c)).collect();
+    Some(Estimate::new(
+        "arw_from_row_noise",
+        "deg/sqrt(h)",
+        arw(&ones),
+        &reps,
+    ))
+}
+
+/// Measured / simulator (`GyroParams::paper_default`) for the temperature sensitivity at
+/// the mean T (`t_mean_c`), the Shupe coefficient and the ARW (`est` as built above).
+fn ratios_to_simulator(est: &[Estimate], t_mean_c: f64) -> Vec<Ratio> {
+    let sim = crate::sim::GyroParams::paper_default();
+    let d = &sim.drift;
+    let sensitivity = d.bias_dph_per_c + 2.0 * d.bias_dph_per_c2 * (t_mean_c - d.bias_ref_c);
+    let pairs = [
+        (
+            "bias_dph_per_c",
+            "temperature sensitivity at the mean T",
+            sensitivity,
+        ),
+        (
+            "shupe_dph_per_cps",
+            "Shupe coefficient",
+            d.shupe_dph_per_cps,
+        ),
+        ("arw_from_row_noise", "ARW (row noise)", sim.noise.arw_dpsh),
+    ];
+    pairs
+        .iter()
+        .filter_map(|&(key, name, s)| {
+            let e = est.iter().find(|e| e.name == key)?;
+            Some(Ratio {
+                name: name.to_owned(),
+                unit: e.unit.clone(),
+                measured: e.value,
+                measured_plus_minus: e.plus_minus,
+                simulator: s,
+                ratio: e.scaled(format!("{name}: measured / simulator"), "1", 1.0 / s),
+            })
+        })
+        .collect()
+}
