@@ -545,9 +545,11 @@ mod tests {
                 boots: u32::MAX,
             },
         };
-        // The padding before a status request pays for the largest status reply.
+        // The padding before a status request pays for the largest status reply, as sent
+        // on the host port (inside `link::DeviceFrame`).
         let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
-        let n = encode_frame(&Response::Status(status.clone()), &mut wire).unwrap();
+        let framed = crate::link::DeviceFrame::Upload(Response::Status(status.clone()));
+        let n = encode_frame(&framed, &mut wire).unwrap();
         assert!(n <= STATUS_REQUEST_PADDING, "status reply {n} B");
         let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
         for response in [
