@@ -13,7 +13,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::bit::BitWord;
-use crate::protocol::{decode_message, encode_frame, FrameError, Request, Response};
+use crate::protocol::{decode_message, encode_frame, FrameError, Request, ResetCause, Response};
 use crate::seek_quality::{MotionReason, QualityError, SeekState, Validity};
 use crate::tilt::Tilt;
 
@@ -29,6 +29,19 @@ pub enum ResetReason {
     Software,
     Lockup,
     Unknown,
+}
+
+impl From<ResetCause> for ResetReason {
+    /// The firmware's recorded cause (no-init RAM, issue 11) on the link: a panic or a
+    /// fatal boot error is a software reset, a CPU exception (hard fault) a lockup.
+    fn from(c: ResetCause) -> Self {
+        match c {
+            ResetCause::PowerOn => ResetReason::PowerOn,
+            ResetCause::Watchdog => ResetReason::Watchdog,
+            ResetCause::Panic | ResetCause::FatalBoot => ResetReason::Software,
+            ResetCause::Exception => ResetReason::Lockup,
+        }
+    }
 }
 
 /// PC -> device.
