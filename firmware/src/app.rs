@@ -370,7 +370,11 @@ where
             tilt: r.tilt,
             duration_s: r.duration_s as f32,
             t_end_s: r.t_end_s,
-            positions: r.n_positions,
+            // The mode (2 or 4, as in `StartSeek`), not the dwells (2 + the ambiguity one).
+            positions: match r.mode {
+                SeekMode::TwoPosition => 2,
+                SeekMode::FourPosition => 4,
+            },
             validity,
         }
     }

@@ -208,12 +208,15 @@ impl<L: Read + Write> UploadClient<L> {
                 }
                 Ok(_) => {
                     if let Some(frame) = self.rx.push(byte[0]) {
-                        let payload = frame.map_err(ClientError::Frame)?;
                         // The device's north-finder messages (periodic `Status`, seek
-                        // results) share the port: not ours, skipped.
-                        match decode_message::<DeviceFrame>(payload).map_err(ClientError::Frame)? {
-                            DeviceFrame::Upload(response) => return Ok(response),
-                            DeviceFrame::Link(_) => {}
+                        // results) share the port: not ours, skipped. So is a corrupt
+                        // frame (line noise, or a status frame whose start another reader
+                        // of the port took): our answer may still follow, and the deadline
+                        // bounds the wait.
+                        let Ok(payload) = frame else { continue };
+                        match decode_message::<DeviceFrame>(payload) {
+                            Ok(DeviceFrame::Upload(response)) => return Ok(response),
+                            Ok(DeviceFrame::Link(_)) | Err(_) => {}
                         }
                     }
                 }

@@ -13,7 +13,7 @@
 //! - the inclinometer: the MPS2 board (and QEMU) has no SPI SCL3300, so this binary reads
 //!   a `SimulatedInclinometer` (the same `Inclinometer` trait the SCL3300 driver
 //!   implements) at 1 Hz of sample time; its tilt comes from the semihosting argument
-//!   `tilt-mdeg=PITCH,ROLL` (millidegrees, default level);
+//!   `tilt-mdeg=PITCH:ROLL` (millidegrees, default level);
 //! - SysTick: 1 kHz time base for turntable timeouts and the gyro's frame time base
 //!   (counter wraps during a stall are recovered from it);
 //! - the CMSDK watchdog (0x4000_8000): 500 ms, fed only while the gyro path is serviced;
@@ -298,6 +298,8 @@ fn main() -> ! {
             }
             if changed {
                 swap_model(server, model, &mut app);
+                // The BIT's model item and the status follow at once.
+                next_status_s = now_s;
                 if options.inject == Inject::PanicAfterCommit {
                     core::panic!("injected panic after a commit");
                 }
@@ -432,7 +434,7 @@ enum Inject {
 struct TestOptions {
     inject: Inject,
     gyro_rate_hz: u32,
-    /// `tilt-mdeg=PITCH,ROLL`: the simulated inclinometer's base tilt.
+    /// `tilt-mdeg=PITCH:ROLL`: the simulated inclinometer's base tilt.
     tilt: Tilt,
     /// `seek-dwell-s=N`: dwell per main position (QEMU runs a short seek).
     seek_dwell_s: Option<u32>,
@@ -473,10 +475,10 @@ fn test_options(reset: &ResetRecord) -> TestOptions {
     o
 }
 
-/// `PITCH,ROLL` in integer millidegrees (no float parsing code in the image).
+/// `PITCH:ROLL` in integer millidegrees (no float parsing code in the image).
 #[cfg(feature = "log-semihosting")]
 fn parse_tilt_mdeg(v: &str) -> Option<Tilt> {
-    let (p, r) = v.split_once(',')?;
+    let (p, r) = v.split_once(':')?;
     let (p, r): (i32, i32) = (p.parse().ok()?, r.parse().ok()?);
     Some(Tilt {
         pitch_deg: p as f32 / 1000.0,
