@@ -55,6 +55,7 @@ use embedded_hal_nb::serial::{Read as _, Write as _};
 use fog_core::bit::BitLimits;
 use fog_core::compensator::Compensator;
 use fog_core::hal::Gyro;
+use fog_core::heading_cal::{HeadingCalRecord, HeadingHarmonic, FLASH_RECORD_LEN};
 use fog_core::link::{DeviceMessage, ResetReason};
 use fog_core::model::RbfModel;
 use fog_core::protocol::ResetRecord;
@@ -69,6 +70,7 @@ use fog_firmware::drivers::inclinometer::{
 use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig};
 use fog_firmware::health::{StuckDetector, StuckEvent, DEFAULT_STUCK_RUN};
 use fog_firmware::link_out::{queue_whole, LinkFrame};
+use fog_firmware::store::store_len;
 use fog_firmware::upload::UploadServer;
 use resets::BootFault;
 
@@ -132,6 +134,8 @@ fn main() -> ! {
 
     // The long-lived state lives in statics (counted in the static-RAM budget by the
     // linker), not in main's stack frame.
+    let mut flash = flash;
+    let heading_cal = read_heading_cal(&mut flash);
     let server = start_upload_server(flash, reset);
     // Decoded in place into `MODEL` (the compensator keeps its own copy).
     let stored = server.load_active_model_into(model).unwrap_or_else(|e| {
@@ -160,6 +164,7 @@ fn main() -> ! {
             resets::fatal_boot(BootFault::Configuration)
         }
     };
+    app.set_heading_correction(heading_cal);
     let mut gyro = FogSerialGyro::with_clock(gyro_uart, gyro_rate_hz, millis::MillisClock);
     let mut last_t_s = 0.0;
     // Clock reading at the last gyro sample (`None` until the gyro starts).
@@ -311,6 +316,33 @@ fn main() -> ! {
                 break;
             }
             let _ = tx_queue.pop_front();
+        }
+    }
+}
+
+/// The heading calibration (`HeadingCalRecord`) from its own flash sector, right after
+/// the two model slots; `None` if none was written or it is unreadable (then logged:
+/// seeks run uncalibrated, as before any calibration).
+fn read_heading_cal(flash: &mut flash::ModelFlash) -> Option<HeadingHarmonic> {
+    use embedded_storage::nor_flash::{NorFlash, ReadNorFlash};
+    let at = store_len(<flash::ModelFlash as NorFlash>::ERASE_SIZE) as u32;
+    let mut buf = [0u8; FLASH_RECORD_LEN];
+    if flash.read(at, &mut buf).is_err() {
+        defmt::warn!("heading calibration sector unreadable");
+        return None;
+    }
+    match HeadingCalRecord::decode_flash(&buf) {
+        Ok(Some(r)) => {
+            defmt::info!(
+                "heading calibration applied ({} headings)",
+                r.harmonic.n_headings
+            );
+            Some(r.harmonic)
+        }
+        Ok(None) => None,
+        Err(e) => {
+            defmt::warn!("heading calibration record refused: {}", e);
+            None
         }
     }
 }
