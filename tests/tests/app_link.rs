@@ -129,7 +129,7 @@ fn a_commanded_seek_reports_progress_and_its_result() {
     let mut aborted = false;
     while result.is_none() && i < 20_000 {
         let t_s = f64::from(i) / RATE_HZ;
-        if i % 10 == 0 {
+        if i.is_multiple_of(10) {
             a.on_tilt(tilt);
         }
         if a.temp_due(t_s) {
@@ -164,7 +164,7 @@ fn a_commanded_seek_reports_progress_and_its_result() {
             rate_dph: rate as f32,
         });
         // Progress of the second seek (the first one was aborted).
-        if i % 10 == 0 && aborted && a.supervisor().is_seeking() {
+        if i.is_multiple_of(10) && aborted && a.supervisor().is_seeking() {
             progress.push(a.status(board(t_s)).progress);
         }
         if let Some(SeekOutcome::Done(r, v)) = step.seek {
