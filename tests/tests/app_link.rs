@@ -2,29 +2,16 @@
 //! answers to host commands (`App::command`), the status it reports, a commanded seek to
 //! its `Result`, and the BIT word `BitMonitor` derives from the firmware's counters.
 
+mod app_support;
+
+use app_support::InstantTable;
 use fog_core::bit::{BitItem, BitLimits, BitWord};
-use fog_core::hal::{GyroSample, TableState, TempSample, Turntable};
+use fog_core::hal::{GyroSample, TempSample};
 use fog_core::link::{Command, DeviceMessage, Refusal, ResetReason};
 use fog_core::seek_quality::{QualityError, SeekState, Validity};
 use fog_core::tilt::{earth_rate_on_axis_dph, Tilt};
 use fog_firmware::app::{App, AppConfig, BoardStatus, SeekOutcome};
 use fog_firmware::bit_monitor::{BitCounters, BitMonitor, TABLE_FAULT_HOLD_S};
-
-/// A table that settles at once wherever it is told to go.
-struct InstantTable(f32);
-
-impl Turntable for InstantTable {
-    type Error = ();
-    fn command_heading(&mut self, h: f32) -> Result<(), ()> {
-        self.0 = h;
-        Ok(())
-    }
-    fn poll(&mut self) -> Result<TableState, ()> {
-        Ok(TableState::Settled {
-            heading_deg: self.0,
-        })
-    }
-}
 
 const RATE_HZ: f64 = 10.0;
 

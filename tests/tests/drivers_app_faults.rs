@@ -3,12 +3,15 @@
 //! the driver's own error; a temperature sensor that fails marks its window invalid and
 //! the north finder never gets a result from it.
 
+mod app_support;
+
 use std::cell::Cell;
 
+use app_support::InstantTable;
 use embedded_hal_mock::eh1::serial::{Mock, Transaction};
 use embedded_hal_nb::nb;
 use fog_core::compensator::WindowStatus;
-use fog_core::hal::{GyroSample, TableState, TempSample, Turntable};
+use fog_core::hal::{GyroSample, TempSample};
 use fog_core::seek_quality::{FinderFault, QualityError, Validity};
 use fog_firmware::app::{App, AppConfig, SeekOutcome};
 use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig, TurntableError};
@@ -19,22 +22,6 @@ fn config(seeks: u16) -> AppConfig {
     let mut cfg = AppConfig::for_rate(RATE_HZ as f32);
     cfg.seeks = seeks;
     cfg
-}
-
-/// A table that settles at once wherever it is told to go.
-struct InstantTable(f32);
-
-impl Turntable for InstantTable {
-    type Error = ();
-    fn command_heading(&mut self, h: f32) -> Result<(), ()> {
-        self.0 = h;
-        Ok(())
-    }
-    fn poll(&mut self) -> Result<TableState, ()> {
-        Ok(TableState::Settled {
-            heading_deg: self.0,
-        })
-    }
 }
 
 #[test]

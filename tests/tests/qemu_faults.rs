@@ -22,10 +22,9 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use fog_core::protocol::ResetCause;
-use fog_firmware::drivers::gyro_frame::GyroFrame;
 use fog_sim::upload::{ClientError, UploadClient};
 use fog_tests::qemu_ready;
-use qemu_support::{start, wait_line};
+use qemu_support::{start, stream_gyro_frames, wait_line};
 use upload_support::*;
 
 #[test]
@@ -104,31 +103,16 @@ const FLOOD_GYRO_HZ: u32 = 200;
 /// Bytes per second a 115,200 baud 8N1 host link carries.
 const HOST_LINE_BYTES_PER_S: f64 = 115_200.0 / 10.0;
 
-/// Gyro frames at `FLOOD_GYRO_HZ`, paced in real time in 5 ms batches, until `stop`.
-fn stream_gyro(mut link: TcpStream, stop: Arc<AtomicBool>) -> u64 {
+/// Gyro frames at `FLOOD_GYRO_HZ`, paced in real time, until `stop`.
+fn stream_gyro(link: TcpStream, stop: Arc<AtomicBool>) -> u64 {
     let period_s = 1.0 / f64::from(FLOOD_GYRO_HZ);
-    let start = Instant::now();
-    let mut sent = 0u64;
     // White rate noise of a FOG with ARW 0.005 deg/sqrt(h) at this rate, deg/h.
     let noise = rand_distr::Normal::new(0.0, 0.005 * 60.0 / period_s.sqrt()).unwrap();
     let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(7);
-    while !stop.load(Ordering::Relaxed) {
-        let due = (start.elapsed().as_secs_f64() / period_s) as u64;
-        let mut batch = Vec::new();
-        while sent < due {
-            // Earth rate component plus a slow ripple plus the gyro's white noise.
-            let rate_dph = 9.7
-                + 0.3 * (sent as f64 * 0.001).sin()
-                + rand_distr::Distribution::sample(&noise, &mut rng);
-            batch.extend(GyroFrame::from_physical(sent as u8, rate_dph, 25.0, period_s).encode());
-            sent += 1;
-        }
-        if link.write_all(&batch).is_err() {
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    sent
+    stream_gyro_frames(link, FLOOD_GYRO_HZ, 1.0, &stop, |n| {
+        // Earth rate component plus a slow ripple plus the gyro's white noise.
+        9.7 + 0.3 * (n as f64 * 0.001).sin() + rand_distr::Distribution::sample(&noise, &mut rng)
+    })
 }
 
 #[test]

@@ -39,11 +39,10 @@ use fog_core::consts::EARTH_RATE_DPH;
 use fog_core::link::{Command, ResetReason, SeekReport, Status};
 use fog_core::seek_quality::{SeekState, Validity};
 use fog_core::tilt::{earth_rate_on_axis_dph, Tilt};
-use fog_firmware::drivers::gyro_frame::GyroFrame;
 use fog_sim::monitor::{monitor, MonitorOptions, MonitorSummary, ResultLog};
 use fog_sim::upload::UploadClient;
 use fog_tests::{qemu_ready, scratch_dir};
-use qemu_support::{start, wait_line, wait_line_where};
+use qemu_support::{start, stream_gyro_frames, wait_line, wait_line_where};
 use rand_distr::Distribution;
 use upload_support::*;
 
@@ -104,29 +103,17 @@ fn serve_table(link: TcpStream, heading: Heading, stop: Arc<AtomicBool>) {
     }
 }
 
-/// The FOG: frames at `RATE_HZ` of sample time, `SPEED` times real time, until `stop`.
-fn stream_gyro(mut link: TcpStream, heading: Heading, stop: Arc<AtomicBool>) -> u64 {
+/// The FOG: Earth rate at the table's current heading, bias and white noise.
+fn stream_gyro(link: TcpStream, heading: Heading, stop: Arc<AtomicBool>) -> u64 {
     let period_s = 1.0 / f64::from(RATE_HZ);
     let noise = rand_distr::Normal::new(0.0, ARW_DPSH * 60.0 / period_s.sqrt()).unwrap();
     let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(10);
-    let start = Instant::now();
-    let mut sent = 0u64;
-    while !stop.load(Ordering::Relaxed) {
-        let due = (start.elapsed().as_secs_f64() * SPEED / period_s) as u64;
+    stream_gyro_frames(link, RATE_HZ, SPEED, &stop, |_| {
         let h = *heading.lock().unwrap();
-        let earth = earth_rate_on_axis_dph(LATITUDE_DEG, TRUE_AZIMUTH_DEG, TILT, h);
-        let mut batch = Vec::new();
-        while sent < due {
-            let rate_dph = earth + BIAS_DPH + noise.sample(&mut rng);
-            batch.extend(GyroFrame::from_physical(sent as u8, rate_dph, 25.0, period_s).encode());
-            sent += 1;
-        }
-        if link.write_all(&batch).is_err() {
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    sent
+        earth_rate_on_axis_dph(LATITUDE_DEG, TRUE_AZIMUTH_DEG, TILT, h)
+            + BIAS_DPH
+            + noise.sample(&mut rng)
+    })
 }
 
 /// One `fogsim monitor` session on the host port: sends `commands`, collects statuses

@@ -1,13 +1,15 @@
 //! Shared by the QEMU scenarios that run the real `fog-app` with its UARTs on loopback
 //! sockets (qemu_faults.rs, qemu_seek.rs): start it, and wait for its tagged
-//! semihosting console lines (`FOG-...`).
+//! semihosting console lines (`FOG-...`); stream simulated gyro frames to its UART1.
 #![allow(dead_code)]
 
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Write};
 use std::net::TcpStream;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{channel, Receiver};
 use std::time::{Duration, Instant};
 
+use fog_firmware::drivers::gyro_frame::GyroFrame;
 use fog_tests::{
     connect_loopback, firmware_elf, free_loopback_port, spawn_qemu, KillOnDrop, QemuOptions,
 };
@@ -73,4 +75,33 @@ pub fn wait_line_where(
 /// Waits (bounded) for a console line starting with `prefix`.
 pub fn wait_line(rx: &Receiver<String>, prefix: &str, within: Duration) -> String {
     wait_line_where(rx, prefix, within, |_| true)
+}
+
+/// A simulated FOG on `link`: frames at `rate_hz` of sample time, sent `speed` times
+/// faster than real time (the firmware's time base is the frame count) in 5 ms batches,
+/// 25 degC, the rate of frame `n` from `rate_dph(n)`, until `stop`. Returns frames sent.
+pub fn stream_gyro_frames(
+    mut link: TcpStream,
+    rate_hz: u32,
+    speed: f64,
+    stop: &AtomicBool,
+    mut rate_dph: impl FnMut(u64) -> f64,
+) -> u64 {
+    let period_s = 1.0 / f64::from(rate_hz);
+    let start = Instant::now();
+    let mut sent = 0u64;
+    while !stop.load(Ordering::Relaxed) {
+        let due = (start.elapsed().as_secs_f64() * speed / period_s) as u64;
+        let mut batch = Vec::new();
+        while sent < due {
+            let frame = GyroFrame::from_physical(sent as u8, rate_dph(sent), 25.0, period_s);
+            batch.extend(frame.encode());
+            sent += 1;
+        }
+        if link.write_all(&batch).is_err() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    sent
 }
