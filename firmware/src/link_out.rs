@@ -25,13 +25,14 @@ impl LinkFrame {
     }
 
     pub fn bytes(&self) -> &[u8] {
-        &self.buf[..self.len]
+        // `len <= buf.len()` by construction; `get` keeps a panic path out of the image.
+        self.buf.get(..self.len).unwrap_or(&[])
     }
 }
 
 /// Appends `frame` to `tx` whole, or not at all (`false`: no room).
 pub fn queue_whole<const N: usize>(tx: &mut Deque<u8, N>, frame: &[u8]) -> bool {
-    if frame.len() > N - tx.len() {
+    if frame.len() > N.saturating_sub(tx.len()) {
         return false;
     }
     for &b in frame {

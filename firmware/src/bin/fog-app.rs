@@ -542,6 +542,9 @@ fn report<E: defmt::Format>(step: fog_firmware::app::Step<E>) {
             defmt::warn!("t={} s window invalid: {}", w.t_end_s, w.status);
         }
     }
+    if let Some(why) = step.restarted {
+        defmt::warn!("north seek restarted: base moved ({})", why);
+    }
     match step.seek {
         Some(SeekOutcome::Done(r, _)) => defmt::info!(
             "north seek: azimuth {} deg +- {} deg ({} s)",
