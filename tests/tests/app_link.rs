@@ -7,7 +7,7 @@ mod app_support;
 use app_support::InstantTable;
 use fog_core::bit::{BitItem, BitLimits, BitWord};
 use fog_core::hal::{GyroSample, TempSample};
-use fog_core::link::{Command, DeviceMessage, Refusal, ResetReason};
+use fog_core::link::{Command, DeviceMessage, Refusal, ResetReason, SeekReport};
 use fog_core::seek_quality::{QualityError, SeekState, Validity};
 use fog_core::tilt::{earth_rate_on_axis_dph, Tilt};
 use fog_firmware::app::{App, AppConfig, BoardStatus, SeekOutcome};
@@ -91,6 +91,42 @@ fn commands_are_answered_and_refused_with_their_reason() {
     ));
 }
 
+/// Drives `a` with a level-or-`tilt` base and the gyro law `rate_dph(t_s, table_heading)`
+/// at `RATE_HZ` until a seek finishes (bounded); `hook(a, i, t_s)` runs before each
+/// sample (commands), `progress` gets the running seek's progress once per second.
+fn drive(
+    a: &mut App<InstantTable>,
+    tilt: Tilt,
+    rate_dph: impl Fn(f64, f64) -> f64,
+    mut hook: impl FnMut(&mut App<InstantTable>, u32, f64),
+    progress: &mut Vec<f32>,
+) -> SeekReport {
+    for i in 0..20_000u32 {
+        let t_s = f64::from(i) / RATE_HZ;
+        if i.is_multiple_of(10) {
+            a.on_tilt(tilt);
+        }
+        if a.temp_due(t_s) {
+            a.on_temp(t_s, Some(TempSample { t_s, temp_c: 25.0 }));
+        }
+        hook(a, i, t_s);
+        let rate = rate_dph(t_s, f64::from(a.table().0));
+        let step = a.on_gyro(GyroSample {
+            t_s,
+            rate_dph: rate as f32,
+        });
+        if i.is_multiple_of(10) && a.supervisor().is_seeking() {
+            progress.push(a.status(board(t_s)).progress);
+        }
+        match step.seek {
+            Some(SeekOutcome::Done(r, v)) => return a.report(&r, v),
+            Some(failed) => panic!("{failed:?}"),
+            None => {}
+        }
+    }
+    panic!("no seek finished")
+}
+
 /// A commanded seek on a noiseless gyro (Earth rate on a tilted axis plus a bias): busy
 /// while running, abortable, and the next one ends with a valid `Result` at the truth.
 #[test]
@@ -110,58 +146,34 @@ fn a_commanded_seek_reports_progress_and_its_result() {
         ),
         Some(DeviceMessage::Accepted)
     );
-    let mut result = None;
     let mut progress = Vec::new();
-    let mut i = 0u32;
-    let mut aborted = false;
-    while result.is_none() && i < 20_000 {
-        let t_s = f64::from(i) / RATE_HZ;
-        if i.is_multiple_of(10) {
-            a.on_tilt(tilt);
-        }
-        if a.temp_due(t_s) {
-            a.on_temp(t_s, Some(TempSample { t_s, temp_c: 25.0 }));
-        }
-        if i == 105 {
-            assert_eq!(
-                a.command(Command::StartSeek { positions: 2 }, t_s),
-                Some(DeviceMessage::Accepted)
-            );
-            assert_eq!(
-                a.command(Command::StartSeek { positions: 2 }, t_s),
-                Some(DeviceMessage::Refused(Refusal::Quality(QualityError::Busy)))
-            );
-        }
-        if i == 400 && !aborted {
-            aborted = true;
-            assert_eq!(
-                a.command(Command::Abort, t_s),
-                Some(DeviceMessage::Accepted)
-            );
-            assert_eq!(a.status(board(t_s)).state, SeekState::Ready);
-            assert_eq!(
-                a.command(Command::StartSeek { positions: 2 }, t_s),
-                Some(DeviceMessage::Accepted)
-            );
-        }
-        let h = f64::from(a.table().0);
-        let rate = earth_rate_on_axis_dph(lat, truth, tilt, h) + 0.2;
-        let step = a.on_gyro(GyroSample {
-            t_s,
-            rate_dph: rate as f32,
-        });
-        // Progress of the second seek (the first one was aborted).
-        if i.is_multiple_of(10) && aborted && a.supervisor().is_seeking() {
-            progress.push(a.status(board(t_s)).progress);
-        }
-        if let Some(SeekOutcome::Done(r, v)) = step.seek {
-            result = Some(a.report(&r, v));
-        }
-        assert!(step.seek.is_none() || result.is_some(), "{:?}", step.seek);
-        i += 1;
-    }
-    let r = result.expect("the seek finished");
-    assert!(progress.windows(2).all(|p| p[1] >= p[0]), "{progress:?}");
+    let r = drive(
+        &mut a,
+        tilt,
+        |_, h| earth_rate_on_axis_dph(lat, truth, tilt, h) + 0.2,
+        |a, i, t_s| {
+            let answer = |a: &mut App<InstantTable>, c| a.command(c, t_s);
+            let start = Command::StartSeek { positions: 2 };
+            if i == 105 {
+                assert_eq!(answer(a, start), Some(DeviceMessage::Accepted));
+                assert_eq!(
+                    answer(a, start),
+                    Some(DeviceMessage::Refused(Refusal::Quality(QualityError::Busy)))
+                );
+            }
+            if i == 400 {
+                assert_eq!(answer(a, Command::Abort), Some(DeviceMessage::Accepted));
+                assert_eq!(a.status(board(t_s)).state, SeekState::Ready);
+                assert_eq!(answer(a, start), Some(DeviceMessage::Accepted));
+            }
+        },
+        &mut progress,
+    );
+    // Progress rises in each seek and falls once: at the abort and restart (40 s).
+    let drops: Vec<usize> = (1..progress.len())
+        .filter(|&k| progress[k] < progress[k - 1])
+        .collect();
+    assert_eq!(drops.len(), 1, "{progress:?}");
     assert!(
         progress.last().copied().unwrap_or(0.0) > 0.8,
         "{progress:?}"
@@ -173,6 +185,54 @@ fn a_commanded_seek_reports_progress_and_its_result() {
     assert!((r.azimuth_deg - truth).abs() < 0.01, "{r:?}");
     assert!((r.tilt.pitch_deg - 3.0).abs() < 1e-4 && (r.tilt.roll_deg + 2.0).abs() < 1e-4);
     assert_eq!(a.status(board(0.0)).state, SeekState::Ready);
+}
+
+/// The twin with another law: the site is really at 60 deg N but the host says 39.9, and
+/// the gyro has a 0.3 % scale-factor error and a 0.2 deg/h bias. Four positions (atan2)
+/// cancel scale and bias, so the azimuth is right, and the latitude check flags the
+/// mismatch with the observed latitude.
+#[test]
+fn a_four_position_seek_at_the_wrong_latitude_is_flagged() {
+    let (true_lat, said_lat, truth) = (60.0, 39.9f32, 251.7);
+    let mut a = app();
+    assert_eq!(
+        a.command(
+            Command::SetLatitude {
+                latitude_deg: said_lat
+            },
+            0.0
+        ),
+        Some(DeviceMessage::Accepted)
+    );
+    let mut progress = Vec::new();
+    let r = drive(
+        &mut a,
+        Tilt::LEVEL,
+        |_, h| 1.003 * earth_rate_on_axis_dph(true_lat, truth, Tilt::LEVEL, h) + 0.2,
+        |a, i, t_s| {
+            if i == 105 {
+                let c = Command::StartSeek { positions: 4 };
+                assert_eq!(a.command(c, t_s), Some(DeviceMessage::Accepted));
+            }
+        },
+        &mut progress,
+    );
+    assert_eq!(r.positions, 4);
+    assert!((r.azimuth_deg - truth).abs() < 0.01, "{r:?}");
+    let Validity::LatitudeMismatch {
+        observed_latitude_deg,
+    } = r.validity
+    else {
+        panic!("latitude mismatch not flagged: {r:?}")
+    };
+    // acos(1.003 cos 60 deg) = 59.90 deg: the scale error is in what is observed.
+    let expected = (1.003 * f64::cos(true_lat.to_radians()))
+        .acos()
+        .to_degrees();
+    assert!(
+        (f64::from(observed_latitude_deg) - expected).abs() < 0.01,
+        "{observed_latitude_deg} vs {expected}"
+    );
 }
 
 fn good(now_s: f64) -> BitCounters {
