@@ -11,8 +11,11 @@
 //! loop end to end.
 //!
 //! Gyro law: Earth rate on the tilted input axis (`fog_core::tilt::earth_rate_on_axis_dph`,
-//! true azimuth of table zero `TRUE_AZIMUTH_DEG`) + a constant bias + white noise of ARW
-//! `ARW_DPSH`; 25 degC. The table turns instantly on `MOV` (no rotation rate is simulated:
+//! true azimuth of table zero `TRUE_AZIMUTH_DEG`) + a constant bias + a heading-dependent
+//! bias a cos(alpha) + b sin(alpha) of the axis azimuth alpha (`HEADING`) + white noise of
+//! ARW `ARW_DPSH`; 25 degC. The heading harmonic's calibration record is preloaded into
+//! the flash sector after the model slots (QEMU `-device loader`): the device must apply it
+//! at boot, or its b part alone would turn the azimuth by ~0.5 deg (> 15 predicted sigma). The table turns instantly on `MOV` (no rotation rate is simulated:
 //! the windows during a move are discarded by the north finder anyway).
 //!
 //! Checked: two refusals first (a latitude out of range: `BadLatitude`; a seek before any
@@ -36,13 +39,15 @@ use std::time::{Duration, Instant};
 
 use fog_core::bit::{BitItem, BitWord};
 use fog_core::consts::EARTH_RATE_DPH;
+use fog_core::heading_cal::{HeadingCalRecord, HeadingHarmonic, FLASH_RECORD_LEN};
 use fog_core::link::{Command, ResetReason, SeekReport, Status};
 use fog_core::seek_quality::{SeekState, Validity};
 use fog_core::tilt::{earth_rate_on_axis_dph, Tilt};
+use fog_firmware::store::store_len;
 use fog_sim::monitor::{monitor, MonitorOptions, MonitorSummary, ResultLog};
 use fog_sim::upload::UploadClient;
 use fog_tests::{qemu_ready, scratch_dir};
-use qemu_support::{start, stream_gyro_frames, wait_line, wait_line_where};
+use qemu_support::{start_with, stream_gyro_frames, wait_line, wait_line_where};
 use rand_distr::Distribution;
 use upload_support::*;
 
@@ -62,6 +67,19 @@ const TILT: Tilt = Tilt {
 const ARW_DPSH: f64 = 0.0011;
 /// Constant gyro bias, deg/h (cancels in the two-position difference).
 const BIAS_DPH: f64 = 0.35;
+
+/// The gyro's heading-dependent bias and its calibration record (8 headings).
+const HEADING: HeadingHarmonic = HeadingHarmonic {
+    cos_dph: 0.2,
+    sin_dph: 0.1,
+    cos_sigma_dph: 0.002,
+    sin_sigma_dph: 0.002,
+    correlation: 0.0,
+    n_headings: 8,
+};
+/// Start of the model region (memory.x `MODELS`); the heading record follows the two
+/// 4 KiB model slots.
+const MODELS_ORIGIN: u32 = 0x000F_C000;
 
 /// The simulated table's heading, deg (table frame).
 type Heading = Arc<Mutex<f64>>;
@@ -112,6 +130,7 @@ fn stream_gyro(link: TcpStream, heading: Heading, stop: Arc<AtomicBool>) -> u64 
         let h = *heading.lock().unwrap();
         earth_rate_on_axis_dph(LATITUDE_DEG, TRUE_AZIMUTH_DEG, TILT, h)
             + BIAS_DPH
+            + HEADING.bias_dph(TRUE_AZIMUTH_DEG + h)
             + noise.sample(&mut rng)
     })
 }
@@ -173,7 +192,16 @@ fn qemu_whole_seek_over_the_host_link_with_status_result_and_refusals() {
         ),
     ];
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let (_qemu, mut streams, console) = start(&args, 3);
+    let dir = scratch_dir("qemu_seek");
+    let record = dir.join("heading-cal.bin");
+    let mut sector = [0xFFu8; FLASH_RECORD_LEN];
+    HeadingCalRecord::new(HEADING)
+        .encode_flash(&mut sector)
+        .unwrap();
+    std::fs::write(&record, sector).unwrap();
+    let at = MODELS_ORIGIN + store_len(4096) as u32;
+    let loader = format!("loader,file={},addr={at:#x},force-raw=on", record.display());
+    let (_qemu, mut streams, console) = start_with(&args, 3, vec!["-device".into(), loader]);
     let table_link = streams.pop().expect("table link");
     let gyro_link = streams.pop().expect("gyro link");
     let host = streams.pop().expect("host link");
@@ -183,6 +211,11 @@ fn qemu_whole_seek_over_the_host_link_with_status_result_and_refusals() {
         &console,
         "FOG-BOOT 1 reset=PowerOn",
         Duration::from_secs(30),
+    );
+    wait_line(
+        &console,
+        "FOG-HEADING-CAL applied n_headings=8",
+        Duration::from_secs(10),
     );
 
     let heading: Heading = Arc::new(Mutex::new(0.0));
@@ -196,7 +229,6 @@ fn qemu_whole_seek_over_the_host_link_with_status_result_and_refusals() {
         std::thread::spawn(move || stream_gyro(gyro_link, h, s))
     };
     wait_line(&console, "FOG-WINDOW", Duration::from_secs(20));
-    let dir = scratch_dir("qemu_seek");
     let mut log = ResultLog::open(&dir.join("results.csv")).unwrap();
 
     // Refusal 1: a latitude where Omega_H vanishes.

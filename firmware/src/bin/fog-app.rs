@@ -337,6 +337,11 @@ fn read_heading_cal(flash: &mut flash::ModelFlash) -> Option<HeadingHarmonic> {
                 "heading calibration applied ({} headings)",
                 r.harmonic.n_headings
             );
+            #[cfg(feature = "log-semihosting")]
+            semihosting::eprintln!(
+                "FOG-HEADING-CAL applied n_headings={}",
+                r.harmonic.n_headings
+            );
             Some(r.harmonic)
         }
         Ok(None) => None,

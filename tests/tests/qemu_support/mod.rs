@@ -18,8 +18,16 @@ use fog_tests::{
 /// UART2 = turntable) on loopback servers; returns QEMU, the connected streams and the
 /// semihosting console lines.
 pub fn start(args: &[&str], serial_ports: usize) -> (KillOnDrop, Vec<TcpStream>, Receiver<String>) {
+    start_with(args, serial_ports, Vec::new())
+}
+
+/// `start` with extra QEMU arguments (e.g. `-device loader,...` to preload flash).
+pub fn start_with(
+    args: &[&str],
+    serial_ports: usize,
+    mut extra: Vec<String>,
+) -> (KillOnDrop, Vec<TcpStream>, Receiver<String>) {
     let ports: Vec<u16> = (0..serial_ports).map(|_| free_loopback_port()).collect();
-    let mut extra = Vec::new();
     for p in &ports {
         extra.push("-serial".to_string());
         extra.push(format!("tcp:127.0.0.1:{p},server=on,wait=on"));
