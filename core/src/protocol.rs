@@ -29,8 +29,10 @@ use crate::model::ModelError;
 use heapless::String;
 use serde::{Deserialize, Serialize};
 
-/// Protocol version spoken by this build (sent in `Hello` and `DeviceStatus`).
-pub const PROTOCOL_VERSION: u16 = 2;
+/// Protocol version spoken by this build (sent in `Hello` and `DeviceStatus`). 3: every
+/// frame is wrapped in `link::HostFrame` / `link::DeviceFrame` (one host port for the
+/// upload and the north-finder link); the messages themselves are those of version 2.
+pub const PROTOCOL_VERSION: u16 = 3;
 /// Most model bytes in one `Chunk`.
 pub const MAX_CHUNK_LEN: usize = 256;
 /// Length of an Ed25519 signature, bytes.
