@@ -1,15 +1,19 @@
 //! Host-link messages of the north finder (device <-> PC over the host UART or RS-422):
-//! status, seek results and commands.
+//! status, seek results and commands, and the outer enums that let them share the one host
+//! port with the model upload.
 //!
-//! Exists so that the firmware and `fogsim monitor` build against one set of types. Frames
-//! are exactly the upload's: `fog_core::protocol::encode_frame` / `decode_frame` /
-//! `FrameReceiver` (postcard, CRC-32, COBS, 0x00 delimiter); this module only adds the
-//! message types and two thin helpers that call those functions.
+//! Exists so that the firmware, `fogsim monitor` and `fogsim upload` build against one set
+//! of types. Frames are exactly the upload's: `fog_core::protocol::encode_frame` /
+//! `decode_frame` / `FrameReceiver` (postcard, CRC-32, COBS, 0x00 delimiter). Every frame
+//! on the host port carries one [`HostFrame`] (PC -> device) or [`DeviceFrame`]
+//! (device -> PC): the outer postcard tag (0 upload, 1 link) comes first, then the inner
+//! message unchanged, so an upload client skips the device's periodic `Status` frames and
+//! a monitor skips upload replies.
 
 use serde::{Deserialize, Serialize};
 
 use crate::bit::BitWord;
-use crate::protocol::{decode_message, encode_frame, FrameError};
+use crate::protocol::{decode_message, encode_frame, FrameError, Request, ResetCause, Response};
 use crate::seek_quality::{MotionReason, QualityError, SeekState, Validity};
 use crate::tilt::Tilt;
 
@@ -25,6 +29,19 @@ pub enum ResetReason {
     Software,
     Lockup,
     Unknown,
+}
+
+impl From<ResetCause> for ResetReason {
+    /// The firmware's recorded cause (no-init RAM, issue 11) on the link: a panic or a
+    /// fatal boot error is a software reset, a CPU exception (hard fault) a lockup.
+    fn from(c: ResetCause) -> Self {
+        match c {
+            ResetCause::PowerOn => ResetReason::PowerOn,
+            ResetCause::Watchdog => ResetReason::Watchdog,
+            ResetCause::Panic | ResetCause::FatalBoot => ResetReason::Software,
+            ResetCause::Exception => ResetReason::Lockup,
+        }
+    }
 }
 
 /// PC -> device.
@@ -102,6 +119,23 @@ pub struct SeekReport {
     pub t_end_s: f64,
     pub positions: u8,
     pub validity: Validity,
+}
+
+/// Everything the PC sends on the host port.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum HostFrame<'a> {
+    /// Model upload (`fog_core::protocol`), answered with `DeviceFrame::Upload`.
+    Upload(#[serde(borrow)] Request<'a>),
+    /// North-finder command, answered with `DeviceFrame::Link` (`Accepted`/`Refused`,
+    /// then a `Status`).
+    Link(Command),
+}
+
+/// Everything the device sends on the host port.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum DeviceFrame {
+    Upload(Response),
+    Link(DeviceMessage),
 }
 
 /// Largest frame of any link message on the wire, bytes (checked by a test).
@@ -184,15 +218,16 @@ mod tests {
         let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
         let mut rx = FrameReceiver::new();
         for m in all_messages() {
-            let n = encode(&m, &mut wire).unwrap();
+            let framed = DeviceFrame::Link(m);
+            let n = encode(&framed, &mut wire).unwrap();
             assert!(n <= MAX_LINK_FRAME_LEN, "{m:?}: {n} bytes");
             let mut got = None;
             for &b in &wire[..n] {
                 if let Some(p) = rx.push(b) {
-                    got = Some(decode::<DeviceMessage>(p.unwrap()).unwrap());
+                    got = Some(decode::<DeviceFrame>(p.unwrap()).unwrap());
                 }
             }
-            assert_eq!(got, Some(m));
+            assert_eq!(got, Some(framed));
         }
         for c in [
             Command::StartSeek { positions: 2 },
@@ -202,10 +237,37 @@ mod tests {
             Command::Abort,
             Command::GetStatus,
         ] {
-            let n = encode(&c, &mut wire).unwrap();
+            let n = encode(&HostFrame::Link(c), &mut wire).unwrap();
             let p = crate::protocol::decode_frame(&mut wire[..n - 1]).unwrap();
-            assert_eq!(decode::<Command>(p).unwrap(), c);
+            assert_eq!(decode::<HostFrame>(p).unwrap(), HostFrame::Link(c));
         }
+    }
+
+    #[test]
+    fn the_outer_tag_separates_upload_from_link_and_keeps_the_inner_bytes() {
+        let request = Request::Begin {
+            model_len: 1234,
+            model_crc32: 0xCAFE_F00D,
+        };
+        let inner = postcard::to_allocvec(&request).unwrap();
+        let outer = postcard::to_allocvec(&HostFrame::Upload(request)).unwrap();
+        assert_eq!(outer[0], 0, "upload is outer tag 0");
+        assert_eq!(
+            &outer[1..],
+            &inner[..],
+            "the upload message itself is unchanged"
+        );
+        let cmd = postcard::to_allocvec(&HostFrame::Link(Command::GetStatus)).unwrap();
+        assert_eq!(cmd[0], 1, "link is outer tag 1");
+        // A bare (unwrapped) upload request is not mistaken for a link command.
+        let bare = postcard::to_allocvec(&Request::Status).unwrap();
+        assert!(!matches!(
+            postcard::from_bytes::<HostFrame>(&bare),
+            Ok(HostFrame::Link(_))
+        ));
+        let reply = DeviceFrame::Upload(Response::Aborted);
+        let bytes = postcard::to_allocvec(&reply).unwrap();
+        assert_eq!(postcard::from_bytes::<DeviceFrame>(&bytes).unwrap(), reply);
     }
 
     #[test]

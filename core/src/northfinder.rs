@@ -317,7 +317,7 @@ impl NorthFinder {
             },
             Phase::Dwelling { .. } => SeekStatus::Dwelling {
                 position: self.position,
-                windows: self.acc[self.position as usize].n,
+                windows: self.acc.get(self.position as usize).map_or(0, |a| a.n),
             },
         }
     }

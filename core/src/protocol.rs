@@ -29,8 +29,10 @@ use crate::model::ModelError;
 use heapless::String;
 use serde::{Deserialize, Serialize};
 
-/// Protocol version spoken by this build (sent in `Hello` and `DeviceStatus`).
-pub const PROTOCOL_VERSION: u16 = 2;
+/// Protocol version spoken by this build (sent in `Hello` and `DeviceStatus`). 3: every
+/// frame is wrapped in `link::HostFrame` / `link::DeviceFrame` (one host port for the
+/// upload and the north-finder link); the messages themselves are those of version 2.
+pub const PROTOCOL_VERSION: u16 = 3;
 /// Most model bytes in one `Chunk`.
 pub const MAX_CHUNK_LEN: usize = 256;
 /// Length of an Ed25519 signature, bytes.
@@ -545,9 +547,11 @@ mod tests {
                 boots: u32::MAX,
             },
         };
-        // The padding before a status request pays for the largest status reply.
+        // The padding before a status request pays for the largest status reply, as sent
+        // on the host port (inside `link::DeviceFrame`).
         let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
-        let n = encode_frame(&Response::Status(status.clone()), &mut wire).unwrap();
+        let framed = crate::link::DeviceFrame::Upload(Response::Status(status.clone()));
+        let n = encode_frame(&framed, &mut wire).unwrap();
         assert!(n <= STATUS_REQUEST_PADDING, "status reply {n} B");
         let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
         for response in [

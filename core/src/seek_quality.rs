@@ -18,7 +18,7 @@ use crate::bit::{BitItem, BitWord};
 use crate::compensator::WindowResult;
 use crate::consts::{EARTH_RATE_DPH, WINDOW_S};
 use crate::hal::Turntable;
-use crate::northfinder::{NorthFinder, SeekError, SeekMode, SeekResult, SeekStatus};
+use crate::northfinder::{NorthFinder, SeekConfig, SeekError, SeekMode, SeekResult, SeekStatus};
 use crate::tilt::Tilt;
 use serde::{Deserialize, Serialize};
 
@@ -209,6 +209,34 @@ impl SeekSupervisor {
 
     pub fn finder_mut(&mut self) -> &mut NorthFinder {
         &mut self.finder
+    }
+
+    /// True while a seek runs (including its restarts).
+    pub fn is_seeking(&self) -> bool {
+        self.seeking
+    }
+
+    /// Polls the turntable of the running seek; an error ends the seek.
+    pub fn poll<T: Turntable>(&mut self, table: &mut T, t_now_s: f64) -> Result<(), QualityError> {
+        if !self.seeking {
+            return Ok(());
+        }
+        self.finder.poll(table, t_now_s).map(|_| ()).map_err(|e| {
+            self.abort();
+            e.into()
+        })
+    }
+
+    /// New seek settings (mode, latitude, dwells) for the next seek; the heading
+    /// calibration is kept. Refused while seeking (`Busy`) or if `cfg` is out of range.
+    pub fn reconfigure(&mut self, cfg: SeekConfig) -> Result<(), SeekError> {
+        if self.seeking {
+            return Err(SeekError::Busy);
+        }
+        let mut finder = NorthFinder::new(cfg)?;
+        finder.set_heading_correction(self.finder.heading_correction().copied());
+        self.finder = finder;
+        Ok(())
     }
 
     /// Restarts of the current (or last) seek and the last reason.
@@ -469,7 +497,6 @@ mod tests {
     use crate::bit::BitItem;
     use crate::compensator::WindowStatus;
     use crate::hal::TableState;
-    use crate::northfinder::SeekConfig;
     use crate::synthetic::SplitMix64;
     use crate::tilt::earth_rate_on_axis_dph;
 

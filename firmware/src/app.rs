@@ -1,8 +1,12 @@
 //! The north-finder application logic, independent of any board: raw gyro samples and
 //! 1 Hz temperatures go into fog-core's `Compensator` (10 s averager + RBF drift), each
-//! closed window goes to fog-core's `NorthFinder`, which drives the turntable. The
-//! firmware's main loop and the QEMU replay both run exactly this code, and so does the
-//! host side of the replay test, which is what makes the bit-exact comparison meaningful.
+//! closed window goes with the inclinometer's mean tilt over that window to fog-core's
+//! `SeekSupervisor` (the `NorthFinder` with BIT gating, tilt range, motion restarts,
+//! progress, predicted sigma and the latitude check), which drives the turntable. Seeks
+//! run back to back from power-on (`AppConfig::seeks`, the replay) or on the host's
+//! `Command::StartSeek` (`command`). The firmware's main loop and the QEMU replay both
+//! run exactly this code, and so does the host side of the replay test, which is what
+//! makes the bit-exact comparison meaningful.
 //!
 //! Fault policy: a missing or faulty temperature reading is reported to the compensator
 //! (`report_fault`), which marks that window invalid; invalid windows never give a
@@ -12,16 +16,27 @@
 
 use core::borrow::BorrowMut;
 
+use fog_core::bit::BitWord;
 use fog_core::compensator::{Compensator, CompensatorConfig, CompensatorError, WindowResult};
 use fog_core::hal::{GyroSample, TableState, TempSample, Turntable};
+use fog_core::heading_cal::HeadingHarmonic;
+use fog_core::link::{
+    Command, DeviceMessage, Refusal, ResetReason, SeekReport, Status, LINK_VERSION,
+};
 use fog_core::model::RbfModel;
-use fog_core::northfinder::{NorthFinder, SeekConfig, SeekError, SeekResult, SeekStatus};
+use fog_core::northfinder::{NorthFinder, SeekConfig, SeekError, SeekMode, SeekResult};
+use fog_core::seek_quality::{
+    MotionReason, QualityConfig, QualityError, SeekSupervisor, SupervisorEvent, Validity,
+};
+use fog_core::tilt::Tilt;
 
 /// Application settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AppConfig {
     pub compensator: CompensatorConfig,
     pub seek: SeekConfig,
+    /// Seek quality limits (tilt range, motion, latitude check).
+    pub quality: QualityConfig,
     /// Temperature reading period, s (1 Hz as the compensator expects).
     pub temp_period_s: f64,
     /// Turntable poll period while a seek is running, s.
@@ -40,6 +55,7 @@ impl AppConfig {
                 ..CompensatorConfig::default()
             },
             seek: SeekConfig::default(),
+            quality: QualityConfig::default(),
             temp_period_s: 1.0,
             table_poll_s: 0.1,
             seeks: 6,
@@ -47,11 +63,11 @@ impl AppConfig {
     }
 }
 
-/// A seek that did not finish: the north finder's reason and, if the turntable caused
+/// A seek that did not finish: the supervisor's reason and, if the turntable caused
 /// it, the driver's own error.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SeekFailure<E> {
-    pub error: SeekError,
+    pub error: QualityError,
     pub table_error: Option<E>,
     /// When it failed, s since power-on.
     pub t_s: f64,
@@ -60,7 +76,8 @@ pub struct SeekFailure<E> {
 /// What one seek produced.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SeekOutcome<E> {
-    Done(SeekResult),
+    /// Finished, with the latitude check's verdict.
+    Done(SeekResult, Validity),
     Failed(SeekFailure<E>),
 }
 
@@ -71,6 +88,8 @@ pub struct Step<E> {
     pub window: Option<WindowResult>,
     /// A seek finished or failed.
     pub seek: Option<SeekOutcome<E>>,
+    /// The base moved: the running seek started again from its first position.
+    pub restarted: Option<MotionReason>,
 }
 
 impl<E> Default for Step<E> {
@@ -78,8 +97,41 @@ impl<E> Default for Step<E> {
         Self {
             window: None,
             seek: None,
+            restarted: None,
         }
     }
+}
+
+/// Mean of the inclinometer readings within one 10 s window.
+#[derive(Clone, Copy, Debug, Default)]
+struct TiltMean {
+    pitch_sum_deg: f32,
+    roll_sum_deg: f32,
+    n: u16,
+}
+
+impl TiltMean {
+    fn push(&mut self, t: Tilt) {
+        self.pitch_sum_deg += t.pitch_deg;
+        self.roll_sum_deg += t.roll_deg;
+        self.n = self.n.saturating_add(1);
+    }
+
+    fn mean(&self) -> Option<Tilt> {
+        (self.n > 0).then(|| Tilt {
+            pitch_deg: self.pitch_sum_deg / self.n as f32,
+            roll_deg: self.roll_sum_deg / self.n as f32,
+        })
+    }
+}
+
+/// What the board adds to the application's own fields in a `Status`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoardStatus {
+    pub t_s: f64,
+    pub temp_c: f32,
+    pub model_crc32: Option<u32>,
+    pub reset_reason: ResetReason,
 }
 
 /// Remembers the turntable driver's last error, which `NorthFinder` reduces to
@@ -116,11 +168,18 @@ where
 pub struct App<T: Turntable, C: BorrowMut<Compensator> = Compensator> {
     cfg: AppConfig,
     compensator: C,
-    finder: NorthFinder,
+    supervisor: SeekSupervisor,
     table: ErrorLatch<T>,
     next_temp_s: f64,
     next_table_poll_s: f64,
     seeks_started: u16,
+    seeks_done: u32,
+    /// The latest built-in test word (set by the board; `PASS` where there is none).
+    bit: BitWord,
+    /// Inclinometer readings of the open window, and the last closed window's mean
+    /// (level until the first reading: a board without an inclinometer, the replay).
+    tilt_window: TiltMean,
+    tilt: Tilt,
 }
 
 impl<T: Turntable> App<T>
@@ -155,7 +214,7 @@ where
         Ok(Self {
             cfg,
             compensator,
-            finder,
+            supervisor: SeekSupervisor::new(finder, cfg.quality),
             table: ErrorLatch {
                 table,
                 last_error: None,
@@ -163,6 +222,10 @@ where
             next_temp_s: 0.0,
             next_table_poll_s: 0.0,
             seeks_started: 0,
+            seeks_done: 0,
+            bit: BitWord::PASS,
+            tilt_window: TiltMean::default(),
+            tilt: Tilt::LEVEL,
         })
     }
 
@@ -198,7 +261,131 @@ where
 
     /// True once all configured seeks have been started and none is running.
     pub fn finished(&self) -> bool {
-        self.seeks_started >= self.cfg.seeks && !self.finder.is_busy()
+        self.seeks_started >= self.cfg.seeks && !self.supervisor.is_seeking()
+    }
+
+    /// The seek supervisor (state, progress, predicted sigma).
+    pub fn supervisor(&self) -> &SeekSupervisor {
+        &self.supervisor
+    }
+
+    /// The built-in test word from the board's counters: a failed item blocks the
+    /// next seek (a running one goes on; its own checks guard it).
+    pub fn set_bit(&mut self, bit: BitWord) {
+        self.bit = bit;
+    }
+
+    pub fn bit(&self) -> BitWord {
+        self.bit
+    }
+
+    /// One inclinometer reading (the board reads it at >= 1 Hz); averaged per window.
+    pub fn on_tilt(&mut self, tilt: Tilt) {
+        self.tilt_window.push(tilt);
+    }
+
+    /// The last closed window's mean base tilt.
+    pub fn tilt(&self) -> Tilt {
+        self.tilt
+    }
+
+    /// The heading calibration to apply to the following seeks (from its flash record).
+    pub fn set_heading_correction(&mut self, h: Option<HeadingHarmonic>) {
+        self.supervisor.finder_mut().set_heading_correction(h);
+    }
+
+    /// A host command at `t_s`: the answer to send (`None`: `GetStatus`, answered by the
+    /// status alone).
+    pub fn command(&mut self, cmd: Command, t_s: f64) -> Option<DeviceMessage> {
+        let refused = |r| Some(DeviceMessage::Refused(r));
+        match cmd {
+            Command::GetStatus => None,
+            Command::Abort => {
+                if !self.supervisor.is_seeking() {
+                    return refused(Refusal::NotSeeking);
+                }
+                self.supervisor.abort();
+                Some(DeviceMessage::Accepted)
+            }
+            Command::SetLatitude { latitude_deg } => {
+                let cfg = SeekConfig {
+                    latitude_deg: latitude_deg as f64,
+                    ..*self.supervisor.finder().config()
+                };
+                match self.supervisor.reconfigure(cfg) {
+                    Ok(()) => Some(DeviceMessage::Accepted),
+                    Err(_) => refused(Refusal::BadLatitude),
+                }
+            }
+            Command::StartSeek { positions } => {
+                let mode = match positions {
+                    2 => SeekMode::TwoPosition,
+                    4 => SeekMode::FourPosition,
+                    _ => return refused(Refusal::BadPositions),
+                };
+                if self.supervisor.is_seeking() {
+                    return refused(Refusal::Quality(QualityError::Busy));
+                }
+                let cfg = SeekConfig {
+                    mode,
+                    ..*self.supervisor.finder().config()
+                };
+                if self.supervisor.reconfigure(cfg).is_err() {
+                    return refused(Refusal::BadPositions);
+                }
+                match self.start_seek(t_s) {
+                    Ok(()) => Some(DeviceMessage::Accepted),
+                    Err(e) => refused(Refusal::Quality(e)),
+                }
+            }
+        }
+    }
+
+    /// The status message: the application's fields and the board's.
+    pub fn status(&self, board: BoardStatus) -> Status {
+        let (restarts, last_restart) = self.supervisor.restarts();
+        Status {
+            link_version: LINK_VERSION,
+            t_s: board.t_s as f32,
+            state: self.supervisor.state(self.bit),
+            progress: self.supervisor.progress(),
+            predicted_sigma_deg: self.supervisor.predicted_sigma_deg(),
+            temp_c: board.temp_c,
+            model_crc32: board.model_crc32,
+            bit: self.bit,
+            reset_reason: board.reset_reason,
+            latitude_deg: self.supervisor.finder().config().latitude_deg as f32,
+            tilt: self.tilt,
+            restarts,
+            last_restart,
+        }
+    }
+
+    /// The result message of a finished seek (numbered from 1 since power-on).
+    pub fn report(&self, r: &SeekResult, validity: Validity) -> SeekReport {
+        SeekReport {
+            sequence: self.seeks_done,
+            azimuth_deg: r.azimuth_deg,
+            sigma_deg: r.sigma_deg as f32,
+            tilt: r.tilt,
+            duration_s: r.duration_s as f32,
+            t_end_s: r.t_end_s,
+            // The mode (2 or 4, as in `StartSeek`), not the dwells (2 + the ambiguity one).
+            positions: match r.mode {
+                SeekMode::TwoPosition => 2,
+                SeekMode::FourPosition => 4,
+            },
+            validity,
+        }
+    }
+
+    fn start_seek(&mut self, t_s: f64) -> Result<(), QualityError> {
+        self.table.last_error = None;
+        self.supervisor
+            .start(&mut self.table, t_s, self.tilt, self.bit)?;
+        self.seeks_started = self.seeks_started.saturating_add(1);
+        self.next_table_poll_s = t_s + self.cfg.table_poll_s;
+        Ok(())
     }
 
     /// True if a temperature reading is due at `t_s` (the caller then reads its sensor
@@ -227,33 +414,37 @@ where
     /// One raw gyro sample: feeds the averager, and drives the seek.
     pub fn on_gyro(&mut self, s: GyroSample) -> Step<T::Error> {
         let mut step = Step::default();
-        if !self.finder.is_busy() && self.seeks_started < self.cfg.seeks {
-            self.seeks_started += 1;
-            self.table.last_error = None;
-            if let Err(e) = self.finder.start(&mut self.table, s.t_s) {
+        if !self.supervisor.is_seeking() && self.seeks_started < self.cfg.seeks {
+            if let Err(e) = self.start_seek(s.t_s) {
+                self.seeks_started = self.seeks_started.saturating_add(1);
                 step.seek = Some(self.fail(e, s.t_s));
             }
-            self.next_table_poll_s = s.t_s + self.cfg.table_poll_s;
-        } else if self.finder.is_busy() && s.t_s >= self.next_table_poll_s {
+        } else if self.supervisor.is_seeking() && s.t_s >= self.next_table_poll_s {
             self.next_table_poll_s += self.cfg.table_poll_s;
-            if let Err(e) = self.finder.poll(&mut self.table, s.t_s) {
+            if let Err(e) = self.supervisor.poll(&mut self.table, s.t_s) {
                 step.seek = Some(self.fail(e, s.t_s));
             }
         }
         if let Some(w) = self.compensator.borrow_mut().push_gyro(s) {
-            if self.finder.is_busy() {
-                match self.finder.on_window(&w, &mut self.table) {
-                    Ok(SeekStatus::Done(r)) => step.seek = Some(SeekOutcome::Done(r)),
-                    Ok(_) => {}
-                    Err(e) => step.seek = Some(self.fail(e, w.t_end_s)),
+            if let Some(t) = self.tilt_window.mean() {
+                self.tilt = t;
+            }
+            self.tilt_window = TiltMean::default();
+            match self.supervisor.on_window(&w, self.tilt, &mut self.table) {
+                Ok(SupervisorEvent::Done(r, v)) => {
+                    self.seeks_done = self.seeks_done.saturating_add(1);
+                    step.seek = Some(SeekOutcome::Done(r, v));
                 }
+                Ok(SupervisorEvent::Restarted(why)) => step.restarted = Some(why),
+                Ok(SupervisorEvent::Running) => {}
+                Err(e) => step.seek = Some(self.fail(e, w.t_end_s)),
             }
             step.window = Some(w);
         }
         step
     }
 
-    fn fail(&mut self, error: SeekError, t_s: f64) -> SeekOutcome<T::Error> {
+    fn fail(&mut self, error: QualityError, t_s: f64) -> SeekOutcome<T::Error> {
         // A failed seek stops the sequence: a broken table needs an operator.
         self.seeks_started = self.cfg.seeks;
         SeekOutcome::Failed(SeekFailure {

@@ -18,7 +18,7 @@ use embedded_hal_nb::serial::{ErrorKind, ErrorType, Read as SerialRead};
 use fog_core::compensator::{Compensator, WindowResult, WindowStatus};
 use fog_core::hal::{Gyro, TableState, Turntable};
 use fog_core::model::RbfModel;
-use fog_core::northfinder::SeekError;
+use fog_core::seek_quality::{FinderFault, QualityError};
 
 use crate::app::{App, AppConfig, AppError, SeekOutcome};
 use crate::drivers::fog_serial::{FogSerialGyro, GyroStats};
@@ -240,14 +240,19 @@ pub fn status_code(s: WindowStatus) -> u8 {
 }
 
 /// Small numeric code of a seek error for the output lines.
-pub fn seek_error_code(e: SeekError) -> u8 {
+pub fn seek_error_code(e: QualityError) -> u8 {
     match e {
-        SeekError::BadConfig => 1,
-        SeekError::Busy => 2,
-        SeekError::Turntable => 3,
-        SeekError::TableTimeout { position } => 10 + position,
-        SeekError::TooManyInvalidWindows { position } => 20 + position,
-        SeekError::InconsistentRates => 4,
+        QualityError::Finder(f) => match f {
+            FinderFault::BadConfig => 1,
+            FinderFault::Turntable => 3,
+            FinderFault::TableTimeout { position } => 10 + position,
+            FinderFault::TooManyInvalidWindows { position } => 20 + position,
+            FinderFault::InconsistentRates => 4,
+        },
+        QualityError::Busy => 2,
+        QualityError::TiltOutOfRange { .. } => 5,
+        QualityError::TooMuchMotion(_) => 6,
+        QualityError::Blocked(item) => 30 + item as u8,
     }
 }
 
@@ -270,7 +275,7 @@ pub fn write_window(out: &mut impl Write, w: &WindowResult) -> core::fmt::Result
 /// `S azimuth sigma duration bias` (f64 bits) or `F code t` for a failed seek.
 pub fn write_seek<E>(out: &mut impl Write, s: &SeekOutcome<E>) -> core::fmt::Result {
     match s {
-        SeekOutcome::Done(r) => writeln!(
+        SeekOutcome::Done(r, _) => writeln!(
             out,
             "S {:016x} {:016x} {:016x} {:016x}",
             r.azimuth_deg.to_bits(),
@@ -411,7 +416,7 @@ where
         }
         if let Some(s) = step.seek {
             match s {
-                SeekOutcome::Done(_) => sum.seeks_done += 1,
+                SeekOutcome::Done(..) => sum.seeks_done += 1,
                 SeekOutcome::Failed(_) => sum.seeks_failed += 1,
             }
             write_seek(out, &s).map_err(|_| ReplayError::Output)?;

@@ -1,7 +1,9 @@
 //! The device side of the model upload: a byte-driven state machine over the UART.
 //!
 //! The application feeds every received UART byte to [`UploadServer::push_byte`] and
-//! queues the returned response frame for sending; nothing here touches hardware, so
+//! queues the returned response frame for sending. The host port carries
+//! `fog_core::link::HostFrame`s: upload requests are handled here, north-finder commands
+//! are handed to the application (they share the framing and the reply budget); nothing here touches hardware, so
 //! the same code runs in host tests and in the firmware. A model becomes active only
 //! after its CRC, its security counter (no rollback), its Ed25519 signature over
 //! `signed_prefix(counter, this gyro) ++ model` (checked before any parsing of the
@@ -22,6 +24,7 @@
 //! (another key, tampered flash) is not used and the other slot is tried.
 
 use embedded_storage::nor_flash::NorFlash;
+use fog_core::link::{Command, DeviceFrame, HostFrame};
 use fog_core::model::{ModelError, RbfModel, MAX_ENCODED_LEN};
 use fog_core::protocol::{
     decode_message, encode_frame, signed_prefix, DeviceStatus, FrameReceiver, ModelInfo,
@@ -34,12 +37,15 @@ use heapless::String;
 use crate::signature::verify_model;
 use crate::store::{ActiveSlot, ModelStore, StoreError};
 
-/// One response to send back, and whether the active model just changed
-/// (then call [`UploadServer::load_active_model`] and swap it into the compensator).
+/// What one received frame produced: an upload response to send back, whether the active
+/// model just changed (then call [`UploadServer::load_active_model`] and swap it into the
+/// compensator), or a north-finder command for the application (`frame` empty; the
+/// application answers it, paying with [`UploadServer::spend_reply_credit`]).
 pub struct Reply<'a> {
-    /// A complete wire frame (COBS, ends with 0x00).
+    /// A complete wire frame (COBS, ends with 0x00; a `DeviceFrame::Upload`).
     pub frame: &'a [u8],
     pub model_changed: bool,
+    pub command: Option<Command>,
 }
 
 /// Why the active model could not be handed to the application.
@@ -212,9 +218,16 @@ impl<F: NorFlash> UploadServer<F> {
         }
         let outcome = match self.rx.push(byte)? {
             Err(e) => Err(e.as_upload_error()),
-            Ok(payload) => match decode_message::<Request<'_>>(payload) {
+            Ok(payload) => match decode_message::<HostFrame<'_>>(payload) {
                 Err(e) => Err(e.as_upload_error()),
-                Ok(request) => Ok(request),
+                Ok(HostFrame::Upload(request)) => Ok(request),
+                Ok(HostFrame::Link(command)) => {
+                    return Some(Reply {
+                        frame: &[],
+                        model_changed: false,
+                        command: Some(command),
+                    })
+                }
             },
         };
         let (response, model_changed) = match outcome {
@@ -244,20 +257,35 @@ impl<F: NorFlash> UploadServer<F> {
         };
         // Every response fits MAX_WIRE_FRAME_LEN (`largest_response_fits_a_frame` in
         // fog-core), so the empty fallback is unreachable.
-        let len = encode_frame(&response, &mut self.tx).unwrap_or(0);
         let frame_level = outcome_is_frame_level(&response, model_changed);
+        let len = encode_frame(&DeviceFrame::Upload(response), &mut self.tx).unwrap_or(0);
         if len > self.reply_credit || (frame_level && len > frame_len) {
             self.note_reply_dropped();
             return model_changed.then_some(Reply {
                 frame: &[],
                 model_changed,
+                command: None,
             });
         }
         self.reply_credit -= len;
         Some(Reply {
             frame: &self.tx[..len],
             model_changed,
+            command: None,
         })
+    }
+
+    /// Takes `len` bytes of reply credit for an answer the application sends itself (to a
+    /// link command): `false` (nothing taken, answer not sent, counted) if the bytes
+    /// received so far do not pay for it, so no input makes the device send more than it
+    /// got.
+    pub fn spend_reply_credit(&mut self, len: usize) -> bool {
+        if len > self.reply_credit {
+            self.note_reply_dropped();
+            return false;
+        }
+        self.reply_credit -= len;
+        true
     }
 
     /// Reads and decodes the active model from flash (`Ok(None)`: no model stored).

@@ -17,8 +17,10 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context, Result};
-use fog_core::link::{decode, encode, Command, DeviceMessage, SeekReport, Status};
-use fog_core::protocol::{FrameReceiver, MAX_WIRE_FRAME_LEN};
+use fog_core::link::{
+    decode, encode, Command, DeviceFrame, DeviceMessage, HostFrame, SeekReport, Status,
+};
+use fog_core::protocol::{FrameReceiver, MAX_WIRE_FRAME_LEN, STATUS_REQUEST_PADDING};
 use fog_core::seek_quality::Validity;
 
 /// Header of the results CSV.
@@ -112,6 +114,9 @@ pub struct MonitorSummary {
     pub statuses: usize,
     pub results: usize,
     pub bad_frames: usize,
+    /// Upload answers seen (another client on the same port).
+    pub upload_frames: usize,
+    pub accepted: usize,
     pub refusals: Vec<String>,
     pub last_status: Option<Status>,
 }
@@ -126,7 +131,12 @@ pub fn monitor<L: Read + Write>(
 ) -> Result<MonitorSummary> {
     let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
     for c in &opts.commands {
-        let n = encode(c, &mut wire).map_err(|e| anyhow::anyhow!("encoding {c:?}: {e}"))?;
+        let n = encode(&HostFrame::Link(*c), &mut wire)
+            .map_err(|e| anyhow::anyhow!("encoding {c:?}: {e}"))?;
+        // The zero bytes (empty frames, ignored) pay for the answer and the status that
+        // follows under the device's reply budget (never more bytes out than in).
+        link.write_all(&[0u8; STATUS_REQUEST_PADDING])
+            .context("sending a command")?;
         link.write_all(&wire[..n]).context("sending a command")?;
     }
     link.flush()?;
@@ -150,25 +160,43 @@ pub fn monitor<L: Read + Write>(
         };
         for &b in &buf[..n] {
             let Some(frame) = rx.push(b) else { continue };
-            let msg = frame.and_then(decode::<DeviceMessage>);
+            let msg = frame.and_then(decode::<DeviceFrame>);
             match msg {
                 Err(_) => sum.bad_frames += 1,
-                Ok(DeviceMessage::Status(s)) => {
-                    sum.statuses += 1;
-                    on_status(&s);
-                    sum.last_status = Some(s);
+                // An upload client's answers share the port.
+                Ok(DeviceFrame::Upload(_)) => sum.upload_frames += 1,
+                Ok(DeviceFrame::Link(m)) => {
+                    handle(m, log, &mut sum, &mut on_status, &mut on_result)?
                 }
-                Ok(DeviceMessage::Result(r)) => {
-                    log.append(&r)?;
-                    sum.results += 1;
-                    on_result(&r);
-                }
-                Ok(DeviceMessage::Accepted) => {}
-                Ok(DeviceMessage::Refused(why)) => sum.refusals.push(format!("{why:?}")),
             }
         }
     }
     Ok(sum)
+}
+
+/// One north-finder message: counted, shown, results appended to the CSV.
+fn handle(
+    msg: DeviceMessage,
+    log: &mut ResultLog,
+    sum: &mut MonitorSummary,
+    on_status: &mut impl FnMut(&Status),
+    on_result: &mut impl FnMut(&SeekReport),
+) -> Result<()> {
+    match msg {
+        DeviceMessage::Status(s) => {
+            sum.statuses += 1;
+            on_status(&s);
+            sum.last_status = Some(s);
+        }
+        DeviceMessage::Result(r) => {
+            log.append(&r)?;
+            sum.results += 1;
+            on_result(&r);
+        }
+        DeviceMessage::Accepted => sum.accepted += 1,
+        DeviceMessage::Refused(why) => sum.refusals.push(format!("{why:?}")),
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -210,14 +238,17 @@ mod tests {
             let mut b = [0u8; 1];
             while got.len() < 2 && s.read(&mut b).map(|n| n == 1).unwrap_or(false) {
                 if let Some(Ok(p)) = rx.push(b[0]) {
-                    got.push(decode::<Command>(p).unwrap());
+                    match decode::<HostFrame>(p).unwrap() {
+                        HostFrame::Link(c) => got.push(c),
+                        HostFrame::Upload(r) => panic!("monitor sent an upload request {r:?}"),
+                    }
                 }
             }
             let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
             for k in 0..seeks {
                 for i in 0..4 {
-                    let n =
-                        encode(&DeviceMessage::Status(status(i as f32 / 4.0)), &mut wire).unwrap();
+                    let m = DeviceMessage::Status(status(i as f32 / 4.0));
+                    let n = encode(&DeviceFrame::Link(m), &mut wire).unwrap();
                     s.write_all(&wire[..n]).unwrap();
                 }
                 s.write_all(&[0x13, 0x37, 0x00]).unwrap(); // a corrupt frame
@@ -240,7 +271,7 @@ mod tests {
                         Validity::Valid
                     },
                 });
-                let n = encode(&r, &mut wire).unwrap();
+                let n = encode(&DeviceFrame::Link(r), &mut wire).unwrap();
                 s.write_all(&wire[..n]).unwrap();
             }
             got

@@ -1,6 +1,8 @@
 //! The training PC's side of the model upload: sign a model and send it to the device.
 //!
-//! Speaks `fog_core::protocol` over any byte link (`Read + Write`): a serial port
+//! Speaks `fog_core::protocol` inside `fog_core::link::HostFrame::Upload` (the host port
+//! also carries the north finder's messages, which this client skips) over any byte
+//! link (`Read + Write`): a serial port
 //! (`serialport` crate) for real hardware, or TCP for QEMU's `-serial tcp:...`.
 //! Every wait is bounded by a deadline; every refusal comes back as the device's typed
 //! `UploadError`, so callers and tests can tell a bad signature from a bad CRC.
@@ -12,6 +14,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use ed25519_compact::{KeyPair, Seed};
+use fog_core::link::{DeviceFrame, HostFrame};
 use fog_core::protocol::{
     crc32, decode_message, encode_frame, signed_prefix, DeviceStatus, FrameError, FrameReceiver,
     ModelInfo, Request, Response, UploadError, MAX_CHUNK_LEN, MAX_WIRE_FRAME_LEN, PROTOCOL_VERSION,
@@ -168,7 +171,8 @@ impl<L: Read + Write> UploadClient<L> {
     pub fn request(&mut self, request: &Request<'_>) -> Result<Response, ClientError> {
         let mut wire = [0u8; MAX_WIRE_FRAME_LEN + 1];
         // A leading delimiter flushes any partial frame left in the device's buffer.
-        let n = encode_frame(request, &mut wire[1..]).map_err(ClientError::Frame)?;
+        let n = encode_frame(&HostFrame::Upload(*request), &mut wire[1..])
+            .map_err(ClientError::Frame)?;
         self.send_raw(&wire[..n + 1])?;
         // That delimiter makes the device answer any stale partial frame (line noise)
         // with a frame-level rejection first: skip those. The answer to our own frame,
@@ -204,8 +208,16 @@ impl<L: Read + Write> UploadClient<L> {
                 }
                 Ok(_) => {
                     if let Some(frame) = self.rx.push(byte[0]) {
-                        let payload = frame.map_err(ClientError::Frame)?;
-                        return decode_message::<Response>(payload).map_err(ClientError::Frame);
+                        // The device's north-finder messages (periodic `Status`, seek
+                        // results) share the port: not ours, skipped. So is a corrupt
+                        // frame (line noise, or a status frame whose start another reader
+                        // of the port took): our answer may still follow, and the deadline
+                        // bounds the wait.
+                        let Ok(payload) = frame else { continue };
+                        match decode_message::<DeviceFrame>(payload) {
+                            Ok(DeviceFrame::Upload(response)) => return Ok(response),
+                            Ok(DeviceFrame::Link(_)) | Err(_) => {}
+                        }
                     }
                 }
                 Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}

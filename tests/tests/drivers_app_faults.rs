@@ -3,13 +3,16 @@
 //! the driver's own error; a temperature sensor that fails marks its window invalid and
 //! the north finder never gets a result from it.
 
+mod app_support;
+
 use std::cell::Cell;
 
+use app_support::InstantTable;
 use embedded_hal_mock::eh1::serial::{Mock, Transaction};
 use embedded_hal_nb::nb;
 use fog_core::compensator::WindowStatus;
-use fog_core::hal::{GyroSample, TableState, TempSample, Turntable};
-use fog_core::northfinder::SeekError;
+use fog_core::hal::{GyroSample, TempSample};
+use fog_core::seek_quality::{FinderFault, QualityError, Validity};
 use fog_firmware::app::{App, AppConfig, SeekOutcome};
 use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig, TurntableError};
 
@@ -19,22 +22,6 @@ fn config(seeks: u16) -> AppConfig {
     let mut cfg = AppConfig::for_rate(RATE_HZ as f32);
     cfg.seeks = seeks;
     cfg
-}
-
-/// A table that settles at once wherever it is told to go.
-struct InstantTable(f32);
-
-impl Turntable for InstantTable {
-    type Error = ();
-    fn command_heading(&mut self, h: f32) -> Result<(), ()> {
-        self.0 = h;
-        Ok(())
-    }
-    fn poll(&mut self) -> Result<TableState, ()> {
-        Ok(TableState::Settled {
-            heading_deg: self.0,
-        })
-    }
 }
 
 #[test]
@@ -61,7 +48,7 @@ fn silent_turntable_aborts_the_seek_with_the_driver_error() {
         }
     }
     let f = failure.expect("the missing ACK ends the seek within the reply timeout");
-    assert_eq!(f.error, SeekError::Turntable);
+    assert_eq!(f.error, QualityError::Finder(FinderFault::Turntable));
     assert_eq!(f.table_error, Some(TurntableError::Timeout));
     assert_eq!(f.t_s, 0.75, "reported at the first poll past the timeout");
     assert!(app.finished(), "no silent retry after a table fault");
@@ -130,7 +117,7 @@ fn seeks_run_back_to_back_and_report_each_result() {
     }
     assert_eq!(results.len(), 2, "{results:?}");
     for r in results {
-        let SeekOutcome::Done(r) = r else {
+        let SeekOutcome::Done(r, validity) = r else {
             panic!("seek failed: {r:?}")
         };
         assert!(
@@ -138,5 +125,6 @@ fn seeks_run_back_to_back_and_report_each_result() {
             "azimuth {}",
             r.azimuth_deg
         );
+        assert_eq!(validity, Validity::Valid);
     }
 }

@@ -12,74 +12,20 @@
 //! Skips loudly without QEMU / the target unless FOG_REQUIRE_QEMU=1. Every wait is
 //! bounded; QEMU is killed when the test ends.
 
+mod qemu_support;
 mod upload_support;
 
-use std::io::{BufRead, BufReader, Write};
+use std::io::Write;
 use std::net::TcpStream;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc::{channel, Receiver};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use fog_core::protocol::ResetCause;
-use fog_firmware::drivers::gyro_frame::GyroFrame;
 use fog_sim::upload::{ClientError, UploadClient};
-use fog_tests::{
-    connect_loopback, firmware_elf, free_loopback_port, qemu_ready, spawn_qemu, KillOnDrop,
-    QemuOptions,
-};
+use fog_tests::qemu_ready;
+use qemu_support::{start, stream_gyro_frames, wait_line};
 use upload_support::*;
-
-/// Starts fog-app with `args` and `serial_ports.len()` UARTs on loopback servers;
-/// returns QEMU, the connected streams and the semihosting console lines.
-fn start(args: &[&str], serial_ports: usize) -> (KillOnDrop, Vec<TcpStream>, Receiver<String>) {
-    let ports: Vec<u16> = (0..serial_ports).map(|_| free_loopback_port()).collect();
-    let mut extra = Vec::new();
-    for p in &ports {
-        extra.push("-serial".to_string());
-        extra.push(format!("tcp:127.0.0.1:{p},server=on,wait=on"));
-    }
-    let opts = QemuOptions {
-        args: args.iter().map(|s| s.to_string()).collect(),
-        extra,
-        ..QemuOptions::default()
-    };
-    let mut qemu = spawn_qemu(&firmware_elf("fog-app"), &opts).expect("start QEMU");
-    let streams = ports
-        .iter()
-        .map(|&p| connect_loopback(p, Duration::from_secs(30)))
-        .collect();
-    let (tx, rx) = channel();
-    let stderr = qemu.0.stderr.take().expect("piped");
-    std::thread::spawn(move || {
-        // The console mixes defmt's binary frames with our text lines: split on '\n'
-        // and keep the tagged lines.
-        let mut reader = BufReader::new(stderr);
-        let mut line = Vec::new();
-        while reader.read_until(b'\n', &mut line).is_ok_and(|n| n > 0) {
-            let text = String::from_utf8_lossy(&line);
-            if let Some(at) = text.find("FOG-") {
-                let _ = tx.send(text[at..].trim_end().to_string());
-            }
-            line.clear();
-        }
-    });
-    (qemu, streams, rx)
-}
-
-/// Waits (bounded) for a console line starting with `prefix`.
-fn wait_line(rx: &Receiver<String>, prefix: &str, within: Duration) -> String {
-    let deadline = Instant::now() + within;
-    let mut seen = Vec::new();
-    while let Some(left) = deadline.checked_duration_since(Instant::now()) {
-        match rx.recv_timeout(left) {
-            Ok(line) if line.starts_with(prefix) => return line,
-            Ok(line) => seen.push(line),
-            Err(_) => break,
-        }
-    }
-    panic!("no console line {prefix:?} within {within:?}; saw {seen:#?}")
-}
 
 #[test]
 fn qemu_watchdog_resets_a_hung_main_loop_and_reports_it() {
@@ -157,31 +103,16 @@ const FLOOD_GYRO_HZ: u32 = 200;
 /// Bytes per second a 115,200 baud 8N1 host link carries.
 const HOST_LINE_BYTES_PER_S: f64 = 115_200.0 / 10.0;
 
-/// Gyro frames at `FLOOD_GYRO_HZ`, paced in real time in 5 ms batches, until `stop`.
-fn stream_gyro(mut link: TcpStream, stop: Arc<AtomicBool>) -> u64 {
+/// Gyro frames at `FLOOD_GYRO_HZ`, paced in real time, until `stop`.
+fn stream_gyro(link: TcpStream, stop: Arc<AtomicBool>) -> u64 {
     let period_s = 1.0 / f64::from(FLOOD_GYRO_HZ);
-    let start = Instant::now();
-    let mut sent = 0u64;
     // White rate noise of a FOG with ARW 0.005 deg/sqrt(h) at this rate, deg/h.
     let noise = rand_distr::Normal::new(0.0, 0.005 * 60.0 / period_s.sqrt()).unwrap();
     let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(7);
-    while !stop.load(Ordering::Relaxed) {
-        let due = (start.elapsed().as_secs_f64() / period_s) as u64;
-        let mut batch = Vec::new();
-        while sent < due {
-            // Earth rate component plus a slow ripple plus the gyro's white noise.
-            let rate_dph = 9.7
-                + 0.3 * (sent as f64 * 0.001).sin()
-                + rand_distr::Distribution::sample(&noise, &mut rng);
-            batch.extend(GyroFrame::from_physical(sent as u8, rate_dph, 25.0, period_s).encode());
-            sent += 1;
-        }
-        if link.write_all(&batch).is_err() {
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    sent
+    stream_gyro_frames(link, FLOOD_GYRO_HZ, 1.0, &stop, |n| {
+        // Earth rate component plus a slow ripple plus the gyro's white noise.
+        9.7 + 0.3 * (n as f64 * 0.001).sin() + rand_distr::Distribution::sample(&noise, &mut rng)
+    })
 }
 
 #[test]

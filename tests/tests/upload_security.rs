@@ -6,6 +6,7 @@
 
 mod upload_support;
 
+use fog_core::link::HostFrame;
 use fog_core::protocol::{
     encode_frame, Request, Response, UploadError, UploadPhase, MAX_WIRE_FRAME_LEN,
     SESSION_IDLE_TIMEOUT_S,
@@ -204,7 +205,7 @@ fn replies_never_exceed_what_caused_them() {
     // credit saved during the garbage is capped at one wire frame).
     let mut bytes_in = 0usize;
     let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
-    let n = encode_frame(&Request::Status, &mut wire).unwrap();
+    let n = encode_frame(&HostFrame::Upload(Request::Status), &mut wire).unwrap();
     for i in 0..20_000usize {
         let frame: Vec<u8> = if i % 3 == 0 {
             wire[..n].to_vec()

@@ -1,12 +1,19 @@
 //! The north-finder firmware for the MPS2-AN386 board (Cortex-M4F; QEMU in CI).
 //!
 //! Wiring (a real board changes only this file and `target/`):
-//! - UART0 (0x4000_4000, QEMU's first `-serial`): link to the training PC, carrying the
-//!   model-upload protocol, handled by `fog_firmware::upload::UploadServer`;
+//! - UART0 (0x4000_4000, QEMU's first `-serial`): the host port (RS-422 on the product),
+//!   carrying `fog_core::link::HostFrame`s: model uploads, handled by
+//!   `fog_firmware::upload::UploadServer`, and north-finder commands (StartSeek,
+//!   SetLatitude, Abort, GetStatus), answered by the application; the device sends a
+//!   `Status` about once per second and after each command, and a `Result` per seek;
 //! - UART1 (0x4000_5000): the FOG's RS-422 frame stream at 2 kHz (`FogSerialGyro`);
 //!   the gyro's internal coil temperature comes with every frame and is read at 1 Hz
 //!   (a board with a TMP117 on I2C uses `drivers::tmp117` instead);
 //! - UART2 (0x4000_6000): the turntable controller (`SerialTurntable`);
+//! - the inclinometer: the MPS2 board (and QEMU) has no SPI SCL3300, so this binary reads
+//!   a `SimulatedInclinometer` (the same `Inclinometer` trait the SCL3300 driver
+//!   implements) at 1 Hz of sample time; its tilt comes from the semihosting argument
+//!   `tilt-mdeg=PITCH:ROLL` (millidegrees, default level);
 //! - SysTick: 1 kHz time base for turntable timeouts and the gyro's frame time base
 //!   (counter wraps during a stall are recovered from it);
 //! - the CMSDK watchdog (0x4000_8000): 500 ms, fed only while the gyro path is serviced;
@@ -45,15 +52,25 @@ use defmt_semihosting as _;
 
 use cortex_m_rt::entry;
 use embedded_hal_nb::serial::{Read as _, Write as _};
+use fog_core::bit::BitLimits;
 use fog_core::compensator::Compensator;
 use fog_core::hal::Gyro;
+use fog_core::heading_cal::{HeadingCalRecord, HeadingHarmonic, FLASH_RECORD_LEN};
+use fog_core::link::{DeviceMessage, ResetReason};
 use fog_core::model::RbfModel;
 use fog_core::protocol::ResetRecord;
-use fog_firmware::app::{App, AppConfig, SeekOutcome};
+use fog_core::tilt::Tilt;
+use fog_firmware::app::{App, AppConfig, BoardStatus, SeekOutcome};
+use fog_firmware::bit_monitor::{BitCounters, BitMonitor};
 use fog_firmware::clock::Clock;
 use fog_firmware::drivers::fog_serial::FogSerialGyro;
+use fog_firmware::drivers::inclinometer::{
+    Inclinometer, SimulatedInclinometer, SIMULATED_NOISE_DEG,
+};
 use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig};
 use fog_firmware::health::{StuckDetector, StuckEvent, DEFAULT_STUCK_RUN};
+use fog_firmware::link_out::{queue_whole, LinkFrame};
+use fog_firmware::store::store_len;
 use fog_firmware::upload::UploadServer;
 use resets::BootFault;
 
@@ -74,6 +91,12 @@ const HOST_BYTES_PER_PASS: usize = 64;
 const TX_QUEUE_LEN: usize = 512;
 /// No gyro sample for this long marks the gyro silent (a fault in the window), s.
 const GYRO_SILENCE_S: f64 = 0.1;
+/// Status period on the host port and BIT evaluation period, s (clock time).
+const STATUS_PERIOD_S: f64 = 1.0;
+/// Inclinometer reading period, s of sample time.
+const TILT_PERIOD_S: f64 = 1.0;
+/// Seed of the simulated inclinometer's noise.
+const TILT_NOISE_SEED: u64 = 0x5C13_3000;
 
 /// The model-verifying public key and the gyro id, chosen at build time (build.rs).
 const VERIFY_KEY: [u8; 32] = *include_bytes!(concat!(env!("OUT_DIR"), "/verify_key.bin"));
@@ -87,7 +110,7 @@ fn main() -> ! {
     // as `&'static mut` exactly once (no unsafe here).
     static mut COMPENSATOR: Compensator = Compensator::unconfigured();
     static mut MODEL: RbfModel = RbfModel::empty();
-    static mut TX_QUEUE: heapless::Deque<u8, TX_QUEUE_LEN> = heapless::Deque::new();
+    static mut TX_QUEUE: TxQueue = heapless::Deque::new();
     let (compensator, model, tx_queue) = (COMPENSATOR, MODEL, TX_QUEUE);
     let reset = resets::boot_record();
     announce_boot(&reset);
@@ -111,6 +134,8 @@ fn main() -> ! {
 
     // The long-lived state lives in statics (counted in the static-RAM budget by the
     // linker), not in main's stack frame.
+    let mut flash = flash;
+    let heading_cal = read_heading_cal(&mut flash);
     let server = start_upload_server(flash, reset);
     // Decoded in place into `MODEL` (the compensator keeps its own copy).
     let stored = server.load_active_model_into(model).unwrap_or_else(|e| {
@@ -125,7 +150,13 @@ fn main() -> ! {
 
     let table = SerialTurntable::new(table_uart, millis::MillisClock, TurntableConfig::default());
     // Configured in place in `COMPENSATOR`; the `App` around it is a few hundred bytes.
-    let cfg = AppConfig::for_rate(gyro_rate_hz as f32);
+    let mut cfg = AppConfig::for_rate(gyro_rate_hz as f32);
+    // Seeks run on the host's StartSeek only.
+    cfg.seeks = 0;
+    if let Some(d) = options.seek_dwell_s {
+        cfg.seek.dwell_s = d as f32;
+        cfg.seek.ambiguity_dwell_s = (d as f32 / 6.0).max(10.0);
+    }
     let mut app = match App::with_compensator(cfg, stored.then_some(&*model), table, compensator) {
         Ok(a) => a,
         Err(e) => {
@@ -133,12 +164,21 @@ fn main() -> ! {
             resets::fatal_boot(BootFault::Configuration)
         }
     };
+    app.set_heading_correction(heading_cal);
     let mut gyro = FogSerialGyro::with_clock(gyro_uart, gyro_rate_hz, millis::MillisClock);
     let mut last_t_s = 0.0;
     // Clock reading at the last gyro sample (`None` until the gyro starts).
     let mut last_sample_clock_s: Option<f64> = None;
     let mut gyro_silent = false;
     let mut stuck = StuckDetector::new(DEFAULT_STUCK_RUN);
+    let mut inclinometer =
+        SimulatedInclinometer::new(options.tilt, SIMULATED_NOISE_DEG, TILT_NOISE_SEED);
+    let mut next_tilt_s = 0.0;
+    let mut last_tilt_clock_s: Option<f64> = None;
+    let mut last_table_error_s: Option<f64> = None;
+    let mut bit_monitor = BitMonitor::new(BitLimits::default());
+    let mut next_status_s = 0.0;
+    let reset_reason = ResetReason::from(reset.cause);
 
     loop {
         let now_s = millis::MillisClock.now_s();
@@ -173,9 +213,31 @@ fn main() -> ! {
                         }
                         app.on_temp(s.t_s, t);
                     }
+                    if s.t_s >= next_tilt_s {
+                        next_tilt_s = s.t_s + TILT_PERIOD_S;
+                        match inclinometer.read_tilt() {
+                            Ok(t) => {
+                                app.on_tilt(t);
+                                last_tilt_clock_s = Some(now_s);
+                            }
+                            Err(e) => defmt::warn!("inclinometer: {}", e),
+                        }
+                    }
                     let step = app.on_gyro(s);
                     if let Some(w) = &step.window {
                         window_line(w, gyro.stats().frames_lost, gyro.uart_mut().dropped());
+                    }
+                    if let Some(SeekOutcome::Failed(f)) = &step.seek {
+                        if f.table_error.is_some() {
+                            last_table_error_s = Some(now_s);
+                        }
+                    }
+                    if let Some(SeekOutcome::Done(r, v)) = &step.seek {
+                        let report = app.report(r, *v);
+                        send_link(tx_queue, DeviceMessage::Result(report));
+                        seek_line(&report);
+                        // The state changed: a status now.
+                        next_status_s = now_s;
                     }
                     report(step);
                 }
@@ -200,31 +262,55 @@ fn main() -> ! {
             watchdog::feed();
         }
 
-        // 2. Host link: a bounded number of bytes per pass, replies queued.
+        // 2. BIT from the counters and the periodic status.
+        if now_s >= next_status_s {
+            next_status_s = now_s + STATUS_PERIOD_S;
+            let stats = gyro.stats();
+            let counters = BitCounters {
+                now_s,
+                last_gyro_s: last_sample_clock_s,
+                frames_ok: stats.frames.frames_ok,
+                frames_bad: stats.frames.crc_errors,
+                temp: gyro.latest_temp().map(|t| (t.t_s, t.temp_c)),
+                last_tilt_s: last_tilt_clock_s,
+                last_table_error_s,
+                model_valid: app.model().is_some() && server.active_info().is_some(),
+                flash_ok: server.slots_refused_at_boot() == 0,
+            };
+            app.set_bit(bit_monitor.evaluate(&counters));
+            let board = board_status(last_t_s, gyro.latest_temp(), server, reset_reason);
+            send_link(tx_queue, DeviceMessage::Status(app.status(board)));
+        }
+
+        // 3. Host link: a bounded number of bytes per pass, replies queued.
         server.set_time_s(now_s);
         for _ in 0..HOST_BYTES_PER_PASS {
             let Ok(byte) = host.read() else { break };
             let Some(reply) = server.push_byte(byte) else {
                 continue;
             };
-            let (frame, changed) = (reply.frame, reply.model_changed);
-            let fits = frame.len() <= TX_QUEUE_LEN - tx_queue.len();
-            if fits {
-                for &b in frame {
-                    let _ = tx_queue.push_back(b);
-                }
-            }
-            if !fits {
+            let (frame, changed, command) = (reply.frame, reply.model_changed, reply.command);
+            if !queue_whole(tx_queue, frame) {
                 server.note_reply_dropped();
+            }
+            if let Some(cmd) = command {
+                let answer = app.command(cmd, last_t_s);
+                let board = board_status(last_t_s, gyro.latest_temp(), server, reset_reason);
+                let status = DeviceMessage::Status(app.status(board));
+                for msg in answer.into_iter().chain(core::iter::once(status)) {
+                    answer_link(server, tx_queue, msg);
+                }
             }
             if changed {
                 swap_model(server, model, &mut app);
+                // The BIT's model item and the status follow at once.
+                next_status_s = now_s;
                 if options.inject == Inject::PanicAfterCommit {
                     core::panic!("injected panic after a commit");
                 }
             }
         }
-        // 3. Replies out, never waiting for the UART.
+        // 4. Replies out, never waiting for the UART.
         while let Some(&b) = tx_queue.front() {
             if host.write(b).is_err() {
                 break;
@@ -233,6 +319,89 @@ fn main() -> ! {
         }
     }
 }
+
+/// The heading calibration (`HeadingCalRecord`) from its own flash sector, right after
+/// the two model slots; `None` if none was written or it is unreadable (then logged:
+/// seeks run uncalibrated, as before any calibration).
+fn read_heading_cal(flash: &mut flash::ModelFlash) -> Option<HeadingHarmonic> {
+    use embedded_storage::nor_flash::{NorFlash, ReadNorFlash};
+    let at = store_len(<flash::ModelFlash as NorFlash>::ERASE_SIZE) as u32;
+    let mut buf = [0u8; FLASH_RECORD_LEN];
+    if flash.read(at, &mut buf).is_err() {
+        defmt::warn!("heading calibration sector unreadable");
+        return None;
+    }
+    match HeadingCalRecord::decode_flash(&buf) {
+        Ok(Some(r)) => {
+            defmt::info!(
+                "heading calibration applied ({} headings)",
+                r.harmonic.n_headings
+            );
+            #[cfg(feature = "log-semihosting")]
+            semihosting::eprintln!(
+                "FOG-HEADING-CAL applied n_headings={}",
+                r.harmonic.n_headings
+            );
+            Some(r.harmonic)
+        }
+        Ok(None) => None,
+        Err(e) => {
+            defmt::warn!("heading calibration record refused: {}", e);
+            None
+        }
+    }
+}
+
+/// The board's part of a status message.
+fn board_status(
+    t_s: f64,
+    temp: Option<fog_core::hal::TempSample>,
+    server: &Server,
+    reset_reason: ResetReason,
+) -> BoardStatus {
+    BoardStatus {
+        t_s,
+        temp_c: temp.map_or(f32::NAN, |t| t.temp_c),
+        model_crc32: server.active_info().map(|i| i.model_crc32),
+        reset_reason,
+    }
+}
+
+/// A time-driven link message (status, result): queued whole if the TX queue has room,
+/// otherwise dropped (the next status follows within a second).
+fn send_link(tx: &mut TxQueue, msg: DeviceMessage) {
+    if let Some(f) = LinkFrame::encode(msg) {
+        let _ = queue_whole(tx, f.bytes());
+    }
+}
+
+/// An answer to a host command: sent only if the bytes the host sent pay for it (the
+/// reply budget of issue 11 covers both protocols on the port).
+fn answer_link(server: &mut Server, tx: &mut TxQueue, msg: DeviceMessage) {
+    let Some(f) = LinkFrame::encode(msg) else {
+        return;
+    };
+    if server.spend_reply_credit(f.bytes().len()) && !queue_whole(tx, f.bytes()) {
+        server.note_reply_dropped();
+    }
+}
+
+/// A finished seek as one plain-text line on the semihosting console (QEMU tests).
+fn seek_line(r: &fog_core::link::SeekReport) {
+    #[cfg(feature = "log-semihosting")]
+    semihosting::eprintln!(
+        "FOG-SEEK sequence={} azimuth_mdeg={} sigma_mdeg={} positions={}",
+        r.sequence,
+        // Integer millidegrees: no float formatting code in the image.
+        (r.azimuth_deg * 1000.0) as i64,
+        (r.sigma_deg * 1000.0) as i64,
+        r.positions
+    );
+    #[cfg(not(feature = "log-semihosting"))]
+    let _ = r;
+}
+
+type TxQueue = heapless::Deque<u8, TX_QUEUE_LEN>;
 
 /// A committed model: load it and hand it to the compensator.
 fn swap_model<T, C>(server: &mut Server, model: &mut RbfModel, app: &mut App<T, C>)
@@ -302,12 +471,18 @@ enum Inject {
 struct TestOptions {
     inject: Inject,
     gyro_rate_hz: u32,
+    /// `tilt-mdeg=PITCH:ROLL`: the simulated inclinometer's base tilt.
+    tilt: Tilt,
+    /// `seek-dwell-s=N`: dwell per main position (QEMU runs a short seek).
+    seek_dwell_s: Option<u32>,
 }
 
 fn test_options(reset: &ResetRecord) -> TestOptions {
     let mut o = TestOptions {
         inject: Inject::None,
         gyro_rate_hz: GYRO_RATE_HZ,
+        tilt: Tilt::LEVEL,
+        seek_dwell_s: None,
     };
     #[cfg(feature = "log-semihosting")]
     if let Ok(args) = semi::Args::get() {
@@ -320,6 +495,12 @@ fn test_options(reset: &ResetRecord) -> TestOptions {
                     if let Some(hz) = a.strip_prefix("gyro-rate=").and_then(|v| v.parse().ok()) {
                         o.gyro_rate_hz = hz;
                     }
+                    if let Some(d) = a.strip_prefix("seek-dwell-s=").and_then(|v| v.parse().ok()) {
+                        o.seek_dwell_s = Some(d);
+                    }
+                    if let Some(t) = a.strip_prefix("tilt-mdeg=").and_then(parse_tilt_mdeg) {
+                        o.tilt = t;
+                    }
                 }
                 Err(_) => {}
             }
@@ -329,6 +510,17 @@ fn test_options(reset: &ResetRecord) -> TestOptions {
         o.inject = Inject::None;
     }
     o
+}
+
+/// `PITCH:ROLL` in integer millidegrees (no float parsing code in the image).
+#[cfg(feature = "log-semihosting")]
+fn parse_tilt_mdeg(v: &str) -> Option<Tilt> {
+    let (p, r) = v.split_once(':')?;
+    let (p, r): (i32, i32) = (p.parse().ok()?, r.parse().ok()?);
+    Some(Tilt {
+        pitch_deg: p as f32 / 1000.0,
+        roll_deg: r as f32 / 1000.0,
+    })
 }
 
 fn inject_fault_at_boot(o: TestOptions) {
@@ -355,8 +547,11 @@ fn report<E: defmt::Format>(step: fog_firmware::app::Step<E>) {
             defmt::warn!("t={} s window invalid: {}", w.t_end_s, w.status);
         }
     }
+    if let Some(why) = step.restarted {
+        defmt::warn!("north seek restarted: base moved ({})", why);
+    }
     match step.seek {
-        Some(SeekOutcome::Done(r)) => defmt::info!(
+        Some(SeekOutcome::Done(r, _)) => defmt::info!(
             "north seek: azimuth {} deg +- {} deg ({} s)",
             r.azimuth_deg,
             r.sigma_deg,

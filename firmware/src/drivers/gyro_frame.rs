@@ -151,7 +151,13 @@ impl FrameDecoder {
                 return None;
             }
         }
-        self.buf[self.len] = byte;
+        // `len < FRAME_LEN` here (a full frame resets it below); `get_mut` keeps the
+        // panic path out of the 2 kHz loop.
+        let Some(slot) = self.buf.get_mut(self.len) else {
+            self.len = 0;
+            return None;
+        };
+        *slot = byte;
         self.len += 1;
         if self.len < FRAME_LEN {
             return None;

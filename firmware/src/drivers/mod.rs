@@ -4,6 +4,7 @@
 
 pub mod fog_serial;
 pub mod gyro_frame;
+pub mod inclinometer;
 pub mod scl3300;
 pub mod tmp117;
 pub mod turntable;

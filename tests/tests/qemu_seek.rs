@@ -1,0 +1,359 @@
+//! QEMU seek scenario (issue 10): the real `fog-app` under `qemu-system-arm -machine
+//! mps2-an386` runs a whole north seek started by `Command::StartSeek` over the host link.
+//!
+//! The test is the world around the device: a simulated FOG on UART1 (frames at
+//! `RATE_HZ` of sample time, sent `SPEED` times faster than real time: the firmware's time
+//! base is the frame count), a simulated turntable controller on UART2 (the ASCII protocol
+//! of `drivers::turntable`), and the PC on UART0 using the real tools: `fogsim upload`'s
+//! client and `fogsim monitor`'s session loop, sharing the one host port
+//! (`HostFrame`/`DeviceFrame`). The firmware's inclinometer is the simulated one, given the
+//! same base tilt as the gyro generator (`tilt-mdeg=`), so the tilt compensation is in the
+//! loop end to end.
+//!
+//! Gyro law: Earth rate on the tilted input axis (`fog_core::tilt::earth_rate_on_axis_dph`,
+//! true azimuth of table zero `TRUE_AZIMUTH_DEG`) + a constant bias + a heading-dependent
+//! bias a cos(alpha) + b sin(alpha) of the axis azimuth alpha (`HEADING`) + white noise of
+//! ARW `ARW_DPSH`; 25 degC. The heading harmonic's calibration record is preloaded into
+//! the flash sector after the model slots (QEMU `-device loader`): the device must apply it
+//! at boot, or its b part alone would turn the azimuth by ~0.5 deg (> 15 predicted sigma). The table turns instantly on `MOV` (no rotation rate is simulated:
+//! the windows during a move are discarded by the north finder anyway).
+//!
+//! Checked: two refusals first (a latitude out of range: `BadLatitude`; a seek before any
+//! model is in flash: BIT item `Model` blocks it, in the refusal and in the status), then
+//! after an upload over the same port the seek: statuses go to `Seeking` with rising
+//! progress and a finite predicted sigma, one `Result` (2 positions, `Valid`, azimuth
+//! within 5 predicted 1-sigma of the truth, the device's own sigma within a factor 3 of the
+//! prediction, the measured tilt), then `Ready` with the BIT passing.
+//!
+//! Skips loudly without QEMU / the target unless FOG_REQUIRE_QEMU=1. Every wait is
+//! bounded; QEMU is killed when the test ends.
+
+mod qemu_support;
+mod upload_support;
+
+use std::io::{BufRead, BufReader, Write};
+use std::net::TcpStream;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use fog_core::bit::{BitItem, BitWord};
+use fog_core::consts::EARTH_RATE_DPH;
+use fog_core::heading_cal::{HeadingCalRecord, HeadingHarmonic, FLASH_RECORD_LEN};
+use fog_core::link::{Command, ResetReason, SeekReport, Status};
+use fog_core::seek_quality::{SeekState, Validity};
+use fog_core::tilt::{earth_rate_on_axis_dph, Tilt};
+use fog_firmware::store::store_len;
+use fog_sim::monitor::{monitor, MonitorOptions, MonitorSummary, ResultLog};
+use fog_sim::upload::UploadClient;
+use fog_tests::{qemu_ready, scratch_dir};
+use qemu_support::{start_with, stream_gyro_frames, wait_line, wait_line_where};
+use rand_distr::Distribution;
+use upload_support::*;
+
+/// Gyro output rate of the scenario (sample time), Hz.
+const RATE_HZ: u32 = 20;
+/// Sample time per real time.
+const SPEED: f64 = 10.0;
+/// Dwell per main position, s (semihosting `seek-dwell-s=`); whole 10 s windows.
+const DWELL_S: u32 = 60;
+const LATITUDE_DEG: f64 = 39.9;
+const TRUE_AZIMUTH_DEG: f64 = 108.4;
+const TILT: Tilt = Tilt {
+    pitch_deg: 2.0,
+    roll_deg: -1.5,
+};
+/// Gyro angle random walk, deg/sqrt(h) (the supervisor's default motion floor assumes it).
+const ARW_DPSH: f64 = 0.0011;
+/// Constant gyro bias, deg/h (cancels in the two-position difference).
+const BIAS_DPH: f64 = 0.35;
+
+/// The gyro's heading-dependent bias and its calibration record (8 headings).
+const HEADING: HeadingHarmonic = HeadingHarmonic {
+    cos_dph: 0.2,
+    sin_dph: 0.1,
+    cos_sigma_dph: 0.002,
+    sin_sigma_dph: 0.002,
+    correlation: 0.0,
+    n_headings: 8,
+};
+/// Start of the model region (memory.x `MODELS`); the heading record follows the two
+/// 4 KiB model slots.
+const MODELS_ORIGIN: u32 = 0x000F_C000;
+
+/// The simulated table's heading, deg (table frame).
+type Heading = Arc<Mutex<f64>>;
+
+/// The turntable controller: `MOV h` -> `ACK` (the heading changes at once), `POS?` ->
+/// `POS h S`. Ends when the link closes or `stop` is set.
+fn serve_table(link: TcpStream, heading: Heading, stop: Arc<AtomicBool>) {
+    link.set_read_timeout(Some(Duration::from_millis(50)))
+        .unwrap();
+    let mut out = link.try_clone().unwrap();
+    let mut reader = BufReader::new(link);
+    let mut line = Vec::new();
+    while !stop.load(Ordering::Relaxed) {
+        match reader.read_until(b'\r', &mut line) {
+            Ok(0) => return,
+            Ok(_) if line.ends_with(b"\r") => {
+                let text = String::from_utf8_lossy(&line).trim().to_string();
+                line.clear();
+                let reply = if let Some(h) = text.strip_prefix("MOV ") {
+                    match h.parse::<f64>() {
+                        Ok(h) => {
+                            *heading.lock().unwrap() = h;
+                            "ACK".to_string()
+                        }
+                        Err(_) => "NAK".to_string(),
+                    }
+                } else if text == "POS?" {
+                    format!("POS {:.3} S", *heading.lock().unwrap())
+                } else {
+                    continue;
+                };
+                if out.write_all(format!("{reply}\r").as_bytes()).is_err() {
+                    return;
+                }
+            }
+            // A timeout may leave a partial line in `line`: keep reading.
+            _ => {}
+        }
+    }
+}
+
+/// The FOG: Earth rate at the table's current heading, bias and white noise.
+fn stream_gyro(link: TcpStream, heading: Heading, stop: Arc<AtomicBool>) -> u64 {
+    let period_s = 1.0 / f64::from(RATE_HZ);
+    let noise = rand_distr::Normal::new(0.0, ARW_DPSH * 60.0 / period_s.sqrt()).unwrap();
+    let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(10);
+    stream_gyro_frames(link, RATE_HZ, SPEED, &stop, |_| {
+        let h = *heading.lock().unwrap();
+        earth_rate_on_axis_dph(LATITUDE_DEG, TRUE_AZIMUTH_DEG, TILT, h)
+            + BIAS_DPH
+            + HEADING.bias_dph(TRUE_AZIMUTH_DEG + h)
+            + noise.sample(&mut rng)
+    })
+}
+
+/// One `fogsim monitor` session on the host port: sends `commands`, collects statuses
+/// and results for at most `within` (or until `results` results).
+fn session(
+    host: &TcpStream,
+    log: &mut ResultLog,
+    commands: Vec<Command>,
+    results: usize,
+    within: Duration,
+) -> (MonitorSummary, Vec<Status>, Vec<SeekReport>) {
+    let mut link = host.try_clone().unwrap();
+    let opts = MonitorOptions {
+        max_results: results,
+        max_duration: within,
+        commands,
+    };
+    let (mut statuses, mut reports) = (Vec::new(), Vec::new());
+    let sum = monitor(
+        &mut link,
+        log,
+        &opts,
+        |s| statuses.push(*s),
+        |r| reports.push(*r),
+    )
+    .expect("monitor session");
+    (sum, statuses, reports)
+}
+
+/// Predicted 1-sigma of the two-position azimuth from the generator's noise: the
+/// difference of two dwells of `n` windows, each window mean with ARW / sqrt(10 s),
+/// over the horizontal Earth rate (at |sin(azimuth)| = 1; sin(108.4) = 0.95).
+fn predicted_sigma_deg() -> f64 {
+    let window_dph = ARW_DPSH * 60.0 / 10f64.sqrt();
+    let n = f64::from(DWELL_S / 10);
+    let omega_h = EARTH_RATE_DPH * LATITUDE_DEG.to_radians().cos();
+    (window_dph / (2.0 * n).sqrt() / omega_h).to_degrees()
+}
+
+fn azimuth_error_deg(a: f64, b: f64) -> f64 {
+    (a - b + 540.0).rem_euclid(360.0) - 180.0
+}
+
+#[test]
+fn qemu_whole_seek_over_the_host_link_with_status_result_and_refusals() {
+    if !qemu_ready("qemu_seek") {
+        return;
+    }
+    let t0 = Instant::now();
+    let args = [
+        format!("gyro-rate={RATE_HZ}"),
+        format!("seek-dwell-s={DWELL_S}"),
+        format!(
+            "tilt-mdeg={}:{}",
+            (TILT.pitch_deg * 1000.0) as i32,
+            (TILT.roll_deg * 1000.0) as i32
+        ),
+    ];
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let dir = scratch_dir("qemu_seek");
+    let record = dir.join("heading-cal.bin");
+    let mut sector = [0xFFu8; FLASH_RECORD_LEN];
+    HeadingCalRecord::new(HEADING)
+        .encode_flash(&mut sector)
+        .unwrap();
+    std::fs::write(&record, sector).unwrap();
+    let at = MODELS_ORIGIN + store_len(4096) as u32;
+    let loader = format!("loader,file={},addr={at:#x},force-raw=on", record.display());
+    let (_qemu, mut streams, console) = start_with(&args, 3, vec!["-device".into(), loader]);
+    let table_link = streams.pop().expect("table link");
+    let gyro_link = streams.pop().expect("gyro link");
+    let host = streams.pop().expect("host link");
+    host.set_read_timeout(Some(Duration::from_millis(50)))
+        .unwrap();
+    wait_line(
+        &console,
+        "FOG-BOOT 1 reset=PowerOn",
+        Duration::from_secs(30),
+    );
+    wait_line(
+        &console,
+        "FOG-HEADING-CAL applied n_headings=8",
+        Duration::from_secs(10),
+    );
+
+    let heading: Heading = Arc::new(Mutex::new(0.0));
+    let stop = Arc::new(AtomicBool::new(false));
+    let table = {
+        let (h, s) = (heading.clone(), stop.clone());
+        std::thread::spawn(move || serve_table(table_link, h, s))
+    };
+    let gyro = {
+        let (h, s) = (heading.clone(), stop.clone());
+        std::thread::spawn(move || stream_gyro(gyro_link, h, s))
+    };
+    wait_line(&console, "FOG-WINDOW", Duration::from_secs(20));
+    let mut log = ResultLog::open(&dir.join("results.csv")).unwrap();
+
+    // Refusal 1: a latitude where Omega_H vanishes.
+    let (sum, _, _) = session(
+        &host,
+        &mut log,
+        vec![Command::SetLatitude { latitude_deg: 89.0 }],
+        usize::MAX,
+        Duration::from_millis(1500),
+    );
+    assert_eq!(sum.refusals, vec!["BadLatitude".to_string()], "{sum:?}");
+    // Refusal 2: no model in flash yet -> BIT item Model fails and blocks the seek.
+    let (sum, statuses, _) = session(
+        &host,
+        &mut log,
+        vec![Command::StartSeek { positions: 2 }],
+        usize::MAX,
+        Duration::from_millis(1500),
+    );
+    assert_eq!(
+        sum.refusals,
+        vec!["Quality(Blocked(Model))".to_string()],
+        "{sum:?}"
+    );
+    let last = statuses.last().expect("a status after the command");
+    assert_eq!(last.state, SeekState::NotReady(BitItem::Model), "{last:?}");
+    assert_eq!(last.bit, BitWord(1 << BitItem::Model as u16), "{last:?}");
+    assert_eq!(last.model_crc32, None);
+
+    // Upload a model over the same port (the client skips the status frames).
+    let mut client = UploadClient::new(host.try_clone().unwrap(), Duration::from_secs(10));
+    let bytes = encode(&sample_model(QEMU_GYRO, 8, 1.0));
+    let sig = sign_for_gyro(1, QEMU_GYRO, &bytes);
+    let info = client
+        .upload(&bytes, 1, &sig, |_, _| {})
+        .expect("upload over the shared host port");
+    wait_line_where(&console, "FOG-WINDOW", Duration::from_secs(20), |l| {
+        l.contains("status=Valid")
+    });
+
+    // The seek.
+    let (sum, statuses, reports) = session(
+        &host,
+        &mut log,
+        vec![
+            Command::SetLatitude {
+                latitude_deg: LATITUDE_DEG as f32,
+            },
+            Command::StartSeek { positions: 2 },
+        ],
+        1,
+        Duration::from_secs(40),
+    );
+    assert!(sum.refusals.is_empty(), "{sum:?}");
+    assert_eq!(sum.accepted, 2, "{sum:?}");
+    let seeking: Vec<&Status> = statuses
+        .iter()
+        .filter(|s| s.state == SeekState::Seeking)
+        .collect();
+    assert!(seeking.len() >= 5, "statuses while seeking: {statuses:#?}");
+    for pair in seeking.windows(2) {
+        assert!(
+            pair[1].progress >= pair[0].progress || pair[1].restarts > pair[0].restarts,
+            "progress falls without a restart: {pair:#?}"
+        );
+    }
+    let top = seeking.iter().map(|s| s.progress).fold(0.0f32, f32::max);
+    assert!(top >= 0.5, "progress seen up to {top}");
+    assert!(seeking
+        .iter()
+        .all(|s| s.predicted_sigma_deg.is_finite() && s.predicted_sigma_deg > 0.0));
+    let [r] = reports.as_slice() else {
+        panic!("one result expected: {reports:#?}\n{statuses:#?}")
+    };
+    let predicted = predicted_sigma_deg();
+    let err = azimuth_error_deg(r.azimuth_deg, TRUE_AZIMUTH_DEG);
+    eprintln!(
+        "seek: azimuth {:.4} deg (error {err:+.4}), device sigma {:.4}, predicted {predicted:.4}, \
+         duration {} s, tilt {:?}; {} statuses, {:.1} s wall so far",
+        r.azimuth_deg,
+        r.sigma_deg,
+        r.duration_s,
+        r.tilt,
+        statuses.len(),
+        t0.elapsed().as_secs_f64()
+    );
+    assert_eq!((r.positions, r.validity), (2, Validity::Valid), "{r:?}");
+    assert!(err.abs() <= 5.0 * predicted, "azimuth error {err} deg");
+    let ratio = f64::from(r.sigma_deg) / predicted;
+    assert!(
+        (1.0 / 3.0..=3.0).contains(&ratio),
+        "device sigma {} vs predicted {predicted}",
+        r.sigma_deg
+    );
+    assert!(
+        (r.tilt.pitch_deg - TILT.pitch_deg).abs() < 0.01
+            && (r.tilt.roll_deg - TILT.roll_deg).abs() < 0.01,
+        "{:?}",
+        r.tilt
+    );
+    wait_line(&console, "FOG-SEEK sequence=1", Duration::from_secs(5));
+
+    // Back to ready, everything passing.
+    let (_, statuses, _) = session(
+        &host,
+        &mut log,
+        vec![Command::GetStatus],
+        usize::MAX,
+        Duration::from_millis(1500),
+    );
+    let last = statuses.last().expect("status after the seek");
+    assert_eq!(last.state, SeekState::Ready, "{last:?}");
+    assert_eq!(last.bit, BitWord::PASS);
+    assert_eq!(last.progress, 0.0);
+    assert_eq!(last.model_crc32, Some(info.model_crc32));
+    assert_eq!(last.reset_reason, ResetReason::PowerOn);
+    assert!((last.latitude_deg - LATITUDE_DEG as f32).abs() < 1e-4);
+    assert!((last.temp_c - 25.0).abs() < 0.01, "{last:?}");
+
+    stop.store(true, Ordering::Relaxed);
+    let frames = gyro.join().unwrap();
+    let _ = table.join();
+    eprintln!(
+        "gyro frames {frames} ({:.0} s of sample time), wall {:.1} s",
+        frames as f64 / f64::from(RATE_HZ),
+        t0.elapsed().as_secs_f64()
+    );
+}
