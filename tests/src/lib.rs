@@ -7,6 +7,8 @@
 //! sets `FOG_REQUIRE_QEMU=1`, in which case they fail: CI sets it, a laptop without QEMU
 //! still runs every host test.
 
+pub mod console;
+
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};

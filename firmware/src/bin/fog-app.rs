@@ -24,6 +24,9 @@
 
 #[path = "target/flash.rs"]
 mod flash;
+#[cfg(feature = "log-semihosting")]
+#[path = "target/flash_file.rs"]
+mod flash_file;
 #[path = "target/millis.rs"]
 mod millis;
 #[path = "target/panic_reset.rs"]
@@ -105,7 +108,7 @@ fn main() -> ! {
             uart::CmsdkUart::new(0, HOST_BAUD),
             uart::CmsdkUart::new(1, GYRO_BAUD),
             uart::CmsdkUart::new(2, TABLE_BAUD),
-            flash::ModelFlash::take(),
+            flash::take_app_flash(),
         )
     };
 
@@ -122,6 +125,7 @@ fn main() -> ! {
         stored,
         server.slots_refused_at_boot()
     );
+    report_slots(server.boot_report());
 
     let table = SerialTurntable::new(table_uart, millis::MillisClock, TurntableConfig::default());
     // Configured in place in `COMPENSATOR`; the `App` around it is a few hundred bytes.
@@ -268,6 +272,20 @@ fn announce_boot(reset: &ResetRecord) {
     );
 }
 
+/// The boot check of both model slots (why a stored model is or is not used). Under
+/// QEMU also as a plain `FOG-SLOT` line per slot on the semihosting console.
+fn report_slots(report: [fog_firmware::upload::SlotVerdict; 2]) {
+    for (name, verdict) in ["A", "B"].into_iter().zip(report) {
+        if verdict.refused() {
+            defmt::warn!("model slot {}: {}", name, verdict);
+        } else {
+            defmt::info!("model slot {}: {}", name, verdict);
+        }
+        #[cfg(feature = "log-semihosting")]
+        semihosting::eprintln!("FOG-SLOT {} {}", name, verdict);
+    }
+}
+
 /// A closed window as one plain-text line on the semihosting console (QEMU tests).
 fn window_line(w: &fog_core::compensator::WindowResult, frames_lost: u32, bytes_dropped: u32) {
     #[cfg(feature = "log-semihosting")]
@@ -372,13 +390,13 @@ fn report<E: defmt::Format>(step: fog_firmware::app::Step<E>) {
     }
 }
 
-type Server = UploadServer<flash::ModelFlash>;
+type Server = UploadServer<flash::AppFlash>;
 
 /// The upload server, in a static. Its own frame (never inlined into `main`): building it
 /// (store scan, signature re-check, decoding the active model for its identity) needs
 /// ~10 KB of temporaries, which are then given back instead of staying in `main`'s frame.
 #[inline(never)]
-fn start_upload_server(flash: flash::ModelFlash, reset: ResetRecord) -> &'static mut Server {
+fn start_upload_server(flash: flash::AppFlash, reset: ResetRecord) -> &'static mut Server {
     let Ok(gyro_id) = heapless::String::try_from(GYRO_ID) else {
         resets::fatal_boot(BootFault::Configuration)
     };
