@@ -97,7 +97,7 @@ fn main() -> ! {
     let Some(cp) = cortex_m::Peripherals::take() else {
         resets::fatal_boot(BootFault::CorePeripherals)
     };
-    millis::start_millis(cp.SYST);
+    millis::start_millis(cp.SYST, millis::CORE_HZ);
     watchdog::start(WATCHDOG_TIMEOUT_MS);
     let options = test_options(&reset);
     inject_fault_at_boot(options);
