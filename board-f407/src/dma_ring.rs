@@ -5,7 +5,8 @@
 //!
 //! The stream runs in circular mode with its half- and full-transfer interrupts on;
 //! each interrupt counts one half lap, so the total written is known even when the
-//! reader falls more than a lap behind (then it skips ahead and counts the loss).
+//! reader falls more than a lap behind (then it skips ahead and counts the loss; the
+//! arithmetic is `fog_firmware::circular_dma`, tested on the host).
 //! Registers (RM0090 §10.5): LISR/HISR 0x00/0x04, LIFCR/HIFCR 0x08/0x0C, stream x at
 //! 0x10 + 0x18·x: CR, NDTR, PAR, M0AR (+0x0C). Request mapping (RM0090 table 42/43):
 //! USART1_RX DMA2 stream 5 ch 4, USART2_RX DMA1 stream 5 ch 4, USART3_RX DMA1 stream 1 ch 4.
@@ -16,11 +17,11 @@ use core::sync::atomic::{AtomicU32, Ordering};
 
 use embedded_hal_nb::nb;
 use embedded_hal_nb::serial::{ErrorKind, ErrorType, Read, Write};
+use fog_firmware::circular_dma::{total_written, RingReader};
 
 /// Bytes of each ring: 1,024 B is 85 gyro frames, 42 ms at 2 kHz (under the 64 ms half
 /// counter wrap the gyro driver's clock time base needs, as on the QEMU build).
 pub const RING_LEN: usize = 1024;
-const HALF: u32 = (RING_LEN / 2) as u32;
 
 const DMA1: usize = 0x4002_6000;
 const DMA2: usize = 0x4002_6400;
@@ -130,9 +131,7 @@ impl RxDma {
 pub struct DmaRx {
     dma: RxDma,
     ring: &'static Ring,
-    /// Total bytes consumed (or skipped) since start.
-    read: u32,
-    dropped: u32,
+    reader: RingReader,
     dropped_seen: u32,
 }
 
@@ -170,8 +169,7 @@ impl DmaRx {
         Self {
             dma,
             ring,
-            read: 0,
-            dropped: 0,
+            reader: RingReader::default(),
             dropped_seen: 0,
         }
     }
@@ -182,45 +180,29 @@ impl DmaRx {
             let laps = self.ring.half_laps.load(Ordering::Acquire);
             // SAFETY: NDTR of this stream.
             let ndtr = unsafe { read_volatile(self.dma.stream_reg(0x04)) } & 0xFFFF;
-            if laps != self.ring.half_laps.load(Ordering::Acquire) {
-                continue;
+            if laps == self.ring.half_laps.load(Ordering::Acquire) {
+                return total_written(laps, ndtr, RING_LEN as u32);
             }
-            let pos = (RING_LEN as u32 - ndtr) % RING_LEN as u32;
-            // A half boundary crossed whose interrupt has not run yet: count it here.
-            let in_second_half = pos >= HALF;
-            let expect_second_half = laps % 2 == 1;
-            let pending = u32::from(in_second_half != expect_second_half);
-            return (laps + pending) * HALF + pos % HALF;
         }
     }
 
     /// Bytes lost so far (overwritten before they were read).
     pub fn dropped(&self) -> u32 {
-        self.dropped
+        self.reader.dropped
     }
 
-    /// Bytes written and not yet read; after an overrun (the DMA lapped the reader)
-    /// the reader skips to the newest half ring, which the DMA is not writing, and
-    /// counts what it skipped.
     fn catch_up(&mut self) -> u32 {
         let written = self.written();
-        if written.wrapping_sub(self.read) >= RING_LEN as u32 {
-            let resume = written.wrapping_sub(HALF);
-            self.dropped = self.dropped.wrapping_add(resume.wrapping_sub(self.read));
-            self.read = resume;
-        }
-        written.wrapping_sub(self.read)
+        self.reader.catch_up(written, RING_LEN as u32)
     }
 
     fn pop(&mut self) -> Option<u8> {
         if self.catch_up() == 0 {
             return None;
         }
-        let at = self.read as usize % RING_LEN;
+        let at = self.reader.take(RING_LEN as u32);
         // SAFETY: the slot is behind the DMA's write position.
-        let byte = unsafe { read_volatile(self.ring.buf.get().cast::<u8>().add(at)) };
-        self.read = self.read.wrapping_add(1);
-        Some(byte)
+        Some(unsafe { read_volatile(self.ring.buf.get().cast::<u8>().add(at)) })
     }
 }
 
@@ -231,8 +213,8 @@ impl ErrorType for DmaRx {
 impl Read<u8> for DmaRx {
     fn read(&mut self) -> nb::Result<u8, ErrorKind> {
         self.catch_up();
-        if self.dropped != self.dropped_seen {
-            self.dropped_seen = self.dropped;
+        if self.reader.dropped != self.dropped_seen {
+            self.dropped_seen = self.reader.dropped;
             return Err(nb::Error::Other(ErrorKind::Overrun));
         }
         self.pop().ok_or(nb::Error::WouldBlock)

@@ -26,6 +26,8 @@ mod panic_reset;
 #[path = "../../firmware/src/bin/target/resets.rs"]
 mod resets;
 mod sector_flash;
+#[path = "../../firmware/src/bin/target/upload_boot.rs"]
+mod upload_boot;
 
 use defmt_rtt as _;
 
@@ -34,6 +36,7 @@ use embedded_hal_nb::serial::{Read as _, Write as _};
 use fog_core::compensator::Compensator;
 use fog_core::hal::{Gyro, TemperatureSensor};
 use fog_core::model::RbfModel;
+use fog_core::protocol::ResetRecord;
 use fog_firmware::app::{App, AppConfig};
 use fog_firmware::clock::Clock;
 use fog_firmware::drivers::fog_serial::FogSerialGyro;
@@ -260,24 +263,9 @@ fn or_reset<T, E>(r: Result<T, E>) -> T {
     r.unwrap_or_else(|_| resets::fatal_boot(BootFault::Configuration))
 }
 
-/// The upload server in a static, built in its own frame (its ~10 KB of boot
-/// temporaries are given back).
-#[inline(never)]
-fn start_upload_server(
-    flash: SectorFlash,
-    reset: fog_core::protocol::ResetRecord,
-) -> &'static mut Server {
-    let Ok(gyro_id) = heapless::String::try_from(GYRO_ID) else {
-        resets::fatal_boot(BootFault::Configuration)
-    };
-    let mut server = match UploadServer::new(flash, 0, VERIFY_KEY, gyro_id) {
-        Ok(s) => s,
-        Err(e) => {
-            defmt::error!("model store unusable: {}", e);
-            resets::fatal_boot(BootFault::StoreGeometry)
-        }
-    };
-    server.set_reset_record(reset);
+/// The upload server, in a static (`upload_boot.rs` builds it).
+fn start_upload_server(flash: SectorFlash, reset: ResetRecord) -> &'static mut Server {
+    let server = upload_boot::new_upload_server(flash, VERIFY_KEY, GYRO_ID, reset);
     let Some(server) = cortex_m::singleton!(: Server = server) else {
         resets::fatal_boot(BootFault::Singleton)
     };

@@ -2,7 +2,7 @@
 //!
 //! Everything here builds and is tested on the host; the target-only glue (runtime,
 //! UART registers, semihosting, SysTick) lives in `src/bin/`. Modules:
-//! `clock` (time for drivers), `drivers` (gyro frames, TMP117, turntable),
+//! `clock` (time for drivers), `circular_dma` (reading behind a circular DMA ring), `drivers` (gyro frames, TMP117, turntable),
 //! `app` (samples -> 10 s windows -> compensation -> north seek), `health` (stuck-sensor
 //! detection), `replay` (the QEMU
 //! replay scenario's file formats, shared with the host test).
@@ -10,6 +10,7 @@
 #![forbid(unsafe_code)]
 
 pub mod app;
+pub mod circular_dma;
 pub mod clock;
 pub mod drivers;
 pub mod health;

@@ -38,6 +38,8 @@ mod resets;
 mod semi;
 #[path = "target/uart.rs"]
 mod uart;
+#[path = "target/upload_boot.rs"]
+mod upload_boot;
 #[path = "target/watchdog.rs"]
 mod watchdog;
 
@@ -392,22 +394,9 @@ fn report<E: defmt::Format>(step: fog_firmware::app::Step<E>) {
 
 type Server = UploadServer<flash::AppFlash>;
 
-/// The upload server, in a static. Its own frame (never inlined into `main`): building it
-/// (store scan, signature re-check, decoding the active model for its identity) needs
-/// ~10 KB of temporaries, which are then given back instead of staying in `main`'s frame.
-#[inline(never)]
+/// The upload server, in a static (`upload_boot.rs` builds it).
 fn start_upload_server(flash: flash::AppFlash, reset: ResetRecord) -> &'static mut Server {
-    let Ok(gyro_id) = heapless::String::try_from(GYRO_ID) else {
-        resets::fatal_boot(BootFault::Configuration)
-    };
-    let mut server = match UploadServer::new(flash, 0, VERIFY_KEY, gyro_id) {
-        Ok(s) => s,
-        Err(e) => {
-            defmt::error!("model store unusable: {}", e);
-            resets::fatal_boot(BootFault::StoreGeometry)
-        }
-    };
-    server.set_reset_record(reset);
+    let server = upload_boot::new_upload_server(flash, VERIFY_KEY, GYRO_ID, reset);
     let Some(server) = cortex_m::singleton!(: Server = server) else {
         resets::fatal_boot(BootFault::Singleton)
     };
