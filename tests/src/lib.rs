@@ -174,6 +174,8 @@ pub struct QemuOptions {
     pub extra: Vec<String>,
     /// Working directory (semihosting file paths are relative to it).
     pub cwd: Option<PathBuf>,
+    /// QEMU machine (`None`: `QEMU_MACHINE`, mps2-an386).
+    pub machine: Option<&'static str>,
 }
 
 /// The QEMU command line for `elf`.
@@ -186,7 +188,8 @@ pub fn qemu_command(elf: &Path, opts: &QemuOptions) -> Command {
         semi.push_str(a);
     }
     let mut cmd = Command::new("qemu-system-arm");
-    cmd.args(["-machine", QEMU_MACHINE, "-cpu", "cortex-m4", "-nographic"])
+    let machine = opts.machine.unwrap_or(QEMU_MACHINE);
+    cmd.args(["-machine", machine, "-cpu", "cortex-m4", "-nographic"])
         .args(["-monitor", "none"])
         .args(["-semihosting-config", &semi]);
     if opts.icount {
