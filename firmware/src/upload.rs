@@ -190,8 +190,8 @@ impl<F: NorFlash> UploadServer<F> {
     /// that verifies and decodes is used, none if neither does.
     /// The boot report says why each slot is or is not used.
     fn select_verified_slot(&mut self) {
-        for slot in 0..2u8 {
-            self.boot_report[usize::from(slot)] = match self.store.check(slot) {
+        for (slot, verdict) in (0u8..).zip(self.boot_report.iter_mut()) {
+            *verdict = match self.store.check(slot) {
                 Ok(_) => SlotVerdict::Standby,
                 Err(defect) => SlotVerdict::Defect(defect),
             };
@@ -202,7 +202,9 @@ impl<F: NorFlash> UploadServer<F> {
             self.store.select(Some(candidate));
             let mut model = RbfModel::empty();
             let verdict = self.verify_active_into(&mut model);
-            self.boot_report[usize::from(candidate.slot)] = verdict;
+            if let Some(entry) = self.boot_report.get_mut(usize::from(candidate.slot)) {
+                *entry = verdict;
+            }
             if verdict == SlotVerdict::InUse {
                 self.active_info = Some(model_info(&candidate, &model));
                 return;
