@@ -11,7 +11,7 @@
 //!   1 Hz as the model's temperature input;
 //! - flash sectors 10 and 11: the model slots (`sector_flash`);
 //! - IWDG, 3 s, fed only while the gyro ring is drained without loss (and before each
-//!   sector erase); panics and fatal boot errors record their reason in no-init RAM and
+//!   sector erase); a silent or stuck gyro marks its windows invalid (`health`); panics and fatal boot errors record their reason in no-init RAM and
 //!   reset (the QEMU build's `resets`), reported by the next boot and in `DeviceStatus`;
 //! - SysTick at 1 kHz: the clock for timeouts and the gyro time base;
 //! - defmt over RTT; flashed and run with `cargo board-run` (probe-rs).
@@ -42,6 +42,7 @@ use fog_firmware::clock::Clock;
 use fog_firmware::drivers::fog_serial::FogSerialGyro;
 use fog_firmware::drivers::tmp117::Tmp117;
 use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig};
+use fog_firmware::health::{StuckDetector, StuckEvent, DEFAULT_STUCK_RUN};
 use fog_firmware::upload::UploadServer;
 use resets::BootFault;
 use stm32f4xx_hal::i2c::I2c;
@@ -184,6 +185,7 @@ fn main() -> ! {
     let mut last_sample_clock_s: Option<f64> = None;
     let mut last_t_s = 0.0;
     let mut gyro_silent = false;
+    let mut stuck = StuckDetector::new(DEFAULT_STUCK_RUN);
 
     loop {
         let now_s = millis::MillisClock.now_s();
@@ -194,6 +196,14 @@ fn main() -> ! {
                     last_t_s = s.t_s;
                     last_sample_clock_s = Some(now_s);
                     gyro_silent = false;
+                    match stuck.push(s.rate_dph) {
+                        Some(StuckEvent::Stuck) => defmt::warn!("t={} s: gyro stuck", s.t_s),
+                        Some(StuckEvent::Recovered) => defmt::info!("t={} s: gyro moving", s.t_s),
+                        None => {}
+                    }
+                    if stuck.is_stuck() {
+                        app.on_fault(s.t_s);
+                    }
                     if app.temp_due(s.t_s) {
                         let reading = tmp117.as_mut().and_then(|t| t.read_temp().ok());
                         app.on_temp(s.t_s, reading);
