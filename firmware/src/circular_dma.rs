@@ -6,8 +6,8 @@
 //! mode); its half- and full-transfer interrupts each count one half lap. The total
 //! written is `half laps x half + position in the half`, corrected for a half boundary
 //! the DMA has crossed but whose interrupt has not run yet. The reader keeps its own
-//! total; falling a whole ring behind is an overrun: it skips to the newest half ring
-//! (which the DMA is not writing) and counts what it skipped.
+//! total; falling (nearly) a whole ring behind is an overrun: it skips to the newest
+//! half ring (which the DMA is not writing) and counts what it skipped.
 
 /// Total bytes the DMA has written into a `len`-byte ring (`len` even), from the
 /// half laps its interrupts counted and the NDTR register read after them (the caller
@@ -35,8 +35,10 @@ pub struct RingReader {
 
 impl RingReader {
     /// Bytes waiting, given the DMA's total `written`; skips ahead after an overrun.
+    /// A reader within `len / 8` bytes of being lapped counts as overrun too: the byte
+    /// it would read next could be overwritten between this check and the read.
     pub fn catch_up(&mut self, written: u32, len: u32) -> u32 {
-        if written.wrapping_sub(self.read) >= len {
+        if written.wrapping_sub(self.read) >= len - len / 8 {
             let resume = written.wrapping_sub(len / 2);
             self.dropped = self.dropped.wrapping_add(resume.wrapping_sub(self.read));
             self.read = resume;
