@@ -13,11 +13,14 @@
 //! - IWDG, 3 s, fed only while the gyro ring is drained without loss (and before each
 //!   sector erase); a silent or stuck gyro marks its windows invalid (`health`); panics and fatal boot errors record their reason in no-init RAM and
 //!   reset (the QEMU build's `resets`), reported by the next boot and in `DeviceStatus`;
+//! - clocks: 168 MHz from the 8 MHz crystal, or from the internal RC oscillator if the
+//!   crystal does not start within 100 ms (`clocks`);
 //! - SysTick at 1 kHz: the clock for timeouts and the gyro time base;
 //! - defmt over RTT; flashed and run with `cargo board-run` (probe-rs).
 #![no_std]
 #![no_main]
 
+mod clocks;
 mod dma_ring;
 #[path = "../../firmware/src/bin/target/millis.rs"]
 mod millis;
@@ -48,15 +51,12 @@ use resets::BootFault;
 use stm32f4xx_hal::i2c::I2c;
 use stm32f4xx_hal::pac::{self, interrupt, Interrupt};
 use stm32f4xx_hal::prelude::*;
-use stm32f4xx_hal::rcc::Config as ClockConfig;
 use stm32f4xx_hal::watchdog::IndependentWatchdog;
 
+use clocks::ClockSource;
 use dma_ring::{DmaRx, DmaSerial, Ring, USART1_RX, USART2_RX, USART3_RX};
 use sector_flash::SectorFlash;
 
-/// Core clock from the 8 MHz crystal through the PLL, Hz.
-const CORE_HZ: u32 = 168_000_000;
-const HSE_HZ: u32 = 8_000_000;
 const GYRO_RATE_HZ: u32 = 2000;
 const HOST_BAUD: u32 = 115_200;
 const GYRO_BAUD: u32 = 460_800;
@@ -95,15 +95,16 @@ fn main() -> ! {
     let (Some(cp), Some(dp)) = (cortex_m::Peripherals::take(), pac::Peripherals::take()) else {
         resets::fatal_boot(BootFault::CorePeripherals)
     };
-    let mut rcc = dp.RCC.freeze(
-        ClockConfig::hse(HSE_HZ.Hz())
-            .sysclk(CORE_HZ.Hz())
-            .pclk1(42.MHz())
-            .pclk2(84.MHz()),
-    );
-    millis::start_millis(cp.SYST, CORE_HZ);
+    // The watchdog first: it runs from its own oscillator, so a clock set-up that never
+    // finishes (a PLL that does not lock) resets the chip instead of hanging it.
     let mut watchdog = IndependentWatchdog::new(dp.IWDG);
     watchdog.start(WATCHDOG_MS.millis());
+    let (clock_config, clock_source) = clocks::choose();
+    if clock_source == ClockSource::InternalRc {
+        defmt::warn!("crystal did not start: PLL from the internal RC oscillator");
+    }
+    let mut rcc = dp.RCC.freeze(clock_config);
+    millis::start_millis(cp.SYST, clocks::CORE_HZ);
 
     let gpioa = dp.GPIOA.split(&mut rcc);
     let gpiob = dp.GPIOB.split(&mut rcc);

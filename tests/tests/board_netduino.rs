@@ -3,26 +3,43 @@
 //!
 //! QEMU models that machine's USARTs, timers, SPI, ADC, SYSCFG and EXTI, and maps RCC,
 //! the flash interface, IWDG, I2C, DMA and GPIO as unimplemented (reads 0, writes
-//! ignored: `info mtree`, `-d unimp`). So the image boots from 0x0800_0000 (reset
-//! vector, RAM init, `main`), reads the reset record, and the HAL's clock set-up writes
-//! the real 168 MHz configuration, then waits for ever for the crystal (RCC_CR.HSERDY
-//! never sets). This test checks that boot and the clock tree the firmware programs
-//! (PLL from the 8 MHz crystal: 168 MHz core, 48 MHz USB/SDIO clock; 5 flash wait
-//! states with prefetch and caches), and that QEMU saw no guest error on the way.
-//! Everything after the clock set-up (UART DMA, TMP117, flash store, IWDG) is not run
-//! by QEMU; the DMA ring arithmetic is tested on the host (board_dma_ring.rs).
+//! ignored: `info mtree`, `-d unimp`, which logs every access to them). So the image
+//! boots from 0x0800_0000 (reset vector, RAM init, `main`, reset record), starts the
+//! IWDG (3 s), tries the crystal with a bounded wait (HSERDY never sets in QEMU), gives
+//! it up, programs the PLL from the internal RC oscillator for 168 MHz, and then waits
+//! for PLLRDY, which QEMU never sets either (on a chip the running IWDG would reset it).
+//! This test checks that sequence from the register writes: the watchdog period, the
+//! crystal attempt being bounded, the clock tree (168 MHz core, 48 MHz USB clock, 5 flash
+//! wait states with prefetch and caches), and that QEMU saw no guest error. Everything
+//! after the clock set-up (UART DMA, TMP117, flash store) is not run by QEMU; the DMA
+//! ring arithmetic is tested on the host (board_dma_ring.rs).
 
 use std::io::{BufRead, BufReader};
 use std::time::{Duration, Instant};
 
 use fog_tests::{build_board_elf, qemu_ready, spawn_qemu, QemuOptions};
 
-const RCC_CR_OFFSET: u32 = 0x000;
-const RCC_PLLCFGR_OFFSET: u32 = 0x004;
-const HSE_HZ: f64 = 8e6;
+const HSI_HZ: f64 = 16e6;
+const LSI_HZ: f64 = 32e3;
+/// CR reads the firmware may spend on the crystal (320,000 polls, +1 to clear HSEON).
+const HSE_POLL_LIMIT: usize = 320_001;
+/// CR polls after PLLON that show the PLL wait does not end.
+const PLL_WAIT_POLLS: usize = 100_000;
+
+/// One access logged by `-d unimp`.
+#[derive(Debug, PartialEq)]
+enum Access {
+    Write {
+        device: String,
+        offset: u32,
+        value: u32,
+    },
+    /// A read of RCC_CR (the oscillator and PLL ready flags).
+    RccCrPoll,
+}
 
 /// `(device, offset, value)` of an "unimplemented device write" line of `-d unimp`.
-fn unimp_write(line: &str) -> Option<(String, u32, u32)> {
+fn unimp_write(line: &str) -> Option<Access> {
     let (device, rest) = line.split_once(": unimplemented device write")?;
     let field = |name: &str| {
         let at = rest.find(name)? + name.len();
@@ -34,7 +51,31 @@ fn unimp_write(line: &str) -> Option<(String, u32, u32)> {
             .collect();
         u32::from_str_radix(&text, 16).ok()
     };
-    Some((device.trim().to_string(), field("offset")?, field("value")?))
+    Some(Access::Write {
+        device: device.trim().to_string(),
+        offset: field("offset")?,
+        value: field("value")?,
+    })
+}
+
+/// Index and value of the first write to `device` (one of the names) at `offset`
+/// matching `pred`.
+fn find_write(
+    log: &[Access],
+    devices: &[&str],
+    at: u32,
+    pred: impl Fn(u32) -> bool,
+) -> Option<(usize, u32)> {
+    log.iter().enumerate().find_map(|(i, a)| match a {
+        Access::Write {
+            device,
+            offset,
+            value,
+        } if devices.contains(&device.as_str()) && *offset == at && pred(*value) => {
+            Some((i, *value))
+        }
+        _ => None,
+    })
 }
 
 #[test]
@@ -50,54 +91,87 @@ fn board_binary_boots_on_netduinoplus2_up_to_the_clock_setup() {
     };
     let mut qemu = spawn_qemu(&elf, &opts).expect("start QEMU");
     let stderr = qemu.0.stderr.take().expect("piped");
-    let mut writes = Vec::new();
-    let mut cr_polls = 0u32;
+    let mut log = Vec::new();
     let mut guest_errors = Vec::new();
-    let deadline = Instant::now() + Duration::from_secs(20);
+    let mut polls_since_write = 0;
+    let mut pll_on_seen = false;
+    let deadline = Instant::now() + Duration::from_secs(30);
     for line in BufReader::new(stderr).lines() {
         let Ok(line) = line else { break };
         if let Some(w) = unimp_write(&line) {
-            writes.push(w);
+            if let Access::Write {
+                device,
+                offset: 0,
+                value,
+            } = &w
+            {
+                pll_on_seen |= device == "RCC" && value & (1 << 24) != 0;
+            }
+            log.push(w);
+            polls_since_write = 0;
         } else if line.starts_with("RCC: unimplemented device read  (size 4, offset 0x000)") {
-            cr_polls += 1;
+            log.push(Access::RccCrPoll);
+            polls_since_write += 1;
         } else if !line.contains("unimplemented device read") {
             guest_errors.push(line);
         }
-        if cr_polls >= 10_000 || Instant::now() > deadline {
+        // Past the crystal wait and stuck on the PLL: done.
+        if (pll_on_seen && polls_since_write > PLL_WAIT_POLLS) || Instant::now() > deadline {
             break;
         }
     }
     drop(qemu);
     assert!(guest_errors.is_empty(), "QEMU reported {guest_errors:#?}");
-    let rcc = |offset| {
-        writes
-            .iter()
-            .find(|(d, o, _)| d == "RCC" && *o == offset)
-            .map(|w| w.2)
-    };
-    let pllcfgr = rcc(RCC_PLLCFGR_OFFSET).expect("PLLCFGR written");
+
+    // IWDG (QEMU names its unimplemented region IWDG or I2S2ext): prescaler, reload,
+    // start, before any clock register is touched.
+    let iwdg = ["IWDG", "I2S2ext"];
+    let (start_at, _) = find_write(&log, &iwdg, 0x0, |v| v == 0xCCCC).expect("IWDG started");
+    let (_, pr) = find_write(&log, &iwdg, 0x4, |_| true).expect("IWDG prescaler");
+    let (_, rlr) = find_write(&log, &iwdg, 0x8, |_| true).expect("IWDG reload");
+    let period_s = f64::from(rlr) * f64::from(4u32 << pr) / LSI_HZ;
+    assert!((2.9..=3.1).contains(&period_s), "IWDG period {period_s} s");
+
+    // The crystal: HSEON, a bounded wait, HSEON cleared.
+    let (hse_on, _) = find_write(&log, &["RCC"], 0x0, |v| v == 1 << 16).expect("HSEON");
+    let (hse_off, _) = find_write(&log, &["RCC"], 0x0, |v| v & (1 << 16) == 0).expect("HSE off");
+    assert!(
+        start_at < hse_on && hse_on < hse_off,
+        "IWDG, then HSEON, then HSE off"
+    );
+    let waited = log[hse_on..hse_off]
+        .iter()
+        .filter(|a| **a == Access::RccCrPoll)
+        .count();
+    assert!(
+        (1_000..=HSE_POLL_LIMIT).contains(&waited),
+        "crystal wait bounded: {waited} polls"
+    );
+
+    // The PLL from the internal RC oscillator: 168 MHz core, 48 MHz USB clock.
+    let (_, pllcfgr) = find_write(&log, &["RCC"], 0x4, |_| true).expect("PLLCFGR written");
+    assert_eq!(pllcfgr & (1 << 22), 0, "PLL source: HSI");
     let (m, n) = (pllcfgr & 0x3F, (pllcfgr >> 6) & 0x1FF);
     let p = 2 * (((pllcfgr >> 16) & 0b11) + 1);
     let q = (pllcfgr >> 24) & 0xF;
-    assert_ne!(pllcfgr & (1 << 22), 0, "PLL source: the crystal (HSE)");
-    let vco_hz = HSE_HZ / f64::from(m) * f64::from(n);
+    let vco_hz = HSI_HZ / f64::from(m) * f64::from(n);
     assert_eq!(
         vco_hz / f64::from(p),
         168e6,
-        "core clock from PLLCFGR {pllcfgr:#x}"
+        "core clock, PLLCFGR {pllcfgr:#x}"
     );
     assert_eq!(vco_hz / f64::from(q), 48e6, "USB/SDIO clock");
-    let acr = writes
-        .iter()
-        .find(|(d, o, _)| d == "Flash Int" && *o == 0)
-        .map(|w| w.2)
-        .expect("flash ACR written");
+    let (_, acr) = find_write(&log, &["Flash Int"], 0x0, |_| true).expect("flash ACR");
     assert_eq!(acr & 0xF, 5, "5 wait states at 168 MHz, 2.7-3.6 V");
     assert_eq!(
         acr & 0x700,
         0x700,
         "prefetch, instruction and data caches on"
     );
-    assert_eq!(rcc(RCC_CR_OFFSET), Some(1 << 16), "HSEON, then");
-    assert!(cr_polls >= 10_000, "waiting for HSERDY ({cr_polls} polls)");
+    let (pll_on, _) = find_write(&log, &["RCC"], 0x0, |v| v & (1 << 24) != 0).expect("PLLON");
+    assert!(pll_on > hse_off);
+    assert!(
+        polls_since_write > PLL_WAIT_POLLS,
+        "then waits for PLLRDY (which QEMU never sets)"
+    );
 }
