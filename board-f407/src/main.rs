@@ -164,7 +164,11 @@ fn main() -> ! {
     };
 
     // SAFETY: the model sectors are taken once, here.
-    let server = start_upload_server(unsafe { SectorFlash::take() }, reset);
+    let Some(model_flash) = (unsafe { SectorFlash::take() }) else {
+        defmt::error!("memory.x MODELS region is not flash sectors 10-11");
+        resets::fatal_boot(BootFault::StoreGeometry)
+    };
+    let server = start_upload_server(model_flash, reset);
     let stored = server.load_active_model_into(model).unwrap_or_else(|e| {
         defmt::warn!("stored model not loaded ({}): running uncompensated", e);
         false

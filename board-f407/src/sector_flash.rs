@@ -44,8 +44,9 @@ const CR_STRT: u32 = 1 << 16;
 const CR_LOCK: u32 = 1 << 31;
 const ACR_DCEN: u32 = 1 << 10;
 const ACR_DCRST: u32 = 1 << 12;
-/// Sector of `_models_start` (0x080C_0000 on a 1 MiB F407).
+/// Sector of `_models_start`, and its address on a 1 MiB F407.
 const FIRST_SECTOR: u32 = 10;
+const FIRST_SECTOR_ADDR: usize = 0x080C_0000;
 const SECTOR_LEN: usize = 128 * 1024;
 /// IWDG key register: writing 0xAAAA reloads the counter.
 const IWDG_KR: usize = 0x4000_3000;
@@ -90,15 +91,18 @@ pub struct SectorFlash {
 }
 
 impl SectorFlash {
+    /// The model sectors, or `None` if the linker's `MODELS` region is not exactly
+    /// sectors 10-11 (a changed memory.x must never make an erase hit the code).
+    ///
     /// # Safety
     /// Only one `SectorFlash` may exist, and nothing else may use the flash controller.
-    pub unsafe fn take() -> Self {
+    pub unsafe fn take() -> Option<Self> {
         let base = addr_of!(_models_start) as usize;
         let end = addr_of!(_models_end) as usize;
-        Self {
+        (base == FIRST_SECTOR_ADDR && end == FIRST_SECTOR_ADDR + 2 * SECTOR_LEN).then_some(Self {
             base,
             len: end - base,
-        }
+        })
     }
 
     /// Runs `op` with the controller unlocked, then waits, checks and locks it again.
