@@ -98,6 +98,8 @@ fn main() -> ! {
     // The watchdog first: it runs from its own oscillator, so a clock set-up that never
     // finishes (a PLL that does not lock) resets the chip instead of hanging it.
     let mut watchdog = IndependentWatchdog::new(dp.IWDG);
+    // Paused while a debug probe halts the core (probe-rs breakpoints, RTT reads).
+    watchdog.stop_on_debug(&dp.DBGMCU, true);
     watchdog.start(WATCHDOG_MS.millis());
     let (clock_config, clock_source) = clocks::choose();
     if clock_source == ClockSource::InternalRc {
