@@ -7,11 +7,14 @@ cd "$(dirname "$0")/.."
 out="$PWD/docs/budgets.md"
 table="$(mktemp)"
 stack="$(mktemp)"
-trap 'rm -f "$table" "$stack"' EXIT
+board="$(mktemp)"
+trap 'rm -f "$table" "$stack" "$board"' EXIT
 FOG_REQUIRE_QEMU=1 FOG_BUDGETS_OUT="$table" \
     cargo test -p fog-tests --test fw_budgets -- --nocapture
 FOG_REQUIRE_QEMU=1 FOG_BUDGETS_STACK_OUT="$stack" \
     cargo test -p fog-tests --test qemu_replay -- --nocapture
+FOG_REQUIRE_QEMU=1 FOG_BUDGETS_BOARD_OUT="$board" \
+    cargo test -p fog-tests --test board_budgets -- --nocapture
 # Hand-written notes below the table (from the marker on) are kept.
 notes="$(sed -n '/<!-- notes:begin -->/,$p' "$out" 2>/dev/null || true)"
 {
@@ -21,7 +24,7 @@ notes="$(sed -n '/<!-- notes:begin -->/,$p' "$out" 2>/dev/null || true)"
     echo "(\`cargo test -p fog-tests --test fw_budgets\` and \`--test qemu_replay\`; firmware profile \`fw\`, QEMU"
     echo "\`mps2-an386\` with \`-icount shift=0\`: instruction counts, not cycles)."
     echo
-    cat "$table" "$stack"
+    cat "$table" "$stack" "$board"
     if [ -n "$notes" ]; then
         echo
         echo "$notes"
@@ -32,7 +35,7 @@ echo "wrote $out"
 # The README carries the same table between its budget markers.
 readme="$PWD/README.md"
 if grep -q '<!-- budgets:begin -->' "$readme"; then
-    python3 - "$readme" "$table" "$stack" <<'PY'
+    python3 - "$readme" "$table" "$stack" "$board" <<'PY'
 import sys
 readme, parts = sys.argv[1], sys.argv[2:]
 text = open(readme).read()

@@ -2,9 +2,9 @@
 //!
 //! Everything here builds and is tested on the host; the target-only glue (runtime,
 //! UART registers, semihosting, SysTick) lives in `src/bin/`. Modules:
-//! `clock` (time for drivers), `drivers` (gyro frames, TMP117, turntable, inclinometer),
-//! `bit_monitor` (the BIT word from the firmware's counters), `link_out` (status and
-//! result frames on the host port),
+//! `clock` (time for drivers), `circular_dma` (reading behind a circular DMA ring),
+//! `drivers` (gyro frames, TMP117, turntable, inclinometer), `bit_monitor` (the BIT word
+//! from the firmware's counters), `link_out` (status and result frames on the host port),
 //! `app` (samples -> 10 s windows -> compensation -> north seek), `health` (stuck-sensor
 //! detection), `replay` (the QEMU
 //! replay scenario's file formats, shared with the host test).
@@ -13,6 +13,7 @@
 
 pub mod app;
 pub mod bit_monitor;
+pub mod circular_dma;
 pub mod clock;
 pub mod drivers;
 pub mod health;

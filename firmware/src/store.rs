@@ -22,6 +22,7 @@
 //! version and CRC, and a body matching its CRC: every torn erase or write fails one
 //! of these, so boot falls back to the other slot, which was never touched.
 
+pub mod mirrored;
 pub mod ram_flash;
 
 use embedded_storage::nor_flash::NorFlash;
@@ -74,6 +75,34 @@ impl core::fmt::Display for StoreError {
             Self::SequenceExhausted => write!(f, "slot sequence counter exhausted"),
             Self::BufferTooSmall => write!(f, "buffer shorter than the stored model"),
         }
+    }
+}
+
+/// Why a slot holds no usable model (what `ModelStore::check` found).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum SlotDefect {
+    /// Erased: never written (not a fault).
+    Empty,
+    /// No complete commit marker: a commit was cut before its end, or the marker decayed.
+    Incomplete,
+    /// Committed, but the header's magic, version, CRC or length is wrong.
+    HeaderCorrupt,
+    /// Header intact, but the model bytes do not match its CRC-32.
+    BodyCorrupt,
+    /// The flash could not be read.
+    Unreadable,
+}
+
+impl core::fmt::Display for SlotDefect {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Self::Empty => "empty",
+            Self::Incomplete => "incomplete commit (no commit marker)",
+            Self::HeaderCorrupt => "header corrupt (magic, version, CRC or length)",
+            Self::BodyCorrupt => "model bytes do not match the header CRC-32",
+            Self::Unreadable => "flash read failed",
+        })
     }
 }
 
@@ -319,28 +348,45 @@ impl<F: NorFlash> ModelStore<F> {
 
     /// The header of `slot` if the slot is complete and intact (marker, header, body CRC).
     fn read_slot(&mut self, slot: u8) -> Option<SlotHeader> {
-        let base = self.slot_base(slot);
+        self.check(slot).ok()
+    }
+
+    /// The header of `slot` (0 = A, 1 = B) if it is complete and intact, else what is
+    /// wrong with it (the boot report). Reads only; the active slot is unchanged.
+    pub fn check(&mut self, slot: u8) -> Result<SlotHeader, SlotDefect> {
+        let base = self.slot_base(slot.min(1));
         let mut marker = [0u8; MARKER_LEN];
+        let mut raw = [0u8; HEADER_LEN];
         self.flash
             .read(base + MARKER_OFFSET as u32, &mut marker)
-            .ok()?;
+            .and_then(|()| self.flash.read(base, &mut raw))
+            .map_err(|_| SlotDefect::Unreadable)?;
         if marker != COMMIT_MARKER {
-            return None;
+            let erased = marker.iter().chain(&raw).all(|&b| b == 0xFF);
+            return Err(if erased {
+                SlotDefect::Empty
+            } else {
+                SlotDefect::Incomplete
+            });
         }
-        let mut raw = [0u8; HEADER_LEN];
-        self.flash.read(base, &mut raw).ok()?;
-        let header = SlotHeader::from_bytes(&raw)?;
+        let header = SlotHeader::from_bytes(&raw).ok_or(SlotDefect::HeaderCorrupt)?;
         let mut digest = CRC32.digest();
         let mut piece = [0u8; 64];
         let mut at = base + BODY_OFFSET as u32;
         let mut left = header.model_len as usize;
         while left > 0 {
             let n = left.min(piece.len());
-            self.flash.read(at, &mut piece[..n]).ok()?;
+            self.flash
+                .read(at, &mut piece[..n])
+                .map_err(|_| SlotDefect::Unreadable)?;
             digest.update(&piece[..n]);
             at += n as u32;
             left -= n;
         }
-        (digest.finalize() == header.model_crc32).then_some(header)
+        if digest.finalize() == header.model_crc32 {
+            Ok(header)
+        } else {
+            Err(SlotDefect::BodyCorrupt)
+        }
     }
 }

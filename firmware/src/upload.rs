@@ -35,7 +35,7 @@ use fog_core::protocol::{
 use heapless::String;
 
 use crate::signature::verify_model;
-use crate::store::{ActiveSlot, ModelStore, StoreError};
+use crate::store::{ActiveSlot, ModelStore, SlotDefect, StoreError};
 
 /// What one received frame produced: an upload response to send back, whether the active
 /// model just changed (then call [`UploadServer::load_active_model`] and swap it into the
@@ -65,6 +65,46 @@ impl core::fmt::Display for LoadError {
             Self::UploadInProgress => write!(f, "an upload is in progress"),
             Self::Store(e) => write!(f, "model store: {e}"),
             Self::Model(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+/// What the boot check found in one slot (`UploadServer::boot_report`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum SlotVerdict {
+    /// Intact, signature verified, decoded for this gyro: the model in use.
+    InUse,
+    /// Intact (marker, header and body CRC) but not the model in use; its signature
+    /// is not re-checked while the other slot verifies.
+    Standby,
+    /// Not usable as stored (`SlotDefect::Empty` for a slot never written).
+    Defect(SlotDefect),
+    /// Intact, but the signature does not verify with this build's key.
+    SignatureInvalid,
+    /// Signed and intact, but a model this build cannot decode or for another gyro.
+    ModelRefused,
+}
+
+impl SlotVerdict {
+    /// A slot that holds something but was refused (an empty slot is not refused).
+    pub fn refused(self) -> bool {
+        !matches!(
+            self,
+            Self::InUse | Self::Standby | Self::Defect(SlotDefect::Empty)
+        )
+    }
+}
+
+impl core::fmt::Display for SlotVerdict {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::InUse => f.write_str("in use"),
+            Self::Standby => f.write_str("standby (intact, older)"),
+            Self::Defect(SlotDefect::Empty) => f.write_str("empty"),
+            Self::Defect(d) => write!(f, "refused: {d}"),
+            Self::SignatureInvalid => f.write_str("refused: signature does not verify"),
+            Self::ModelRefused => f.write_str("refused: not a model for this build and gyro"),
         }
     }
 }
@@ -104,6 +144,7 @@ pub struct UploadServer<F> {
     frame_bytes: usize,
     last_reset: ResetRecord,
     slots_refused_at_boot: u8,
+    boot_report: [SlotVerdict; 2],
 }
 
 #[derive(Clone, Copy, Default)]
@@ -145,6 +186,7 @@ impl<F: NorFlash> UploadServer<F> {
             frame_bytes: 0,
             last_reset: ResetRecord::POWER_ON,
             slots_refused_at_boot: 0,
+            boot_report: [SlotVerdict::Defect(SlotDefect::Empty); 2],
         };
         server.select_verified_slot();
         Ok(server)
@@ -152,13 +194,24 @@ impl<F: NorFlash> UploadServer<F> {
 
     /// Re-checks the active slot's signature (and then the other slot's): the first
     /// that verifies and decodes is used, none if neither does.
+    /// The boot report says why each slot is or is not used.
     fn select_verified_slot(&mut self) {
+        for (slot, verdict) in (0u8..).zip(self.boot_report.iter_mut()) {
+            *verdict = match self.store.check(slot) {
+                Ok(_) => SlotVerdict::Standby,
+                Err(defect) => SlotVerdict::Defect(defect),
+            };
+        }
         let first = self.store.active().copied();
         let second = self.store.inactive();
         for candidate in [first, second].into_iter().flatten() {
             self.store.select(Some(candidate));
             let mut model = RbfModel::empty();
-            if self.verify_active_into(&mut model) {
+            let verdict = self.verify_active_into(&mut model);
+            if let Some(entry) = self.boot_report.get_mut(usize::from(candidate.slot)) {
+                *entry = verdict;
+            }
+            if verdict == SlotVerdict::InUse {
                 self.active_info = Some(model_info(&candidate, &model));
                 return;
             }
@@ -169,22 +222,33 @@ impl<F: NorFlash> UploadServer<F> {
     }
 
     /// Reads the active slot, checks its signature for this gyro and decodes it.
-    fn verify_active_into(&mut self, model: &mut RbfModel) -> bool {
+    fn verify_active_into(&mut self, model: &mut RbfModel) -> SlotVerdict {
         let Some(slot) = self.store.active().copied() else {
-            return false;
+            return SlotVerdict::Defect(SlotDefect::Empty);
         };
         let Some(prefix) = signed_prefix(slot.header.security_counter, &self.gyro_id) else {
-            return false;
+            return SlotVerdict::ModelRefused;
         };
         let (head, body) = self.buf.split_at_mut(SIGNED_PREFIX_LEN);
         head.copy_from_slice(&prefix);
         let Ok(Some(bytes)) = self.store.read_active(body) else {
-            return false;
+            return SlotVerdict::Defect(SlotDefect::Unreadable);
         };
         let len = SIGNED_PREFIX_LEN + bytes.len();
-        verify_model(&self.public_key, &self.buf[..len], &slot.header.signature).is_ok()
-            && model.decode_into(&self.buf[SIGNED_PREFIX_LEN..len]).is_ok()
-            && model.meta.gyro_id == self.gyro_id
+        if verify_model(&self.public_key, &self.buf[..len], &slot.header.signature).is_err() {
+            return SlotVerdict::SignatureInvalid;
+        }
+        let decoded = model.decode_into(&self.buf[SIGNED_PREFIX_LEN..len]).is_ok();
+        if decoded && model.meta.gyro_id == self.gyro_id {
+            SlotVerdict::InUse
+        } else {
+            SlotVerdict::ModelRefused
+        }
+    }
+
+    /// What the boot check found in slot A and slot B.
+    pub fn boot_report(&self) -> [SlotVerdict; 2] {
+        self.boot_report
     }
 
     /// Slots whose signature did not verify at boot (0 normally).

@@ -7,6 +7,8 @@
 //! sets `FOG_REQUIRE_QEMU=1`, in which case they fail: CI sets it, a laptop without QEMU
 //! still runs every host test.
 
+pub mod console;
+
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
@@ -97,7 +99,33 @@ pub fn firmware_target_dir() -> PathBuf {
 /// cargo's own lock of the target directory.
 pub fn build_firmware() -> Result<PathBuf, String> {
     static BUILT: OnceLock<Mutex<Option<Result<PathBuf, String>>>> = OnceLock::new();
-    let cell = BUILT.get_or_init(|| Mutex::new(None));
+    build_target_once(
+        &BUILT,
+        &[
+            "-p",
+            "fog-firmware",
+            "--bins",
+            "--features",
+            "log-semihosting,test-key",
+        ],
+    )
+}
+
+/// Build the STM32F407 board binary (`board-f407/`, profile `fw`, TEST key: the CI
+/// build) once per test process; returns the path of its ELF.
+pub fn build_board_elf() -> Result<PathBuf, String> {
+    static BUILT: OnceLock<Mutex<Option<Result<PathBuf, String>>>> = OnceLock::new();
+    build_target_once(&BUILT, &["-p", "fog-board-f407", "--features", "test-key"])
+        .map(|dir| dir.join("f407-app"))
+}
+
+/// `cargo build --profile fw --target FW_TARGET <args>` into `firmware_target_dir()`,
+/// once per `cell`; the directory holding the artefacts.
+fn build_target_once(
+    cell: &OnceLock<Mutex<Option<Result<PathBuf, String>>>>,
+    args: &[&str],
+) -> Result<PathBuf, String> {
+    let cell = cell.get_or_init(|| Mutex::new(None));
     let mut guard = cell.lock().unwrap_or_else(|e| e.into_inner());
     if let Some(done) = guard.as_ref() {
         return done.clone();
@@ -105,20 +133,8 @@ pub fn build_firmware() -> Result<PathBuf, String> {
     let target_dir = firmware_target_dir();
     let out = Command::new(cargo())
         .current_dir(workspace_root())
-        .args([
-            "build",
-            "-p",
-            "fog-firmware",
-            "--profile",
-            FW_PROFILE,
-            "--bins",
-        ])
-        .args([
-            "--target",
-            FW_TARGET,
-            "--features",
-            "log-semihosting,test-key",
-        ])
+        .args(["build", "--profile", FW_PROFILE, "--target", FW_TARGET])
+        .args(args)
         .arg("--target-dir")
         .arg(&target_dir)
         .env_remove("CARGO_TARGET_DIR")
@@ -129,7 +145,7 @@ pub fn build_firmware() -> Result<PathBuf, String> {
             Ok(target_dir.join(FW_TARGET).join(FW_PROFILE))
         } else {
             Err(format!(
-                "firmware build failed ({}):\n{}",
+                "firmware build {args:?} failed ({}):\n{}",
                 o.status,
                 String::from_utf8_lossy(&o.stderr)
             ))
@@ -158,6 +174,8 @@ pub struct QemuOptions {
     pub extra: Vec<String>,
     /// Working directory (semihosting file paths are relative to it).
     pub cwd: Option<PathBuf>,
+    /// QEMU machine (`None`: `QEMU_MACHINE`, mps2-an386).
+    pub machine: Option<&'static str>,
 }
 
 /// The QEMU command line for `elf`.
@@ -170,7 +188,8 @@ pub fn qemu_command(elf: &Path, opts: &QemuOptions) -> Command {
         semi.push_str(a);
     }
     let mut cmd = Command::new("qemu-system-arm");
-    cmd.args(["-machine", QEMU_MACHINE, "-cpu", "cortex-m4", "-nographic"])
+    let machine = opts.machine.unwrap_or(QEMU_MACHINE);
+    cmd.args(["-machine", machine, "-cpu", "cortex-m4", "-nographic"])
         .args(["-monitor", "none"])
         .args(["-semihosting-config", &semi]);
     if opts.icount {
@@ -270,8 +289,16 @@ pub struct FirmwareSize {
     pub static_ram: u64,
 }
 
-/// Measure an ELF's flash and static RAM with `llvm-size -A` (sysV: per section).
-pub fn firmware_size(elf: &Path) -> Result<FirmwareSize, String> {
+/// One allocated section of an ELF: name, size and address (bytes).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Section {
+    pub name: String,
+    pub size: u64,
+    pub addr: u64,
+}
+
+/// The sections of `elf` (`llvm-size -A`, sysV format: one per line).
+pub fn elf_sections(elf: &Path) -> Result<Vec<Section>, String> {
     let tool = llvm_tool("llvm-size")?;
     let out = Command::new(&tool)
         .arg("-A")
@@ -281,22 +308,32 @@ pub fn firmware_size(elf: &Path) -> Result<FirmwareSize, String> {
     if !out.status.success() {
         return Err(String::from_utf8_lossy(&out.stderr).into_owned());
     }
+    Ok(String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter_map(|line| {
+            let mut it = line.split_whitespace();
+            let name = it.next()?.to_string();
+            let size = it.next()?.parse().ok()?;
+            let addr = it.next()?.parse().ok()?;
+            Some(Section { name, size, addr })
+        })
+        .collect())
+}
+
+/// Measure an ELF's flash and static RAM with `llvm-size -A` (sysV: per section).
+pub fn firmware_size(elf: &Path) -> Result<FirmwareSize, String> {
     let mut size = FirmwareSize {
         flash: 0,
         static_ram: 0,
     };
-    for line in String::from_utf8_lossy(&out.stdout).lines() {
-        let mut it = line.split_whitespace();
-        let (Some(name), Some(Ok(bytes))) = (it.next(), it.next().map(str::parse::<u64>)) else {
-            continue;
-        };
-        match name {
-            ".vector_table" | ".text" | ".rodata" => size.flash += bytes,
+    for s in elf_sections(elf)? {
+        match s.name.as_str() {
+            ".vector_table" | ".text" | ".rodata" => size.flash += s.size,
             ".data" => {
-                size.flash += bytes;
-                size.static_ram += bytes;
+                size.flash += s.size;
+                size.static_ram += s.size;
             }
-            ".bss" | ".uninit" => size.static_ram += bytes,
+            ".bss" | ".uninit" => size.static_ram += s.size,
             _ => {}
         }
     }

@@ -12,7 +12,7 @@ use fog_core::protocol::{
     SESSION_IDLE_TIMEOUT_S,
 };
 use fog_firmware::store::EmulatedModelFlash;
-use fog_firmware::upload::UploadServer;
+use fog_firmware::upload::{SlotVerdict, UploadServer};
 use fog_sim::upload::{key_from_seed, ClientError};
 use upload_support::*;
 
@@ -157,11 +157,16 @@ fn slot_signatures_are_rechecked_at_boot() {
         UploadServer::new(flash.clone(), 0, other_key, TEST_GYRO.try_into().unwrap()).unwrap();
     assert_eq!(strict.active_info(), None);
     assert_eq!(strict.slots_refused_at_boot(), 2);
+    assert_eq!(strict.boot_report(), [SlotVerdict::SignatureInvalid; 2]);
     // Newest slot's signature corrupted in flash (header CRC fixed up as an attacker
     // with flash access would): boot falls back to the older, authentic slot.
     let tampered = tamper_newest_signature(flash);
     let server = reboot(tampered);
     assert_eq!(server.slots_refused_at_boot(), 1);
+    assert_eq!(
+        server.boot_report(),
+        [SlotVerdict::InUse, SlotVerdict::SignatureInvalid]
+    );
     assert_eq!(server.active_info(), Some(&info_a));
 }
 

@@ -31,6 +31,9 @@
 
 #[path = "target/flash.rs"]
 mod flash;
+#[cfg(feature = "log-semihosting")]
+#[path = "target/flash_file.rs"]
+mod flash_file;
 #[path = "target/millis.rs"]
 mod millis;
 #[path = "target/panic_reset.rs"]
@@ -42,6 +45,8 @@ mod resets;
 mod semi;
 #[path = "target/uart.rs"]
 mod uart;
+#[path = "target/upload_boot.rs"]
+mod upload_boot;
 #[path = "target/watchdog.rs"]
 mod watchdog;
 
@@ -117,7 +122,7 @@ fn main() -> ! {
     let Some(cp) = cortex_m::Peripherals::take() else {
         resets::fatal_boot(BootFault::CorePeripherals)
     };
-    millis::start_millis(cp.SYST);
+    millis::start_millis(cp.SYST, millis::CORE_HZ);
     watchdog::start(WATCHDOG_TIMEOUT_MS);
     let options = test_options(&reset);
     inject_fault_at_boot(options);
@@ -128,7 +133,7 @@ fn main() -> ! {
             uart::CmsdkUart::new(0, HOST_BAUD),
             uart::CmsdkUart::new(1, GYRO_BAUD),
             uart::CmsdkUart::new(2, TABLE_BAUD),
-            flash::ModelFlash::take(),
+            flash::take_app_flash(),
         )
     };
 
@@ -147,6 +152,7 @@ fn main() -> ! {
         stored,
         server.slots_refused_at_boot()
     );
+    report_slots(server.boot_report());
 
     let table = SerialTurntable::new(table_uart, millis::MillisClock, TurntableConfig::default());
     // Configured in place in `COMPENSATOR`; the `App` around it is a few hundred bytes.
@@ -437,6 +443,20 @@ fn announce_boot(reset: &ResetRecord) {
     );
 }
 
+/// The boot check of both model slots (why a stored model is or is not used). Under
+/// QEMU also as a plain `FOG-SLOT` line per slot on the semihosting console.
+fn report_slots(report: [fog_firmware::upload::SlotVerdict; 2]) {
+    for (name, verdict) in ["A", "B"].into_iter().zip(report) {
+        if verdict.refused() {
+            defmt::warn!("model slot {}: {}", name, verdict);
+        } else {
+            defmt::info!("model slot {}: {}", name, verdict);
+        }
+        #[cfg(feature = "log-semihosting")]
+        semihosting::eprintln!("FOG-SLOT {} {}", name, verdict);
+    }
+}
+
 /// A closed window as one plain-text line on the semihosting console (QEMU tests).
 fn window_line(w: &fog_core::compensator::WindowResult, frames_lost: u32, bytes_dropped: u32) {
     #[cfg(feature = "log-semihosting")]
@@ -567,24 +587,11 @@ fn report<E: defmt::Format>(step: fog_firmware::app::Step<E>) {
     }
 }
 
-type Server = UploadServer<flash::ModelFlash>;
+type Server = UploadServer<flash::AppFlash>;
 
-/// The upload server, in a static. Its own frame (never inlined into `main`): building it
-/// (store scan, signature re-check, decoding the active model for its identity) needs
-/// ~10 KB of temporaries, which are then given back instead of staying in `main`'s frame.
-#[inline(never)]
-fn start_upload_server(flash: flash::ModelFlash, reset: ResetRecord) -> &'static mut Server {
-    let Ok(gyro_id) = heapless::String::try_from(GYRO_ID) else {
-        resets::fatal_boot(BootFault::Configuration)
-    };
-    let mut server = match UploadServer::new(flash, 0, VERIFY_KEY, gyro_id) {
-        Ok(s) => s,
-        Err(e) => {
-            defmt::error!("model store unusable: {}", e);
-            resets::fatal_boot(BootFault::StoreGeometry)
-        }
-    };
-    server.set_reset_record(reset);
+/// The upload server, in a static (`upload_boot.rs` builds it).
+fn start_upload_server(flash: flash::AppFlash, reset: ResetRecord) -> &'static mut Server {
+    let server = upload_boot::new_upload_server(flash, VERIFY_KEY, GYRO_ID, reset);
     let Some(server) = cortex_m::singleton!(: Server = server) else {
         resets::fatal_boot(BootFault::Singleton)
     };

@@ -3,16 +3,16 @@
 //! semihosting console lines (`FOG-...`); stream simulated gyro frames to its UART1.
 #![allow(dead_code)]
 
-use std::io::{BufRead, BufReader, Write};
+use std::io::Write;
 use std::net::TcpStream;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc::{channel, Receiver};
+use std::sync::mpsc::Receiver;
 use std::time::{Duration, Instant};
 
 use fog_firmware::drivers::gyro_frame::GyroFrame;
-use fog_tests::{
-    connect_loopback, firmware_elf, free_loopback_port, spawn_qemu, KillOnDrop, QemuOptions,
-};
+use fog_tests::console::start_with_console;
+pub use fog_tests::console::{wait_line, wait_line_where};
+use fog_tests::{firmware_elf, KillOnDrop, QemuOptions};
 
 /// Starts fog-app with `args` and `serial_ports` UARTs (UART0 = host, UART1 = gyro,
 /// UART2 = turntable) on loopback servers; returns QEMU, the connected streams and the
@@ -25,64 +25,14 @@ pub fn start(args: &[&str], serial_ports: usize) -> (KillOnDrop, Vec<TcpStream>,
 pub fn start_with(
     args: &[&str],
     serial_ports: usize,
-    mut extra: Vec<String>,
+    extra: Vec<String>,
 ) -> (KillOnDrop, Vec<TcpStream>, Receiver<String>) {
-    let ports: Vec<u16> = (0..serial_ports).map(|_| free_loopback_port()).collect();
-    for p in &ports {
-        extra.push("-serial".to_string());
-        extra.push(format!("tcp:127.0.0.1:{p},server=on,wait=on"));
-    }
     let opts = QemuOptions {
         args: args.iter().map(|s| s.to_string()).collect(),
         extra,
         ..QemuOptions::default()
     };
-    let mut qemu = spawn_qemu(&firmware_elf("fog-app"), &opts).expect("start QEMU");
-    let streams = ports
-        .iter()
-        .map(|&p| connect_loopback(p, Duration::from_secs(30)))
-        .collect();
-    let (tx, rx) = channel();
-    let stderr = qemu.0.stderr.take().expect("piped");
-    std::thread::spawn(move || {
-        // The console mixes defmt's binary frames with our text lines: split on '\n'
-        // and keep the tagged lines.
-        let mut reader = BufReader::new(stderr);
-        let mut line = Vec::new();
-        while reader.read_until(b'\n', &mut line).is_ok_and(|n| n > 0) {
-            let text = String::from_utf8_lossy(&line);
-            if let Some(at) = text.find("FOG-") {
-                let _ = tx.send(text[at..].trim_end().to_string());
-            }
-            line.clear();
-        }
-    });
-    (qemu, streams, rx)
-}
-
-/// Waits (bounded) for a console line starting with `prefix` and satisfying `accept`.
-pub fn wait_line_where(
-    rx: &Receiver<String>,
-    prefix: &str,
-    within: Duration,
-    accept: impl Fn(&str) -> bool,
-) -> String {
-    let deadline = Instant::now() + within;
-    let mut seen = Vec::new();
-    while let Some(left) = deadline.checked_duration_since(Instant::now()) {
-        match rx.recv_timeout(left) {
-            Ok(line) if line.starts_with(prefix) && accept(&line) => return line,
-            Ok(line) => seen.push(line),
-            Err(_) => break,
-        }
-    }
-    let tail = &seen[seen.len().saturating_sub(20)..];
-    panic!("no console line {prefix:?} within {within:?}; last lines seen {tail:#?}")
-}
-
-/// Waits (bounded) for a console line starting with `prefix`.
-pub fn wait_line(rx: &Receiver<String>, prefix: &str, within: Duration) -> String {
-    wait_line_where(rx, prefix, within, |_| true)
+    start_with_console(&firmware_elf("fog-app"), opts, serial_ports)
 }
 
 /// A simulated FOG on `link`: frames at `rate_hz` of sample time, sent `speed` times

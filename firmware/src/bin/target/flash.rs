@@ -2,7 +2,8 @@
 //! region (linker symbols `_models_start`/`_models_end`, see memory.x) is plain memory,
 //! so this driver enforces NOR semantics itself: erase sets 4 KiB sectors to 0xFF,
 //! a write can only clear bits. A real board replaces this file with its flash
-//! controller driver (same traits, same geometry or its own).
+//! controller driver (same traits, same geometry or its own). Under QEMU `AppFlash`
+//! mirrors the region into a host file, so the store persists across QEMU restarts.
 
 use core::ptr::{addr_of, read_volatile, write_volatile};
 
@@ -94,4 +95,30 @@ impl NorFlash for ModelFlash {
         }
         Ok(())
     }
+}
+
+/// The model flash `fog-app` uses. Under QEMU (semihosting builds) it is mirrored into
+/// the host file named by `flash-file=PATH`, so models survive a QEMU restart
+/// (`flash_file.rs`); otherwise the region alone.
+#[cfg(feature = "log-semihosting")]
+pub type AppFlash =
+    fog_firmware::store::mirrored::MirroredFlash<ModelFlash, crate::flash_file::HostImage>;
+#[cfg(not(feature = "log-semihosting"))]
+pub type AppFlash = ModelFlash;
+
+/// Takes the model region (and, under QEMU, attaches its image file).
+///
+/// # Safety
+/// As [`ModelFlash::take`]: called once.
+pub unsafe fn take_app_flash() -> AppFlash {
+    // SAFETY: forwarded to the caller.
+    let flash = unsafe { ModelFlash::take() };
+    #[cfg(feature = "log-semihosting")]
+    {
+        let mut flash = flash;
+        let image = crate::flash_file::open_image(&mut flash);
+        fog_firmware::store::mirrored::MirroredFlash::new(flash, image)
+    }
+    #[cfg(not(feature = "log-semihosting"))]
+    flash
 }

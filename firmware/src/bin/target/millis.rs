@@ -1,5 +1,6 @@
 //! The application's time base on the target: SysTick on the core clock (25 MHz on
-//! mps2-an386) interrupting at 1 kHz, read through `fog_firmware::clock::Clock`
+//! mps2-an386, 168 MHz on the STM32F407 board, which includes this file) interrupting
+//! at 1 kHz, read through `fog_firmware::clock::Clock`
 //! (turntable timeouts).
 
 use core::sync::atomic::{AtomicU32, Ordering};
@@ -9,14 +10,15 @@ use cortex_m::peripheral::SYST;
 use fog_firmware::clock::Clock;
 
 /// Core clock of mps2-an386, Hz.
+#[allow(dead_code)] // the board binary passes its own
 pub const CORE_HZ: u32 = 25_000_000;
 
 static MILLIS: AtomicU32 = AtomicU32::new(0);
 
 /// 1 kHz interrupt-driven millisecond clock.
-pub fn start_millis(mut syst: SYST) {
+pub fn start_millis(mut syst: SYST, core_hz: u32) {
     syst.set_clock_source(SystClkSource::Core);
-    syst.set_reload(CORE_HZ / 1000 - 1);
+    syst.set_reload(core_hz / 1000 - 1);
     syst.clear_current();
     syst.enable_interrupt();
     syst.enable_counter();

@@ -42,6 +42,15 @@ impl Args {
         CStr::from_bytes_with_nul(v).map_err(|_| "argument has a NUL byte")
     }
 
+    /// The value of argument `i` if it is `prefix` followed by a path (`flash-file=PATH`).
+    pub fn value_path(&self, i: usize, prefix: &str) -> Option<&CStr> {
+        let v = self.items.get(i)?;
+        let rest = v.strip_prefix(prefix.as_bytes())?;
+        CStr::from_bytes_with_nul(rest)
+            .ok()
+            .filter(|p| !p.is_empty())
+    }
+
     /// Argument `i` as text.
     pub fn str(&self, i: usize) -> Result<&str, &'static str> {
         let v = self.items.get(i).ok_or("missing argument")?;

@@ -1,0 +1,102 @@
+//! The QEMU build's persistent model flash: the model region mirrored into a host file
+//! through semihosting, so a model uploaded in one QEMU process is in flash when QEMU
+//! is started again on the same file (mps2-an386 has no pflash to do this).
+//!
+//! The file is named by the semihosting argument `flash-file=PATH`. At boot:
+//! - no argument: the region is RAM only (models are lost when QEMU exits);
+//! - the file exists: it must be exactly the region's size, and is loaded into it;
+//!   any other file is refused whole (region erased, file untouched, reason logged);
+//! - the file does not exist: it is created, fully erased (0xFF).
+//!
+//! Afterwards every erase and write is written through (`fog_firmware::store::mirrored`).
+//! Each outcome is logged, also as a plain `FOG-FLASH` line on the semihosting console.
+
+use core::ffi::CStr;
+
+use embedded_storage::nor_flash::{NorFlash, ReadNorFlash};
+use fog_firmware::store::mirrored::{load_image, Backing, BackingFailed, ImageError};
+use semihosting::fs::File;
+use semihosting::io::{Read as _, Seek as _, SeekFrom, Write as _};
+
+use crate::flash::ModelFlash;
+use crate::semi::Args;
+
+/// The semihosting argument naming the flash image file.
+const ARG_PREFIX: &str = "flash-file=";
+
+/// The flash image file, opened for reading and writing.
+pub struct HostImage(File);
+
+impl Backing for HostImage {
+    fn write_at(&mut self, offset: u32, bytes: &[u8]) -> Result<(), BackingFailed> {
+        self.0
+            .seek(SeekFrom::Start(u64::from(offset)))
+            .map_err(|_| BackingFailed)?;
+        self.0.write_all(bytes).map_err(|_| BackingFailed)
+    }
+}
+
+/// Loads or creates the image named on the command line; `None`: no persistence.
+pub fn open_image(flash: &mut ModelFlash) -> Option<HostImage> {
+    let args = Args::get().ok()?;
+    let path = (0..args.len()).find_map(|i| args.value_path(i, ARG_PREFIX))?;
+    let name = path.to_str().unwrap_or("<not UTF-8>");
+    match attach(flash, path) {
+        Ok((image, what)) => {
+            defmt::info!("model flash: {} ({})", name, what);
+            semihosting::eprintln!("FOG-FLASH file={} {}", name, what);
+            Some(image)
+        }
+        Err(why) => {
+            defmt::error!("model flash {} refused: models are not kept", name);
+            semihosting::eprintln!("FOG-FLASH file={} refused: {}", name, why);
+            None
+        }
+    }
+}
+
+/// Why the image file is not used.
+enum AttachError {
+    Image(ImageError),
+    File(&'static str),
+}
+
+impl core::fmt::Display for AttachError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Image(e) => write!(f, "{e} (file left as it was)"),
+            Self::File(e) => f.write_str(e),
+        }
+    }
+}
+
+fn attach(flash: &mut ModelFlash, path: &CStr) -> Result<(HostImage, &'static str), AttachError> {
+    let capacity = flash.capacity();
+    if let Ok(mut existing) = File::open(path) {
+        load_image(flash, |buf| existing.read(buf).map_err(|_| BackingFailed))
+            .map_err(AttachError::Image)?;
+        drop(existing);
+        let file = File::options()
+            .read(true)
+            .write(true)
+            .open(path)
+            .map_err(|_| AttachError::File("loaded, but cannot be opened for writing"))?;
+        return Ok((HostImage(file), "loaded"));
+    }
+    let mut file = File::options()
+        .read(true)
+        .write(true)
+        .create(true)
+        .truncate(true)
+        .open(path)
+        .map_err(|_| AttachError::File("cannot be created"))?;
+    let erased = [0xFFu8; 256];
+    for _ in 0..capacity / erased.len() {
+        file.write_all(&erased)
+            .map_err(|_| AttachError::File("cannot be written"))?;
+    }
+    flash
+        .erase(0, capacity as u32)
+        .map_err(|_| AttachError::File("flash erase failed"))?;
+    Ok((HostImage(file), "created, erased"))
+}

@@ -1,0 +1,152 @@
+//! QEMU scenario (issue 11 item 5): the model store persists across a QEMU restart.
+//!
+//! `fog-app` runs under `qemu-system-arm -machine mps2-an386` with the semihosting
+//! argument `flash-file=models.img`: its model region is mirrored into that host file
+//! (`fog_firmware::store::mirrored`, `src/bin/target/flash_file.rs`). The scenario
+//! uploads two signed models over the host link, kills QEMU (no clean shutdown), starts
+//! it again on the same file and finds the newer model active; then flips one byte of
+//! a stored model in the file: the next boot refuses that slot, says why on its
+//! console (`FOG-SLOT B refused: ...`), falls back to the older intact model and keeps
+//! answering; with both slots damaged it runs without a model. A file that is not a
+//! flash image is refused whole and left as it was.
+//!
+//! Skips loudly without QEMU / the target unless FOG_REQUIRE_QEMU=1. Every wait is
+//! bounded; QEMU is killed when each run ends.
+
+mod upload_support;
+
+use std::net::TcpStream;
+use std::path::Path;
+use std::sync::mpsc::Receiver;
+use std::time::Duration;
+
+use fog_core::protocol::{DeviceStatus, ModelInfo, ResetCause};
+use fog_sim::upload::UploadClient;
+use fog_tests::console::{start_with_console, wait_line};
+use fog_tests::{firmware_elf, qemu_ready, scratch_dir, KillOnDrop, QemuOptions};
+use upload_support::*;
+
+/// The model region of the QEMU build: the last 16 KiB of flash (memory.x).
+const IMAGE_LEN: usize = 16 * 1024;
+const WAIT: Duration = Duration::from_secs(30);
+
+/// One QEMU process on `file` (relative to `dir`): QEMU, the host link, the console.
+fn boot(dir: &Path, file: &str) -> (KillOnDrop, UploadClient<TcpStream>, Receiver<String>) {
+    let opts = QemuOptions {
+        args: vec![format!("flash-file={file}")],
+        cwd: Some(dir.to_path_buf()),
+        ..QemuOptions::default()
+    };
+    let (qemu, mut streams, console) = start_with_console(&firmware_elf("fog-app"), opts, 1);
+    let link = streams.remove(0);
+    link.set_read_timeout(Some(Duration::from_millis(50)))
+        .unwrap();
+    (
+        qemu,
+        UploadClient::new(link, Duration::from_secs(20)),
+        console,
+    )
+}
+
+/// Flips every bit of the byte in the middle of `needle`'s copy in `path`.
+fn flip_byte_inside(path: &Path, needle: &[u8]) {
+    let mut image = std::fs::read(path).unwrap();
+    let at = image
+        .windows(needle.len())
+        .position(|w| w == needle)
+        .expect("the model's bytes are in the flash image");
+    image[at + needle.len() / 2] ^= 0xFF;
+    std::fs::write(path, image).unwrap();
+}
+
+/// A status answered after a boot that was not a reset loop.
+fn first_boot_status(client: &mut UploadClient<TcpStream>) -> DeviceStatus {
+    let status = client.status().expect("the firmware answers after booting");
+    assert_eq!(
+        (status.last_reset.cause, status.last_reset.boots),
+        (ResetCause::PowerOn, 1),
+        "booted once, no reset"
+    );
+    status
+}
+
+#[test]
+fn qemu_model_survives_restart_and_a_flipped_byte_is_refused_with_its_reason() {
+    if !qemu_ready("qemu_persist") {
+        return;
+    }
+    let dir = scratch_dir("qemu_persist");
+    let image = dir.join("models.img");
+    let first = encode(&sample_model(QEMU_GYRO, 35, 1.0));
+    let second = encode(&sample_model(QEMU_GYRO, 48, 0.5));
+
+    // Run 1: a new file; two signed models (slot A, then slot B); QEMU killed.
+    let (info1, info2): (ModelInfo, ModelInfo) = {
+        let (_qemu, mut client, console) = boot(&dir, "models.img");
+        wait_line(&console, "FOG-FLASH file=models.img created", WAIT);
+        let status = first_boot_status(&mut client);
+        assert_eq!(status.active, None, "a new flash holds no model");
+        let info1 = client
+            .upload(&first, 1, &sign_for_gyro(1, QEMU_GYRO, &first), |_, _| {})
+            .expect("upload 1");
+        let info2 = client
+            .upload(&second, 2, &sign_for_gyro(2, QEMU_GYRO, &second), |_, _| {})
+            .expect("upload 2");
+        assert_eq!((info1.slot, info2.slot), (0, 1));
+        (info1, info2)
+    };
+    assert_eq!(std::fs::read(&image).unwrap().len(), IMAGE_LEN);
+
+    // Run 2: same file, the newer model is active without any upload.
+    {
+        let (_qemu, mut client, console) = boot(&dir, "models.img");
+        wait_line(&console, "FOG-FLASH file=models.img loaded", WAIT);
+        wait_line(&console, "FOG-SLOT A standby", WAIT);
+        wait_line(&console, "FOG-SLOT B in use", WAIT);
+        assert_eq!(first_boot_status(&mut client).active, Some(info2.clone()));
+    }
+
+    // Run 3: one byte of the newer model flipped in the file: refused with its
+    // reason, the older intact model is used, the firmware answers.
+    flip_byte_inside(&image, &second);
+    {
+        let (_qemu, mut client, console) = boot(&dir, "models.img");
+        wait_line(&console, "FOG-FLASH file=models.img loaded", WAIT);
+        wait_line(&console, "FOG-SLOT A in use", WAIT);
+        wait_line(
+            &console,
+            "FOG-SLOT B refused: model bytes do not match the header CRC-32",
+            WAIT,
+        );
+        assert_eq!(first_boot_status(&mut client).active, Some(info1.clone()));
+    }
+
+    // Run 4: both slots damaged: no model, still running and answering.
+    flip_byte_inside(&image, &first);
+    {
+        let (_qemu, mut client, console) = boot(&dir, "models.img");
+        wait_line(&console, "FOG-SLOT A refused: model bytes", WAIT);
+        wait_line(&console, "FOG-SLOT B refused: model bytes", WAIT);
+        assert_eq!(first_boot_status(&mut client).active, None);
+    }
+}
+
+#[test]
+fn qemu_file_that_is_not_a_flash_image_is_refused_whole_and_kept() {
+    if !qemu_ready("qemu_persist") {
+        return;
+    }
+    let dir = scratch_dir("qemu_persist_bad");
+    let short = dir.join("short.img");
+    let content: Vec<u8> = (0..IMAGE_LEN / 2).map(|i| (i % 251) as u8).collect();
+    std::fs::write(&short, &content).unwrap();
+    let (_qemu, mut client, console) = boot(&dir, "short.img");
+    let line = wait_line(&console, "FOG-FLASH file=short.img refused:", WAIT);
+    assert!(line.contains("8192") && line.contains("16384"), "{line}");
+    assert_eq!(first_boot_status(&mut client).active, None);
+    assert_eq!(
+        std::fs::read(&short).unwrap(),
+        content,
+        "a refused file is never written"
+    );
+}
