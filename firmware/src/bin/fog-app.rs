@@ -329,9 +329,10 @@ fn main() -> ! {
 /// The heading calibration (`HeadingCalRecord`) from its own flash sector, right after
 /// the two model slots; `None` if none was written or it is unreadable (then logged:
 /// seeks run uncalibrated, as before any calibration).
-fn read_heading_cal(flash: &mut flash::ModelFlash) -> Option<HeadingHarmonic> {
-    use embedded_storage::nor_flash::{NorFlash, ReadNorFlash};
-    let at = store_len(<flash::ModelFlash as NorFlash>::ERASE_SIZE) as u32;
+fn read_heading_cal<F: embedded_storage::nor_flash::NorFlash>(
+    flash: &mut F,
+) -> Option<HeadingHarmonic> {
+    let at = store_len(F::ERASE_SIZE) as u32;
     let mut buf = [0u8; FLASH_RECORD_LEN];
     if flash.read(at, &mut buf).is_err() {
         defmt::warn!("heading calibration sector unreadable");
