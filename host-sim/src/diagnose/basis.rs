@@ -91,8 +91,17 @@ fn mean_nearest_distance(c: &[Vec<f64>]) -> f64 {
     total / c.len() as f64
 }
 
-/// Lloyd's k-means from a farthest-point start (deterministic).
-fn kmeans(pts: &[Vec<f64>], k: usize) -> Vec<Vec<f64>> {
+/// Lloyd's k-means from a farthest-point start (deterministic: no seed, no RNG stream).
+///
+/// Kept hand-written after measuring it against linfa-clustering 0.8.1's `KMeans`
+/// (`benches/diagnose_kmeans.rs`, docs/diagnose.md "Libraries"): on z-scored campaign
+/// points (n 500 / 5,000, k 8 / 24, 2-d and 3-d) linfa with one run is not better
+/// (inertia 0.89-1.02x ours) and 1.4-6.3x slower at n = 500; its default 10 runs lowers the
+/// inertia by 0.5-14.5% but costs 7.6-47x the time, and diagnose runs k-means for every
+/// centre count x width of every RBF fit and candidate, picking centre count, width and
+/// ridge on held-out data anyway. linfa was deterministic (same seed twice, 1 vs 2
+/// threads), so that was not the reason.
+pub fn kmeans(pts: &[Vec<f64>], k: usize) -> Vec<Vec<f64>> {
     if pts.is_empty() {
         return vec![vec![]];
     }
