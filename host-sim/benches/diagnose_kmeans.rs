@@ -12,9 +12,6 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use fog_sim::diagnose::basis::kmeans;
-use fog_sim::pipeline::campaign::{simulate_campaign, CampaignSpec};
-use fog_sim::sim::GyroParams;
-use fog_sim::train::{dataset_from_runs, default_specs};
 use linfa::traits::Fit;
 use linfa::DatasetBase;
 use linfa_clustering::KMeans;
@@ -22,6 +19,10 @@ use ndarray::Array2;
 use rand_xoshiro::rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256Plus;
 use std::hint::black_box;
+
+#[path = "support/campaign.rs"]
+mod campaign;
+use campaign::paper_training_set;
 
 /// diagnose's iteration cap (`basis::kmeans`), given to linfa too.
 const MAX_ITERATIONS: u64 = 12;
@@ -31,17 +32,7 @@ const LINFA_DEFAULT_RUNS: usize = 10;
 
 /// z-scored campaign points: (T, dT/dt), or (T, dT/dt, t since power-on) when `with_time`.
 fn campaign_points(with_time: bool) -> Vec<Vec<f64>> {
-    let spec = CampaignSpec {
-        runs_per_ambient: 3,
-        raw_rate_hz: 10.0,
-        ..CampaignSpec::paper(1)
-    };
-    let runs: Vec<_> = simulate_campaign(&GyroParams::paper_default(), &spec)
-        .expect("campaign")
-        .into_iter()
-        .map(|c| c.run)
-        .collect();
-    let ds = dataset_from_runs(&runs, &default_specs()).expect("dataset");
+    let ds = paper_training_set();
     let mut cols: Vec<Vec<f64>> = (0..ds.n_inputs())
         .map(|j| ds.rows().map(|r| r[j]).collect())
         .collect();

@@ -4,27 +4,12 @@
 //! `cargo bench -p fog-sim --bench train`
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use fog_sim::pipeline::campaign::{simulate_campaign, CampaignSpec};
-use fog_sim::sim::GyroParams;
-use fog_sim::train::{
-    dataset_from_runs, default_specs, fit_width, grid_candidates, Dataset, GaussianDesign, Method,
-    Normalizer, TrainConfig,
-};
+use fog_sim::train::{fit_width, grid_candidates, GaussianDesign, Method, Normalizer, TrainConfig};
 use std::hint::black_box;
 
-fn paper_training_set() -> Dataset {
-    let spec = CampaignSpec {
-        runs_per_ambient: 3,
-        raw_rate_hz: 10.0,
-        ..CampaignSpec::paper(1)
-    };
-    let runs: Vec<_> = simulate_campaign(&GyroParams::paper_default(), &spec)
-        .expect("campaign")
-        .into_iter()
-        .map(|c| c.run)
-        .collect();
-    dataset_from_runs(&runs, &default_specs()).expect("dataset")
-}
+#[path = "support/campaign.rs"]
+mod campaign;
+use campaign::paper_training_set;
 
 fn bench_train(c: &mut Criterion) {
     let ds = paper_training_set();
