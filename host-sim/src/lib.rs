@@ -19,9 +19,10 @@
 //! report/     JSON report structures and terminal tables; plots/ the SVG charts
 //! io/         fog-runs reader (streaming, csv crate) and writer, 10 s binning, model
 //!   |         files, import, the one atomic writer, the output guard
+//!   |         upload, monitor: the host-link clients (model upload, status/results)
 //! stats/      statistics: std/rms, the one pooled within-run std, drift metrics, Allan,
-//!             windows in fog-core's convention; seed (the one SplitMix64 seed mix) and
-//!             fanout (the one thread fan-out, results in job order)
+//!             windows in fog-core's convention; beside it seed (the one SplitMix64
+//!             seed mix) and fanout (the one thread fan-out, results in job order)
 //! ```
 
 pub mod cmd;

@@ -100,3 +100,118 @@ fn train_writes_a_valid_model_and_rejects_bad_input_without_output() {
     assert!(!bad_model.exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Writes one fog-runs v1 warm-up whose drift is `shupe_dph_s_per_c` x dT/dt plus, with
+/// `noise_only`, a drift that has nothing to do with temperature (a hashed sequence).
+fn write_law_run(path: &Path, ambient_c: f64, run: usize, shupe: f64, noise_only: bool) {
+    let mut s = format!("# fog-runs v1\n# ambient_c: {ambient_c}\nt_s,rate_dph,temp_c,earth_dph\n");
+    let mut h = 0x9E37_79B9_7F4A_7C15u64 ^ (run as u64 + 1).wrapping_mul(0xD1B5_4A32_D192_ED03);
+    for i in 1..=120u32 {
+        let t = 10.0 * f64::from(i);
+        let tau = 500.0 + 50.0 * run as f64;
+        let temp = ambient_c + 5.0 * (1.0 - (-t / tau).exp());
+        let rate_c_s = 5.0 / tau * (-t / tau).exp();
+        h ^= h << 13;
+        h ^= h >> 7;
+        h ^= h << 17;
+        let noise = 0.01 * ((h >> 11) as f64 / (1u64 << 53) as f64 - 0.5);
+        let drift = if noise_only {
+            noise
+        } else {
+            shupe * rate_c_s + 0.1 * noise
+        };
+        s += &format!("{t},{},{temp:.4},9.7\n", 9.7 + drift);
+    }
+    std::fs::write(path, s).unwrap();
+}
+
+#[test]
+fn train_refuses_a_model_that_does_not_help_and_compensate_warns_when_one_hurts() {
+    let dir = std::env::temp_dir().join(format!("fogsim_train_guard_{}", std::process::id()));
+    let noise = dir.join("noise");
+    let shupe = dir.join("shupe");
+    let reversed = dir.join("reversed");
+    for d in [&noise, &shupe, &reversed] {
+        std::fs::create_dir_all(d).unwrap();
+    }
+    for (a, amb) in [0.0, 20.0].iter().enumerate() {
+        for r in 0..3 {
+            let name = format!("a{a}_run{r}.csv");
+            write_law_run(&noise.join(&name), *amb, r, 0.0, true);
+            write_law_run(&shupe.join(&name), *amb, r, 15.0, false);
+            // The twin law: the same warm-up with the opposite Shupe sign.
+            write_law_run(&reversed.join(&name), *amb, r, -15.0, false);
+        }
+    }
+    // Drift unrelated to temperature: the guard refuses, says why, writes the JSON only.
+    let model = dir.join("noise_model.bin");
+    let json = dir.join("noise_report.json");
+    let args = |extra: &[&str]| {
+        let mut v = vec![
+            "train",
+            noise.to_str().unwrap(),
+            "--out",
+            model.to_str().unwrap(),
+            "--json",
+            json.to_str().unwrap(),
+        ];
+        v.extend_from_slice(extra);
+        v.into_iter().map(str::to_string).collect::<Vec<_>>()
+    };
+    let refused = fogsim(&args(&[]).iter().map(String::as_str).collect::<Vec<_>>());
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(!refused.status.success(), "{err}");
+    assert!(
+        err.contains("not clearly better") && err.contains("--force"),
+        "{err}"
+    );
+    assert!(!model.exists(), "a refused model must not be written");
+    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(report["verdict"], "not_better");
+    // --force writes it anyway, still warning.
+    let forced = fogsim(
+        &args(&["--force"])
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>(),
+    );
+    assert!(forced.status.success());
+    assert!(String::from_utf8_lossy(&forced.stderr).contains("--force"));
+    assert!(RbfModel::decode(&std::fs::read(&model).unwrap()).is_ok());
+
+    // A model of the +Shupe gyro helps its own gyro and hurts the reversed one: compensate
+    // warns for each record it makes worse, and only for those.
+    let shupe_model = dir.join("shupe_model.bin");
+    let trained = fogsim(&[
+        "train",
+        shupe.to_str().unwrap(),
+        "--out",
+        shupe_model.to_str().unwrap(),
+    ]);
+    assert!(
+        trained.status.success(),
+        "{}",
+        String::from_utf8_lossy(&trained.stderr)
+    );
+    let own = fogsim(&[
+        "compensate",
+        shupe.to_str().unwrap(),
+        "--model",
+        shupe_model.to_str().unwrap(),
+    ]);
+    assert!(own.status.success());
+    assert!(!String::from_utf8_lossy(&own.stderr).contains("makes this record worse"));
+    let other = fogsim(&[
+        "compensate",
+        reversed.to_str().unwrap(),
+        "--model",
+        shupe_model.to_str().unwrap(),
+    ]);
+    assert!(other.status.success());
+    let warned = String::from_utf8_lossy(&other.stderr)
+        .lines()
+        .filter(|l| l.contains("makes this record worse"))
+        .count();
+    assert_eq!(warned, 6, "{}", String::from_utf8_lossy(&other.stderr));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -23,8 +23,9 @@ use std::time::{Duration, Instant};
 
 use fog_core::protocol::ResetCause;
 use fog_sim::upload::{ClientError, UploadClient};
+use fog_tests::console::wait_line;
 use fog_tests::qemu_ready;
-use qemu_support::{start, stream_gyro_frames, wait_line};
+use qemu_support::{start, stream_gyro_frames};
 use upload_support::*;
 
 #[test]

@@ -46,8 +46,9 @@ use fog_core::seek_quality::{SeekState, Validity};
 use fog_core::tilt::{earth_rate_on_axis_dph, Tilt};
 use fog_sim::monitor::{monitor, MonitorOptions, MonitorSummary, ResultLog};
 use fog_sim::upload::UploadClient;
+use fog_tests::console::{wait_line, wait_line_where};
 use fog_tests::{qemu_ready, scratch_dir};
-use qemu_support::{start, stream_gyro_frames, wait_line, wait_line_where};
+use qemu_support::{start, stream_gyro_frames};
 use rand_distr::Distribution;
 use upload_support::*;
 

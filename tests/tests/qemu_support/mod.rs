@@ -11,7 +11,6 @@ use std::time::{Duration, Instant};
 
 use fog_firmware::drivers::gyro_frame::GyroFrame;
 use fog_tests::console::start_with_console;
-pub use fog_tests::console::{wait_line, wait_line_where};
 use fog_tests::{firmware_elf, KillOnDrop, QemuOptions};
 
 /// Starts fog-app with `args` and `serial_ports` UARTs (UART0 = host, UART1 = gyro,
