@@ -530,7 +530,8 @@ fn every_truncation_and_flipped_byte_of_a_heading_model_is_rejected() {
 #[test]
 fn implausible_heading_harmonics_get_their_typed_error() {
     let good = warmup_model(35, 2, 2.0, 5);
-    let cases: [(fn(&mut HeadingHarmonic), ModelError); 7] = [
+    type Corruption = fn(&mut HeadingHarmonic);
+    let cases: [(Corruption, ModelError); 7] = [
         (
             |h| h.cos_dph = f32::NAN,
             ModelError::NonFinite {
