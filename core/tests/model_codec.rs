@@ -531,58 +531,23 @@ fn every_truncation_and_flipped_byte_of_a_heading_model_is_rejected() {
 fn implausible_heading_harmonics_get_their_typed_error() {
     let good = warmup_model(35, 2, 2.0, 5);
     type Corruption = fn(&mut HeadingHarmonic);
-    let cases: [(Corruption, ModelError); 7] = [
-        (
-            |h| h.cos_dph = f32::NAN,
-            ModelError::NonFinite {
-                field: ModelField::Heading,
-                index: 0,
-            },
-        ),
-        (
-            |h| h.sin_sigma_dph = f32::INFINITY,
-            ModelError::NonFinite {
-                field: ModelField::Heading,
-                index: 3,
-            },
-        ),
-        (
-            |h| h.sin_dph = -10.5,
-            ModelError::OutOfBounds {
-                field: ModelField::Heading,
-                index: 1,
-            },
-        ),
-        (
-            |h| h.cos_dph = 36.0,
-            ModelError::OutOfBounds {
-                field: ModelField::Heading,
-                index: 0,
-            },
-        ),
-        (
-            |h| h.cos_sigma_dph = -0.001,
-            ModelError::OutOfBounds {
-                field: ModelField::Heading,
-                index: 2,
-            },
-        ),
-        (
-            |h| h.correlation = 1.5,
-            ModelError::OutOfBounds {
-                field: ModelField::Heading,
-                index: 4,
-            },
-        ),
-        (
-            |h| h.n_headings = 3,
-            ModelError::OutOfBounds {
-                field: ModelField::Heading,
-                index: 5,
-            },
-        ),
+    // (corruption, index of the harmonic field, non-finite rather than out of bounds)
+    let cases: [(Corruption, u16, bool); 7] = [
+        (|h| h.cos_dph = f32::NAN, 0, true),
+        (|h| h.sin_sigma_dph = f32::INFINITY, 3, true),
+        (|h| h.sin_dph = -10.5, 1, false),
+        (|h| h.cos_dph = 36.0, 0, false),
+        (|h| h.cos_sigma_dph = -0.001, 2, false),
+        (|h| h.correlation = 1.5, 4, false),
+        (|h| h.n_headings = 3, 5, false),
     ];
-    for (corrupt, want) in cases {
+    for (corrupt, index, non_finite) in cases {
+        let field = ModelField::Heading;
+        let want = if non_finite {
+            ModelError::NonFinite { field, index }
+        } else {
+            ModelError::OutOfBounds { field, index }
+        };
         let mut h = harmonic();
         corrupt(&mut h);
         let mut loose = LooseModel::from(&good);

@@ -98,6 +98,28 @@ fn explicit_coefficients_are_attached_and_bad_ones_refused() {
     assert_eq!(std::fs::read(dir.join("model.bin")).unwrap(), before);
 }
 
+/// Writes `report` as diagnose's JSON to `json` and runs `heading-cal --from-diagnose`.
+fn attach_report(
+    dir: &std::path::Path,
+    report: &fog_sim::diagnose::Report,
+    json: &str,
+    out: &str,
+) -> std::process::Output {
+    std::fs::write(dir.join(json), serde_json::to_vec_pretty(report).unwrap()).unwrap();
+    fogsim(
+        dir,
+        &[
+            "heading-cal",
+            "--model",
+            "model.bin",
+            "--from-diagnose",
+            json,
+            "--out",
+            out,
+        ],
+    )
+}
+
 #[test]
 fn diagnoses_between_run_harmonic_is_attached_with_the_same_bias_at_every_azimuth() {
     let dir = scratch_dir("heading-cal-diagnose");
@@ -108,23 +130,7 @@ fn diagnoses_between_run_harmonic_is_attached_with_the_same_bias_at_every_azimut
     let d = diagnose(&runs).expect("diagnose");
     let named = d.report.between_run.heading.clone().expect("heading named");
     assert_eq!(expected, Some("heading_deg:run_harmonic"));
-    std::fs::write(
-        dir.join("d.json"),
-        serde_json::to_vec_pretty(&d.report).unwrap(),
-    )
-    .unwrap();
-    let out = fogsim(
-        &dir,
-        &[
-            "heading-cal",
-            "--model",
-            "model.bin",
-            "--from-diagnose",
-            "d.json",
-            "--out",
-            "cal.bin",
-        ],
-    );
+    let out = attach_report(&dir, &d.report, "d.json", "cal.bin");
     assert!(out.status.success(), "{}", stderr(&out));
     let h = read(dir.join("cal.bin"))
         .heading
@@ -147,23 +153,7 @@ fn diagnoses_between_run_harmonic_is_attached_with_the_same_bias_at_every_azimut
     let (null_runs, _) = campaign(Hidden::Null, 3);
     let null = diagnose(&null_runs).expect("diagnose null");
     assert!(null.report.between_run.heading.is_none());
-    std::fs::write(
-        dir.join("null.json"),
-        serde_json::to_vec(&null.report).unwrap(),
-    )
-    .unwrap();
-    let out = fogsim(
-        &dir,
-        &[
-            "heading-cal",
-            "--model",
-            "model.bin",
-            "--from-diagnose",
-            "null.json",
-            "--out",
-            "n.bin",
-        ],
-    );
+    let out = attach_report(&dir, &null.report, "null.json", "n.bin");
     assert!(!out.status.success() && stderr(&out).contains("between_run.heading is null"));
     assert!(!dir.join("n.bin").exists());
 }

@@ -305,12 +305,12 @@ fn the_bit_word_follows_each_counter() {
 fn the_heading_correction_follows_the_active_model() {
     use fog_core::heading_cal::HeadingHarmonic;
     let harmonic = HeadingHarmonic {
-        cos_dph: 0.2,
-        sin_dph: 0.1,
-        cos_sigma_dph: 0.002,
-        sin_sigma_dph: 0.002,
-        correlation: 0.0,
-        n_headings: 8,
+        cos_dph: -0.04,
+        sin_dph: 0.07,
+        cos_sigma_dph: 0.003,
+        sin_sigma_dph: 0.004,
+        correlation: 0.1,
+        n_headings: 12,
     };
     let plain = fog_core::synthetic::warmup_model(8, 2, 1.0, 3);
     let mut calibrated = plain.clone();
