@@ -1,6 +1,8 @@
 //! Heading-dependent bias calibration: the first harmonic of the gyro bias in the azimuth of
 //! its input axis (e.g. a magnetic/Faraday bias from the Earth's field), estimated from N
-//! dwells at known headings and stored beside the drift model in its own small record.
+//! dwells at known headings. A device gets it inside the drift model (`model`, format
+//! version 3, covered by the model's CRC and the upload signature; `fogsim heading-cal`
+//! attaches it); `HeadingCalRecord` is the standalone form for files and logs.
 //!
 //! Exists because such a bias, a cos(alpha) + b sin(alpha) with alpha the input axis azimuth,
 //! is the same harmonic as Earth rate: no seek can separate it, so it has to be measured once
@@ -337,37 +339,7 @@ impl HeadingCalRecord {
         }
         Ok(rec)
     }
-    /// The record as stored in its own flash sector: a little-endian u16 length, then
-    /// `encode`'s bytes. Returns the bytes used (<= `FLASH_RECORD_LEN`).
-    pub fn encode_flash(&self, out: &mut [u8]) -> Result<usize, HeadingCalError> {
-        let (len, body) = out
-            .split_at_mut_checked(2)
-            .ok_or(HeadingCalError::BufferTooSmall)?;
-        let n = self.encode(body)?;
-        len.copy_from_slice(&(n as u16).to_le_bytes());
-        Ok(n + 2)
-    }
-
-    /// Reads the flash sector's first `FLASH_RECORD_LEN` bytes: `Ok(None)` if no record
-    /// was ever written (length 0xFFFF: erased NOR; 0: zero-filled memory, e.g. QEMU's),
-    /// otherwise the record accepted whole, or why not.
-    pub fn decode_flash(bytes: &[u8]) -> Result<Option<Self>, HeadingCalError> {
-        let [a, b, rest @ ..] = bytes else {
-            return Err(HeadingCalError::Malformed);
-        };
-        match u16::from_le_bytes([*a, *b]) {
-            0 | 0xFFFF => Ok(None),
-            n => rest
-                .get(..n as usize)
-                .ok_or(HeadingCalError::Malformed)
-                .and_then(Self::decode)
-                .map(Some),
-        }
-    }
 }
-
-/// Bytes to read from the record's flash sector (length prefix + largest record).
-pub const FLASH_RECORD_LEN: usize = 2 + MAX_RECORD_LEN;
 
 #[cfg(test)]
 mod tests {
@@ -443,23 +415,6 @@ mod tests {
         for len in 0..n {
             assert!(HeadingCalRecord::decode(&buf[..len]).is_err(), "len {len}");
         }
-    }
-
-    #[test]
-    fn flash_record_roundtrips_and_an_empty_sector_is_no_record() {
-        let d = dwells(20.0, 45.0, -0.01, 0.04, 0.1, 8);
-        let (h, _) = calibrate(&d, 20.0, 45.0, Tilt::LEVEL).unwrap();
-        let mut sector = [0xFFu8; 64];
-        assert_eq!(HeadingCalRecord::decode_flash(&sector), Ok(None));
-        assert_eq!(HeadingCalRecord::decode_flash(&[0u8; 64]), Ok(None));
-        let n = HeadingCalRecord::new(h).encode_flash(&mut sector).unwrap();
-        assert!(n <= FLASH_RECORD_LEN);
-        let back = HeadingCalRecord::decode_flash(&sector[..FLASH_RECORD_LEN]).unwrap();
-        assert_eq!(back.map(|r| r.harmonic), Some(h));
-        // A length pointing past what was read, or a corrupted body, is refused.
-        assert!(HeadingCalRecord::decode_flash(&sector[..n - 1]).is_err());
-        sector[5] ^= 0x10;
-        assert!(HeadingCalRecord::decode_flash(&sector).is_err());
     }
 
     #[test]

@@ -13,12 +13,16 @@
 //! after them are linear-only terms (diagnose may add a cause that way).
 //!
 //! Format versions: 1 has no `poly` (decoded with an empty one), 2 appends `poly` after
-//! `meta`. Validation bounds every parameter's magnitude so that any model that decodes
+//! `meta`, 3 appends `heading` after `poly`: the optional heading harmonic of the bias
+//! (`heading_cal`), stored inside the model bytes so that the model's CRC and the upload
+//! signature cover it (v1 and v2 decode with none). Validation bounds every parameter's magnitude so that any model that decodes
 //! gives a finite drift below `MAX_OUTPUT_DPH` at any finite input.
 
 use heapless::{String, Vec};
 use serde::de::DeserializeSeed as _;
 use serde::{Deserialize, Serialize};
+
+use crate::heading_cal::{HeadingHarmonic, MIN_HEADINGS};
 
 /// Most RBF centres a model may hold.
 pub const MAX_CENTERS: usize = 64;
@@ -26,8 +30,8 @@ pub const MAX_CENTERS: usize = 64;
 pub const MAX_INPUTS: usize = 4;
 /// Magic at the start of every encoded model: "FOGM".
 pub const MODEL_MAGIC: u32 = 0x4D47_4F46;
-/// Current format version (2: polynomial base in the first input).
-pub const MODEL_VERSION: u16 = 2;
+/// Current format version (3: optional heading harmonic after the polynomial base).
+pub const MODEL_VERSION: u16 = 3;
 /// Oldest format version still decoded (1: no polynomial base).
 pub const MODEL_VERSION_OLDEST: u16 = 1;
 /// Highest power of the polynomial base in the first input.
@@ -46,6 +50,12 @@ pub const INPUT_SCALE_RANGE: (f32, f32) = (1.0e-6, 1.0e6);
 pub const MAX_ABS_CENTER: f32 = 99.0;
 /// Allowed Gaussian widths, normalised units (fixed point additionally needs >= 0.0056).
 pub const WIDTH_RANGE: (f32, f32) = (1.0e-3, 100.0);
+/// Largest |a|, |b| of a stored heading harmonic, deg/h (a magnetic bias of a navigation
+/// grade FOG is ~0.01-0.1 deg/h; 10 deg/h is far above any physical one, so a larger value
+/// is a units or sign-of-exponent mistake, not a calibration).
+pub const MAX_HEADING_HARMONIC_DPH: f32 = 10.0;
+/// Largest 1-sigma of a stored heading harmonic coefficient, deg/h.
+pub const MAX_HEADING_SIGMA_DPH: f32 = 10.0;
 /// Largest encoded model, bytes (a 64-centre, 4-input model must fit).
 pub const MAX_ENCODED_LEN: usize = 2048;
 
@@ -128,6 +138,9 @@ pub struct RbfModel {
     /// Polynomial base (format version 2): coefficient k-1 multiplies t^k, deg/h, with
     /// t = normalised input 0 held to its trained range; at most `MAX_POLY_DEGREE` terms.
     pub poly: Vec<f32, MAX_POLY_DEGREE>,
+    /// Heading harmonic of the bias (format version 3), applied by the north finder while
+    /// this model is active; `None`: no heading calibration (also for v1/v2 models).
+    pub heading: Option<HeadingHarmonic>,
 }
 
 /// Most auxiliary (extra sensor) channels a model may refer to.
@@ -152,6 +165,9 @@ pub enum ModelField {
     HeldoutRms,
     TimeConstant,
     Poly,
+    /// The heading harmonic; index 0 a, 1 b, 2 sigma a, 3 sigma b, 4 correlation,
+    /// 5 n_headings.
+    Heading,
 }
 
 impl ModelField {
@@ -171,6 +187,7 @@ impl ModelField {
             ModelField::HeldoutRms => "meta.heldout_rms_dph",
             ModelField::TimeConstant => "inputs[].tau_s",
             ModelField::Poly => "poly",
+            ModelField::Heading => "heading",
         }
     }
 }
@@ -387,6 +404,7 @@ impl RbfModel {
                 n_train: 0,
             },
             poly: Vec::new(),
+            heading: None,
         }
     }
 
@@ -409,6 +427,7 @@ impl RbfModel {
         copy(&mut self.widths, &src.widths);
         copy(&mut self.weights, &src.weights);
         copy(&mut self.poly, &src.poly);
+        self.heading = src.heading;
         self.bias_dph = src.bias_dph;
         self.meta.gyro_id.clear();
         let _ = self.meta.gyro_id.push_str(&src.meta.gyro_id);
@@ -499,7 +518,46 @@ impl RbfModel {
                 index: self.poly.len() as u16,
             });
         }
+        self.check_heading()?;
         self.check_bounds()
+    }
+
+    /// The heading harmonic, if any: finite, |a|, |b| <= `MAX_HEADING_HARMONIC_DPH`,
+    /// sigmas in [0, `MAX_HEADING_SIGMA_DPH`], |correlation| <= 1, at least `MIN_HEADINGS`.
+    fn check_heading(&self) -> Result<(), ModelError> {
+        let Some(h) = &self.heading else {
+            return Ok(());
+        };
+        let values = [
+            h.cos_dph,
+            h.sin_dph,
+            h.cos_sigma_dph,
+            h.sin_sigma_dph,
+            h.correlation,
+        ];
+        check_finite(ModelField::Heading, &values)?;
+        let limits = [
+            (-MAX_HEADING_HARMONIC_DPH, MAX_HEADING_HARMONIC_DPH),
+            (-MAX_HEADING_HARMONIC_DPH, MAX_HEADING_HARMONIC_DPH),
+            (0.0, MAX_HEADING_SIGMA_DPH),
+            (0.0, MAX_HEADING_SIGMA_DPH),
+            (-1.0, 1.0),
+        ];
+        if let Some(i) =
+            (0..values.len()).find(|&i| !(limits[i].0..=limits[i].1).contains(&values[i]))
+        {
+            return Err(ModelError::OutOfBounds {
+                field: ModelField::Heading,
+                index: i as u16,
+            });
+        }
+        if (h.n_headings as usize) < MIN_HEADINGS {
+            return Err(ModelError::OutOfBounds {
+                field: ModelField::Heading,
+                index: 5,
+            });
+        }
+        Ok(())
     }
 
     /// Magnitude bounds: every intermediate of the evaluators stays finite and the
@@ -704,7 +762,7 @@ impl RbfModel {
         let mut de = postcard::Deserializer::from_bytes(model_bytes);
         crate::model_in_place::ModelInPlace {
             model: self,
-            has_poly: version >= 2,
+            version,
         }
         .deserialize(&mut de)
         .map_err(|_| ModelError::Malformed)?;

@@ -30,24 +30,33 @@ const FIELDS: &[&str] = &[
     "bias_dph",
     "meta",
     "poly",
+    "heading",
 ];
 
-/// Seed that fills `model` with the model being deserialised; `has_poly` is false for
-/// format version 1 (no `poly` field: it is left empty).
+/// Seed that fills `model` with the model being deserialised in format `version`: 1 has
+/// no `poly` (left empty), 1 and 2 no `heading` (left `None`).
 pub(crate) struct ModelInPlace<'a> {
     pub(crate) model: &'a mut RbfModel,
-    pub(crate) has_poly: bool,
+    pub(crate) version: u16,
+}
+
+impl ModelInPlace<'_> {
+    fn has_poly(&self) -> bool {
+        self.version >= 2
+    }
+
+    fn has_heading(&self) -> bool {
+        self.version >= 3
+    }
 }
 
 impl<'de> DeserializeSeed<'de> for ModelInPlace<'_> {
     type Value = ();
 
     fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<(), D::Error> {
-        let fields = if self.has_poly {
-            FIELDS
-        } else {
-            &FIELDS[..FIELDS.len() - 1]
-        };
+        let n_fields =
+            FIELDS.len() - usize::from(!self.has_poly()) - usize::from(!self.has_heading());
+        let fields = &FIELDS[..n_fields];
         d.deserialize_struct("RbfModel", fields, self)
     }
 }
@@ -79,6 +88,7 @@ impl<'de> Visitor<'de> for ModelInPlace<'_> {
     }
 
     fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<(), A::Error> {
+        let (has_poly, has_heading) = (self.has_poly(), self.has_heading());
         let m = self.model;
         m.n_rbf_inputs = next(&mut seq, 0)?;
         next_vec(&mut seq, 1, &mut m.inputs)?;
@@ -92,11 +102,16 @@ impl<'de> Visitor<'de> for ModelInPlace<'_> {
         next_vec(&mut seq, 9, &mut m.weights)?;
         m.bias_dph = next(&mut seq, 10)?;
         m.meta = next(&mut seq, 11)?;
-        if self.has_poly {
+        if has_poly {
             next_vec(&mut seq, 12, &mut m.poly)?;
         } else {
             m.poly.clear();
         }
+        m.heading = if has_heading {
+            next(&mut seq, 13)?
+        } else {
+            None
+        };
         Ok(())
     }
 }
@@ -148,7 +163,7 @@ mod tests {
         let mut de = postcard::Deserializer::from_bytes(bytes);
         ModelInPlace {
             model: &mut target,
-            has_poly: true,
+            version: crate::model::MODEL_VERSION,
         }
         .deserialize(&mut de)
         .expect("in place");
@@ -168,7 +183,7 @@ mod tests {
             let mut de = postcard::Deserializer::from_bytes(&bytes[..len]);
             let seed = ModelInPlace {
                 model: &mut target,
-                has_poly: true,
+                version: crate::model::MODEL_VERSION,
             };
             assert!(
                 seed.deserialize(&mut de).is_err(),

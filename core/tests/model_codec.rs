@@ -1,6 +1,7 @@
 //! Model format: round trip, size budget, and rejection of every kind of corrupted model
 //! with the matching typed error.
 
+use fog_core::heading_cal::HeadingHarmonic;
 use fog_core::model::{
     crc32, FeatureKind, ModelError, ModelField, RbfModel, MAX_CENTERS, MAX_ENCODED_LEN,
     MODEL_MAGIC, MODEL_VERSION,
@@ -31,6 +32,7 @@ struct LooseModel {
     bias_dph: f32,
     meta: fog_core::model::TrainingMeta,
     poly: Vec<f32>,
+    heading: Option<HeadingHarmonic>,
 }
 
 impl From<&RbfModel> for LooseModel {
@@ -49,6 +51,7 @@ impl From<&RbfModel> for LooseModel {
             bias_dph: m.bias_dph,
             meta: m.meta.clone(),
             poly: m.poly.to_vec(),
+            heading: m.heading,
         }
     }
 }
@@ -167,8 +170,10 @@ fn every_flipped_byte_is_rejected() {
 fn wrong_version_and_magic_are_named() {
     let m = LooseModel::from(&warmup_model(35, 2, 2.0, 5));
     assert_eq!(
-        RbfModel::decode(&encode_loose(&m, 3)),
-        Err(ModelError::UnsupportedVersion { found: 3 })
+        RbfModel::decode(&encode_loose(&m, MODEL_VERSION + 1)),
+        Err(ModelError::UnsupportedVersion {
+            found: MODEL_VERSION + 1
+        })
     );
     let mut bytes = encode_loose(&m, MODEL_VERSION);
     bytes[0] = 0x01; // still a valid varint, different value
@@ -324,7 +329,58 @@ fn random_bytes_never_panic() {
 /// Format version 1 (before the polynomial base): the body ends after `meta`.
 fn encode_v1(m: &RbfModel) -> Vec<u8> {
     let loose = LooseModel::from(m);
-    let v1 = (
+    let body = postcard::to_allocvec(&(
+        m.inputs.len() as u16,
+        m.centers.len() as u16,
+        v1_fields(&loose),
+    ))
+    .unwrap();
+    wrap(&body, 1)
+}
+
+/// Format version 2 (before the heading harmonic): the body ends after `poly`.
+fn encode_v2(m: &RbfModel) -> Vec<u8> {
+    let loose = LooseModel::from(m);
+    let body = postcard::to_allocvec(&(
+        m.inputs.len() as u16,
+        m.centers.len() as u16,
+        v1_fields(&loose),
+        &loose.poly,
+    ))
+    .unwrap();
+    wrap(&body, 2)
+}
+
+fn wrap(body: &[u8], version: u16) -> Vec<u8> {
+    postcard::to_allocvec(&Wire {
+        magic: MODEL_MAGIC,
+        version,
+        body,
+        crc32: crc32(body),
+    })
+    .unwrap()
+}
+
+/// The fields every format version has, in order (postcard tuples and structs are
+/// both their fields back to back).
+#[allow(clippy::type_complexity)]
+fn v1_fields(
+    loose: &LooseModel,
+) -> (
+    u8,
+    &Vec<fog_core::model::FeatureSpec>,
+    &Vec<f32>,
+    &Vec<f32>,
+    &Vec<f32>,
+    &Vec<f32>,
+    &Vec<f32>,
+    &Vec<[f32; 4]>,
+    &Vec<f32>,
+    &Vec<f32>,
+    f32,
+    &fog_core::model::TrainingMeta,
+) {
+    (
         loose.n_rbf_inputs,
         &loose.inputs,
         &loose.input_offset,
@@ -337,15 +393,7 @@ fn encode_v1(m: &RbfModel) -> Vec<u8> {
         &loose.weights,
         loose.bias_dph,
         &loose.meta,
-    );
-    let body = postcard::to_allocvec(&(m.inputs.len() as u16, m.centers.len() as u16, v1)).unwrap();
-    postcard::to_allocvec(&Wire {
-        magic: MODEL_MAGIC,
-        version: 1,
-        body: &body,
-        crc32: crc32(&body),
-    })
-    .unwrap()
+    )
 }
 
 #[test]
@@ -404,4 +452,124 @@ fn models_that_could_give_huge_or_infinite_drift_are_refused() {
             "{name}: {got:?}"
         );
     }
+}
+
+/// A calibrated magnetic harmonic as `heading_cal::calibrate` returns it (8 headings).
+fn harmonic() -> HeadingHarmonic {
+    HeadingHarmonic {
+        cos_dph: 0.031,
+        sin_dph: -0.022,
+        cos_sigma_dph: 0.0011,
+        sin_sigma_dph: 0.0012,
+        correlation: -0.05,
+        n_headings: 8,
+    }
+}
+
+#[test]
+fn heading_harmonic_round_trips_and_old_versions_decode_without_it() {
+    let mut m = warmup_model(35, 2, 2.0, 5);
+    m.poly.extend_from_slice(&[0.1, -0.02]).unwrap();
+    let plain = m.clone();
+    m.heading = Some(harmonic());
+    assert_eq!(RbfModel::decode(&encode(&m)), Ok(m.clone()));
+    // Version 2 bytes (no heading field) decode with none.
+    assert_eq!(RbfModel::decode(&encode_v2(&m)), Ok(plain.clone()));
+    // A version-3 body announced as version 2 has trailing bytes (the heading field).
+    assert!(matches!(
+        RbfModel::decode(&encode_loose(&LooseModel::from(&m), 2)),
+        Err(ModelError::TrailingBytes { .. })
+    ));
+    // The harmonic costs 1 + 5 x 4 + 1 bytes over "none" (1 byte).
+    assert_eq!(encode(&m).len(), encode(&plain).len() + 21);
+}
+
+#[test]
+fn full_model_with_heading_fits_the_limit() {
+    let mut m = warmup_model(MAX_CENTERS, 4, 2.0, 11);
+    m.meta.gyro_id.clear();
+    m.meta.gyro_id.push_str("0123456789ABCDEF").unwrap();
+    m.poly.extend_from_slice(&[0.3, -0.05, 0.01]).unwrap();
+    m.heading = Some(HeadingHarmonic {
+        n_headings: u16::MAX,
+        ..harmonic()
+    });
+    let bytes = encode(&m);
+    println!(
+        "64 centres x 4 inputs + poly + heading: {} bytes",
+        bytes.len()
+    );
+    assert!(bytes.len() <= MAX_ENCODED_LEN, "{} bytes", bytes.len());
+}
+
+#[test]
+fn every_truncation_and_flipped_byte_of_a_heading_model_is_rejected() {
+    let mut m = warmup_model(35, 2, 2.0, 5);
+    m.heading = Some(harmonic());
+    let bytes = encode(&m);
+    for len in 0..bytes.len() {
+        assert!(RbfModel::decode(&bytes[..len]).is_err(), "{len} bytes");
+    }
+    // The harmonic (22 bytes) ends the body, just before the CRC varint: flipping any of
+    // its bytes is a CRC error.
+    let loose = LooseModel::from(&m);
+    let body =
+        postcard::to_allocvec(&(m.inputs.len() as u16, m.centers.len() as u16, &loose)).unwrap();
+    let crc_len = postcard::to_allocvec(&crc32(&body)).unwrap().len();
+    let heading_end = bytes.len() - crc_len;
+    for i in heading_end - 22..heading_end {
+        let mut b = bytes.clone();
+        b[i] ^= 0xFF;
+        assert!(
+            matches!(RbfModel::decode(&b), Err(ModelError::CrcMismatch { .. })),
+            "byte {i}"
+        );
+    }
+}
+
+#[test]
+fn implausible_heading_harmonics_get_their_typed_error() {
+    let good = warmup_model(35, 2, 2.0, 5);
+    type Corruption = fn(&mut HeadingHarmonic);
+    // (corruption, index of the harmonic field, non-finite rather than out of bounds)
+    let cases: [(Corruption, u16, bool); 7] = [
+        (|h| h.cos_dph = f32::NAN, 0, true),
+        (|h| h.sin_sigma_dph = f32::INFINITY, 3, true),
+        (|h| h.sin_dph = -10.5, 1, false),
+        (|h| h.cos_dph = 36.0, 0, false),
+        (|h| h.cos_sigma_dph = -0.001, 2, false),
+        (|h| h.correlation = 1.5, 4, false),
+        (|h| h.n_headings = 3, 5, false),
+    ];
+    for (corrupt, index, non_finite) in cases {
+        let field = ModelField::Heading;
+        let want = if non_finite {
+            ModelError::NonFinite { field, index }
+        } else {
+            ModelError::OutOfBounds { field, index }
+        };
+        let mut h = harmonic();
+        corrupt(&mut h);
+        let mut loose = LooseModel::from(&good);
+        loose.heading = Some(h);
+        assert_eq!(
+            RbfModel::decode(&encode_loose(&loose, MODEL_VERSION)),
+            Err(want)
+        );
+        let mut m = good.clone();
+        m.heading = Some(h);
+        assert_eq!(
+            m.encode(&mut [0u8; 4096]),
+            Err(want),
+            "encode must refuse too"
+        );
+    }
+    // The bound itself is accepted.
+    let mut m = good.clone();
+    m.heading = Some(HeadingHarmonic {
+        cos_dph: 10.0,
+        sin_dph: -10.0,
+        ..harmonic()
+    });
+    assert_eq!(RbfModel::decode(&encode(&m)), Ok(m));
 }

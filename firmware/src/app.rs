@@ -210,7 +210,8 @@ where
             .borrow_mut()
             .configure(cfg.compensator, model)
             .map_err(AppError::Compensator)?;
-        let finder = NorthFinder::new(cfg.seek).map_err(AppError::Seek)?;
+        let mut finder = NorthFinder::new(cfg.seek).map_err(AppError::Seek)?;
+        finder.set_heading_correction(model.and_then(|m| m.heading));
         Ok(Self {
             cfg,
             compensator,
@@ -230,13 +231,25 @@ where
     }
 
     /// Replace the drift model (after a verified upload). On error the old one stays.
+    /// The model's heading harmonic (format v3) becomes the seek's heading correction; a
+    /// model without one (or no model) clears it: the correction always belongs to the
+    /// active model, whose CRC and upload signature cover it.
     pub fn set_model(&mut self, model: Option<RbfModel>) -> Result<(), CompensatorError> {
-        self.compensator.borrow_mut().set_model_from(model.as_ref())
+        self.set_model_from(model.as_ref())
     }
 
     /// `set_model` from a reference (no copy of the model on the stack).
     pub fn set_model_from(&mut self, model: Option<&RbfModel>) -> Result<(), CompensatorError> {
-        self.compensator.borrow_mut().set_model_from(model)
+        self.compensator.borrow_mut().set_model_from(model)?;
+        self.supervisor
+            .finder_mut()
+            .set_heading_correction(model.and_then(|m| m.heading));
+        Ok(())
+    }
+
+    /// The heading correction the seeks apply (the active model's harmonic).
+    pub fn heading_correction(&self) -> Option<&HeadingHarmonic> {
+        self.supervisor.finder().heading_correction()
     }
 
     /// The active model.
@@ -287,11 +300,6 @@ where
     /// The last closed window's mean base tilt.
     pub fn tilt(&self) -> Tilt {
         self.tilt
-    }
-
-    /// The heading calibration to apply to the following seeks (from its flash record).
-    pub fn set_heading_correction(&mut self, h: Option<HeadingHarmonic>) {
-        self.supervisor.finder_mut().set_heading_correction(h);
     }
 
     /// A host command at `t_s`: the answer to send (`None`: `GetStatus`, answered by the

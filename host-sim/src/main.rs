@@ -34,6 +34,8 @@ enum Command {
     Import(cmd::import::Args),
     /// Upload a signed model to the firmware over a serial link.
     Upload(cmd::upload::Args),
+    /// Attach a heading calibration (bias harmonic) to a model, for a signed upload.
+    HeadingCal(cmd::heading_cal::Args),
     /// Live north-finder status with a progress bar; seek results appended to a CSV.
     Monitor(cmd::monitor::Args),
 }
@@ -51,6 +53,7 @@ fn main() {
         Command::Import(a) => cmd::import::run(a),
         Command::Upload(a) => cmd::upload::run(a),
         Command::Monitor(a) => cmd::monitor::run(a),
+        Command::HeadingCal(a) => cmd::heading_cal::run(a),
     };
     if let Err(e) = result {
         eprintln!("fogsim: error: {e:#}");

@@ -297,3 +297,48 @@ fn the_bit_word_follows_each_counter() {
     assert!(w.failed(BitItem::Model) && w.failed(BitItem::Flash));
     assert_eq!(w.seek_permission(), Err(BitItem::Model));
 }
+
+/// Issue 10 item 5: the heading correction belongs to the active model (format v3): it
+/// is applied when a model carrying it becomes active, at start-up or on a change, and
+/// cleared by a model without one or by running without a model.
+#[test]
+fn the_heading_correction_follows_the_active_model() {
+    use fog_core::heading_cal::HeadingHarmonic;
+    let harmonic = HeadingHarmonic {
+        cos_dph: -0.04,
+        sin_dph: 0.07,
+        cos_sigma_dph: 0.003,
+        sin_sigma_dph: 0.004,
+        correlation: 0.1,
+        n_headings: 12,
+    };
+    let plain = fog_core::synthetic::warmup_model(8, 2, 1.0, 3);
+    let mut calibrated = plain.clone();
+    calibrated.heading = Some(harmonic);
+    let mut cfg = AppConfig::for_rate(RATE_HZ as f32);
+    cfg.seeks = 0;
+
+    let mut a = App::new(cfg, Some(calibrated.clone()), InstantTable(0.0)).expect("config");
+    assert_eq!(
+        a.heading_correction(),
+        Some(&harmonic),
+        "applied at start-up"
+    );
+    a.set_model_from(Some(&plain)).expect("plain model");
+    assert_eq!(
+        a.heading_correction(),
+        None,
+        "a model without one clears it"
+    );
+    a.set_model(Some(calibrated.clone()))
+        .expect("calibrated model");
+    assert_eq!(
+        a.heading_correction(),
+        Some(&harmonic),
+        "applied on a change"
+    );
+    a.set_model(None).expect("no model");
+    assert_eq!(a.heading_correction(), None, "no model, no correction");
+    let b = App::new(cfg, Some(plain), InstantTable(0.0)).expect("config");
+    assert_eq!(b.heading_correction(), None);
+}

@@ -13,10 +13,11 @@
 //! Gyro law: Earth rate on the tilted input axis (`fog_core::tilt::earth_rate_on_axis_dph`,
 //! true azimuth of table zero `TRUE_AZIMUTH_DEG`) + a constant bias + a heading-dependent
 //! bias a cos(alpha) + b sin(alpha) of the axis azimuth alpha (`HEADING`) + white noise of
-//! ARW `ARW_DPSH`; 25 degC. The heading harmonic's calibration record is preloaded into
-//! the flash sector after the model slots (QEMU `-device loader`): the device must apply it
-//! at boot, or its b part alone would turn the azimuth by ~0.5 deg (> 15 predicted sigma). The table turns instantly on `MOV` (no rotation rate is simulated:
-//! the windows during a move are discarded by the north finder anyway).
+//! ARW `ARW_DPSH`; 25 degC. The heading harmonic's calibration travels inside the model
+//! uploaded over the host link (format v3, signed): the device must apply it when the model
+//! becomes active: uploaded without it, the same run measured an error of -0.180 deg (6.0
+//! predicted sigma, beyond the 5-sigma limit below); with it -0.013 deg. The table turns instantly on `MOV` (no rotation rate is simulated: the windows
+//! during a move are discarded by the north finder anyway).
 //!
 //! Checked: two refusals first (a latitude out of range: `BadLatitude`; a seek before any
 //! model is in flash: BIT item `Model` blocks it, in the refusal and in the status), then
@@ -39,16 +40,15 @@ use std::time::{Duration, Instant};
 
 use fog_core::bit::{BitItem, BitWord};
 use fog_core::consts::EARTH_RATE_DPH;
-use fog_core::heading_cal::{HeadingCalRecord, HeadingHarmonic, FLASH_RECORD_LEN};
+use fog_core::heading_cal::HeadingHarmonic;
 use fog_core::link::{Command, ResetReason, SeekReport, Status};
 use fog_core::seek_quality::{SeekState, Validity};
 use fog_core::tilt::{earth_rate_on_axis_dph, Tilt};
-use fog_firmware::store::store_len;
 use fog_sim::monitor::{monitor, MonitorOptions, MonitorSummary, ResultLog};
 use fog_sim::upload::UploadClient;
 use fog_tests::console::{wait_line, wait_line_where};
 use fog_tests::{qemu_ready, scratch_dir};
-use qemu_support::{start_with, stream_gyro_frames};
+use qemu_support::{start, stream_gyro_frames};
 use rand_distr::Distribution;
 use upload_support::*;
 
@@ -69,7 +69,7 @@ const ARW_DPSH: f64 = 0.0011;
 /// Constant gyro bias, deg/h (cancels in the two-position difference).
 const BIAS_DPH: f64 = 0.35;
 
-/// The gyro's heading-dependent bias and its calibration record (8 headings).
+/// The gyro's heading-dependent bias and its calibration (8 headings), carried by the model.
 const HEADING: HeadingHarmonic = HeadingHarmonic {
     cos_dph: 0.2,
     sin_dph: 0.1,
@@ -78,10 +78,6 @@ const HEADING: HeadingHarmonic = HeadingHarmonic {
     correlation: 0.0,
     n_headings: 8,
 };
-/// Start of the model region (memory.x `MODELS`); the heading record follows the two
-/// 4 KiB model slots.
-const MODELS_ORIGIN: u32 = 0x000F_C000;
-
 /// The simulated table's heading, deg (table frame).
 type Heading = Arc<Mutex<f64>>;
 
@@ -194,15 +190,7 @@ fn qemu_whole_seek_over_the_host_link_with_status_result_and_refusals() {
     ];
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let dir = scratch_dir("qemu_seek");
-    let record = dir.join("heading-cal.bin");
-    let mut sector = [0xFFu8; FLASH_RECORD_LEN];
-    HeadingCalRecord::new(HEADING)
-        .encode_flash(&mut sector)
-        .unwrap();
-    std::fs::write(&record, sector).unwrap();
-    let at = MODELS_ORIGIN + store_len(4096) as u32;
-    let loader = format!("loader,file={},addr={at:#x},force-raw=on", record.display());
-    let (_qemu, mut streams, console) = start_with(&args, 3, vec!["-device".into(), loader]);
+    let (_qemu, mut streams, console) = start(&args, 3);
     let table_link = streams.pop().expect("table link");
     let gyro_link = streams.pop().expect("gyro link");
     let host = streams.pop().expect("host link");
@@ -213,9 +201,10 @@ fn qemu_whole_seek_over_the_host_link_with_status_result_and_refusals() {
         "FOG-BOOT 1 reset=PowerOn",
         Duration::from_secs(30),
     );
+    // No model yet: no heading correction.
     wait_line(
         &console,
-        "FOG-HEADING-CAL applied n_headings=8",
+        "FOG-HEADING-CAL n_headings=0",
         Duration::from_secs(10),
     );
 
@@ -261,11 +250,19 @@ fn qemu_whole_seek_over_the_host_link_with_status_result_and_refusals() {
 
     // Upload a model over the same port (the client skips the status frames).
     let mut client = UploadClient::new(host.try_clone().unwrap(), Duration::from_secs(10));
-    let bytes = encode(&sample_model(QEMU_GYRO, 8, 1.0));
+    // The model carries the heading calibration (format v3): signed with it.
+    let mut model = sample_model(QEMU_GYRO, 8, 1.0);
+    model.heading = Some(HEADING);
+    let bytes = encode(&model);
     let sig = sign_for_gyro(1, QEMU_GYRO, &bytes);
     let info = client
         .upload(&bytes, 1, &sig, |_, _| {})
         .expect("upload over the shared host port");
+    wait_line(
+        &console,
+        "FOG-HEADING-CAL n_headings=8",
+        Duration::from_secs(10),
+    );
     wait_line_where(&console, "FOG-WINDOW", Duration::from_secs(20), |l| {
         l.contains("status=Valid")
     });

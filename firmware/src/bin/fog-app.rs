@@ -60,7 +60,6 @@ use embedded_hal_nb::serial::{Read as _, Write as _};
 use fog_core::bit::BitLimits;
 use fog_core::compensator::Compensator;
 use fog_core::hal::Gyro;
-use fog_core::heading_cal::{HeadingCalRecord, HeadingHarmonic, FLASH_RECORD_LEN};
 use fog_core::link::{DeviceMessage, ResetReason};
 use fog_core::model::RbfModel;
 use fog_core::protocol::ResetRecord;
@@ -75,7 +74,6 @@ use fog_firmware::drivers::inclinometer::{
 use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig};
 use fog_firmware::health::{StuckDetector, StuckEvent, DEFAULT_STUCK_RUN};
 use fog_firmware::link_out::{queue_whole, LinkFrame};
-use fog_firmware::store::store_len;
 use fog_firmware::upload::UploadServer;
 use resets::BootFault;
 
@@ -139,8 +137,6 @@ fn main() -> ! {
 
     // The long-lived state lives in statics (counted in the static-RAM budget by the
     // linker), not in main's stack frame.
-    let mut flash = flash;
-    let heading_cal = read_heading_cal(&mut flash);
     let server = start_upload_server(flash, reset);
     // Decoded in place into `MODEL` (the compensator keeps its own copy).
     let stored = server.load_active_model_into(model).unwrap_or_else(|e| {
@@ -170,7 +166,7 @@ fn main() -> ! {
             resets::fatal_boot(BootFault::Configuration)
         }
     };
-    app.set_heading_correction(heading_cal);
+    announce_heading_correction(&app);
     let mut gyro = FogSerialGyro::with_clock(gyro_uart, gyro_rate_hz, millis::MillisClock);
     let mut last_t_s = 0.0;
     // Clock reading at the last gyro sample (`None` until the gyro starts).
@@ -326,37 +322,19 @@ fn main() -> ! {
     }
 }
 
-/// The heading calibration (`HeadingCalRecord`) from its own flash sector, right after
-/// the two model slots; `None` if none was written or it is unreadable (then logged:
-/// seeks run uncalibrated, as before any calibration).
-fn read_heading_cal<F: embedded_storage::nor_flash::NorFlash>(
-    flash: &mut F,
-) -> Option<HeadingHarmonic> {
-    let at = store_len(F::ERASE_SIZE) as u32;
-    let mut buf = [0u8; FLASH_RECORD_LEN];
-    if flash.read(at, &mut buf).is_err() {
-        defmt::warn!("heading calibration sector unreadable");
-        return None;
-    }
-    match HeadingCalRecord::decode_flash(&buf) {
-        Ok(Some(r)) => {
-            defmt::info!(
-                "heading calibration applied ({} headings)",
-                r.harmonic.n_headings
-            );
-            #[cfg(feature = "log-semihosting")]
-            semihosting::eprintln!(
-                "FOG-HEADING-CAL applied n_headings={}",
-                r.harmonic.n_headings
-            );
-            Some(r.harmonic)
-        }
-        Ok(None) => None,
-        Err(e) => {
-            defmt::warn!("heading calibration record refused: {}", e);
-            None
-        }
-    }
+/// Logs the heading correction the active model brought (format v3 models carry it; the
+/// App applies it on every model change). Under QEMU also as plain text, where the seek
+/// scenario checks that an uploaded harmonic is in use.
+fn announce_heading_correction<T, C>(app: &App<T, C>)
+where
+    T: fog_core::hal::Turntable,
+    T::Error: Copy,
+    C: core::borrow::BorrowMut<Compensator>,
+{
+    let n_headings = app.heading_correction().map_or(0, |h| h.n_headings);
+    defmt::info!("heading correction: {} headings (0: none)", n_headings);
+    #[cfg(feature = "log-semihosting")]
+    semihosting::eprintln!("FOG-HEADING-CAL n_headings={}", n_headings);
 }
 
 /// The board's part of a status message.
@@ -419,7 +397,10 @@ where
 {
     match server.load_active_model_into(model) {
         Ok(stored) => match app.set_model_from(stored.then_some(&*model)) {
-            Ok(()) => defmt::info!("new model in use"),
+            Ok(()) => {
+                defmt::info!("new model in use");
+                announce_heading_correction(app);
+            }
             Err(e) => defmt::error!("new model refused: {}", e),
         },
         Err(e) => defmt::error!("new model not loaded: {}", e),

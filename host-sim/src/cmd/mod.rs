@@ -5,6 +5,7 @@ pub mod campaign;
 pub mod compensate;
 pub mod demo;
 pub mod diagnose;
+pub mod heading_cal;
 pub mod import;
 pub mod monitor;
 pub mod north_seek;

@@ -37,6 +37,7 @@ pub fn sample_model(gyro_id: &str, n_centers: usize, weight_scale: f32) -> RbfMo
             n_train: 1350,
         },
         poly: Default::default(),
+        heading: None,
     };
     for i in 0..n_centers {
         let u = i as f32 / n_centers.max(1) as f32;
