@@ -45,7 +45,7 @@ use fog_firmware::clock::Clock;
 use fog_firmware::drivers::fog_serial::FogSerialGyro;
 use fog_firmware::drivers::tmp117::Tmp117;
 use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig};
-use fog_firmware::health::{StuckDetector, StuckEvent, DEFAULT_STUCK_RUN};
+use fog_firmware::health::{GyroWatch, StuckEvent, DEFAULT_STUCK_RUN};
 use fog_firmware::upload::UploadServer;
 use resets::BootFault;
 use stm32f4xx_hal::i2c::I2c;
@@ -189,10 +189,7 @@ fn main() -> ! {
         }
     };
     let mut gyro = FogSerialGyro::with_clock(gyro_port, GYRO_RATE_HZ, millis::MillisClock);
-    let mut last_sample_clock_s: Option<f64> = None;
-    let mut last_t_s = 0.0;
-    let mut gyro_silent = false;
-    let mut stuck = StuckDetector::new(DEFAULT_STUCK_RUN);
+    let mut watch = GyroWatch::new(GYRO_SILENCE_S, DEFAULT_STUCK_RUN);
 
     loop {
         let now_s = millis::MillisClock.now_s();
@@ -200,15 +197,13 @@ fn main() -> ! {
         loop {
             match gyro.read() {
                 Ok(Some(s)) => {
-                    last_t_s = s.t_s;
-                    last_sample_clock_s = Some(now_s);
-                    gyro_silent = false;
-                    match stuck.push(s.rate_dph) {
+                    let health = watch.on_sample(now_s, s.t_s, s.rate_dph);
+                    match health.stuck_event {
                         Some(StuckEvent::Stuck) => defmt::warn!("t={} s: gyro stuck", s.t_s),
                         Some(StuckEvent::Recovered) => defmt::info!("t={} s: gyro moving", s.t_s),
                         None => {}
                     }
-                    if stuck.is_stuck() {
+                    if health.stuck {
                         app.on_fault(s.t_s);
                     }
                     if app.temp_due(s.t_s) {
@@ -229,15 +224,13 @@ fn main() -> ! {
                 Ok(None) => break,
                 Err(e) => {
                     defmt::warn!("gyro UART error {}", e);
-                    app.on_fault(last_t_s);
+                    app.on_fault(watch.last_t_s());
                 }
             }
         }
-        let silent_s = last_sample_clock_s.map_or(0.0, |t| now_s - t);
-        if !gyro_silent && silent_s > GYRO_SILENCE_S {
-            gyro_silent = true;
-            defmt::warn!("t={} s: gyro silent: window invalid", last_t_s);
-            app.on_fault(last_t_s);
+        if watch.became_silent(now_s) {
+            defmt::warn!("t={} s: gyro silent: window invalid", watch.last_t_s());
+            app.on_fault(watch.last_t_s());
         }
         if gyro.uart_mut().dropped() == drops_before {
             watchdog.feed();

@@ -67,3 +67,74 @@ impl StuckDetector {
         None
     }
 }
+
+/// What a sample told the main loop about the gyro's health.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SampleHealth {
+    /// Samples arrive again after the gyro was silent.
+    pub resumed: bool,
+    /// The stuck detector's change, if any.
+    pub stuck_event: Option<StuckEvent>,
+    /// The sample belongs to a stuck run: its window is invalid.
+    pub stuck: bool,
+}
+
+/// The main loop's view of the gyro between passes: the last sample (sample time and
+/// clock time), silence beyond `silence_s`, and the stuck detector. One type, so that
+/// `fog-app` and the board binary judge a dead or stuck gyro the same way.
+#[derive(Clone, Copy, Debug)]
+pub struct GyroWatch {
+    last_sample_clock_s: Option<f64>,
+    last_t_s: f64,
+    silent: bool,
+    silence_s: f64,
+    stuck: StuckDetector,
+}
+
+impl GyroWatch {
+    /// `silence_s`: clock time without a sample that makes the gyro silent;
+    /// `stuck_run`: identical samples in a row that make it stuck.
+    pub const fn new(silence_s: f64, stuck_run: u32) -> Self {
+        Self {
+            last_sample_clock_s: None,
+            last_t_s: 0.0,
+            silent: false,
+            silence_s,
+            stuck: StuckDetector::new(stuck_run),
+        }
+    }
+
+    /// A sample of sample time `t_s` and rate `rate_dph` arrived at clock time `now_s`.
+    pub fn on_sample(&mut self, now_s: f64, t_s: f64, rate_dph: f32) -> SampleHealth {
+        self.last_t_s = t_s;
+        self.last_sample_clock_s = Some(now_s);
+        let resumed = core::mem::replace(&mut self.silent, false);
+        let stuck_event = self.stuck.push(rate_dph);
+        SampleHealth {
+            resumed,
+            stuck_event,
+            stuck: self.stuck.is_stuck(),
+        }
+    }
+
+    /// True once, when no sample has come for longer than the silence limit at clock
+    /// time `now_s` (before the first sample the gyro is not judged).
+    pub fn became_silent(&mut self, now_s: f64) -> bool {
+        let quiet_s = self.last_sample_clock_s.map_or(0.0, |t| now_s - t);
+        if !self.silent && quiet_s > self.silence_s {
+            self.silent = true;
+            return true;
+        }
+        false
+    }
+
+    /// Sample time of the last sample, s (0 before the first).
+    pub fn last_t_s(&self) -> f64 {
+        self.last_t_s
+    }
+
+    /// Clock time of the last sample, s.
+    pub fn last_sample_clock_s(&self) -> Option<f64> {
+        self.last_sample_clock_s
+    }
+}

@@ -2,8 +2,10 @@
 //! flagged after the run limit and cleared when the value moves; realistic FOG noise
 //! (simulated ARW at the frame's 1e-9 deg resolution) never triggers it, and neither
 //! does a different law: a quieter gyro with heavy-tailed noise on a bias random walk.
+//! `GyroWatch` (silence and stuck bookkeeping shared by both firmware binaries) reports
+//! each change once.
 
-use fog_firmware::health::{StuckDetector, StuckEvent, DEFAULT_STUCK_RUN};
+use fog_firmware::health::{GyroWatch, StuckDetector, StuckEvent, DEFAULT_STUCK_RUN};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 
@@ -60,4 +62,31 @@ fn fog_noise_and_a_quantised_ramp_never_look_stuck() {
         let laplace = scale_dph * (exp.sample(&mut rng) - exp.sample(&mut rng));
         assert_eq!(d.push(quantise(9.7 + bias_dph + laplace)), None);
     }
+}
+
+#[test]
+fn gyro_watch_reports_silence_once_and_resumption_once() {
+    let mut watch = GyroWatch::new(0.1, DEFAULT_STUCK_RUN);
+    // Before the first sample the gyro is not judged.
+    assert!(!watch.became_silent(100.0));
+    let h = watch.on_sample(1.0, 0.5, 1.0);
+    assert!(!h.resumed && !h.stuck && h.stuck_event.is_none());
+    assert!(!watch.became_silent(1.05), "within the 0.1 s limit");
+    assert!(watch.became_silent(1.2));
+    assert!(!watch.became_silent(5.0), "silence is reported once");
+    assert_eq!(watch.last_t_s(), 0.5);
+    assert_eq!(watch.last_sample_clock_s(), Some(1.0));
+    let h = watch.on_sample(5.0, 0.6, 2.0);
+    assert!(h.resumed);
+    assert!(!watch.on_sample(5.001, 0.7, 3.0).resumed);
+    // A frozen output: stuck at the limit, windows invalid until it moves.
+    let mut last = watch.on_sample(5.002, 0.8, 7.0);
+    for i in 1..DEFAULT_STUCK_RUN {
+        last = watch.on_sample(5.002, 0.8 + f64::from(i) * 1e-3, 7.0);
+    }
+    assert_eq!(last.stuck_event, Some(StuckEvent::Stuck));
+    assert!(last.stuck);
+    let moved = watch.on_sample(6.0, 2.0, 7.5);
+    assert_eq!(moved.stuck_event, Some(StuckEvent::Recovered));
+    assert!(!moved.stuck);
 }

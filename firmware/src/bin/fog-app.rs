@@ -72,7 +72,7 @@ use fog_firmware::drivers::inclinometer::{
     Inclinometer, SimulatedInclinometer, SIMULATED_NOISE_DEG,
 };
 use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig};
-use fog_firmware::health::{StuckDetector, StuckEvent, DEFAULT_STUCK_RUN};
+use fog_firmware::health::{GyroWatch, StuckEvent, DEFAULT_STUCK_RUN};
 use fog_firmware::link_out::{queue_whole, LinkFrame};
 use fog_firmware::upload::UploadServer;
 use resets::BootFault;
@@ -168,11 +168,8 @@ fn main() -> ! {
     };
     announce_heading_correction(&app);
     let mut gyro = FogSerialGyro::with_clock(gyro_uart, gyro_rate_hz, millis::MillisClock);
-    let mut last_t_s = 0.0;
     // Clock reading at the last gyro sample (`None` until the gyro starts).
-    let mut last_sample_clock_s: Option<f64> = None;
-    let mut gyro_silent = false;
-    let mut stuck = StuckDetector::new(DEFAULT_STUCK_RUN);
+    let mut watch = GyroWatch::new(GYRO_SILENCE_S, DEFAULT_STUCK_RUN);
     let mut inclinometer =
         SimulatedInclinometer::new(options.tilt, SIMULATED_NOISE_DEG, TILT_NOISE_SEED);
     let mut next_tilt_s = 0.0;
@@ -190,13 +187,11 @@ fn main() -> ! {
         while !drained {
             match gyro.read() {
                 Ok(Some(s)) => {
-                    last_t_s = s.t_s;
-                    last_sample_clock_s = Some(now_s);
-                    if gyro_silent {
-                        gyro_silent = false;
+                    let health = watch.on_sample(now_s, s.t_s, s.rate_dph);
+                    if health.resumed {
                         defmt::info!("t={} s: gyro samples again", s.t_s);
                     }
-                    match stuck.push(s.rate_dph) {
+                    match health.stuck_event {
                         Some(StuckEvent::Stuck) => {
                             defmt::warn!("t={} s: gyro output stuck: windows invalid", s.t_s)
                         }
@@ -205,7 +200,7 @@ fn main() -> ! {
                         }
                         None => {}
                     }
-                    if stuck.is_stuck() {
+                    if health.stuck {
                         app.on_fault(s.t_s);
                     }
                     if app.temp_due(s.t_s) {
@@ -246,18 +241,16 @@ fn main() -> ! {
                 Ok(None) => drained = true,
                 Err(e) => {
                     defmt::warn!("gyro UART error {}", e);
-                    app.on_fault(last_t_s);
+                    app.on_fault(watch.last_t_s());
                 }
             }
         }
-        let silent_s = last_sample_clock_s.map_or(0.0, |t| now_s - t);
-        if !gyro_silent && silent_s > GYRO_SILENCE_S {
-            gyro_silent = true;
+        if watch.became_silent(now_s) {
             defmt::warn!(
                 "t={} s: gyro silent (dead sensor or cable): window invalid",
-                last_t_s
+                watch.last_t_s()
             );
-            app.on_fault(last_t_s);
+            app.on_fault(watch.last_t_s());
         }
         // The gyro path is healthy when its ring was drained and lost nothing.
         if gyro.uart_mut().dropped() == drops_before {
@@ -270,7 +263,7 @@ fn main() -> ! {
             let stats = gyro.stats();
             let counters = BitCounters {
                 now_s,
-                last_gyro_s: last_sample_clock_s,
+                last_gyro_s: watch.last_sample_clock_s(),
                 frames_ok: stats.frames.frames_ok,
                 frames_bad: stats.frames.crc_errors,
                 temp: gyro.latest_temp().map(|t| (t.t_s, t.temp_c)),
@@ -280,7 +273,7 @@ fn main() -> ! {
                 flash_ok: server.slots_refused_at_boot() == 0,
             };
             app.set_bit(bit_monitor.evaluate(&counters));
-            let board = board_status(last_t_s, gyro.latest_temp(), server, reset_reason);
+            let board = board_status(watch.last_t_s(), gyro.latest_temp(), server, reset_reason);
             send_link(tx_queue, DeviceMessage::Status(app.status(board)));
         }
 
@@ -296,8 +289,9 @@ fn main() -> ! {
                 server.note_reply_dropped();
             }
             if let Some(cmd) = command {
-                let answer = app.command(cmd, last_t_s);
-                let board = board_status(last_t_s, gyro.latest_temp(), server, reset_reason);
+                let answer = app.command(cmd, watch.last_t_s());
+                let board =
+                    board_status(watch.last_t_s(), gyro.latest_temp(), server, reset_reason);
                 let status = DeviceMessage::Status(app.status(board));
                 for msg in answer.into_iter().chain(core::iter::once(status)) {
                     answer_link(server, tx_queue, msg);
