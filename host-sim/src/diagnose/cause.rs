@@ -84,6 +84,7 @@ mod tests {
             source: Source::Temp,
             transform: Transform::Lag,
             tau_s: Some(240.0),
+            half_s: None,
         };
         let cause = Cause::from(&cand);
         assert_eq!(cause.label(), cand.label());

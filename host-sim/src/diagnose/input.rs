@@ -7,6 +7,7 @@
 //! Raw-rate records are averaged into 10 s windows (the paper's protocol); slower
 //! records (e.g. one mean per burst) are kept as they are.
 
+use super::derivatives::{self, WidthChoice, HALF_WIDTHS_S};
 use super::error::DiagnoseError;
 use crate::io::runs::Run;
 
@@ -39,12 +40,25 @@ pub struct Campaign {
     pub runs: Vec<Series>,
     pub extra_names: Vec<String>,
     pub exclusions: Vec<Exclusion>,
+    /// Half-width of every derivative, chosen per column by leave-one-out validation
+    /// (`derivatives::choose`): `temp_c` first, then the extras, rate before accel.
+    pub derivative_widths: Vec<WidthChoice>,
 }
 
 impl Campaign {
     /// Total number of 10 s points.
     pub fn points(&self) -> usize {
         self.runs.iter().map(|r| r.t_s.len()).sum()
+    }
+
+    /// The validated half-width of the order-`order` derivative of `column`, s (the
+    /// narrowest grid width when the column could not be validated: too few samples).
+    pub fn half_width_s(&self, column: &str, order: usize) -> f64 {
+        let derivative = if order == 1 { "rate" } else { "accel" };
+        self.derivative_widths
+            .iter()
+            .find(|w| w.column == column && w.derivative == derivative)
+            .map_or(HALF_WIDTHS_S[0], |w| w.half_width_s)
     }
 
     /// Index of an extra column by name.
@@ -62,11 +76,13 @@ pub fn prepare(runs: &[Run]) -> Result<Campaign, DiagnoseError> {
         check_run(run)?;
     }
     let (extra_names, exclusions) = usable_extras(runs);
-    let series = runs.iter().map(|r| to_series(r, &extra_names)).collect();
+    let series: Vec<Series> = runs.iter().map(|r| to_series(r, &extra_names)).collect();
+    let derivative_widths = choose_widths(&series, &extra_names);
     let campaign = Campaign {
         runs: series,
         extra_names,
         exclusions,
+        derivative_widths,
     };
     for (name, pick) in [("temp_c", 0usize), ("rate_dph", 1)] {
         let all: Vec<f64> = campaign
@@ -88,6 +104,33 @@ pub fn prepare(runs: &[Run]) -> Result<Campaign, DiagnoseError> {
         }
     }
     Ok(campaign)
+}
+
+/// Validated derivative half-widths of `temp_c` and every extra column (rate, accel).
+fn choose_widths(series: &[Series], extra_names: &[String]) -> Vec<WidthChoice> {
+    let mut out = Vec::new();
+    let columns = std::iter::once(("temp_c", None)).chain(
+        extra_names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| (n.as_str(), Some(i))),
+    );
+    for (name, extra) in columns {
+        let runs: Vec<(&[f64], &[f64])> = series
+            .iter()
+            .map(|s| {
+                let x: &[f64] = match extra {
+                    None => &s.temp_c,
+                    Some(i) => &s.extras[i],
+                };
+                (s.t_s.as_slice(), x)
+            })
+            .collect();
+        for order in [1, 2] {
+            out.extend(derivatives::choose(name, &runs, order));
+        }
+    }
+    out
 }
 
 fn check_run(run: &Run) -> Result<(), DiagnoseError> {

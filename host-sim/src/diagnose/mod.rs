@@ -18,6 +18,7 @@ pub mod between;
 pub mod bootstrap;
 pub mod cause;
 pub mod cv;
+pub mod derivatives;
 pub mod error;
 pub mod input;
 pub mod linalg;
@@ -135,6 +136,7 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
         residual_structure: residuals::structure(&campaign, &folds, &st, &base.cv.residual),
         outliers: outliers::locate(&folds, &run_names, &st.t_s, &st.y, &base.cv.residual),
         between_run,
+        derivative_widths: campaign.derivative_widths.clone(),
         candidates: screening.scored.iter().map(candidate_row).collect(),
         named_cause: cause,
         cause_in_words: words,

@@ -5,9 +5,9 @@
 
 use super::basis::RbfBasis;
 use super::cv::{CvResult, Folds, Prepared};
+use super::derivatives;
 use super::error::DiagnoseError;
 use super::input::Campaign;
-use super::transforms::{local_derivative, RATE_HALF_S};
 
 /// Width factors tried (x mean centre spacing).
 pub const WIDTH_FACTORS: [f64; 3] = [0.5, 1.0, 2.0];
@@ -27,8 +27,10 @@ pub struct Stacked {
 }
 
 impl Stacked {
-    /// Stacks drift, time, temperature and dT/dt (centred least-squares slope).
+    /// Stacks drift, time, temperature and dT/dt (centred local polynomial, half-width
+    /// validated on the temperature, `derivatives`).
     pub fn new(c: &Campaign) -> Self {
+        let rate_half_s = c.half_width_s("temp_c", 1);
         let cat = |f: &dyn Fn(&super::input::Series) -> Vec<f64>| {
             c.runs.iter().flat_map(f).collect::<Vec<f64>>()
         };
@@ -36,7 +38,7 @@ impl Stacked {
             y: cat(&|s| s.drift_dph.clone()),
             t_s: cat(&|s| s.t_s.clone()),
             temp_c: cat(&|s| s.temp_c.clone()),
-            temp_rate_cps: cat(&|s| local_derivative(&s.t_s, &s.temp_c, 1, RATE_HALF_S)),
+            temp_rate_cps: cat(&|s| derivatives::centred(&s.t_s, &s.temp_c, 1, rate_half_s)),
             run_lengths: c.runs.iter().map(|s| s.t_s.len()).collect(),
         }
     }

@@ -107,6 +107,9 @@ pub struct Report {
     pub residual_structure: Structure,
     pub outliers: super::outliers::Outliers,
     pub between_run: super::between::BetweenRun,
+    /// Half-width of every `rate` / `accel` window, chosen per column by leave-one-out
+    /// validation of the local polynomial on the column itself.
+    pub derivative_widths: Vec<super::derivatives::WidthChoice>,
     pub candidates: Vec<CandidateRow>,
     pub named_cause: Option<Cause>,
     pub cause_in_words: String,
@@ -263,9 +266,33 @@ fn write_residual(s: &mut String, r: &Report) {
     }
 }
 
+/// The validated derivative windows, one line per column.
+fn write_derivative_widths(s: &mut String, widths: &[super::derivatives::WidthChoice]) {
+    let _ = writeln!(
+        s,
+        "  derivative windows (local polynomial, half-width by leave-one-out on the column itself):"
+    );
+    let mut columns: Vec<&str> = widths.iter().map(|w| w.column.as_str()).collect();
+    columns.dedup();
+    for col in columns {
+        let parts: Vec<String> = widths
+            .iter()
+            .filter(|w| w.column == col)
+            .map(|w| {
+                format!(
+                    "{} +/-{:.0} s (degree {}, LOO rms {:.3e})",
+                    w.derivative, w.half_width_s, w.poly_degree, w.loo_rms
+                )
+            })
+            .collect();
+        let _ = writeln!(s, "    {col:<14} {}", parts.join("; "));
+    }
+}
+
 /// Section 3: ranked within-run candidates, then the between-run ones.
 fn write_candidates(s: &mut String, r: &Report) {
     let _ = writeln!(s, "\n3. Candidate causes (ranked by held-out rms; p = family-wise sign-flip test over whole validation units)");
+    write_derivative_widths(s, &r.derivative_widths);
     for row in r.candidates.iter().take(8) {
         let label = crate::report::feature_label(&row.column, row.transform.name(), row.tau_s);
         let _ = writeln!(

@@ -2,18 +2,16 @@
 //! `lag` (several tau), plus `t_s:decay` and `harmonic` for `*_deg` columns.
 //!
 //! Derivatives are local least-squares polynomial fits over a centred window (zero
-//! delay, edges use the samples available): a diagnosis looks at the whole record, so it
+//! delay, edges use the samples available) whose half-width was chosen per column by
+//! leave-one-out validation (`derivatives`): a diagnosis looks at the whole record, so it
 //! need not be causal. Lags are exact first-order low-passes started at the first value.
 
+use super::derivatives;
 use super::input::{Campaign, Series};
 use serde::Serialize;
 
 /// Time constants tried for `lag` and `decay`, s.
 pub const TAUS_S: [f64; 7] = [30.0, 60.0, 120.0, 240.0, 480.0, 960.0, 1920.0];
-/// Half-width of the `rate` window, s (at least one sample each side).
-pub const RATE_HALF_S: f64 = 30.0;
-/// Half-width of the `accel` window, s (at least two samples each side).
-pub const ACCEL_HALF_S: f64 = 60.0;
 
 /// How a column is turned into a feature.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
@@ -61,6 +59,8 @@ pub struct Candidate {
     pub source: Source,
     pub transform: Transform,
     pub tau_s: Option<f64>,
+    /// Half-width of a `rate` or `accel` window, s (validated per column).
+    pub half_s: Option<f64>,
 }
 
 impl Candidate {
@@ -88,10 +88,11 @@ impl Candidate {
             Source::Extra(i) => &s.extras[i],
         };
         let tau = self.tau_s.unwrap_or(0.0);
+        let half_s = self.half_s.unwrap_or(derivatives::HALF_WIDTHS_S[0]);
         match self.transform {
             Transform::Value => vec![x.to_vec()],
-            Transform::Rate => vec![local_derivative(&s.t_s, x, 1, RATE_HALF_S)],
-            Transform::Accel => vec![local_derivative(&s.t_s, x, 2, ACCEL_HALF_S)],
+            Transform::Rate => vec![derivatives::centred(&s.t_s, x, 1, half_s)],
+            Transform::Accel => vec![derivatives::centred(&s.t_s, x, 2, half_s)],
             Transform::Lag => vec![first_order_lag(&s.t_s, x, tau)],
             Transform::Decay => vec![s.t_s.iter().map(|t| (-t / tau).exp()).collect()],
             Transform::Harmonic => vec![
@@ -110,6 +111,11 @@ pub fn enumerate(c: &Campaign) -> Vec<Candidate> {
         source,
         transform,
         tau_s,
+        half_s: match transform {
+            Transform::Rate => Some(c.half_width_s(column, 1)),
+            Transform::Accel => Some(c.half_width_s(column, 2)),
+            _ => None,
+        },
     };
     for tau in TAUS_S {
         out.push(mk("t_s", Source::Time, Transform::Decay, Some(tau)));
@@ -133,65 +139,6 @@ pub fn enumerate(c: &Campaign) -> Vec<Candidate> {
     out
 }
 
-/// Derivative of order 1 or 2 from a local polynomial (degree = order) least-squares fit
-/// over samples within `half_s` of each point (at least `order` samples each side where
-/// the record allows).
-pub fn local_derivative(t: &[f64], x: &[f64], order: usize, half_s: f64) -> Vec<f64> {
-    let n = t.len();
-    let need = order + 1;
-    (0..n)
-        .map(|i| {
-            if n < need {
-                return 0.0;
-            }
-            let mut lo = i;
-            let mut hi = i;
-            while lo > 0 && (t[i] - t[lo - 1] <= half_s + 1e-9 || i - lo < order) {
-                lo -= 1;
-            }
-            while hi + 1 < n && (t[hi + 1] - t[i] <= half_s + 1e-9 || hi - i < order) {
-                hi += 1;
-            }
-            while hi - lo + 1 < need {
-                if lo > 0 {
-                    lo -= 1;
-                } else {
-                    hi += 1;
-                }
-            }
-            poly_coef(&t[lo..=hi], &x[lo..=hi], t[i], order)
-        })
-        .collect()
-}
-
-/// Fits x = sum_k c_k (t - t0)^k, k <= degree, and returns the degree-th derivative at t0.
-fn poly_coef(t: &[f64], x: &[f64], t0: f64, degree: usize) -> f64 {
-    let p = degree + 1;
-    let mut a = [[0.0f64; 3]; 3];
-    let mut b = [0.0f64; 3];
-    let scale = t.iter().map(|v| (v - t0).abs()).fold(1e-9, f64::max);
-    for (&ti, &xi) in t.iter().zip(x) {
-        let u = (ti - t0) / scale;
-        let pw = [1.0, u, u * u];
-        for r in 0..p {
-            b[r] += pw[r] * xi;
-            for c in 0..p {
-                a[r][c] += pw[r] * pw[c];
-            }
-        }
-    }
-    let mut m: Vec<f64> = (0..p)
-        .flat_map(|r| (0..p).map(move |c| (r, c)))
-        .map(|(r, c)| a[r][c])
-        .collect();
-    let mut rhs: Vec<f64> = b[..p].to_vec();
-    if super::linalg::solve_spd(&mut m, &mut rhs, p).is_err() {
-        return 0.0;
-    }
-    let fact = if degree == 2 { 2.0 } else { 1.0 };
-    fact * rhs[degree] / scale.powi(degree as i32)
-}
-
 /// First-order low-pass with time constant `tau_s`, exact for piecewise-constant input.
 pub fn first_order_lag(t: &[f64], x: &[f64], tau_s: f64) -> Vec<f64> {
     let mut out = Vec::with_capacity(x.len());
@@ -209,25 +156,6 @@ pub fn first_order_lag(t: &[f64], x: &[f64], tau_s: f64) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn derivatives_of_a_quadratic_are_exact() {
-        let t: Vec<f64> = (0..40).map(|i| 10.0 * i as f64).collect();
-        let x: Vec<f64> = t.iter().map(|t| 3.0 + 0.2 * t + 0.001 * t * t).collect();
-        let r = local_derivative(&t, &x, 1, RATE_HALF_S);
-        let a = local_derivative(&t, &x, 2, ACCEL_HALF_S);
-        for i in 0..t.len() {
-            assert!((a[i] - 0.002).abs() < 1e-9, "accel at {i}");
-            // a line through a parabola is exact only on a centred window
-            if (3..t.len() - 3).contains(&i) {
-                assert!((r[i] - (0.2 + 0.002 * t[i])).abs() < 1e-9, "rate at {i}");
-            }
-        }
-        let line: Vec<f64> = t.iter().map(|t| 1.0 - 0.5 * t).collect();
-        assert!(local_derivative(&t, &line, 1, RATE_HALF_S)
-            .iter()
-            .all(|r| (r + 0.5).abs() < 1e-9));
-    }
 
     #[test]
     fn lag_settles_to_a_step() {

@@ -19,6 +19,13 @@ pub enum Hidden {
     /// A cos(heading - phase), constant within a run (magnetic bias); its rms over
     /// headings is this many turn-on repeatability sigmas.
     HeadingBetweenRuns(f64),
+    /// The chamber air cycles (a sinusoid of random period and amplitude) and the drift
+    /// has a term k d2T/dt2 whose rms over the campaign is this many 10 s noise sigmas (0:
+    /// the same cycling campaign with nothing hidden, its null twin). The gyro follows the
+    /// chamber through the same critically damped law, integrated (RK4, 1 s), so d2T/dt2
+    /// is not a function of T and dT/dt.
+    #[allow(dead_code)] // constructed by diagnose_derivatives only
+    TempAccel(f64),
 }
 
 /// Turn-on repeatability (sd of run offsets), deg/h.
@@ -36,7 +43,7 @@ pub fn campaign(hidden: Hidden, seed: u64) -> (Vec<Run>, Option<&'static str>) {
     // rms of A cos(h - phase) over uniform headings is A / sqrt 2
     let sigmas = match hidden {
         Hidden::HeadingBetweenRuns(s) => s,
-        Hidden::Null => 0.0,
+        Hidden::Null | Hidden::TempAccel(_) => 0.0,
     };
     let amp = sigmas * REPEATABILITY_DPH * std::f64::consts::SQRT_2;
     let (k1, k2) = (
@@ -46,6 +53,7 @@ pub fn campaign(hidden: Hidden, seed: u64) -> (Vec<Run>, Option<&'static str>) {
     let shupe = rng.random_range(2.0..6.0);
     let mut runs = Vec::new();
     let mut cabinet = 20.0;
+    let mut accel_rows: Vec<Vec<f64>> = Vec::new();
     for (i, amb) in ambients.iter().flat_map(|a| [*a; 5]).enumerate() {
         let heading: f64 = rng.random_range(0.0..360.0);
         let warm = i % 3 == 2;
@@ -59,13 +67,20 @@ pub fn campaign(hidden: Hidden, seed: u64) -> (Vec<Run>, Option<&'static str>) {
         let offset = REPEATABILITY_DPH * g.sample(&mut rng);
         let mut supply = 24.0;
         let mut cols: Vec<Vec<f64>> = (0..6).map(|_| Vec::with_capacity(rows)).collect();
+        let mut cycled = matches!(hidden, Hidden::TempAccel(_))
+            .then(|| CycledChamber::draw(&mut rng, amb, rise, tau, start));
         for k in 0..rows {
             let t = (k + 1) as f64;
             let x = t / tau;
             // critically damped: 1 - (1 + x) e^-x, started part-way on a warm restart
             let frac = start + (1.0 - start) * (1.0 - (1.0 + x) * (-x).exp());
-            let temp = amb + rise * frac;
-            let dtemp = (1.0 - start) * rise * x * (-x).exp() / tau;
+            let (temp, dtemp) = match cycled.as_mut() {
+                Some(c) => c.advance_to(t),
+                None => (
+                    amb + rise * frac,
+                    (1.0 - start) * rise * x * (-x).exp() / tau,
+                ),
+            };
             let d = temp - 25.0;
             cabinet += 0.01 * g.sample(&mut rng);
             if rng.random::<f64>() < 0.002 {
@@ -82,6 +97,7 @@ pub fn campaign(hidden: Hidden, seed: u64) -> (Vec<Run>, Option<&'static str>) {
                 c.push(v);
             }
         }
+        accel_rows.push(cycled.map(|c| c.accel).unwrap_or_default());
         runs.push(Run {
             path: format!("ind{seed}_run{i:02}.csv").into(),
             meta: vec![
@@ -101,6 +117,87 @@ pub fn campaign(hidden: Hidden, seed: u64) -> (Vec<Run>, Option<&'static str>) {
             data: cols,
         });
     }
-    let expected = (sigmas > 0.0).then_some("heading_deg:run_harmonic");
+    let expected = match hidden {
+        Hidden::TempAccel(s) if s > 0.0 => {
+            add_accel_effect(&mut runs, &accel_rows, s * NOISE_10S_DPH);
+            Some("temp_c:accel")
+        }
+        _ => (sigmas > 0.0).then_some("heading_deg:run_harmonic"),
+    };
     (runs, expected)
+}
+
+/// The gyro's temperature under a cycling chamber: tau^2 T'' + 2 tau T' + T = u(t), u the
+/// chamber plus self-heating, integrated by RK4 in 1 s steps; keeps the true d2T/dt2.
+struct CycledChamber {
+    tau_s: f64,
+    /// Settled temperature without the cycle (ambient + self-heating rise), degC.
+    settled_c: f64,
+    amp_c: f64,
+    omega_rps: f64,
+    phase: f64,
+    t_s: f64,
+    temp_c: f64,
+    rate_cps: f64,
+    accel: Vec<f64>,
+}
+
+impl CycledChamber {
+    fn draw(rng: &mut ChaCha8Rng, amb: f64, rise: f64, tau_s: f64, start: f64) -> Self {
+        Self {
+            tau_s,
+            settled_c: amb + rise,
+            amp_c: rng.random_range(1.0..3.0),
+            omega_rps: std::f64::consts::TAU / rng.random_range(900.0..2400.0),
+            phase: rng.random_range(0.0..std::f64::consts::TAU),
+            t_s: 0.0,
+            temp_c: amb + rise * start,
+            rate_cps: 0.0,
+            accel: Vec::new(),
+        }
+    }
+
+    /// Chamber input at `t_s` (starts at the ambient: the cycle is zero at power-on).
+    fn input_c(&self, t_s: f64) -> f64 {
+        self.settled_c + self.amp_c * ((self.omega_rps * t_s + self.phase).sin() - self.phase.sin())
+    }
+
+    /// T'' from the state (T, T') at time t.
+    fn second(&self, t_s: f64, temp: f64, rate: f64) -> f64 {
+        (self.input_c(t_s) - temp - 2.0 * self.tau_s * rate) / (self.tau_s * self.tau_s)
+    }
+
+    /// Integrates to `t_s` (1 s steps); returns (T, dT/dt) and records d2T/dt2 there.
+    fn advance_to(&mut self, t_s: f64) -> (f64, f64) {
+        while self.t_s < t_s - 1e-9 {
+            let h = (t_s - self.t_s).min(1.0);
+            let (t0, x0, v0) = (self.t_s, self.temp_c, self.rate_cps);
+            let a1 = self.second(t0, x0, v0);
+            let (x2, v2) = (x0 + 0.5 * h * v0, v0 + 0.5 * h * a1);
+            let a2 = self.second(t0 + 0.5 * h, x2, v2);
+            let (x3, v3) = (x0 + 0.5 * h * v2, v0 + 0.5 * h * a2);
+            let a3 = self.second(t0 + 0.5 * h, x3, v3);
+            let (x4, v4) = (x0 + h * v3, v0 + h * a3);
+            let a4 = self.second(t0 + h, x4, v4);
+            self.temp_c = x0 + h / 6.0 * (v0 + 2.0 * v2 + 2.0 * v3 + v4);
+            self.rate_cps = v0 + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
+            self.t_s = t0 + h;
+        }
+        self.accel
+            .push(self.second(self.t_s, self.temp_c, self.rate_cps));
+        (self.temp_c, self.rate_cps)
+    }
+}
+
+/// Adds k d2T/dt2 to every run's `rate_dph` (column 1), k such that the effect's rms over
+/// the campaign is `rms_dph`.
+fn add_accel_effect(runs: &mut [Run], accel: &[Vec<f64>], rms_dph: f64) {
+    let all: Vec<f64> = accel.iter().flatten().copied().collect();
+    let rms = (all.iter().map(|a| a * a).sum::<f64>() / all.len().max(1) as f64).sqrt();
+    let k = if rms > 0.0 { rms_dph / rms } else { 0.0 };
+    for (run, a) in runs.iter_mut().zip(accel) {
+        for (r, a) in run.data[1].iter_mut().zip(a) {
+            *r += k * a;
+        }
+    }
 }

@@ -1,0 +1,79 @@
+//! Derivatives on a quantised thermometer (issue 9, item 3): a d2T/dt2 drift term at 1
+//! noise sigma, hidden in campaigns of the independent generator (`common/independent.rs`,
+//! `Hidden::TempAccel`: a critically damped gyro under a cycling chamber, 1 Hz rows, a
+//! 0.0625 degC thermometer), must be named `temp_c:accel` by the family-wise decision, and
+//! its null twin (the same cycling campaigns, nothing hidden) must name nothing. The
+//! chosen derivative windows and, for the named cause, the device's causal estimate are
+//! printed per seed. Seeds: `DIAG_SEEDS` (default 11, 22, 33).
+
+#[path = "common/independent.rs"]
+#[allow(dead_code)] // the heading variants are used by diagnose_between
+mod independent;
+use fog_sim::diagnose::diagnose;
+use independent::{campaign, Hidden};
+
+#[path = "common/seeds.rs"]
+mod seeds;
+
+/// One line per seed: (right?, what happened).
+fn per_seed(hidden: Hidden) -> Vec<(bool, String)> {
+    std::thread::scope(|s| {
+        let handles: Vec<_> = seeds::seeds()
+            .into_iter()
+            .map(|seed| {
+                s.spawn(move || {
+                    let (runs, expected) = campaign(hidden, seed);
+                    let r = diagnose(&runs).expect("diagnose runs").report;
+                    let named = r.named_cause.as_ref().map(|c| c.label());
+                    let ok = named.as_deref() == expected
+                        && (expected.is_none() || r.extended.gain_pct > 0.0);
+                    let accel = r
+                        .candidates
+                        .iter()
+                        .position(|c| c.column == "temp_c" && c.transform.name() == "accel")
+                        .map(|i| (i + 1, &r.candidates[i]));
+                    let widths: Vec<String> = r
+                        .derivative_widths
+                        .iter()
+                        .filter(|w| w.column == "temp_c")
+                        .map(|w| format!("{} +/-{:.0} s", w.derivative, w.half_width_s))
+                        .collect();
+                    let line = format!(
+                        "{hidden:?} seed {seed}: named {named:?}; temp_c:accel rank {:?} gain {:+.2}% p {:.4}; base {}; \
+                         temp_c windows {widths:?}; top {:?} {:+.2}% p {:.4}",
+                        accel.map(|a| a.0),
+                        accel.map_or(f64::NAN, |a| a.1.gain_pct),
+                        accel.map_or(f64::NAN, |a| a.1.p_value),
+                        r.base.name,
+                        r.candidates.first().map(|c| fog_sim::report::feature_label(&c.column, c.transform.name(), c.tau_s)),
+                        r.candidates.first().map_or(f64::NAN, |c| c.gain_pct),
+                        r.candidates.first().map_or(f64::NAN, |c| c.p_value),
+                    );
+                    (ok, line)
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("case thread"))
+            .collect()
+    })
+}
+
+fn check(hidden: Hidden) {
+    let lines = per_seed(hidden);
+    for (ok, l) in &lines {
+        println!("{} {l}", if *ok { "ok  " } else { "FAIL" });
+    }
+    assert!(lines.iter().all(|(ok, _)| *ok), "see the FAIL lines above");
+}
+
+#[test]
+fn a_one_sigma_d2t_dt2_term_on_a_quantised_thermometer_is_named() {
+    check(Hidden::TempAccel(1.0));
+}
+
+#[test]
+fn its_null_twin_names_nothing() {
+    check(Hidden::TempAccel(0.0));
+}
