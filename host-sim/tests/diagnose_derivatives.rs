@@ -25,8 +25,14 @@ fn per_seed(hidden: Hidden) -> Vec<(bool, String)> {
                     let (runs, expected) = campaign(hidden, seed);
                     let r = diagnose(&runs).expect("diagnose runs").report;
                     let named = r.named_cause.as_ref().map(|c| c.label());
+                    // a named derivative must come with the device's causal estimate and
+                    // its measured delay (half the trailing span for a least-squares fit)
+                    let causal_ok = r.causal_derivative.as_ref().is_some_and(|c| {
+                        !c.causal.is_empty()
+                            && c.causal.iter().all(|k| (k.delay_s - k.span_s / 2.0).abs() < 1.0)
+                    });
                     let ok = named.as_deref() == expected
-                        && (expected.is_none() || r.extended.gain_pct > 0.0);
+                        && (expected.is_none() || (r.extended.gain_pct > 0.0 && causal_ok));
                     let accel = r
                         .candidates
                         .iter()
@@ -49,6 +55,15 @@ fn per_seed(hidden: Hidden) -> Vec<(bool, String)> {
                         r.candidates.first().map_or(f64::NAN, |c| c.gain_pct),
                         r.candidates.first().map_or(f64::NAN, |c| c.p_value),
                     );
+                    let causal = r.causal_derivative.as_ref().map(|c| {
+                        let k: Vec<String> = c
+                            .causal
+                            .iter()
+                            .map(|k| format!("span {:.0} s delay {:.1} s gain {:+.2}%", k.span_s, k.delay_s, k.gain_pct))
+                            .collect();
+                        format!("centred {:+.2}% vs causal {k:?}", c.centred_gain_pct)
+                    });
+                    let line = format!("{line}; causal: {causal:?}");
                     (ok, line)
                 })
             })

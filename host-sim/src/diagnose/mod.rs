@@ -16,6 +16,7 @@ pub mod bases;
 pub mod basis;
 pub mod between;
 pub mod bootstrap;
+pub mod causal;
 pub mod cause;
 pub mod cv;
 pub mod derivatives;
@@ -96,6 +97,8 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
         named.map(|s| s.cols.as_slice()),
     )?;
     let (extended, ext_resid) = extended_model(base, named, cause.as_ref());
+    let causal_derivative =
+        named.and_then(|s| causal::check(&campaign, &folds, base, &s.cand, &s.cols));
     let uncertainty = uncertainty::estimate(
         &campaign,
         &folds,
@@ -151,6 +154,7 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
         parsimony_note: screening.parsimony_note.clone(),
         drift_std: drift_std(&folds, &st.y, &base.cv.residual, &ext_resid),
         extended,
+        causal_derivative,
         azimuth,
         uncertainty,
         raw_rows: None,

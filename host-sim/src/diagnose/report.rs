@@ -116,6 +116,9 @@ pub struct Report {
     pub competing: Vec<Competitor>,
     pub parsimony_note: Option<String>,
     pub extended: Extended,
+    /// For a named `rate` / `accel` cause: the device's causal estimate, its delay and
+    /// held-out gain next to the centred one.
+    pub causal_derivative: Option<super::causal::CausalCheck>,
     pub drift_std: DriftStd,
     pub azimuth: Option<Azimuth>,
     /// +/- (block bootstrap) on every fitted coefficient, ratios to the simulator.
@@ -289,6 +292,23 @@ fn write_derivative_widths(s: &mut String, widths: &[super::derivatives::WidthCh
     }
 }
 
+/// The named derivative as the device would compute it (causal), next to the centred one.
+fn write_causal(s: &mut String, c: &super::causal::CausalCheck) {
+    let _ = writeln!(
+        s,
+        "  on the device: centred +/-{:.0} s window: held-out rms {:.4} deg/h, gain {:+.2}% (linear term)",
+        c.centred_half_width_s, c.centred_heldout_rms_dph, c.centred_gain_pct
+    );
+    for k in &c.causal {
+        let _ = writeln!(
+            s,
+            "    causal, span {:.0} s, delay {:.1} s ({}): held-out rms {:.4} deg/h, gain {:+.2}% ({} warm-up rows per run at 0)",
+            k.span_s, k.delay_s, k.estimator, k.heldout_rms_dph, k.gain_pct, k.warmup_rows
+        );
+    }
+    let _ = writeln!(s, "  {}", c.in_words);
+}
+
 /// Section 3: ranked within-run candidates, then the between-run ones.
 fn write_candidates(s: &mut String, r: &Report) {
     let _ = writeln!(s, "\n3. Candidate causes (ranked by held-out rms; p = family-wise sign-flip test over whole validation units)");
@@ -346,6 +366,9 @@ fn write_cause(s: &mut String, r: &Report) {
             "  competes: {} explains the same thing (its gain drops to {:+.2}% once the named cause is in)",
             comp.candidate, comp.conditional_gain_pct
         );
+    }
+    if let Some(c) = &r.causal_derivative {
+        write_causal(s, c);
     }
     let b = &r.between_run;
     if let Some(n) = &b.named {

@@ -52,6 +52,17 @@ pub enum Source {
     Extra(usize),
 }
 
+impl Source {
+    /// This signal in one run.
+    pub fn of(self, s: &Series) -> &[f64] {
+        match self {
+            Source::Time => &s.t_s,
+            Source::Temp => &s.temp_c,
+            Source::Extra(i) => &s.extras[i],
+        }
+    }
+}
+
 /// One candidate feature (one or two model columns).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Candidate {
@@ -82,11 +93,7 @@ impl Candidate {
 
     /// The feature's columns for one run.
     pub fn compute(&self, s: &Series) -> Vec<Vec<f64>> {
-        let x: &[f64] = match self.source {
-            Source::Time => &s.t_s,
-            Source::Temp => &s.temp_c,
-            Source::Extra(i) => &s.extras[i],
-        };
+        let x = self.source.of(s);
         let tau = self.tau_s.unwrap_or(0.0);
         let half_s = self.half_s.unwrap_or(derivatives::HALF_WIDTHS_S[0]);
         match self.transform {
