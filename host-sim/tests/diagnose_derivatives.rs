@@ -46,11 +46,12 @@ fn per_seed(hidden: Hidden) -> Vec<(bool, String)> {
                         .collect();
                     let line = format!(
                         "{hidden:?} seed {seed}: named {named:?}; temp_c:accel rank {:?} gain {:+.2}% p {:.4}; base {}; \
-                         temp_c windows {widths:?}; top {:?} {:+.2}% p {:.4}",
+                         base dT/dt +/-{:.0} s; temp_c windows {widths:?}; top {:?} {:+.2}% p {:.4}",
                         accel.map(|a| a.0),
                         accel.map_or(f64::NAN, |a| a.1.gain_pct),
                         accel.map_or(f64::NAN, |a| a.1.p_value),
                         r.base.name,
+                        r.base.rate_half_width_s,
                         r.candidates.first().map(|c| fog_sim::report::feature_label(&c.column, c.transform.name(), c.tau_s)),
                         r.candidates.first().map_or(f64::NAN, |c| c.gain_pct),
                         r.candidates.first().map_or(f64::NAN, |c| c.p_value),

@@ -87,6 +87,41 @@ pub struct BaseChoice {
     pub collinearity_warning: Option<String>,
 }
 
+/// Significance (paired sign flips over validation units) a dT/dt window other than the
+/// device's must reach to replace it in the base.
+pub const RATE_WINDOW_ALPHA: f64 = 0.05;
+
+/// The base and the window of its dT/dt. By default dT/dt is the device's least-squares
+/// span (fog-core `DEFAULT_RATE_SPAN_S`, the `TempRateCps` input the deployed model runs
+/// on), centred. The temperature's own leave-one-out window (`derivatives`) replaces it
+/// when the best base with it is better held out in significantly many validation units
+/// (paired sign flips, `RATE_WINDOW_ALPHA`), as a coarse thermometer needs: a base whose
+/// choice flips on noise would move every candidate's p-value. Returns the stacked
+/// campaign with the chosen dT/dt.
+pub fn choose_with_rate_window(
+    campaign: &super::input::Campaign,
+    folds: &Folds,
+) -> Result<(Stacked, BaseChoice), DiagnoseError> {
+    let device_half_s = fog_core::features::DEFAULT_RATE_SPAN_S / 2.0;
+    let st = Stacked::with_rate_half_width(campaign, device_half_s);
+    let device = choose(folds, &st)?;
+    let loo_half_s = campaign.half_width_s("temp_c", 1);
+    if (loo_half_s - device_half_s).abs() < 1e-9 {
+        return Ok((st, device));
+    }
+    let st_loo = Stacked::with_rate_half_width(campaign, loo_half_s);
+    let Ok(loo) = choose(folds, &st_loo) else {
+        return Ok((st, device));
+    };
+    let gains = super::screen::unit_gains(&device.chosen.cv, &loo.chosen.cv);
+    let p = super::signflip::paired_pvalue(&gains, super::screen::FLIP_SEED);
+    if loo.chosen.cv.rms() < device.chosen.cv.rms() && p < RATE_WINDOW_ALPHA {
+        Ok((st_loo, loo))
+    } else {
+        Ok((st, device))
+    }
+}
+
 /// Mean and (population) standard deviation used to normalise a column (1 when constant).
 pub fn zscore_params(v: &[f64]) -> (f64, f64) {
     let n = v.len().max(1) as f64;
@@ -269,6 +304,7 @@ mod tests {
         let noise = |i: usize| 0.01 * white[i];
         let mk = |y: Vec<f64>| Stacked {
             temp_rate_cps: temp.iter().map(|t| t.sin()).collect(),
+            temp_rate_half_s: 0.0,
             y,
             t_s: t_s.clone(),
             temp_c: temp.clone(),

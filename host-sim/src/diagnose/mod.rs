@@ -77,9 +77,9 @@ pub struct Diagnosis {
 /// Runs the whole diagnosis on a campaign.
 pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
     let campaign = input::prepare(runs)?;
-    let st = Stacked::new(&campaign);
-    let folds = Folds::new(&st.run_lengths)?;
-    let choice = bases::choose(&folds, &st)?;
+    let run_lengths: Vec<usize> = campaign.runs.iter().map(|s| s.t_s.len()).collect();
+    let folds = Folds::new(&run_lengths)?;
+    let (st, choice) = bases::choose_with_rate_window(&campaign, &folds)?;
     let base = &choice.chosen;
     let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
     let latitude = campaign
@@ -135,7 +135,7 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
             skipped_candidates: screening.skipped.iter().map(to_exclusion).collect(),
             smallest_attainable_p,
         },
-        base: base_summary(&choice),
+        base: base_summary(&choice, &st),
         residual_structure: residuals::structure(&campaign, &folds, &st, &base.cv.residual),
         outliers: outliers::locate(&folds, &run_names, &st.t_s, &st.y, &base.cv.residual),
         between_run,
@@ -241,12 +241,13 @@ fn extended_model(
 }
 
 /// The chosen base and every base tried, for the report.
-fn base_summary(choice: &bases::BaseChoice) -> ModelSummary {
+fn base_summary(choice: &bases::BaseChoice, st: &Stacked) -> ModelSummary {
     let base = &choice.chosen;
     ModelSummary {
         name: base.spec.name.clone(),
         poly_degree_t: base.spec.poly_degree_t,
         uses_rate: base.spec.uses_rate,
+        rate_half_width_s: st.temp_rate_half_s,
         inputs: base.spec.inputs(),
         heldout_rms_dph: base.cv.rms(),
         centres: base.centres,

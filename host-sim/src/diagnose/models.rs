@@ -23,14 +23,20 @@ pub struct Stacked {
     pub t_s: Vec<f64>,
     pub temp_c: Vec<f64>,
     pub temp_rate_cps: Vec<f64>,
+    /// Half-width of the centred window `temp_rate_cps` was computed over, s.
+    pub temp_rate_half_s: f64,
     pub run_lengths: Vec<usize>,
 }
 
 impl Stacked {
-    /// Stacks drift, time, temperature and dT/dt (centred local polynomial, half-width
-    /// validated on the temperature, `derivatives`).
+    /// Stacks drift, time, temperature and dT/dt (centred local polynomial, the
+    /// temperature's leave-one-out half-width, `derivatives`).
     pub fn new(c: &Campaign) -> Self {
-        let rate_half_s = c.half_width_s("temp_c", 1);
+        Self::with_rate_half_width(c, c.half_width_s("temp_c", 1))
+    }
+
+    /// The same with dT/dt over a centred window of `rate_half_s`.
+    pub fn with_rate_half_width(c: &Campaign, rate_half_s: f64) -> Self {
         let cat = |f: &dyn Fn(&super::input::Series) -> Vec<f64>| {
             c.runs.iter().flat_map(f).collect::<Vec<f64>>()
         };
@@ -39,6 +45,7 @@ impl Stacked {
             t_s: cat(&|s| s.t_s.clone()),
             temp_c: cat(&|s| s.temp_c.clone()),
             temp_rate_cps: cat(&|s| derivatives::centred(&s.t_s, &s.temp_c, 1, rate_half_s)),
+            temp_rate_half_s: rate_half_s,
             run_lengths: c.runs.iter().map(|s| s.t_s.len()).collect(),
         }
     }

@@ -18,6 +18,8 @@ pub struct ModelSummary {
     pub name: String,
     pub poly_degree_t: Option<u8>,
     pub uses_rate: bool,
+    /// Half-width of the centred dT/dt window (chosen with the base on held-out drift), s.
+    pub rate_half_width_s: f64,
     pub inputs: Vec<String>,
     pub heldout_rms_dph: f64,
     pub centres: usize,
@@ -212,9 +214,10 @@ fn write_baseline(s: &mut String, r: &Report) {
     );
     let _ = writeln!(
         s,
-        "  chosen base {} ({}): held-out rms {:.4} deg/h; uncompensated drift std {:.4} deg/h; candidates are screened against it",
+        "  chosen base {} ({}; dT/dt over +/-{:.0} s): held-out rms {:.4} deg/h; uncompensated drift std {:.4} deg/h; candidates are screened against it",
         r.base.name,
         r.base.inputs.join(", "),
+        r.base.rate_half_width_s,
         r.base.heldout_rms_dph,
         r.drift_std.uncompensated_dph
     );
