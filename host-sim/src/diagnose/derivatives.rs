@@ -140,6 +140,24 @@ fn loo_sum(runs: &[(&[f64], &[f64])], order: usize, half_s: f64) -> (f64, usize)
     (sum, count)
 }
 
+/// Median over every point of every run of the window's actual half-span (the farthest
+/// sample from the centre), s: larger than `half_s` where rows are sparse (the window is
+/// widened to `order + 3` points), smaller where the run is short.
+pub fn effective_half_width_s(runs: &[(&[f64], &[f64])], order: usize, half_s: f64) -> f64 {
+    let need = degree_for(order) + 2;
+    let mut spans: Vec<f64> = runs
+        .iter()
+        .flat_map(|&(t, _)| {
+            (0..t.len()).map(move |i| {
+                let (lo, hi) = window(t, i, half_s, need);
+                (t[i] - t[lo]).max(t[hi] - t[i])
+            })
+        })
+        .collect();
+    spans.sort_by(f64::total_cmp);
+    spans.get(spans.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
 /// A grid point's leave-one-out rms.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct GridScore {
@@ -156,6 +174,9 @@ pub struct WidthChoice {
     pub derivative: &'static str,
     pub poly_degree: usize,
     pub half_width_s: f64,
+    /// The windows' actual half-span at that width (median), s: see
+    /// [`effective_half_width_s`].
+    pub effective_half_width_s: f64,
     /// Leave-one-out rms at the chosen half-width, column units.
     pub loo_rms: f64,
     /// Every half-width tried.
@@ -186,6 +207,7 @@ pub fn choose(column: &str, runs: &[(&[f64], &[f64])], order: usize) -> Option<W
         derivative: if order == 1 { "rate" } else { "accel" },
         poly_degree: degree_for(order),
         half_width_s: best.half_width_s,
+        effective_half_width_s: effective_half_width_s(runs, order, best.half_width_s),
         loo_rms: best.loo_rms,
         grid,
     })

@@ -135,7 +135,7 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
             skipped_candidates: screening.skipped.iter().map(to_exclusion).collect(),
             smallest_attainable_p,
         },
-        base: base_summary(&choice, &st),
+        base: base_summary(&choice, &st, &campaign),
         residual_structure: residuals::structure(&campaign, &folds, &st, &base.cv.residual),
         outliers: outliers::locate(&folds, &run_names, &st.t_s, &st.y, &base.cv.residual),
         between_run,
@@ -241,13 +241,26 @@ fn extended_model(
 }
 
 /// The chosen base and every base tried, for the report.
-fn base_summary(choice: &bases::BaseChoice, st: &Stacked) -> ModelSummary {
+fn base_summary(
+    choice: &bases::BaseChoice,
+    st: &Stacked,
+    campaign: &input::Campaign,
+) -> ModelSummary {
     let base = &choice.chosen;
     ModelSummary {
         name: base.spec.name.clone(),
         poly_degree_t: base.spec.poly_degree_t,
         uses_rate: base.spec.uses_rate,
         rate_half_width_s: st.temp_rate_half_s,
+        rate_effective_half_width_s: derivatives::effective_half_width_s(
+            &campaign
+                .runs
+                .iter()
+                .map(|s| (s.t_s.as_slice(), s.temp_c.as_slice()))
+                .collect::<Vec<_>>(),
+            1,
+            st.temp_rate_half_s,
+        ),
         inputs: base.spec.inputs(),
         heldout_rms_dph: base.cv.rms(),
         centres: base.centres,

@@ -20,6 +20,8 @@ pub struct ModelSummary {
     pub uses_rate: bool,
     /// Half-width of the centred dT/dt window (chosen with the base on held-out drift), s.
     pub rate_half_width_s: f64,
+    /// The dT/dt windows' actual half-span (median; wider where rows are sparse), s.
+    pub rate_effective_half_width_s: f64,
     pub inputs: Vec<String>,
     pub heldout_rms_dph: f64,
     pub centres: usize,
@@ -214,10 +216,11 @@ fn write_baseline(s: &mut String, r: &Report) {
     );
     let _ = writeln!(
         s,
-        "  chosen base {} ({}; dT/dt over +/-{:.0} s): held-out rms {:.4} deg/h; uncompensated drift std {:.4} deg/h; candidates are screened against it",
+        "  chosen base {} ({}; dT/dt over +/-{:.0} s, actual +/-{:.0} s): held-out rms {:.4} deg/h; uncompensated drift std {:.4} deg/h; candidates are screened against it",
         r.base.name,
         r.base.inputs.join(", "),
         r.base.rate_half_width_s,
+        r.base.rate_effective_half_width_s,
         r.base.heldout_rms_dph,
         r.drift_std.uncompensated_dph
     );
@@ -286,8 +289,12 @@ fn write_derivative_widths(s: &mut String, widths: &[super::derivatives::WidthCh
             .filter(|w| w.column == col)
             .map(|w| {
                 format!(
-                    "{} +/-{:.0} s (degree {}, LOO rms {:.3e})",
-                    w.derivative, w.half_width_s, w.poly_degree, w.loo_rms
+                    "{} +/-{:.0} s (actual +/-{:.0} s; degree {}, LOO rms {:.3e})",
+                    w.derivative,
+                    w.half_width_s,
+                    w.effective_half_width_s,
+                    w.poly_degree,
+                    w.loo_rms
                 )
             })
             .collect();
