@@ -162,19 +162,6 @@ impl Estimator {
     }
 }
 
-/// Median spacing of the rows (10 s for 10 s means).
-fn median_dt_s(c: &Campaign) -> f64 {
-    let mut dt: Vec<f64> = c
-        .runs
-        .iter()
-        .flat_map(|s| s.t_s.windows(2).map(|w| w[1] - w[0]))
-        .collect();
-    dt.sort_by(f64::total_cmp);
-    dt.get(dt.len() / 2)
-        .copied()
-        .unwrap_or(super::input::WINDOW_S)
-}
-
 /// The causal check of a named `rate` / `accel` cause (None for other transforms).
 pub fn check(
     campaign: &Campaign,
@@ -192,7 +179,12 @@ pub fn check(
     let gain = |rms: f64| 100.0 * (1.0 - rms / base_rms);
     let centred = base.prepared.validate_with(folds, centred_cols).ok()?;
     let half_s = cand.half_s.unwrap_or(f64::NAN);
-    let dt = median_dt_s(campaign);
+    let runs: Vec<(&[f64], &[f64])> = campaign
+        .runs
+        .iter()
+        .map(|s| (s.t_s.as_slice(), s.t_s.as_slice()))
+        .collect();
+    let dt = super::derivatives::median_spacing_s(&runs, super::input::WINDOW_S);
     let matched_span = 2.0 * half_s;
     let estimators: Vec<Estimator> = match device_kind(cand) {
         Some(kind) => {

@@ -10,7 +10,8 @@
 //! error is known in closed form: (x_i - xhat_i) / (1 - h_ii), h_ii the leverage of point i
 //! in its own window. For every column and order the half-width with the smallest pooled
 //! leave-one-out mean square over all runs is chosen from a log-spaced grid
-//! ([`HALF_WIDTHS_S`]): a general rule, no constant tuned to a generator.
+//! ([`HALF_WIDTHS_ROWS`], 2 to 64 row spacings): a general rule, no constant tuned to a
+//! generator.
 //!
 //! Edges are honest: a window holds only samples that exist (one-sided near the ends of a
 //! run), widened on the side that has samples until it holds p + 2 points; nothing is
@@ -20,10 +21,21 @@
 use nalgebra::{Matrix4, Vector4};
 use serde::Serialize;
 
-/// Half-widths tried, s: 20 s x 2^(k/2), k = 0..=10 (20 .. 640 s).
-pub const HALF_WIDTHS_S: [f64; 11] = [
-    20.0, 28.28, 40.0, 56.57, 80.0, 113.1, 160.0, 226.3, 320.0, 452.5, 640.0,
+/// Half-widths tried, in row spacings: 2 x 2^(k/2), k = 0..=10 (2 .. 64 rows; for 10 s
+/// means 20 .. 640 s). In rows, so that sparse records (one mean per burst) get a choice too.
+pub const HALF_WIDTHS_ROWS: [f64; 11] = [
+    2.0, 2.828, 4.0, 5.657, 8.0, 11.31, 16.0, 22.63, 32.0, 45.25, 64.0,
 ];
+
+/// Median spacing of the rows over every run, s (`fallback_s` with fewer than two rows).
+pub fn median_spacing_s(runs: &[(&[f64], &[f64])], fallback_s: f64) -> f64 {
+    let mut dt: Vec<f64> = runs
+        .iter()
+        .flat_map(|(t, _)| t.windows(2).map(|w| w[1] - w[0]))
+        .collect();
+    dt.sort_by(f64::total_cmp);
+    dt.get(dt.len() / 2).copied().unwrap_or(fallback_s)
+}
 
 /// Polynomial degree used for derivative order `order` (1 or 2).
 pub fn degree_for(order: usize) -> usize {
@@ -184,13 +196,15 @@ pub struct WidthChoice {
 }
 
 /// Chooses the half-width of the order-`order` derivative of one column (stacked over
-/// `runs`, each `(t_s, x)`): the grid point with the smallest leave-one-out mean square
-/// (the narrowest on a tie). `None` when no grid point can be validated (every run has
-/// fewer than `order + 3` samples).
+/// `runs`, each `(t_s, x)`): the grid point ([`HALF_WIDTHS_ROWS`] x the median row
+/// spacing) with the smallest leave-one-out mean square (the narrowest on a tie). `None`
+/// when no grid point can be validated (every run has fewer than `order + 3` samples).
 pub fn choose(column: &str, runs: &[(&[f64], &[f64])], order: usize) -> Option<WidthChoice> {
-    let grid: Vec<GridScore> = HALF_WIDTHS_S
+    let dt = median_spacing_s(runs, super::input::WINDOW_S);
+    let grid: Vec<GridScore> = HALF_WIDTHS_ROWS
         .iter()
-        .filter_map(|&h| {
+        .map(|k| k * dt)
+        .filter_map(|h| {
             let (sum, count) = loo_sum(runs, order, h);
             (count > 0).then(|| GridScore {
                 half_width_s: h,

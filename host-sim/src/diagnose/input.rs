@@ -7,7 +7,7 @@
 //! Raw-rate records are averaged into 10 s windows (the paper's protocol); slower
 //! records (e.g. one mean per burst) are kept as they are.
 
-use super::derivatives::{self, WidthChoice, HALF_WIDTHS_S};
+use super::derivatives::{self, WidthChoice};
 use super::error::DiagnoseError;
 use crate::io::runs::Run;
 
@@ -51,14 +51,15 @@ impl Campaign {
         self.runs.iter().map(|r| r.t_s.len()).sum()
     }
 
-    /// The validated half-width of the order-`order` derivative of `column`, s (the
-    /// narrowest grid width when the column could not be validated: too few samples).
+    /// The validated half-width of the order-`order` derivative of `column`, s (two 10 s
+    /// windows when the column could not be validated: too few samples; the fit then uses
+    /// what the run has).
     pub fn half_width_s(&self, column: &str, order: usize) -> f64 {
         let derivative = if order == 1 { "rate" } else { "accel" };
         self.derivative_widths
             .iter()
             .find(|w| w.column == column && w.derivative == derivative)
-            .map_or(HALF_WIDTHS_S[0], |w| w.half_width_s)
+            .map_or(2.0 * WINDOW_S, |w| w.half_width_s)
     }
 
     /// Index of an extra column by name.

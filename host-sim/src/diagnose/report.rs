@@ -304,19 +304,26 @@ fn write_derivative_widths(s: &mut String, widths: &[super::derivatives::WidthCh
 
 /// The named derivative as the device would compute it (causal), next to the centred one.
 fn write_causal(s: &mut String, c: &super::causal::CausalCheck) {
-    let _ = writeln!(
+    let causal: Vec<String> = c
+        .causal
+        .iter()
+        .map(|k| {
+            format!(
+                "    causal, span {:.0} s, delay {:.1} s ({}): held-out rms {:.4} deg/h, gain {:+.2}% \
+                 ({} warm-up rows per run at 0)\n",
+                k.span_s, k.delay_s, k.estimator, k.heldout_rms_dph, k.gain_pct, k.warmup_rows
+            )
+        })
+        .collect();
+    let _ = write!(
         s,
-        "  on the device: centred +/-{:.0} s window: held-out rms {:.4} deg/h, gain {:+.2}% (linear term)",
-        c.centred_half_width_s, c.centred_heldout_rms_dph, c.centred_gain_pct
+        "  on the device: centred +/-{:.0} s window: held-out rms {:.4} deg/h, gain {:+.2}% (linear term)\n{}  {}\n",
+        c.centred_half_width_s,
+        c.centred_heldout_rms_dph,
+        c.centred_gain_pct,
+        causal.concat(),
+        c.in_words
     );
-    for k in &c.causal {
-        let _ = writeln!(
-            s,
-            "    causal, span {:.0} s, delay {:.1} s ({}): held-out rms {:.4} deg/h, gain {:+.2}% ({} warm-up rows per run at 0)",
-            k.span_s, k.delay_s, k.estimator, k.heldout_rms_dph, k.gain_pct, k.warmup_rows
-        );
-    }
-    let _ = writeln!(s, "  {}", c.in_words);
 }
 
 /// Section 3: ranked within-run candidates, then the between-run ones.

@@ -95,7 +95,7 @@ impl Candidate {
     pub fn compute(&self, s: &Series) -> Vec<Vec<f64>> {
         let x = self.source.of(s);
         let tau = self.tau_s.unwrap_or(0.0);
-        let half_s = self.half_s.unwrap_or(derivatives::HALF_WIDTHS_S[0]);
+        let half_s = self.half_s.unwrap_or(2.0 * super::input::WINDOW_S);
         match self.transform {
             Transform::Value => vec![x.to_vec()],
             Transform::Rate => vec![derivatives::centred(&s.t_s, x, 1, half_s)],
