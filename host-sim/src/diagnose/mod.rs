@@ -16,6 +16,7 @@ pub mod bases;
 pub mod basis;
 pub mod between;
 pub mod bootstrap;
+pub mod buffer;
 pub mod cause;
 pub mod cv;
 pub mod error;
@@ -74,10 +75,14 @@ pub struct Diagnosis {
 
 /// Runs the whole diagnosis on a campaign.
 pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
+    diagnose_with(runs, buffer::BufferRule::default())
+}
+
+/// [`diagnose`] with a chosen rule for the buffers between time blocks of single records.
+pub fn diagnose_with(runs: &[Run], rule: buffer::BufferRule) -> Result<Diagnosis, DiagnoseError> {
     let campaign = input::prepare(runs)?;
     let st = Stacked::new(&campaign);
-    let folds = Folds::new(&st.run_lengths)?;
-    let choice = bases::choose(&folds, &st)?;
+    let (folds, choice) = buffer::choose_buffered(Folds::new(&st.run_lengths)?, &st, rule)?;
     let base = &choice.chosen;
     let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
     let latitude = campaign
