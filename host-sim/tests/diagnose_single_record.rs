@@ -133,27 +133,26 @@ fn allowed_false_names(records: usize) -> usize {
     records
 }
 
-#[test]
-fn null_single_records_with_autocorrelated_noise_name_nothing_beyond_the_level() {
-    let t = tallies(0.0);
+/// The buffered rule's false names (`wrong[1]`) must stay within the level.
+fn assert_within_level(t: &Tally, wrong: [usize; 2], what: &str) {
     let allowed = allowed_false_names(t.records);
     assert!(
-        t.named[1] <= allowed,
-        "buffered rule named something in {} of {} null records (level allows {allowed})",
-        t.named[1],
+        wrong[1] <= allowed,
+        "buffered rule named {what} in {} of {} records (level allows {allowed})",
+        wrong[1],
         t.records
     );
 }
 
 #[test]
+fn null_single_records_with_autocorrelated_noise_name_nothing_beyond_the_level() {
+    let t = tallies(0.0);
+    assert_within_level(&t, t.named, "something (null)");
+}
+
+#[test]
 fn a_planted_supply_effect_in_one_record_is_named_without_wrong_columns() {
     let t = tallies(2.0);
-    let allowed = allowed_false_names(t.records);
-    assert!(
-        t.wrong_column[1] <= allowed,
-        "buffered rule named a wrong column in {} of {} records (level allows {allowed})",
-        t.wrong_column[1],
-        t.records
-    );
+    assert_within_level(&t, t.wrong_column, "a wrong column");
     assert!(t.right[1] > 0, "the planted effect was never named");
 }
