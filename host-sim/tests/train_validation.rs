@@ -4,7 +4,7 @@
 
 mod train_support;
 
-use fog_sim::train::{cross_validate, fold_of_rows, Method, TrainConfig};
+use fog_sim::train::{cross_validate, fold_of_rows, Method, TrainConfig, WidthSearch};
 use train_support::{campaign, shupe_like};
 
 const AMBIENTS: [f64; 5] = [-30.0, -10.0, 10.0, 30.0, 50.0];
@@ -102,4 +102,57 @@ fn orr_gcv_and_validated_ols_both_stop_well_below_the_maximum() {
     assert!(orr.best.mean_centers < 0.75 * 64.0);
     assert!(orr.best.heldout_rms_dph < 1.05 * ols.best.heldout_rms_dph);
     assert!(ols.best.heldout_rms_dph < 1.05 * orr.best.heldout_rms_dph);
+}
+
+/// A second drift law for the width search: a static bias quadratic in T and a Shupe
+/// coefficient that itself changes with T (a narrower structure than `shupe_like`).
+fn quadratic_bias_and_t_dependent_shupe(temp_c: f64, rate_cps: f64) -> f64 {
+    let x = (temp_c - 15.0) / 30.0;
+    0.2 * x * x - 0.05 * x + 20.0 * rate_cps * (1.0 + 0.8 * (-(x * 3.0).powi(2)).exp())
+}
+
+#[test]
+fn the_width_climb_finds_the_full_searchs_best_scoring_fewer_widths() {
+    let laws: [(&str, fn(f64, f64) -> f64); 2] = [
+        ("shupe_like", shupe_like),
+        (
+            "quadratic bias, T-dependent Shupe",
+            quadratic_bias_and_t_dependent_shupe,
+        ),
+    ];
+    for (name, law) in laws {
+        let ds = campaign(&AMBIENTS, 3, 0.02, 17, law);
+        let full = cross_validate(
+            &ds,
+            &TrainConfig {
+                width_search: WidthSearch::Full,
+                ..TrainConfig::default()
+            },
+            3,
+        )
+        .unwrap();
+        let climb = cross_validate(&ds, &TrainConfig::default(), 3).unwrap();
+        let widths = |cv: &fog_sim::train::CvReport| {
+            let mut w: Vec<f64> = cv.scan.iter().map(|s| s.width).collect();
+            w.dedup();
+            w
+        };
+        eprintln!(
+            "{name}: full scored {:?} -> {} (deg {}), climb scored {:?} -> {} (deg {})",
+            widths(&full),
+            full.best.width,
+            full.best.degree,
+            widths(&climb),
+            climb.best.width,
+            climb.best.degree
+        );
+        assert_eq!(
+            climb.best, full.best,
+            "{name}: the climb missed the best shape"
+        );
+        assert!(
+            widths(&climb).len() < widths(&full).len(),
+            "{name}: the climb scored as many widths as the full search"
+        );
+    }
 }

@@ -8,7 +8,7 @@ use crate::io::runs::read_runs;
 use crate::io::{write_atomic, OutputGuard};
 use crate::train::{
     dataset_from_runs, default_specs, train_model, Method, TrainConfig, TrainOutcome, Verdict,
-    GUARD_RATIO,
+    WidthSearch, GUARD_RATIO,
 };
 use anyhow::Context;
 use fog_core::model::MAX_ENCODED_LEN;
@@ -54,6 +54,10 @@ pub struct Args {
     /// Gaussian widths (sigma, normalised input units) tried by grouped validation.
     #[arg(long, value_delimiter = ',', default_values_t = TrainConfig::default().width_candidates)]
     pub widths: Vec<f64>,
+    /// How the widths are searched: `climb` (from the middle width towards lower held-out
+    /// error, stopping when both neighbours of the best are worse) or `full` (all).
+    #[arg(long, default_value = "climb", value_parser = parse_width_search)]
+    pub width_search: WidthSearch,
     /// Folds of the grouped (whole runs held out) cross-validation.
     #[arg(long, default_value_t = TrainConfig::default().folds)]
     pub folds: usize,
@@ -67,6 +71,16 @@ pub struct Args {
     /// Write the training report as JSON here.
     #[arg(long)]
     pub json: Option<PathBuf>,
+}
+
+fn parse_width_search(s: &str) -> Result<WidthSearch, String> {
+    match s {
+        "climb" => Ok(WidthSearch::Climb),
+        "full" => Ok(WidthSearch::Full),
+        _ => Err(format!(
+            "`{s}` is not a width search (use `climb` or `full`)"
+        )),
+    }
 }
 
 fn parse_method(s: &str) -> Result<Method, String> {
@@ -88,6 +102,7 @@ impl Args {
             max_candidates: self.max_candidates,
             max_centers: self.max_centers,
             width_candidates: self.widths.clone(),
+            width_search: self.width_search,
             folds: self.folds,
             collinearity_tol: self.collinearity_tol,
             gyro_id: self.gyro_id.clone(),

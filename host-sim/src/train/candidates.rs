@@ -2,7 +2,7 @@
 //! n x K rather than n x n. A grid over the normalised RBF inputs with cells a fraction
 //! of the Gaussian width keeps the first point of every occupied cell (deterministic, in
 //! data order); the cell grows until at most `max_candidates` cells are occupied. Every
-//! training point then lies within about width/4 per axis of a candidate, so the
+//! training point then lies within about width/3 per axis of a candidate, so the
 //! reduction removes only near-duplicate candidates (held-out accuracy unchanged:
 //! `docs/trainer.md`). A grid rather than k-means: one pass, no iterations, no seed,
 //! and it keeps candidates in sparsely sampled corners that k-means would average away.
@@ -10,10 +10,11 @@
 use std::collections::HashMap;
 
 /// Cell edge as a fraction of the Gaussian width at the start of the search. Training
-/// time is quadratic in the candidates (the Gram matrix); a coarser grid (0.5) kept the
-/// simulated campaign's held-out rms (0.01815 against 0.01812 deg/h) at 2.5x less CPU,
+/// time is quadratic in the candidates (the Gram matrix). Width/3 (was width/4) keeps
+/// the simulated campaign's held-out numbers (grouped CV 0.0181, runs 4-5 0.0171 deg/h)
+/// at ~0.56x the candidates; width/2 also kept them (0.01815 against 0.01812 deg/h)
 /// but no longer recovers a function built on sample centres to 2e-4 (`train_ols`).
-const CELL_OF_WIDTH: f64 = 0.25;
+const CELL_OF_WIDTH: f64 = 1.0 / 3.0;
 /// Growth of the cell per round when too many cells are occupied.
 const CELL_GROWTH: f64 = 1.25;
 
@@ -63,8 +64,8 @@ mod tests {
         let pts: Vec<f32> = (0..10_000)
             .flat_map(|i| [(i % 100) as f32 * 0.01, (i / 100) as f32 * 0.01])
             .collect();
-        let c = grid_candidates(&pts, 2, 2, 0.4, 500);
-        assert_eq!(c.len(), 100, "0.1 cells over a unit square");
+        let c = grid_candidates(&pts, 2, 2, 0.6, 500);
+        assert_eq!(c.len(), 25, "0.2 cells over a unit square");
         let all = grid_candidates(&pts[..200], 2, 2, 0.4, 500);
         assert_eq!(all, (0..100).collect::<Vec<_>>());
     }

@@ -14,6 +14,18 @@ pub enum Method {
     OrrGcv,
 }
 
+/// How `cross_validate` walks the (sorted) width grid. Narrow widths cost the most (more
+/// candidate centres, a larger Gram matrix), and held-out error over the width is
+/// normally one valley, so the default climbs: it scores the middle width, then the
+/// neighbours of the best so far, and stops once both neighbours of the best are worse
+/// (widening the grid at an edge as before). `Full` scores every width.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum WidthSearch {
+    Climb,
+    Full,
+}
+
 /// Everything `train_model` needs besides the data.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TrainConfig {
@@ -36,6 +48,8 @@ pub struct TrainConfig {
     pub max_centers: usize,
     /// Gaussian widths (sigma, in normalised input units) tried by grouped validation.
     pub width_candidates: Vec<f64>,
+    /// How the width grid is searched (every width, or a climb from its middle).
+    pub width_search: WidthSearch,
     /// Folds of the grouped (by run) cross-validation that picks the width.
     pub folds: usize,
     /// The last `linear_only_inputs` dataset inputs enter the model only as linear terms.
@@ -62,6 +76,7 @@ impl Default for TrainConfig {
             max_design_bytes: 2 << 30,
             max_centers: MAX_CENTERS,
             width_candidates: vec![0.2, 0.35, 0.6, 1.0, 1.6],
+            width_search: WidthSearch::Climb,
             folds: 3,
             linear_only_inputs: 0,
             linear_on_rbf_inputs: false,

@@ -75,13 +75,35 @@ pub fn fit_path(ds: &Dataset, cfg: &TrainConfig, shape: &Shape) -> Result<PathFi
         1,
         thread_count(cfg.threads),
     );
-    let path = select_path(grams.all(), &width_design, cfg, shape);
+    Ok(path_on_gram(
+        ds,
+        cfg,
+        (normalizer, points),
+        &width_design,
+        &grams,
+        shape,
+    ))
+}
+
+/// Runs selection at `shape` on the Gram of all rows of an already accumulated design
+/// (`grams.all()`: validation's per-fold Grams summed, so the final fit costs no pass
+/// over the rows). `normalized`: the normaliser and the points it made.
+pub(super) fn path_on_gram(
+    ds: &Dataset,
+    cfg: &TrainConfig,
+    normalized: (Normalizer, Vec<f32>),
+    width_design: &WidthDesign,
+    grams: &FoldGrams,
+    shape: &Shape,
+) -> PathFit {
+    let (normalizer, points) = normalized;
+    let path = select_path(grams.all(), width_design, cfg, shape);
     let centers = path
         .selected
         .iter()
         .map(|&k| width_design.candidates[k])
         .collect();
-    Ok(PathFit {
+    PathFit {
         normalizer,
         points,
         forced: path.forced,
@@ -92,7 +114,7 @@ pub fn fit_path(ds: &Dataset, cfg: &TrainConfig, shape: &Shape) -> Result<PathFi
         gram_bytes: grams.bytes(),
         n_candidates: width_design.candidates.len(),
         n_rbf_inputs: width_design.n_rbf,
-    })
+    }
 }
 
 /// The extended design of one width: candidate centres and the forced columns of every
@@ -268,7 +290,12 @@ impl PathFit {
 /// Trains on all rows of `ds` at `shape` (centres: `shape.centers`, else where the
 /// selection stopped).
 pub fn fit_shape(ds: &Dataset, cfg: &TrainConfig, shape: &Shape) -> Result<Fit> {
-    let pf = fit_path(ds, cfg, shape)?;
+    fit_from_path(&fit_path(ds, cfg, shape)?, ds, cfg, shape)
+}
+
+/// The model of a selection path at `shape` (centres: `shape.centers`, else where the
+/// selection stopped).
+pub fn fit_from_path(pf: &PathFit, ds: &Dataset, cfg: &TrainConfig, shape: &Shape) -> Result<Fit> {
     let m = shape.centers.unwrap_or(pf.full_len()).min(pf.full_len());
     let m = if pf.thetas.get(m).is_some_and(Option::is_some) {
         m

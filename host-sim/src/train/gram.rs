@@ -279,11 +279,31 @@ impl<'a> GaussianRow<'a> {
     }
 }
 
-/// g[j][k] += sum_r a[r][j] a[r][k] for k >= the 4-row tile holding j: register tiles of
-/// 4 x 8, so the compiler keeps the accumulators in registers and vectorises over k.
+/// g[j][k] += sum_r a[r][j] a[r][k] for k >= the 4-row tile holding j. On x86-64 CPUs
+/// with AVX2 the same code is compiled for 256-bit vectors with wider tiles (chosen at
+/// run time). Every entry is still one multiply then one add per row, in row order (no
+/// fused multiply-add), so the result is bit-identical on every CPU.
 fn rank_update_upper(a: &[f64], rows: usize, p: usize, g: &mut [f64]) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked just above).
+        unsafe { rank_update_upper_avx2(a, rows, p, g) };
+        return;
+    }
+    rank_update_tiles::<4>(a, rows, p, g);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn rank_update_upper_avx2(a: &[f64], rows: usize, p: usize, g: &mut [f64]) {
+    rank_update_tiles::<8>(a, rows, p, g);
+}
+
+/// The rank update in register tiles of 4 x TK, so the compiler keeps the accumulators
+/// in registers and vectorises over k.
+#[inline(always)]
+fn rank_update_tiles<const TK: usize>(a: &[f64], rows: usize, p: usize, g: &mut [f64]) {
     const TJ: usize = 4;
-    const TK: usize = 4;
     for j0 in (0..p).step_by(TJ) {
         let jn = (p - j0).min(TJ);
         for k0 in (j0..p).step_by(TK) {

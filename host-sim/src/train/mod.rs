@@ -32,7 +32,7 @@ mod validate;
 pub mod features;
 
 pub use candidates::grid_candidates;
-pub use config::{Method, TrainConfig};
+pub use config::{Method, TrainConfig, WidthSearch};
 pub use dataset::Dataset;
 pub use design::GaussianDesign;
 pub use error::{Result, TrainError};
@@ -146,10 +146,11 @@ pub fn train_model(ds: &Dataset, cfg: &TrainConfig) -> Result<TrainOutcome> {
         });
     }
     let started = Instant::now();
-    let cv = cross_validate(ds, cfg, cfg.folds)?;
+    let (cv, path) = validate::cross_validate_and_fit(ds, cfg, cfg.folds)?;
     let validation_s = started.elapsed().as_secs_f64();
     let started = Instant::now();
-    let mut fit = fit_shape(
+    let mut fit = fit::fit_from_path(
+        &path,
         ds,
         cfg,
         &Shape {

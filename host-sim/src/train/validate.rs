@@ -5,14 +5,16 @@
 //! scores every prefix (0..=M centres) on its held-out Gram, so the number of centres,
 //! the width and the degree are all chosen by held-out error, never by a fit-energy
 //! ratio, without a pass over the rows per fit. The width grid widens itself while the
-//! best width sits at its edge. `cross_validate` is public so `diagnose` can score
+//! best width sits at its edge; by default the grid is climbed from its middle
+//! (`WidthSearch::Climb`) rather than scored whole. `cross_validate` is public so `diagnose` can score
 //! candidate inputs the same way.
 
 use super::assemble::ForcedTerm;
-use super::config::{Method, TrainConfig};
+use super::config::{Method, TrainConfig, WidthSearch};
 use super::dataset::Dataset;
 use super::error::{Result, TrainError};
-use super::fit::{select_path, SelectedPath, Shape, WidthDesign};
+use super::fit::{path_on_gram, select_path, PathFit, SelectedPath, Shape, WidthDesign};
+use super::gram::FoldGrams;
 use super::normalize::Normalizer;
 use crate::fanout::{map_in_order, thread_count};
 pub use crate::stats::rms;
@@ -76,60 +78,139 @@ pub fn fold_of_rows(ds: &Dataset, folds: usize) -> Result<Vec<usize>> {
 /// grouped `folds`-fold cross-validation and returns the best (lowest pooled held-out
 /// rms; ties go to the first tried, i.e. the smaller model).
 pub fn cross_validate(ds: &Dataset, cfg: &TrainConfig, folds: usize) -> Result<CvReport> {
+    Ok(search(ds, cfg, folds)?.report)
+}
+
+/// Cross-validation (as `cross_validate`) followed by the selection path on all rows at
+/// the best width and degree, from the Gram validation already accumulated (the folds'
+/// Grams summed): the final fit costs no pass over the rows.
+pub(super) fn cross_validate_and_fit(
+    ds: &Dataset,
+    cfg: &TrainConfig,
+    folds: usize,
+) -> Result<(CvReport, PathFit)> {
+    let found = search(ds, cfg, folds)?;
+    let best = &found.report.best;
+    let shape = Shape {
+        width: best.width,
+        degree: best.degree,
+        centers: best.centers,
+    };
+    let (design, grams) = &found.best_gram;
+    let path = path_on_gram(
+        ds,
+        cfg,
+        (found.normalizer, found.points),
+        design,
+        grams,
+        &shape,
+    );
+    Ok((found.report, path))
+}
+
+/// A finished width search: the report, the normalisation it used and the best
+/// width's design with its per-fold Grams.
+struct Search {
+    report: CvReport,
+    normalizer: Normalizer,
+    points: Vec<f32>,
+    best_gram: (WidthDesign, FoldGrams),
+}
+
+fn search(ds: &Dataset, cfg: &TrainConfig, folds: usize) -> Result<Search> {
     cfg.check(ds.n_inputs())?;
     if ds.is_empty() {
         return Err(TrainError::EmptyDataset);
     }
     let fold = fold_of_rows(ds, folds)?;
-    let mut widths: Vec<f64> = cfg.width_candidates.clone();
-    widths.sort_by(f64::total_cmp);
-    widths.dedup();
-    let mut scan: Vec<WidthScore> = Vec::new();
-    let mut best: Option<(usize, Vec<f64>)> = None;
-    let mut tried: Vec<f64> = Vec::new();
-    let mut queue = widths.clone();
-    const MAX_WIDENING: usize = 4;
-    const WIDEN: f64 = 1.6;
+    let mut grid: Vec<f64> = cfg.width_candidates.clone();
+    grid.sort_by(f64::total_cmp);
+    grid.dedup();
     let normalizer = Normalizer::fit(ds)?;
     let points = normalizer.normalized_rows(ds);
     let ctx = FoldContext::new(ds, &points, &fold, folds);
-    for round in 0..=MAX_WIDENING {
+    let mut scan: Vec<WidthScore> = Vec::new();
+    let mut best: Option<(usize, Vec<f64>)> = None;
+    let mut tried: Vec<f64> = Vec::new();
+    let mut widenings = 0;
+    let mut best_gram: Option<(WidthDesign, FoldGrams)> = None;
+    let mut queue = match cfg.width_search {
+        WidthSearch::Full => grid.clone(),
+        WidthSearch::Climb => vec![grid[grid.len() / 2]],
+    };
+    while !queue.is_empty() {
         for &width in &queue {
-            for (score, residuals) in score_width(&ctx, cfg, width) {
+            let scored = score_width(&ctx, cfg, width);
+            let mut improved = false;
+            for (score, residuals) in scored.scores {
                 let better = best
                     .as_ref()
                     .is_none_or(|(b, _)| score.heldout_rms_dph < scan[*b].heldout_rms_dph);
                 scan.push(score);
                 if better {
                     best = Some((scan.len() - 1, residuals));
+                    improved = true;
                 }
+            }
+            if improved {
+                best_gram = Some((scored.design, scored.grams));
             }
             tried.push(width);
         }
         let Some((b, _)) = &best else { break };
-        let w = scan[*b].width;
-        let lo = tried.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = tried.iter().copied().fold(0.0, f64::max);
-        queue = if w >= hi && hi * WIDEN <= f64::from(WIDTH_RANGE.1) {
-            vec![hi * WIDEN]
-        } else if w <= lo && lo / WIDEN >= f64::from(WIDTH_RANGE.0) * 10.0 {
-            vec![lo / WIDEN]
-        } else {
-            break;
-        };
-        if round == MAX_WIDENING {
-            break;
-        }
+        queue = next_widths(&mut grid, &tried, scan[*b].width, &mut widenings);
     }
     let (b, residuals_dph) = best.ok_or(TrainError::EmptyDataset)?;
-    Ok(CvReport {
-        folds,
-        best: scan[b].clone(),
-        scan,
-        raw_std_dph: pooled_std(&ds.targets_dph),
-        compensated_std_dph: pooled_std(&residuals_dph),
-        residuals_dph,
+    let best_gram = best_gram.ok_or(TrainError::EmptyDataset)?;
+    Ok(Search {
+        report: CvReport {
+            folds,
+            best: scan[b].clone(),
+            scan,
+            raw_std_dph: pooled_std(&ds.targets_dph),
+            compensated_std_dph: pooled_std(&residuals_dph),
+            residuals_dph,
+        },
+        normalizer,
+        points,
+        best_gram,
     })
+}
+
+/// Widths to score next, given the best width `w` so far: its wider grid neighbour if
+/// not yet scored (the cheaper side: fewer candidates), else its narrower one. Held-out
+/// error over the width being one valley, a scored neighbour that is worse rules out
+/// everything beyond it, so the search ends once both neighbours of the best are
+/// scored. At the grid's edge it goes one width beyond (x1.6 or /1.6, at most
+/// `MAX_WIDENING` times, inside the model format's range). With `WidthSearch::Full`
+/// the whole grid was queued first, so only the widening remains.
+fn next_widths(grid: &mut Vec<f64>, tried: &[f64], w: f64, widenings: &mut usize) -> Vec<f64> {
+    const MAX_WIDENING: usize = 4;
+    const WIDEN: f64 = 1.6;
+    let i = grid.iter().position(|&g| g == w).unwrap_or(0);
+    let untried_neighbour = [Some(i + 1), i.checked_sub(1)]
+        .into_iter()
+        .flatten()
+        .filter_map(|j| grid.get(j).copied())
+        .find(|g| !tried.contains(g));
+    if let Some(g) = untried_neighbour {
+        return vec![g];
+    }
+    if *widenings >= MAX_WIDENING {
+        return Vec::new();
+    }
+    let (lo, hi) = (grid[0], grid[grid.len() - 1]);
+    let beyond = if w >= hi && hi * WIDEN <= f64::from(WIDTH_RANGE.1) {
+        hi * WIDEN
+    } else if w <= lo && lo / WIDEN >= f64::from(WIDTH_RANGE.0) * 10.0 {
+        lo / WIDEN
+    } else {
+        return Vec::new();
+    };
+    *widenings += 1;
+    grid.push(beyond);
+    grid.sort_by(f64::total_cmp);
+    vec![beyond]
 }
 
 /// Std around the overall mean.
@@ -180,11 +261,15 @@ impl<'a> FoldContext<'a> {
 /// per (degree, fold) on the fold's training Gram, every prefix scored on the fold's
 /// held-out Gram; the best prefix's held-out residuals are then computed row by row.
 /// Degrees are scored in parallel (`fanout`), results in degree order.
-fn score_width(
-    ctx: &FoldContext<'_>,
-    cfg: &TrainConfig,
-    width: f64,
-) -> Vec<(WidthScore, Vec<f64>)> {
+/// One width scored: every degree's score and held-out residuals, and the design and
+/// per-fold Grams they came from.
+struct ScoredWidth {
+    scores: Vec<(WidthScore, Vec<f64>)>,
+    design: WidthDesign,
+    grams: FoldGrams,
+}
+
+fn score_width(ctx: &FoldContext<'_>, cfg: &TrainConfig, width: f64) -> ScoredWidth {
     let (ds, folds) = (ctx.ds, ctx.folds);
     let max_degree = cfg.poly_degrees.iter().copied().max().unwrap_or(0);
     let clock = Instant::now();
@@ -257,7 +342,11 @@ fn score_width(
             clock.elapsed().as_secs_f64() - gram_s - grid_s
         );
     }
-    scores
+    ScoredWidth {
+        scores,
+        design,
+        grams,
+    }
 }
 
 /// `FOG_TRAIN_PROFILE=1`: print where cross-validation spends its time, per width.
