@@ -2,7 +2,8 @@
 //! wrong, the cause, the extended model and its held-out gain (issues 4 and 9).
 //!
 //! Pipeline: [`input`] checks and averages the runs ([`rawrows`] streams the files and
-//! analyses the raw rows on the way); [`bases`] chooses the base model on held-out data
+//! analyses the raw rows on the way); [`buffer`] sizes the time blocks and buffers of
+//! single records; [`bases`] chooses the base model on held-out data
 //! ([`cv`], [`models`]); [`simfit`] calibrates the simulator's physics; [`residuals`]
 //! and [`outliers`] describe what is left; [`transforms`] builds every candidate feature;
 //! [`screen`] ranks them by held-out gain with the family-wise sign-flip test of
