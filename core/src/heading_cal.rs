@@ -2,7 +2,9 @@
 //! its input axis (e.g. a magnetic/Faraday bias from the Earth's field), estimated from N
 //! dwells at known headings. A device gets it inside the drift model (`model`, format
 //! version 3, covered by the model's CRC and the upload signature; `fogsim heading-cal`
-//! attaches it); `HeadingCalRecord` is the standalone form for files and logs.
+//! attaches it). There is no separate calibration record: the harmonic lives only under
+//! the model's CRC and signature (a standalone "FHCL" record existed and was removed when
+//! the device stopped reading it).
 //!
 //! Exists because such a bias, a cos(alpha) + b sin(alpha) with alpha the input axis azimuth,
 //! is the same harmonic as Earth rate: no seek can separate it, so it has to be measured once
@@ -13,22 +15,12 @@
 //! term E comes from `tilt::earth_rate_on_axis_dph`, and (b0, a, b) from weighted least
 //! squares (weights 1 / sigma_k^2). The covariance is (J^T W J)^-1, scaled up by the reduced
 //! chi-square when the residuals scatter more than the dwell sigmas say.
-//!
-//! Record (postcard, then CRC-32/ISO-HDLC of those bytes, little-endian):
-//! `HeadingCalRecord { magic: u32 = HEADING_CAL_MAGIC, version: u16, harmonic }`.
 
 use serde::{Deserialize, Serialize};
 
 use crate::numeric::sin_cos_deg;
-use crate::protocol::crc32;
 use crate::tilt::{earth_rate_on_axis_dph, Tilt};
 
-/// "FHCL" little-endian: marks a heading calibration record.
-pub const HEADING_CAL_MAGIC: u32 = u32::from_le_bytes(*b"FHCL");
-/// Record format version written by this build.
-pub const HEADING_CAL_VERSION: u16 = 1;
-/// Largest encoded record, bytes (postcard varints + CRC).
-pub const MAX_RECORD_LEN: usize = 48;
 /// Fewest headings a calibration accepts (three unknowns plus one degree of freedom).
 pub const MIN_HEADINGS: usize = 4;
 
@@ -88,21 +80,6 @@ impl HeadingHarmonic {
         let var = b * b * sa * sa + a * a * sb * sb - 2.0 * a * b * self.correlation * sa * sb;
         (libm::sqrtf(var.max(0.0)) / amp2).to_degrees().min(180.0)
     }
-
-    fn is_valid(&self) -> bool {
-        let f = [
-            self.cos_dph,
-            self.sin_dph,
-            self.cos_sigma_dph,
-            self.sin_sigma_dph,
-            self.correlation,
-        ];
-        f.iter().all(|v| v.is_finite())
-            && self.cos_sigma_dph >= 0.0
-            && self.sin_sigma_dph >= 0.0
-            && libm::fabsf(self.correlation) <= 1.0
-            && self.n_headings as usize >= MIN_HEADINGS
-    }
 }
 
 /// One calibration dwell.
@@ -121,29 +98,13 @@ pub struct HeadingDwell {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum HeadingCalError {
     /// Fewer than `MIN_HEADINGS` dwells.
-    TooFewHeadings {
-        n: u16,
-    },
+    TooFewHeadings { n: u16 },
     /// Dwell `index` has a non-finite value or a sigma <= 0.
-    BadDwell {
-        index: u16,
-    },
+    BadDwell { index: u16 },
     /// Reference azimuth or latitude not finite / |latitude| >= 90.
     BadReference,
     /// The headings do not span the circle (normal equations singular).
     HeadingsDegenerate,
-    /// Output buffer too small.
-    BufferTooSmall,
-    /// Not postcard-decodable, truncated or with trailing bytes.
-    Malformed,
-    /// Magic is not `HEADING_CAL_MAGIC`.
-    BadMagic,
-    UnsupportedVersion {
-        version: u16,
-    },
-    CrcMismatch,
-    /// Non-finite or negative values.
-    InvalidContent,
 }
 
 impl core::fmt::Display for HeadingCalError {
@@ -165,17 +126,6 @@ impl core::fmt::Display for HeadingCalError {
                 f,
                 "heading calibration: headings do not span the circle (spread them evenly)"
             ),
-            Self::BufferTooSmall => write!(f, "heading calibration record: buffer too small"),
-            Self::Malformed => write!(f, "heading calibration record: malformed or truncated"),
-            Self::BadMagic => write!(f, "heading calibration record: wrong magic"),
-            Self::UnsupportedVersion { version } => {
-                write!(
-                    f,
-                    "heading calibration record: version {version} not supported"
-                )
-            }
-            Self::CrcMismatch => write!(f, "heading calibration record: CRC-32 mismatch"),
-            Self::InvalidContent => write!(f, "heading calibration record: invalid values"),
         }
     }
 }
@@ -281,66 +231,6 @@ fn invert3(m: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
     }))
 }
 
-/// The stored record.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct HeadingCalRecord {
-    pub magic: u32,
-    pub version: u16,
-    pub harmonic: HeadingHarmonic,
-}
-
-impl HeadingCalRecord {
-    pub fn new(harmonic: HeadingHarmonic) -> Self {
-        Self {
-            magic: HEADING_CAL_MAGIC,
-            version: HEADING_CAL_VERSION,
-            harmonic,
-        }
-    }
-
-    /// Writes postcard + CRC-32 into `out`; returns the length.
-    pub fn encode(&self, out: &mut [u8]) -> Result<usize, HeadingCalError> {
-        if !self.harmonic.is_valid() {
-            return Err(HeadingCalError::InvalidContent);
-        }
-        let body = postcard::to_slice(self, out)
-            .map_err(|_| HeadingCalError::BufferTooSmall)?
-            .len();
-        let crc = crc32(&out[..body]).to_le_bytes();
-        out.get_mut(body..body + 4)
-            .ok_or(HeadingCalError::BufferTooSmall)?
-            .copy_from_slice(&crc);
-        Ok(body + 4)
-    }
-
-    /// Checks CRC, magic, version and values; a record is accepted whole or not at all.
-    pub fn decode(bytes: &[u8]) -> Result<Self, HeadingCalError> {
-        if bytes.len() < 5 {
-            return Err(HeadingCalError::Malformed);
-        }
-        let (body, crc) = bytes.split_at(bytes.len() - 4);
-        if crc32(body) != u32::from_le_bytes([crc[0], crc[1], crc[2], crc[3]]) {
-            return Err(HeadingCalError::CrcMismatch);
-        }
-        let rec: Self = match postcard::take_from_bytes(body) {
-            Ok((r, [])) => r,
-            _ => return Err(HeadingCalError::Malformed),
-        };
-        if rec.magic != HEADING_CAL_MAGIC {
-            return Err(HeadingCalError::BadMagic);
-        }
-        if rec.version != HEADING_CAL_VERSION {
-            return Err(HeadingCalError::UnsupportedVersion {
-                version: rec.version,
-            });
-        }
-        if !rec.harmonic.is_valid() {
-            return Err(HeadingCalError::InvalidContent);
-        }
-        Ok(rec)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -397,51 +287,6 @@ mod tests {
         assert_eq!(
             calibrate(&d, 0.0, 39.9, Tilt::LEVEL).err(),
             Some(HeadingCalError::BadDwell { index: 2 })
-        );
-    }
-
-    #[test]
-    fn record_roundtrips_and_every_flipped_bit_is_caught() {
-        let d = dwells(20.0, 45.0, -0.01, 0.04, 0.1, 8);
-        let (h, _) = calibrate(&d, 20.0, 45.0, Tilt::LEVEL).unwrap();
-        let mut buf = [0u8; MAX_RECORD_LEN];
-        let n = HeadingCalRecord::new(h).encode(&mut buf).unwrap();
-        assert_eq!(HeadingCalRecord::decode(&buf[..n]).unwrap().harmonic, h);
-        for bit in 0..n * 8 {
-            let mut c = buf;
-            c[bit / 8] ^= 1 << (bit % 8);
-            assert!(HeadingCalRecord::decode(&c[..n]).is_err(), "bit {bit}");
-        }
-        for len in 0..n {
-            assert!(HeadingCalRecord::decode(&buf[..len]).is_err(), "len {len}");
-        }
-    }
-
-    #[test]
-    fn wrong_version_and_magic_are_named() {
-        let h = HeadingHarmonic {
-            cos_dph: 0.01,
-            sin_dph: 0.0,
-            cos_sigma_dph: 0.001,
-            sin_sigma_dph: 0.001,
-            correlation: 0.0,
-            n_headings: 8,
-        };
-        let mut buf = [0u8; MAX_RECORD_LEN];
-        let mut rec = HeadingCalRecord::new(h);
-        rec.version = 9;
-        // encode does not check the version, so a future record can be simulated.
-        let n = rec.encode(&mut buf).unwrap();
-        assert_eq!(
-            HeadingCalRecord::decode(&buf[..n]).err(),
-            Some(HeadingCalError::UnsupportedVersion { version: 9 })
-        );
-        let mut rec = HeadingCalRecord::new(h);
-        rec.magic = 1;
-        let n = rec.encode(&mut buf).unwrap();
-        assert_eq!(
-            HeadingCalRecord::decode(&buf[..n]).err(),
-            Some(HeadingCalError::BadMagic)
         );
     }
 }
