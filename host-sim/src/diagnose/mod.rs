@@ -2,7 +2,8 @@
 //! wrong, the cause, the extended model and its held-out gain (issues 4 and 9).
 //!
 //! Pipeline: [`input`] checks and averages the runs ([`rawrows`] streams the files and
-//! analyses the raw rows on the way); [`bases`] chooses the base model on held-out data
+//! analyses the raw rows on the way); [`buffer`] sizes the time blocks and buffers of
+//! single records; [`bases`] chooses the base model on held-out data
 //! ([`cv`], [`models`]); [`simfit`] calibrates the simulator's physics; [`residuals`]
 //! and [`outliers`] describe what is left; [`transforms`] builds every candidate feature;
 //! [`screen`] ranks them by held-out gain with the family-wise sign-flip test of
@@ -16,6 +17,7 @@ pub mod bases;
 pub mod basis;
 pub mod between;
 pub mod bootstrap;
+pub mod buffer;
 pub mod cause;
 pub mod cv;
 pub mod error;
@@ -74,10 +76,14 @@ pub struct Diagnosis {
 
 /// Runs the whole diagnosis on a campaign.
 pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
+    diagnose_with(runs, buffer::BufferRule::default())
+}
+
+/// [`diagnose`] with a chosen rule for the buffers between time blocks of single records.
+pub fn diagnose_with(runs: &[Run], rule: buffer::BufferRule) -> Result<Diagnosis, DiagnoseError> {
     let campaign = input::prepare(runs)?;
     let st = Stacked::new(&campaign);
-    let folds = Folds::new(&st.run_lengths)?;
-    let choice = bases::choose(&folds, &st)?;
+    let (folds, choice) = buffer::choose_buffered(Folds::new(&st.run_lengths)?, &st, rule)?;
     let base = &choice.chosen;
     let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
     let latitude = campaign
