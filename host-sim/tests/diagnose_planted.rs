@@ -32,9 +32,12 @@ fn check(effect: Effect) {
                         .take(4)
                         .map(|c| format!("{}:{}({:?}) {:+.2}% p{:.4}", c.column, c.transform.name(), c.tau_s, c.gain_pct, c.p_value))
                         .collect();
+                    let between = r.between_run.rows.first().map(|x| {
+                        format!("{} {:+.1}% fw p {:.4} perm p {:.4}", x.label, x.gain_pct, x.p_value, x.permutation_p)
+                    });
                     let line = format!(
-                        "{effect:?} seed {seed}: expected {expected:?}, named {named:?}, gain {:+.2}%, base {:.4} -> {:.4}; top {top:?}",
-                        r.extended.gain_pct, r.base.heldout_rms_dph, r.extended.heldout_rms_dph
+                        "{effect:?} seed {seed}: expected {expected:?}, named {named:?} (between runs {:?}), gain {:+.2}%, base {:.4} -> {:.4}; top {top:?}; best between-run {between:?}",
+                        r.between_run.named, r.extended.gain_pct, r.base.heldout_rms_dph, r.extended.heldout_rms_dph
                     );
                     (ok, line)
                 })

@@ -60,6 +60,26 @@ fn train_writes_a_valid_model_and_rejects_bad_input_without_output() {
     assert_eq!(report["n_runs"], 6);
     assert!(report["heldout_rms_dph"].as_f64().unwrap() < 0.01);
 
+    // --linear-inputs: linear terms in T and dT/dt under the Gaussians, in the model.
+    let model_lin = dir.join("model_lin.bin");
+    let out = fogsim(&[
+        "train",
+        runs.to_str().unwrap(),
+        "--out",
+        model_lin.to_str().unwrap(),
+        "--linear-inputs",
+        "--widths",
+        "0.5,1",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lin = RbfModel::decode(&std::fs::read(&model_lin).unwrap()).unwrap();
+    assert_eq!(lin.linear.len(), 2, "one linear weight per RBF input");
+    assert!(lin.linear.iter().any(|w| *w != 0.0));
+
     // A malformed cell: error names the file and line, exit != 0, no model written.
     let bad_dir = dir.join("bad");
     std::fs::create_dir_all(&bad_dir).unwrap();

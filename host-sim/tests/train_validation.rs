@@ -113,7 +113,8 @@ fn quadratic_bias_and_t_dependent_shupe(temp_c: f64, rate_cps: f64) -> f64 {
 
 #[test]
 fn the_width_climb_finds_the_full_searchs_best_scoring_fewer_widths() {
-    let laws: [(&str, fn(f64, f64) -> f64); 2] = [
+    type DriftLaw = fn(f64, f64) -> f64;
+    let laws: [(&str, DriftLaw); 2] = [
         ("shupe_like", shupe_like),
         (
             "quadratic bias, T-dependent Shupe",

@@ -65,6 +65,10 @@ pub struct Args {
     /// to the selection); larger values give smaller, better-conditioned weights.
     #[arg(long, default_value_t = TrainConfig::default().collinearity_tol)]
     pub collinearity_tol: f64,
+    /// Also fit linear terms in the RBF inputs (e.g. a Shupe term linear in dT/dt) under
+    /// the Gaussians, jointly with the centres.
+    #[arg(long)]
+    pub linear_inputs: bool,
     /// Gyro id stored in the model (at most 16 bytes).
     #[arg(long, default_value = "sim")]
     pub gyro_id: String,
@@ -105,6 +109,7 @@ impl Args {
             width_search: self.width_search,
             folds: self.folds,
             collinearity_tol: self.collinearity_tol,
+            linear_on_rbf_inputs: self.linear_inputs,
             gyro_id: self.gyro_id.clone(),
             ..TrainConfig::default()
         }

@@ -91,6 +91,11 @@ pub struct BaseChoice {
 /// device's must reach to replace it in the base.
 pub const RATE_WINDOW_ALPHA: f64 = 0.05;
 
+/// Half-width of the base's default dT/dt window: the device's least-squares span, centred, s.
+pub fn device_rate_half_s() -> f64 {
+    fog_core::features::DEFAULT_RATE_SPAN_S / 2.0
+}
+
 /// The base and the window of its dT/dt. By default dT/dt is the device's least-squares
 /// span (fog-core `DEFAULT_RATE_SPAN_S`, the `TempRateCps` input the deployed model runs
 /// on), centred. The temperature's own leave-one-out window (`derivatives`) replaces it
@@ -102,7 +107,7 @@ pub fn choose_with_rate_window(
     campaign: &super::input::Campaign,
     folds: &Folds,
 ) -> Result<(Stacked, BaseChoice), DiagnoseError> {
-    let device_half_s = fog_core::features::DEFAULT_RATE_SPAN_S / 2.0;
+    let device_half_s = device_rate_half_s();
     let st = Stacked::with_rate_half_width(campaign, device_half_s);
     let device = choose(folds, &st)?;
     let loo_half_s = campaign.half_width_s("temp_c", 1);

@@ -6,6 +6,11 @@
 //! or, for one to three continuous records, contiguous time blocks (the run offsets are
 //! fitted as dummy columns from the other blocks of the same run). Fits are ridge
 //! least squares on per-unit Gram matrices, so a fold costs one small solve.
+//!
+//! Time blocks may carry a buffer (h-block / hv-block validation): the rows within
+//! `buffer_points` of the held-out block are dropped from its training set too, so
+//! autocorrelated noise in the neighbours cannot leak into the held-out score. The
+//! buffer is chosen from the data (`buffer.rs`); a run-grouped layout needs none.
 
 use super::error::DiagnoseError;
 use super::linalg::solve_spd;
@@ -38,6 +43,10 @@ pub struct Folds {
     pub unit_rows: Vec<std::ops::Range<usize>>,
     pub run_rows: Vec<std::ops::Range<usize>>,
     pub offsets: Offsets,
+    /// Rows dropped from training on each side of a held-out time block (0: none).
+    pub buffer_points: usize,
+    /// Row spacing, s (for stating the buffer in seconds).
+    pub row_spacing_s: f64,
 }
 
 impl Folds {
@@ -62,6 +71,8 @@ impl Folds {
                 unit_rows: run_rows.clone(),
                 run_rows,
                 offsets: Offsets::PerUnit,
+                buffer_points: 0,
+                row_spacing_s: 0.0,
             });
         }
         if run_lengths.iter().any(|&n| n < MIN_POINTS_PER_BLOCK_RUN) {
@@ -86,7 +97,64 @@ impl Folds {
             unit_rows,
             run_rows,
             offsets: Offsets::RunDummies,
+            buffer_points: 0,
+            row_spacing_s: 0.0,
         })
+    }
+
+    /// The largest buffer a time-block layout allows: half the shortest block, so a
+    /// held-out block drops at most half a block on each side and every run keeps rows to
+    /// fit its offset even with two blocks (0 for run-grouped layouts).
+    pub fn max_buffer_points(&self) -> usize {
+        match self.offsets {
+            Offsets::PerUnit => 0,
+            Offsets::RunDummies => self.unit_rows.iter().map(|r| r.len()).min().unwrap_or(0) / 2,
+        }
+    }
+
+    /// This time-block layout re-split so that every block is at least `min_len` rows
+    /// long: blocks shorter than the noise's correlation length are not independent
+    /// units for the sign-flip test. At most the current count per run, at least 2
+    /// (fewer blocks: a larger smallest reachable p, said as "no test power").
+    pub fn with_min_block_len(mut self, min_len: usize) -> Self {
+        if self.offsets == Offsets::PerUnit {
+            return self;
+        }
+        let mut unit_rows = Vec::new();
+        for run in &self.run_rows {
+            let current = self
+                .unit_rows
+                .iter()
+                .filter(|u| run.start <= u.start && u.end <= run.end)
+                .count();
+            let n = run.len();
+            let blocks = (n / min_len.max(1)).clamp(2.min(current), current.max(1));
+            for b in 0..blocks {
+                unit_rows.push(run.start + b * n / blocks..run.start + (b + 1) * n / blocks);
+            }
+        }
+        self.unit_rows = unit_rows;
+        self
+    }
+
+    /// This layout with a buffer of `points` rows (capped at [`Self::max_buffer_points`])
+    /// each side of every held-out time block; `row_spacing_s` only labels it.
+    pub fn with_buffer(mut self, points: usize, row_spacing_s: f64) -> Self {
+        self.buffer_points = points.min(self.max_buffer_points());
+        self.row_spacing_s = row_spacing_s;
+        self
+    }
+
+    /// Rows kept out of unit u's training set: the unit and its buffer, within its run.
+    pub fn excluded_rows(&self, u: usize) -> std::ops::Range<usize> {
+        let r = &self.unit_rows[u];
+        let run = self
+            .run_rows
+            .iter()
+            .find(|run| run.start <= r.start && r.end <= run.end)
+            .unwrap_or(r);
+        r.start.saturating_sub(self.buffer_points).max(run.start)
+            ..(r.end + self.buffer_points).min(run.end)
     }
 
     /// Total number of rows.
@@ -99,9 +167,11 @@ impl Folds {
         match self.offsets {
             Offsets::PerUnit => format!("grouped by run ({} folds, a run is never split)", self.unit_rows.len()),
             Offsets::RunDummies => format!(
-                "contiguous time blocks ({} blocks of {} run(s): too few runs to hold whole runs out)",
+                "contiguous time blocks ({} blocks of {} run(s): too few runs to hold whole runs out); buffer {} point(s) = {:.0} s each side of a held-out block (the base residual's correlation length; blocks at least that long)",
                 self.unit_rows.len(),
-                self.run_rows.len()
+                self.run_rows.len(),
+                self.buffer_points,
+                self.buffer_points as f64 * self.row_spacing_s
             ),
         }
     }
@@ -114,7 +184,33 @@ pub struct Prepared {
     y: Vec<f64>,
     grams: Vec<Vec<f64>>,
     xty: Vec<Vec<f64>>,
+    /// Per-unit Grams and X'y over each unit's excluded rows (unit plus buffer); empty
+    /// when the layout has no buffer (the unit's own then serve).
+    excluded_grams: Vec<Vec<f64>>,
+    excluded_xty: Vec<Vec<f64>>,
     ridge: f64,
+}
+
+/// Gram matrix and X'y of `cols` against `y` over `rows`.
+fn range_system(
+    cols: &[Vec<f64>],
+    y: &[f64],
+    rows: std::ops::Range<usize>,
+) -> (Vec<f64>, Vec<f64>) {
+    let p = cols.len();
+    let mut g = vec![0.0; p * p];
+    for i in 0..p {
+        for j in 0..=i {
+            let v = dot(&cols[i][rows.clone()], &cols[j][rows.clone()]);
+            g[i * p + j] = v;
+            g[j * p + i] = v;
+        }
+    }
+    let c = cols
+        .iter()
+        .map(|col| dot(&col[rows.clone()], &y[rows.clone()]))
+        .collect();
+    (g, c)
 }
 
 /// Held-out result.
@@ -161,30 +257,25 @@ impl Prepared {
             }
         }
         let y = adjust(folds, y);
-        let p = adj.len();
-        let mut grams = Vec::new();
-        let mut xty = Vec::new();
-        for r in &folds.unit_rows {
-            let mut g = vec![0.0; p * p];
-            for i in 0..p {
-                for j in 0..=i {
-                    let v = dot(&adj[i][r.clone()], &adj[j][r.clone()]);
-                    g[i * p + j] = v;
-                    g[j * p + i] = v;
-                }
-            }
-            grams.push(g);
-            xty.push(
-                (0..p)
-                    .map(|i| dot(&adj[i][r.clone()], &y[r.clone()]))
-                    .collect(),
-            );
-        }
+        let (grams, xty) = folds
+            .unit_rows
+            .iter()
+            .map(|r| range_system(&adj, &y, r.clone()))
+            .unzip();
+        let (excluded_grams, excluded_xty) = if folds.buffer_points > 0 {
+            (0..folds.unit_rows.len())
+                .map(|u| range_system(&adj, &y, folds.excluded_rows(u)))
+                .unzip()
+        } else {
+            (vec![], vec![])
+        };
         Self {
             cols: adj,
             y,
             grams,
             xty,
+            excluded_grams,
+            excluded_xty,
             ridge,
         }
     }
@@ -211,6 +302,8 @@ impl Prepared {
         extra: &[Vec<f64>],
     ) -> Result<CvResult, DiagnoseError> {
         let (grams, xty, cols) = self.augmented(folds, extra);
+        let buffered = (folds.buffer_points > 0).then(|| self.augmented_excluded(folds, &cols));
+        let (excl_g, excl_c) = buffered.as_ref().map_or((&grams, &xty), |(g, c)| (g, c));
         let q = cols.len();
         let total_g = sum_all(&grams);
         let total_c = sum_all(&xty);
@@ -218,8 +311,8 @@ impl Prepared {
         let mut unit_sse = Vec::with_capacity(folds.unit_rows.len());
         let mut residual = vec![0.0; folds.rows()];
         for (u, r) in folds.unit_rows.iter().enumerate() {
-            let mut a: Vec<f64> = total_g.iter().zip(&grams[u]).map(|(t, g)| t - g).collect();
-            let mut b: Vec<f64> = total_c.iter().zip(&xty[u]).map(|(t, g)| t - g).collect();
+            let mut a: Vec<f64> = total_g.iter().zip(&excl_g[u]).map(|(t, g)| t - g).collect();
+            let mut b: Vec<f64> = total_c.iter().zip(&excl_c[u]).map(|(t, g)| t - g).collect();
             add_ridge(&mut a, &diag_scale, q, self.ridge);
             solve_spd(&mut a, &mut b, q).map_err(|_| DiagnoseError::Singular {
                 what: "held-out fit",
@@ -271,26 +364,55 @@ impl Prepared {
 
     /// Per-unit Grams of the design augmented by `extra` columns (cross terms only).
     fn augmented<'a>(&'a self, folds: &Folds, extra: &[Vec<f64>]) -> Augmented<'a> {
-        let p = self.cols.len();
-        let m = extra.len();
-        let q = p + m;
         let ex: Vec<Vec<f64>> = extra.iter().map(|c| adjust(folds, c)).collect();
+        let ranges: Vec<_> = folds.unit_rows.clone();
+        let (grams, xty) = self.augment_over(&ranges, &self.grams, &self.xty, &ex);
         let mut cols: Vec<std::borrow::Cow<'a, [f64]>> = self
             .cols
             .iter()
             .map(|c| std::borrow::Cow::Borrowed(c.as_slice()))
             .collect();
-        let mut grams = Vec::with_capacity(folds.unit_rows.len());
-        let mut xty = Vec::with_capacity(folds.unit_rows.len());
-        for (u, r) in folds.unit_rows.iter().enumerate() {
+        cols.extend(ex.into_iter().map(std::borrow::Cow::Owned));
+        (grams, xty, cols)
+    }
+
+    /// Grams and X'y over every unit's excluded rows (unit plus buffer) for the
+    /// augmented design `cols` (this design's columns first, then the adjusted extras).
+    fn augmented_excluded(
+        &self,
+        folds: &Folds,
+        cols: &[std::borrow::Cow<'_, [f64]>],
+    ) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+        let ranges: Vec<_> = (0..folds.unit_rows.len())
+            .map(|u| folds.excluded_rows(u))
+            .collect();
+        let ex: Vec<Vec<f64>> = cols[self.cols.len()..].iter().map(|c| c.to_vec()).collect();
+        self.augment_over(&ranges, &self.excluded_grams, &self.excluded_xty, &ex)
+    }
+
+    /// Per-range Grams and X'y of this design plus the adjusted `ex` columns, from this
+    /// design's own per-range systems (`base_g`, `base_c`) and the cross terms.
+    fn augment_over(
+        &self,
+        ranges: &[std::ops::Range<usize>],
+        base_g: &[Vec<f64>],
+        base_c: &[Vec<f64>],
+        ex: &[Vec<f64>],
+    ) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+        let p = self.cols.len();
+        let m = ex.len();
+        let q = p + m;
+        let mut grams = Vec::with_capacity(ranges.len());
+        let mut xty = Vec::with_capacity(ranges.len());
+        for (u, r) in ranges.iter().enumerate() {
             if m == 0 {
-                grams.push(self.grams[u].clone());
-                xty.push(self.xty[u].clone());
+                grams.push(base_g[u].clone());
+                xty.push(base_c[u].clone());
                 continue;
             }
             let mut g = vec![0.0; q * q];
             for i in 0..p {
-                g[i * q..i * q + p].copy_from_slice(&self.grams[u][i * p..(i + 1) * p]);
+                g[i * q..i * q + p].copy_from_slice(&base_g[u][i * p..(i + 1) * p]);
             }
             for (k, e) in ex.iter().enumerate() {
                 let e = &e[r.clone()];
@@ -305,13 +427,12 @@ impl Prepared {
                     g[(p + k2) * q + p + k] = v;
                 }
             }
-            let mut c = self.xty[u].clone();
+            let mut c = base_c[u].clone();
             c.extend(ex.iter().map(|e| dot(&e[r.clone()], &self.y[r.clone()])));
             grams.push(g);
             xty.push(c);
         }
-        cols.extend(ex.into_iter().map(std::borrow::Cow::Owned));
-        (grams, xty, cols)
+        (grams, xty)
     }
 }
 
@@ -392,5 +513,43 @@ mod tests {
         assert_eq!(Folds::new(&[40]).unwrap().unit_rows.len(), MIN_BLOCK_UNITS);
         assert_eq!(Folds::new(&[20]).unwrap().unit_rows.len(), 6);
         assert_eq!(Folds::new(&[40, 40]).unwrap().unit_rows.len(), 10);
+    }
+
+    #[test]
+    fn a_buffer_keeps_the_held_out_blocks_neighbours_out_of_its_training() {
+        let folds = Folds::new(&[80]).unwrap();
+        assert_eq!(folds.unit_rows[3], 30..40);
+        let x: Vec<f64> = (0..80).map(|i| ((i * 37) % 11) as f64).collect();
+        // rows right next to block 3 are contaminated by a common disturbance
+        let near = |i: usize| (25..30).contains(&i) || (40..45).contains(&i);
+        let y: Vec<f64> = (0..80)
+            .map(|i| 2.0 * x[i] + if near(i) { 50.0 + 9.0 * x[i] } else { 0.0 })
+            .collect();
+        let sse3 = |f: &Folds| {
+            Prepared::new(f, std::slice::from_ref(&x), &y, 1e-9)
+                .validate(f)
+                .unwrap()
+                .unit_sse[3]
+        };
+        let plain = sse3(&folds);
+        let buffered = folds.clone().with_buffer(5, 10.0);
+        assert_eq!(buffered.excluded_rows(3), 25..45);
+        assert_eq!(
+            buffered.excluded_rows(0),
+            0..15,
+            "clipped at the run's start"
+        );
+        assert!(
+            sse3(&buffered) < 1e-6 * plain,
+            "{} vs {plain}",
+            sse3(&buffered)
+        );
+        assert_eq!(
+            folds.clone().with_buffer(99, 10.0).buffer_points,
+            5,
+            "capped at half a block"
+        );
+        assert_eq!(folds.clone().with_min_block_len(30).unit_rows.len(), 2);
+        assert_eq!(folds.with_min_block_len(1).unit_rows.len(), MIN_BLOCK_UNITS);
     }
 }

@@ -2,7 +2,8 @@
 //! wrong, the cause, the extended model and its held-out gain (issues 4 and 9).
 //!
 //! Pipeline: [`input`] checks and averages the runs ([`rawrows`] streams the files and
-//! analyses the raw rows on the way); [`bases`] chooses the base model on held-out data
+//! analyses the raw rows on the way); [`buffer`] sizes the time blocks and buffers of
+//! single records; [`bases`] chooses the base model on held-out data
 //! ([`cv`], [`models`]); [`simfit`] calibrates the simulator's physics; [`residuals`]
 //! and [`outliers`] describe what is left; [`transforms`] builds every candidate feature;
 //! [`screen`] ranks them by held-out gain with the family-wise sign-flip test of
@@ -16,6 +17,7 @@ pub mod bases;
 pub mod basis;
 pub mod between;
 pub mod bootstrap;
+pub mod buffer;
 pub mod causal;
 pub mod cause;
 pub mod cv;
@@ -76,9 +78,17 @@ pub struct Diagnosis {
 
 /// Runs the whole diagnosis on a campaign.
 pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
+    diagnose_with(runs, buffer::BufferRule::default())
+}
+
+/// [`diagnose`] with a chosen rule for the buffers between time blocks of single records.
+pub fn diagnose_with(runs: &[Run], rule: buffer::BufferRule) -> Result<Diagnosis, DiagnoseError> {
     let campaign = input::prepare(runs)?;
+    // buffers between time blocks are sized on the base with the device's dT/dt span;
+    // the base and its dT/dt window are then chosen on that layout
+    let device_rate = Stacked::with_rate_half_width(&campaign, bases::device_rate_half_s());
     let run_lengths: Vec<usize> = campaign.runs.iter().map(|s| s.t_s.len()).collect();
-    let folds = Folds::new(&run_lengths)?;
+    let (folds, _) = buffer::choose_buffered(Folds::new(&run_lengths)?, &device_rate, rule)?;
     let (st, choice) = bases::choose_with_rate_window(&campaign, &folds)?;
     let base = &choice.chosen;
     let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();

@@ -4,8 +4,10 @@
 //! modes), each run at ONE heading (turntable set between runs), 1 Hz rows, a
 //! thermometer quantised to 0.0625 degC, decoy columns (a cabinet temperature random
 //! walk and a supply with load steps), cold and warm restarts, turn-on bias offsets.
-//! Planted effects are sized at 1 noise sigma: the heading bias's rms over runs equals
-//! the turn-on repeatability.
+//! Two sizings of the heading bias: against the turn-on repeatability (its rms over
+//! runs = k x 0.005 deg/h, a harsh power limit) and the issue's (amplitude = k x the white
+//! noise sigma of 10 s means in a campaign at the issue's noise level, 0.03 deg/h: the
+//! issue's "0.03 deg/h amplitude against ~0.005 deg/h turn-on repeatability").
 
 use fog_sim::io::runs::Run;
 use rand::{Rng, SeedableRng};
@@ -26,12 +28,21 @@ pub enum Hidden {
     /// is not a function of T and dT/dt.
     #[allow(dead_code)] // constructed by diagnose_derivatives only
     TempAccel(f64),
+    /// The issue's sizing: amplitude = this many white-noise sigmas of 10 s means, in a
+    /// campaign whose 10 s noise is [`ISSUE_NOISE_10S_DPH`] (repeatability unchanged).
+    #[allow(dead_code)] // only diagnose_between plants it; other tests share the module
+    HeadingNoiseSigmas(f64),
+    /// Nothing planted, at the issue's noise level (the null twin of `HeadingNoiseSigmas`).
+    #[allow(dead_code)] // only diagnose_between uses it
+    NullIssueNoise,
 }
 
 /// Turn-on repeatability (sd of run offsets), deg/h.
 pub const REPEATABILITY_DPH: f64 = 0.005;
 /// White noise of 10 s means, deg/h.
 pub const NOISE_10S_DPH: f64 = 0.004;
+/// White noise of 10 s means in the issue's campaigns (its 1-sigma heading amplitude), deg/h.
+pub const ISSUE_NOISE_10S_DPH: f64 = 0.03;
 
 /// 20 runs x 45 min at 1 Hz (4 ambients x 5 runs); the expected run-level label.
 pub fn campaign(hidden: Hidden, seed: u64) -> (Vec<Run>, Option<&'static str>) {
@@ -41,11 +52,15 @@ pub fn campaign(hidden: Hidden, seed: u64) -> (Vec<Run>, Option<&'static str>) {
     let rows = 45 * 60;
     let phase = rng.random_range(0.0..std::f64::consts::TAU);
     // rms of A cos(h - phase) over uniform headings is A / sqrt 2
-    let sigmas = match hidden {
-        Hidden::HeadingBetweenRuns(s) => s,
-        Hidden::Null | Hidden::TempAccel(_) => 0.0,
+    let (amp, noise_10s_dph) = match hidden {
+        Hidden::HeadingBetweenRuns(s) => (
+            s * REPEATABILITY_DPH * std::f64::consts::SQRT_2,
+            NOISE_10S_DPH,
+        ),
+        Hidden::HeadingNoiseSigmas(s) => (s * ISSUE_NOISE_10S_DPH, ISSUE_NOISE_10S_DPH),
+        Hidden::NullIssueNoise => (0.0, ISSUE_NOISE_10S_DPH),
+        Hidden::Null | Hidden::TempAccel(_) => (0.0, NOISE_10S_DPH),
     };
-    let amp = sigmas * REPEATABILITY_DPH * std::f64::consts::SQRT_2;
     let (k1, k2) = (
         rng.random_range(-0.004..0.004),
         rng.random_range(-6e-5..6e-5),
@@ -88,7 +103,7 @@ pub fn campaign(hidden: Hidden, seed: u64) -> (Vec<Run>, Option<&'static str>) {
             }
             let mut drift = offset + k1 * d + k2 * d * d + shupe * dtemp;
             drift += amp * (heading.to_radians() - phase).cos();
-            let rate = drift + NOISE_10S_DPH * 10f64.sqrt() * g.sample(&mut rng);
+            let rate = drift + noise_10s_dph * 10f64.sqrt() * g.sample(&mut rng);
             let temp_q = ((temp + 0.02 * g.sample(&mut rng)) / 0.0625).round() * 0.0625;
             for (c, v) in cols
                 .iter_mut()
@@ -122,7 +137,7 @@ pub fn campaign(hidden: Hidden, seed: u64) -> (Vec<Run>, Option<&'static str>) {
             add_accel_effect(&mut runs, &accel_rows, s * NOISE_10S_DPH);
             Some("temp_c:accel")
         }
-        _ => (sigmas > 0.0).then_some("heading_deg:run_harmonic"),
+        _ => (amp > 0.0).then_some("heading_deg:run_harmonic"),
     };
     (runs, expected)
 }
