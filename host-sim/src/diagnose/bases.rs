@@ -103,13 +103,15 @@ pub fn device_rate_half_s() -> f64 {
 /// (paired sign flips, `RATE_WINDOW_ALPHA`), as a coarse thermometer needs: a base whose
 /// choice flips on noise would move every candidate's p-value. Returns the stacked
 /// campaign with the chosen dT/dt.
+///
+/// `device` is the campaign stacked with the device's span (`device_rate_half_s`) and the
+/// base chosen on it with `folds` (already computed when the folds were laid out).
 pub fn choose_with_rate_window(
     campaign: &super::input::Campaign,
     folds: &Folds,
+    (st, device): (Stacked, BaseChoice),
 ) -> Result<(Stacked, BaseChoice), DiagnoseError> {
-    let device_half_s = device_rate_half_s();
-    let st = Stacked::with_rate_half_width(campaign, device_half_s);
-    let device = choose(folds, &st)?;
+    let device_half_s = st.temp_rate_half_s;
     let loo_half_s = campaign.half_width_s("temp_c", 1);
     if (loo_half_s - device_half_s).abs() < 1e-9 {
         return Ok((st, device));

@@ -84,12 +84,7 @@ pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
 /// [`diagnose`] with a chosen rule for the buffers between time blocks of single records.
 pub fn diagnose_with(runs: &[Run], rule: buffer::BufferRule) -> Result<Diagnosis, DiagnoseError> {
     let campaign = input::prepare(runs)?;
-    // buffers between time blocks are sized on the base with the device's dT/dt span;
-    // the base and its dT/dt window are then chosen on that layout
-    let device_rate = Stacked::with_rate_half_width(&campaign, bases::device_rate_half_s());
-    let run_lengths: Vec<usize> = campaign.runs.iter().map(|s| s.t_s.len()).collect();
-    let (folds, _) = buffer::choose_buffered(Folds::new(&run_lengths)?, &device_rate, rule)?;
-    let (st, choice) = bases::choose_with_rate_window(&campaign, &folds)?;
+    let (folds, st, choice) = layout_and_base(&campaign, rule)?;
     let base = &choice.chosen;
     let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
     let latitude = campaign
@@ -184,6 +179,22 @@ pub fn diagnose_with(runs: &[Run], rule: buffer::BufferRule) -> Result<Diagnosis
         cause_feature: named.and_then(|s| s.cols.first().cloned()),
         sim_terms,
     })
+}
+
+/// The validation layout, the stacked campaign and the base: buffers between time blocks
+/// are sized on the base with the device's dT/dt span; the base and its dT/dt window are
+/// then chosen on that layout (`bases::choose_with_rate_window`).
+fn layout_and_base(
+    campaign: &input::Campaign,
+    rule: buffer::BufferRule,
+) -> Result<(Folds, Stacked, bases::BaseChoice), DiagnoseError> {
+    let device_rate = Stacked::with_rate_half_width(campaign, bases::device_rate_half_s());
+    let run_lengths: Vec<usize> = campaign.runs.iter().map(|s| s.t_s.len()).collect();
+    let (folds, device_choice) =
+        buffer::choose_buffered(Folds::new(&run_lengths)?, &device_rate, rule)?;
+    let (st, choice) =
+        bases::choose_with_rate_window(campaign, &folds, (device_rate, device_choice))?;
+    Ok((folds, st, choice))
 }
 
 /// Within-run screening and the between-run analysis, decided as one family.

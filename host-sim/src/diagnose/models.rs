@@ -29,13 +29,8 @@ pub struct Stacked {
 }
 
 impl Stacked {
-    /// Stacks drift, time, temperature and dT/dt (centred local polynomial, the
-    /// temperature's leave-one-out half-width, `derivatives`).
-    pub fn new(c: &Campaign) -> Self {
-        Self::with_rate_half_width(c, c.half_width_s("temp_c", 1))
-    }
-
-    /// The same with dT/dt over a centred window of `rate_half_s`.
+    /// Stacks drift, time, temperature and dT/dt (a centred local polynomial over
+    /// +/-`rate_half_s`, `derivatives`; the window is chosen with the base, `bases`).
     pub fn with_rate_half_width(c: &Campaign, rate_half_s: f64) -> Self {
         let cat = |f: &dyn Fn(&super::input::Series) -> Vec<f64>| {
             c.runs.iter().flat_map(f).collect::<Vec<f64>>()
