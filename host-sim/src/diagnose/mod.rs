@@ -122,12 +122,8 @@ pub fn diagnose_with(runs: &[Run], rule: buffer::BufferRule) -> Result<Diagnosis
         extended: azimuth::azimuth_effect(&folds, &st.t_s, &ext_resid, latitude),
     });
     let smallest_attainable_p = signflip::smallest_p(folds.unit_rows.len());
-    let nothing = cause.is_none() && between_run.named.is_none();
-    let power_check = if nothing && smallest_attainable_p < screen::ALPHA {
-        power::check(&campaign, &folds, &st, base, &screening)?
-    } else {
-        None
-    };
+    let silent = cause.is_none() && between_run.named.is_none();
+    let power_check = power::check_if_silent(silent, &campaign, &folds, &st, base, &screening)?;
     let words = cause_in_words(
         cause.as_ref(),
         &between_run,
