@@ -5,6 +5,8 @@
 mod planted;
 use fog_sim::diagnose::{diagnose, DiagnoseError};
 use fog_sim::io::runs::Run;
+use fog_sim::pipeline::campaign::{simulate_campaign, CampaignSpec};
+use fog_sim::sim::GyroParams;
 use planted::{campaign, Effect, Shape};
 
 fn small() -> Vec<Run> {
@@ -204,6 +206,40 @@ fn nothing_named_says_whether_the_record_could_have_shown_an_effect() {
     assert!(d.report.campaign.power_check.is_none());
     assert!(
         d.report.cause_in_words.contains("no test power"),
+        "{}",
+        d.report.cause_in_words
+    );
+}
+
+#[test]
+fn a_record_whose_candidates_are_all_functions_of_the_base_says_power_was_not_checked() {
+    // The project's simulator at one ambient, nothing but time, temperature and a fixed
+    // heading: every candidate (lags, rates, decays of T and t) is mostly predicted by a
+    // base in T on a warm-up, so planting one could not test power, and the report says
+    // that rather than claiming either way.
+    let spec = CampaignSpec {
+        ambients_c: vec![20.0],
+        runs_per_ambient: 20,
+        minutes: 45.0,
+        seed: 3,
+        latitude_deg: 39.9,
+        raw_rate_hz: 1.0,
+    };
+    let runs: Vec<Run> = simulate_campaign(&GyroParams::paper_default(), &spec)
+        .unwrap()
+        .into_iter()
+        .map(|c| c.run)
+        .collect();
+    let d = diagnose(&runs).unwrap();
+    let pc = d
+        .report
+        .campaign
+        .power_check
+        .as_ref()
+        .expect("checked when nothing is named");
+    assert_eq!(pc.planted, None, "{pc:?}");
+    assert!(
+        d.report.cause_in_words.contains("power not checked"),
         "{}",
         d.report.cause_in_words
     );

@@ -30,8 +30,10 @@ pub const PLANTED_SIGMAS: f64 = 1.0;
 /// The outcome of planting a known effect into the record.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct PowerCheck {
-    /// Label of the candidate whose (orthogonalised) feature was planted.
-    pub planted: String,
+    /// Label of the candidate whose (orthogonalised) feature was planted; `None` when
+    /// none of the `TRIED` best-ranked candidates could be (each mostly predicted by the
+    /// base: nothing else is counted then).
+    pub planted: Option<String>,
     /// Its rms within runs, deg/h (`PLANTED_SIGMAS` x the residual's).
     pub planted_rms_dph: f64,
     /// Whether the family-wise screen named it.
@@ -68,8 +70,17 @@ pub fn check(
     base: &BaseFit,
     screening: &Screening,
 ) -> Result<Option<PowerCheck>, DiagnoseError> {
-    let Some((label, planted)) = plantable(folds, st, base, screening)? else {
+    if screening.scored.is_empty() {
         return Ok(None);
+    }
+    let Some((label, planted)) = plantable(folds, st, base, screening)? else {
+        return Ok(Some(PowerCheck {
+            planted: None,
+            planted_rms_dph: 0.0,
+            named: false,
+            gain_pct: 0.0,
+            p_value: 1.0,
+        }));
     };
     let mut with_effect = st.clone();
     with_effect
@@ -91,7 +102,7 @@ pub fn check(
         (again.scored[i].gain_pct, again.scored[i].p_value)
     });
     Ok(Some(PowerCheck {
-        planted: label,
+        planted: Some(label),
         planted_rms_dph: within_rms(&folds.run_rows, &planted),
         named: found.is_some() && again.named == found,
         gain_pct,
@@ -100,7 +111,7 @@ pub fn check(
 }
 
 /// Candidates tried in rank order for planting.
-const TRIED: usize = 5;
+pub const TRIED: usize = 20;
 /// Least share of a feature's within-run variance the base must leave unexplained held
 /// out for the feature to be planted: a feature the base predicts (a copy of T under a
 /// base in T) cannot be told from the base on any record, which is confounding, not a

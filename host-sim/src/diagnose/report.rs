@@ -138,22 +138,29 @@ pub fn nothing_named(
             super::screen::ALPHA
         );
     }
-    match power_check {
-        Some(pc) if !pc.named => format!(
+    match power_check.map(|pc| (pc, pc.planted.as_deref())) {
+        Some((_, None)) => format!(
+            "no significant cause: the residual of the chosen base shows no structure that any \
+             candidate explains better than chance on held-out data (power not checked: each of \
+             the {} best-ranked candidates is mostly predicted by the base itself, so an effect \
+             of their shape could not be told from the base on this record)",
+            super::power::TRIED
+        ),
+        Some((pc, Some(planted))) if !pc.named => format!(
             "cannot decide: no test power at {} sigma (a copy of {} planted at the residual's own \
              size, {:.4} deg/h rms, was not named: gain {:+.1} %, p {:.4}); absence of a named \
              cause says nothing about effects of that size",
             super::power::PLANTED_SIGMAS,
-            pc.planted,
+            planted,
             pc.planted_rms_dph,
             pc.gain_pct,
             pc.p_value
         ),
-        Some(pc) => format!(
+        Some((pc, Some(planted))) => format!(
             "no significant cause: the residual of the chosen base shows no structure that any \
              candidate explains better than chance on held-out data (power check: a copy of {} \
              planted at {} sigma, {:.4} deg/h rms, is named, p {:.4})",
-            pc.planted,
+            planted,
             super::power::PLANTED_SIGMAS,
             pc.planted_rms_dph,
             pc.p_value
@@ -191,11 +198,15 @@ fn write_campaign(s: &mut String, c: &CampaignSummary) {
             super::screen::ALPHA
         );
     }
-    if let Some(pc) = &c.power_check {
+    if let Some((pc, planted)) = c
+        .power_check
+        .as_ref()
+        .and_then(|pc| pc.planted.as_ref().map(|p| (pc, p)))
+    {
         let _ = writeln!(
             s,
             "  power check (nothing named): a copy of {} planted at {} sigma ({:.4} deg/h rms, orthogonal to the residual) is {}: gain {:+.1} %, p {:.4}",
-            pc.planted,
+            planted,
             super::power::PLANTED_SIGMAS,
             pc.planted_rms_dph,
             if pc.named { "named" } else { "NOT named (no test power at that size)" },
