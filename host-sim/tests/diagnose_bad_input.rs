@@ -5,6 +5,8 @@
 mod planted;
 use fog_sim::diagnose::{diagnose, DiagnoseError};
 use fog_sim::io::runs::Run;
+use fog_sim::pipeline::campaign::{simulate_campaign, CampaignSpec};
+use fog_sim::sim::GyroParams;
 use planted::{campaign, Effect, Shape};
 
 fn small() -> Vec<Run> {
@@ -149,11 +151,51 @@ fn a_single_record_is_validated_on_time_blocks_and_says_so() {
 }
 
 #[test]
-fn a_record_too_short_for_test_power_says_cannot_decide() {
+fn nothing_named_says_whether_the_record_could_have_shown_an_effect() {
+    // 20 runs, nothing planted: nothing named, and a copy of a candidate planted at one
+    // residual sigma is named, so "no significant cause" is a statement about the drift.
+    let many = campaign(
+        Effect::Null,
+        9,
+        Shape {
+            runs: 20,
+            minutes: 45.0,
+            sigmas: 1.0,
+        },
+    )
+    .0;
+    let d = diagnose(&many).unwrap();
+    assert!(d.report.campaign.smallest_attainable_p < 0.01);
+    let pc = d
+        .report
+        .campaign
+        .power_check
+        .as_ref()
+        .expect("checked when nothing is named");
+    assert!(pc.named, "{pc:?}");
+    assert!(
+        d.report.cause_in_words.starts_with("no significant cause"),
+        "{}",
+        d.report.cause_in_words
+    );
+    // One 45 min record with drift wander: 8 time blocks reach p 0.0039, but the planted
+    // one-sigma copy is not named, so the tool cannot decide and says so.
     let long = one_record();
     let d = diagnose(&long).unwrap();
     assert!(d.report.campaign.smallest_attainable_p < 0.01);
-    assert!(d.report.cause_in_words.starts_with("no significant cause"));
+    let pc = d
+        .report
+        .campaign
+        .power_check
+        .as_ref()
+        .expect("checked when nothing is named");
+    assert!(!pc.named, "{pc:?}");
+    assert!(
+        d.report.cause_in_words.contains("no test power at 1 sigma"),
+        "{}",
+        d.report.cause_in_words
+    );
+    // 20 points: too few validation units for any p below the level.
     let mut short = long;
     for v in short[0].data.iter_mut() {
         v.truncate(20);
@@ -161,8 +203,43 @@ fn a_record_too_short_for_test_power_says_cannot_decide() {
     let d = diagnose(&short).unwrap();
     let p = d.report.campaign.smallest_attainable_p;
     assert!(p >= 0.01, "20 points, 6 blocks: smallest p {p}");
+    assert!(d.report.campaign.power_check.is_none());
     assert!(
         d.report.cause_in_words.contains("no test power"),
+        "{}",
+        d.report.cause_in_words
+    );
+}
+
+#[test]
+fn a_record_whose_candidates_are_all_functions_of_the_base_says_power_was_not_checked() {
+    // The project's simulator at one ambient, nothing but time, temperature and a fixed
+    // heading: every candidate (lags, rates, decays of T and t) is mostly predicted by a
+    // base in T on a warm-up, so planting one could not test power, and the report says
+    // that rather than claiming either way.
+    let spec = CampaignSpec {
+        ambients_c: vec![20.0],
+        runs_per_ambient: 20,
+        minutes: 45.0,
+        seed: 3,
+        latitude_deg: 39.9,
+        raw_rate_hz: 1.0,
+    };
+    let runs: Vec<Run> = simulate_campaign(&GyroParams::paper_default(), &spec)
+        .unwrap()
+        .into_iter()
+        .map(|c| c.run)
+        .collect();
+    let d = diagnose(&runs).unwrap();
+    let pc = d
+        .report
+        .campaign
+        .power_check
+        .as_ref()
+        .expect("checked when nothing is named");
+    assert_eq!(pc.planted, None, "{pc:?}");
+    assert!(
+        d.report.cause_in_words.contains("power not checked"),
         "{}",
         d.report.cause_in_words
     );

@@ -9,7 +9,8 @@
 //! [`screen`] ranks them by held-out gain with the family-wise sign-flip test of
 //! [`signflip`], [`between`] does the same for run-level effects; the named [`cause`] is
 //! mapped onto the simulator by [`simterm`]; [`uncertainty`] puts block-bootstrap
-//! ([`bootstrap`]) ranges on every coefficient; [`report`] states the result, [`plots`]
+//! ([`bootstrap`]) ranges on every coefficient; [`power`] plants a known effect when
+//! nothing is named, to say whether the record could have shown one; [`report`] states the result, [`plots`]
 //! draws it, [`azimuth`] translates it into north-seeking error.
 
 pub mod azimuth;
@@ -29,6 +30,7 @@ pub mod models;
 pub mod olscheck;
 pub mod outliers;
 pub mod plots;
+pub mod power;
 pub mod rawrows;
 pub mod report;
 pub mod residuals;
@@ -123,11 +125,14 @@ pub fn diagnose_with(runs: &[Run], rule: buffer::BufferRule) -> Result<Diagnosis
         extended: azimuth::azimuth_effect(&folds, &st.t_s, &ext_resid, latitude),
     });
     let smallest_attainable_p = signflip::smallest_p(folds.unit_rows.len());
+    let silent = cause.is_none() && between_run.named.is_none();
+    let power_check = power::check_if_silent(silent, &campaign, &folds, &st, base, &screening)?;
     let words = cause_in_words(
         cause.as_ref(),
         &between_run,
         &sim.effect_coef,
         smallest_attainable_p,
+        power_check.as_ref(),
     );
     let sim_terms = simterm::terms_per_run(runs, cause.as_ref(), &sim.effect_coef);
     let cause_column = cause.as_ref().map(|c| c.column.clone());
@@ -139,6 +144,7 @@ pub fn diagnose_with(runs: &[Run], rule: buffer::BufferRule) -> Result<Diagnosis
             excluded_columns: campaign.exclusions.clone(),
             skipped_candidates: screening.skipped.iter().map(to_exclusion).collect(),
             smallest_attainable_p,
+            power_check,
         },
         base: base_summary(&choice, &st, &campaign),
         residual_structure: residuals::structure(&campaign, &folds, &st, &base.cv.residual),
@@ -330,13 +336,14 @@ fn cause_in_words(
     between_run: &between::BetweenRun,
     coef: &[f64],
     smallest_attainable_p: f64,
+    power_check: Option<&power::PowerCheck>,
 ) -> String {
     match (cause, &between_run.named) {
         (Some(c), _) => c.in_words(coef),
         (None, Some(b)) => {
             format!("no within-run cause; between runs: {b} (see the heading / run-level lines)")
         }
-        (None, None) => report::nothing_named(smallest_attainable_p),
+        (None, None) => report::nothing_named(smallest_attainable_p, power_check),
     }
 }
 

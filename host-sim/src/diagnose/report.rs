@@ -101,6 +101,9 @@ pub struct CampaignSummary {
     pub skipped_candidates: Vec<Exclusion>,
     /// Smallest p-value the sign-flip test can reach with this many validation units.
     pub smallest_attainable_p: f64,
+    /// When nothing is named: whether a planted 1-sigma effect would have been
+    /// (`power`).
+    pub power_check: Option<super::power::PowerCheck>,
 }
 
 /// The whole diagnosis.
@@ -132,18 +135,49 @@ pub struct Report {
     pub simulation: Simulation,
 }
 
-/// What "nothing named" means: no structure found, or no test power to find any.
-pub fn nothing_named(smallest_attainable_p: f64) -> String {
+/// What "nothing named" means: no structure found, or no test power to find any (too
+/// few validation units, or a planted 1-sigma effect that was not named either).
+pub fn nothing_named(
+    smallest_attainable_p: f64,
+    power_check: Option<&super::power::PowerCheck>,
+) -> String {
     if smallest_attainable_p >= super::screen::ALPHA {
-        format!(
+        return format!(
             "cannot decide: no test power (smallest reachable p {smallest_attainable_p:.4} >= alpha {} with this \
              few validation units); absence of a named cause says nothing about the drift",
             super::screen::ALPHA
-        )
-    } else {
-        "no significant cause: the residual of the chosen base shows no structure that any \
-         candidate explains better than chance on held-out data"
-            .into()
+        );
+    }
+    match power_check.map(|pc| (pc, pc.planted.as_deref())) {
+        Some((_, None)) => format!(
+            "no significant cause: the residual of the chosen base shows no structure that any \
+             candidate explains better than chance on held-out data (power not checked: each of \
+             the {} best-ranked candidates is mostly predicted by the base itself, so an effect \
+             of their shape could not be told from the base on this record)",
+            super::power::TRIED
+        ),
+        Some((pc, Some(planted))) if !pc.named => format!(
+            "cannot decide: no test power at {} sigma (a copy of {} planted at the residual's own \
+             size, {:.4} deg/h rms, was not named: gain {:+.1} %, p {:.4}); absence of a named \
+             cause says nothing about effects of that size",
+            super::power::PLANTED_SIGMAS,
+            planted,
+            pc.planted_rms_dph,
+            pc.gain_pct,
+            pc.p_value
+        ),
+        Some((pc, Some(planted))) => format!(
+            "no significant cause: the residual of the chosen base shows no structure that any \
+             candidate explains better than chance on held-out data (power check: a copy of {} \
+             planted at {} sigma, {:.4} deg/h rms, is named, p {:.4})",
+            planted,
+            super::power::PLANTED_SIGMAS,
+            pc.planted_rms_dph,
+            pc.p_value
+        ),
+        None => "no significant cause: the residual of the chosen base shows no structure that \
+                 any candidate explains better than chance on held-out data"
+            .into(),
     }
 }
 
@@ -172,6 +206,22 @@ fn write_campaign(s: &mut String, c: &CampaignSummary) {
             "  note: with this few validation units the smallest attainable p is {:.3} >= alpha {}: no cause can be named",
             c.smallest_attainable_p,
             super::screen::ALPHA
+        );
+    }
+    if let Some((pc, planted)) = c
+        .power_check
+        .as_ref()
+        .and_then(|pc| pc.planted.as_ref().map(|p| (pc, p)))
+    {
+        let _ = writeln!(
+            s,
+            "  power check (nothing named): a copy of {} planted at {} sigma ({:.4} deg/h rms, orthogonal to the residual) is {}: gain {:+.1} %, p {:.4}",
+            planted,
+            super::power::PLANTED_SIGMAS,
+            pc.planted_rms_dph,
+            if pc.named { "named" } else { "NOT named (no test power at that size)" },
+            pc.gain_pct,
+            pc.p_value
         );
     }
     for e in &c.excluded_columns {
