@@ -3,6 +3,7 @@
 #[allow(dead_code)]
 #[path = "common/planted.rs"]
 mod planted;
+use fog_sim::diagnose::power::PowerCheck;
 use fog_sim::diagnose::{diagnose, DiagnoseError};
 use fog_sim::io::runs::Run;
 use fog_sim::pipeline::campaign::{simulate_campaign, CampaignSpec};
@@ -150,6 +151,16 @@ fn a_single_record_is_validated_on_time_blocks_and_says_so() {
     assert!(d.report.named_cause.is_none());
 }
 
+/// The power check of a diagnosis that named nothing on a layout that can reach p < 0.01.
+fn power_check_with_reachable_p(d: &fog_sim::diagnose::Diagnosis) -> &PowerCheck {
+    assert!(d.report.campaign.smallest_attainable_p < 0.01);
+    d.report
+        .campaign
+        .power_check
+        .as_ref()
+        .expect("checked when nothing is named")
+}
+
 #[test]
 fn nothing_named_says_whether_the_record_could_have_shown_an_effect() {
     // 20 runs, nothing planted: nothing named, and a copy of a candidate planted at one
@@ -165,13 +176,7 @@ fn nothing_named_says_whether_the_record_could_have_shown_an_effect() {
     )
     .0;
     let d = diagnose(&many).unwrap();
-    assert!(d.report.campaign.smallest_attainable_p < 0.01);
-    let pc = d
-        .report
-        .campaign
-        .power_check
-        .as_ref()
-        .expect("checked when nothing is named");
+    let pc = power_check_with_reachable_p(&d);
     assert!(pc.named, "{pc:?}");
     assert!(
         d.report.cause_in_words.starts_with("no significant cause"),
@@ -182,13 +187,7 @@ fn nothing_named_says_whether_the_record_could_have_shown_an_effect() {
     // one-sigma copy is not named, so the tool cannot decide and says so.
     let long = one_record();
     let d = diagnose(&long).unwrap();
-    assert!(d.report.campaign.smallest_attainable_p < 0.01);
-    let pc = d
-        .report
-        .campaign
-        .power_check
-        .as_ref()
-        .expect("checked when nothing is named");
+    let pc = power_check_with_reachable_p(&d);
     assert!(!pc.named, "{pc:?}");
     assert!(
         d.report.cause_in_words.contains("no test power at 1 sigma"),
@@ -231,12 +230,7 @@ fn a_record_whose_candidates_are_all_functions_of_the_base_says_power_was_not_ch
         .map(|c| c.run)
         .collect();
     let d = diagnose(&runs).unwrap();
-    let pc = d
-        .report
-        .campaign
-        .power_check
-        .as_ref()
-        .expect("checked when nothing is named");
+    let pc = power_check_with_reachable_p(&d);
     assert_eq!(pc.planted, None, "{pc:?}");
     assert!(
         d.report.cause_in_words.contains("power not checked"),

@@ -25,6 +25,26 @@ fn fogsim(args: &[&str]) -> std::process::Output {
     app_support::fogsim(&std::env::temp_dir(), args)
 }
 
+/// `fogsim train RUNS --out MODEL --widths 0.5,1 EXTRA...` must succeed; the model it wrote.
+fn train_ok(runs: &Path, model: &Path, extra: &[&str]) -> RbfModel {
+    let mut args = vec![
+        "train",
+        runs.to_str().unwrap(),
+        "--out",
+        model.to_str().unwrap(),
+        "--widths",
+        "0.5,1",
+    ];
+    args.extend_from_slice(extra);
+    let out = fogsim(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    RbfModel::decode(&std::fs::read(model).unwrap()).unwrap()
+}
+
 #[test]
 fn train_writes_a_valid_model_and_rejects_bad_input_without_output() {
     let dir = std::env::temp_dir().join(format!("fogsim_train_cli_{}", std::process::id()));
@@ -37,46 +57,18 @@ fn train_writes_a_valid_model_and_rejects_bad_input_without_output() {
     }
     let model = dir.join("model.bin");
     let json = dir.join("report.json");
-    let out = fogsim(&[
-        "train",
-        runs.to_str().unwrap(),
-        "--out",
-        model.to_str().unwrap(),
-        "--json",
-        json.to_str().unwrap(),
-        "--max-centers",
-        "10",
-        "--widths",
-        "0.5,1",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let m = train_ok(
+        &runs,
+        &model,
+        &["--json", json.to_str().unwrap(), "--max-centers", "10"],
     );
-    let m = RbfModel::decode(&std::fs::read(&model).unwrap()).unwrap();
     assert!(!m.centers.is_empty() && m.centers.len() <= 10);
     let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
     assert_eq!(report["n_runs"], 6);
     assert!(report["heldout_rms_dph"].as_f64().unwrap() < 0.01);
 
     // --linear-inputs: linear terms in T and dT/dt under the Gaussians, in the model.
-    let model_lin = dir.join("model_lin.bin");
-    let out = fogsim(&[
-        "train",
-        runs.to_str().unwrap(),
-        "--out",
-        model_lin.to_str().unwrap(),
-        "--linear-inputs",
-        "--widths",
-        "0.5,1",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let lin = RbfModel::decode(&std::fs::read(&model_lin).unwrap()).unwrap();
+    let lin = train_ok(&runs, &dir.join("model_lin.bin"), &["--linear-inputs"]);
     assert_eq!(lin.linear.len(), 2, "one linear weight per RBF input");
     assert!(lin.linear.iter().any(|w| *w != 0.0));
 

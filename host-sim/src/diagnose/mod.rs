@@ -126,7 +126,7 @@ pub fn diagnose_with(runs: &[Run], rule: buffer::BufferRule) -> Result<Diagnosis
     });
     let smallest_attainable_p = signflip::smallest_p(folds.unit_rows.len());
     let silent = cause.is_none() && between_run.named.is_none();
-    let power_check = power::check_if_silent(silent, &campaign, &folds, &st, base, &screening)?;
+    let power_check = power::check(silent, &campaign, &folds, &st, base, &screening)?;
     let words = cause_in_words(
         cause.as_ref(),
         &between_run,

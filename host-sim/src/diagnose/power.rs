@@ -43,9 +43,11 @@ pub struct PowerCheck {
     pub p_value: f64,
 }
 
-/// [`check`] when nothing was named (`silent`) and the layout can reach p < alpha at
-/// all (otherwise the report already says "no test power"); else `None`.
-pub fn check_if_silent(
+/// When nothing was named (`silent`) and the layout can reach p < alpha at all
+/// (otherwise the report already says "no test power"): plants the top-ranked plantable
+/// candidate of `screening` at 1 residual sigma into `st.y` and screens again. `None`
+/// when not silent, p < alpha is unreachable, or there is no candidate.
+pub fn check(
     silent: bool,
     campaign: &Campaign,
     folds: &Folds,
@@ -54,23 +56,7 @@ pub fn check_if_silent(
     screening: &Screening,
 ) -> Result<Option<PowerCheck>, DiagnoseError> {
     let reachable = super::signflip::smallest_p(folds.unit_rows.len()) < screen::ALPHA;
-    if silent && reachable {
-        check(campaign, folds, st, base, screening)
-    } else {
-        Ok(None)
-    }
-}
-
-/// Plants the top-ranked candidate of `screening` at 1 residual sigma into `st.y` and
-/// screens again; `None` when there is no candidate or nothing of it is left to plant.
-pub fn check(
-    campaign: &Campaign,
-    folds: &Folds,
-    st: &Stacked,
-    base: &BaseFit,
-    screening: &Screening,
-) -> Result<Option<PowerCheck>, DiagnoseError> {
-    if screening.scored.is_empty() {
+    if !silent || !reachable || screening.scored.is_empty() {
         return Ok(None);
     }
     let Some((label, planted)) = plantable(folds, st, base, screening)? else {
