@@ -25,7 +25,7 @@ use fog_core::protocol::ResetCause;
 use fog_sim::upload::{ClientError, UploadClient};
 use fog_tests::console::wait_line;
 use fog_tests::qemu_ready;
-use qemu_support::{start, stream_gyro_frames};
+use qemu_support::{polled, start, stream_gyro_frames, wait_boot};
 use upload_support::*;
 
 #[test]
@@ -34,19 +34,9 @@ fn qemu_watchdog_resets_a_hung_main_loop_and_reports_it() {
         return;
     }
     let (_qemu, mut streams, console) = start(&["inject=hang"], 1);
-    wait_line(
-        &console,
-        "FOG-BOOT 1 reset=PowerOn",
-        Duration::from_secs(30),
-    );
-    wait_line(
-        &console,
-        "FOG-BOOT 2 reset=Watchdog",
-        Duration::from_secs(30),
-    );
-    let link = streams.remove(0);
-    link.set_read_timeout(Some(Duration::from_millis(50)))
-        .unwrap();
+    wait_boot(&console, 1, "PowerOn");
+    wait_boot(&console, 2, "Watchdog");
+    let link = polled(streams.remove(0));
     let mut client = UploadClient::new(link, Duration::from_secs(20));
     let status = client.status().expect("status after the watchdog reset");
     assert_eq!(status.last_reset.cause, ResetCause::Watchdog);
@@ -59,14 +49,8 @@ fn qemu_panic_resets_reports_its_line_and_keeps_the_model() {
         return;
     }
     let (_qemu, mut streams, console) = start(&["inject=panic-after-commit"], 1);
-    wait_line(
-        &console,
-        "FOG-BOOT 1 reset=PowerOn",
-        Duration::from_secs(30),
-    );
-    let link = streams.remove(0);
-    link.set_read_timeout(Some(Duration::from_millis(50)))
-        .unwrap();
+    wait_boot(&console, 1, "PowerOn");
+    let link = polled(streams.remove(0));
     let mut client = UploadClient::new(link, Duration::from_secs(5));
     let before = client.hello().expect("hello");
     let counter = before.active.as_ref().map_or(0, |m| m.security_counter) + 1;
@@ -77,7 +61,7 @@ fn qemu_panic_resets_reports_its_line_and_keeps_the_model() {
         Ok(_) | Err(ClientError::Timeout(_)) => {}
         Err(e) => panic!("upload: {e}"),
     }
-    let line = wait_line(&console, "FOG-BOOT 2 reset=Panic", Duration::from_secs(30));
+    let line = wait_boot(&console, 2, "Panic");
     let detail: u32 = line
         .rsplit("detail=")
         .next()
@@ -125,11 +109,7 @@ fn qemu_host_flood_never_costs_a_gyro_window() {
     let (_qemu, mut streams, console) = start(&[&rate_arg], 2);
     let gyro_link = streams.pop().expect("gyro link");
     let mut host_link = streams.pop().expect("host link");
-    wait_line(
-        &console,
-        "FOG-BOOT 1 reset=PowerOn",
-        Duration::from_secs(30),
-    );
+    wait_boot(&console, 1, "PowerOn");
     let stop = Arc::new(AtomicBool::new(false));
     let gyro = {
         let stop = stop.clone();

@@ -48,7 +48,7 @@ use fog_sim::monitor::{monitor, MonitorOptions, MonitorSummary, ResultLog};
 use fog_sim::upload::UploadClient;
 use fog_tests::console::{wait_line, wait_line_where};
 use fog_tests::{qemu_ready, scratch_dir};
-use qemu_support::{start, stream_gyro_frames};
+use qemu_support::{polled, start, stream_gyro_frames, wait_boot};
 use rand_distr::Distribution;
 use upload_support::*;
 
@@ -84,8 +84,7 @@ type Heading = Arc<Mutex<f64>>;
 /// The turntable controller: `MOV h` -> `ACK` (the heading changes at once), `POS?` ->
 /// `POS h S`. Ends when the link closes or `stop` is set.
 fn serve_table(link: TcpStream, heading: Heading, stop: Arc<AtomicBool>) {
-    link.set_read_timeout(Some(Duration::from_millis(50)))
-        .unwrap();
+    let link = polled(link);
     let mut out = link.try_clone().unwrap();
     let mut reader = BufReader::new(link);
     let mut line = Vec::new();
@@ -193,14 +192,8 @@ fn qemu_whole_seek_over_the_host_link_with_status_result_and_refusals() {
     let (_qemu, mut streams, console) = start(&args, 3);
     let table_link = streams.pop().expect("table link");
     let gyro_link = streams.pop().expect("gyro link");
-    let host = streams.pop().expect("host link");
-    host.set_read_timeout(Some(Duration::from_millis(50)))
-        .unwrap();
-    wait_line(
-        &console,
-        "FOG-BOOT 1 reset=PowerOn",
-        Duration::from_secs(30),
-    );
+    let host = polled(streams.pop().expect("host link"));
+    wait_boot(&console, 1, "PowerOn");
     // No model yet: no heading correction.
     wait_line(
         &console,

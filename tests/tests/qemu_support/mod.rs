@@ -34,6 +34,23 @@ pub fn start_with(
     start_with_console(&firmware_elf("fog-app"), opts, serial_ports)
 }
 
+/// Waits (30 s at most) for boot `n`'s `FOG-BOOT n reset=<reason>` console line, which
+/// every fog-app boot prints; returns the whole line (it may carry `detail=`).
+pub fn wait_boot(console: &Receiver<String>, n: u32, reason: &str) -> String {
+    fog_tests::console::wait_line(
+        console,
+        &format!("FOG-BOOT {n} reset={reason}"),
+        Duration::from_secs(30),
+    )
+}
+
+/// `link` with the 50 ms read timeout the host-port clients poll with.
+pub fn polled(link: TcpStream) -> TcpStream {
+    link.set_read_timeout(Some(Duration::from_millis(50)))
+        .expect("read timeout on a loopback socket");
+    link
+}
+
 /// A simulated FOG on `link`: frames at `rate_hz` of sample time, sent `speed` times
 /// faster than real time (the firmware's time base is the frame count) in 5 ms batches,
 /// 25 degC, the rate of frame `n` from `rate_dph(n)`, until `stop`. Returns frames sent.
