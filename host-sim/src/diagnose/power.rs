@@ -20,6 +20,7 @@ use super::cv::Folds;
 use super::error::DiagnoseError;
 use super::input::Campaign;
 use super::models::Stacked;
+use super::residuals::demeaned_by_run;
 use super::screen::{self, Screening};
 use super::transforms;
 use serde::Serialize;
@@ -141,8 +142,8 @@ fn planted_effect(
     feature: &[f64],
     residual: &[f64],
 ) -> Option<Vec<f64>> {
-    let f = demeaned(runs, feature);
-    let r = demeaned(runs, residual);
+    let f = demeaned_by_run(runs, feature);
+    let r = demeaned_by_run(runs, residual);
     let rr: f64 = r.iter().map(|v| v * v).sum();
     let fr: f64 = f.iter().zip(&r).map(|(a, b)| a * b).sum();
     let along = if rr > 0.0 { fr / rr } else { 0.0 };
@@ -157,18 +158,9 @@ fn planted_effect(
     })
 }
 
-fn demeaned(runs: &[std::ops::Range<usize>], v: &[f64]) -> Vec<f64> {
-    let mut out = v.to_vec();
-    for r in runs {
-        let m = v[r.clone()].iter().sum::<f64>() / r.len().max(1) as f64;
-        out[r.clone()].iter_mut().for_each(|x| *x -= m);
-    }
-    out
-}
-
 /// Rms around each run's own mean.
 fn within_rms(runs: &[std::ops::Range<usize>], v: &[f64]) -> f64 {
-    let d = demeaned(runs, v);
+    let d = demeaned_by_run(runs, v);
     (d.iter().map(|x| x * x).sum::<f64>() / d.len().max(1) as f64).sqrt()
 }
 
@@ -186,7 +178,7 @@ mod tests {
             .map(|i| f64::from(i) * 0.01 + (f64::from(i) * 0.37).sin())
             .collect();
         let e = planted_effect(&runs, &feature, &residual).unwrap();
-        let r = demeaned(&runs, &residual);
+        let r = demeaned_by_run(&runs, &residual);
         let dot: f64 = e.iter().zip(&r).map(|(a, b)| a * b).sum();
         assert!(dot.abs() < 1e-9, "not orthogonal: {dot}");
         let ratio = within_rms(&runs, &e) / within_rms(&runs, &residual);

@@ -49,9 +49,10 @@ fn slice(label: String, r: impl Iterator<Item = f64>) -> Slice {
     }
 }
 
-fn demeaned_by_run(folds: &Folds, v: &[f64]) -> Vec<f64> {
+/// `v` with each run's own mean removed (`runs`: the rows of each run).
+pub fn demeaned_by_run(runs: &[std::ops::Range<usize>], v: &[f64]) -> Vec<f64> {
     let mut out = v.to_vec();
-    for r in &folds.run_rows {
+    for r in runs {
         let m = v[r.clone()].iter().sum::<f64>() / r.len() as f64;
         out[r.clone()].iter_mut().for_each(|x| *x -= m);
     }
@@ -60,8 +61,8 @@ fn demeaned_by_run(folds: &Folds, v: &[f64]) -> Vec<f64> {
 
 /// Within-run Pearson correlation.
 pub fn within_run_correlation(folds: &Folds, a: &[f64], b: &[f64]) -> f64 {
-    let a = demeaned_by_run(folds, a);
-    let b = demeaned_by_run(folds, b);
+    let a = demeaned_by_run(&folds.run_rows, a);
+    let b = demeaned_by_run(&folds.run_rows, b);
     let ab: f64 = a.iter().zip(&b).map(|(x, y)| x * y).sum();
     let aa: f64 = a.iter().map(|x| x * x).sum();
     let bb: f64 = b.iter().map(|x| x * x).sum();
