@@ -6,12 +6,12 @@ use super::dataset::Dataset;
 use super::error::{Result, TrainError};
 use crate::io::runs::Run;
 use crate::report::feature_label;
-use fog_core::features::{features_for_series, FeatureVector};
-use fog_core::model::{FeatureKind, FeatureSpec, MAX_INPUTS};
+use fog_core::compensation::features::{features_for_series, FeatureVector};
+use fog_core::model::format::{FeatureKind, FeatureSpec, MAX_INPUTS};
 
 /// The paper's inputs: gyro temperature and its rate.
 pub fn default_specs() -> Vec<FeatureSpec> {
-    fog_core::model::PAPER_INPUTS.to_vec()
+    fog_core::model::format::PAPER_INPUTS.to_vec()
 }
 
 /// Report name of an input, `<column>:<transform>` as in the fog-runs format notes.
