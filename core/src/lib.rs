@@ -10,8 +10,8 @@
 //! - [`model`]: the RBF drift model: its stored/wire `format`, and its evaluation paths
 //!   (`rbf` f32/f64, `fixed` integer-only, `accuracy` of one against the other, `synthetic`
 //!   models for benchmarks and tests);
-//! - [`compensation`]: sensor streams -> model inputs (`features`) -> drift-free 10 s windows
-//!   (`compensator`);
+//! - [`compensation`]: sensor streams -> model inputs (`features`, named by `label`) ->
+//!   drift-free 10 s windows (`compensator`);
 //! - [`seeking`]: compensated windows -> azimuth (`northfinder`, `tilt`, `heading_cal`,
 //!   seek `quality`);
 //! - [`link`]: the host port: model `upload` and frame format, north-finder `messages`, the
