@@ -227,7 +227,7 @@ pub fn summary(outcome: &TrainOutcome, n_runs: usize, model_bytes: usize) -> Str
     );
     s += &format!(
         "time: width selection {:.2} s, final fit {:.2} s; model {} bytes\n",
-        r.validation_s, r.final_fit_s, model_bytes
+        r.timings.validation_s, r.timings.final_fit_s, model_bytes
     );
     s
 }
