@@ -41,7 +41,7 @@ impl LinkArgs {
 pub struct Args {
     #[command(flatten)]
     pub link: LinkArgs,
-    /// Ed25519 signing seed (64 hex digits). Default: the repository's public TEST key.
+    /// Ed25519 signing seed (64 hex digits) [default: the repository's public TEST key].
     #[arg(long)]
     pub key: Option<PathBuf>,
     /// Seconds to wait for each response.

@@ -118,18 +118,21 @@ impl MonteCarloConfig {
         }
         if !self.latitude_deg.is_finite() || self.latitude_deg.abs() > 90.0 {
             bail!(
-                "--latitude {}: must be within -90..=90 deg",
+                "--latitude-deg {}: must be within -90..=90 deg",
                 self.latitude_deg
             );
         }
         if self.latitude_deg.abs() >= 85.0 {
-            bail!("--latitude {}: north seeking needs |latitude| < 85 deg (horizontal Earth rate too small)", self.latitude_deg);
+            bail!("--latitude-deg {}: north seeking needs |latitude| < 85 deg (horizontal Earth rate too small)", self.latitude_deg);
         }
         if !self.true_azimuth_deg.is_finite() {
-            bail!("--azimuth: must be a finite angle in degrees");
+            bail!("--azimuth-deg: must be a finite angle in degrees");
         }
         if !(self.dwell_s.is_finite() && self.dwell_s >= 10.0) {
-            bail!("--dwell {}: must be at least one 10 s window", self.dwell_s);
+            bail!(
+                "--dwell-s {}: must be at least one 10 s window",
+                self.dwell_s
+            );
         }
         if self.threads == 0 {
             bail!("--threads: must be at least 1");
