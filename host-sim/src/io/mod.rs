@@ -10,7 +10,7 @@ pub mod model;
 pub mod reader;
 pub mod runs;
 
-pub use atomic::{write_atomic, write_atomic_with};
+pub use atomic::{write_atomic, write_atomic_with, StagedFiles};
 pub use bin::{read_binned, read_runs_binned, WindowBinner};
 pub use guard::{OutputError, OutputGuard};
 pub use reader::{visit_rows, RunHeader, RunReader};
