@@ -51,7 +51,7 @@ fn small_reproduce_writes_report_and_plots() {
         .zip([("model_t_rate.bin", 2), ("model_t_rate_accel.bin", 3)])
     {
         let bytes = std::fs::read(dir.join("plots").join(file)).unwrap();
-        let model = fog_core::model::RbfModel::decode(&bytes).unwrap();
+        let model = fog_core::model::format::RbfModel::decode(&bytes).unwrap();
         assert_eq!(model.n_inputs(), inputs, "{file}");
         assert_eq!(
             model.n_centers() as u64,

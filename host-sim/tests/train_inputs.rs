@@ -7,7 +7,7 @@
 mod app_support;
 
 use app_support::{fogsim, scratch_dir, stderr};
-use fog_core::model::{FeatureKind, RbfModel};
+use fog_core::model::format::{FeatureKind, RbfModel};
 use std::path::Path;
 
 #[derive(Clone, Copy)]

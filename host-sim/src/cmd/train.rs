@@ -14,7 +14,7 @@ use crate::train::{
     TrainOutcome, TrainReport, Verdict, WidthSearch, GUARD_RATIO,
 };
 use anyhow::Context;
-use fog_core::model::MAX_ENCODED_LEN;
+use fog_core::model::format::MAX_ENCODED_LEN;
 use serde::Serialize;
 use std::path::Path;
 use std::path::PathBuf;

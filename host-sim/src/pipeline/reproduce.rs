@@ -25,7 +25,7 @@ use crate::report::{
 use crate::sim::{GyroParams, RunSpec, SimGyro, StartState};
 use crate::stats::{self, SPEC_DPH};
 use crate::train::{InputSet, TrainReport};
-use fog_core::model::FeatureSpec;
+use fog_core::model::format::FeatureSpec;
 
 /// Everything a reproduce run needs.
 #[derive(Clone, Debug)]
@@ -58,8 +58,8 @@ pub fn model_file_name(specs: &[FeatureSpec]) -> String {
 }
 
 /// Writes a model in fog-core's encoding (what `fogsim upload` sends), atomically.
-fn write_model_file(path: &Path, model: &fog_core::model::RbfModel) -> Result<()> {
-    let mut buf = [0u8; fog_core::model::MAX_ENCODED_LEN];
+fn write_model_file(path: &Path, model: &fog_core::model::format::RbfModel) -> Result<()> {
+    let mut buf = [0u8; fog_core::model::format::MAX_ENCODED_LEN];
     let len = model
         .encode(&mut buf)
         .map_err(|e| anyhow!("encoding the trained model: {e}"))?;

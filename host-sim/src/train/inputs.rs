@@ -8,7 +8,7 @@
 
 use std::collections::HashSet;
 
-use fog_core::model::{FeatureKind, FeatureSpec};
+use fog_core::model::format::{FeatureKind, FeatureSpec};
 use serde::Serialize;
 
 use super::error::{Result, TrainError};
