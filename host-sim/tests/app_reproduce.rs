@@ -45,6 +45,20 @@ fn small_reproduce_writes_report_and_plots() {
         assert!(m["targets"]["azimuth_std_over_floor"].as_f64().is_some());
     }
     assert!(json["paper_vs_us"].as_array().unwrap().len() >= 10);
+    // The deployable models beside the plots: the ones the report describes.
+    for (m, (file, inputs)) in models
+        .iter()
+        .zip([("model_t_rate.bin", 2), ("model_t_rate_accel.bin", 3)])
+    {
+        let bytes = std::fs::read(dir.join("plots").join(file)).unwrap();
+        let model = fog_core::model::format::RbfModel::decode(&bytes).unwrap();
+        assert_eq!(model.n_inputs(), inputs, "{file}");
+        assert_eq!(
+            model.n_centers() as u64,
+            m["training"]["n_centers"].as_u64().unwrap(),
+            "{file}"
+        );
+    }
     for f in [
         "model_extended/startup_after.svg",
         "model_extended/azimuth_scatter.svg",

@@ -68,7 +68,11 @@ fn train_writes_a_valid_model_and_rejects_bad_input_without_output() {
     assert!(report["heldout_rms_dph"].as_f64().unwrap() < 0.01);
 
     // --linear-inputs: linear terms in T and dT/dt under the Gaussians, in the model.
-    let lin = train_ok(&runs, &dir.join("model_lin.bin"), &["--linear-inputs"]);
+    let lin = train_ok(
+        &runs,
+        &dir.join("model_lin.bin"),
+        &["--linear-inputs", "--inputs", "t,rate"],
+    );
     assert_eq!(lin.linear.len(), 2, "one linear weight per RBF input");
     assert!(lin.linear.iter().any(|w| *w != 0.0));
 

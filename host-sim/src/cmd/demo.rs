@@ -51,7 +51,7 @@ pub fn run(args: Args) -> Result<()> {
     print!("{}", summary(&report));
     write_json(&args.out.join("report.json"), &report)?;
     println!(
-        "\nplots and report.json written to {} ({:.1} s)",
+        "\nplots, report.json and the models (model_t_rate.bin, model_t_rate_accel.bin) written to {} ({:.1} s)",
         args.out.display(),
         started.elapsed().as_secs_f64()
     );

@@ -1,17 +1,22 @@
-//! `fogsim train RUNS... --out MODEL`: reads fog-runs files, trains the RBF drift model
-//! (OLS or Orr, width by grouped validation) and writes fog-core's postcard model, plus
-//! an optional JSON report. Everything is checked and encoded before any file is
-//! written, and files are written atomically, so a failure leaves no partial output.
+//! `fogsim train RUNS... --out MODEL`: reads fog-runs files (any rate, binned to 10 s
+//! windows as they stream), chooses the model inputs (`--inputs auto`: by grouped
+//! validation), trains the RBF drift model (OLS or Orr, width by grouped validation) and
+//! writes fog-core's postcard model, plus an optional JSON report. Outputs are locked
+//! for the whole command (a second `train` naming one of them is refused), everything is
+//! checked and encoded before any file is written, and the outputs are committed
+//! together, so a failure leaves no partial output and two runs never mix theirs.
 
 use super::check_output_file;
-use crate::io::runs::read_runs;
-use crate::io::{write_atomic, OutputGuard};
+use crate::io::runs::run_files;
+use crate::io::{read_runs_binned, OutputGuard, OutputLock, StagedFiles};
 use crate::train::{
-    dataset_from_runs, default_specs, train_model, Method, TrainConfig, TrainOutcome, Verdict,
-    WidthSearch, GUARD_RATIO,
+    choose_inputs, train_model, GroupedCvRms, InputChoice, InputSelection, Method, TrainConfig,
+    TrainOutcome, TrainReport, Verdict, WidthSearch, GUARD_RATIO,
 };
 use anyhow::Context;
 use fog_core::model::format::MAX_ENCODED_LEN;
+use serde::Serialize;
+use std::path::Path;
 use std::path::PathBuf;
 
 /// Options of `fogsim train`.
@@ -69,6 +74,11 @@ pub struct Args {
     /// the Gaussians, jointly with the centres.
     #[arg(long)]
     pub linear_inputs: bool,
+    /// Model inputs: `t,rate` (T, dT/dt), `t,rate,accel` (and d2T/dt2, computed by
+    /// fog-core as on the device) or `auto` (each scored by grouped cross-validation over
+    /// whole runs on the same points; the lowest held-out rms wins).
+    #[arg(long, default_value = "auto", value_parser = InputChoice::parse)]
+    pub inputs: InputChoice,
     /// Gyro id stored in the model (at most 16 bytes).
     #[arg(long, default_value = "sim")]
     pub gyro_id: String,
@@ -116,22 +126,91 @@ impl Args {
     }
 }
 
+/// `train --json`: the training report, what `--inputs` chose, and the gyro id written.
+#[derive(Serialize)]
+pub struct TrainCommandReport<'a> {
+    #[serde(flatten)]
+    pub training: &'a TrainReport,
+    pub input_selection: &'a InputSelection,
+    pub gyro_id: &'a str,
+}
+
+/// Checks the outputs before anything is read: creatable, not inputs, distinct.
+fn check_outputs(args: &Args, guard: &OutputGuard) -> anyhow::Result<()> {
+    check_output_file(guard, Some(&args.out), "--out")?;
+    check_output_file(guard, args.json.as_deref(), "--json")?;
+    check_output_file(guard, args.export_design.as_deref(), "--export-design")?;
+    let named = [
+        Some(&args.out),
+        args.json.as_ref(),
+        args.export_design.as_ref(),
+    ];
+    let paths: Vec<&std::path::PathBuf> = named.into_iter().flatten().collect();
+    for (i, p) in paths.iter().enumerate() {
+        if paths[..i].contains(p) {
+            anyhow::bail!("two outputs name the same file {}", p.display());
+        }
+    }
+    Ok(())
+}
+
+/// Stages one output (see [`StagedFiles`]), naming it on failure.
+fn stage(staged: &mut StagedFiles, path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    staged
+        .stage(path, bytes)
+        .with_context(|| format!("writing {}", path.display()))
+}
+
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let cfg = args.config();
-    let specs = default_specs();
+    let candidates = args.inputs.candidates();
+    let most_inputs = candidates
+        .iter()
+        .map(|s| s.specs().len())
+        .max()
+        .unwrap_or(0);
     // Options first: a bad option is reported before any file is read.
-    cfg.check(specs.len()).context("fogsim train")?;
-    // Outputs next: a bad or input-destroying output is refused before any training.
+    cfg.check(most_inputs).context("fogsim train")?;
+    // Outputs next: a bad or input-destroying output is refused before any training,
+    // and held until the command ends.
     let guard = OutputGuard::new(&args.runs);
-    check_output_file(&guard, Some(&args.out), "--out")?;
-    check_output_file(&guard, args.json.as_deref(), "--json")?;
-    if args.json.as_deref() == Some(args.out.as_path()) {
-        anyhow::bail!("--json and --out name the same file {}", args.out.display());
+    check_outputs(&args, &guard)?;
+    let outputs: Vec<&Path> = [
+        Some(&args.out),
+        args.json.as_ref(),
+        args.export_design.as_ref(),
+    ]
+    .into_iter()
+    .flatten()
+    .map(|p| p.as_path())
+    .collect();
+    let _lock = OutputLock::acquire(&outputs).map_err(anyhow::Error::msg)?;
+    // Grouped validation holds out whole runs: too few files is refused before reading.
+    let files = run_files(&args.runs)?;
+    let needed = cfg.folds.max(2);
+    if files.len() < needed {
+        anyhow::bail!(
+            "{} run file(s): grouped validation holds out whole runs (one per file) and needs at least {needed}",
+            files.len()
+        );
     }
-    let runs = read_runs(&args.runs)?;
-    let ds = dataset_from_runs(&runs, &specs)?;
+    let runs = read_runs_binned(&args.runs)?;
+    let (selection, ds) = choose_inputs(&runs, &candidates, &cfg, &GroupedCvRms)?;
+    if args.inputs == InputChoice::Auto {
+        print!("{}", selection.summary());
+    }
     let outcome = train_model(&ds, &cfg)?;
+    let report = TrainCommandReport {
+        training: &outcome.report,
+        input_selection: &selection,
+        gyro_id: &cfg.gyro_id,
+    };
+    let json = match &args.json {
+        Some(_) => Some(serde_json::to_vec_pretty(&report)?),
+        None => None,
+    };
+    let mut staged = StagedFiles::default();
     let cv = &outcome.report.cross_validation;
     if outcome.report.verdict == Verdict::NotBetter {
         eprintln!(
@@ -146,9 +225,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             }
         );
         if !args.force {
-            if let Some(path) = &args.json {
-                write_atomic(path, &serde_json::to_vec_pretty(&outcome.report)?)
-                    .with_context(|| format!("writing {}", path.display()))?;
+            if let (Some(path), Some(bytes)) = (&args.json, &json) {
+                stage(&mut staged, path, bytes)?;
+                staged.commit()?;
             }
             anyhow::bail!("model does not clearly improve held-out drift");
         }
@@ -158,41 +237,48 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .model
         .encode(&mut buf)
         .map_err(|e| anyhow::anyhow!("encoding the trained model: {e}"))?;
-    let json = match &args.json {
-        Some(_) => Some(serde_json::to_vec_pretty(&outcome.report)?),
-        None => None,
-    };
-    write_atomic(&args.out, &buf[..len])
-        .with_context(|| format!("writing {}", args.out.display()))?;
-    if let (Some(path), Some(bytes)) = (&args.json, json) {
-        write_atomic(path, &bytes).with_context(|| format!("writing {}", path.display()))?;
+    stage(&mut staged, &args.out, &buf[..len])?;
+    if let (Some(path), Some(bytes)) = (&args.json, &json) {
+        stage(&mut staged, path, bytes)?;
     }
     if let Some(path) = &args.export_design {
-        let normalizer = crate::train::Normalizer::fit(&ds)?;
-        let points = normalizer.normalized_rows(&ds);
-        let d = ds.n_inputs();
-        let width = outcome.report.width;
-        let candidates = crate::train::grid_candidates(
-            &points,
-            d,
-            d - cfg.linear_only_inputs,
-            width,
-            cfg.max_candidates,
-        );
-        let export = serde_json::json!({
-            "n_inputs": d,
-            "points": points,
-            "targets_dph": ds.targets_dph,
-            "width": width,
-            "candidates": candidates,
-            "n_centers": outcome.report.n_centers,
-            "heldout_rms_dph": outcome.report.heldout_rms_dph,
-        });
-        write_atomic(path, &serde_json::to_vec(&export)?)
-            .with_context(|| format!("writing {}", path.display()))?;
+        stage(
+            &mut staged,
+            path,
+            &serde_json::to_vec(&design_export(&ds, &cfg, &outcome)?)?,
+        )?;
     }
+    staged.commit().context("committing the outputs")?;
     print!("{}", summary(&outcome, runs.len(), len));
     Ok(())
+}
+
+/// `--export-design`: the normalised training points, targets, width and candidates.
+fn design_export(
+    ds: &crate::train::Dataset,
+    cfg: &TrainConfig,
+    outcome: &TrainOutcome,
+) -> anyhow::Result<serde_json::Value> {
+    let normalizer = crate::train::Normalizer::fit(ds)?;
+    let points = normalizer.normalized_rows(ds);
+    let d = ds.n_inputs();
+    let width = outcome.report.width;
+    let candidates = crate::train::grid_candidates(
+        &points,
+        d,
+        d - cfg.linear_only_inputs,
+        width,
+        cfg.max_candidates,
+    );
+    Ok(serde_json::json!({
+        "n_inputs": d,
+        "points": points,
+        "targets_dph": ds.targets_dph,
+        "width": width,
+        "candidates": candidates,
+        "n_centers": outcome.report.n_centers,
+        "heldout_rms_dph": outcome.report.heldout_rms_dph,
+    }))
 }
 
 /// The human-readable summary printed after training.

@@ -37,23 +37,75 @@ pub fn write_atomic_with(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> io::Result<()>,
 ) -> io::Result<()> {
-    let tmp = temp_path_for(path);
-    let result = (|| {
+    let mut staged = StagedFiles::default();
+    let mut w = staged.create(path)?;
+    fill(&mut w)?;
+    StagedFiles::close(w)?;
+    staged.commit()
+}
+
+/// Several outputs of one command, written to temporary siblings and renamed into place
+/// together by [`StagedFiles::commit`]; dropped before that, every temporary is removed
+/// and no output has changed. So a command that fails half-way (a bad row in its third
+/// input file) leaves nothing, and memory never holds an output whole.
+#[derive(Debug, Default)]
+pub struct StagedFiles {
+    /// (temporary, final) per output, in creation order.
+    staged: Vec<(PathBuf, PathBuf)>,
+}
+
+impl StagedFiles {
+    /// Opens the temporary file of output `path` (created new; removed unless committed).
+    pub fn create(&mut self, path: &Path) -> io::Result<BufWriter<fs::File>> {
+        let tmp = temp_path_for(path);
         let file = fs::OpenOptions::new()
             .write(true)
             .create_new(true)
             .open(&tmp)?;
-        let mut w = BufWriter::new(file);
-        fill(&mut w)?;
-        let file = w.into_inner().map_err(io::IntoInnerError::into_error)?;
-        file.sync_all()?;
-        drop(file);
-        fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
+        self.staged.push((tmp, path.to_path_buf()));
+        Ok(BufWriter::new(file))
     }
-    result
+
+    /// Flushes and fsyncs one output's temporary file.
+    pub fn close(w: BufWriter<fs::File>) -> io::Result<()> {
+        let file = w.into_inner().map_err(io::IntoInnerError::into_error)?;
+        file.sync_all()
+    }
+
+    /// Writes a whole output from memory (see [`StagedFiles::create`]).
+    pub fn stage(&mut self, path: &Path, bytes: &[u8]) -> io::Result<()> {
+        let mut w = self.create(path)?;
+        w.write_all(bytes)?;
+        Self::close(w)
+    }
+
+    /// Number of staged outputs.
+    pub fn len(&self) -> usize {
+        self.staged.len()
+    }
+
+    /// Whether nothing is staged.
+    pub fn is_empty(&self) -> bool {
+        self.staged.is_empty()
+    }
+
+    /// Renames every temporary over its output, in creation order.
+    pub fn commit(mut self) -> io::Result<()> {
+        while !self.staged.is_empty() {
+            let (tmp, path) = &self.staged[0];
+            fs::rename(tmp, path)?;
+            self.staged.remove(0);
+        }
+        Ok(())
+    }
+}
+
+impl Drop for StagedFiles {
+    fn drop(&mut self) {
+        for (tmp, _) in &self.staged {
+            let _ = fs::remove_file(tmp);
+        }
+    }
 }
 
 #[cfg(test)]
@@ -103,6 +155,25 @@ mod tests {
         });
         assert!(e.is_err());
         assert_eq!(fs::read(&p).unwrap(), b"old");
+        assert!(leftovers(&dir).is_empty());
+    }
+
+    #[test]
+    fn staged_outputs_appear_together_or_not_at_all() {
+        let dir = scratch("staged");
+        let (a, b) = (dir.join("a.csv"), dir.join("b.csv"));
+        let mut s = StagedFiles::default();
+        s.stage(&a, b"a").unwrap();
+        s.stage(&b, b"b").unwrap();
+        assert!(!a.exists() && !b.exists());
+        drop(s);
+        assert!(!a.exists() && leftovers(&dir).is_empty());
+        let mut s = StagedFiles::default();
+        s.stage(&a, b"a").unwrap();
+        s.stage(&b, b"b").unwrap();
+        assert_eq!(s.len(), 2);
+        s.commit().unwrap();
+        assert_eq!(fs::read(&b).unwrap(), b"b");
         assert!(leftovers(&dir).is_empty());
     }
 

@@ -6,13 +6,15 @@ pub mod atomic;
 pub mod bin;
 pub mod guard;
 pub mod import;
+pub mod lock;
 pub mod model;
 pub mod reader;
 pub mod runs;
 
-pub use atomic::{write_atomic, write_atomic_with};
+pub use atomic::{write_atomic, write_atomic_with, StagedFiles};
 pub use bin::{read_binned, read_runs_binned, WindowBinner};
 pub use guard::{OutputError, OutputGuard};
+pub use lock::OutputLock;
 pub use reader::{visit_rows, RunHeader, RunReader};
 pub use runs::{read_run, read_runs, Run, RunError, RunErrorKind};
 

@@ -426,7 +426,7 @@ fn check_metadata(path: &Path, meta: &[(String, String)]) -> Result<(), RunError
 }
 
 /// A cell value's check: finite and inside its column's physical range.
-pub(super) fn check_value(column: &str, v: f64) -> Result<(), RunErrorKind> {
+pub(crate) fn check_value(column: &str, v: f64) -> Result<(), RunErrorKind> {
     if !v.is_finite() {
         return Err(RunErrorKind::NotFinite);
     }

@@ -24,8 +24,8 @@ use crate::report::{
 };
 use crate::sim::{GyroParams, RunSpec, SimGyro, StartState};
 use crate::stats::{self, SPEC_DPH};
-use crate::train::{default_specs, TrainReport};
-use fog_core::model::format::{FeatureKind, FeatureSpec};
+use crate::train::{InputSet, TrainReport};
+use fog_core::model::format::FeatureSpec;
 
 /// Everything a reproduce run needs.
 #[derive(Clone, Debug)]
@@ -39,12 +39,32 @@ pub struct ReproduceOptions {
 
 /// The model inputs compared: the paper's (T, dT/dt) and this project's (T, dT/dt, d2T/dt2).
 pub fn input_variants() -> Vec<(&'static str, Vec<FeatureSpec>)> {
-    let mut extended = default_specs();
-    extended.push(FeatureSpec::plain(FeatureKind::TempAccelCps2));
     vec![
-        ("paper inputs (T, dT/dt)", default_specs()),
-        ("extended inputs (T, dT/dt, d2T/dt2)", extended),
+        ("paper inputs (T, dT/dt)", InputSet::TempRate.specs()),
+        (
+            "extended inputs (T, dT/dt, d2T/dt2)",
+            InputSet::TempRateAccel.specs(),
+        ),
     ]
+}
+
+/// File name of a variant's deployable model (written beside its plots).
+pub fn model_file_name(specs: &[FeatureSpec]) -> String {
+    let set = InputSet::ALL
+        .into_iter()
+        .find(|s| s.specs() == specs)
+        .map_or("custom", InputSet::name);
+    format!("model_{}.bin", set.replace(',', "_"))
+}
+
+/// Writes a model in fog-core's encoding (what `fogsim upload` sends), atomically.
+fn write_model_file(path: &Path, model: &fog_core::model::format::RbfModel) -> Result<()> {
+    let mut buf = [0u8; fog_core::model::format::MAX_ENCODED_LEN];
+    let len = model
+        .encode(&mut buf)
+        .map_err(|e| anyhow!("encoding the trained model: {e}"))?;
+    crate::io::write_atomic(path, &buf[..len])
+        .map_err(|e| anyhow!("writing {}: {e}", path.display()))
 }
 
 /// Held-out figures of one ambient temperature (runs pooled).
@@ -125,6 +145,10 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
     for (label, specs) in &variants {
         let trained = train_default(&train_runs, specs, "sim")?;
         steps.inc(1);
+        if let Some(dir) = &opts.plots {
+            crate::io::guard::create_dir(dir)?;
+            write_model_file(&dir.join(model_file_name(specs)), &trained.model)?;
+        }
         let (validation, series) = compensate_all(&heldout_runs, &trained.model)?;
         steps.inc(1);
         fitted.push((label.to_string(), trained, validation, series));

@@ -21,6 +21,7 @@ mod design;
 mod error;
 mod fit;
 mod gram;
+mod inputs;
 mod normalize;
 mod ols;
 mod orr;
@@ -42,6 +43,10 @@ pub use features::{
 };
 pub use fit::{fit_path, fit_shape, fit_width, Fit, PathFit, Shape};
 pub use gram::gram_bytes;
+pub use inputs::{
+    choose_inputs, GroupedCvRms, InputChoice, InputCriterion, InputSelection, InputSet,
+    InputSetScore,
+};
 pub use normalize::Normalizer;
 pub use path::StopReason;
 pub use predict::predict_batch;

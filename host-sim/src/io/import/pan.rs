@@ -1,6 +1,4 @@
-//! Converts a foreign recording into fog-runs v1 so `diagnose` can read it.
-//!
-//! Supported: the PAN "Cold TVC ETU Test 3/7/2020" MEMS log (`TVCtest3_7_20.csv`, see
+//! The PAN preset of `fogsim import`: the "Cold TVC ETU Test 3/7/2020" MEMS log (`TVCtest3_7_20.csv`, see
 //! `shared/data/measured/pan-tvac-mems/SOURCE.md`; MIT, Copyright (c) 2020 Pathfinder for
 //! Autonomous Navigation (PAN)). Columns: time (ms), magnetometer x/y/z (T), gyro x/y/z
 //! (rad/s), raw temperature register (uint16 as written). Conversion, as SOURCE.md says:
@@ -16,10 +14,11 @@
 //! Bad input (wrong header, non-numeric cell, ragged row, time going backwards) is
 //! rejected with the line named; nothing is written then.
 
-use super::reader::{excerpt, MAX_LINE_BYTES};
+use super::lines::{check_size, BoundedLines};
+use super::ImportError;
+use crate::io::reader::excerpt;
 use crate::io::runs::Run;
-use std::fmt;
-use std::io::{BufRead, Read};
+use std::io::BufRead;
 use std::path::Path;
 
 /// The header the PAN file must have.
@@ -30,25 +29,6 @@ pub const BURST_GAP_S: f64 = 1.0;
 /// Outlier threshold in robust sigmas.
 pub const OUTLIER_MADS: f64 = 10.0;
 const RADS_TO_DPH: f64 = 180.0 / std::f64::consts::PI * 3600.0;
-
-/// Why a recording cannot be imported.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ImportError {
-    pub file: String,
-    pub line: Option<usize>,
-    pub what: String,
-}
-
-impl fmt::Display for ImportError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.line {
-            Some(l) => write!(f, "{}:{l}: {}", self.file, self.what),
-            None => write!(f, "{}: {}", self.file, self.what),
-        }
-    }
-}
-
-impl std::error::Error for ImportError {}
 
 /// One raw sample.
 #[derive(Clone, Copy, Debug)]
@@ -77,41 +57,18 @@ pub fn lsm6dsm_temp_c(raw: f64) -> f64 {
 }
 
 /// Streams the samples of a PAN log to `each` in file order, checking every row; lines
-/// are bounded ([`MAX_LINE_BYTES`]) and quoted text cut ([`excerpt`]), so a huge or
+/// are bounded ([`BoundedLines`]) and quoted text cut ([`excerpt`]), so a huge or
 /// wrong file is neither read whole nor echoed whole.
 fn parse_stream(
     file: &str,
-    mut input: impl BufRead,
+    input: impl BufRead,
     mut each: impl FnMut(Sample),
 ) -> Result<usize, ImportError> {
-    let err = |line: Option<usize>, what: String| ImportError {
-        file: file.to_owned(),
-        line,
-        what,
-    };
-    let mut buf = Vec::new();
-    let mut next_line = |n: usize| -> Result<Option<String>, ImportError> {
-        buf.clear();
-        let got = (&mut input)
-            .take(MAX_LINE_BYTES as u64 + 1)
-            .read_until(b'\n', &mut buf)
-            .map_err(|e| err(Some(n), e.to_string()))?;
-        if got == 0 {
-            return Ok(None);
-        }
-        if buf.len() > MAX_LINE_BYTES && !buf.ends_with(b"\n") {
-            return Err(err(
-                Some(n),
-                format!("line longer than {MAX_LINE_BYTES} bytes"),
-            ));
-        }
-        let text = std::str::from_utf8(&buf)
-            .map_err(|_| err(Some(n), "bytes that are not valid UTF-8".into()))?;
-        Ok(Some(text.trim_end_matches(['\n', '\r']).to_owned()))
-    };
-    match next_line(1)? {
-        Some(h) if h.trim() == PAN_HEADER => {}
-        Some(h) => {
+    let err = |line: Option<usize>, what: String| ImportError::at(file, line, what);
+    let mut lines = BoundedLines::new(file, input);
+    match lines.next_line()? {
+        Some((_, h)) if h.trim() == PAN_HEADER => {}
+        Some((_, h)) => {
             return Err(err(
                 Some(1),
                 format!(
@@ -124,9 +81,7 @@ fn parse_stream(
     }
     let mut count = 0;
     let mut last_t_s: Option<f64> = None;
-    let mut n = 1;
-    while let Some(l) = next_line(n + 1)? {
-        n += 1;
+    while let Some((n, l)) = lines.next_line()? {
         if l.trim().is_empty() {
             continue;
         }
@@ -222,11 +177,9 @@ fn clean_burst(b: &[Sample]) -> Vec<Sample> {
 /// Imports the PAN TVAC file; `axes` are 0 = x, 1 = y, 2 = z.
 pub fn import_pan(path: &Path, axes: &[usize]) -> Result<PanImport, ImportError> {
     let file = path.display().to_string();
-    let input = std::fs::File::open(path).map_err(|e| ImportError {
-        file: file.clone(),
-        line: None,
-        what: e.to_string(),
-    })?;
+    check_size(path)?;
+    let input =
+        std::fs::File::open(path).map_err(|e| ImportError::at(&file, None, e.to_string()))?;
     // Streamed burst by burst: memory holds one burst and one mean per burst.
     let mut means: Vec<BurstMean> = Vec::new();
     let mut burst: Vec<Sample> = Vec::new();
@@ -282,11 +235,9 @@ pub fn import_pan(path: &Path, axes: &[usize]) -> Result<PanImport, ImportError>
             ("note".to_owned(), "cooling in a thermal-vacuum chamber, not a power-on warm-up; t_s is time since flight-computer boot".to_owned()),
         ];
         let path = format!("{stem}_gyro_{name}.csv");
-        runs.push(Run::new(path, meta, cols).map_err(|e| ImportError {
-            file: file.clone(),
-            line: None,
-            what: e.to_string(),
-        })?);
+        runs.push(
+            Run::new(path, meta, cols).map_err(|e| ImportError::at(&file, None, e.to_string()))?,
+        );
     }
     Ok(PanImport {
         runs,
