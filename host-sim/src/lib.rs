@@ -32,6 +32,7 @@ pub mod io;
 pub mod monitor;
 pub mod pipeline;
 pub mod plots;
+pub mod registry;
 pub mod report;
 pub mod seed;
 pub mod sim;

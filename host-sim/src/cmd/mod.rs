@@ -9,6 +9,7 @@ pub mod heading_cal;
 pub mod import;
 pub mod monitor;
 pub mod north_seek;
+pub mod registry;
 pub mod reproduce;
 pub mod train;
 pub mod upload;
