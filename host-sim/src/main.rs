@@ -40,6 +40,8 @@ enum Command {
     Monitor(cmd::monitor::Args),
     /// The calibration registry: a gyro's history, or the seek results as a CSV.
     Registry(cmd::registry::Args),
+    /// Serve a simulated gyro and turntable on the firmware's links (QEMU or a board).
+    Rig(cmd::rig::Args),
 }
 
 fn main() {
@@ -57,6 +59,7 @@ fn main() {
         Command::Monitor(a) => cmd::monitor::run(a),
         Command::HeadingCal(a) => cmd::heading_cal::run(a),
         Command::Registry(a) => cmd::registry::run(a),
+        Command::Rig(a) => cmd::rig::run(a),
     };
     if let Err(e) = result {
         eprintln!("fogsim: error: {e:#}");

@@ -11,6 +11,7 @@ pub mod monitor;
 pub mod north_seek;
 pub mod registry;
 pub mod reproduce;
+pub mod rig;
 pub mod train;
 pub mod upload;
 
