@@ -12,9 +12,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-use fog_core::link::SeekReport;
-use fog_core::seek_quality::Validity;
-use fog_core::tilt::Tilt;
+use fog_core::link::messages::SeekReport;
+use fog_core::seeking::quality::Validity;
+use fog_core::seeking::tilt::Tilt;
 use fog_sim::registry::{Registry, SeekContext, SeekRecord};
 
 const GYRO: &str = "FOG-CONC";

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
-use fog_core::link::{Command, Status};
+use fog_core::link::messages::{Command, Status};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::upload::LinkArgs;

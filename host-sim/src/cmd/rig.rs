@@ -7,7 +7,7 @@ use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
 use anyhow::{bail, Result};
-use fog_core::tilt::Tilt;
+use fog_core::seeking::tilt::Tilt;
 
 use crate::rig::{open_rig_link, Rig, RigConfig};
 use crate::sim::{GyroParams, DEFAULT_LATITUDE_DEG};

@@ -14,7 +14,7 @@ use std::time::Duration;
 
 use anyhow::{bail, Context};
 use ed25519_compact::KeyPair;
-use fog_core::model::RbfModel;
+use fog_core::model::format::RbfModel;
 
 use crate::io::model::read_model_file;
 use crate::registry::{self, ModelRecord, Registry};
@@ -158,7 +158,7 @@ fn send(
     bytes: &[u8],
     counter: u32,
     signature: &[u8],
-) -> anyhow::Result<fog_core::protocol::ModelInfo> {
+) -> anyhow::Result<fog_core::link::upload::ModelInfo> {
     let committed = client
         .upload(bytes, counter, signature, |done, total| {
             eprint!("\r  sent {done}/{total} bytes")

@@ -14,7 +14,7 @@ use std::io::{BufRead, BufReader, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use fog_core::link::SeekReport;
+use fog_core::link::messages::SeekReport;
 
 use crate::registry::{csv_line, Registry, SeekContext, SeekRecord, RESULTS_CSV_HEADER};
 

@@ -17,10 +17,10 @@ use std::io::{Read, Write};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
-use fog_core::link::{
+use fog_core::link::messages::{
     decode, encode, Command, DeviceFrame, DeviceMessage, HostFrame, SeekReport, Status,
 };
-use fog_core::protocol::{FrameReceiver, MAX_WIRE_FRAME_LEN, STATUS_REQUEST_PADDING};
+use fog_core::link::upload::{FrameReceiver, MAX_WIRE_FRAME_LEN, STATUS_REQUEST_PADDING};
 
 use crate::registry::{SeekContext, SeekRecord};
 
@@ -135,11 +135,11 @@ fn handle(
 mod tests {
     use super::*;
     use crate::registry::{Registry, RESULTS_CSV_HEADER};
-    use fog_core::bit::BitWord;
-    use fog_core::link::{ResetReason, LINK_VERSION};
-    use fog_core::seek_quality::SeekState;
-    use fog_core::seek_quality::Validity;
-    use fog_core::tilt::Tilt;
+    use fog_core::link::bit::BitWord;
+    use fog_core::link::messages::{ResetReason, LINK_VERSION};
+    use fog_core::seeking::quality::SeekState;
+    use fog_core::seeking::quality::Validity;
+    use fog_core::seeking::tilt::Tilt;
     use std::net::{TcpListener, TcpStream};
     use std::path::Path;
 

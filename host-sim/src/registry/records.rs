@@ -1,9 +1,9 @@
 //! The registry's records: models sent, uploads and their outcome, seek results; and the
 //! history of one gyro read back. Each write is one transaction (whole or not at all).
 
-use fog_core::link::SeekReport;
-use fog_core::model::RbfModel;
-use fog_core::seek_quality::Validity;
+use fog_core::link::messages::SeekReport;
+use fog_core::model::format::RbfModel;
+use fog_core::seeking::quality::Validity;
 use rusqlite::{params, Row};
 
 use super::utc::now_utc;
@@ -33,7 +33,7 @@ impl ModelRecord {
             .collect();
         Self {
             gyro_id: model.meta.gyro_id.to_string(),
-            model_crc32: fog_core::protocol::crc32(bytes),
+            model_crc32: fog_core::link::upload::crc32(bytes),
             model_len: bytes.len() as u32,
             inputs: inputs.join(","),
             n_centers: model.centers.len() as u32,

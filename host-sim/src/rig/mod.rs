@@ -18,7 +18,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use fog_core::hal::Turntable;
-use fog_core::tilt::Tilt;
+use fog_core::seeking::tilt::Tilt;
 use fog_firmware::drivers::gyro_frame::GyroFrame;
 
 use crate::sim::{rig, BaseMotion, GyroParams, RunSpec, SimGyro, StartState, TurntableParams};
