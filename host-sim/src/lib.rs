@@ -19,7 +19,9 @@
 //! report/     JSON report structures and terminal tables; plots/ the SVG charts
 //! io/         fog-runs reader (streaming, csv crate) and writer, 10 s binning, model
 //!   |         files, import, the one atomic writer, the output guard
-//!   |         upload, monitor: the host-link clients (model upload, status/results)
+//!   |         upload, monitor: the host-link clients (model upload, status/results);
+//!   |         rig: the simulated gyro + turntable served on the device's links;
+//!   |         registry: the calibration registry (SQLite: counters, models, uploads, results)
 //! stats/      statistics: std/rms, the one pooled within-run std, drift metrics, Allan,
 //!             windows in fog-core's convention; beside it seed (the one SplitMix64
 //!             seed mix) and fanout (the one thread fan-out, results in job order)
@@ -32,7 +34,9 @@ pub mod io;
 pub mod monitor;
 pub mod pipeline;
 pub mod plots;
+pub mod registry;
 pub mod report;
+pub mod rig;
 pub mod seed;
 pub mod sim;
 pub mod stats;

@@ -36,8 +36,12 @@ enum Command {
     Upload(cmd::upload::Args),
     /// Attach a heading calibration (bias harmonic) to a model, for a signed upload.
     HeadingCal(cmd::heading_cal::Args),
-    /// Live north-finder status with a progress bar; seek results appended to a CSV.
+    /// Live north-finder status; seek results stored in the calibration registry.
     Monitor(cmd::monitor::Args),
+    /// The calibration registry: a gyro's history, or the seek results as a CSV.
+    Registry(cmd::registry::Args),
+    /// Serve a simulated gyro and turntable on the firmware's links (QEMU or a board).
+    Rig(cmd::rig::Args),
 }
 
 fn main() {
@@ -54,6 +58,8 @@ fn main() {
         Command::Upload(a) => cmd::upload::run(a),
         Command::Monitor(a) => cmd::monitor::run(a),
         Command::HeadingCal(a) => cmd::heading_cal::run(a),
+        Command::Registry(a) => cmd::registry::run(a),
+        Command::Rig(a) => cmd::rig::run(a),
     };
     if let Err(e) = result {
         eprintln!("fogsim: error: {e:#}");

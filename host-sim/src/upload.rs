@@ -26,19 +26,40 @@ pub fn test_key_path() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../keys/TEST-ONLY-signing-key.seed.hex")
 }
 
-/// Loads an Ed25519 key pair from a file holding the 32-byte seed as 64 hex digits.
+/// Largest key file read, bytes: 64 hex digits with room for whitespace and a newline.
+pub const MAX_KEY_FILE_BYTES: u64 = 256;
+
+/// Loads an Ed25519 key pair from a file holding the 32-byte seed as 64 hex digits. The
+/// file is read only if it holds at most [`MAX_KEY_FILE_BYTES`], and an error quotes at
+/// most a short excerpt of it (never the key file echoed back).
 pub fn load_signing_key(path: &Path) -> anyhow::Result<KeyPair> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("reading signing key {}", path.display()))?;
+    let bytes = crate::io::read_bounded(path, MAX_KEY_FILE_BYTES)
+        .map_err(|e| anyhow::anyhow!("signing key {}: {e}", path.display()))?;
+    let text = String::from_utf8_lossy(&bytes);
     let hex = text.trim();
-    let seed = decode_hex::<32>(hex).with_context(|| {
-        format!(
-            "{}: expected 64 hex digits (an Ed25519 seed), found {:?}",
+    let seed = decode_hex::<32>(hex).map_err(|e| {
+        anyhow::anyhow!(
+            "signing key {}: expected 64 hex digits (an Ed25519 seed): {e}; starts {:?}",
             path.display(),
-            hex
+            key_excerpt(hex)
         )
     })?;
     Ok(key_from_seed(seed))
+}
+
+/// The first characters of a malformed key file, enough to recognise it.
+fn key_excerpt(text: &str) -> String {
+    const SHOWN: usize = 12;
+    let head: String = text
+        .chars()
+        .take(SHOWN)
+        .map(|c| if c.is_control() { '?' } else { c })
+        .collect();
+    if text.chars().count() > SHOWN {
+        format!("{head}...")
+    } else {
+        head
+    }
 }
 
 /// The Ed25519 key pair of a 32-byte seed.
@@ -55,7 +76,9 @@ fn decode_hex<const N: usize>(hex: &str) -> anyhow::Result<[u8; N]> {
     );
     let mut out = [0u8; N];
     for (i, byte) in out.iter_mut().enumerate() {
-        *byte = u8::from_str_radix(&hex[2 * i..2 * i + 2], 16)
+        *byte = hex
+            .get(2 * i..2 * i + 2)
+            .and_then(|pair| u8::from_str_radix(pair, 16).ok())
             .with_context(|| format!("not hex at character {}", 2 * i))?;
     }
     Ok(out)

@@ -38,13 +38,14 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use fog_core::consts::EARTH_RATE_DPH;
 use fog_core::link::bit::{BitItem, BitWord};
-use fog_core::link::messages::{Command, ResetReason, SeekReport, Status};
+use fog_core::consts::EARTH_RATE_DPH;
 use fog_core::seeking::heading_cal::HeadingHarmonic;
+use fog_core::link::messages::{Command, ResetReason, SeekReport, Status};
 use fog_core::seeking::quality::{SeekState, Validity};
 use fog_core::seeking::tilt::{earth_rate_on_axis_dph, Tilt};
-use fog_sim::monitor::{monitor, MonitorOptions, MonitorSummary, ResultLog};
+use fog_sim::monitor::{monitor, CsvAppend, MonitorOptions, MonitorSummary, ResultLog};
+use fog_sim::registry::Registry;
 use fog_sim::upload::UploadClient;
 use fog_tests::console::{wait_line, wait_line_where};
 use fog_tests::{qemu_ready, scratch_dir};
@@ -152,7 +153,7 @@ fn session(
         log,
         &opts,
         |s| statuses.push(*s),
-        |r| reports.push(*r),
+        |r, _| reports.push(*r),
     )
     .expect("monitor session");
     (sum, statuses, reports)
@@ -212,7 +213,11 @@ fn qemu_whole_seek_over_the_host_link_with_status_result_and_refusals() {
         std::thread::spawn(move || stream_gyro(gyro_link, h, s))
     };
     wait_line(&console, "FOG-WINDOW", Duration::from_secs(20));
-    let mut log = ResultLog::open(&dir.join("results.csv")).unwrap();
+    let mut log = ResultLog::new(
+        Registry::open(&dir.join("registry.sqlite")).unwrap(),
+        Some(CsvAppend::open(&dir.join("results.csv")).unwrap()),
+        QEMU_GYRO,
+    );
 
     // Refusal 1: a latitude where Omega_H vanishes.
     let (sum, _, _) = session(

@@ -9,7 +9,9 @@ pub mod heading_cal;
 pub mod import;
 pub mod monitor;
 pub mod north_seek;
+pub mod registry;
 pub mod reproduce;
+pub mod rig;
 pub mod train;
 pub mod upload;
 

@@ -1,18 +1,23 @@
 //! `fogsim upload`: sign a trained model and install it on the gyro over its UART.
 //!
-//! Checks the model file locally first (a bad file never goes out), signs it with the
-//! training PC's Ed25519 key for its gyro and the given security counter, checks that
-//! the device is that gyro and runs a lower counter, uploads it in chunks (one
-//! session), commits, then asks the device for its status and confirms that the new
-//! model (sequence, CRC, counter) is the one in use.
+//! Checks the model file, the key and the registry locally first (a bad file never goes
+//! out; every file read is size-bounded), checks that the device is the model's gyro,
+//! takes the security counter from the calibration registry (the next one for this gyro,
+//! or `--security-counter` checked against it: never 0, never reused, above the
+//! device's), signs the model for that gyro and counter, uploads it in chunks (one
+//! session), commits, asks the device for its status and confirms that the new model
+//! (sequence, CRC, counter) is the one in use. The registry records the model, the
+//! counter and the upload's outcome.
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{bail, Context};
-use fog_core::link::upload::SIGNATURE_LEN;
+use ed25519_compact::KeyPair;
 use fog_core::model::format::RbfModel;
 
+use crate::io::model::read_model_file;
+use crate::registry::{self, ModelRecord, Registry};
 use crate::upload::{
     describe_model, load_signing_key, open_link, sign_upload, test_key_path, UploadClient,
 };
@@ -47,16 +52,28 @@ pub struct Args {
     /// Seconds to wait for each response.
     #[arg(long, default_value_t = 5.0)]
     pub timeout_s: f64,
-    /// Security counter signed with the model: must exceed the counter of the model the
-    /// device runs (rollback protection); keep one increasing counter per gyro.
-    #[arg(long, required_unless_present = "status_only")]
+    /// Security counter signed with the model. Default: the next one from the registry
+    /// (above every counter issued for this gyro and above the device's). If given, it
+    /// must be above both, and never 0.
+    #[arg(long)]
     pub security_counter: Option<u32>,
+    /// Calibration registry (SQLite). Default: $XDG_DATA_HOME/fogsim/registry.sqlite
+    /// (~/.local/share/fogsim/registry.sqlite).
+    #[arg(long)]
+    pub registry: Option<PathBuf>,
     /// Only query and print the device status; no upload.
     #[arg(long)]
     pub status_only: bool,
     /// The model file written by `fogsim train --out` (`RbfModel::encode` bytes).
     #[arg(required_unless_present = "status_only")]
     pub model: Option<PathBuf>,
+}
+
+/// A model checked locally, with its signing key.
+struct Prepared {
+    bytes: Vec<u8>,
+    model: RbfModel,
+    key: KeyPair,
 }
 
 /// Runs the subcommand.
@@ -67,10 +84,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             args.timeout_s
         );
     }
-    // Check everything local first: a bad file or key never reaches the device.
-    let prepared = match (&args.model, args.security_counter) {
-        (Some(path), Some(counter)) => Some(prepare(path, args.key.clone(), counter)?),
+    if args.security_counter == Some(0) {
+        bail!("--security-counter 0: counter 0 is never accepted (counters start at 1; docs/upload.md)");
+    }
+    // Check everything local first: a bad file, key or registry never reaches the device.
+    let prepared = match &args.model {
+        Some(path) if !args.status_only => Some(prepare(path, args.key.clone())?),
         _ => None,
+    };
+    let mut reg = match &prepared {
+        Some(_) => Some(Registry::open(&registry::resolve(
+            args.registry.as_deref(),
+        )?)?),
+        None => None,
     };
     let link = args.link.open()?;
     let mut client = UploadClient::new(link, Duration::from_secs_f64(args.timeout_s));
@@ -83,59 +109,77 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         "device: gyro {}, last reset {:?} (detail {}), boot {}",
         before.gyro_id, before.last_reset.cause, before.last_reset.detail, before.last_reset.boots
     );
-    let Some((bytes, gyro_id, counter, signature)) = prepared else {
+    let (Some(p), Some(reg)) = (prepared, reg.as_mut()) else {
         return Ok(());
     };
+    let gyro_id = p.model.meta.gyro_id.as_str();
     if gyro_id != before.gyro_id.as_str() {
         bail!(
             "model is for gyro {gyro_id} but the device is gyro {}: not sent",
             before.gyro_id
         );
     }
-    if let Some(active) = before
-        .active
-        .as_ref()
-        .filter(|a| a.security_counter >= counter)
-    {
-        if active.model_crc32 != fog_core::link::upload::crc32(&bytes) {
-            bail!(
-                "--security-counter {counter} is not above the device's {}: the device would refuse it as a rollback",
-                active.security_counter
-            );
-        }
-    }
+    let record = ModelRecord::of(&p.model, &p.bytes);
+    let device_counter = before.active.as_ref().map_or(0, |a| a.security_counter);
+    let counter = reg
+        .issue_counter(
+            gyro_id,
+            args.security_counter,
+            device_counter,
+            record.model_crc32,
+        )
+        .map_err(|e| {
+            anyhow::anyhow!(
+                "--security-counter: {e} (registry {})",
+                reg.path().display()
+            )
+        })?;
+    let signature = sign_upload(&p.key, counter, gyro_id, &p.bytes)?;
+    reg.record_model(&record)?;
+    let upload_id = reg.begin_upload(gyro_id, counter, record.model_crc32)?;
+    println!(
+        "security counter {counter} (registry {})",
+        reg.path().display()
+    );
+    let outcome = send(&mut client, &p.bytes, counter, &signature);
+    let result = match &outcome {
+        Ok(_) => "committed".to_string(),
+        Err(e) => format!("failed: {e:#}"),
+    };
+    reg.finish_upload(upload_id, &result)?;
+    let active = outcome?;
+    println!("device model now:    {}", describe_model(&active));
+    Ok(())
+}
+
+/// Uploads, commits and confirms with a status that the committed model is active.
+fn send(
+    client: &mut UploadClient<Box<dyn crate::upload::Link>>,
+    bytes: &[u8],
+    counter: u32,
+    signature: &[u8],
+) -> anyhow::Result<fog_core::link::upload::ModelInfo> {
     let committed = client
-        .upload(&bytes, counter, &signature, |done, total| {
+        .upload(bytes, counter, signature, |done, total| {
             eprint!("\r  sent {done}/{total} bytes")
         })
         .context("upload")?;
     eprintln!();
     let after = client.status().context("status after commit")?;
     match after.active {
-        Some(active) if active == committed => {
-            println!("device model now:    {}", describe_model(&active));
-            Ok(())
-        }
+        Some(active) if active == committed => Ok(active),
         other => bail!("device committed {committed:?} but reports {other:?} as active"),
     }
 }
 
-/// What `prepare` hands to the upload: model bytes, its gyro id, counter, signature.
-type Prepared = (Vec<u8>, String, u32, [u8; SIGNATURE_LEN]);
-
-/// Reads and validates the model file, loads the key and signs it for its gyro and
-/// `counter`.
-fn prepare(model_path: &Path, key: Option<PathBuf>, counter: u32) -> anyhow::Result<Prepared> {
-    let bytes = std::fs::read(model_path)
-        .with_context(|| format!("reading model {}", model_path.display()))?;
-    let model = RbfModel::decode(&bytes)
-        .map_err(|e| anyhow::anyhow!("{}: not a valid model file: {e}", model_path.display()))?;
+/// Reads (size-bounded) and validates the model file and loads the key.
+fn prepare(model_path: &Path, key: Option<PathBuf>) -> anyhow::Result<Prepared> {
+    let (bytes, model) = read_model_file(model_path)?;
     let key_path = key.unwrap_or_else(test_key_path);
     if key_path == test_key_path() {
         eprintln!("fogsim upload: WARNING signing with the public TEST key (keys/README.md)");
     }
-    let gyro_id = model.meta.gyro_id.as_str();
-    let signature = sign_upload(&load_signing_key(&key_path)?, counter, gyro_id, &bytes)?;
+    let key = load_signing_key(&key_path)?;
     println!(
         "model {}: {} bytes, gyro {}, {} centres, {} inputs",
         model_path.display(),
@@ -144,5 +188,5 @@ fn prepare(model_path: &Path, key: Option<PathBuf>, counter: u32) -> anyhow::Res
         model.centers.len(),
         model.inputs.len()
     );
-    Ok((bytes, gyro_id.to_string(), counter, signature))
+    Ok(Prepared { bytes, model, key })
 }

@@ -4,6 +4,7 @@
 
 pub mod atomic;
 pub mod bin;
+pub mod bounded;
 pub mod guard;
 pub mod import;
 pub mod lock;
@@ -13,6 +14,7 @@ pub mod runs;
 
 pub use atomic::{write_atomic, write_atomic_with, StagedFiles};
 pub use bin::{read_binned, read_runs_binned, WindowBinner};
+pub use bounded::{read_bounded, BoundedReadError};
 pub use guard::{OutputError, OutputGuard};
 pub use lock::OutputLock;
 pub use reader::{visit_rows, RunHeader, RunReader};

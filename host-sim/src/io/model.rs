@@ -2,10 +2,11 @@
 //! the size bounded before anything is decoded, so a wrong (huge) file is never read whole.
 
 use std::fmt;
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use fog_core::model::format::{ModelError, RbfModel, MAX_ENCODED_LEN};
+
+use super::bounded::{read_bounded, BoundedReadError};
 
 /// Why a model file cannot be used.
 #[derive(Debug)]
@@ -33,22 +34,23 @@ impl std::error::Error for ModelFileError {}
 
 /// Reads and validates a fog-core model file, reading at most `MAX_ENCODED_LEN + 1` bytes.
 pub fn read_model(path: &Path) -> Result<RbfModel, ModelFileError> {
-    let io = |e: std::io::Error| ModelFileError::Io {
-        path: path.to_path_buf(),
-        why: e.to_string(),
-    };
-    let file = std::fs::File::open(path).map_err(io)?;
-    let mut bytes = Vec::with_capacity(MAX_ENCODED_LEN + 1);
-    file.take(MAX_ENCODED_LEN as u64 + 1)
-        .read_to_end(&mut bytes)
-        .map_err(io)?;
-    if bytes.len() > MAX_ENCODED_LEN {
-        return Err(ModelFileError::TooLarge {
+    read_model_file(path).map(|(_, model)| model)
+}
+
+/// [`read_model`] that also returns the file's bytes (what an upload sends and signs).
+pub fn read_model_file(path: &Path) -> Result<(Vec<u8>, RbfModel), ModelFileError> {
+    let bytes = read_bounded(path, MAX_ENCODED_LEN as u64).map_err(|e| match e {
+        BoundedReadError::TooLarge { .. } => ModelFileError::TooLarge {
             path: path.to_path_buf(),
-        });
-    }
-    RbfModel::decode(&bytes).map_err(|why| ModelFileError::Decode {
+        },
+        BoundedReadError::Io(e) => ModelFileError::Io {
+            path: path.to_path_buf(),
+            why: e.to_string(),
+        },
+    })?;
+    let model = RbfModel::decode(&bytes).map_err(|why| ModelFileError::Decode {
         path: path.to_path_buf(),
         why,
-    })
+    })?;
+    Ok((bytes, model))
 }

@@ -1,103 +1,28 @@
-//! `fogsim monitor`: the PC side of the north finder's host link (`fog_core::link::messages`).
+//! `fogsim monitor`: the PC side of the north finder's host link (`fog_core::link`).
 //!
 //! Exists so an operator sees the device's live status (state, progress, predicted accuracy,
 //! BIT) and gets every seek result in a CSV. Frames are decoded with fog-core's
 //! `FrameReceiver` (the upload framing). The loop is bounded: it stops after `max_results`
 //! results or `max_duration`, whichever comes first.
 //!
-//! CSV: the file is opened in append mode (created with a header if absent or empty); each
-//! result is ONE `write_all` of one complete line on an `O_APPEND` descriptor followed by
-//! `sync_data`, so a reader or a crash sees whole lines only (POSIX appends of one write are
-//! not interleaved on a local file system). An existing file whose first line is not this
-//! header is refused (it is someone's input, not our log), and nothing is ever truncated.
+//! Results: every one is stored in the calibration registry with the context of the
+//! status before it (model CRC, temperature, latitude) and the gyro id, and, if asked,
+//! appended to a CSV under a lock (`log`: whole lines, one header, torn lines repaired).
 
-use std::fs::OpenOptions;
-use std::io::{BufRead, BufReader, Read, Write};
-use std::path::Path;
+mod log;
+
+pub use log::{Appended, CsvAppend, ResultLog};
+
+use std::io::{Read, Write};
 use std::time::{Duration, Instant};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use fog_core::link::messages::{
     decode, encode, Command, DeviceFrame, DeviceMessage, HostFrame, SeekReport, Status,
 };
 use fog_core::link::upload::{FrameReceiver, MAX_WIRE_FRAME_LEN, STATUS_REQUEST_PADDING};
-use fog_core::seeking::quality::Validity;
 
-/// Header of the results CSV.
-pub const CSV_HEADER: &str =
-    "sequence,t_end_s,azimuth_deg,sigma_deg,pitch_deg,roll_deg,duration_s,positions,validity,observed_latitude_deg";
-
-/// One CSV line (with its newline) of a result.
-pub fn csv_line(r: &SeekReport) -> String {
-    let (validity, lat) = match r.validity {
-        Validity::Valid => ("valid", String::new()),
-        Validity::LatitudeMismatch {
-            observed_latitude_deg,
-        } => ("latitude_mismatch", format!("{observed_latitude_deg:.3}")),
-    };
-    format!(
-        "{},{:.3},{:.6},{:.6},{:.4},{:.4},{:.1},{},{},{}\n",
-        r.sequence,
-        r.t_end_s,
-        r.azimuth_deg,
-        r.sigma_deg,
-        r.tilt.pitch_deg,
-        r.tilt.roll_deg,
-        r.duration_s,
-        r.positions,
-        validity,
-        lat
-    )
-}
-
-/// Appends results to a CSV, creating it with the header.
-pub struct ResultLog {
-    file: std::fs::File,
-}
-
-impl ResultLog {
-    /// Opens `path` for appending; refuses a non-empty file that is not a results log.
-    pub fn open(path: &Path) -> Result<Self> {
-        if path.is_dir() {
-            bail!("--csv {}: is a directory", path.display());
-        }
-        let existing_header = match std::fs::File::open(path) {
-            Ok(f) => {
-                let mut first = String::new();
-                BufReader::new(f.take(4096))
-                    .read_line(&mut first)
-                    .with_context(|| format!("--csv {}: cannot read", path.display()))?;
-                Some(first)
-            }
-            Err(_) => None,
-        };
-        let mut file = OpenOptions::new()
-            .append(true)
-            .create(true)
-            .open(path)
-            .with_context(|| format!("--csv {}: cannot open for appending", path.display()))?;
-        match existing_header.as_deref() {
-            None | Some("") => {
-                file.write_all(format!("{CSV_HEADER}\n").as_bytes())?;
-                file.sync_data()?;
-            }
-            Some(h) if h.trim_end() == CSV_HEADER => {}
-            Some(h) => bail!(
-                "--csv {}: exists and is not a fogsim monitor log (first line {:?}); refusing to append to it",
-                path.display(),
-                h.trim_end()
-            ),
-        }
-        Ok(Self { file })
-    }
-
-    /// Appends one result as a single write.
-    pub fn append(&mut self, r: &SeekReport) -> Result<()> {
-        self.file.write_all(csv_line(r).as_bytes())?;
-        self.file.sync_data()?;
-        Ok(())
-    }
-}
+use crate::registry::{SeekContext, SeekRecord};
 
 /// Limits and commands of one monitoring session.
 #[derive(Clone, Debug)]
@@ -127,7 +52,7 @@ pub fn monitor<L: Read + Write>(
     log: &mut ResultLog,
     opts: &MonitorOptions,
     mut on_status: impl FnMut(&Status),
-    mut on_result: impl FnMut(&SeekReport),
+    mut on_result: impl FnMut(&SeekReport, &SeekRecord),
 ) -> Result<MonitorSummary> {
     let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
     for c in &opts.commands {
@@ -174,13 +99,13 @@ pub fn monitor<L: Read + Write>(
     Ok(sum)
 }
 
-/// One north-finder message: counted, shown, results appended to the CSV.
+/// One north-finder message: counted, shown, results stored.
 fn handle(
     msg: DeviceMessage,
     log: &mut ResultLog,
     sum: &mut MonitorSummary,
     on_status: &mut impl FnMut(&Status),
-    on_result: &mut impl FnMut(&SeekReport),
+    on_result: &mut impl FnMut(&SeekReport, &SeekRecord),
 ) -> Result<()> {
     match msg {
         DeviceMessage::Status(s) => {
@@ -189,9 +114,16 @@ fn handle(
             sum.last_status = Some(s);
         }
         DeviceMessage::Result(r) => {
-            log.append(&r)?;
+            let ctx = sum
+                .last_status
+                .map_or_else(SeekContext::default, |s| SeekContext {
+                    model_crc32: s.model_crc32,
+                    temp_c: Some(f64::from(s.temp_c)),
+                    latitude_deg: Some(f64::from(s.latitude_deg)),
+                });
+            let record = log.append(&r, ctx)?;
             sum.results += 1;
-            on_result(&r);
+            on_result(&r, &record);
         }
         DeviceMessage::Accepted => sum.accepted += 1,
         DeviceMessage::Refused(why) => sum.refusals.push(format!("{why:?}")),
@@ -202,11 +134,14 @@ fn handle(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::registry::{Registry, RESULTS_CSV_HEADER};
     use fog_core::link::bit::BitWord;
     use fog_core::link::messages::{ResetReason, LINK_VERSION};
     use fog_core::seeking::quality::SeekState;
+    use fog_core::seeking::quality::Validity;
     use fog_core::seeking::tilt::Tilt;
     use std::net::{TcpListener, TcpStream};
+    use std::path::Path;
 
     fn status(progress: f32) -> Status {
         Status {
@@ -278,38 +213,51 @@ mod tests {
         })
     }
 
-    #[test]
-    fn monitors_a_fake_device_and_appends_to_the_csv() {
-        let dir = std::env::temp_dir().join(format!("fogsim-monitor-{}", std::process::id()));
+    fn scratch(name: &str) -> std::path::PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("fogsim-monitor-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
-        let csv = dir.join("results.csv");
-        let _ = std::fs::remove_file(&csv);
-        for round in 0..2 {
-            let listener = TcpListener::bind("127.0.0.1:0").unwrap();
-            let addr = listener.local_addr().unwrap();
-            let dev = fake_device(listener, 2);
-            let mut link = TcpStream::connect(addr).unwrap();
-            link.set_read_timeout(Some(Duration::from_millis(50)))
-                .unwrap();
-            let mut log = ResultLog::open(&csv).unwrap();
-            let opts = MonitorOptions {
-                max_results: 10,
-                max_duration: Duration::from_secs(5),
-                commands: vec![
-                    Command::SetLatitude { latitude_deg: 39.9 },
-                    Command::StartSeek { positions: 2 },
-                ],
-            };
-            let mut progress = Vec::new();
-            let sum = monitor(
-                &mut link,
-                &mut log,
-                &opts,
-                |s| progress.push(s.progress),
-                |_| {},
-            )
+        dir
+    }
+
+    /// One monitor session against a fake device sending `seeks` results.
+    fn session(registry: &Path, csv: &Path, gyro: &str, seeks: u32) -> (MonitorSummary, Vec<f32>) {
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let addr = listener.local_addr().unwrap();
+        let dev = fake_device(listener, seeks);
+        let mut link = TcpStream::connect(addr).unwrap();
+        link.set_read_timeout(Some(Duration::from_millis(50)))
             .unwrap();
-            assert_eq!(dev.join().unwrap(), opts.commands);
+        let reg = Registry::open(registry).unwrap();
+        let mut log = ResultLog::new(reg, Some(CsvAppend::open(csv).unwrap()), gyro);
+        let opts = MonitorOptions {
+            max_results: 10,
+            max_duration: Duration::from_secs(20),
+            commands: vec![
+                Command::SetLatitude { latitude_deg: 39.9 },
+                Command::StartSeek { positions: 2 },
+            ],
+        };
+        let mut progress = Vec::new();
+        let sum = monitor(
+            &mut link,
+            &mut log,
+            &opts,
+            |s| progress.push(s.progress),
+            |_, _| {},
+        )
+        .unwrap();
+        assert_eq!(dev.join().unwrap(), opts.commands);
+        (sum, progress)
+    }
+
+    #[test]
+    fn monitors_a_fake_device_into_the_registry_and_the_csv() {
+        let dir = scratch("one");
+        let (reg, csv) = (dir.join("reg.sqlite"), dir.join("results.csv"));
+        for round in 0..2 {
+            let (sum, progress) = session(&reg, &csv, "FOG-A17", 2);
             assert_eq!(
                 (sum.statuses, sum.results, sum.bad_frames),
                 (8, 2, 2),
@@ -321,21 +269,104 @@ mod tests {
         let lines: Vec<&str> = text.lines().collect();
         // One header, then both rounds' results: appended, never overwritten.
         assert_eq!(lines.len(), 5, "{text}");
-        assert_eq!(lines[0], CSV_HEADER);
-        assert!(lines[1].starts_with("0,300.000,108.400000,"));
-        assert!(lines[2].ends_with(",latitude_mismatch,60.000"));
-        assert_eq!(lines[3], lines[1]);
+        assert_eq!(lines[0], RESULTS_CSV_HEADER);
+        let fields: Vec<&str> = lines[2].split(',').collect();
+        assert_eq!(
+            &fields[1..9],
+            [
+                "FOG-A17",
+                "1",
+                "600.000",
+                "108.410000",
+                "0.020000",
+                "latitude_mismatch",
+                "60.000",
+                "0x00000007"
+            ]
+        );
+        assert_eq!(
+            &fields[9..],
+            ["25.00", "39.9000", "5.0000", "-1.0000", "2", "270.0"]
+        );
+        let stored = Registry::open(&reg)
+            .unwrap()
+            .seeks(Some("FOG-A17"))
+            .unwrap();
+        assert_eq!(stored.len(), 4);
+        assert_eq!(stored[1].verdict, "latitude_mismatch");
+        assert_eq!(stored[0].model_crc32, Some(7));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Issue 17.2: monitors running at once on one registry and one CSV (created by
+    /// them): every result stored once, one header, every line whole. 10 rounds of 4.
+    #[test]
+    fn concurrent_monitors_lose_nothing_and_write_one_header() {
+        let dir = scratch("concurrent");
+        let reg = dir.join("reg.sqlite");
+        let (monitors, seeks, rounds) = (4, 3, 10);
+        for round in 0..rounds {
+            let csv = dir.join(format!("results-{round}.csv"));
+            let threads: Vec<_> = (0..monitors)
+                .map(|m| {
+                    let (reg, csv) = (reg.clone(), csv.clone());
+                    std::thread::spawn(move || {
+                        session(&reg, &csv, &format!("G{m}"), seeks).0.results
+                    })
+                })
+                .collect();
+            let results: usize = threads.into_iter().map(|t| t.join().unwrap()).sum();
+            assert_eq!(results, monitors * seeks as usize);
+            let text = std::fs::read_to_string(&csv).unwrap();
+            let lines: Vec<&str> = text.lines().collect();
+            assert_eq!(lines.len(), 1 + results, "round {round}: {text}");
+            assert_eq!(lines[0], RESULTS_CSV_HEADER);
+            assert!(
+                lines[1..]
+                    .iter()
+                    .all(|l| l.split(',').count() == 15 && l.ends_with(",2,270.0")),
+                "{text}"
+            );
+        }
+        let stored = Registry::open(&reg).unwrap();
+        for m in 0..monitors {
+            assert_eq!(
+                stored.seeks(Some(&format!("G{m}"))).unwrap().len(),
+                rounds * seeks as usize
+            );
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Issue 17.2: a last line torn by a crash never merges with the next result.
+    #[test]
+    fn a_torn_last_line_is_ended_before_the_next_row() {
+        let dir = scratch("torn");
+        let csv = dir.join("results.csv");
+        let torn = format!("{RESULTS_CSV_HEADER}\n2026-01-01T00:00:00.000Z,G,0,1.0,2.0,0.1,valid,,,,,0,0,2,270.0\n2026-01-01T00:05:00.000Z,G,1,30");
+        std::fs::write(&csv, &torn).unwrap();
+        let (sum, _) = session(&dir.join("reg.sqlite"), &csv, "G", 1);
+        assert_eq!(sum.results, 1);
+        let text = std::fs::read_to_string(&csv).unwrap();
+        assert!(
+            text.starts_with(&torn),
+            "nothing before the tear is changed"
+        );
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 4, "{text}");
+        assert_eq!(lines[2], "2026-01-01T00:05:00.000Z,G,1,30");
+        assert_eq!(lines[3].split(',').count(), 15);
+        assert!(text.ends_with('\n'));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
     fn refuses_to_append_to_a_file_that_is_not_its_log() {
-        let dir = std::env::temp_dir().join(format!("fogsim-monitor-in-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = scratch("input");
         let input = dir.join("run.csv");
         std::fs::write(&input, "t_s,rate_dph\n0,1\n").unwrap();
-        let err = ResultLog::open(&input).err().unwrap().to_string();
-        assert!(err.contains("not a fogsim monitor log"), "{err}");
+        let err = CsvAppend::open(&input).err().unwrap().to_string();
+        assert!(err.contains("not a fogsim results log"), "{err}");
         assert_eq!(
             std::fs::read_to_string(&input).unwrap(),
             "t_s,rate_dph\n0,1\n"

@@ -1,0 +1,110 @@
+//! `fogsim rig --gyro-port P --table-port P ...`: serve the simulated gyro and turntable
+//! on the firmware's links (`crate::rig`), for `fog-app` under QEMU (`cargo fw-run`) or a
+//! board on the bench. Prints the truth (azimuth of the table's zero) and the firmware
+//! arguments that must match the rig (`gyro-rate=`, `tilt-mdeg=`), then one summary line.
+
+use std::sync::atomic::AtomicBool;
+use std::time::Duration;
+
+use anyhow::{bail, Result};
+use fog_core::seeking::tilt::Tilt;
+
+use crate::rig::{open_rig_link, Rig, RigConfig};
+use crate::sim::{GyroParams, DEFAULT_LATITUDE_DEG};
+
+/// Options of `fogsim rig`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// The gyro link: `tcp:127.0.0.1:PORT` (listened on; QEMU's UART1 connects) or a
+    /// serial device.
+    #[arg(long)]
+    pub gyro_port: String,
+    /// The turntable link (UART2), same forms as --gyro-port.
+    #[arg(long)]
+    pub table_port: String,
+    /// Serial baud rate of both links (ignored for tcp:).
+    #[arg(long, default_value_t = 460_800)]
+    pub baud: u32,
+    /// Seed of every random draw (same seed, same frames).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Ambient (chamber) temperature, degC; the gyro starts cold, soaked at it.
+    #[arg(long, default_value_t = 20.0, allow_negative_numbers = true)]
+    pub ambient_c: f64,
+    /// Site latitude, deg (north positive).
+    #[arg(long, default_value_t = DEFAULT_LATITUDE_DEG, allow_negative_numbers = true)]
+    pub latitude_deg: f64,
+    /// True azimuth of the table's zero, deg from north: what a seek should find.
+    #[arg(long, default_value_t = 108.4)]
+    pub azimuth_deg: f64,
+    /// Base tilt, pitch and roll, deg (give the firmware the same: `tilt-mdeg=`).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub pitch_deg: f64,
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub roll_deg: f64,
+    /// Gyro frames per second of sample time (give the firmware the same: `gyro-rate=`).
+    #[arg(long, default_value_t = 20)]
+    pub rate_hz: u32,
+    /// Sample time per real time (QEMU's serial link cannot take more than about 10x20 Hz).
+    #[arg(long, default_value_t = 10.0)]
+    pub speed: f64,
+    /// Stop after this many seconds of sample time (default: until a link closes).
+    #[arg(long)]
+    pub duration_s: Option<f64>,
+    /// Wait at most this many seconds for each link to connect.
+    #[arg(long, default_value_t = 120)]
+    pub connect_timeout_s: u64,
+}
+
+/// Runs the subcommand.
+pub fn run(a: Args) -> Result<()> {
+    if !(a.speed.is_finite() && a.speed > 0.0 && a.speed <= 1000.0) {
+        bail!("--speed {}: must be within (0, 1000]", a.speed);
+    }
+    if !(1..=2000).contains(&a.rate_hz) {
+        bail!("--rate-hz {}: must be within 1..=2000", a.rate_hz);
+    }
+    if !(0.0..360.0).contains(&a.azimuth_deg) {
+        bail!("--azimuth-deg {}: must be within [0, 360)", a.azimuth_deg);
+    }
+    if !(a.pitch_deg.abs() <= 10.0 && a.roll_deg.abs() <= 10.0) {
+        bail!("--pitch-deg/--roll-deg: a base tilt is at most 10 deg per axis");
+    }
+    let tilt = Tilt {
+        pitch_deg: a.pitch_deg as f32,
+        roll_deg: a.roll_deg as f32,
+    };
+    let cfg = RigConfig {
+        params: GyroParams::paper_default(),
+        seed: a.seed,
+        ambient_c: a.ambient_c,
+        latitude_deg: a.latitude_deg,
+        azimuth_deg: a.azimuth_deg,
+        tilt,
+        rate_hz: f64::from(a.rate_hz),
+        speed: a.speed,
+        duration_s: a.duration_s,
+    };
+    let mut rig = Rig::new(cfg).map_err(|e| anyhow::anyhow!("rig: {e}"))?;
+    println!(
+        "rig truth azimuth_deg={:.4} latitude_deg={} ambient_c={} seed={} | firmware arguments: gyro-rate={} tilt-mdeg={}:{}",
+        a.azimuth_deg,
+        a.latitude_deg,
+        a.ambient_c,
+        a.seed,
+        a.rate_hz,
+        (a.pitch_deg * 1000.0).round() as i64,
+        (a.roll_deg * 1000.0).round() as i64
+    );
+    let within = Duration::from_secs(a.connect_timeout_s);
+    let mut gyro = open_rig_link(&a.gyro_port, a.baud, within)?;
+    let mut table = open_rig_link(&a.table_port, a.baud, within)?;
+    println!("rig connected: gyro {} table {}", a.gyro_port, a.table_port);
+    let stop = AtomicBool::new(false);
+    let sum = rig.serve(gyro.as_mut(), table.as_mut(), &stop)?;
+    println!(
+        "rig summary frames={} sample_time_s={:.1} table_commands={} moves={} ended=\"{}\"",
+        sum.frames, sum.sample_time_s, sum.table_commands, sum.moves, sum.ended
+    );
+    Ok(())
+}

@@ -1,0 +1,193 @@
+//! `fogsim rig`: the bench around the device, simulated. The same `sim/` physics as the
+//! campaign (a `SimGyro` cold-started at the rig's power-on, on a `SimTurntable`, on a
+//! possibly tilted base) served on the firmware's own links: the FOG's 12-byte frames
+//! (`fog_firmware::drivers::gyro_frame`, the one encoder) on the gyro link, the ASCII
+//! turntable protocol (`table`) on the table link. A link is a serial device (a board on
+//! the bench) or a TCP port the rig listens on (QEMU's `-serial tcp:...` client).
+//!
+//! Time: the firmware's time base is the frame count, so the rig sends `rate_hz` frames
+//! per second of sample time, `speed` times faster than real time (QEMU cannot take a
+//! 2 kHz stream in real time); the table moves in sample time (it shares the gyro's
+//! clock). Power-on is the moment the gyro link is connected: frame 1 is the first
+//! sample of the cold start. Deterministic: same seed, same frames.
+
+mod table;
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result};
+use fog_core::hal::Turntable;
+use fog_core::seeking::tilt::Tilt;
+use fog_firmware::drivers::gyro_frame::GyroFrame;
+
+use crate::sim::{rig, BaseMotion, GyroParams, RunSpec, SimGyro, StartState, TurntableParams};
+use crate::upload::Link;
+
+pub use table::TableServer;
+
+/// What the rig simulates.
+#[derive(Clone, Debug)]
+pub struct RigConfig {
+    pub params: GyroParams,
+    pub seed: u64,
+    pub ambient_c: f64,
+    pub latitude_deg: f64,
+    /// True azimuth of the table's zero, deg from north (what a seek measures).
+    pub azimuth_deg: f64,
+    /// Base tilt (the firmware's inclinometer must read the same: `tilt-mdeg=`).
+    pub tilt: Tilt,
+    /// Gyro frames per second of sample time.
+    pub rate_hz: f64,
+    /// Sample time per real time.
+    pub speed: f64,
+    /// Stop after this much sample time, s (`None`: until a link closes or `stop`).
+    pub duration_s: Option<f64>,
+}
+
+/// What a rig session did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RigSummary {
+    pub frames: u64,
+    pub sample_time_s: f64,
+    pub table_commands: u64,
+    pub moves: u64,
+    /// Why it ended.
+    pub ended: String,
+}
+
+/// The simulated gyro on its table, ready to be served.
+pub struct Rig {
+    gyro: SimGyro,
+    table: TableServer,
+    cfg: RigConfig,
+}
+
+impl Rig {
+    /// Builds the gyro (cold start at `ambient_c`) on its table and base.
+    pub fn new(cfg: RigConfig) -> Result<Self> {
+        let spec = RunSpec {
+            ambient_c: cfg.ambient_c,
+            // Only bounds the validation of the specification: the rig runs until stopped.
+            minutes: 24.0 * 60.0,
+            latitude_deg: cfg.latitude_deg,
+            heading_deg: cfg.azimuth_deg,
+            input_axis_vertical: false,
+            raw_rate_hz: cfg.rate_hz,
+            seed: cfg.seed,
+            start: StartState::Soaked,
+        };
+        let (mut gyro, table) = rig(&cfg.params, &spec, TurntableParams::default())?;
+        let mut base = BaseMotion::tilted(0.0, 0.0);
+        base.pitch_deg = f64::from(cfg.tilt.pitch_deg);
+        base.roll_deg = f64::from(cfg.tilt.roll_deg);
+        gyro.set_base(base)?;
+        Ok(Self {
+            gyro,
+            table: TableServer::new(table),
+            cfg,
+        })
+    }
+
+    /// The table, for tests that drive it directly.
+    pub fn table_mut(&mut self) -> &mut impl Turntable {
+        self.table.table_mut()
+    }
+
+    /// The next frame (sequence `n` mod 256) and the sample behind it.
+    pub fn next_frame(&mut self, n: u64, temp_c: &mut f64) -> (GyroFrame, crate::sim::RawSample) {
+        let s = self.gyro.next_sample();
+        // The coil temperature sensor is read once per second of sample time.
+        let per_s = self.cfg.rate_hz.round().max(1.0) as u64;
+        if n % per_s == 0 || temp_c.is_nan() {
+            *temp_c = self.gyro.read_sensor_c();
+        }
+        let frame = GyroFrame::from_physical(n as u8, s.rate_dph, *temp_c, 1.0 / self.cfg.rate_hz);
+        (frame, s)
+    }
+
+    /// Serves the gyro and table links until `stop`, the duration, or a link closing.
+    pub fn serve(
+        &mut self,
+        gyro_link: &mut dyn Link,
+        table_link: &mut dyn Link,
+        stop: &AtomicBool,
+    ) -> Result<RigSummary> {
+        let mut sum = RigSummary::default();
+        let period_s = 1.0 / self.cfg.rate_hz;
+        let start = Instant::now();
+        let mut temp_c = f64::NAN;
+        let mut batch = Vec::new();
+        loop {
+            if stop.load(Ordering::Relaxed) {
+                sum.ended = "stopped".into();
+                break;
+            }
+            let mut due = (start.elapsed().as_secs_f64() * self.cfg.speed / period_s) as u64;
+            if let Some(d) = self.cfg.duration_s {
+                due = due.min((d / period_s) as u64);
+                if sum.frames >= due {
+                    sum.ended = format!("duration {d} s of sample time reached");
+                    break;
+                }
+            }
+            batch.clear();
+            while sum.frames < due {
+                let (frame, _) = self.next_frame(sum.frames, &mut temp_c);
+                batch.extend_from_slice(&frame.encode());
+                sum.frames += 1;
+            }
+            if let Err(e) = gyro_link.write_all(&batch).and_then(|()| gyro_link.flush()) {
+                sum.ended = format!("gyro link closed: {e}");
+                break;
+            }
+            match self.table.serve(table_link) {
+                Ok(n) => sum.table_commands += n,
+                Err(e) => {
+                    sum.ended = format!("table link closed: {e}");
+                    break;
+                }
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        }
+        sum.moves = self.table.moves();
+        sum.sample_time_s = sum.frames as f64 * period_s;
+        Ok(sum)
+    }
+}
+
+/// Opens a rig link: `tcp:HOST:PORT` is listened on (one connection accepted, waiting at
+/// most `accept_within`), anything else is a serial device at `baud`.
+pub fn open_rig_link(port: &str, baud: u32, accept_within: Duration) -> Result<Box<dyn Link>> {
+    if let Some(addr) = port.strip_prefix("tcp:") {
+        let listener =
+            std::net::TcpListener::bind(addr).with_context(|| format!("{port}: cannot listen"))?;
+        listener.set_nonblocking(true)?;
+        let t0 = Instant::now();
+        let stream = loop {
+            match listener.accept() {
+                Ok((s, _)) => break s,
+                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {
+                    if t0.elapsed() > accept_within {
+                        anyhow::bail!(
+                            "{port}: nothing connected within {} s",
+                            accept_within.as_secs()
+                        );
+                    }
+                    std::thread::sleep(Duration::from_millis(20));
+                }
+                Err(e) => return Err(e).with_context(|| format!("{port}: accept")),
+            }
+        };
+        stream.set_nonblocking(false)?;
+        stream.set_nodelay(true)?;
+        stream.set_read_timeout(Some(Duration::from_millis(1)))?;
+        Ok(Box::new(stream))
+    } else {
+        let serial = serialport::new(port, baud)
+            .timeout(Duration::from_millis(1))
+            .open()
+            .with_context(|| format!("opening serial port {port} at {baud} Bd"))?;
+        Ok(Box::new(serial))
+    }
+}
