@@ -141,10 +141,12 @@ pub fn render_text(r: &AllanReport) -> String {
                 "  {:?} {:<18} {:.4e} +/- {:.2e} {:<14} read from {range}",
                 t.term, t.name, t.value, t.sigma, t.unit
             )
+        } else if t.in_fit {
+            writeln!(s, "  {:?} {:<18} not significant: {:.2e} +/- {:.2e} {} (below 2 sigma in variance; strongest at {range})", t.term, t.name, t.value, t.sigma, t.unit)
         } else {
             writeln!(
                 s,
-                "  {:?} {:<18} not detected (1-sigma bound {:.2e} {})",
+                "  {:?} {:<18} not in the best fit (1-sigma upper bound {:.2e} {})",
                 t.term, t.name, t.sigma, t.unit
             )
         };

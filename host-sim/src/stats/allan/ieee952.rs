@@ -84,6 +84,8 @@ pub struct TermEstimate {
     pub term: Term,
     pub name: &'static str,
     pub unit: &'static str,
+    /// Whether the best fit includes the term.
+    pub in_fit: bool,
     /// Fitted value (0 when the best fit leaves the term out).
     pub value: f64,
     /// 1 sigma of the value (for a term left out: the 1-sigma upper bound it could have).
@@ -176,6 +178,7 @@ pub fn fit(points: &[Point]) -> NoiseFit {
                 term: t,
                 name: t.name(),
                 unit: t.unit(),
+                in_fit: false,
                 value: 0.0,
                 sigma: f64::NAN,
                 detected: false,
@@ -278,6 +281,7 @@ pub fn fit(points: &[Point]) -> NoiseFit {
                 term: t,
                 name: t.name(),
                 unit: t.unit(),
+                in_fit: pos.is_some(),
                 value,
                 sigma,
                 detected,
