@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::{bail, Result};
-use fog_core::link::Command;
+use fog_core::link::messages::Command;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::upload::LinkArgs;
