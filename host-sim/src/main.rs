@@ -16,6 +16,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Allan-family deviations with confidence intervals and the IEEE 952 noise terms.
+    Allan(cmd::allan::Args),
     /// Simulate the paper's test campaign: one fog-runs CSV per power-on.
     Campaign(cmd::campaign::Args),
     /// Train the RBF drift model (OLS) on fog-runs files.
@@ -47,6 +49,7 @@ enum Command {
 fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Allan(a) => cmd::allan::run(a),
         Command::Campaign(a) => cmd::campaign::run(a),
         Command::Train(a) => cmd::train::run(a),
         Command::Compensate(a) => cmd::compensate::run(a),

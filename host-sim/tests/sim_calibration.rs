@@ -5,12 +5,10 @@
 
 use fog_sim::io::runs::{format_run, Run};
 use fog_sim::pipeline::campaign::{simulate_campaign, CampaignSpec};
-use fog_sim::plots::{allan_chart, startup_chart, write_svg, Series, StartupCurve};
+use fog_sim::plots::{allan_chart, startup_chart, write_svg, RunCurve};
 use fog_sim::sim::{simulate_run, GyroParams, RunSpec, SimGyro, StartState};
-use fog_sim::stats::{
-    allan_deviation, arw_dpsh, bias_instability_dph, max_deviation, mean, settled_mean, std_dev,
-    time_to_spec_s, SPEC_DPH,
-};
+use fog_sim::stats::allan::{adev_of_series, Term};
+use fog_sim::stats::{max_deviation, mean, settled_mean, std_dev, time_to_spec_s, SPEC_DPH};
 use std::path::Path;
 
 fn paper_run(ambient_c: f64, seed: u64) -> Run {
@@ -94,36 +92,18 @@ fn allan_deviation_of_a_steady_record_gives_the_noise_parameters() {
         .take(3 * 3600 * 10)
         .map(|s| s.rate_dph - s.earth_dph)
         .collect();
-    let adev = allan_deviation(&y, 0.1);
-    let arw = arw_dpsh(&adev).unwrap();
-    let bi = bias_instability_dph(&adev).unwrap();
+    let analysis = adev_of_series(&y, 0.1).unwrap();
+    let adev = &analysis.adev.points;
+    let arw = analysis.noise.detected(Term::N).unwrap().value;
+    let bi = analysis.noise.detected(Term::B).unwrap().value;
     println!("| tau (s) | Allan deviation (deg/h) |\n|---:|---:|");
-    for a in &adev {
-        println!("| {:.1} | {:.5} |", a.tau_s, a.adev_dph);
+    for a in adev {
+        println!("| {:.1} | {:.5} |", a.tau_s, a.dev);
     }
     println!("ARW {arw:.5} deg/sqrt(h), bias instability {bi:.5} deg/h");
-    let (tau, ad): (Vec<f64>, Vec<f64>) = adev.iter().map(|a| (a.tau_s, a.adev_dph)).unzip();
-    let arw_line = tau
-        .iter()
-        .map(|&t| (t, arw / (t / 3600.0).sqrt()))
-        .collect();
-    let bi_line = tau.iter().map(|&t| (t, 0.664 * bi)).collect();
     let chart = allan_chart(
         "Simulated FOG, steady record (3 h, 10 Hz, 20 degC)",
-        &tau,
-        &ad,
-        vec![
-            Series::line(
-                format!("ARW {arw:.5} deg/sqrt(h) (slope -1/2)"),
-                arw_line,
-                1,
-            ),
-            Series::line(
-                format!("0.664 x bias instability {bi:.4} deg/h"),
-                bi_line,
-                2,
-            ),
-        ],
+        &analysis,
     );
     write_svg(
         &Path::new(env!("CARGO_TARGET_TMPDIR")).join("simulator-allan.svg"),
@@ -145,7 +125,7 @@ fn allan_deviation_of_a_steady_record_gives_the_noise_parameters() {
         .iter()
         .find(|a| (a.tau_s - 12.8).abs() < 0.01)
         .unwrap()
-        .adev_dph;
+        .dev;
     assert!(
         sigma_10s < SPEC_DPH && sigma_10s > 0.5 * SPEC_DPH,
         "10 s sigma {sigma_10s}"
@@ -167,15 +147,16 @@ fn ambient_temperature_changes_the_startup_curve() {
         "cold gyros drift more: {devs:?}"
     );
     assert!(devs[0] / devs[3] > 1.5, "{devs:?}");
-    let curves: Vec<StartupCurve> = runs
+    let curves: Vec<RunCurve> = runs
         .iter()
         .map(|r| {
             let d = r.drift_dph();
             let nominal = settled_mean(r.t_s(), &d);
-            StartupCurve {
+            RunCurve {
                 label: format!("ambient {} degC", r.ambient_c().unwrap()),
+                ambient_c: r.ambient_c(),
                 t_s: r.t_s().to_vec(),
-                drift_dph: d.iter().map(|v| v - nominal).collect(),
+                y: d.iter().map(|v| v - nominal).collect(),
             }
         })
         .collect();

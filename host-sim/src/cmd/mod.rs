@@ -1,6 +1,7 @@
 //! One module per `fogsim` subcommand: each has clap `Args` and a `run` function that
 //! checks flags and outputs, calls a pipeline and prints. Nothing outside `cmd` imports it.
 
+pub mod allan;
 pub mod campaign;
 pub mod compensate;
 pub mod demo;

@@ -2,14 +2,15 @@
 //! the -1/2 slope, bias instability at the flat minimum, IEEE Std 952 terms),
 //! quantisation (smallest step of the thermometer and of the rate) and steps, all
 //! computed while the rows stream past on their way into 10 s windows, so memory stays
-//! bounded whatever the row count: the Allan deviation uses octave-spaced
-//! non-overlapping block means (a cascade of pair averages: one pending value and one
-//! previous block mean per octave), quantisation keeps the few smallest distinct steps,
-//! the step detector a ring of `2 STEP_WINDOW_ROWS` rows.
+//! bounded whatever the row count: the Allan deviation is `stats::allan` (overlapping,
+//! octave taus, chi-squared intervals, IEEE 952 fit) on its bounded `RateRecord`,
+//! quantisation keeps the few smallest distinct steps, the step detector a ring of
+//! `2 STEP_WINDOW_ROWS` rows.
 
 use crate::io::bin::WindowBinner;
 use crate::io::reader::RunReader;
 use crate::io::runs::{Run, RunError};
+use crate::stats::allan::{self, RateRecord, Term};
 use serde::Serialize;
 use std::collections::VecDeque;
 use std::path::Path;
@@ -23,86 +24,11 @@ pub const STEP_SIGMA: f64 = 8.0;
 pub const STEPS_LISTED: usize = 20;
 /// Distinct smallest steps kept per column for the quantisation check.
 pub const SMALLEST_STEPS: usize = 6;
-/// IEEE Std 952: bias instability B = sigma_min / 0.664 (flicker floor of the Allan deviation).
-pub const FLICKER_FLOOR_FACTOR: f64 = 0.664;
-/// Fewest block pairs for an Allan point to be reported.
-pub const MIN_ALLAN_PAIRS: u64 = 3;
-
-/// One octave of the Allan cascade.
-#[derive(Clone, Debug, Default)]
-struct Octave {
-    pending: Option<f64>,
-    prev: Option<f64>,
-    sum_sq: f64,
-    pairs: u64,
-}
-
-/// Streaming non-overlapping Allan variance at tau0 * 2^k.
-#[derive(Clone, Debug, Default)]
-pub struct AllanCascade {
-    octaves: Vec<Octave>,
-}
-
-impl AllanCascade {
-    /// Adds one sample (a block mean at octave 0).
-    pub fn push(&mut self, x: f64) {
-        let mut mean = x;
-        let mut k = 0;
-        loop {
-            if self.octaves.len() == k {
-                self.octaves.push(Octave::default());
-            }
-            let o = &mut self.octaves[k];
-            if let Some(p) = o.prev {
-                o.sum_sq += (mean - p) * (mean - p);
-                o.pairs += 1;
-            }
-            o.prev = Some(mean);
-            match o.pending.take() {
-                None => {
-                    o.pending = Some(mean);
-                    return;
-                }
-                Some(first) => {
-                    mean = 0.5 * (first + mean);
-                    k += 1;
-                }
-            }
-        }
-    }
-
-    /// A gap (new run): blocks never span it; the sums are kept.
-    pub fn break_record(&mut self) {
-        for o in &mut self.octaves {
-            o.pending = None;
-            o.prev = None;
-        }
-    }
-
-    /// (tau, Allan deviation, block pairs) for every octave with enough pairs.
-    pub fn points(&self, tau0_s: f64) -> Vec<AllanPoint> {
-        self.octaves
-            .iter()
-            .enumerate()
-            .filter(|(_, o)| o.pairs >= MIN_ALLAN_PAIRS)
-            .map(|(k, o)| {
-                let adev = (o.sum_sq / (2.0 * o.pairs as f64)).sqrt();
-                AllanPoint {
-                    tau_s: tau0_s * f64::from(1u32 << k.min(31)),
-                    adev_dph: adev,
-                    // Non-overlapping estimate: relative 1 sigma 1 / sqrt(2 (K - 1)).
-                    adev_plus_minus_dph: adev / (2.0 * (o.pairs.max(2) - 1) as f64).sqrt(),
-                    pairs: o.pairs,
-                }
-            })
-            .collect()
-    }
-}
-
 /// One point of the Allan deviation.
 #[derive(Clone, Debug, Serialize)]
 pub struct AllanPoint {
     pub tau_s: f64,
+    /// Overlapping ADEV and half its 1-sigma chi-squared interval.
     pub adev_dph: f64,
     pub adev_plus_minus_dph: f64,
     pub pairs: u64,
@@ -281,7 +207,7 @@ pub struct RawRows {
 /// Everything streamed per campaign.
 struct Accumulators {
     tau0_s: Option<f64>,
-    allan: AllanCascade,
+    allan: RateRecord,
     temp_steps: StepSizes,
     rate_steps: StepSizes,
     detector: StepDetector,
@@ -296,7 +222,7 @@ struct Accumulators {
 pub fn read_runs<P: AsRef<Path>>(paths: &[P]) -> Result<(Vec<Run>, RawRows), RunError> {
     let mut acc = Accumulators {
         tau0_s: None,
-        allan: AllanCascade::default(),
+        allan: RateRecord::default(),
         temp_steps: StepSizes::default(),
         rate_steps: StepSizes::default(),
         detector: StepDetector::default(),
@@ -395,7 +321,7 @@ impl Accumulators {
 
     /// A gap: no Allan block or step window spans two runs.
     fn end_run(&mut self, file: &Path) {
-        self.allan.break_record();
+        self.allan.break_segment();
         let run = file.display().to_string();
         for (t_s, size_dph, sigma) in self.detector.end_run() {
             self.step_count += 1;
@@ -412,9 +338,15 @@ impl Accumulators {
 
     fn finish(self) -> RawRows {
         let tau0 = self.tau0_s.unwrap_or(f64::NAN);
-        let allan = self.allan.points(tau0);
-        let (arw, arw_pm, fit_taus) = arw_from_slope(&allan);
-        let (bi, bi_tau, bi_note) = bias_instability(&allan);
+        let analysis = allan::analyse(
+            &self.allan,
+            tau0,
+            allan::Kind::Adev,
+            allan::TauSpacing::Octave,
+        )
+        .ok();
+        let (allan, (arw, arw_pm, fit_taus), (bi, bi_tau, bi_note)) =
+            from_analysis(analysis.as_ref());
         RawRows {
             rows: self.rows,
             sample_period_s: tau0,
@@ -440,49 +372,72 @@ impl Accumulators {
     }
 }
 
-/// N from the shortest taus whose local log-log slope is -1/2 +/- 1/4 (white rate noise):
-/// N = mean of sigma(tau) sqrt(tau) over them, in deg/sqrt(h) (sigma in deg/h, tau in h).
-fn arw_from_slope(p: &[AllanPoint]) -> (Option<f64>, Option<f64>, Vec<f64>) {
-    let on_slope = |i: usize| {
-        ((p[i + 1].adev_dph / p[i].adev_dph).ln() / (p[i + 1].tau_s / p[i].tau_s).ln() + 0.5).abs()
-            <= 0.25
+/// The Allan points, N (value, 1 sigma, the taus it is read from) and B (value, the
+/// middle of its tau range, where it is read from) of `stats::allan`'s analysis.
+#[allow(clippy::type_complexity)]
+fn from_analysis(
+    a: Option<&allan::Analysis>,
+) -> (
+    Vec<AllanPoint>,
+    (Option<f64>, Option<f64>, Vec<f64>),
+    (Option<f64>, Option<f64>, String),
+) {
+    let Some(a) = a else {
+        return (
+            vec![],
+            (None, None, vec![]),
+            (None, None, "too few rows for an Allan deviation".into()),
+        );
     };
-    let Some(first) = (0..p.len().saturating_sub(1)).find(|&i| on_slope(i)) else {
-        return (None, None, vec![]);
-    };
-    let mut last = first + 1;
-    while last + 1 < p.len() && on_slope(last) {
-        last += 1;
-    }
-    let n = |q: &AllanPoint, v: f64| v * (q.tau_s / 3600.0).sqrt();
-    let used = &p[first..=last];
-    let arw = used.iter().map(|q| n(q, q.adev_dph)).sum::<f64>() / used.len() as f64;
-    // The shortest tau has the most pairs; its relative error stands for the estimate's.
-    let pm = n(&used[0], used[0].adev_plus_minus_dph);
-    (Some(arw), Some(pm), used.iter().map(|q| q.tau_s).collect())
-}
-
-/// B = sigma_min / 0.664 at the minimum of the Allan deviation; says whether the minimum
-/// is a floor or just the longest tau measured (then B is an upper bound).
-fn bias_instability(p: &[AllanPoint]) -> (Option<f64>, Option<f64>, String) {
-    let Some((i, m)) = p
+    let points = a
+        .adev
+        .points
         .iter()
-        .enumerate()
-        .min_by(|a, b| a.1.adev_dph.total_cmp(&b.1.adev_dph))
-    else {
-        return (None, None, "no Allan points".into());
+        .map(|p| AllanPoint {
+            tau_s: p.tau_s,
+            adev_dph: p.dev,
+            adev_plus_minus_dph: 0.5 * (p.dev_hi - p.dev_lo),
+            pairs: p.terms,
+        })
+        .collect();
+    let range = |t: &allan::TermEstimate| -> Vec<f64> {
+        a.adev
+            .points
+            .iter()
+            .map(|p| p.tau_s)
+            .filter(|tau| {
+                t.tau_from_s.is_some_and(|lo| *tau >= lo) && t.tau_to_s.is_some_and(|hi| *tau <= hi)
+            })
+            .collect()
     };
-    let note = if i + 1 == p.len() {
-        "minimum at the longest tau measured: no floor reached, B is an upper bound".to_owned()
-    } else {
-        let next = &p[i + 1];
-        if next.adev_dph - m.adev_dph <= 2.0 * (next.adev_plus_minus_dph + m.adev_plus_minus_dph) {
-            "flat minimum (next octave within 2 sigma)".to_owned()
-        } else {
-            "minimum between a falling and a rising slope (no wide floor)".to_owned()
-        }
+    let n = a.noise.detected(Term::N);
+    let arw = (
+        n.map(|t| t.value),
+        n.map(|t| t.sigma),
+        n.map(range).unwrap_or_default(),
+    );
+    let b = a.noise.detected(Term::B);
+    let bi = match b {
+        Some(t) => (
+            Some(t.value),
+            t.tau_from_s
+                .zip(t.tau_to_s)
+                .map(|(lo, hi)| (lo * hi).sqrt()),
+            format!(
+                "IEEE 952 fit: B {:.2e} +/- {:.1e} deg/h read from tau {:.4}..{:.4} s",
+                t.value,
+                t.sigma,
+                t.tau_from_s.unwrap_or(f64::NAN),
+                t.tau_to_s.unwrap_or(f64::NAN)
+            ),
+        ),
+        None => (
+            None,
+            None,
+            "IEEE 952 fit: no bias-instability floor detected".into(),
+        ),
     };
-    (Some(m.adev_dph / FLICKER_FLOOR_FACTOR), Some(m.tau_s), note)
+    (points, arw, bi)
 }
 
 #[cfg(test)]
@@ -491,34 +446,6 @@ mod tests {
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
     use rand_distr::{Distribution, Normal};
-
-    /// White rate noise: sigma(tau) = sigma0 / sqrt(tau / tau0), ARW recovered; a twin
-    /// with a random walk of the rate (RRW) rises as +1/2 and has no -1/2 region.
-    #[test]
-    fn white_noise_gives_its_arw_and_a_random_walk_does_not() {
-        let mut rng = ChaCha8Rng::seed_from_u64(3);
-        let normal = Normal::new(0.0, 1.0).unwrap();
-        let (tau0, sigma0) = (1.0, 0.06); // deg/h at 1 s: N = 0.06 / 60 = 0.001 deg/sqrt(h)
-        let mut white = AllanCascade::default();
-        let mut walk = AllanCascade::default();
-        let mut level = 0.0;
-        for _ in 0..200_000 {
-            white.push(sigma0 * normal.sample(&mut rng));
-            level += 0.01 * normal.sample(&mut rng);
-            walk.push(level);
-        }
-        let p = white.points(tau0);
-        let (arw, pm, taus) = arw_from_slope(&p);
-        let arw = arw.unwrap();
-        assert!((arw / 0.001 - 1.0).abs() < 0.05, "arw {arw}");
-        assert!(pm.unwrap() < 0.05 * arw && taus.first() == Some(&1.0));
-        let w = walk.points(tau0);
-        assert!(
-            w[5].adev_dph > w[1].adev_dph,
-            "a random walk rises with tau"
-        );
-        assert!(arw_from_slope(&w).0.is_none());
-    }
 
     #[test]
     fn quantised_steps_and_a_jump_are_found() {

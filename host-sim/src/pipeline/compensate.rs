@@ -10,7 +10,7 @@ use crate::io::runs::Run;
 use crate::pipeline::compensation_replay::{
     compensate_run, drift_stats, pooled_stats, CompensatedSeries,
 };
-use crate::plots::{startup_chart, write_svg, StartupCurve};
+use crate::plots::{startup_pair, write_svg, RunCurve};
 use crate::report::{BeforeAfter, CompensateReport, CompensatedRun, Table};
 use crate::stats::SPEC_DPH;
 
@@ -98,7 +98,7 @@ pub fn write_startup_plots(
     series: &[CompensatedSeries],
     tag: &str,
 ) -> Result<()> {
-    let curves = |after: bool| -> Vec<StartupCurve> {
+    let curves = |after: bool| -> Vec<RunCurve> {
         runs.iter()
             .zip(series)
             .map(|(run, s)| {
@@ -108,22 +108,17 @@ pub fn write_startup_plots(
                     (&s.t_s, &s.before_dph)
                 };
                 let settled = crate::stats::settled_mean(t, y);
-                StartupCurve {
+                RunCurve {
                     label: run.name(),
+                    ambient_c: run.ambient_c(),
                     t_s: t.clone(),
-                    drift_dph: y.iter().map(|v| v - settled).collect(),
+                    y: y.iter().map(|v| v - settled).collect(),
                 }
             })
             .collect()
     };
-    let title = |what: &str| format!("startup drift {what} compensation{tag}");
-    write_svg(
-        &dir.join("startup_before.svg"),
-        &startup_chart(&title("before"), &curves(false), Some(SPEC_DPH)),
-    )?;
-    write_svg(
-        &dir.join("startup_after.svg"),
-        &startup_chart(&title("after"), &curves(true), Some(SPEC_DPH)),
-    )?;
+    let (before, after) = startup_pair(tag, &curves(false), &curves(true), Some(SPEC_DPH));
+    write_svg(&dir.join("startup_before.svg"), &before)?;
+    write_svg(&dir.join("startup_after.svg"), &after)?;
     Ok(())
 }

@@ -2,6 +2,7 @@
 //! the north-seek Monte Carlo, the simulated campaign), built from the engines (`sim`,
 //! `train`, `diagnose`) over `io` and `stats`. They never print and never name flags.
 
+pub mod allan;
 pub mod campaign;
 pub mod campaign_steps;
 pub mod compensate;

@@ -17,13 +17,13 @@ use crate::pipeline::compensation_replay::{pooled_stats, CompensatedSeries};
 use crate::pipeline::northseek::{
     build_report, run_monte_carlo, seek_table, MonteCarloConfig, PAPER_SEEK_DURATION_S,
 };
-use crate::plots::{allan_chart, azimuth_scatter_chart, temperature_chart, write_svg, Series};
+use crate::plots::{allan_chart, azimuth_scatter_chart, temperature_chart, write_svg, RunCurve};
 use crate::report::{
     drift_cells, fmt_minutes, progress_bar, CompensateReport, DriftStats, NorthSeekReport, Table,
     DRIFT_COLUMNS,
 };
 use crate::sim::{GyroParams, RunSpec, SimGyro, StartState};
-use crate::stats::{self, SPEC_DPH};
+use crate::stats::{allan, SPEC_DPH};
 use crate::train::{InputSet, TrainReport};
 use fog_core::model::format::FeatureSpec;
 
@@ -435,8 +435,8 @@ pub fn summary(r: &ReproduceReport) -> String {
     )
 }
 
-/// Allan deviation of a steady (warm) record: 2 h at 10 Hz, input axis vertical.
-fn steady_allan(params: &GyroParams, seed: u64) -> Result<(Vec<f64>, Vec<f64>, Option<f64>)> {
+/// Allan analysis of a steady (warm) record: 2 h at 10 Hz, input axis vertical.
+fn steady_allan(params: &GyroParams, seed: u64) -> Result<allan::Analysis> {
     let spec = RunSpec {
         minutes: 120.0,
         raw_rate_hz: 10.0,
@@ -451,13 +451,7 @@ fn steady_allan(params: &GyroParams, seed: u64) -> Result<(Vec<f64>, Vec<f64>, O
             s.rate_dph - s.earth_dph
         })
         .collect();
-    let adev = stats::allan_deviation(&y, 1.0 / spec.raw_rate_hz);
-    let arw = stats::arw_dpsh(&adev);
-    Ok((
-        adev.iter().map(|p| p.tau_s).collect(),
-        adev.iter().map(|p| p.adev_dph).collect(),
-        arw,
-    ))
+    allan::adev_of_series(&y, 1.0 / spec.raw_rate_hz).map_err(|e| anyhow!("Allan deviation: {e}"))
 }
 
 /// Plots of one model variant: startup before/after at room temperature and the azimuths.
@@ -512,39 +506,24 @@ fn write_model_plots(
 /// Plots of the campaign itself: coil temperature after power-on, Allan deviation.
 fn write_campaign_plots(dir: &Path, params: &GyroParams, campaign: &[CampaignRun]) -> Result<()> {
     crate::io::guard::create_dir(dir)?;
-    let temps: Vec<(String, Vec<f64>, Vec<f64>)> = campaign
+    let temps: Vec<RunCurve> = campaign
         .iter()
         .filter(|c| c.index == 1)
-        .map(|c| {
-            (
-                format!("{:+.0} degC", c.ambient_c),
-                c.run.t_s().to_vec(),
-                c.run.temp_c().to_vec(),
-            )
+        .map(|c| RunCurve {
+            label: format!("{:+.0} degC", c.ambient_c),
+            ambient_c: Some(c.ambient_c),
+            t_s: c.run.t_s().to_vec(),
+            y: c.run.temp_c().to_vec(),
         })
         .collect();
     write_svg(
         &dir.join("temperature.svg"),
         &temperature_chart("gyro temperature after power-on", &temps),
     )?;
-    let (tau, adev, arw) = steady_allan(params, 7)?;
-    let mut fits = Vec::new();
-    if let Some(n) = arw {
-        let line = tau.iter().map(|&t| (t, n / (t / 3600.0).sqrt())).collect();
-        fits.push(Series::line(
-            format!("ARW {n:.5} deg/sqrt(h) (slope -1/2)"),
-            line,
-            1,
-        ));
-    }
+    let analysis = steady_allan(params, 7)?;
     write_svg(
         &dir.join("allan.svg"),
-        &allan_chart(
-            "Allan deviation, steady 2 h record (20 degC)",
-            &tau,
-            &adev,
-            fits,
-        ),
+        &allan_chart("Allan deviation, steady 2 h record (20 degC)", &analysis),
     )?;
     Ok(())
 }

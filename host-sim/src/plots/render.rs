@@ -1,0 +1,404 @@
+//! Renders a [`Chart`] to SVG with plotters: the plot on the left, the legend in its own
+//! panel on the right (so it never covers data), everything in the one `style`; written
+//! atomically (temp file + rename), so a failed plot never leaves a partial file.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::chart::{Chart, Color as SeriesColor, Mark};
+use super::style;
+
+/// Why a chart could not be written.
+#[derive(Debug)]
+pub enum PlotError {
+    /// No finite (and, on log axes, positive) data point at all.
+    NoData { title: String },
+    /// plotters failed while drawing.
+    Draw { title: String, message: String },
+    /// Writing the SVG file failed.
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+impl fmt::Display for PlotError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            PlotError::NoData { title } => write!(f, "chart '{title}': no plottable data"),
+            PlotError::Draw { title, message } => {
+                write!(f, "chart '{title}': drawing failed: {message}")
+            }
+            PlotError::Io { path, source } => {
+                write!(f, "{}: cannot write chart: {source}", path.display())
+            }
+        }
+    }
+}
+
+impl std::error::Error for PlotError {}
+
+fn rgb(c: SeriesColor) -> RGBColor {
+    match c {
+        SeriesColor::Palette(i) => style::palette(i),
+        SeriesColor::Ambient(t) => style::ambient_color(t),
+    }
+}
+
+/// Data range of one axis, padded (5 % linear, a factor on log axes).
+fn axis_range(values: impl Iterator<Item = f64>, log: bool) -> Option<(f64, f64)> {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in values.filter(|v| v.is_finite() && (!log || *v > 0.0)) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if !lo.is_finite() {
+        return None;
+    }
+    if log {
+        if hi <= lo {
+            return Some((lo / 2.0, hi * 2.0));
+        }
+        let pad = (hi / lo).powf(0.05);
+        return Some((lo / pad, hi * pad));
+    }
+    let span = hi - lo;
+    let pad = if span > 0.0 {
+        0.05 * span
+    } else {
+        lo.abs().max(1.0) * 0.05
+    };
+    Some((lo - pad, hi + pad))
+}
+
+fn plottable(chart: &Chart, (x, y): (f64, f64)) -> bool {
+    x.is_finite() && y.is_finite() && (!chart.x_log || x > 0.0) && (!chart.y_log || y > 0.0)
+}
+
+fn draw_err(chart: &Chart, e: impl fmt::Display) -> PlotError {
+    PlotError::Draw {
+        title: chart.title.clone(),
+        message: e.to_string(),
+    }
+}
+
+/// Renders `chart` to an SVG document.
+pub fn render_svg(chart: &Chart) -> Result<String, PlotError> {
+    let no_data = || PlotError::NoData {
+        title: chart.title.clone(),
+    };
+    let has_point = chart
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter())
+        .any(|p| plottable(chart, *p))
+        || chart
+            .bands
+            .iter()
+            .flat_map(|b| b.points.iter())
+            .any(|p| plottable(chart, (p.0, p.1)));
+    if !has_point {
+        return Err(no_data());
+    }
+    let x = axis_range(chart.x_values(), chart.x_log).ok_or_else(no_data)?;
+    let y = match chart.y_range {
+        Some(r) => r,
+        None => axis_range(chart.y_values(), chart.y_log).ok_or_else(no_data)?,
+    };
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, style::CHART_SIZE_PX).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| draw_err(chart, e))?;
+        let (plot, legend) =
+            root.split_horizontally(style::CHART_SIZE_PX.0 - style::LEGEND_WIDTH_PX);
+        match (chart.x_log, chart.y_log) {
+            (false, false) => draw_on(&plot, chart, x.0..x.1, y.0..y.1),
+            (true, false) => draw_on(&plot, chart, (x.0..x.1).log_scale(), y.0..y.1),
+            (false, true) => draw_on(&plot, chart, x.0..x.1, (y.0..y.1).log_scale()),
+            (true, true) => draw_on(&plot, chart, (x.0..x.1).log_scale(), (y.0..y.1).log_scale()),
+        }?;
+        draw_legend(&legend, chart).map_err(|e| draw_err(chart, e))?;
+        root.present().map_err(|e| draw_err(chart, e))?;
+    }
+    Ok(svg)
+}
+
+/// Whole numbers only (integer tick labels); other values get no label.
+fn integer_label(v: &f64) -> String {
+    if (v - v.round()).abs() < 1e-9 {
+        format!("{}", v.round() as i64)
+    } else {
+        String::new()
+    }
+}
+
+/// Compact numbers for tick labels (1e-3 instead of 0.0010000).
+fn number_label(v: &f64) -> String {
+    let a = v.abs();
+    if *v == 0.0 {
+        "0".into()
+    } else if !(1e-3..1e5).contains(&a) {
+        format!("{v:.0e}")
+    } else {
+        let s = format!("{v:.4}");
+        s.trim_end_matches('0').trim_end_matches('.').to_owned()
+    }
+}
+
+fn draw_on<XR, YR>(
+    root: &DrawingArea<SVGBackend<'_>, Shift>,
+    chart: &Chart,
+    x_range: XR,
+    y_range: YR,
+) -> Result<(), PlotError>
+where
+    XR: AsRangedCoord<Value = f64>,
+    YR: AsRangedCoord<Value = f64>,
+    XR::CoordDescType: ValueFormatter<f64>,
+    YR::CoordDescType: ValueFormatter<f64>,
+{
+    let mut ctx = ChartBuilder::on(root)
+        .caption(&chart.title, (style::FONT, style::TITLE_FONT_PX))
+        .margin(16)
+        .x_label_area_size(50)
+        .y_label_area_size(84)
+        .build_cartesian_2d(x_range, y_range)
+        .map_err(|e| draw_err(chart, e))?;
+    let x_span = {
+        let (lo, hi) = chart
+            .x_values()
+            .filter(|v| v.is_finite() && (!chart.x_log || *v > 0.0))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            });
+        (lo, hi)
+    };
+    {
+        let mut mesh = ctx.configure_mesh();
+        mesh.x_desc(chart.x_label.as_str())
+            .y_desc(chart.y_label.as_str())
+            .label_style((style::FONT, style::LABEL_FONT_PX))
+            .axis_desc_style((style::FONT, style::LABEL_FONT_PX))
+            .light_line_style(WHITE.mix(0.0))
+            .bold_line_style(BLACK.mix(0.08))
+            .y_label_formatter(&number_label);
+        if chart.x_integer_ticks {
+            let span = (x_span.1 - x_span.0).round().max(1.0) as usize;
+            mesh.x_labels(span + 1).x_label_formatter(&integer_label);
+        } else {
+            mesh.x_label_formatter(&number_label);
+        }
+        mesh.draw().map_err(|e| draw_err(chart, e))?;
+    }
+    for b in &chart.bands {
+        let c = rgb(b.color);
+        let pts: Vec<(f64, f64, f64)> = b
+            .points
+            .iter()
+            .copied()
+            .filter(|p| plottable(chart, (p.0, p.1)) && plottable(chart, (p.0, p.2)))
+            .collect();
+        let outline: Vec<(f64, f64)> = pts
+            .iter()
+            .map(|p| (p.0, p.1))
+            .chain(pts.iter().rev().map(|p| (p.0, p.2)))
+            .collect();
+        ctx.draw_series(std::iter::once(Polygon::new(
+            outline,
+            c.mix(style::BAND_OPACITY).filled(),
+        )))
+        .map_err(|e| draw_err(chart, e))?;
+    }
+    for r in &chart.ref_lines {
+        ctx.draw_series(DashedLineSeries::new(
+            [(x_span.0, r.y), (x_span.1, r.y)],
+            6,
+            4,
+            style::REFERENCE.stroke_width(1),
+        ))
+        .map_err(|e| draw_err(chart, e))?;
+    }
+    for s in &chart.series {
+        let color = rgb(s.color);
+        if let Some(err) = &s.y_err {
+            // Vertical bar in data coordinates, 8 px caps at both ends.
+            for (p, (lo, hi)) in s.points.iter().zip(err) {
+                if !(plottable(chart, (p.0, *lo)) && plottable(chart, (p.0, *hi))) {
+                    continue;
+                }
+                let stroke = color.stroke_width(1);
+                ctx.draw_series(LineSeries::new([(p.0, *lo), (p.0, *hi)], stroke))
+                    .map_err(|e| draw_err(chart, e))?;
+                let cap = |y: f64| {
+                    EmptyElement::at((p.0, y)) + PathElement::new(vec![(-4, 0), (4, 0)], stroke)
+                };
+                ctx.draw_series([cap(*lo), cap(*hi)])
+                    .map_err(|e| draw_err(chart, e))?;
+            }
+        }
+        let points: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .copied()
+            .filter(|p| plottable(chart, *p))
+            .collect();
+        match s.mark {
+            Mark::Line => ctx
+                .draw_series(LineSeries::new(
+                    points,
+                    color.stroke_width(style::LINE_WIDTH_PX),
+                ))
+                .map(|_| ()),
+            Mark::ThinLine => ctx
+                .draw_series(LineSeries::new(
+                    points,
+                    color.mix(style::THIN_OPACITY).stroke_width(1),
+                ))
+                .map(|_| ()),
+            Mark::Dashed => ctx
+                .draw_series(DashedLineSeries::new(
+                    points,
+                    10,
+                    6,
+                    color.stroke_width(style::LINE_WIDTH_PX),
+                ))
+                .map(|_| ()),
+            Mark::Points => ctx
+                .draw_series(
+                    points
+                        .into_iter()
+                        .map(|p| Circle::new(p, style::POINT_RADIUS_PX, color.filled())),
+                )
+                .map(|_| ()),
+        }
+        .map_err(|e| draw_err(chart, e))?;
+    }
+    Ok(())
+}
+
+/// The legend panel: one row per labelled band, reference line and series.
+fn draw_legend(
+    area: &DrawingArea<SVGBackend<'_>, Shift>,
+    chart: &Chart,
+) -> Result<(), DrawingAreaErrorKind<std::io::Error>> {
+    let font = (style::FONT, style::LEGEND_FONT_PX)
+        .into_font()
+        .color(&BLACK);
+    let row_px = style::LEGEND_FONT_PX as i32 + 10;
+    let mut y = 60;
+    let x0 = 8;
+    let text = |label: &str, y: i32| -> Result<(), DrawingAreaErrorKind<std::io::Error>> {
+        // Long labels wrap at about 26 characters.
+        let mut line = String::new();
+        let mut dy = 0;
+        for word in label.split(' ') {
+            if line.len() + word.len() > 26 && !line.is_empty() {
+                area.draw(&Text::new(
+                    line.clone(),
+                    (x0 + 34, y - 7 + dy),
+                    font.clone(),
+                ))?;
+                line.clear();
+                dy += style::LEGEND_FONT_PX as i32 + 2;
+            }
+            if !line.is_empty() {
+                line.push(' ');
+            }
+            line.push_str(word);
+        }
+        area.draw(&Text::new(line, (x0 + 34, y - 7 + dy), font.clone()))
+    };
+    let extra = |label: &str| (label.len() as i32 / 27) * (style::LEGEND_FONT_PX as i32 + 2);
+    for s in chart.series.iter().filter(|s| !s.label.is_empty()) {
+        let c = rgb(s.color);
+        match s.mark {
+            Mark::Points => area.draw(&Circle::new(
+                (x0 + 14, y),
+                style::POINT_RADIUS_PX + 1,
+                c.filled(),
+            ))?,
+            Mark::ThinLine => area.draw(&PathElement::new(
+                vec![(x0, y), (x0 + 28, y)],
+                c.mix(style::THIN_OPACITY).stroke_width(2),
+            ))?,
+            Mark::Line | Mark::Dashed => area.draw(&PathElement::new(
+                vec![(x0, y), (x0 + 28, y)],
+                c.stroke_width(style::LINE_WIDTH_PX),
+            ))?,
+        }
+        if s.y_err.is_some() {
+            area.draw(&PathElement::new(
+                vec![(x0 + 14, y - 7), (x0 + 14, y + 7)],
+                c.stroke_width(1),
+            ))?;
+        }
+        text(&s.label, y)?;
+        y += row_px + extra(&s.label);
+    }
+    for b in chart.bands.iter().filter(|b| !b.label.is_empty()) {
+        let c = rgb(b.color);
+        area.draw(&Rectangle::new(
+            [(x0, y - 6), (x0 + 28, y + 6)],
+            c.mix(style::BAND_OPACITY * 2.0).filled(),
+        ))?;
+        text(&b.label, y)?;
+        y += row_px + extra(&b.label);
+    }
+    for r in chart.ref_lines.iter().filter(|r| !r.label.is_empty()) {
+        area.draw(&PathElement::new(
+            vec![(x0, y), (x0 + 28, y)],
+            style::REFERENCE.stroke_width(1),
+        ))?;
+        text(&r.label, y)?;
+        y += row_px + extra(&r.label);
+    }
+    Ok(())
+}
+
+/// Renders `chart` and writes it to `path` atomically (temp file in the same directory, then rename).
+pub fn write_svg(path: &Path, chart: &Chart) -> Result<(), PlotError> {
+    let svg = render_svg(chart)?;
+    crate::io::write_atomic(path, svg.as_bytes()).map_err(|source| PlotError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plots::chart::Series;
+
+    #[test]
+    fn renders_linear_and_log_charts() {
+        let mut chart = Chart {
+            title: "t".into(),
+            series: vec![Series::line(
+                "a",
+                vec![(1.0, 2.0), (10.0, 3.0), (100.0, 0.5)],
+                0,
+            )],
+            ..Chart::default()
+        };
+        let lin = render_svg(&chart).unwrap();
+        assert!(lin.starts_with("<svg") && lin.contains("<polyline"));
+        chart.x_log = true;
+        chart.y_log = true;
+        assert!(render_svg(&chart).unwrap().contains("<polyline"));
+    }
+
+    #[test]
+    fn empty_or_nonpositive_log_data_is_an_error() {
+        let chart = Chart {
+            title: "neg".into(),
+            y_log: true,
+            series: vec![Series::line("a", vec![(1.0, -2.0), (2.0, f64::NAN)], 0)],
+            ..Chart::default()
+        };
+        assert!(matches!(render_svg(&chart), Err(PlotError::NoData { .. })));
+    }
+}
