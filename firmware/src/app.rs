@@ -21,7 +21,7 @@ use fog_core::compensator::{Compensator, CompensatorConfig, CompensatorError, Wi
 use fog_core::hal::{GyroSample, TableState, TempSample, Turntable};
 use fog_core::heading_cal::HeadingHarmonic;
 use fog_core::link::{
-    Command, DeviceMessage, Refusal, ResetReason, SeekReport, Status, LINK_VERSION,
+    Command, DeviceMessage, FaultState, Refusal, ResetReason, SeekReport, Status, LINK_VERSION,
 };
 use fog_core::model::RbfModel;
 use fog_core::northfinder::{NorthFinder, SeekConfig, SeekError, SeekMode, SeekResult};
@@ -132,6 +132,8 @@ pub struct BoardStatus {
     pub temp_c: f32,
     pub model_crc32: Option<u32>,
     pub reset_reason: ResetReason,
+    /// Faults across resets (the no-init record) and safe mode.
+    pub faults: FaultState,
 }
 
 /// Remembers the turntable driver's last error, which `NorthFinder` reduces to
@@ -366,6 +368,8 @@ where
             tilt: self.tilt,
             restarts,
             last_restart,
+            heading_cal: self.heading_correction().is_some(),
+            faults: board.faults,
         }
     }
 

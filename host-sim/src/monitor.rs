@@ -223,6 +223,8 @@ mod tests {
             tilt: Tilt::LEVEL,
             restarts: 0,
             last_restart: None,
+            heading_cal: false,
+            faults: fog_core::link::FaultState::NONE,
         }
     }
 

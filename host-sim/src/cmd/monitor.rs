@@ -73,8 +73,14 @@ pub fn run(a: Args) -> Result<()> {
                 Ok(()) => "BIT ok".to_string(),
                 Err(item) => format!("BIT: {}", item.name()),
             };
+            let heading = if s.heading_cal {
+                "heading cal"
+            } else {
+                "no heading cal"
+            };
+            let faults = fault_text(&s.faults);
             bar.set_message(format!(
-                "{:?} | predicted 1-sigma {:.4} deg | {:.2} degC | tilt {:.2}/{:.2} deg | restarts {} | {bit}",
+                "{:?} | predicted 1-sigma {:.4} deg | {:.2} degC | tilt {:.2}/{:.2} deg | restarts {} | {bit} | {heading}{faults}",
                 s.state, s.predicted_sigma_deg, s.temp_c, s.tilt.pitch_deg, s.tilt.roll_deg, s.restarts
             ));
         },
@@ -97,4 +103,18 @@ pub fn run(a: Args) -> Result<()> {
         println!("device refused a command: {r}");
     }
     Ok(())
+}
+
+/// The status line's fault part: empty without faults in a row, else the count, the
+/// last cause and whether the device is in safe mode.
+fn fault_text(f: &fog_core::link::FaultState) -> String {
+    match (f.safe_mode, f.faults_in_a_row) {
+        (false, 0) => String::new(),
+        (safe, n) => format!(
+            " | {}{n} faults in a row, last {:?} (detail {})",
+            if safe { "SAFE MODE: " } else { "" },
+            f.last_cause,
+            f.last_detail
+        ),
+    }
 }
