@@ -79,3 +79,81 @@ pub fn stream_gyro_frames(
     }
     sent
 }
+
+/// Sends one link command, preceded by the zero bytes that pay for its answer under
+/// the device's reply budget.
+pub fn send_link_command(link: &mut TcpStream, cmd: fog_core::link::Command) {
+    use fog_core::link::{encode, HostFrame};
+    use fog_core::protocol::{MAX_WIRE_FRAME_LEN, STATUS_REQUEST_PADDING};
+    let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
+    let n = encode(&HostFrame::Link(cmd), &mut wire).expect("encode");
+    link.write_all(&[0u8; STATUS_REQUEST_PADDING])
+        .and_then(|()| link.write_all(&wire[..n]))
+        .expect("send a link command");
+}
+
+/// Reads link messages (upload replies skipped) until `pick` returns something or
+/// `within` has passed (then `None`).
+pub fn read_link_until<T>(
+    link: &mut TcpStream,
+    within: Duration,
+    mut pick: impl FnMut(fog_core::link::DeviceMessage) -> Option<T>,
+) -> Option<T> {
+    use fog_core::link::{decode, DeviceFrame};
+    let deadline = Instant::now() + within;
+    let mut rx = fog_core::protocol::FrameReceiver::new();
+    let mut buf = [0u8; 256];
+    while Instant::now() < deadline {
+        let got = match std::io::Read::read(link, &mut buf) {
+            Ok(0) => return None,
+            Ok(k) => k,
+            Err(_) => continue, // read timeout: poll again
+        };
+        for &b in &buf[..got] {
+            let Some(Ok(payload)) = rx.push(b) else {
+                continue;
+            };
+            if let Ok(DeviceFrame::Link(m)) = decode::<DeviceFrame>(payload) {
+                if let Some(t) = pick(m) {
+                    return Some(t);
+                }
+            }
+        }
+    }
+    None
+}
+
+/// Asks for a link `Status` and waits (within `within`) for one that satisfies
+/// `accept` (the device also sends one every second).
+pub fn wait_status(
+    link: &mut TcpStream,
+    within: Duration,
+    accept: impl Fn(&fog_core::link::Status) -> bool,
+) -> fog_core::link::Status {
+    use fog_core::link::{Command, DeviceMessage};
+    send_link_command(link, Command::GetStatus);
+    let mut last = None;
+    let found = read_link_until(link, within, |m| match m {
+        DeviceMessage::Status(s) if accept(&s) => Some(s),
+        DeviceMessage::Status(s) => {
+            last = Some(s);
+            None
+        }
+        _ => None,
+    });
+    found.unwrap_or_else(|| panic!("no accepted link status within {within:?}; last {last:#?}"))
+}
+
+/// Sends one link command and waits for its answer (`Accepted` or `Refused`).
+pub fn link_command(
+    link: &mut TcpStream,
+    cmd: fog_core::link::Command,
+    within: Duration,
+) -> fog_core::link::DeviceMessage {
+    use fog_core::link::DeviceMessage;
+    send_link_command(link, cmd);
+    read_link_until(link, within, |m| {
+        matches!(m, DeviceMessage::Accepted | DeviceMessage::Refused(_)).then_some(m)
+    })
+    .unwrap_or_else(|| panic!("no answer to {cmd:?} within {within:?}"))
+}
