@@ -205,6 +205,12 @@ fn main() -> ! {
             match gyro.read() {
                 Ok(Some(s)) => {
                     let health = watch.on_sample(now_s, s.t_s, s.rate_dph);
+                    if health.resumed {
+                        // A stall mid-seek restarts the seek, with its reason.
+                        if let Some(why) = app.on_gyro_stall(s.t_s, health.gap_s).restarted {
+                            defmt::warn!("north seek restarted: {}", why);
+                        }
+                    }
                     match health.stuck_event {
                         Some(StuckEvent::Stuck) => defmt::warn!("t={} s: gyro stuck", s.t_s),
                         Some(StuckEvent::Recovered) => defmt::info!("t={} s: gyro moving", s.t_s),

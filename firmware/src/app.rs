@@ -423,6 +423,22 @@ where
         self.compensator.borrow_mut().report_fault(t_s);
     }
 
+    /// The gyro link stalled and samples come again at `t_s` after `lost_s` of sample
+    /// time: a running seek restarts from its first position with the reason
+    /// (`Step::restarted`), or fails if it has restarted too often.
+    pub fn on_gyro_stall(&mut self, t_s: f64, lost_s: f64) -> Step<T::Error> {
+        let mut step = Step::default();
+        match self
+            .supervisor
+            .on_gyro_stall(&mut self.table, t_s, self.tilt, lost_s)
+        {
+            Ok(SupervisorEvent::Restarted(why)) => step.restarted = Some(why),
+            Ok(_) => {}
+            Err(e) => step.seek = Some(self.fail(e, t_s)),
+        }
+        step
+    }
+
     /// One raw gyro sample: feeds the averager, and drives the seek.
     pub fn on_gyro(&mut self, s: GyroSample) -> Step<T::Error> {
         let mut step = Step::default();

@@ -224,6 +224,8 @@ fn main() -> ! {
                     let health = watch.on_sample(now_s, s.t_s, s.rate_dph);
                     if health.resumed {
                         defmt::info!("t={} s: gyro samples again", s.t_s);
+                        // A stall mid-seek restarts the seek, with its reason.
+                        report(app.on_gyro_stall(s.t_s, health.gap_s));
                     }
                     match health.stuck_event {
                         Some(StuckEvent::Stuck) => {
@@ -609,7 +611,9 @@ fn report<E: defmt::Format>(step: fog_firmware::app::Step<E>) {
         }
     }
     if let Some(why) = step.restarted {
-        defmt::warn!("north seek restarted: base moved ({})", why);
+        defmt::warn!("north seek restarted: {}", why);
+        #[cfg(feature = "log-semihosting")]
+        semihosting::eprintln!("FOG-SEEK-RESTART reason={:?}", why);
     }
     match step.seek {
         Some(SeekOutcome::Done(r, _)) => defmt::info!(
