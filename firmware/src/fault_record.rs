@@ -15,8 +15,8 @@
 //! sectors and could itself be cut by the reset. The target side (`resets.rs` under
 //! `src/bin/target/`) only moves [`RawRecord`]s in and out of that RAM.
 
-use fog_core::link::FaultState;
-use fog_core::protocol::{crc32, ResetCause, ResetRecord};
+use fog_core::link::messages::FaultState;
+use fog_core::link::upload::{crc32, ResetCause, ResetRecord};
 
 /// Faults in a row that put the device in safe mode. One fault may be a glitch and a
 /// second its after-effect (a watchdog reset while recovering); a third with no clean

@@ -7,12 +7,12 @@
 //! upload server run, so the operator sees the reason and can install a good model,
 //! which clears the record and lets the boot go on.
 
-use fog_core::bit::{BitItem, BitWord};
-use fog_core::link::{
+use fog_core::link::bit::{BitItem, BitWord};
+use fog_core::link::messages::{
     Command, DeviceMessage, FaultState, Refusal, ResetReason, Status, LINK_VERSION,
 };
-use fog_core::seek_quality::SeekState;
-use fog_core::tilt::Tilt;
+use fog_core::seeking::quality::SeekState;
+use fog_core::seeking::tilt::Tilt;
 
 /// The safe-mode status at `t_s` (s since boot): not ready (the gyro is not read), the
 /// model in flash if any, and the fault state with `safe_mode` set.

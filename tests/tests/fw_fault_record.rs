@@ -3,8 +3,8 @@
 //! (`fog_firmware::boot_args`). The QEMU scenarios (qemu_faults.rs, qemu_reset_loop.rs)
 //! run the same code on the target.
 
-use fog_core::link::{Command, DeviceMessage, Refusal};
-use fog_core::protocol::{ResetCause, ResetRecord};
+use fog_core::link::messages::{Command, DeviceMessage, Refusal};
+use fog_core::link::upload::{ResetCause, ResetRecord};
 use fog_firmware::boot_args::{parse, Inject};
 use fog_firmware::fault_record::{
     BootFault, CleanRun, FaultRecord, RawRecord, CLEAN_RUN_S, SAFE_MODE_AFTER,

@@ -29,7 +29,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use fog_core::protocol::ResetCause;
+use fog_core::link::upload::ResetCause;
 use fog_firmware::fault_record::{BootFault, CLEAN_RUN_S};
 use fog_sim::upload::{ClientError, UploadClient};
 use fog_tests::console::wait_line;
@@ -85,7 +85,7 @@ fn qemu_panic_resets_reports_its_line_and_keeps_the_model() {
         .expect("the committed model survived the reset");
     assert_eq!(
         (active.security_counter, active.model_crc32),
-        (counter, fog_core::protocol::crc32(&bytes))
+        (counter, fog_core::link::upload::crc32(&bytes))
     );
 }
 
@@ -234,7 +234,10 @@ fn qemu_hardfault_is_recorded_reset_reported_and_a_clean_run_clears_it() {
         (s.faults.last_cause, s.faults.last_detail),
         (ResetCause::Exception, pc)
     );
-    assert_eq!(s.reset_reason, fog_core::link::ResetReason::Lockup);
+    assert_eq!(
+        s.reset_reason,
+        fog_core::link::messages::ResetReason::Lockup
+    );
     let mut client = UploadClient::new(link.try_clone().unwrap(), Duration::from_secs(5));
     let status = client.status().expect("upload status after the HardFault");
     assert_eq!(

@@ -25,9 +25,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use fog_core::link::{Command, DeviceMessage};
-use fog_core::seek_quality::{MotionReason, SeekState};
-use fog_core::tilt::{earth_rate_on_axis_dph, Tilt};
+use fog_core::link::messages::{Command, DeviceMessage};
+use fog_core::seeking::quality::{MotionReason, SeekState};
+use fog_core::seeking::tilt::{earth_rate_on_axis_dph, Tilt};
 use fog_sim::upload::UploadClient;
 use fog_tests::console::{wait_line, wait_line_where};
 use fog_tests::qemu_ready;

@@ -21,7 +21,7 @@ use std::path::Path;
 use std::sync::mpsc::Receiver;
 use std::time::Duration;
 
-use fog_core::protocol::{crc32, ModelInfo};
+use fog_core::link::upload::{crc32, ModelInfo};
 use fog_sim::upload::UploadClient;
 use fog_tests::console::{start_with_console, wait_line};
 use fog_tests::{firmware_elf, qemu_ready, scratch_dir, KillOnDrop, QemuOptions};

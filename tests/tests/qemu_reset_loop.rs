@@ -16,9 +16,9 @@ mod upload_support;
 
 use std::time::Duration;
 
-use fog_core::link::{Command, DeviceMessage, Refusal};
-use fog_core::protocol::{crc32, ResetCause};
-use fog_core::seek_quality::SeekState;
+use fog_core::link::messages::{Command, DeviceMessage, Refusal};
+use fog_core::link::upload::{crc32, ResetCause};
+use fog_core::seeking::quality::SeekState;
 use fog_firmware::fault_record::{BootFault, SAFE_MODE_AFTER};
 use fog_sim::upload::UploadClient;
 use fog_tests::console::wait_line;

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::{bail, Result};
-use fog_core::link::Command;
+use fog_core::link::messages::Command;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::upload::LinkArgs;
@@ -107,7 +107,7 @@ pub fn run(a: Args) -> Result<()> {
 
 /// The status line's fault part: empty without faults in a row, else the count, the
 /// last cause and whether the device is in safe mode.
-fn fault_text(f: &fog_core::link::FaultState) -> String {
+fn fault_text(f: &fog_core::link::messages::FaultState) -> String {
     match (f.safe_mode, f.faults_in_a_row) {
         (false, 0) => String::new(),
         (safe, n) => format!(

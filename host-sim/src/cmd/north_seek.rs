@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Result};
-use fog_core::northfinder::SeekMode;
+use fog_core::seeking::northfinder::SeekMode;
 
 use super::check_output_file;
 use crate::io::model::read_model;

@@ -11,7 +11,7 @@ use crate::train::{
     WidthSearch, GUARD_RATIO,
 };
 use anyhow::Context;
-use fog_core::model::MAX_ENCODED_LEN;
+use fog_core::model::format::MAX_ENCODED_LEN;
 use std::path::PathBuf;
 
 /// Options of `fogsim train`.

@@ -49,7 +49,7 @@ pub use validate::{
     cross_validate, fold_of_rows, pooled_std, rms, std_within_groups, CvReport, WidthScore,
 };
 
-use fog_core::model::RbfModel;
+use fog_core::model::format::RbfModel;
 use serde::Serialize;
 use std::time::Instant;
 

@@ -161,9 +161,9 @@ pub fn serve_table(link: TcpStream, heading: Heading, stop: std::sync::Arc<Atomi
 
 /// Sends one link command, preceded by the zero bytes that pay for its answer under
 /// the device's reply budget.
-pub fn send_link_command(link: &mut TcpStream, cmd: fog_core::link::Command) {
-    use fog_core::link::{encode, HostFrame};
-    use fog_core::protocol::{MAX_WIRE_FRAME_LEN, STATUS_REQUEST_PADDING};
+pub fn send_link_command(link: &mut TcpStream, cmd: fog_core::link::messages::Command) {
+    use fog_core::link::messages::{encode, HostFrame};
+    use fog_core::link::upload::{MAX_WIRE_FRAME_LEN, STATUS_REQUEST_PADDING};
     let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
     let n = encode(&HostFrame::Link(cmd), &mut wire).expect("encode");
     link.write_all(&[0u8; STATUS_REQUEST_PADDING])
@@ -176,11 +176,11 @@ pub fn send_link_command(link: &mut TcpStream, cmd: fog_core::link::Command) {
 pub fn read_link_until<T>(
     link: &mut TcpStream,
     within: Duration,
-    mut pick: impl FnMut(fog_core::link::DeviceMessage) -> Option<T>,
+    mut pick: impl FnMut(fog_core::link::messages::DeviceMessage) -> Option<T>,
 ) -> Option<T> {
-    use fog_core::link::{decode, DeviceFrame};
+    use fog_core::link::messages::{decode, DeviceFrame};
     let deadline = Instant::now() + within;
-    let mut rx = fog_core::protocol::FrameReceiver::new();
+    let mut rx = fog_core::link::upload::FrameReceiver::new();
     let mut buf = [0u8; 256];
     while Instant::now() < deadline {
         let got = match std::io::Read::read(link, &mut buf) {
@@ -207,9 +207,9 @@ pub fn read_link_until<T>(
 pub fn wait_status(
     link: &mut TcpStream,
     within: Duration,
-    accept: impl Fn(&fog_core::link::Status) -> bool,
-) -> fog_core::link::Status {
-    use fog_core::link::{Command, DeviceMessage};
+    accept: impl Fn(&fog_core::link::messages::Status) -> bool,
+) -> fog_core::link::messages::Status {
+    use fog_core::link::messages::{Command, DeviceMessage};
     send_link_command(link, Command::GetStatus);
     let mut last = None;
     let found = read_link_until(link, within, |m| match m {
@@ -226,10 +226,10 @@ pub fn wait_status(
 /// Sends one link command and waits for its answer (`Accepted` or `Refused`).
 pub fn link_command(
     link: &mut TcpStream,
-    cmd: fog_core::link::Command,
+    cmd: fog_core::link::messages::Command,
     within: Duration,
-) -> fog_core::link::DeviceMessage {
-    use fog_core::link::DeviceMessage;
+) -> fog_core::link::messages::DeviceMessage {
+    use fog_core::link::messages::DeviceMessage;
     send_link_command(link, cmd);
     read_link_until(link, within, |m| {
         matches!(m, DeviceMessage::Accepted | DeviceMessage::Refused(_)).then_some(m)

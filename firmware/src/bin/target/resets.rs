@@ -11,7 +11,7 @@
 use core::mem::MaybeUninit;
 use core::ptr::{addr_of_mut, read_volatile, write_volatile};
 
-use fog_core::protocol::ResetCause;
+use fog_core::link::upload::ResetCause;
 pub use fog_firmware::fault_record::BootFault;
 use fog_firmware::fault_record::{FaultRecord, RawRecord};
 

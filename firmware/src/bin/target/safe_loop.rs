@@ -7,7 +7,7 @@
 
 use embedded_hal_nb::serial::{Read, Write};
 use embedded_storage::nor_flash::NorFlash;
-use fog_core::link::{DeviceMessage, FaultState};
+use fog_core::link::messages::{DeviceMessage, FaultState};
 use fog_firmware::clock::Clock as _;
 use fog_firmware::link_out::{queue_whole, LinkFrame};
 use fog_firmware::safe_mode;
