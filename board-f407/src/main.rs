@@ -85,12 +85,14 @@ fn main() -> ! {
     static mut MODEL: RbfModel = RbfModel::empty();
     static mut TX_QUEUE: heapless::Deque<u8, TX_QUEUE_LEN> = heapless::Deque::new();
     let (compensator, model, tx_queue) = (COMPENSATOR, MODEL, TX_QUEUE);
-    let reset = resets::boot_record();
+    let record = resets::boot_record();
+    let reset = record.reset;
     defmt::info!(
-        "f407-app: boot {} after {} (detail {})",
+        "f407-app: boot {} after {} (detail {}), {} faults in a row",
         reset.boots,
         reset.cause,
-        reset.detail
+        reset.detail,
+        record.faults_in_a_row
     );
     let (Some(cp), Some(dp)) = (cortex_m::Peripherals::take(), pac::Peripherals::take()) else {
         resets::fatal_boot(BootFault::CorePeripherals)
@@ -190,14 +192,25 @@ fn main() -> ! {
     };
     let mut gyro = FogSerialGyro::with_clock(gyro_port, GYRO_RATE_HZ, millis::MillisClock);
     let mut watch = GyroWatch::new(GYRO_SILENCE_S, DEFAULT_STUCK_RUN);
+    let mut clean_run = fog_firmware::fault_record::CleanRun::new(&record);
 
     loop {
         let now_s = millis::MillisClock.now_s();
+        if clean_run.due(now_s) {
+            defmt::info!("clean run: faults in a row cleared");
+            resets::clear_faults();
+        }
         let drops_before = gyro.uart_mut().dropped();
         loop {
             match gyro.read() {
                 Ok(Some(s)) => {
                     let health = watch.on_sample(now_s, s.t_s, s.rate_dph);
+                    if health.resumed {
+                        // A stall mid-seek restarts the seek, with its reason.
+                        if let Some(why) = app.on_gyro_stall(s.t_s, health.gap_s).restarted {
+                            defmt::warn!("north seek restarted: {}", why);
+                        }
+                    }
                     match health.stuck_event {
                         Some(StuckEvent::Stuck) => defmt::warn!("t={} s: gyro stuck", s.t_s),
                         Some(StuckEvent::Recovered) => defmt::info!("t={} s: gyro moving", s.t_s),
@@ -251,6 +264,8 @@ fn main() -> ! {
                 server.note_reply_dropped();
             }
             if changed {
+                // A good upload clears the faults in a row (fault_record.rs).
+                resets::clear_faults();
                 let loaded = server.load_active_model_into(model);
                 match loaded.map(|stored| app.set_model_from(stored.then_some(&*model))) {
                     Ok(Ok(())) => defmt::info!("new model in use"),

@@ -22,7 +22,7 @@ use fog_core::compensation::compensator::{
 use fog_core::hal::{GyroSample, TableState, TempSample, Turntable};
 use fog_core::link::bit::BitWord;
 use fog_core::link::messages::{
-    Command, DeviceMessage, Refusal, ResetReason, SeekReport, Status, LINK_VERSION,
+    Command, DeviceMessage, FaultState, Refusal, ResetReason, SeekReport, Status, LINK_VERSION,
 };
 use fog_core::model::format::RbfModel;
 use fog_core::seeking::heading_cal::HeadingHarmonic;
@@ -134,6 +134,8 @@ pub struct BoardStatus {
     pub temp_c: f32,
     pub model_crc32: Option<u32>,
     pub reset_reason: ResetReason,
+    /// Faults across resets (the no-init record) and safe mode.
+    pub faults: FaultState,
 }
 
 /// Remembers the turntable driver's last error, which `NorthFinder` reduces to
@@ -368,6 +370,8 @@ where
             tilt: self.tilt,
             restarts,
             last_restart,
+            heading_cal: self.heading_correction().is_some(),
+            faults: board.faults,
         }
     }
 
@@ -419,6 +423,22 @@ where
     /// the window containing it is marked invalid.
     pub fn on_fault(&mut self, t_s: f64) {
         self.compensator.borrow_mut().report_fault(t_s);
+    }
+
+    /// The gyro link stalled and samples come again at `t_s` after `lost_s` of sample
+    /// time: a running seek restarts from its first position with the reason
+    /// (`Step::restarted`), or fails if it has restarted too often.
+    pub fn on_gyro_stall(&mut self, t_s: f64, lost_s: f64) -> Step<T::Error> {
+        let mut step = Step::default();
+        match self
+            .supervisor
+            .on_gyro_stall(&mut self.table, t_s, self.tilt, lost_s)
+        {
+            Ok(SupervisorEvent::Restarted(why)) => step.restarted = Some(why),
+            Ok(_) => {}
+            Err(e) => step.seek = Some(self.fail(e, t_s)),
+        }
+        step
     }
 
     /// One raw gyro sample: feeds the averager, and drives the seek.

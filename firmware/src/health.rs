@@ -69,10 +69,13 @@ impl StuckDetector {
 }
 
 /// What a sample told the main loop about the gyro's health.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SampleHealth {
     /// Samples arrive again after the gyro was silent.
     pub resumed: bool,
+    /// Sample time since the previous sample, s (one period normally; the length of
+    /// the stall when `resumed`).
+    pub gap_s: f64,
     /// The stuck detector's change, if any.
     pub stuck_event: Option<StuckEvent>,
     /// The sample belongs to a stuck run: its window is invalid.
@@ -106,12 +109,14 @@ impl GyroWatch {
 
     /// A sample of sample time `t_s` and rate `rate_dph` arrived at clock time `now_s`.
     pub fn on_sample(&mut self, now_s: f64, t_s: f64, rate_dph: f32) -> SampleHealth {
+        let gap_s = t_s - self.last_t_s;
         self.last_t_s = t_s;
         self.last_sample_clock_s = Some(now_s);
         let resumed = core::mem::replace(&mut self.silent, false);
         let stuck_event = self.stuck.push(rate_dph);
         SampleHealth {
             resumed,
+            gap_s,
             stuck_event,
             stuck: self.stuck.is_stuck(),
         }

@@ -600,8 +600,11 @@ fn commit<F: NorFlash>(
             return Ok((info.clone(), false));
         }
     }
+    // The counter must be above every counter either slot holds, and counter 0 is
+    // never accepted (not even on an empty store): with floor 0 any counter-0 model
+    // could otherwise replace any other again and again (docs/upload.md).
     let floor = s.store.security_floor();
-    if floor > 0 && security_counter <= floor {
+    if security_counter <= floor {
         return Err(UploadError::Rollback {
             active_counter: floor,
         });

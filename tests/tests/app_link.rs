@@ -29,6 +29,7 @@ fn board(t_s: f64) -> BoardStatus {
         temp_c: 25.0,
         model_crc32: Some(7),
         reset_reason: ResetReason::Watchdog,
+        faults: fog_core::link::messages::FaultState::NONE,
     }
 }
 

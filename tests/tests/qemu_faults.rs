@@ -9,6 +9,14 @@
 //!   UART1 (at 200 Hz: see `FLOOD_GYRO_HZ`): every 10 s window stays valid and no
 //!   gyro frame or byte is lost.
 //!
+//! - A HardFault (an undefined instruction) resets the chip; the next boot reports
+//!   `Exception` with the faulting address, counts one fault in a row, and a clean run
+//!   of `CLEAN_RUN_S` clears the count.
+//! - Each fatal boot error (`BootFault`) is recorded, resets, and is reported with its
+//!   code by the next boot (console and link status).
+//! - An unknown firmware argument, or one with a bad value, is refused at boot with its
+//!   name, and QEMU exits with status 2.
+//!
 //! Skips loudly without QEMU / the target unless FOG_REQUIRE_QEMU=1. Every wait is
 //! bounded; QEMU is killed when the test ends.
 
@@ -22,10 +30,11 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use fog_core::link::upload::ResetCause;
+use fog_firmware::fault_record::{BootFault, CLEAN_RUN_S};
 use fog_sim::upload::{ClientError, UploadClient};
 use fog_tests::console::wait_line;
 use fog_tests::qemu_ready;
-use qemu_support::{polled, start, stream_gyro_frames, wait_boot};
+use qemu_support::{polled, start, stream_gyro_frames, wait_boot, wait_status};
 use upload_support::*;
 
 #[test]
@@ -185,6 +194,117 @@ fn qemu_host_flood_never_costs_a_gyro_window() {
         assert!(
             w.ends_with("gyro_bytes_dropped=0"),
             "gyro bytes dropped: {w}"
+        );
+    }
+}
+
+/// The number after `key=` in a console line.
+fn field(line: &str, key: &str) -> u32 {
+    line.split_whitespace()
+        .find_map(|w| w.strip_prefix(key)?.strip_prefix('='))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no {key}= in {line:?}"))
+}
+
+/// The firmware's code in flash (memory.x: FLASH at 0, 1008 KiB before the model slots).
+const CODE_END: u32 = 1008 * 1024;
+
+#[test]
+fn qemu_hardfault_is_recorded_reset_reported_and_a_clean_run_clears_it() {
+    if !qemu_ready("qemu_faults") {
+        return;
+    }
+    let (_qemu, mut streams, console) = start(&["inject=hardfault"], 1);
+    wait_boot(&console, 1, "PowerOn");
+    let line = wait_boot(&console, 2, "Exception");
+    let pc = field(&line, "detail");
+    assert!(
+        pc > 0 && pc < CODE_END,
+        "the faulting instruction's address is recorded: {line}"
+    );
+    assert_eq!(field(&line, "faults_in_a_row"), 1, "{line}");
+    let mut link = polled(streams.remove(0));
+    let s = wait_status(&mut link, Duration::from_secs(5), |_| true);
+    assert_eq!(
+        (s.faults.faults_in_a_row, s.faults.safe_mode),
+        (1, false),
+        "{s:?}"
+    );
+    assert_eq!(
+        (s.faults.last_cause, s.faults.last_detail),
+        (ResetCause::Exception, pc)
+    );
+    assert_eq!(
+        s.reset_reason,
+        fog_core::link::messages::ResetReason::Lockup
+    );
+    let mut client = UploadClient::new(link.try_clone().unwrap(), Duration::from_secs(5));
+    let status = client.status().expect("upload status after the HardFault");
+    assert_eq!(
+        (status.last_reset.cause, status.last_reset.detail),
+        (ResetCause::Exception, pc)
+    );
+    // A clean run (no fault for CLEAN_RUN_S) clears the count; the record stays.
+    wait_line(
+        &console,
+        "FOG-FAULTS cleared by clean run",
+        Duration::from_secs_f64(CLEAN_RUN_S + 20.0),
+    );
+    let s = wait_status(&mut link, Duration::from_secs(5), |s| {
+        s.faults.faults_in_a_row == 0
+    });
+    assert_eq!(s.faults.last_cause, ResetCause::Exception);
+}
+
+#[test]
+fn qemu_each_fatal_boot_error_is_recorded_and_reported_with_its_code() {
+    if !qemu_ready("qemu_faults") {
+        return;
+    }
+    for fault in BootFault::ALL {
+        let arg = format!("inject=boot-fault={}", fault.name());
+        let (_qemu, mut streams, console) = start(&[&arg], 1);
+        wait_boot(&console, 1, "PowerOn");
+        let line = wait_boot(&console, 2, "FatalBoot");
+        assert_eq!(field(&line, "detail"), fault.code(), "{arg}: {line}");
+        assert_eq!(field(&line, "faults_in_a_row"), 1, "{arg}: {line}");
+        let mut link = polled(streams.remove(0));
+        let s = wait_status(&mut link, Duration::from_secs(5), |_| true);
+        assert_eq!(
+            (
+                s.faults.last_cause,
+                s.faults.last_detail,
+                s.faults.faults_in_a_row
+            ),
+            (ResetCause::FatalBoot, fault.code(), 1),
+            "{arg}"
+        );
+    }
+}
+
+#[test]
+fn qemu_unknown_or_malformed_argument_is_refused_with_its_name() {
+    if !qemu_ready("qemu_faults") {
+        return;
+    }
+    let elf = fog_tests::firmware_elf("fog-app");
+    for (arg, why) in [
+        ("gyro-rat=200", "unknown argument"),
+        ("verbose", "unknown argument"),
+        ("gyro-rate=fast", "not a whole number of Hz"),
+        ("inject=meltdown", "unknown fault to inject"),
+    ] {
+        let opts = fog_tests::QemuOptions {
+            args: vec!["seek-dwell-s=30".into(), arg.into()],
+            ..Default::default()
+        };
+        let run = fog_tests::run_qemu(&elf, &opts, Duration::from_secs(30)).expect("QEMU run");
+        assert_eq!(run.status.code(), Some(2), "{arg}: {}", run.stderr);
+        let expected = format!("FOG-ARGS refused: argument {arg:?}: {why}");
+        assert!(run.stderr.contains(&expected), "{arg}: {}", run.stderr);
+        assert!(
+            !run.stderr.contains("FOG-SLOT"),
+            "{arg}: refused before the firmware started"
         );
     }
 }

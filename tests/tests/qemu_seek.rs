@@ -24,7 +24,9 @@
 //! after an upload over the same port the seek: statuses go to `Seeking` with rising
 //! progress and a finite predicted sigma, one `Result` (2 positions, `Valid`, azimuth
 //! within 5 predicted 1-sigma of the truth, the device's own sigma within a factor 3 of the
-//! prediction, the measured tilt), then `Ready` with the BIT passing.
+//! prediction, the measured tilt), then `Ready` with the BIT passing; the status says
+//! whether the active model carries a heading calibration (`heading_cal`: no before the
+//! upload, yes after).
 //!
 //! Skips loudly without QEMU / the target unless FOG_REQUIRE_QEMU=1. Every wait is
 //! bounded; QEMU is killed when the test ends.
@@ -32,7 +34,6 @@
 mod qemu_support;
 mod upload_support;
 
-use std::io::{BufRead, BufReader, Write};
 use std::net::TcpStream;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
@@ -49,7 +50,7 @@ use fog_sim::registry::Registry;
 use fog_sim::upload::UploadClient;
 use fog_tests::console::{wait_line, wait_line_where};
 use fog_tests::{qemu_ready, scratch_dir};
-use qemu_support::{polled, start, stream_gyro_frames, wait_boot};
+use qemu_support::{polled, serve_table, start, stream_gyro_frames, wait_boot, Heading};
 use rand_distr::Distribution;
 use upload_support::*;
 
@@ -79,45 +80,6 @@ const HEADING: HeadingHarmonic = HeadingHarmonic {
     correlation: 0.0,
     n_headings: 8,
 };
-/// The simulated table's heading, deg (table frame).
-type Heading = Arc<Mutex<f64>>;
-
-/// The turntable controller: `MOV h` -> `ACK` (the heading changes at once), `POS?` ->
-/// `POS h S`. Ends when the link closes or `stop` is set.
-fn serve_table(link: TcpStream, heading: Heading, stop: Arc<AtomicBool>) {
-    let link = polled(link);
-    let mut out = link.try_clone().unwrap();
-    let mut reader = BufReader::new(link);
-    let mut line = Vec::new();
-    while !stop.load(Ordering::Relaxed) {
-        match reader.read_until(b'\r', &mut line) {
-            Ok(0) => return,
-            Ok(_) if line.ends_with(b"\r") => {
-                let text = String::from_utf8_lossy(&line).trim().to_string();
-                line.clear();
-                let reply = if let Some(h) = text.strip_prefix("MOV ") {
-                    match h.parse::<f64>() {
-                        Ok(h) => {
-                            *heading.lock().unwrap() = h;
-                            "ACK".to_string()
-                        }
-                        Err(_) => "NAK".to_string(),
-                    }
-                } else if text == "POS?" {
-                    format!("POS {:.3} S", *heading.lock().unwrap())
-                } else {
-                    continue;
-                };
-                if out.write_all(format!("{reply}\r").as_bytes()).is_err() {
-                    return;
-                }
-            }
-            // A timeout may leave a partial line in `line`: keep reading.
-            _ => {}
-        }
-    }
-}
-
 /// The FOG: Earth rate at the table's current heading, bias and white noise.
 fn stream_gyro(link: TcpStream, heading: Heading, stop: Arc<AtomicBool>) -> u64 {
     let period_s = 1.0 / f64::from(RATE_HZ);
@@ -245,6 +207,7 @@ fn qemu_whole_seek_over_the_host_link_with_status_result_and_refusals() {
     assert_eq!(last.state, SeekState::NotReady(BitItem::Model), "{last:?}");
     assert_eq!(last.bit, BitWord(1 << BitItem::Model as u16), "{last:?}");
     assert_eq!(last.model_crc32, None);
+    assert!(!last.heading_cal, "no model, no heading calibration");
 
     // Upload a model over the same port (the client skips the status frames).
     let mut client = UploadClient::new(host.try_clone().unwrap(), Duration::from_secs(10));
@@ -340,6 +303,10 @@ fn qemu_whole_seek_over_the_host_link_with_status_result_and_refusals() {
     assert_eq!(last.bit, BitWord::PASS);
     assert_eq!(last.progress, 0.0);
     assert_eq!(last.model_crc32, Some(info.model_crc32));
+    assert!(
+        last.heading_cal,
+        "the uploaded model carries its heading calibration"
+    );
     assert_eq!(last.reset_reason, ResetReason::PowerOn);
     assert!((last.latitude_deg - LATITUDE_DEG as f32).abs() < 1e-4);
     assert!((last.temp_c - 25.0).abs() < 0.01, "{last:?}");

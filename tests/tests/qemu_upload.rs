@@ -59,6 +59,11 @@ fn qemu_upload_installs_signed_model_and_refuses_bad_ones() {
     );
     let counter = hello.active.as_ref().map_or(0, |m| m.security_counter) + 1;
     let first = encode(&sample_model(QEMU_GYRO, 35, 1.0));
+    // Counter 0 is never accepted (issue 17 item 1: A(0) -> B(0) -> A(0) was).
+    match client.upload(&first, 0, &sign_for_gyro(0, QEMU_GYRO, &first), |_, _| {}) {
+        Err(ClientError::Rejected(UploadError::Rollback { .. })) => {}
+        other => panic!("counter-0 upload: {other:?}"),
+    }
     let info = client
         .upload(
             &first,
@@ -112,6 +117,15 @@ fn qemu_upload_installs_signed_model_and_refuses_bad_ones() {
         )
         .expect("re-commit of the active model");
     assert_eq!(again, info);
+    // Another model with the same counter, or with counter 0: refused.
+    for c in [counter, 0] {
+        match client.upload(&second, c, &sign_for_gyro(c, QEMU_GYRO, &second), |_, _| {}) {
+            Err(ClientError::Rejected(UploadError::Rollback { active_counter })) => {
+                assert_eq!(active_counter, counter)
+            }
+            other => panic!("upload B({c}) over A({counter}): {other:?}"),
+        }
+    }
     let info2 = client
         .upload(
             &second,

@@ -52,6 +52,43 @@ fn an_older_counter_is_refused_as_rollback_even_with_a_valid_signature() {
     assert_eq!(e, UploadError::Rollback { active_counter: 9 });
 }
 
+/// Issue 17 item 1: with the old rule (`floor > 0 && counter <= floor`) counter 0 was
+/// never checked, so A(0) -> B(0) -> A(0) ... were all accepted.
+#[test]
+fn counter_zero_is_never_accepted_and_an_equal_counter_is_refused() {
+    let a = encode(&sample_model(TEST_GYRO, 35, 1.0));
+    let b = encode(&sample_model(TEST_GYRO, 20, 0.5));
+    // A(0) on an empty store: refused, nothing installed.
+    let mut server = fresh_server();
+    let mut c = client(&mut server);
+    let e = rejected(c.upload(&a, 0, &sign_with_test_key(0, &a), |_, _| {}));
+    assert_eq!(e, UploadError::Rollback { active_counter: 0 });
+    assert_eq!(c.status().unwrap().active, None);
+    // A(1) -> B(1): refused; B(0): refused; A(1) stays.
+    let info_a = c
+        .upload(&a, 1, &sign_with_test_key(1, &a), |_, _| {})
+        .unwrap();
+    let e = rejected(c.upload(&b, 1, &sign_with_test_key(1, &b), |_, _| {}));
+    assert_eq!(e, UploadError::Rollback { active_counter: 1 });
+    let e = rejected(c.upload(&b, 0, &sign_with_test_key(0, &b), |_, _| {}));
+    assert_eq!(e, UploadError::Rollback { active_counter: 1 });
+    assert_eq!(c.status().unwrap().active, Some(info_a));
+    // A(1) -> B(2): accepted; then A(1) and A(0) again: refused.
+    let info_b = c
+        .upload(&b, 2, &sign_with_test_key(2, &b), |_, _| {})
+        .unwrap();
+    assert_eq!(info_b.security_counter, 2);
+    for counter in [0, 1, 2] {
+        let e = rejected(c.upload(&a, counter, &sign_with_test_key(counter, &a), |_, _| {}));
+        assert_eq!(
+            e,
+            UploadError::Rollback { active_counter: 2 },
+            "A({counter})"
+        );
+    }
+    assert_eq!(c.status().unwrap().active, Some(info_b));
+}
+
 #[test]
 fn a_model_for_another_gyro_is_refused() {
     let mut server = fresh_server();

@@ -19,8 +19,11 @@ use crate::link::upload::{
 use crate::seeking::quality::{MotionReason, QualityError, SeekState, Validity};
 use crate::seeking::tilt::Tilt;
 
-/// Version of these messages (in every `Status`).
-pub const LINK_VERSION: u16 = 1;
+/// Version of these messages (in every `Status`). 2: `Status` gained `heading_cal` and
+/// `faults` (safe mode), `Refusal` gained `SafeMode`; a version-1 peer cannot decode a
+/// version-2 status (postcard has no optional trailing fields), so both ends move
+/// together (they build against this crate).
+pub const LINK_VERSION: u16 = 2;
 
 /// Why the device last reset.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -80,6 +83,32 @@ pub enum Refusal {
     BadPositions,
     /// `Abort` with no seek running.
     NotSeeking,
+    /// The device is in safe mode after a reset loop (`Status::faults`): no seeks until
+    /// a good model upload (or a power cycle) clears it.
+    SafeMode,
+}
+
+/// Faults across resets (the firmware's no-init RAM record): resets by a fault in a row
+/// since the last clean run or good upload, whether they put the device in safe mode
+/// (host link and model upload only), and the cause of the last reset.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FaultState {
+    pub faults_in_a_row: u8,
+    pub safe_mode: bool,
+    pub last_cause: ResetCause,
+    /// Cause-specific detail (panic line, boot fault code, faulting PC).
+    pub last_detail: u32,
+}
+
+impl FaultState {
+    /// A first boot after power-on.
+    pub const NONE: Self = Self {
+        faults_in_a_row: 0,
+        safe_mode: false,
+        last_cause: ResetCause::PowerOn,
+        last_detail: 0,
+    };
 }
 
 /// Periodic status (about once per second and after every command).
@@ -105,6 +134,11 @@ pub struct Status {
     /// Restarts of the running seek and the last reason.
     pub restarts: u8,
     pub last_restart: Option<MotionReason>,
+    /// The active model carries a heading calibration (format v3 harmonic) that the
+    /// seeks apply.
+    pub heading_cal: bool,
+    /// Faults across resets and safe mode (link version 2).
+    pub faults: FaultState,
 }
 
 /// One finished seek.
@@ -179,6 +213,13 @@ mod tests {
             },
             restarts: 2,
             last_restart: Some(MotionReason::TiltChange { change_mdeg: 120 }),
+            heading_cal: true,
+            faults: FaultState {
+                faults_in_a_row: u8::MAX,
+                safe_mode: true,
+                last_cause: ResetCause::Exception,
+                last_detail: u32::MAX,
+            },
         }
     }
 
@@ -212,6 +253,7 @@ mod tests {
                 FinderFault::TableTimeout { position: 3 },
             ))),
             DeviceMessage::Refused(Refusal::NotSeeking),
+            DeviceMessage::Refused(Refusal::SafeMode),
         ]
     }
 

@@ -280,7 +280,8 @@ pub enum UploadError {
     FlashFailure,
     /// Sequence counter exhausted (u32::MAX uploads).
     SequenceExhausted,
-    /// The security counter is below the active model's (or equal for another model).
+    /// The security counter is 0, or not above the highest counter of the stored slots
+    /// (`active_counter`; equal is refused for any other model).
     Rollback { active_counter: u32 },
     /// The model was trained for another gyro than this device's.
     WrongGyro,
@@ -323,7 +324,7 @@ impl core::fmt::Display for UploadError {
             Self::SequenceExhausted => write!(f, "store sequence counter exhausted"),
             Self::Rollback { active_counter } => write!(
                 f,
-                "security counter not above the active model's ({active_counter}): rollback refused"
+                "security counter must be at least 1 and above {active_counter} (the highest installed): rollback refused"
             ),
             Self::WrongGyro => write!(f, "model is for another gyro id than this device's"),
             Self::SessionMismatch => write!(f, "request is not for the active upload session"),

@@ -68,6 +68,9 @@ pub enum MotionReason {
     RateJump { position: u8, sigmas: u16 },
     /// The tilt moved by `change_mdeg` millidegrees from the start of the seek.
     TiltChange { change_mdeg: u32 },
+    /// Not motion: the gyro link stalled; `gap_ms` of sample time between the samples
+    /// around the stall (lost frames included), so the dwell has a hole (link version 2).
+    GyroStall { gap_ms: u32 },
 }
 
 /// Why a seek was refused or stopped.
@@ -308,6 +311,24 @@ impl SeekSupervisor {
     }
 
     /// Abandons the seek.
+    /// The gyro link stalled during the seek and samples come again `lost_s` of sample
+    /// time after the last one: the dwell has a hole, so the seek starts again from its first
+    /// position (`Restarted(GyroStall)`), counted against `max_restarts` like motion.
+    /// Nothing happens when no seek runs.
+    pub fn on_gyro_stall<T: Turntable>(
+        &mut self,
+        table: &mut T,
+        t_now_s: f64,
+        tilt: Tilt,
+        lost_s: f64,
+    ) -> Result<SupervisorEvent, QualityError> {
+        if !self.seeking {
+            return Ok(SupervisorEvent::Running);
+        }
+        let gap_ms = libm::round(lost_s.max(0.0) * 1000.0).min(u32::MAX as f64) as u32;
+        self.restart(table, t_now_s, tilt, MotionReason::GyroStall { gap_ms })
+    }
+
     pub fn abort(&mut self) {
         self.finder.abort();
         self.seeking = false;

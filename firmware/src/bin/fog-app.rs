@@ -40,6 +40,8 @@ mod millis;
 mod panic_reset;
 #[path = "target/resets.rs"]
 mod resets;
+#[path = "target/safe_loop.rs"]
+mod safe_loop;
 #[cfg(feature = "log-semihosting")]
 #[path = "target/semi.rs"]
 mod semi;
@@ -60,18 +62,20 @@ use embedded_hal_nb::serial::{Read as _, Write as _};
 use fog_core::compensation::compensator::Compensator;
 use fog_core::hal::Gyro;
 use fog_core::link::bit::BitLimits;
-use fog_core::link::messages::{DeviceMessage, ResetReason};
+use fog_core::link::messages::{DeviceMessage, FaultState, ResetReason};
 use fog_core::link::upload::ResetRecord;
 use fog_core::model::format::RbfModel;
 use fog_core::seeking::tilt::Tilt;
 use fog_firmware::app::{App, AppConfig, BoardStatus, SeekOutcome};
 use fog_firmware::bit_monitor::{BitCounters, BitMonitor};
+use fog_firmware::boot_args::{BootArgs, Inject};
 use fog_firmware::clock::Clock;
 use fog_firmware::drivers::fog_serial::FogSerialGyro;
 use fog_firmware::drivers::inclinometer::{
     Inclinometer, SimulatedInclinometer, SIMULATED_NOISE_DEG,
 };
 use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig};
+use fog_firmware::fault_record::{CleanRun, FaultRecord};
 use fog_firmware::health::{GyroWatch, StuckEvent, DEFAULT_STUCK_RUN};
 use fog_firmware::link_out::{queue_whole, LinkFrame};
 use fog_firmware::upload::UploadServer;
@@ -115,14 +119,17 @@ fn main() -> ! {
     static mut MODEL: RbfModel = RbfModel::empty();
     static mut TX_QUEUE: TxQueue = heapless::Deque::new();
     let (compensator, model, tx_queue) = (COMPENSATOR, MODEL, TX_QUEUE);
-    let reset = resets::boot_record();
-    announce_boot(&reset);
-    let Some(cp) = cortex_m::Peripherals::take() else {
+    let record = resets::boot_record();
+    let reset = record.reset;
+    announce_boot(&record);
+    let options = test_options(&reset);
+    let Some(cp) =
+        cortex_m::Peripherals::take().filter(|_| !options.injects(BootFault::CorePeripherals))
+    else {
         resets::fatal_boot(BootFault::CorePeripherals)
     };
     millis::start_millis(cp.SYST, millis::CORE_HZ);
     watchdog::start(WATCHDOG_TIMEOUT_MS);
-    let options = test_options(&reset);
     inject_fault_at_boot(options);
     let gyro_rate_hz = options.gyro_rate_hz;
     // SAFETY: each UART block and the model region are taken exactly once, here.
@@ -137,7 +144,26 @@ fn main() -> ! {
 
     // The long-lived state lives in statics (counted in the static-RAM budget by the
     // linker), not in main's stack frame.
-    let server = start_upload_server(flash, reset);
+    let mut faults = record.state(false);
+    let server = if record.safe_mode() {
+        // A reset loop: host link and upload server only, until a good upload.
+        let server = upload_boot::try_new_upload_server(flash, VERIFY_KEY, GYRO_ID, reset)
+            .ok()
+            .map(|s| keep_server(s, options));
+        let mut server = server;
+        safe_loop::run(
+            &mut host,
+            server.as_deref_mut(),
+            tx_queue,
+            faults,
+            watchdog::feed,
+        );
+        faults = record.cleared().state(false);
+        // `run` returns only after a good upload, which needs the store.
+        server.unwrap_or_else(|| resets::fatal_boot(BootFault::StoreGeometry))
+    } else {
+        start_upload_server(flash, reset, options)
+    };
     // Decoded in place into `MODEL` (the compensator keeps its own copy).
     let stored = server.load_active_model_into(model).unwrap_or_else(|e| {
         defmt::warn!("stored model not loaded ({}): running uncompensated", e);
@@ -153,6 +179,10 @@ fn main() -> ! {
     let table = SerialTurntable::new(table_uart, millis::MillisClock, TurntableConfig::default());
     // Configured in place in `COMPENSATOR`; the `App` around it is a few hundred bytes.
     let mut cfg = AppConfig::for_rate(gyro_rate_hz as f32);
+    if options.injects(BootFault::Configuration) {
+        // The real path of a refused configuration: a gyro rate the compensator refuses.
+        cfg.compensator.gyro_rate_hz = 0.0;
+    }
     // Seeks run on the host's StartSeek only.
     cfg.seeks = 0;
     if let Some(d) = options.seek_dwell_s {
@@ -178,9 +208,13 @@ fn main() -> ! {
     let mut bit_monitor = BitMonitor::new(BitLimits::default());
     let mut next_status_s = 0.0;
     let reset_reason = ResetReason::from(reset.cause);
+    let mut clean_run = CleanRun::new(&record);
 
     loop {
         let now_s = millis::MillisClock.now_s();
+        if clean_run.due(now_s) {
+            clear_faults(&mut faults, "clean run");
+        }
         // 1. Gyro first: everything its ring holds.
         let drops_before = gyro.uart_mut().dropped();
         let mut drained = false;
@@ -190,6 +224,8 @@ fn main() -> ! {
                     let health = watch.on_sample(now_s, s.t_s, s.rate_dph);
                     if health.resumed {
                         defmt::info!("t={} s: gyro samples again", s.t_s);
+                        // A stall mid-seek restarts the seek, with its reason.
+                        report(app.on_gyro_stall(s.t_s, health.gap_s));
                     }
                     match health.stuck_event {
                         Some(StuckEvent::Stuck) => {
@@ -273,7 +309,13 @@ fn main() -> ! {
                 flash_ok: server.slots_refused_at_boot() == 0,
             };
             app.set_bit(bit_monitor.evaluate(&counters));
-            let board = board_status(watch.last_t_s(), gyro.latest_temp(), server, reset_reason);
+            let board = board_status(
+                watch.last_t_s(),
+                gyro.latest_temp(),
+                server,
+                reset_reason,
+                faults,
+            );
             send_link(tx_queue, DeviceMessage::Status(app.status(board)));
         }
 
@@ -290,14 +332,22 @@ fn main() -> ! {
             }
             if let Some(cmd) = command {
                 let answer = app.command(cmd, watch.last_t_s());
-                let board =
-                    board_status(watch.last_t_s(), gyro.latest_temp(), server, reset_reason);
+                let board = board_status(
+                    watch.last_t_s(),
+                    gyro.latest_temp(),
+                    server,
+                    reset_reason,
+                    faults,
+                );
                 let status = DeviceMessage::Status(app.status(board));
                 for msg in answer.into_iter().chain(core::iter::once(status)) {
                     answer_link(server, tx_queue, msg);
                 }
             }
             if changed {
+                #[cfg(feature = "log-semihosting")]
+                semihosting::eprintln!("FOG-COMMITTED flash_writes={}", flash_file::writes());
+                clear_faults(&mut faults, "good upload");
                 swap_model(server, model, &mut app);
                 // The BIT's model item and the status follow at once.
                 next_status_s = now_s;
@@ -337,13 +387,28 @@ fn board_status(
     temp: Option<fog_core::hal::TempSample>,
     server: &Server,
     reset_reason: ResetReason,
+    faults: FaultState,
 ) -> BoardStatus {
     BoardStatus {
         t_s,
         temp_c: temp.map_or(f32::NAN, |t| t.temp_c),
         model_crc32: server.active_info().map(|i| i.model_crc32),
         reset_reason,
+        faults,
     }
+}
+
+/// A clean run or a good upload: the record's faults in a row are forgotten (the
+/// status shows it at once).
+fn clear_faults(faults: &mut FaultState, why: &str) {
+    if faults.faults_in_a_row == 0 {
+        return;
+    }
+    resets::clear_faults();
+    faults.faults_in_a_row = 0;
+    defmt::info!("faults in a row cleared: {}", why);
+    #[cfg(feature = "log-semihosting")]
+    semihosting::eprintln!("FOG-FAULTS cleared by {}", why);
 }
 
 /// A time-driven link message (status, result): queued whole if the TX queue has room,
@@ -403,18 +468,21 @@ where
 
 /// The boot line: why the previous run ended. Under QEMU also as plain text on the
 /// semihosting console, where the fault tests count boots.
-fn announce_boot(reset: &ResetRecord) {
+fn announce_boot(record: &FaultRecord) {
+    let reset = record.reset;
     defmt::info!(
-        "fog-app: boot {} after {} (detail {})",
+        "fog-app: boot {} after {} (detail {}), {} faults in a row",
         reset.boots,
         reset.cause,
-        reset.detail
+        reset.detail,
+        record.faults_in_a_row
     );
     #[cfg(feature = "log-semihosting")]
     semihosting::eprintln!(
-        "FOG-BOOT {} reset={:?} detail={}",
+        "FOG-BOOT {} reset={:?} faults_in_a_row={} detail={}",
         reset.boots,
         reset.cause,
+        record.faults_in_a_row,
         reset.detail
     );
 }
@@ -454,19 +522,13 @@ fn window_line(
     let _ = (w, frames_lost, bytes_dropped);
 }
 
-/// What the QEMU scenarios ask for (tests/tests/qemu_faults.rs) through semihosting
-/// arguments: `inject=panic`, `inject=hang` (no watchdog feed) or
-/// `inject=panic-after-commit` (first boot only), and `gyro-rate=N` (Hz: QEMU's serial
-/// backend cannot deliver the 24 kB/s of a 2 kHz gyro in real time). Hardware builds
-/// have no semihosting and use the defaults.
-#[derive(Clone, Copy, PartialEq)]
-enum Inject {
-    None,
-    Panic,
-    Hang,
-    PanicAfterCommit,
-}
-
+/// What the QEMU scenarios ask for through semihosting arguments
+/// (`fog_firmware::boot_args`; every one is listed in docs/firmware.md): faults to
+/// inject (first boot only), the gyro rate (QEMU's serial backend cannot deliver the
+/// 24 kB/s of a 2 kHz gyro in real time), the seek dwell, the simulated tilt and the
+/// power-cut point of the flash image. An argument the firmware does not know, or a
+/// value it cannot read, is refused with its name and QEMU exits with status 2.
+/// Hardware builds have no semihosting and use the defaults.
 #[derive(Clone, Copy)]
 struct TestOptions {
     inject: Inject,
@@ -477,34 +539,26 @@ struct TestOptions {
     seek_dwell_s: Option<u32>,
 }
 
+impl TestOptions {
+    fn injects(&self, fault: BootFault) -> bool {
+        self.inject == Inject::Boot(fault)
+    }
+}
+
 fn test_options(reset: &ResetRecord) -> TestOptions {
+    let args = boot_args();
     let mut o = TestOptions {
-        inject: Inject::None,
-        gyro_rate_hz: GYRO_RATE_HZ,
-        tilt: Tilt::LEVEL,
-        seek_dwell_s: None,
+        inject: args.inject,
+        gyro_rate_hz: args.gyro_rate_hz.unwrap_or(GYRO_RATE_HZ),
+        tilt: args.tilt_mdeg.map_or(Tilt::LEVEL, |(p, r)| Tilt {
+            pitch_deg: p as f32 / 1000.0,
+            roll_deg: r as f32 / 1000.0,
+        }),
+        seek_dwell_s: args.seek_dwell_s,
     };
     #[cfg(feature = "log-semihosting")]
-    if let Ok(args) = semi::Args::get() {
-        for i in 0..args.len() {
-            match args.str(i) {
-                Ok("inject=panic") => o.inject = Inject::Panic,
-                Ok("inject=hang") => o.inject = Inject::Hang,
-                Ok("inject=panic-after-commit") => o.inject = Inject::PanicAfterCommit,
-                Ok(a) => {
-                    if let Some(hz) = a.strip_prefix("gyro-rate=").and_then(|v| v.parse().ok()) {
-                        o.gyro_rate_hz = hz;
-                    }
-                    if let Some(d) = a.strip_prefix("seek-dwell-s=").and_then(|v| v.parse().ok()) {
-                        o.seek_dwell_s = Some(d);
-                    }
-                    if let Some(t) = a.strip_prefix("tilt-mdeg=").and_then(parse_tilt_mdeg) {
-                        o.tilt = t;
-                    }
-                }
-                Err(_) => {}
-            }
-        }
+    if let Some(n) = args.flash_cut_at {
+        flash_file::cut_at(n);
     }
     if reset.boots != 1 {
         o.inject = Inject::None;
@@ -512,15 +566,25 @@ fn test_options(reset: &ResetRecord) -> TestOptions {
     o
 }
 
-/// `PITCH:ROLL` in integer millidegrees (no float parsing code in the image).
+/// The program arguments, or a refusal naming the bad one (QEMU exits with status 2).
 #[cfg(feature = "log-semihosting")]
-fn parse_tilt_mdeg(v: &str) -> Option<Tilt> {
-    let (p, r) = v.split_once(':')?;
-    let (p, r): (i32, i32) = (p.parse().ok()?, r.parse().ok()?);
-    Some(Tilt {
-        pitch_deg: p as f32 / 1000.0,
-        roll_deg: r as f32 / 1000.0,
-    })
+fn boot_args() -> BootArgs {
+    let refuse = |what: &dyn core::fmt::Display| -> ! {
+        defmt::error!("firmware arguments refused");
+        semihosting::eprintln!("FOG-ARGS refused: {}", what);
+        semihosting::process::exit(2)
+    };
+    let args = semi::Args::get().unwrap_or_else(|e| refuse(&e));
+    let texts = (0..args.len()).map(|i| args.str(i).unwrap_or("<not UTF-8>"));
+    match fog_firmware::boot_args::parse(texts) {
+        Ok(a) => a,
+        Err(e) => refuse(&e),
+    }
+}
+
+#[cfg(not(feature = "log-semihosting"))]
+fn boot_args() -> BootArgs {
+    BootArgs::DEFAULT
 }
 
 fn inject_fault_at_boot(o: TestOptions) {
@@ -529,7 +593,10 @@ fn inject_fault_at_boot(o: TestOptions) {
         Inject::Hang => loop {
             cortex_m::asm::nop();
         },
-        Inject::None | Inject::PanicAfterCommit => {}
+        // An undefined instruction; UsageFault is not enabled, so it escalates to
+        // HardFault (`resets.rs`), which records the faulting address.
+        Inject::HardFault => cortex_m::asm::udf(),
+        Inject::None | Inject::PanicAfterCommit | Inject::Boot(_) => {}
     }
 }
 
@@ -548,7 +615,9 @@ fn report<E: defmt::Format>(step: fog_firmware::app::Step<E>) {
         }
     }
     if let Some(why) = step.restarted {
-        defmt::warn!("north seek restarted: base moved ({})", why);
+        defmt::warn!("north seek restarted: {}", why);
+        #[cfg(feature = "log-semihosting")]
+        semihosting::eprintln!("FOG-SEEK-RESTART reason={:?}", why);
     }
     match step.seek {
         Some(SeekOutcome::Done(r, _)) => defmt::info!(
@@ -570,9 +639,24 @@ fn report<E: defmt::Format>(step: fog_firmware::app::Step<E>) {
 type Server = UploadServer<flash::AppFlash>;
 
 /// The upload server, in a static (`upload_boot.rs` builds it).
-fn start_upload_server(flash: flash::AppFlash, reset: ResetRecord) -> &'static mut Server {
+fn start_upload_server(
+    flash: flash::AppFlash,
+    reset: ResetRecord,
+    options: TestOptions,
+) -> &'static mut Server {
+    if options.injects(BootFault::StoreGeometry) {
+        // Where the store's open fails (`upload_boot.rs`).
+        resets::fatal_boot(BootFault::StoreGeometry)
+    }
     let server = upload_boot::new_upload_server(flash, VERIFY_KEY, GYRO_ID, reset);
-    let Some(server) = cortex_m::singleton!(: Server = server) else {
+    keep_server(server, options)
+}
+
+/// Moves the server into its static (once).
+fn keep_server(server: Server, options: TestOptions) -> &'static mut Server {
+    let Some(server) =
+        cortex_m::singleton!(: Server = server).filter(|_| !options.injects(BootFault::Singleton))
+    else {
         resets::fatal_boot(BootFault::Singleton)
     };
     server

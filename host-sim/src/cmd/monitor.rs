@@ -150,14 +150,20 @@ fn bit_text(s: &Status) -> String {
 /// The progress bar's message.
 fn status_text(s: &Status) -> String {
     format!(
-        "{:?} | predicted 1-sigma {:.4} deg | {:.2} degC | tilt {:.2}/{:.2} deg | restarts {} | BIT {}",
+        "{:?} | predicted 1-sigma {:.4} deg | {:.2} degC | tilt {:.2}/{:.2} deg | restarts {} | BIT {} | {}{}",
         s.state,
         s.predicted_sigma_deg,
         s.temp_c,
         s.tilt.pitch_deg,
         s.tilt.roll_deg,
         s.restarts,
-        bit_text(s)
+        bit_text(s),
+        if s.heading_cal {
+            "heading cal"
+        } else {
+            "no heading cal"
+        },
+        fault_text(&s.faults)
     )
 }
 
@@ -165,7 +171,8 @@ fn status_text(s: &Status) -> String {
 pub fn status_line(s: &Status) -> String {
     format!(
         "t_s={:.1} state={} progress={:.3} predicted_sigma_deg={:.4} temp_c={:.2} latitude_deg={:.4} \
-         pitch_deg={:.3} roll_deg={:.3} restarts={} bit={} model_crc32={}",
+         pitch_deg={:.3} roll_deg={:.3} restarts={} bit={} model_crc32={} heading_cal={} \
+         faults_in_a_row={} safe_mode={}",
         s.t_s,
         format!("{:?}", s.state).replace(' ', ""),
         s.progress,
@@ -177,7 +184,10 @@ pub fn status_line(s: &Status) -> String {
         s.restarts,
         bit_text(s),
         s.model_crc32
-            .map_or("none".to_string(), |c| format!("0x{c:08X}"))
+            .map_or("none".to_string(), |c| format!("0x{c:08X}")),
+        s.heading_cal,
+        s.faults.faults_in_a_row,
+        s.faults.safe_mode
     )
 }
 
@@ -206,4 +216,18 @@ pub fn result_line(r: &SeekRecord) -> String {
         r.duration_s,
         r.t_end_s
     )
+}
+
+/// The status line's fault part: empty without faults in a row, else the count, the
+/// last cause and whether the device is in safe mode.
+fn fault_text(f: &fog_core::link::messages::FaultState) -> String {
+    match (f.safe_mode, f.faults_in_a_row) {
+        (false, 0) => String::new(),
+        (safe, n) => format!(
+            " | {}{n} faults in a row, last {:?} (detail {})",
+            if safe { "SAFE MODE: " } else { "" },
+            f.last_cause,
+            f.last_detail
+        ),
+    }
 }

@@ -158,6 +158,8 @@ mod tests {
             tilt: Tilt::LEVEL,
             restarts: 0,
             last_restart: None,
+            heading_cal: false,
+            faults: fog_core::link::messages::FaultState::NONE,
         }
     }
 

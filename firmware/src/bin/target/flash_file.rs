@@ -12,6 +12,7 @@
 //! Each outcome is logged, also as a plain `FOG-FLASH` line on the semihosting console.
 
 use core::ffi::CStr;
+use core::sync::atomic::{AtomicU32, Ordering};
 
 use embedded_storage::nor_flash::{NorFlash, ReadNorFlash};
 use fog_firmware::store::mirrored::{load_image, Backing, BackingFailed, ImageError};
@@ -27,8 +28,32 @@ const ARG_PREFIX: &str = "flash-file=";
 /// The flash image file, opened for reading and writing.
 pub struct HostImage(File);
 
+/// `flash-cut-at=N` (0: none): the N-th write to the image since boot is not made;
+/// the firmware says so on the console and waits to be killed, so a test cuts the power
+/// at a known point of an upload (tests/tests/qemu_power_cut.rs).
+static CUT_AT: AtomicU32 = AtomicU32::new(0);
+static WRITES: AtomicU32 = AtomicU32::new(0);
+
+/// Arms the power-cut point (`flash-cut-at=N`); call before the first write.
+pub fn cut_at(n: u32) {
+    CUT_AT.store(n, Ordering::Relaxed);
+}
+
+/// Writes made to the image since boot.
+pub fn writes() -> u32 {
+    WRITES.load(Ordering::Relaxed)
+}
+
 impl Backing for HostImage {
     fn write_at(&mut self, offset: u32, bytes: &[u8]) -> Result<(), BackingFailed> {
+        let n = WRITES.fetch_add(1, Ordering::Relaxed) + 1;
+        if n == CUT_AT.load(Ordering::Relaxed) {
+            semihosting::eprintln!("FOG-FLASH-CUT write={} offset={}", n, offset);
+            // Powerless from here: only the watchdog is kept quiet until the kill.
+            loop {
+                crate::watchdog::feed();
+            }
+        }
         self.0
             .seek(SeekFrom::Start(u64::from(offset)))
             .map_err(|_| BackingFailed)?;

@@ -19,16 +19,29 @@ pub fn new_upload_server<F: NorFlash>(
     gyro_id: &str,
     reset: ResetRecord,
 ) -> UploadServer<F> {
+    try_new_upload_server(flash, verify_key, gyro_id, reset)
+        .unwrap_or_else(|fault| resets::fatal_boot(fault))
+}
+
+/// `new_upload_server` that returns the fatal boot error instead of resetting (safe
+/// mode runs on without a store rather than reset again).
+#[inline(never)]
+pub fn try_new_upload_server<F: NorFlash>(
+    flash: F,
+    verify_key: [u8; 32],
+    gyro_id: &str,
+    reset: ResetRecord,
+) -> Result<UploadServer<F>, BootFault> {
     let Ok(gyro_id) = heapless::String::try_from(gyro_id) else {
-        resets::fatal_boot(BootFault::Configuration)
+        return Err(BootFault::Configuration);
     };
     let mut server = match UploadServer::new(flash, 0, verify_key, gyro_id) {
         Ok(s) => s,
         Err(e) => {
             defmt::error!("model store unusable: {}", e);
-            resets::fatal_boot(BootFault::StoreGeometry)
+            return Err(BootFault::StoreGeometry);
         }
     };
     server.set_reset_record(reset);
-    server
+    Ok(server)
 }

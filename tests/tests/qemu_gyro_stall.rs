@@ -1,0 +1,164 @@
+//! QEMU scenario (issue 17 item 6): the gyro link stalls in the middle of a north seek.
+//!
+//! `fog-app` runs a two-position seek (started by `Command::StartSeek` over the host
+//! link, turntable simulated on UART2) while a simulated FOG streams frames on UART1 at
+//! `RATE_HZ` of sample time, `SPEED` times faster than real time. One window into the
+//! seek the link goes dead for `STALL_FRAMES` frames (the gyro keeps sampling, so its
+//! frame counter jumps), then frames come again. Checked:
+//! - the time base stays exact: every window ends on the 10 s grid of sample time, none
+//!   is skipped or shifted, and the window holding the stall has exactly the samples
+//!   that arrived (`10 s * RATE_HZ - STALL_FRAMES`);
+//! - the losses are counted: `frames_lost` is exactly `STALL_FRAMES`, and that window is
+//!   invalid (`SensorFault`, never a compensated value with a hole in it);
+//! - the seek restarts from its first position with its reason, on the console
+//!   (`FOG-SEEK-RESTART reason=GyroStall { gap_ms }`) and in the link status
+//!   (`restarts`, `last_restart`), where `gap_ms` is the sample time between the samples
+//!   around the stall.
+//!
+//! Skips loudly without QEMU / the target unless FOG_REQUIRE_QEMU=1. Every wait is
+//! bounded; QEMU is killed when the test ends.
+
+mod qemu_support;
+mod upload_support;
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use fog_core::link::messages::{Command, DeviceMessage};
+use fog_core::seeking::quality::{MotionReason, SeekState};
+use fog_core::seeking::tilt::{earth_rate_on_axis_dph, Tilt};
+use fog_sim::upload::UploadClient;
+use fog_tests::console::{wait_line, wait_line_where};
+use fog_tests::qemu_ready;
+use qemu_support::*;
+use upload_support::*;
+
+const RATE_HZ: u32 = 20;
+const SPEED: f64 = 10.0;
+/// Frames the stall loses: 5 s of sample time, fewer than one counter wrap (256), so
+/// the count is exact even though the frames arrive faster than real time (the clock
+/// recovery of whole wraps is tested in drivers_gyro.rs).
+const STALL_FRAMES: u64 = 100;
+const WAIT: Duration = Duration::from_secs(30);
+
+/// `key=value` of a console line, as a number.
+fn field(line: &str, key: &str) -> u64 {
+    line.split_whitespace()
+        .find_map(|w| w.strip_prefix(key)?.strip_prefix('='))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no {key}= in {line:?}"))
+}
+
+#[test]
+fn qemu_gyro_stall_mid_seek_keeps_time_counts_losses_and_restarts_with_reason() {
+    if !qemu_ready("qemu_gyro_stall") {
+        return;
+    }
+    let args = [
+        format!("gyro-rate={RATE_HZ}"),
+        "seek-dwell-s=60".to_string(),
+    ];
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (_qemu, mut streams, console) = start(&args, 3);
+    let table_link = streams.pop().unwrap();
+    let gyro_link = streams.pop().unwrap();
+    let mut host = polled(streams.pop().unwrap());
+    wait_boot(&console, 1, "PowerOn");
+
+    let heading: Heading = Arc::new(Mutex::new(0.0));
+    let stop = Arc::new(AtomicBool::new(false));
+    let stall = Arc::new(Stall {
+        frames: STALL_FRAMES,
+        ..Stall::default()
+    });
+    let table = {
+        let (h, s) = (heading.clone(), stop.clone());
+        std::thread::spawn(move || serve_table(table_link, h, s))
+    };
+    let gyro = {
+        let (h, s, st) = (heading.clone(), stop.clone(), stall.clone());
+        let noise =
+            rand_distr::Normal::new(0.0, 0.0011 * 60.0 * f64::from(RATE_HZ).sqrt()).unwrap();
+        let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(17);
+        std::thread::spawn(move || {
+            stream_gyro_frames_with_stall(gyro_link, RATE_HZ, SPEED, &s, &st, |_| {
+                earth_rate_on_axis_dph(40.0, 108.4, Tilt::LEVEL, *h.lock().unwrap())
+                    + rand_distr::Distribution::sample(&noise, &mut rng)
+            })
+        })
+    };
+
+    let bytes = encode(&sample_model(QEMU_GYRO, 8, 1.0));
+    UploadClient::new(host.try_clone().unwrap(), Duration::from_secs(10))
+        .upload(&bytes, 1, &sign_for_gyro(1, QEMU_GYRO, &bytes), |_, _| {})
+        .expect("upload");
+    wait_line_where(&console, "FOG-WINDOW", WAIT, |l| l.contains("status=Valid"));
+    assert_eq!(
+        link_command(&mut host, Command::SetLatitude { latitude_deg: 40.0 }, WAIT),
+        DeviceMessage::Accepted
+    );
+    assert_eq!(
+        link_command(&mut host, Command::StartSeek { positions: 2 }, WAIT),
+        DeviceMessage::Accepted
+    );
+    // One window into the seek, the link stalls (20 frames = 1 s later).
+    let before = wait_line(&console, "FOG-WINDOW", WAIT);
+    let stall_from = stall.next.load(Ordering::Relaxed) + 20;
+    stall.from.store(stall_from, Ordering::Relaxed);
+    let restart = wait_line(&console, "FOG-SEEK-RESTART", WAIT);
+    let gap_ms = (STALL_FRAMES + 1) * 1000 / u64::from(RATE_HZ);
+    assert_eq!(
+        restart,
+        format!("FOG-SEEK-RESTART reason=GyroStall {{ gap_ms: {gap_ms} }}")
+    );
+    // The windows around the stall: on the grid, the hole counted, exactly.
+    let mut windows = vec![before];
+    while windows.len() < 4 {
+        windows.push(wait_line(&console, "FOG-WINDOW", WAIT));
+    }
+    eprintln!("stall from frame {stall_from}: {windows:#?}");
+    let ends: Vec<u64> = windows.iter().map(|w| field(w, "t_end_ms")).collect();
+    for (pair, w) in ends.windows(2).zip(&windows[1..]) {
+        assert_eq!(
+            pair[1] - pair[0],
+            10_000,
+            "a window skipped or shifted: {w}"
+        );
+    }
+    let per_window = 10 * u64::from(RATE_HZ);
+    let stalled: Vec<&String> = windows
+        .iter()
+        .filter(|w| field(w, "n_samples") < per_window - 1)
+        .collect();
+    let [hole] = stalled.as_slice() else {
+        panic!("one window holds the stall: {windows:#?}")
+    };
+    assert_eq!(
+        field(hole, "n_samples"),
+        per_window - STALL_FRAMES,
+        "{hole}"
+    );
+    assert!(hole.contains("status=SensorFault valid=false"), "{hole}");
+    let last = windows.last().unwrap();
+    assert_eq!(field(last, "frames_lost"), STALL_FRAMES, "{last}");
+    assert_eq!(field(last, "gyro_bytes_dropped"), 0, "{last}");
+    // The status: seeking again, one restart, and why.
+    let s = wait_status(&mut host, WAIT, |s| s.restarts > 0);
+    assert_eq!(s.state, SeekState::Seeking, "{s:?}");
+    assert_eq!(
+        (s.restarts, s.last_restart),
+        (
+            1,
+            Some(MotionReason::GyroStall {
+                gap_ms: gap_ms as u32
+            })
+        )
+    );
+    assert_eq!(
+        link_command(&mut host, Command::Abort, WAIT),
+        DeviceMessage::Accepted
+    );
+    stop.store(true, Ordering::Relaxed);
+    let _ = (gyro.join(), table.join());
+}
