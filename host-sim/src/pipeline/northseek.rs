@@ -15,17 +15,17 @@
 //! same seeds with the model but without the tilt (`tilt_uncompensated`). With
 //! `heading_bias_dph` != 0 the gyro has a bias A cos(alpha) of its input axis azimuth; the
 //! heading harmonic is first calibrated over 8 headings on a warm, level gyro at the known
-//! azimuth (`fog_core::heading_cal`), applied in the compensated arm, and a fourth arm runs
+//! azimuth (`fog_core::seeking::heading_cal`), applied in the compensated arm, and a fourth arm runs
 //! without it (`heading_uncalibrated`).
 
 use anyhow::{anyhow, bail, Context, Result};
-use fog_core::compensator::{Compensator, CompensatorConfig};
+use fog_core::compensation::compensator::{Compensator, CompensatorConfig};
 use fog_core::consts::earth_rate_horizontal_dph;
 use fog_core::hal::{GyroSample, TempSample};
-use fog_core::heading_cal::{calibrate, HeadingDwell, HeadingHarmonic};
-use fog_core::model::RbfModel;
-use fog_core::northfinder::{NorthFinder, SeekConfig, SeekMode, SeekStatus};
-use fog_core::tilt::Tilt;
+use fog_core::model::format::RbfModel;
+use fog_core::seeking::heading_cal::{calibrate, HeadingDwell, HeadingHarmonic};
+use fog_core::seeking::northfinder::{NorthFinder, SeekConfig, SeekMode, SeekStatus};
+use fog_core::seeking::tilt::Tilt;
 use serde::Serialize;
 
 use crate::report::{NorthSeekReport, SeekStats, Table};
@@ -118,18 +118,21 @@ impl MonteCarloConfig {
         }
         if !self.latitude_deg.is_finite() || self.latitude_deg.abs() > 90.0 {
             bail!(
-                "--latitude {}: must be within -90..=90 deg",
+                "--latitude-deg {}: must be within -90..=90 deg",
                 self.latitude_deg
             );
         }
         if self.latitude_deg.abs() >= 85.0 {
-            bail!("--latitude {}: north seeking needs |latitude| < 85 deg (horizontal Earth rate too small)", self.latitude_deg);
+            bail!("--latitude-deg {}: north seeking needs |latitude| < 85 deg (horizontal Earth rate too small)", self.latitude_deg);
         }
         if !self.true_azimuth_deg.is_finite() {
-            bail!("--azimuth: must be a finite angle in degrees");
+            bail!("--azimuth-deg: must be a finite angle in degrees");
         }
         if !(self.dwell_s.is_finite() && self.dwell_s >= 10.0) {
-            bail!("--dwell {}: must be at least one 10 s window", self.dwell_s);
+            bail!(
+                "--dwell-s {}: must be at least one 10 s window",
+                self.dwell_s
+            );
         }
         if self.threads == 0 {
             bail!("--threads: must be at least 1");

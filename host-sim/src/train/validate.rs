@@ -18,7 +18,7 @@ use super::gram::FoldGrams;
 use super::normalize::Normalizer;
 use crate::fanout::{map_in_order, thread_count};
 pub use crate::stats::rms;
-use fog_core::model::WIDTH_RANGE;
+use fog_core::model::format::WIDTH_RANGE;
 use serde::Serialize;
 use std::time::Instant;
 
