@@ -49,8 +49,9 @@ fn check(hidden: Hidden, named_required: bool) {
                     let table = harmonic.map(|x| {
                         format!("heading_deg:run_harmonic gain {:+.1}% fw p {:.4} perm p {:.4}", x.gain_pct, x.p_value, x.permutation_p)
                     });
+                    let levels = r.base.levels.as_ref().map(|l| format!("{} {:?} {:.4}+/-{:.4} (best {} {:.4})", l.base, l.law, l.score.heldout_rms_dph, l.score.standard_error_dph, l.best, l.best_heldout_rms_dph));
                     let line = format!(
-                        "{hidden:?} seed {seed}: {table:?}; base {}, repeatability {:.4} deg/h, named between {named:?} within {within:?}; {heading:?}; {top:?}",
+                        "{hidden:?} seed {seed}: {table:?}; base {}, levels {levels:?}, repeatability {:.4} deg/h, named between {named:?} within {within:?}; {heading:?}; {top:?}",
                         r.base.name, b.turn_on_repeatability_dph
                     );
                     (ok, line)

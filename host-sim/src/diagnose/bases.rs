@@ -7,6 +7,7 @@
 
 use super::cv::{CvResult, Folds, Prepared};
 use super::error::DiagnoseError;
+use super::levels::{score, Law, LevelSystems, Score};
 use super::models::{fit_rbf, Stacked, RIDGES};
 use serde::Serialize;
 
@@ -76,7 +77,57 @@ impl BaseFit {
 pub struct BaseScore {
     #[serde(flatten)]
     pub spec: BaseSpec,
+    /// Within runs (free offsets, residual about each held-out run's mean).
     pub heldout_rms_dph: f64,
+    /// Its standard error over the validation units.
+    pub heldout_se_dph: f64,
+    /// Absolute held-out scores (levels included) of the law shared across runs and of
+    /// free offsets (`levels`; empty when runs are too few to hold out whole).
+    pub levels: Vec<LevelScore>,
+}
+
+/// One level treatment's absolute held-out score.
+#[derive(Clone, Debug, Serialize)]
+pub struct LevelScore {
+    pub law: Law,
+    #[serde(flatten)]
+    pub score: Score,
+    /// Law columns plus level parameters (1 shared intercept, or one offset per run).
+    pub parameters: usize,
+    /// Offsets the law fitted on every run leaves (per run), deg/h.
+    #[serde(skip)]
+    pub offsets_left: Vec<f64>,
+    /// Run-level standard deviation left by the shared law (the turn-on repeatability as
+    /// a variance component), deg/h; NaN for free offsets.
+    pub sigma_u_dph: f64,
+    /// Quasi-demeaning of the shared law, chosen on held-out runs (1 for free offsets).
+    pub theta: f64,
+    /// The law's per-run sums (between-run candidates are refitted inside it).
+    #[serde(skip)]
+    pub systems: Option<std::sync::Arc<LevelSystems>>,
+}
+
+/// Which base and level treatment holds across runs (`levels`), chosen on held-out runs
+/// by the one-standard-error rule.
+#[derive(Clone, Debug, Serialize)]
+pub struct LevelChoice {
+    pub base: String,
+    pub law: Law,
+    #[serde(flatten)]
+    pub score: Score,
+    /// Best absolute held-out rms over every base and treatment, and its standard error.
+    pub best_heldout_rms_dph: f64,
+    pub best_standard_error_dph: f64,
+    pub best: String,
+    /// Offsets the chosen law leaves (per run), deg/h: the between-run stage's data.
+    #[serde(skip)]
+    pub offsets_left: Vec<f64>,
+    /// Turn-on repeatability, deg/h: the variance component of the shared law, else the
+    /// spread of the free offsets about their mean.
+    pub repeatability_dph: f64,
+    pub theta: f64,
+    #[serde(skip)]
+    pub systems: Option<std::sync::Arc<LevelSystems>>,
 }
 
 /// The chosen base, every score, and the collinearity warning if any.
@@ -85,6 +136,8 @@ pub struct BaseChoice {
     pub chosen: BaseFit,
     pub scores: Vec<BaseScore>,
     pub collinearity_warning: Option<String>,
+    /// The level treatment (None for time-block layouts: runs are not held out whole).
+    pub levels: Option<LevelChoice>,
 }
 
 /// Significance (paired sign flips over validation units) a dT/dt window other than the
@@ -249,18 +302,117 @@ pub fn choose(folds: &Folds, st: &Stacked) -> Result<BaseChoice, DiagnoseError> 
         .min_by(|a, b| a.cv.rms().total_cmp(&b.cv.rms()))
         .ok_or(DiagnoseError::Singular { what: "every base" })?
         .clone();
-    let scores = fits
+    let scores: Vec<BaseScore> = fits
         .iter()
         .map(|f| BaseScore {
             spec: f.spec.clone(),
             heldout_rms_dph: f.cv.rms(),
+            heldout_se_dph: unit_score(folds, &f.cv).standard_error_dph,
+            levels: level_scores(folds, st, f),
         })
         .collect();
     Ok(BaseChoice {
+        levels: choose_levels(&scores, &chosen.spec.name),
         chosen,
         scores,
         collinearity_warning: ramp_warning(folds, st),
     })
+}
+
+/// The within-run held-out score with its standard error over validation units.
+fn unit_score(folds: &Folds, cv: &CvResult) -> Score {
+    let pts: Vec<f64> = folds.unit_rows.iter().map(|r| r.len() as f64).collect();
+    score(&cv.unit_sse, &pts)
+}
+
+/// Both level treatments of one base, scored leaving one run out (run-grouped layouts).
+fn level_scores(folds: &Folds, st: &Stacked, f: &BaseFit) -> Vec<LevelScore> {
+    if folds.offsets != super::cv::Offsets::PerUnit {
+        return vec![];
+    }
+    let cols = f.raw_columns(st);
+    let lv = std::sync::Arc::new(LevelSystems::new(&folds.run_rows, &cols, &st.y, f.ridge));
+    let pts = lv.run_points();
+    let all = vec![1.0; lv.runs()];
+    let mut out = Vec::new();
+    if let Some((sse, fit)) = lv
+        .heldout_shared()
+        .and_then(|(sse, th)| Some((sse, lv.solve_shared(&all, th)?)))
+    {
+        out.push(LevelScore {
+            law: Law::Shared,
+            score: score(&sse, &pts),
+            parameters: cols.len() + 1,
+            offsets_left: lv.offsets_left(&fit.w),
+            sigma_u_dph: fit.sigma_u_dph,
+            theta: fit.theta,
+            systems: Some(lv.clone()),
+        });
+    }
+    if let (Some(sse), Some(w)) = (lv.heldout_free(), lv.solve_free(&all)) {
+        out.push(LevelScore {
+            law: Law::Free,
+            score: score(&sse, &pts),
+            parameters: cols.len() + lv.runs(),
+            offsets_left: lv.offsets_left(&w),
+            sigma_u_dph: f64::NAN,
+            theta: 1.0,
+            systems: None,
+        });
+    }
+    out
+}
+
+/// For the chosen base (`chosen`, the within-run law): the simpler level treatment
+/// (fewer parameters: the shared law) when its absolute held-out rms is within one
+/// standard error of the better of the two, else free offsets. (Choosing over every
+/// base by absolute score was tried: the level part is a small share of the absolute
+/// error, so the one-standard-error rule then picked laws too simple for the levels,
+/// e.g. T alone, leaving temperature in the offsets.)
+fn choose_levels(scores: &[BaseScore], chosen: &str) -> Option<LevelChoice> {
+    let all: Vec<(&BaseScore, &LevelScore)> = scores
+        .iter()
+        .filter(|b| b.spec.name == chosen)
+        .flat_map(|b| b.levels.iter().map(move |l| (b, l)))
+        .filter(|(_, l)| l.score.heldout_rms_dph.is_finite())
+        .collect();
+    let best = all
+        .iter()
+        .min_by(|a, b| a.1.score.heldout_rms_dph.total_cmp(&b.1.score.heldout_rms_dph))?;
+    let limit = best.1.score.heldout_rms_dph + best.1.score.standard_error_dph.max(0.0);
+    let (b, l) = all
+        .iter()
+        .filter(|(_, l)| l.score.heldout_rms_dph <= limit)
+        .min_by_key(|(_, l)| l.parameters)?;
+    let repeatability_dph = match l.law {
+        Law::Shared => l.sigma_u_dph,
+        Law::Free => {
+            let m = l.offsets_left.iter().sum::<f64>() / l.offsets_left.len().max(1) as f64;
+            (l.offsets_left.iter().map(|o| (o - m).powi(2)).sum::<f64>()
+                / (l.offsets_left.len().max(2) - 1) as f64)
+                .sqrt()
+        }
+    };
+    Some(LevelChoice {
+        base: b.spec.name.clone(),
+        law: l.law,
+        score: l.score,
+        best_heldout_rms_dph: best.1.score.heldout_rms_dph,
+        best_standard_error_dph: best.1.score.standard_error_dph,
+        best: format!("{} ({})", best.0.spec.name, law_name(best.1.law)),
+        offsets_left: l.offsets_left.clone(),
+        repeatability_dph,
+        theta: l.theta,
+        systems: l.systems.clone(),
+    })
+}
+
+/// "shared law" / "free offsets", for the report.
+pub fn law_name(law: Law) -> &'static str {
+    match law {
+        Law::Shared => "one law across runs + random turn-on offset",
+        Law::Free => "free run offsets",
+    }
 }
 
 fn correlation(a: &[f64], b: &[f64]) -> f64 {

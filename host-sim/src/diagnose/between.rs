@@ -70,8 +70,14 @@ pub struct HeadingEffect {
 /// The between-run analysis.
 #[derive(Clone, Debug, Serialize)]
 pub struct BetweenRun {
-    /// rms of the run offsets about their leave-one-out mean, deg/h.
+    /// Turn-on repeatability, deg/h: the run-level variance component of the law shared
+    /// across runs when that law holds (`levels`), else the rms of the free run offsets
+    /// about their leave-one-out mean.
     pub turn_on_repeatability_dph: f64,
+    /// rms of the offsets the chosen law leaves about their leave-one-out mean, deg/h.
+    pub offsets_heldout_rms_dph: f64,
+    /// What the offsets are left by: the chosen base and level treatment.
+    pub offsets_from: String,
     pub rows: Vec<RunRow>,
     /// Label of the named run-level effect, if any.
     pub named: Option<String>,
@@ -263,6 +269,8 @@ pub fn heading_effect(column: &str, coef: &[f64], latitude_deg: f64) -> HeadingE
 /// (p-values filled in later by `finish`).
 pub struct Prepared {
     pub offsets: Vec<f64>,
+    pub offsets_from: String,
+    pub offsets_rms_dph: f64,
     pub cands: Vec<RunCandidate>,
     pub gains: Vec<Vec<f64>>,
     pub rows: Vec<RunRow>,
@@ -275,28 +283,54 @@ pub fn prepare(
     folds: &Folds,
     st: &Stacked,
     base: &BaseFit,
+    levels: Option<&super::bases::LevelChoice>,
 ) -> Result<Prepared, String> {
     if folds.offsets != super::cv::Offsets::PerUnit {
         return Err("between-run effects need >= 4 runs held out whole".into());
     }
-    let offsets = run_offsets(folds, st, base);
+    let (offsets, offsets_from) = match levels {
+        Some(l) => (
+            l.offsets_left.clone(),
+            format!("{} ({})", l.base, super::bases::law_name(l.law)),
+        ),
+        None => (
+            run_offsets(folds, st, base),
+            format!("{} (free run offsets)", base.spec.name),
+        ),
+    };
     let lens: Vec<usize> = folds.run_rows.iter().map(|r| r.len()).collect();
+    let offsets_rms_dph = loo_gains(&offsets, &lens, &vec![vec![]; offsets.len()])
+        .map_or(f64::NAN, |(_, r0, _)| r0);
     let mut out = Prepared {
-        repeatability_dph: 0.0,
+        repeatability_dph: levels.map_or(offsets_rms_dph, |l| l.repeatability_dph),
+        offsets_rms_dph,
+        offsets_from,
         offsets,
         cands: vec![],
         gains: vec![],
         rows: vec![],
     };
+    let shared = levels
+        .filter(|l| l.law == super::levels::Law::Shared)
+        .and_then(|l| Some((l.systems.clone()?, l.theta)));
+    let base_errors = shared
+        .as_ref()
+        .and_then(|(lv, th)| lv.heldout_level_errors(*th));
     for cand in enumerate(c) {
         if cand.features[0].len() + 2 >= out.offsets.len() {
             continue;
         }
-        let Some((g, rms0, rms1)) = loo_gains(&out.offsets, &lens, &cand.features) else {
+        let all: Vec<usize> = (0..out.offsets.len()).collect();
+        let scored = match (&shared, &base_errors) {
+            (Some((lv, th)), Some(e0)) => inside_law(lv, *th, e0, &lens, &cand.features),
+            _ => loo_gains(&out.offsets, &lens, &cand.features).map(|(g, r0, r1)| {
+                let coef = fit(&out.offsets, &cand.features, &all).unwrap_or_default();
+                (g, r0, r1, coef)
+            }),
+        };
+        let Some((g, rms0, rms1, coef)) = scored else {
             continue;
         };
-        let all: Vec<usize> = (0..out.offsets.len()).collect();
-        out.repeatability_dph = rms0;
         out.rows.push(RunRow {
             label: cand.label.clone(),
             heldout_offset_rms_dph: rms1,
@@ -304,12 +338,38 @@ pub fn prepare(
             p_value: 1.0,
             permutation_p: permutation_p(&out.offsets, &lens, &cand.features),
             significant: false,
-            coef: fit(&out.offsets, &cand.features, &all).unwrap_or_default(),
+            coef,
         });
         out.gains.push(g);
         out.cands.push(cand);
     }
     Ok(out)
+}
+
+/// A run-level candidate refitted inside the shared law (`lv` at `theta`), leaving one
+/// run out: per-run gains (points x drop in squared level error), the level rms without
+/// and with it (`e0`: the law's own held-out level errors), and the coefficients fitted
+/// on every run (the law's intercept first, then the candidate's).
+fn inside_law(
+    lv: &super::levels::LevelSystems,
+    theta: f64,
+    e0: &[f64],
+    lens: &[usize],
+    features: &[Vec<f64>],
+) -> Option<(Vec<f64>, f64, f64, Vec<f64>)> {
+    let with = lv.with_run_features(features);
+    let e1 = with.heldout_level_errors(theta)?;
+    let gains = lens
+        .iter()
+        .zip(e0.iter().zip(&e1))
+        .map(|(&n, (a, b))| n as f64 * (a * a - b * b))
+        .collect();
+    let rms = |e: &[f64]| (e.iter().map(|v| v * v).sum::<f64>() / e.len().max(1) as f64).sqrt();
+    let w = with.solve_shared(&vec![1.0; lens.len()], theta)?.w;
+    let k = features.first().map_or(0, Vec::len);
+    let mut coef = vec![w[0]];
+    coef.extend_from_slice(&w[w.len() - k..]);
+    Some((gains, rms(e0), rms(&e1), coef))
 }
 
 /// Fills in the family-wise p-values and names the best significant run-level effect.
@@ -332,6 +392,8 @@ pub fn finish(p: Prepared, family_p: &[f64], latitude_deg: f64) -> BetweenRun {
     rows.sort_by(|a, b| b.gain_pct.total_cmp(&a.gain_pct));
     BetweenRun {
         turn_on_repeatability_dph: p.repeatability_dph,
+        offsets_heldout_rms_dph: p.offsets_rms_dph,
+        offsets_from: p.offsets_from,
         rows,
         named,
         heading,

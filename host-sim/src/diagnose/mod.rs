@@ -25,6 +25,7 @@ pub mod cv;
 pub mod derivatives;
 pub mod error;
 pub mod input;
+pub mod levels;
 pub mod linalg;
 pub mod models;
 pub mod olscheck;
@@ -94,7 +95,7 @@ pub fn diagnose_with(runs: &[Run], rule: buffer::BufferRule) -> Result<Diagnosis
         .iter()
         .find_map(|s| s.latitude_deg)
         .unwrap_or(azimuth::DEFAULT_LATITUDE_DEG);
-    let (screening, between_run) = screen_both(&campaign, &folds, &st, base, latitude)?;
+    let (screening, between_run) = screen_both(&campaign, &folds, &st, &choice, latitude)?;
     let named = screening.named.map(|i| &screening.scored[i]);
     let cause = named.map(|s| Cause::from(&s.cand));
     let sim = simfit::calibrate(
@@ -208,10 +209,11 @@ fn screen_both(
     campaign: &input::Campaign,
     folds: &Folds,
     st: &Stacked,
-    base: &bases::BaseFit,
+    choice: &bases::BaseChoice,
     latitude_deg: f64,
 ) -> Result<(Screening, between::BetweenRun), DiagnoseError> {
-    let run_level = between::prepare(campaign, folds, st, base);
+    let base = &choice.chosen;
+    let run_level = between::prepare(campaign, folds, st, base, choice.levels.as_ref());
     let no_gains = Vec::new();
     let screening = screen::screen(
         campaign,
@@ -225,6 +227,8 @@ fn screen_both(
         Ok(p) => between::finish(p, &screening.between_p, latitude_deg),
         Err(note) => between::BetweenRun {
             turn_on_repeatability_dph: f64::NAN,
+            offsets_heldout_rms_dph: f64::NAN,
+            offsets_from: String::new(),
             rows: vec![],
             named: None,
             heading: None,
@@ -295,6 +299,7 @@ fn base_summary(
         ridge: base.ridge,
         tried: choice.scores.clone(),
         collinearity_warning: choice.collinearity_warning.clone(),
+        levels: choice.levels.clone(),
     }
 }
 

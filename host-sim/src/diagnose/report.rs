@@ -31,6 +31,9 @@ pub struct ModelSummary {
     pub tried: Vec<super::bases::BaseScore>,
     /// Set when T, time and lags of T are nearly collinear.
     pub collinearity_warning: Option<String>,
+    /// Which law holds across runs (shared with random turn-on offsets, or free offsets),
+    /// chosen on held-out runs (None for time-block layouts).
+    pub levels: Option<super::bases::LevelChoice>,
 }
 
 /// One ranked candidate.
@@ -244,7 +247,7 @@ fn write_baseline(s: &mut String, r: &Report) {
     let _ = writeln!(s, "\n1. Baseline");
     let _ = writeln!(
         s,
-        "  simulator calibrated by least squares: thermal tau {:.0} s / {:.0} s (temp rms {:.3} degC), bias {:.4} deg/h/degC, \
+        "  simulator calibrated by least squares: thermal tau {:.0} s / {:.0} s (median over runs) (temp rms {:.3} degC), bias {:.4} deg/h/degC, \
          Shupe {:.3} deg/h per degC/s, white noise {:.4} deg/h (10 s)",
         sim.tau_fast_s, sim.tau_slow_s, sim.temp_rms_c, sim.bias_dph_per_c, sim.shupe_dph_per_cps, sim.noise_10s_dph
     );
@@ -257,13 +260,14 @@ fn write_baseline(s: &mut String, r: &Report) {
         .base
         .tried
         .iter()
-        .map(|b| format!("{} {:.4}", b.spec.name, b.heldout_rms_dph))
+        .map(|b| format!("{} {:.4} +/- {:.4}", b.spec.name, b.heldout_rms_dph, b.heldout_se_dph))
         .collect();
     let _ = writeln!(
         s,
-        "  bases tried (held-out rms, deg/h; run offsets free): {}",
+        "  bases tried (held-out rms +/- standard error, deg/h; run offsets free): {}",
         tried.join(", ")
     );
+    write_levels(s, r);
     let _ = writeln!(
         s,
         "  chosen base {} ({}; dT/dt over +/-{:.0} s, actual +/-{:.0} s): held-out rms {:.4} deg/h; uncompensated drift std {:.4} deg/h; candidates are screened against it",
@@ -277,6 +281,50 @@ fn write_baseline(s: &mut String, r: &Report) {
     if let Some(w) = &r.base.collinearity_warning {
         let _ = writeln!(s, "  warning: {w}");
     }
+}
+
+/// The level treatments tried (absolute held-out rms, level included) and the choice.
+fn write_levels(s: &mut String, r: &Report) {
+    let Some(l) = &r.base.levels else {
+        return;
+    };
+    let tried: Vec<String> = r
+        .base
+        .tried
+        .iter()
+        .flat_map(|b| {
+            b.levels.iter().map(move |v| {
+                format!(
+                    "{}/{} {:.4} +/- {:.4}",
+                    b.spec.name,
+                    match v.law {
+                        super::levels::Law::Shared => "shared",
+                        super::levels::Law::Free => "free",
+                    },
+                    v.score.heldout_rms_dph,
+                    v.score.standard_error_dph
+                )
+            })
+        })
+        .collect();
+    let _ = writeln!(
+        s,
+        "  levels (absolute held-out rms of a run never seen, level included, +/- standard error, deg/h): {}",
+        tried.join(", ")
+    );
+    let _ = writeln!(
+        s,
+        "  levels chosen: {} ({}), {:.4} +/- {:.4} deg/h: the simplest within one standard error of the best, {} {:.4} +/- {:.4}; \
+         turn-on repeatability {:.4} deg/h",
+        l.base,
+        super::bases::law_name(l.law),
+        l.score.heldout_rms_dph,
+        l.score.standard_error_dph,
+        l.best,
+        l.best_heldout_rms_dph,
+        l.best_standard_error_dph,
+        l.repeatability_dph
+    );
 }
 
 /// Section 2: the base's held-out residual by time, ambient, signal; the outliers.
@@ -406,8 +454,8 @@ fn write_candidates(s: &mut String, r: &Report) {
     }
     let _ = writeln!(
         s,
-        "  between runs (run offsets left by the base; turn-on repeatability {:.4} deg/h, leave one run out; p in the same family):",
-        b.turn_on_repeatability_dph
+        "  between runs (run offsets left by {}: rms {:.4} deg/h about their leave-one-out mean; turn-on repeatability {:.4} deg/h; p in the same family):",
+        b.offsets_from, b.offsets_heldout_rms_dph, b.turn_on_repeatability_dph
     );
     for row in b.rows.iter().take(4) {
         let _ = writeln!(

@@ -237,6 +237,8 @@ fn row_spacing_s(folds: &Folds, t_s: &[f64]) -> f64 {
 }
 
 /// The calibrated simulator's linear stage with ranges, and the ratios to the simulator.
+/// With runs held out whole the law shared across runs is bootstrapped (whole runs
+/// redrawn, `simfit::fit_shared`), else the free-offset fit over time blocks.
 fn simulator_estimates(
     campaign: &Campaign,
     folds: &Folds,
@@ -244,27 +246,52 @@ fn simulator_estimates(
     named: Option<&NamedFeature<'_>>,
     counts: &[Vec<f64>],
 ) -> (Vec<Estimate>, Vec<Ratio>) {
-    let (cols, t_mean) = super::simfit::design_columns(campaign);
+    let (mut cols, t_mean) = super::simfit::design_columns(campaign);
+    let n_law = super::simfit::LAW_TERMS.len();
     let prepared = Prepared::new(folds, &cols, &st.y, 0.0);
     let extra: &[Vec<f64>] = named.map_or(&[], |n| n.cols);
-    let sys = prepared.unit_systems(folds, extra);
-    let p = prepared.width();
-    let mut names = vec![
-        ("bias_dph_per_c".to_owned(), "deg/h per degC"),
-        ("bias_dph_per_c2".to_owned(), "deg/h per degC^2"),
-        ("shupe_dph_per_cps".to_owned(), "deg/h per degC/s"),
-    ];
+    let mut names: Vec<(String, &str)> = super::simfit::LAW_TERMS
+        .iter()
+        .map(|(n, u)| ((*n).to_owned(), *u))
+        .collect();
     if let Some(n) = named {
         names.extend(
             (0..extra.len()).map(|k| (format!("{}[{k}]", n.label), "deg/h per feature unit")),
         );
     }
-    let summary = |w: &[f64]| -> Vec<f64> {
-        let mut v = w[..3].to_vec();
-        v.extend_from_slice(&w[p..]);
-        v
+    let sys = prepared.unit_systems(folds, extra);
+    let shared = (folds.offsets == Offsets::PerUnit
+        && folds.run_rows.len() >= super::simfit::MIN_RUNS_SHARED)
+        .then(|| {
+            cols.extend(extra.iter().cloned());
+            super::simfit::fit_shared(&folds.run_rows, &cols, &st.y)
+        })
+        .flatten();
+    let mut out = match shared {
+        Some((coef, _, lv, theta)) => {
+            let reps: Vec<Vec<f64>> = counts
+                .iter()
+                .filter_map(|c| lv.solve_shared(c, theta).map(|f| f.w[1..].to_vec()))
+                .collect();
+            names
+                .iter()
+                .enumerate()
+                .map(|(k, (name, unit))| {
+                    let r: Vec<f64> = reps.iter().map(|v| v[k]).collect();
+                    Estimate::new(name.clone(), unit, coef[k], &r)
+                })
+                .collect()
+        }
+        None => {
+            let p = prepared.width();
+            let summary = |w: &[f64]| -> Vec<f64> {
+                let mut v = w[..n_law].to_vec();
+                v.extend_from_slice(&w[p..]);
+                v
+            };
+            bootstrap(&sys, counts, &names, &summary)
+        }
     };
-    let mut out = bootstrap(&sys, counts, &names, &summary);
     if let Some(arw) = arw_estimate(folds, st, &prepared, &sys, counts) {
         out.push(arw);
     }
@@ -329,17 +356,16 @@ fn ratios_to_simulator(est: &[Estimate], t_mean_c: f64) -> Vec<Ratio> {
     let sim = crate::sim::GyroParams::paper_default();
     let d = &sim.drift;
     let sensitivity = d.bias_dph_per_c + 2.0 * d.bias_dph_per_c2 * (t_mean_c - d.bias_ref_c);
+    // The simulator's Shupe coefficient at the same temperature (its cold gain included).
+    let shupe =
+        d.shupe_dph_per_cps * (1.0 - d.shupe_cold_gain_per_k * (t_mean_c - d.bias_ref_c)).max(0.0);
     let pairs = [
         (
             "bias_dph_per_c",
             "temperature sensitivity at the mean T",
             sensitivity,
         ),
-        (
-            "shupe_dph_per_cps",
-            "Shupe coefficient",
-            d.shupe_dph_per_cps,
-        ),
+        ("shupe_dph_per_cps", "Shupe coefficient at the mean T", shupe),
         ("arw_from_row_noise", "ARW (row noise)", sim.noise.arw_dpsh),
     ];
     pairs
