@@ -6,5 +6,6 @@ pub mod campaign;
 pub mod campaign_steps;
 pub mod compensate;
 pub mod compensation_replay;
+pub mod heading_campaign;
 pub mod northseek;
 pub mod reproduce;
