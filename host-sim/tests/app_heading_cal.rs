@@ -248,18 +248,19 @@ fn bad_heading_runs_are_refused_naming_the_file_and_the_value() {
         text.replace("latitude_deg: 39.9", "latitude_deg: 95"),
     )
     .unwrap();
-    let o = fogsim(
-        &dir,
-        &[
+    let from = |runs: &str| {
+        let args = [
             "heading-cal",
             "--model",
             "model.bin",
             "--out",
             "x.bin",
             "--from-runs",
-            "bad",
-        ],
-    );
+            runs,
+        ];
+        fogsim(&dir, &args)
+    };
+    let o = from("bad");
     let err = stderr(&o);
     assert!(!o.status.success());
     assert!(
@@ -273,18 +274,7 @@ fn bad_heading_runs_are_refused_naming_the_file_and_the_value() {
         text.replace("heading_deg", "table_deg"),
     )
     .unwrap();
-    let o = fogsim(
-        &dir,
-        &[
-            "heading-cal",
-            "--model",
-            "model.bin",
-            "--out",
-            "x.bin",
-            "--from-runs",
-            "bad2",
-        ],
-    );
+    let o = from("bad2");
     assert!(
         stderr(&o).contains("bad2/r.csv: no heading_deg column"),
         "{}",

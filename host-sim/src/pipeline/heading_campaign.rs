@@ -4,8 +4,6 @@
 //! runs and `fogsim heading-cal --from-runs` can fit it. Every run has its own derived
 //! seed (ambient, heading, run), so the bytes never depend on the thread schedule.
 
-use std::path::PathBuf;
-
 use super::campaign::{CampaignError, CampaignRun, CampaignSpec};
 use crate::sim::{simulate_run, GyroParams};
 
@@ -74,14 +72,9 @@ pub fn simulate_heading_campaign(
     jobs.iter()
         .zip(results)
         .map(|(&(a, k, r), res)| {
-            let mut run = res.map_err(CampaignError::Sim)?;
-            run.path = PathBuf::from(file_name(spec, a, headings_deg[k], r));
-            run.set_meta("run", r + 1);
-            Ok(CampaignRun {
-                ambient_c: spec.ambients_c[a],
-                index: r + 1,
-                run,
-            })
+            let run = res.map_err(CampaignError::Sim)?;
+            let name = file_name(spec, a, headings_deg[k], r);
+            Ok(CampaignRun::named(spec, a, r, run, name))
         })
         .collect()
 }
