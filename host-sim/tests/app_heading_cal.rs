@@ -157,3 +157,127 @@ fn diagnoses_between_run_harmonic_is_attached_with_the_same_bias_at_every_azimut
     assert!(!out.status.success() && stderr(&out).contains("between_run.heading is null"));
     assert!(!dir.join("n.bin").exists());
 }
+
+/// `campaign --headings-deg` with a planted heading bias, then `heading-cal --from-runs`
+/// with a model of the same gyro: a and b come back within 3 of their reported sigmas
+/// (A cos(alpha): a = A, b = 0); the null twin (nothing planted) gives a harmonic
+/// compatible with zero; bad runs are refused naming the file and the value.
+#[test]
+fn a_and_b_are_fitted_from_runs_at_several_headings() {
+    let dir = scratch_dir("heading-cal-runs");
+    app_support::campaign_and_model(&dir, 3);
+    for (bias, tag) in [(0.05, "planted"), (0.0, "null")] {
+        let o = fogsim(
+            &dir,
+            &[
+                "campaign",
+                "--out",
+                tag,
+                "--ambient",
+                "20",
+                "--runs",
+                "1",
+                "--headings-deg",
+                "0,45,90,135,180,225,270,315",
+                "--heading-bias-dph",
+                &bias.to_string(),
+                "--seed",
+                "3",
+            ],
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        let out = format!("cal_{tag}.bin");
+        let o = fogsim(
+            &dir,
+            &[
+                "heading-cal",
+                "--model",
+                "model.bin",
+                "--out",
+                &out,
+                "--from-runs",
+                tag,
+            ],
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        let h = read(dir.join(&out)).heading.expect("a harmonic attached");
+        eprintln!(
+            "heading-cal --from-runs {tag}: a {:+.5} +- {:.5}, b {:+.5} +- {:.5} deg/h",
+            h.cos_dph, h.cos_sigma_dph, h.sin_dph, h.sin_sigma_dph
+        );
+        assert_eq!(h.n_headings, 8);
+        assert!(h.cos_sigma_dph > 0.0 && h.cos_sigma_dph < 0.02, "{h:?}");
+        assert!(
+            (f64::from(h.cos_dph) - bias).abs() < 3.0 * f64::from(h.cos_sigma_dph),
+            "{tag}: {h:?}"
+        );
+        assert!(
+            f64::from(h.sin_dph).abs() < 3.0 * f64::from(h.sin_sigma_dph),
+            "{tag}: {h:?}"
+        );
+    }
+}
+
+/// Runs without a heading, or at an impossible latitude: refused naming file and value.
+#[test]
+fn bad_heading_runs_are_refused_naming_the_file_and_the_value() {
+    let dir = scratch_dir("heading-cal-bad-runs");
+    app_support::campaign_and_model(&dir, 3);
+    let o = fogsim(
+        &dir,
+        &[
+            "campaign",
+            "--out",
+            "planted",
+            "--ambient",
+            "20",
+            "--runs",
+            "1",
+            "--minutes",
+            "10",
+            "--headings-deg",
+            "0,90,180,270",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    // A run without a heading, and one at an impossible latitude: file and value named.
+    std::fs::create_dir_all(dir.join("bad")).unwrap();
+    let text = std::fs::read_to_string(dir.join("planted/amb00_p020c_h000.0_run1.csv")).unwrap();
+    std::fs::write(
+        dir.join("bad/r.csv"),
+        text.replace("latitude_deg: 39.9", "latitude_deg: 95"),
+    )
+    .unwrap();
+    let from = |runs: &str| {
+        let args = [
+            "heading-cal",
+            "--model",
+            "model.bin",
+            "--out",
+            "x.bin",
+            "--from-runs",
+            runs,
+        ];
+        fogsim(&dir, &args)
+    };
+    let o = from("bad");
+    let err = stderr(&o);
+    assert!(!o.status.success());
+    assert!(
+        err.contains("bad/r.csv: latitude_deg 95.0000 is out of range"),
+        "{err}"
+    );
+    assert!(!dir.join("x.bin").exists());
+    std::fs::create_dir_all(dir.join("bad2")).unwrap();
+    std::fs::write(
+        dir.join("bad2/r.csv"),
+        text.replace("heading_deg", "table_deg"),
+    )
+    .unwrap();
+    let o = from("bad2");
+    assert!(
+        stderr(&o).contains("bad2/r.csv: no heading_deg column"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -184,9 +184,12 @@ fn compensate_and_train_reject_1e300_naming_the_place() {
         "# fog-runs v1\nt_s,rate_dph,temp_c\n10,0.1,20\n20,1e300,20.1\n",
     )
     .unwrap();
+    // Enough runs for grouped validation (fewer are refused before any row is read).
+    fs::write(dir.join("g1.csv"), GOOD_RUN).unwrap();
+    fs::write(dir.join("g2.csv"), GOOD_RUN).unwrap();
     refused(
         &dir,
-        &["train", "r.csv", "--out", "m.bin"],
+        &["train", "r.csv", "g1.csv", "g2.csv", "--out", "m.bin"],
         &["r.csv:4:2", "rate_dph"],
     );
     fs::write(dir.join("m.bin"), b"x").unwrap();

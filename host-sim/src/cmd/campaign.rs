@@ -4,6 +4,7 @@
 use crate::pipeline::campaign::{
     simulate_campaign, write_campaign, CampaignSpec, PAPER_AMBIENTS_C, PAPER_MINUTES, PAPER_RUNS,
 };
+use crate::pipeline::heading_campaign::{check_headings, simulate_heading_campaign};
 use crate::sim::{GyroParams, DEFAULT_LATITUDE_DEG};
 use anyhow::bail;
 use std::path::PathBuf;
@@ -33,6 +34,20 @@ pub struct Args {
     /// Raw gyro sample rate, Hz.
     #[arg(long, default_value_t = 100.0)]
     pub raw_rate_hz: f64,
+    /// Input axis horizontal at each of these azimuths, deg (comma separated): every
+    /// power-on is repeated at every heading (for `fogsim heading-cal --from-runs`).
+    /// Without it the input axis is vertical, as in the paper.
+    #[arg(long, visible_alias = "headings", value_delimiter = ',')]
+    pub headings_deg: Option<Vec<f64>>,
+    /// Plant a heading-dependent bias A cos(input axis azimuth), deg/h (needs
+    /// --headings-deg; -1..=1).
+    #[arg(
+        long,
+        default_value_t = 0.0,
+        allow_hyphen_values = true,
+        requires = "headings_deg"
+    )]
+    pub heading_bias_dph: f64,
 }
 
 impl Args {
@@ -83,12 +98,28 @@ impl Args {
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let spec = args.to_spec()?;
-    let runs = simulate_campaign(&GyroParams::paper_default(), &spec)?;
+    if !(args.heading_bias_dph.is_finite() && args.heading_bias_dph.abs() <= 1.0) {
+        bail!(
+            "--heading-bias-dph {:.4e}: must be within -1..=1 deg/h",
+            args.heading_bias_dph
+        );
+    }
+    let runs = match &args.headings_deg {
+        Some(h) => {
+            check_headings(h).map_err(|e| anyhow::anyhow!("--headings-deg: {e}"))?;
+            let params = GyroParams::paper_default().with_heading_bias(args.heading_bias_dph);
+            simulate_heading_campaign(&params, &spec, h)?
+        }
+        None => simulate_campaign(&GyroParams::paper_default(), &spec)?,
+    };
     let files = write_campaign(&args.out, &runs)?;
     println!(
-        "fogsim campaign: wrote {} runs ({} ambients x {} power-ons, {} min, seed {}) to {}",
+        "fogsim campaign: wrote {} runs ({} ambients x {}{} power-ons, {} min, seed {}) to {}",
         files.len(),
         spec.ambients_c.len(),
+        args.headings_deg
+            .as_ref()
+            .map_or(String::new(), |h| format!("{} headings x ", h.len())),
         spec.runs_per_ambient,
         spec.minutes,
         spec.seed,

@@ -1,5 +1,7 @@
 //! `fogsim heading-cal --model IN --out OUT (--a-dph A --b-dph B --sigma-dph S
-//! --n-headings N | --from-diagnose D.json)`: attaches a heading calibration to a model.
+//! --n-headings N | --from-diagnose D.json | --from-runs DIR)`: attaches a heading
+//! calibration to a model. `--from-runs` fits a and b with their 1-sigma from runs at
+//! several headings (`fog_sim::pipeline::heading_fit`).
 //!
 //! Exists because the heading harmonic of the bias, a cos(alpha) + b sin(alpha) of the
 //! input axis azimuth alpha, is the same harmonic as Earth rate (no seek can remove it) and
@@ -25,6 +27,9 @@ use serde::Deserialize;
 use super::check_output_file;
 use crate::io::model::read_model;
 use crate::io::{write_atomic, OutputGuard};
+use crate::pipeline::heading_fit::{fit_from_runs, short_number};
+use fog_core::model::format::MAX_HEADING_HARMONIC_DPH;
+use std::io::Read;
 
 /// The diagnose column that is the input axis azimuth (`diagnose::simterm`).
 const AZIMUTH_COLUMN: &str = "heading_deg";
@@ -51,9 +56,17 @@ pub struct Args {
     #[arg(long, requires = "a_dph")]
     pub n_headings: Option<u16>,
     /// `fogsim diagnose --json` output whose between-run heading harmonic to attach.
-    #[arg(long, required_unless_present = "a_dph")]
+    #[arg(long, required_unless_present_any = ["a_dph", "from_runs"], conflicts_with = "from_runs")]
     pub from_diagnose: Option<PathBuf>,
+    /// fog-runs files (or directories) recorded at several headings (`heading_deg`
+    /// column, `latitude_deg` metadata): a and b are fitted from them, compensated with
+    /// --model (e.g. `fogsim campaign --headings-deg 0,45,...`).
+    #[arg(long, num_args = 1.., conflicts_with = "a_dph")]
+    pub from_runs: Option<Vec<PathBuf>>,
 }
+
+/// Largest diagnose report read, bytes (a report of 10 000 runs is a few MB).
+pub const MAX_DIAGNOSE_JSON_BYTES: u64 = 64 << 20;
 
 /// The parts of diagnose's JSON this command reads (the rest is skipped while parsing).
 #[derive(Deserialize)]
@@ -90,9 +103,13 @@ struct RowJson {
 pub fn run(args: Args) -> anyhow::Result<()> {
     let mut inputs = vec![args.model.clone()];
     inputs.extend(args.from_diagnose.clone());
+    inputs.extend(args.from_runs.clone().unwrap_or_default());
     let guard = OutputGuard::new(&inputs);
     check_output_file(&guard, Some(&args.out), "--out")?;
     let harmonic = match (&args.from_diagnose, args.a_dph, args.b_dph, args.n_headings) {
+        (None, None, None, None) if args.from_runs.is_some() => {
+            from_runs(args.from_runs.as_deref().unwrap_or_default(), &args.model)?
+        }
         (Some(path), None, None, None) => from_diagnose(path, args.sigma_dph)?,
         (None, Some(a), Some(b), Some(n)) => {
             let sigma = args
@@ -108,7 +125,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             }
         }
         _ => bail!(
-            "give either --from-diagnose FILE, or --a-dph, --b-dph, --sigma-dph and --n-headings"
+            "give --from-runs DIR, --from-diagnose FILE, or --a-dph, --b-dph, --sigma-dph and --n-headings"
         ),
     };
     let mut model = read_model(&args.model)?;
@@ -138,16 +155,46 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The heading harmonic fitted from runs at several headings, printed dwell by dwell.
+fn from_runs(paths: &[PathBuf], model: &Path) -> anyhow::Result<HeadingHarmonic> {
+    let runs = crate::io::read_runs_binned(paths)?;
+    let model = read_model(model)?;
+    let fit = fit_from_runs(&runs, &model).context("--from-runs")?;
+    println!(
+        "{} runs at latitude {} deg; mean compensated rate per run (Earth rate included):",
+        fit.dwells.len(),
+        fit.latitude_deg
+    );
+    for d in &fit.dwells {
+        println!(
+            "  heading {:>7.2} deg  {:+.5} +- {:.5} deg/h  ({} windows)  {}",
+            d.heading_deg, d.mean_rate_dph, d.sigma_dph, d.windows, d.file
+        );
+    }
+    println!("constant bias b0 {:+.5} deg/h", fit.bias_dph);
+    Ok(fit.harmonic)
+}
+
 /// The between-run heading harmonic of a diagnose report as a `HeadingHarmonic`.
 fn from_diagnose(path: &Path, sigma_dph: Option<f32>) -> anyhow::Result<HeadingHarmonic> {
+    let len = std::fs::metadata(path)
+        .with_context(|| format!("--from-diagnose {}", path.display()))?
+        .len();
+    if len > MAX_DIAGNOSE_JSON_BYTES {
+        bail!(
+            "--from-diagnose {}: {len} bytes, more than the {MAX_DIAGNOSE_JSON_BYTES} a diagnose report can be",
+            path.display()
+        );
+    }
     let file =
         std::fs::File::open(path).with_context(|| format!("--from-diagnose {}", path.display()))?;
-    let d: DiagnoseJson = serde_json::from_reader(BufReader::new(file)).with_context(|| {
-        format!(
-            "--from-diagnose {}: not a `fogsim diagnose --json` report",
-            path.display()
-        )
-    })?;
+    let d: DiagnoseJson = serde_json::from_reader(BufReader::new(file).take(len + 1))
+        .with_context(|| {
+            format!(
+                "--from-diagnose {}: not a `fogsim diagnose --json` report",
+                path.display()
+            )
+        })?;
     harmonic_from_report(&d, sigma_dph)
         .with_context(|| format!("--from-diagnose {}", path.display()))
 }
@@ -166,11 +213,15 @@ fn harmonic_from_report(
             h.column
         );
     }
-    if !(h.amplitude_dph.is_finite() && h.amplitude_dph >= 0.0 && h.phase_deg.is_finite()) {
+    if !(h.amplitude_dph.is_finite()
+        && h.amplitude_dph >= 0.0
+        && h.amplitude_dph <= f64::from(MAX_HEADING_HARMONIC_DPH)
+        && h.phase_deg.is_finite())
+    {
         bail!(
-            "between_run.heading has amplitude {} deg/h, phase {} deg: not usable",
-            h.amplitude_dph,
-            h.phase_deg
+            "between_run.heading has amplitude {} deg/h, phase {} deg: not usable (amplitude must be within 0..={MAX_HEADING_HARMONIC_DPH})",
+            short_number(h.amplitude_dph),
+            short_number(h.phase_deg)
         );
     }
     let n_headings = u16::try_from(d.campaign.runs).unwrap_or(u16::MAX);

@@ -123,16 +123,23 @@ pub fn simulate_campaign(
     jobs.iter()
         .zip(results)
         .map(|(&(a, r), res)| {
-            let mut run = res.map_err(CampaignError::Sim)?;
-            run.path = PathBuf::from(spec.file_name(a, r));
-            run.set_meta("run", r + 1);
-            Ok(CampaignRun {
-                ambient_c: spec.ambients_c[a],
-                index: r + 1,
-                run,
-            })
+            let run = res.map_err(CampaignError::Sim)?;
+            Ok(CampaignRun::named(spec, a, r, run, spec.file_name(a, r)))
         })
         .collect()
+}
+
+impl CampaignRun {
+    /// Power-on `run` (0-based) at ambient index `amb`, stored under file name `name`.
+    pub fn named(spec: &CampaignSpec, amb: usize, run: usize, mut data: Run, name: String) -> Self {
+        data.path = PathBuf::from(name);
+        data.set_meta("run", run + 1);
+        CampaignRun {
+            ambient_c: spec.ambients_c[amb],
+            index: run + 1,
+            run: data,
+        }
+    }
 }
 
 /// Writes a simulated campaign into `dir` (created if missing). If any file fails, the

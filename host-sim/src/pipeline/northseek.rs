@@ -29,10 +29,7 @@ use fog_core::seeking::tilt::Tilt;
 use serde::Serialize;
 
 use crate::report::{NorthSeekReport, SeekStats, Table};
-use crate::sim::{
-    rig, AuxSource, AuxTransform, BaseMotion, DriftTerm, GyroParams, RunSpec, StartState,
-    TurntableParams,
-};
+use crate::sim::{rig, BaseMotion, GyroParams, RunSpec, StartState, TurntableParams};
 use crate::stats::{rms, std_dev};
 
 /// The paper's seek time, 4 min 56 s.
@@ -96,16 +93,7 @@ impl MonteCarloConfig {
 
     /// The simulated gyro of this Monte Carlo: `params` plus the heading bias term.
     pub fn gyro_params(&self, params: &GyroParams) -> GyroParams {
-        if self.heading_bias_dph == 0.0 {
-            return params.clone();
-        }
-        params.clone().with_term(DriftTerm {
-            label: "heading_bias".to_string(),
-            source: AuxSource::HeadingCos,
-            transform: AuxTransform::Value,
-            coeff_dph: self.heading_bias_dph,
-            column: None,
-        })
+        params.clone().with_heading_bias(self.heading_bias_dph)
     }
 
     /// Checks the options, naming the offending one.

@@ -223,4 +223,19 @@ impl GyroParams {
         self.extra_terms.push(term);
         self
     }
+
+    /// Adds a heading-dependent bias A cos(input axis azimuth), deg/h (a magnetic /
+    /// Faraday bias; 0: unchanged). North-seek and the heading campaign plant it.
+    pub fn with_heading_bias(self, amplitude_dph: f64) -> Self {
+        if amplitude_dph == 0.0 {
+            return self;
+        }
+        self.with_term(DriftTerm {
+            label: "heading_bias".to_string(),
+            source: super::terms::AuxSource::HeadingCos,
+            transform: super::terms::AuxTransform::Value,
+            coeff_dph: amplitude_dph,
+            column: None,
+        })
+    }
 }

@@ -83,16 +83,26 @@ impl InputChoice {
     }
 }
 
+/// A criterion's verdict on one input set: the figure (lower is better) and its parts,
+/// one per independent unit (a held-out run, a simulated seek...), in the same order for
+/// every set, so two sets can be compared unit by unit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SetScore {
+    pub value: f64,
+    pub per_unit: Vec<f64>,
+}
+
 /// A held-out criterion for input sets: lower is better.
 pub trait InputCriterion {
     /// What the score is, for reports (`grouped CV held-out rms, deg/h`).
     fn describe(&self) -> &'static str;
     /// Scores one input set's dataset (restricted to the rows every candidate can use).
-    fn score(&self, ds: &Dataset, cfg: &TrainConfig) -> Result<f64>;
+    fn score(&self, ds: &Dataset, cfg: &TrainConfig) -> Result<SetScore>;
 }
 
 /// The trainer's own criterion: pooled held-out rms of grouped cross-validation over
-/// whole runs, at the width, degree and size that validation picks for the set.
+/// whole runs, at the width, degree and size that validation picks for the set; its
+/// units are the runs (mean square held-out residual of each).
 pub struct GroupedCvRms;
 
 impl InputCriterion for GroupedCvRms {
@@ -100,9 +110,48 @@ impl InputCriterion for GroupedCvRms {
         "grouped cross-validation (whole runs held out), pooled held-out rms, deg/h"
     }
 
-    fn score(&self, ds: &Dataset, cfg: &TrainConfig) -> Result<f64> {
-        Ok(cross_validate(ds, cfg, cfg.folds)?.best.heldout_rms_dph)
+    fn score(&self, ds: &Dataset, cfg: &TrainConfig) -> Result<SetScore> {
+        let cv = cross_validate(ds, cfg, cfg.folds)?;
+        let mut sum = vec![0.0; ds.n_groups()];
+        let mut count = vec![0usize; ds.n_groups()];
+        for (r, &g) in cv.residuals_dph.iter().zip(&ds.groups) {
+            sum[g as usize] += r * r;
+            count[g as usize] += 1;
+        }
+        let per_unit = sum
+            .iter()
+            .zip(&count)
+            .filter(|(_, &n)| n > 0)
+            .map(|(s, &n)| s / n as f64)
+            .collect();
+        Ok(SetScore {
+            value: cv.best.heldout_rms_dph,
+            per_unit,
+        })
     }
+}
+
+/// Standard errors a larger set's mean per-unit gain must exceed to replace a smaller
+/// one: a gain the units' scatter cannot tell from zero does not earn an input the
+/// device must compute and the model must fit.
+pub const SIGNIFICANT_GAIN_SE: f64 = 2.0;
+
+/// Whether `larger` beats `smaller` unit by unit: the mean of the paired differences
+/// exceeds [`SIGNIFICANT_GAIN_SE`] standard errors.
+fn significantly_better(larger: &SetScore, smaller: &SetScore) -> bool {
+    let d: Vec<f64> = smaller
+        .per_unit
+        .iter()
+        .zip(&larger.per_unit)
+        .map(|(s, l)| s - l)
+        .collect();
+    let n = d.len() as f64;
+    if d.len() < 2 || larger.per_unit.len() != smaller.per_unit.len() {
+        return larger.value < smaller.value;
+    }
+    let mean = d.iter().sum::<f64>() / n;
+    let var = d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    mean > SIGNIFICANT_GAIN_SE * (var / n).sqrt()
 }
 
 /// One input set's held-out figure.
@@ -114,6 +163,8 @@ pub struct InputSetScore {
     pub score: f64,
     /// Rows it was scored on (the same for every set).
     pub rows: usize,
+    /// Whether its gain over the set chosen before it is significant (unit by unit).
+    pub significant_gain: bool,
 }
 
 /// What `--inputs` chose and why.
@@ -182,8 +233,10 @@ fn common_rows(sets: &[Dataset]) -> Vec<Dataset> {
         .collect()
 }
 
-/// Scores every candidate on the common rows and picks the lowest (ties: the smaller
-/// set). Returns the selection and the chosen set's full dataset (all its ready rows).
+/// Scores every candidate on the common rows; going from the smallest set up, a larger
+/// set replaces the current choice only when it is significantly better unit by unit
+/// ([`SIGNIFICANT_GAIN_SE`]). Returns the selection and the chosen set's full dataset
+/// (all its ready rows).
 pub fn choose_inputs(
     runs: &[Run],
     candidates: &[InputSet],
@@ -195,22 +248,28 @@ pub fn choose_inputs(
         full.push(dataset_from_runs(runs, &set.specs())?);
     }
     let mut scores = Vec::new();
+    let mut best = 0;
     if candidates.len() > 1 {
-        for (set, ds) in candidates.iter().zip(common_rows(&full)) {
+        let mut kept: Option<SetScore> = None;
+        for (i, (set, ds)) in candidates.iter().zip(common_rows(&full)).enumerate() {
+            let score = criterion.score(&ds, cfg)?;
+            let gain = match &kept {
+                None => true,
+                Some(k) => significantly_better(&score, k),
+            };
             scores.push(InputSetScore {
                 set: *set,
                 inputs: ds.input_names.clone(),
-                score: criterion.score(&ds, cfg)?,
+                score: score.value,
                 rows: ds.len(),
+                significant_gain: gain && kept.is_some(),
             });
+            if gain {
+                best = i;
+                kept = Some(score);
+            }
         }
     }
-    let best = scores
-        .iter()
-        .enumerate()
-        .filter(|(_, s)| s.score.is_finite())
-        .min_by(|a, b| a.1.score.total_cmp(&b.1.score))
-        .map_or(0, |(i, _)| i);
     let chosen = *candidates.get(best).ok_or(TrainError::EmptyDataset)?;
     Ok((
         InputSelection {
@@ -240,5 +299,27 @@ mod tests {
         assert!(InputChoice::parse("t,accel").is_err());
         assert_eq!(InputSet::TempRateAccel.specs().len(), 3);
         assert_eq!(InputSet::TempRate.specs(), default_specs());
+    }
+
+    #[test]
+    fn only_a_gain_beyond_the_scatter_of_the_units_counts() {
+        let set = |v: f64, u: &[f64]| SetScore {
+            value: v,
+            per_unit: u.to_vec(),
+        };
+        let small = set(1.0, &[1.0, 1.1, 0.9, 1.0]);
+        assert!(significantly_better(
+            &set(0.8, &[0.8, 0.9, 0.7, 0.8]),
+            &small
+        ));
+        // Lower on average, but one unit much worse: not a consistent gain.
+        assert!(!significantly_better(
+            &set(0.9, &[0.5, 0.6, 0.5, 2.2]),
+            &small
+        ));
+        assert!(!significantly_better(
+            &set(1.0, &[1.0, 1.1, 0.9, 1.0]),
+            &small
+        ));
     }
 }

@@ -45,7 +45,7 @@ pub use fit::{fit_path, fit_shape, fit_width, Fit, PathFit, Shape};
 pub use gram::gram_bytes;
 pub use inputs::{
     choose_inputs, GroupedCvRms, InputChoice, InputCriterion, InputSelection, InputSet,
-    InputSetScore,
+    InputSetScore, SetScore, SIGNIFICANT_GAIN_SE,
 };
 pub use normalize::Normalizer;
 pub use path::StopReason;
