@@ -146,12 +146,27 @@ pub struct UploadClient<L> {
     timeout: Duration,
 }
 
+/// How long a refused TCP connection is retried (a device under QEMU still starting).
+pub const CONNECT_RETRY: Duration = Duration::from_secs(10);
+
 /// Opens `tcp:HOST:PORT` (QEMU) or a serial device path at `baud`, with a short read
 /// timeout so the client's deadlines can be enforced.
 pub fn open_link(port: &str, baud: u32) -> anyhow::Result<Box<dyn Link>> {
     let poll = Duration::from_millis(50);
     if let Some(addr) = port.strip_prefix("tcp:") {
-        let stream = TcpStream::connect(addr).with_context(|| format!("connecting to {addr}"))?;
+        // A QEMU that was just started may not listen yet: retried for a few seconds.
+        let t0 = Instant::now();
+        let stream = loop {
+            match TcpStream::connect(addr) {
+                Ok(s) => break s,
+                Err(e)
+                    if e.kind() == ErrorKind::ConnectionRefused && t0.elapsed() < CONNECT_RETRY =>
+                {
+                    std::thread::sleep(Duration::from_millis(100));
+                }
+                Err(e) => return Err(e).with_context(|| format!("connecting to {addr}")),
+            }
+        };
         stream.set_read_timeout(Some(poll))?;
         stream.set_nodelay(true)?;
         Ok(Box::new(stream))

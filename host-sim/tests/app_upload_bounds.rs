@@ -46,87 +46,53 @@ fn counter_zero_is_refused_in_one_line() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// `fogsim upload` towards the dead port with a scratch registry and `extra` arguments:
+/// it must fail, with one short line; that line.
+fn refused_upload(dir: &std::path::Path, extra: &[&str]) -> String {
+    let mut args = vec!["upload", "--port", DEAD_PORT, "--registry", "reg.sqlite"];
+    args.extend_from_slice(extra);
+    let o = fogsim(dir, &args);
+    assert!(!o.status.success(), "{extra:?} was accepted");
+    one_short_line(&stderr(&o)).to_string()
+}
+
+/// A sparse file of 2 GiB (`truncate -s 2G`).
+fn sparse_2gib(path: &std::path::Path) {
+    std::fs::File::create(path)
+        .unwrap()
+        .set_len(2 << 30)
+        .unwrap();
+}
+
 #[cfg(unix)]
 #[test]
 fn endless_and_huge_files_are_refused_before_reading() {
     let dir = scratch_dir("upload-bounds");
-    let reg = dir.join("reg.sqlite");
-    let reg = reg.to_str().unwrap();
-    // The model: /dev/zero (was read whole: OOM).
     let t0 = std::time::Instant::now();
-    let o = fogsim(
-        &dir,
-        &[
-            "upload",
-            "--port",
-            DEAD_PORT,
-            "--registry",
-            reg,
-            "/dev/zero",
-        ],
-    );
-    let e = stderr(&o);
-    let line = one_short_line(&e);
+    // The model: /dev/zero (was read whole: OOM), then a 2 GiB sparse file.
+    let line = refused_upload(&dir, &["/dev/zero"]);
     assert!(
         line.contains("/dev/zero") && line.contains("2048 bytes"),
         "{line}"
     );
-    // A 2 GiB sparse model.
-    let big = dir.join("big.fogm");
-    std::fs::File::create(&big)
-        .unwrap()
-        .set_len(2 << 30)
-        .unwrap();
-    let o = fogsim(
-        &dir,
-        &["upload", "--port", DEAD_PORT, "--registry", reg, "big.fogm"],
+    sparse_2gib(&dir.join("big.fogm"));
+    let line = refused_upload(&dir, &["big.fogm"]);
+    assert!(
+        line.contains("big.fogm") && line.contains("2048 bytes"),
+        "{line}"
     );
-    let line = one_short_line(&stderr(&o)).to_string();
-    assert!(line.contains("big.fogm"), "{line}");
 
     // A valid model, then a 2 GiB sparse key (was echoed back as a 2.1 GB message) and
     // /dev/zero as the key.
     app_support::campaign_and_model(&dir, 3);
-    let big_key = dir.join("big.key");
-    std::fs::File::create(&big_key)
-        .unwrap()
-        .set_len(2 << 30)
-        .unwrap();
+    sparse_2gib(&dir.join("big.key"));
     for key in ["big.key", "/dev/zero"] {
-        let o = fogsim(
-            &dir,
-            &[
-                "upload",
-                "--port",
-                DEAD_PORT,
-                "--registry",
-                reg,
-                "--key",
-                key,
-                "model.bin",
-            ],
-        );
-        assert!(!o.status.success());
-        let line = one_short_line(&stderr(&o)).to_string();
+        let line = refused_upload(&dir, &["--key", key, "model.bin"]);
         assert!(line.contains(key) && line.contains("256"), "{line}");
     }
     // A key of the right size but not hex: quoted short.
-    let bad_key = dir.join("bad.key");
-    std::fs::write(&bad_key, "z".repeat(64)).unwrap();
-    let o = fogsim(
-        &dir,
-        &[
-            "upload",
-            "--port",
-            DEAD_PORT,
-            "--registry",
-            reg,
-            "--key",
-            "bad.key",
-            "model.bin",
-        ],
-    );
-    let line = one_short_line(&stderr(&o)).to_string();
+    std::fs::write(dir.join("bad.key"), "z".repeat(64)).unwrap();
+    let line = refused_upload(&dir, &["--key", "bad.key", "model.bin"]);
     assert!(
         line.contains("zzzzzzzzzzzz...") && !line.contains(&"z".repeat(13)),
         "{line}"

@@ -39,10 +39,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use fog_core::link::bit::{BitItem, BitWord};
 use fog_core::consts::EARTH_RATE_DPH;
-use fog_core::seeking::heading_cal::HeadingHarmonic;
+use fog_core::link::bit::{BitItem, BitWord};
 use fog_core::link::messages::{Command, ResetReason, SeekReport, Status};
+use fog_core::seeking::heading_cal::HeadingHarmonic;
 use fog_core::seeking::quality::{SeekState, Validity};
 use fog_core::seeking::tilt::{earth_rate_on_axis_dph, Tilt};
 use fog_sim::monitor::{monitor, CsvAppend, MonitorOptions, MonitorSummary, ResultLog};

@@ -98,10 +98,11 @@ pub fn run(a: Args) -> Result<()> {
     )?;
     bar.finish_and_clear();
     println!(
-        "summary statuses={} results={} bad_frames={} gyro={gyro_id} registry={}{}",
+        "summary statuses={} results={} bad_frames={} seek_retries={} gyro={gyro_id} registry={}{}",
         sum.statuses,
         sum.results,
         sum.bad_frames,
+        sum.start_retries,
         reg_path.display(),
         a.csv
             .as_ref()

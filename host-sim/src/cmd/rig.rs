@@ -22,9 +22,12 @@ pub struct Args {
     /// The turntable link (UART2), same forms as --gyro-port.
     #[arg(long)]
     pub table_port: String,
-    /// Serial baud rate of both links (ignored for tcp:).
+    /// Serial baud rate of the gyro link (ignored for tcp:); the firmware's UART1 runs 460,800.
     #[arg(long, default_value_t = 460_800)]
-    pub baud: u32,
+    pub gyro_baud: u32,
+    /// Serial baud rate of the table link (ignored for tcp:); the firmware's UART2 runs 115,200.
+    #[arg(long, default_value_t = 115_200)]
+    pub table_baud: u32,
     /// Seed of every random draw (same seed, same frames).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -97,8 +100,8 @@ pub fn run(a: Args) -> Result<()> {
         (a.roll_deg * 1000.0).round() as i64
     );
     let within = Duration::from_secs(a.connect_timeout_s);
-    let mut gyro = open_rig_link(&a.gyro_port, a.baud, within)?;
-    let mut table = open_rig_link(&a.table_port, a.baud, within)?;
+    let mut gyro = open_rig_link(&a.gyro_port, a.gyro_baud, within)?;
+    let mut table = open_rig_link(&a.table_port, a.table_baud, within)?;
     println!("rig connected: gyro {} table {}", a.gyro_port, a.table_port);
     let stop = AtomicBool::new(false);
     let sum = rig.serve(gyro.as_mut(), table.as_mut(), &stop)?;

@@ -17,10 +17,12 @@ use std::io::{Read, Write};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
+use fog_core::link::messages::Refusal;
 use fog_core::link::messages::{
     decode, encode, Command, DeviceFrame, DeviceMessage, HostFrame, SeekReport, Status,
 };
 use fog_core::link::upload::{FrameReceiver, MAX_WIRE_FRAME_LEN, STATUS_REQUEST_PADDING};
+use fog_core::seeking::quality::{QualityError, SeekState};
 
 use crate::registry::{SeekContext, SeekRecord};
 
@@ -44,6 +46,8 @@ pub struct MonitorSummary {
     pub accepted: usize,
     pub refusals: Vec<String>,
     pub last_status: Option<Status>,
+    /// Seeks asked again after a BIT refusal, once the device was ready.
+    pub start_retries: usize,
 }
 
 /// Runs the session on `link` (reads must time out, see `upload::open_link`).
@@ -54,17 +58,17 @@ pub fn monitor<L: Read + Write>(
     mut on_status: impl FnMut(&Status),
     mut on_result: impl FnMut(&SeekReport, &SeekRecord),
 ) -> Result<MonitorSummary> {
-    let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
     for c in &opts.commands {
-        let n = encode(&HostFrame::Link(*c), &mut wire)
-            .map_err(|e| anyhow::anyhow!("encoding {c:?}: {e}"))?;
-        // The zero bytes (empty frames, ignored) pay for the answer and the status that
-        // follows under the device's reply budget (never more bytes out than in).
-        link.write_all(&[0u8; STATUS_REQUEST_PADDING])
-            .context("sending a command")?;
-        link.write_all(&wire[..n]).context("sending a command")?;
+        send(link, c)?;
     }
     link.flush()?;
+    // A seek refused because a built-in test item fails (the gyro link not up yet, the
+    // model still warming up) is asked again when the device next reports `Ready`.
+    let start = opts.commands.iter().find_map(|c| match c {
+        Command::StartSeek { positions } => Some(*positions),
+        _ => None,
+    });
+    let mut start_pending = false;
     let mut rx = FrameReceiver::new();
     let mut sum = MonitorSummary::default();
     let deadline = Instant::now() + opts.max_duration;
@@ -91,12 +95,39 @@ pub fn monitor<L: Read + Write>(
                 // An upload client's answers share the port.
                 Ok(DeviceFrame::Upload(_)) => sum.upload_frames += 1,
                 Ok(DeviceFrame::Link(m)) => {
-                    handle(m, log, &mut sum, &mut on_status, &mut on_result)?
+                    if matches!(
+                        m,
+                        DeviceMessage::Refused(Refusal::Quality(QualityError::Blocked(_)))
+                    ) {
+                        start_pending = start.is_some() && sum.results == 0;
+                    }
+                    let ready =
+                        matches!(&m, DeviceMessage::Status(s) if s.state == SeekState::Ready);
+                    handle(m, log, &mut sum, &mut on_status, &mut on_result)?;
+                    if let (true, true, Some(positions)) = (ready, start_pending, start) {
+                        start_pending = false;
+                        sum.start_retries += 1;
+                        send(link, &Command::StartSeek { positions })?;
+                        link.flush()?;
+                    }
                 }
             }
         }
     }
     Ok(sum)
+}
+
+/// Sends one command. The zero bytes before it (empty frames, ignored) pay for the
+/// answer and the status that follows under the device's reply budget (never more bytes
+/// out than in).
+fn send<L: Write>(link: &mut L, c: &Command) -> Result<()> {
+    let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
+    let n = encode(&HostFrame::Link(*c), &mut wire)
+        .map_err(|e| anyhow::anyhow!("encoding {c:?}: {e}"))?;
+    link.write_all(&[0u8; STATUS_REQUEST_PADDING])
+        .context("sending a command")?;
+    link.write_all(&wire[..n]).context("sending a command")?;
+    Ok(())
 }
 
 /// One north-finder message: counted, shown, results stored.

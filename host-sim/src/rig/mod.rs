@@ -99,7 +99,7 @@ impl Rig {
         let s = self.gyro.next_sample();
         // The coil temperature sensor is read once per second of sample time.
         let per_s = self.cfg.rate_hz.round().max(1.0) as u64;
-        if n % per_s == 0 || temp_c.is_nan() {
+        if n.is_multiple_of(per_s) || temp_c.is_nan() {
             *temp_c = self.gyro.read_sensor_c();
         }
         let frame = GyroFrame::from_physical(n as u8, s.rate_dph, *temp_c, 1.0 / self.cfg.rate_hz);
@@ -189,5 +189,67 @@ pub fn open_rig_link(port: &str, baud: u32, accept_within: Duration) -> Result<B
             .open()
             .with_context(|| format!("opening serial port {port} at {baud} Bd"))?;
         Ok(Box::new(serial))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fog_firmware::drivers::gyro_frame::FrameDecoder;
+
+    fn cfg(seed: u64) -> RigConfig {
+        RigConfig {
+            params: GyroParams::paper_default(),
+            seed,
+            ambient_c: 20.0,
+            latitude_deg: 39.9,
+            azimuth_deg: 108.4,
+            tilt: Tilt::LEVEL,
+            rate_hz: 20.0,
+            speed: 10.0,
+            duration_s: None,
+        }
+    }
+
+    fn frames(seed: u64, n: u64) -> Vec<u8> {
+        let mut rig = Rig::new(cfg(seed)).unwrap();
+        let mut temp = f64::NAN;
+        (0..n)
+            .flat_map(|i| rig.next_frame(i, &mut temp).0.encode())
+            .collect()
+    }
+
+    #[test]
+    fn same_seed_same_frames_and_the_firmware_decodes_them() {
+        let a = frames(7, 400);
+        assert_eq!(a, frames(7, 400));
+        assert_ne!(a, frames(8, 400));
+        let mut dec = FrameDecoder::new();
+        let decoded: Vec<GyroFrame> = a.iter().filter_map(|&b| dec.push(b)).collect();
+        assert_eq!(decoded.len(), 400);
+        assert!(decoded.iter().all(|f| f.rate_ok() && f.temp_ok()));
+        // A cold start soaked at 20 degC: the coil is within a few degC of the chamber.
+        assert!(decoded.iter().all(|f| (f.temp_c() - 20.0).abs() < 5.0));
+    }
+
+    #[test]
+    fn the_table_answers_the_firmware_protocol_in_sample_time() {
+        let mut rig = Rig::new(cfg(1)).unwrap();
+        let mut temp = f64::NAN;
+        assert_eq!(rig.table.answer(b"MOV abc").as_deref(), Some("NAK"));
+        assert_eq!(rig.table.answer(b"MOV 400.000").as_deref(), Some("NAK"));
+        assert_eq!(rig.table.answer(b"HELLO"), None);
+        assert_eq!(rig.table.answer(b"MOV 90.000").as_deref(), Some("ACK"));
+        assert!(rig.table.answer(b"POS?").unwrap().ends_with(" M"));
+        // 20 deg/s and 2 s settling: settled after 6.5 s of sample time, not before.
+        for n in 0..(6.0 * 20.0) as u64 {
+            rig.next_frame(n, &mut temp);
+        }
+        assert!(rig.table.answer(b"POS?").unwrap().ends_with(" M"));
+        for n in 0..20 {
+            rig.next_frame(200 + n, &mut temp);
+        }
+        assert_eq!(rig.table.answer(b"POS?").as_deref(), Some("POS 90.000 S"));
+        assert_eq!(rig.table.moves(), 1);
     }
 }
