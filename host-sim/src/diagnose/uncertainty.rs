@@ -365,7 +365,11 @@ fn ratios_to_simulator(est: &[Estimate], t_mean_c: f64) -> Vec<Ratio> {
             "temperature sensitivity at the mean T",
             sensitivity,
         ),
-        ("shupe_dph_per_cps", "Shupe coefficient at the mean T", shupe),
+        (
+            "shupe_dph_per_cps",
+            "Shupe coefficient at the mean T",
+            shupe,
+        ),
         ("arw_from_row_noise", "ARW (row noise)", sim.noise.arw_dpsh),
     ];
     pairs
