@@ -41,7 +41,7 @@ fn case(dir: &Path, seed: u64, ambient: &str, runs: &str) -> (bool, String) {
         runs,
         "--seed",
         &seed_s,
-        &format!("--ambient={ambient}"),
+        &format!("--ambient-c={ambient}"),
         "--raw-rate-hz",
         "1",
     ]);
@@ -64,10 +64,18 @@ fn case(dir: &Path, seed: u64, ambient: &str, runs: &str) -> (bool, String) {
         let name = r["name"].as_str().unwrap();
         let value = r["ratio"]["value"].as_f64().unwrap();
         let sigma = r["ratio"]["plus_minus"].as_f64().unwrap();
-        let allowed = 2.0 * sigma + if name.starts_with("Shupe") { SHUPE_BIAS_ALLOWED } else { 0.0 };
+        let allowed = 2.0 * sigma
+            + if name.starts_with("Shupe") {
+                SHUPE_BIAS_ALLOWED
+            } else {
+                0.0
+            };
         let fine = (value - 1.0).abs() <= allowed;
         ok &= fine;
-        line += &format!(" {name} {value:.3} +/- {sigma:.3}{}", if fine { "" } else { " (!)" });
+        line += &format!(
+            " {name} {value:.3} +/- {sigma:.3}{}",
+            if fine { "" } else { " (!)" }
+        );
     }
     (ok, line)
 }

@@ -293,24 +293,25 @@ pub fn fit(folds: &Folds, st: &Stacked, spec: &BaseSpec) -> Result<BaseFit, Diag
 /// T + dT/dt where the RBF was 2 % better, and a 1-sigma supply-voltage effect planted in
 /// the project's simulator was then no longer significant.)
 pub fn choose(folds: &Folds, st: &Stacked) -> Result<BaseChoice, DiagnoseError> {
-    let fits: Vec<BaseFit> = specs()
-        .iter()
-        .filter_map(|spec| fit(folds, st, spec).ok())
-        .collect();
-    let chosen = fits
-        .iter()
-        .min_by(|a, b| a.cv.rms().total_cmp(&b.cv.rms()))
-        .ok_or(DiagnoseError::Singular { what: "every base" })?
-        .clone();
-    let scores: Vec<BaseScore> = fits
-        .iter()
-        .map(|f| BaseScore {
+    // Each base is scored as it is fitted and only the best so far is kept (memory: a
+    // fitted base holds its design, n x columns).
+    let mut chosen: Option<BaseFit> = None;
+    let mut scores: Vec<BaseScore> = Vec::new();
+    for spec in specs() {
+        let Ok(f) = fit(folds, st, &spec) else {
+            continue;
+        };
+        scores.push(BaseScore {
             spec: f.spec.clone(),
             heldout_rms_dph: f.cv.rms(),
             heldout_se_dph: unit_score(folds, &f.cv).standard_error_dph,
-            levels: level_scores(folds, st, f),
-        })
-        .collect();
+            levels: level_scores(folds, st, &f),
+        });
+        if chosen.as_ref().is_none_or(|c| f.cv.rms() < c.cv.rms()) {
+            chosen = Some(f);
+        }
+    }
+    let chosen = chosen.ok_or(DiagnoseError::Singular { what: "every base" })?;
     Ok(BaseChoice {
         levels: choose_levels(&scores, &chosen.spec.name),
         chosen,
@@ -376,9 +377,11 @@ fn choose_levels(scores: &[BaseScore], chosen: &str) -> Option<LevelChoice> {
         .flat_map(|b| b.levels.iter().map(move |l| (b, l)))
         .filter(|(_, l)| l.score.heldout_rms_dph.is_finite())
         .collect();
-    let best = all
-        .iter()
-        .min_by(|a, b| a.1.score.heldout_rms_dph.total_cmp(&b.1.score.heldout_rms_dph))?;
+    let best = all.iter().min_by(|a, b| {
+        a.1.score
+            .heldout_rms_dph
+            .total_cmp(&b.1.score.heldout_rms_dph)
+    })?;
     let limit = best.1.score.heldout_rms_dph + best.1.score.standard_error_dph.max(0.0);
     let (b, l) = all
         .iter()

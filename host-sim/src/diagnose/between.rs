@@ -299,8 +299,8 @@ pub fn prepare(
         ),
     };
     let lens: Vec<usize> = folds.run_rows.iter().map(|r| r.len()).collect();
-    let offsets_rms_dph = loo_gains(&offsets, &lens, &vec![vec![]; offsets.len()])
-        .map_or(f64::NAN, |(_, r0, _)| r0);
+    let offsets_rms_dph =
+        loo_gains(&offsets, &lens, &vec![vec![]; offsets.len()]).map_or(f64::NAN, |(_, r0, _)| r0);
     let mut out = Prepared {
         repeatability_dph: levels.map_or(offsets_rms_dph, |l| l.repeatability_dph),
         offsets_rms_dph,

@@ -231,13 +231,18 @@ impl CvResult {
 
 fn adjust(folds: &Folds, v: &[f64]) -> Vec<f64> {
     let mut out = v.to_vec();
+    adjust_in_place(folds, &mut out);
+    out
+}
+
+/// Demeans `v` within each unit in run-grouped layouts (no-op for time blocks).
+fn adjust_in_place(folds: &Folds, v: &mut [f64]) {
     if folds.offsets == Offsets::PerUnit {
         for r in &folds.unit_rows {
             let m = v[r.clone()].iter().sum::<f64>() / r.len() as f64;
-            out[r.clone()].iter_mut().for_each(|x| *x -= m);
+            v[r.clone()].iter_mut().for_each(|x| *x -= m);
         }
     }
-    out
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -248,7 +253,14 @@ impl Prepared {
     /// Prepares `cols` (full-length columns) and target `y`; `ridge` is relative to each
     /// column's energy.
     pub fn new(folds: &Folds, cols: &[Vec<f64>], y: &[f64], ridge: f64) -> Self {
-        let mut adj: Vec<Vec<f64>> = cols.iter().map(|c| adjust(folds, c)).collect();
+        Self::from_owned(folds, cols.to_vec(), y, ridge)
+    }
+
+    /// [`Prepared::new`] taking the columns by value (adjusted in place: no second copy).
+    pub fn from_owned(folds: &Folds, mut adj: Vec<Vec<f64>>, y: &[f64], ridge: f64) -> Self {
+        for c in &mut adj {
+            adjust_in_place(folds, c);
+        }
         if folds.offsets == Offsets::RunDummies {
             for r in &folds.run_rows {
                 let mut d = vec![0.0; folds.rows()];

@@ -81,7 +81,12 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 impl LevelSystems {
     /// Sums of `cols` (raw, not demeaned; the intercept is added here) and `y` over
     /// `run_rows`; `ridge` relative as in `cv`.
-    pub fn new(run_rows: &[std::ops::Range<usize>], cols: &[Vec<f64>], y: &[f64], ridge: f64) -> Self {
+    pub fn new(
+        run_rows: &[std::ops::Range<usize>],
+        cols: &[Vec<f64>],
+        y: &[f64],
+        ridge: f64,
+    ) -> Self {
         let q = cols.len() + 1;
         let mut runs = Vec::with_capacity(run_rows.len());
         let mut diag_scale = vec![0.0; q];
@@ -143,7 +148,12 @@ impl LevelSystems {
 
     /// White-noise variance of the free-offset fit's residual times its AR(1) inflation
     /// (1 + rho) / (1 - rho): n_r x the variance of a run mean of that noise.
-    fn within_noise(&self, run_rows: &[std::ops::Range<usize>], cols: &[Vec<f64>], y: &[f64]) -> f64 {
+    fn within_noise(
+        &self,
+        run_rows: &[std::ops::Range<usize>],
+        cols: &[Vec<f64>],
+        y: &[f64],
+    ) -> f64 {
         let all = vec![1.0; self.runs.len()];
         let Some(w) = self.solve_free(&all) else {
             return 0.0;
@@ -154,7 +164,13 @@ impl LevelSystems {
             let off = rs.ybar - dot(&rs.zbar[1..], &w[1..]);
             let mut prev: Option<f64> = None;
             for row in r.clone() {
-                let e = y[row] - off - cols.iter().zip(&w[1..]).map(|(c, b)| c[row] * b).sum::<f64>();
+                let e = y[row]
+                    - off
+                    - cols
+                        .iter()
+                        .zip(&w[1..])
+                        .map(|(c, b)| c[row] * b)
+                        .sum::<f64>();
                 s0 += e * e;
                 n += 1.0;
                 if let Some(p) = prev {
@@ -446,10 +462,17 @@ mod tests {
         let fit = lv.solve_shared(&vec![1.0; runs], theta).unwrap();
         assert!((fit.w[1] - 0.002).abs() < 3e-4, "{:?} theta {theta}", fit.w);
         let free_w = lv.solve_free(&vec![1.0; runs]).unwrap();
-        assert!(free_w[1] < 0.0, "the transient biases the within slope: {free_w:?}");
+        assert!(
+            free_w[1] < 0.0,
+            "the transient biases the within slope: {free_w:?}"
+        );
         let lv0 = LevelSystems::new(&rows, &cols, &y_null, 1e-8);
         let (_, theta0) = lv0.heldout_shared().unwrap();
         let null_fit = lv0.solve_shared(&vec![1.0; runs], theta0).unwrap();
-        assert!(null_fit.w[1].abs() < 5e-4, "no law in the levels, yet {:?}", null_fit.w);
+        assert!(
+            null_fit.w[1].abs() < 5e-4,
+            "no law in the levels, yet {:?}",
+            null_fit.w
+        );
     }
 }

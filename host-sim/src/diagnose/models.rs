@@ -70,33 +70,43 @@ pub fn fit_rbf(
     y: &[f64],
 ) -> Result<RbfFit, DiagnoseError> {
     let k_max = centre_count(y.len(), inputs.len());
-    let mut best: Option<RbfFit> = None;
+    // Only the best setting is remembered; its design is rebuilt once at the end, so at
+    // most one design (n x centres) is alive besides the one being scored (memory).
+    let mut best: Option<(usize, f64, f64, f64)> = None;
+    let design = |k: usize, wf: f64| {
+        let basis = RbfBasis::fit(inputs, k, wf);
+        let mut cols = basis.columns(inputs);
+        cols.extend(linear.iter().cloned());
+        let prepared = Prepared::from_owned(folds, cols, y, RIDGES[0]);
+        (basis, prepared)
+    };
     for frac in CENTRE_FRACTIONS {
         let k = ((k_max as f64 * frac).round() as usize).max(3);
         for wf in WIDTH_FACTORS {
-            let basis = RbfBasis::fit(inputs, k, wf);
-            let mut cols = basis.columns(inputs);
-            cols.extend(linear.iter().cloned());
-            let mut prepared = Prepared::new(folds, &cols, y, RIDGES[0]);
+            let (_, mut prepared) = design(k, wf);
             for ridge in RIDGES {
                 prepared.set_ridge(ridge);
                 let Ok(cv) = prepared.validate(folds) else {
                     continue;
                 };
-                if best.as_ref().is_none_or(|b| cv.rms() < b.cv.rms()) {
-                    best = Some(RbfFit {
-                        basis: basis.clone(),
-                        prepared: prepared.clone(),
-                        cv,
-                        centres: k,
-                        width_factor: wf,
-                        ridge,
-                    });
+                if best.is_none_or(|b| cv.rms() < b.3) {
+                    best = Some((k, wf, ridge, cv.rms()));
                 }
             }
         }
     }
-    best.ok_or(DiagnoseError::Singular { what: "RBF fit" })
+    let (k, wf, ridge, _) = best.ok_or(DiagnoseError::Singular { what: "RBF fit" })?;
+    let (basis, mut prepared) = design(k, wf);
+    prepared.set_ridge(ridge);
+    let cv = prepared.validate(folds)?;
+    Ok(RbfFit {
+        basis,
+        prepared,
+        cv,
+        centres: k,
+        width_factor: wf,
+        ridge,
+    })
 }
 
 /// The candidate as a further RBF input next to the chosen base's inputs (T when the base

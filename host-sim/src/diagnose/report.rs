@@ -260,7 +260,12 @@ fn write_baseline(s: &mut String, r: &Report) {
         .base
         .tried
         .iter()
-        .map(|b| format!("{} {:.4} +/- {:.4}", b.spec.name, b.heldout_rms_dph, b.heldout_se_dph))
+        .map(|b| {
+            format!(
+                "{} {:.4} +/- {:.4}",
+                b.spec.name, b.heldout_rms_dph, b.heldout_se_dph
+            )
+        })
         .collect();
     let _ = writeln!(
         s,

@@ -24,7 +24,9 @@ use serde::Serialize;
 /// Coarse grid of fast thermal time constants: 10 s x 2^(k/2), up to 16,384 s (the slow
 /// one and then the fast one are found continuously, `run_taus`).
 pub fn thermal_taus_s() -> Vec<f64> {
-    (0..=21).map(|k| 10.0 * 2f64.powf(f64::from(k) / 2.0)).collect()
+    (0..=21)
+        .map(|k| 10.0 * 2f64.powf(f64::from(k) / 2.0))
+        .collect()
 }
 
 /// The calibrated drift law's coefficients, in design order, with units.

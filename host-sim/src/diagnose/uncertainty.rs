@@ -88,6 +88,11 @@ fn bootstrap(
         .filter_map(|c| sys.solve(c).ok())
         .map(|w| summary(&w))
         .collect();
+    estimates(names, &value, &reps)
+}
+
+/// One Estimate per name: `value[k]` with the spread of the replicates' k-th entries.
+fn estimates(names: &[(String, &str)], value: &[f64], reps: &[Vec<f64>]) -> Vec<Estimate> {
     names
         .iter()
         .enumerate()
@@ -273,14 +278,7 @@ fn simulator_estimates(
                 .iter()
                 .filter_map(|c| lv.solve_shared(c, theta).map(|f| f.w[1..].to_vec()))
                 .collect();
-            names
-                .iter()
-                .enumerate()
-                .map(|(k, (name, unit))| {
-                    let r: Vec<f64> = reps.iter().map(|v| v[k]).collect();
-                    Estimate::new(name.clone(), unit, coef[k], &r)
-                })
-                .collect()
+            estimates(&names, &coef, &reps)
         }
         None => {
             let p = prepared.width();
@@ -365,7 +363,11 @@ fn ratios_to_simulator(est: &[Estimate], t_mean_c: f64) -> Vec<Ratio> {
             "temperature sensitivity at the mean T",
             sensitivity,
         ),
-        ("shupe_dph_per_cps", "Shupe coefficient at the mean T", shupe),
+        (
+            "shupe_dph_per_cps",
+            "Shupe coefficient at the mean T",
+            shupe,
+        ),
         ("arw_from_row_noise", "ARW (row noise)", sim.noise.arw_dpsh),
     ];
     pairs
