@@ -86,13 +86,19 @@ impl Family {
             (Family::Categorical, Variant::Effect) => ("bias per mode level", vec!["mode"]),
             (Family::Categorical, Variant::Twin) => ("T slope per mode level", vec!["mode"]),
             (Family::Smooth, Variant::Effect) => ("tanh((cabinet-c0)/1 degC)", vec!["cabinet_c"]),
-            (Family::Smooth, Variant::Twin) => ("bump exp(-((cabinet-c0)/1.5)^2)", vec!["cabinet_c"]),
+            (Family::Smooth, Variant::Twin) => {
+                ("bump exp(-((cabinet-c0)/1.5)^2)", vec!["cabinet_c"])
+            }
             (Family::Memory, Variant::Effect) => ("backlash of T (0.3 degC play)", vec!["temp_c"]),
             (Family::Memory, Variant::Twin) => ("T through a 900 s lag", vec!["temp_c"]),
             (Family::Metadata, Variant::Effect) => ("offset per # mount", vec!["mount"]),
             (Family::Metadata, Variant::Twin) => ("T slope per # mount", vec!["mount"]),
-            (Family::Stacked, Variant::Effect) => ("tanh(cabinet) + mode bias", vec!["cabinet_c", "mode"]),
-            (Family::Stacked, Variant::Twin) => ("backlash of T + mount offset", vec!["temp_c", "mount"]),
+            (Family::Stacked, Variant::Effect) => {
+                ("tanh(cabinet) + mode bias", vec!["cabinet_c", "mode"])
+            }
+            (Family::Stacked, Variant::Twin) => {
+                ("backlash of T + mount offset", vec!["temp_c", "mount"])
+            }
         };
         Truth { law, columns }
     }
@@ -162,10 +168,17 @@ fn wander(rng: &mut ChaCha8Rng, n: usize, dt: f64, tau_s: f64, sd: f64) -> Vec<f
         .collect()
 }
 
-fn draw_run(rng: &mut ChaCha8Rng, i: usize, n: usize, dt: f64, ambient_c: f64, mount_b: bool) -> Series {
+fn draw_run(
+    rng: &mut ChaCha8Rng,
+    i: usize,
+    n: usize,
+    dt: f64,
+    ambient_c: f64,
+    mount_b: bool,
+) -> Series {
     let start = match i % 3 {
-        0 => 0.0,                         // cold start
-        1 => rng.random_range(0.4..0.7),  // warm restart
+        0 => 0.0,                          // cold start
+        1 => rng.random_range(0.4..0.7),   // warm restart
         _ => rng.random_range(0.85..0.95), // hot restart
     };
     let rise = rng.random_range(6.0..12.0);
@@ -174,7 +187,10 @@ fn draw_run(rng: &mut ChaCha8Rng, i: usize, n: usize, dt: f64, ambient_c: f64, m
     let omega = std::f64::consts::TAU / rng.random_range(1200.0..2400.0);
     let phase = rng.random_range(0.0..std::f64::consts::TAU);
     let t_s: Vec<f64> = (1..=n).map(|k| k as f64 * dt).collect();
-    let chamber: Vec<f64> = t_s.iter().map(|t| cyc_amp * ((omega * t + phase).sin() - phase.sin())).collect();
+    let chamber: Vec<f64> = t_s
+        .iter()
+        .map(|t| cyc_amp * ((omega * t + phase).sin() - phase.sin()))
+        .collect();
     let felt = lag(&chamber, dt, 200.0);
     let temp_c: Vec<f64> = t_s
         .iter()
@@ -198,13 +214,25 @@ fn draw_run(rng: &mut ChaCha8Rng, i: usize, n: usize, dt: f64, ambient_c: f64, m
     let mode = switching(rng, n, dt, 500.0, &[0.0, 1.0, 2.0]);
     let fan = switching(rng, n, dt, 700.0, &[0.0, 1.0]);
     let wander = wander(rng, n, dt, 1200.0, 1.0);
-    Series { t_s, temp_c, dtemp_cps, cabinet_c, supply_v, mode, fan, wander, mount_b, ambient_c }
+    Series {
+        t_s,
+        temp_c,
+        dtemp_cps,
+        cabinet_c,
+        supply_v,
+        mode,
+        fan,
+        wander,
+        mount_b,
+        ambient_c,
+    }
 }
 
 /// Solves a 3x3 system by Cramer's rule (None if singular).
 fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
     let det = |m: [[f64; 3]; 3]| {
-        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
             + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
     };
     let d = det(a);
@@ -232,7 +260,11 @@ fn orthogonalise(e: &mut [Vec<f64>], runs: &[Series]) {
         .iter()
         .map(|s| {
             let d: Vec<f64> = s.temp_c.iter().map(|t| t - 25.0).collect();
-            [demeaned(d.clone()), demeaned(d.iter().map(|x| x * x).collect()), demeaned(s.dtemp_cps.clone())]
+            [
+                demeaned(d.clone()),
+                demeaned(d.iter().map(|x| x * x).collect()),
+                demeaned(s.dtemp_cps.clone()),
+            ]
         })
         .collect();
     let (mut a, mut b) = ([[0.0; 3]; 3], [0.0; 3]);
@@ -258,7 +290,10 @@ fn orthogonalise(e: &mut [Vec<f64>], runs: &[Series]) {
 
 /// Scales `e` to an rms of `target` over all its points.
 fn scale_to(e: &mut [Vec<f64>], target: f64) {
-    let (ss, n) = e.iter().flatten().fold((0.0, 0usize), |(s, n), v| (s + v * v, n + 1));
+    let (ss, n) = e
+        .iter()
+        .flatten()
+        .fold((0.0, 0usize), |(s, n), v| (s + v * v, n + 1));
     let rms = (ss / n.max(1) as f64).sqrt();
     if rms > 0.0 {
         e.iter_mut().flatten().for_each(|v| *v *= target / rms);
@@ -310,16 +345,43 @@ struct Law {
 fn shape_of(c: Cause, s: &Series, law: &Law) -> Vec<f64> {
     let n = s.t_s.len();
     match c {
-        Cause::SupplyRate => s.supply_v.iter().zip(&s.dtemp_cps).map(|(v, r)| (v - 24.0) * r).collect(),
-        Cause::SupplyTemp => s.supply_v.iter().zip(&s.temp_c).map(|(v, t)| (v - 24.0) * (t - law.temp_mid_c)).collect(),
+        Cause::SupplyRate => s
+            .supply_v
+            .iter()
+            .zip(&s.dtemp_cps)
+            .map(|(v, r)| (v - 24.0) * r)
+            .collect(),
+        Cause::SupplyTemp => s
+            .supply_v
+            .iter()
+            .zip(&s.temp_c)
+            .map(|(v, t)| (v - 24.0) * (t - law.temp_mid_c))
+            .collect(),
         Cause::ModeBias => s.mode.iter().map(|m| law.mode_bias[*m as usize]).collect(),
-        Cause::ModeSlope => s.mode.iter().zip(&s.temp_c).map(|(m, t)| law.mode_bias[*m as usize] * (t - law.temp_mid_c)).collect(),
-        Cause::CabinetTanh => s.cabinet_c.iter().map(|c| ((c - law.cabinet_mid_c) / 1.0).tanh()).collect(),
-        Cause::CabinetBump => s.cabinet_c.iter().map(|c| (-((c - law.cabinet_mid_c) / 1.5).powi(2)).exp()).collect(),
+        Cause::ModeSlope => s
+            .mode
+            .iter()
+            .zip(&s.temp_c)
+            .map(|(m, t)| law.mode_bias[*m as usize] * (t - law.temp_mid_c))
+            .collect(),
+        Cause::CabinetTanh => s
+            .cabinet_c
+            .iter()
+            .map(|c| ((c - law.cabinet_mid_c) / 1.0).tanh())
+            .collect(),
+        Cause::CabinetBump => s
+            .cabinet_c
+            .iter()
+            .map(|c| (-((c - law.cabinet_mid_c) / 1.5).powi(2)).exp())
+            .collect(),
         Cause::Backlash => play(&s.temp_c, 0.3),
         Cause::Lagged => lag(&s.temp_c, law.dt, 900.0),
         Cause::MountOffset => vec![if s.mount_b { 1.0 } else { -1.0 }; n],
-        Cause::MountSlope => s.temp_c.iter().map(|t| if s.mount_b { t - law.temp_mid_c } else { 0.0 }).collect(),
+        Cause::MountSlope => s
+            .temp_c
+            .iter()
+            .map(|t| if s.mount_b { t - law.temp_mid_c } else { 0.0 })
+            .collect(),
     }
 }
 
@@ -332,11 +394,15 @@ fn median(v: &mut [f64]) -> f64 {
 /// every random draw but the planted law.
 pub fn campaign(family: Family, variant: Variant, seed: u64, shape: Shape) -> (Vec<Run>, Truth) {
     let salt = FAMILIES.iter().position(|f| *f == family).unwrap_or(0) as u64 + 1;
-    let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (salt << 40) ^ 0x4E0F);
+    let mut rng =
+        ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (salt << 40) ^ 0x4E0F);
     let g = Normal::new(0.0, 1.0).unwrap();
     let dt = family.row_s();
     let n = (shape.minutes * 60.0 / dt).round() as usize;
-    let (k1, k2) = (rng.random_range(-0.006..0.006), rng.random_range(-5e-5..5e-5));
+    let (k1, k2) = (
+        rng.random_range(-0.006..0.006),
+        rng.random_range(-5e-5..5e-5),
+    );
     let shupe = rng.random_range(3.0..8.0) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
     let ambients = [-10.0, 10.0, 30.0, 45.0];
     // half the runs on mount B, in a random order
@@ -353,8 +419,18 @@ pub fn campaign(family: Family, variant: Variant, seed: u64, shape: Shape) -> (V
     let mut bias = [0.0, rng.random_range(0.5..1.0), -rng.random_range(0.5..1.0)];
     bias.swap(0, rng.random_range(0..3));
     let law = Law {
-        temp_mid_c: median(&mut series.iter().flat_map(|s| s.temp_c.clone()).collect::<Vec<_>>()),
-        cabinet_mid_c: median(&mut series.iter().flat_map(|s| s.cabinet_c.clone()).collect::<Vec<_>>()),
+        temp_mid_c: median(
+            &mut series
+                .iter()
+                .flat_map(|s| s.temp_c.clone())
+                .collect::<Vec<_>>(),
+        ),
+        cabinet_mid_c: median(
+            &mut series
+                .iter()
+                .flat_map(|s| s.cabinet_c.clone())
+                .collect::<Vec<_>>(),
+        ),
         mode_bias: bias,
         dt,
     };
@@ -379,11 +455,18 @@ pub fn campaign(family: Family, variant: Variant, seed: u64, shape: Shape) -> (V
             let rate: Vec<f64> = (0..n)
                 .map(|k| {
                     let d = s.temp_c[k] - 25.0;
-                    offset + k1 * d + k2 * d * d + shupe * s.dtemp_cps[k] + p[k] + row_sigma * g.sample(&mut rng)
+                    offset
+                        + k1 * d
+                        + k2 * d * d
+                        + shupe * s.dtemp_cps[k]
+                        + p[k]
+                        + row_sigma * g.sample(&mut rng)
                 })
                 .collect();
             let sensed = |v: &[f64], sd: f64, q: f64, rng: &mut ChaCha8Rng| -> Vec<f64> {
-                v.iter().map(|x| ((x + sd * g.sample(rng)) / q).round() * q).collect()
+                v.iter()
+                    .map(|x| ((x + sd * g.sample(rng)) / q).round() * q)
+                    .collect()
             };
             let temp = sensed(&s.temp_c, 0.01, 0.0625, &mut rng);
             let cabinet = sensed(&s.cabinet_c, 0.05, 0.01, &mut rng);
@@ -401,7 +484,10 @@ pub fn campaign(family: Family, variant: Variant, seed: u64, shape: Shape) -> (V
             let meta = vec![
                 ("gyro".to_owned(), "novel".to_owned()),
                 ("ambient_c".to_owned(), format!("{:.2}", s.ambient_c)),
-                ("mount".to_owned(), if s.mount_b { "B" } else { "A" }.to_owned()),
+                (
+                    "mount".to_owned(),
+                    if s.mount_b { "B" } else { "A" }.to_owned(),
+                ),
             ];
             Run::new(format!("novel_{i:02}.csv"), meta, cols).expect("generator builds valid runs")
         })

@@ -82,8 +82,15 @@ fn derivative(x: &[f64], t: &[f64]) -> Vec<f64> {
     let n = x.len();
     (0..n)
         .map(|k| {
-            let (a, b) = (k.saturating_sub(DERIV_HALF_ROWS), (k + DERIV_HALF_ROWS).min(n - 1));
-            if b > a { (x[b] - x[a]) / (t[b] - t[a]) } else { 0.0 }
+            let (a, b) = (
+                k.saturating_sub(DERIV_HALF_ROWS),
+                (k + DERIV_HALF_ROWS).min(n - 1),
+            );
+            if b > a {
+                (x[b] - x[a]) / (t[b] - t[a])
+            } else {
+                0.0
+            }
         })
         .collect()
 }
@@ -103,7 +110,10 @@ fn lagged(x: &[f64], t: &[f64], tau_s: f64) -> Vec<f64> {
 /// Distinct values of a column over the campaign, if at most MAX_LEVELS.
 fn levels(runs: &[Run], name: &str) -> Option<Vec<f64>> {
     let mut seen: Vec<f64> = Vec::new();
-    for v in runs.iter().flat_map(|r| r.column(name).unwrap_or(&[]).iter()) {
+    for v in runs
+        .iter()
+        .flat_map(|r| r.column(name).unwrap_or(&[]).iter())
+    {
         if !seen.contains(v) {
             seen.push(*v);
             if seen.len() > MAX_LEVELS {
@@ -122,7 +132,15 @@ fn quartiles(v: &[f64]) -> [f64; 3] {
 }
 
 /// Within-run features of one column, stacked over runs.
-fn column_features(name: &str, x: &[f64], t: &[f64], temp: &[f64], dtemp: &[f64], tm: f64, few: bool) -> Vec<(String, Vec<f64>)> {
+fn column_features(
+    name: &str,
+    x: &[f64],
+    t: &[f64],
+    temp: &[f64],
+    dtemp: &[f64],
+    tm: f64,
+    few: bool,
+) -> Vec<(String, Vec<f64>)> {
     let mut f: Vec<(String, Vec<f64>)> = Vec::new();
     let is_temp = name == "temp_c";
     if !is_temp {
@@ -136,32 +154,60 @@ fn column_features(name: &str, x: &[f64], t: &[f64], temp: &[f64], dtemp: &[f64]
     }
     if is_temp {
         f.push((format!("{name}:accel"), derivative(dtemp, t)));
-        f.push((format!("{name}*temp_c:rate"), x.iter().zip(dtemp).map(|(a, b)| (a - tm) * b).collect()));
+        f.push((
+            format!("{name}*temp_c:rate"),
+            x.iter().zip(dtemp).map(|(a, b)| (a - tm) * b).collect(),
+        ));
     } else {
         let xm = mean(x);
-        f.push((format!("{name}*temp_c"), x.iter().zip(temp).map(|(a, b)| (a - xm) * (b - tm)).collect()));
-        f.push((format!("{name}*temp_c:rate"), x.iter().zip(dtemp).map(|(a, b)| (a - xm) * b).collect()));
+        f.push((
+            format!("{name}*temp_c"),
+            x.iter()
+                .zip(temp)
+                .map(|(a, b)| (a - xm) * (b - tm))
+                .collect(),
+        ));
+        f.push((
+            format!("{name}*temp_c:rate"),
+            x.iter().zip(dtemp).map(|(a, b)| (a - xm) * b).collect(),
+        ));
     }
     for tau in LAGS_S {
         f.push((format!("{name}:lag{tau}s"), lagged(x, t, tau)));
     }
     if name.ends_with("_deg") {
-        f.push((format!("{name}:cos"), x.iter().map(|d| d.to_radians().cos()).collect()));
-        f.push((format!("{name}:sin"), x.iter().map(|d| d.to_radians().sin()).collect()));
+        f.push((
+            format!("{name}:cos"),
+            x.iter().map(|d| d.to_radians().cos()).collect(),
+        ));
+        f.push((
+            format!("{name}:sin"),
+            x.iter().map(|d| d.to_radians().sin()).collect(),
+        ));
     }
     f
 }
 
 /// Builds the stacked table: y (drift), the base (1, T, T^2, dT/dt) and the library.
 fn table(runs: &[Run]) -> Table {
-    let names: Vec<String> = runs[0].columns.iter().filter(|c| *c != "rate_dph" && *c != "earth_dph").cloned().collect();
-    let few: Vec<Option<Vec<f64>>> = names.iter().map(|n| if n == "t_s" { None } else { levels(runs, n) }).collect();
+    let names: Vec<String> = runs[0]
+        .columns
+        .iter()
+        .filter(|c| *c != "rate_dph" && *c != "earth_dph")
+        .cloned()
+        .collect();
+    let few: Vec<Option<Vec<f64>>> = names
+        .iter()
+        .map(|n| if n == "t_s" { None } else { levels(runs, n) })
+        .collect();
     // per run: binned drift, columns, level fractions
     let mut per_run: Vec<(Vec<f64>, Vec<Vec<f64>>)> = Vec::new();
     for run in runs {
         let mut raw: Vec<Vec<f64>> = vec![run.drift_dph()];
         for (n, lv) in names.iter().zip(&few) {
-            let x = run.column(n).map_or_else(|| vec![0.0; run.len()], <[f64]>::to_vec);
+            let x = run
+                .column(n)
+                .map_or_else(|| vec![0.0; run.len()], <[f64]>::to_vec);
             for l in lv.iter().flatten().skip(1) {
                 raw.push(x.iter().map(|v| f64::from(u8::from(v == l))).collect());
             }
@@ -181,8 +227,14 @@ fn table(runs: &[Run]) -> Table {
         col_index.push((k, nl));
         k += nl + 1;
     }
-    let value = |r: &(Vec<f64>, Vec<Vec<f64>>), i: usize| r.1[col_index[i].0 + col_index[i].1].clone();
-    let tm = mean(&per_run.iter().flat_map(|r| value(r, temp_i)).collect::<Vec<_>>());
+    let value =
+        |r: &(Vec<f64>, Vec<Vec<f64>>), i: usize| r.1[col_index[i].0 + col_index[i].1].clone();
+    let tm = mean(
+        &per_run
+            .iter()
+            .flat_map(|r| value(r, temp_i))
+            .collect::<Vec<_>>(),
+    );
     let mut run_rows = Vec::new();
     let (mut y, mut base) = (Vec::new(), vec![Vec::new(); 4]);
     let mut lib: Vec<(String, Vec<f64>)> = Vec::new();
@@ -196,7 +248,15 @@ fn table(runs: &[Run]) -> Table {
         let mut feats: Vec<(String, Vec<f64>)> = Vec::new();
         for (i, name) in names.iter().enumerate() {
             let x = value(r, i);
-            feats.extend(column_features(name, &x, &t, &temp, &dtemp, tm, few[i].is_some()));
+            feats.extend(column_features(
+                name,
+                &x,
+                &t,
+                &temp,
+                &dtemp,
+                tm,
+                few[i].is_some(),
+            ));
             if let Some(lv) = &few[i] {
                 for (j, l) in lv.iter().skip(1).enumerate() {
                     feats.push((format!("{name}=={l}"), r.1[col_index[i].0 + j].clone()));
@@ -208,16 +268,25 @@ fn table(runs: &[Run]) -> Table {
             match v.trim().parse::<f64>() {
                 Ok(num) => feats.push((format!("# {key}"), vec![num; n])),
                 Err(_) => {
-                    let mut all: Vec<&str> = runs.iter().filter_map(|r| r.meta_value(key)).collect();
+                    let mut all: Vec<&str> =
+                        runs.iter().filter_map(|r| r.meta_value(key)).collect();
                     all.sort_unstable();
                     all.dedup();
                     for l in all.iter().skip(1) {
-                        feats.push((format!("# {key}=={l}"), vec![f64::from(u8::from(v == l)); n]));
+                        feats.push((
+                            format!("# {key}=={l}"),
+                            vec![f64::from(u8::from(v == l)); n],
+                        ));
                     }
                 }
             }
         }
-        for (b, v) in base.iter_mut().zip([vec![1.0; n], temp.iter().map(|x| x - tm).collect(), temp.iter().map(|x| (x - tm).powi(2)).collect(), dtemp]) {
+        for (b, v) in base.iter_mut().zip([
+            vec![1.0; n],
+            temp.iter().map(|x| x - tm).collect(),
+            temp.iter().map(|x| (x - tm).powi(2)).collect(),
+            dtemp,
+        ]) {
             b.extend(v);
         }
         if ri == 0 {
@@ -237,14 +306,22 @@ fn table(runs: &[Run]) -> Table {
         }
         let x: Vec<f64> = per_run.iter().flat_map(|r| value(r, i)).collect();
         for q in quartiles(&x) {
-            lib.push((format!("{name}:hinge>{q:.3}"), x.iter().map(|v| (v - q).max(0.0)).collect()));
+            lib.push((
+                format!("{name}:hinge>{q:.3}"),
+                x.iter().map(|v| (v - q).max(0.0)).collect(),
+            ));
         }
     }
     lib.retain(|(_, v)| {
         let m = mean(v);
         v.iter().any(|x| (x - m).abs() > 1e-9 * (1.0 + m.abs()))
     });
-    Table { run_rows, y, base, lib }
+    Table {
+        run_rows,
+        y,
+        base,
+        lib,
+    }
 }
 
 /// Least-squares coefficients of `x` on `cols` over `rows` (normal equations, Cholesky).
@@ -265,7 +342,9 @@ fn ols(cols: &[&[f64]], x: &[f64], rows: &[usize]) -> Vec<f64> {
     }
     // Cholesky in place (lower)
     for j in 0..p {
-        let d = (a[j][j] - (0..j).map(|k| a[j][k] * a[j][k]).sum::<f64>()).max(1e-300).sqrt();
+        let d = (a[j][j] - (0..j).map(|k| a[j][k] * a[j][k]).sum::<f64>())
+            .max(1e-300)
+            .sqrt();
         a[j][j] = d;
         for i in j + 1..p {
             a[i][j] = (a[i][j] - (0..j).map(|k| a[i][k] * a[j][k]).sum::<f64>()) / d;
@@ -284,16 +363,27 @@ fn ols(cols: &[&[f64]], x: &[f64], rows: &[usize]) -> Vec<f64> {
 /// `x` minus its projection on `cols` fitted over `rows`, evaluated on every row.
 fn residualise(cols: &[&[f64]], x: &[f64], rows: &[usize]) -> Vec<f64> {
     let w = ols(cols, x, rows);
-    (0..x.len()).map(|r| x[r] - cols.iter().zip(&w).map(|(c, w)| c[r] * w).sum::<f64>()).collect()
+    (0..x.len())
+        .map(|r| x[r] - cols.iter().zip(&w).map(|(c, w)| c[r] * w).sum::<f64>())
+        .collect()
 }
 
 /// Lasso path by coordinate descent (covariance updates: the Gram matrix once, O(p) per
 /// coordinate) on standardised `x` over training `rows`, warm started; calls
 /// `visit(k, beta)` at each penalty of `lambdas`.
-fn lasso_path(x: &[Vec<f64>], y: &[f64], rows: &[usize], lambdas: &[f64], mut visit: impl FnMut(usize, &[f64])) {
+fn lasso_path(
+    x: &[Vec<f64>],
+    y: &[f64],
+    rows: &[usize],
+    lambdas: &[f64],
+    mut visit: impl FnMut(usize, &[f64]),
+) {
     let n = rows.len() as f64;
     let p = x.len();
-    let xs: Vec<Vec<f64>> = x.iter().map(|c| rows.iter().map(|&r| c[r]).collect()).collect();
+    let xs: Vec<Vec<f64>> = x
+        .iter()
+        .map(|c| rows.iter().map(|&r| c[r]).collect())
+        .collect();
     let ys: Vec<f64> = rows.iter().map(|&r| y[r]).collect();
     let mut gram = vec![vec![0.0; p]; p];
     for i in 0..p {
@@ -319,7 +409,10 @@ fn lasso_path(x: &[Vec<f64>], y: &[f64], rows: &[usize], lambdas: &[f64], mut vi
                 let new = rho.signum() * (rho.abs() - lam).max(0.0) / g;
                 let d = new - beta[j];
                 if d != 0.0 {
-                    fitted.iter_mut().zip(&gram[j]).for_each(|(f, gj)| *f += d * gj);
+                    fitted
+                        .iter_mut()
+                        .zip(&gram[j])
+                        .for_each(|(f, gj)| *f += d * gj);
                     beta[j] = new;
                     delta = delta.max(d.abs() * g.sqrt());
                 }
@@ -342,7 +435,9 @@ fn prepared(t: &Table, rows: &[usize]) -> (Vec<f64>, Vec<Vec<f64>>) {
         .map(|(_, v)| {
             let r = residualise(&base, v, rows);
             let sd = (rows.iter().map(|&i| r[i] * r[i]).sum::<f64>() / rows.len() as f64).sqrt();
-            r.iter().map(|v| if sd > 1e-12 { v / sd } else { 0.0 }).collect()
+            r.iter()
+                .map(|v| if sd > 1e-12 { v / sd } else { 0.0 })
+                .collect()
         })
         .collect();
     (y, x)
@@ -352,7 +447,11 @@ fn prepared(t: &Table, rows: &[usize]) -> (Vec<f64>, Vec<Vec<f64>>) {
 /// norm: within-run columns on their within-run variation (run offsets drop out), columns
 /// constant in every run on their run means.
 fn run_scores(t: &Table, resid: &[f64], z: &[f64]) -> (bool, Vec<f64>) {
-    let between = t.run_rows.iter().all(|rr| z[rr.clone()].iter().all(|v| (v - z[rr.start]).abs() < 1e-12));
+    let between = t.run_rows.iter().all(|rr| {
+        z[rr.clone()]
+            .iter()
+            .all(|v| (v - z[rr.start]).abs() < 1e-12)
+    });
     let mut u = Vec::with_capacity(t.run_rows.len());
     let mut ss = 0.0;
     for rr in &t.run_rows {
@@ -376,11 +475,16 @@ fn run_scores(t: &Table, resid: &[f64], z: &[f64]) -> (bool, Vec<f64>) {
 /// `tested`, p = 2 x share of flips whose max over its family reaches the observed score.
 fn sign_flip(t: &Table, resid: &[f64], z: &[Vec<f64>], tested: &[usize], seed: u64) -> Vec<f64> {
     let scores: Vec<(bool, Vec<f64>)> = z.iter().map(|c| run_scores(t, resid, c)).collect();
-    let obs: Vec<f64> = tested.iter().map(|&j| scores[j].1.iter().sum::<f64>().abs()).collect();
+    let obs: Vec<f64> = tested
+        .iter()
+        .map(|&j| scores[j].1.iter().sum::<f64>().abs())
+        .collect();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut exceed = vec![0usize; tested.len()];
     for _ in 0..FLIPS {
-        let eps: Vec<f64> = (0..t.run_rows.len()).map(|_| if rng.random_bool(0.5) { 1.0 } else { -1.0 }).collect();
+        let eps: Vec<f64> = (0..t.run_rows.len())
+            .map(|_| if rng.random_bool(0.5) { 1.0 } else { -1.0 })
+            .collect();
         let mut max = [0.0f64; 2];
         for (between, u) in &scores {
             let m = &mut max[usize::from(*between)];
@@ -390,7 +494,10 @@ fn sign_flip(t: &Table, resid: &[f64], z: &[Vec<f64>], tested: &[usize], seed: u
             *e += usize::from(max[usize::from(scores[j].0)] >= *o - 1e-15);
         }
     }
-    exceed.iter().map(|e| (2.0 * (1 + e) as f64 / (1 + FLIPS) as f64).min(1.0)).collect()
+    exceed
+        .iter()
+        .map(|e| (2.0 * (1 + e) as f64 / (1 + FLIPS) as f64).min(1.0))
+        .collect()
 }
 
 /// Runs the peer on a campaign (>= 3 runs with the same columns and metadata keys).
@@ -398,25 +505,49 @@ pub fn peer(runs: &[Run]) -> PeerReport {
     let t = table(runs);
     let all: Vec<usize> = (0..t.y.len()).collect();
     let (y_all, x_all) = prepared(&t, &all);
-    let lam_max = x_all.iter().map(|c| dot(c, &y_all).abs() / all.len() as f64).fold(1e-300, f64::max);
-    let lambdas: Vec<f64> = (0..LAMBDAS).map(|k| lam_max * 10f64.powf(-3.0 * k as f64 / (LAMBDAS - 1) as f64)).collect();
+    let lam_max = x_all
+        .iter()
+        .map(|c| dot(c, &y_all).abs() / all.len() as f64)
+        .fold(1e-300, f64::max);
+    let lambdas: Vec<f64> = (0..LAMBDAS)
+        .map(|k| lam_max * 10f64.powf(-3.0 * k as f64 / (LAMBDAS - 1) as f64))
+        .collect();
     let folds = runs.len().min(5);
     let mut fold_mse = vec![vec![0.0; LAMBDAS]; folds];
     let mut sse = vec![0.0; LAMBDAS];
     for (f, mse) in fold_mse.iter_mut().enumerate() {
-        let test: Vec<usize> = t.run_rows.iter().enumerate().filter(|(i, _)| i % folds == f).flat_map(|(_, r)| r.clone()).collect();
-        let train: Vec<usize> = t.run_rows.iter().enumerate().filter(|(i, _)| i % folds != f).flat_map(|(_, r)| r.clone()).collect();
+        let test: Vec<usize> = t
+            .run_rows
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| i % folds == f)
+            .flat_map(|(_, r)| r.clone())
+            .collect();
+        let train: Vec<usize> = t
+            .run_rows
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| i % folds != f)
+            .flat_map(|(_, r)| r.clone())
+            .collect();
         let (y, x) = prepared(&t, &train);
         lasso_path(&x, &y, &train, &lambdas, |k, beta| {
-            let e: f64 = test.iter().map(|&r| (y[r] - x.iter().zip(beta).map(|(c, b)| c[r] * b).sum::<f64>()).powi(2)).sum();
+            let e: f64 = test
+                .iter()
+                .map(|&r| (y[r] - x.iter().zip(beta).map(|(c, b)| c[r] * b).sum::<f64>()).powi(2))
+                .sum();
             sse[k] += e;
             mse[k] = e / test.len() as f64;
         });
     }
     let cv: Vec<f64> = sse.iter().map(|s| s / all.len() as f64).collect();
-    let best = (0..LAMBDAS).min_by(|a, b| cv[*a].total_cmp(&cv[*b])).unwrap_or(0);
+    let best = (0..LAMBDAS)
+        .min_by(|a, b| cv[*a].total_cmp(&cv[*b]))
+        .unwrap_or(0);
     let m = mean(&fold_mse.iter().map(|f| f[best]).collect::<Vec<_>>());
-    let se = (fold_mse.iter().map(|f| (f[best] - m).powi(2)).sum::<f64>() / (folds * (folds - 1)).max(1) as f64).sqrt();
+    let se = (fold_mse.iter().map(|f| (f[best] - m).powi(2)).sum::<f64>()
+        / (folds * (folds - 1)).max(1) as f64)
+        .sqrt();
     let chosen = (0..=best).find(|k| cv[*k] <= cv[best] + se).unwrap_or(best);
     let mut selected = Vec::new();
     lasso_path(&x_all, &y_all, &all, &lambdas[..=chosen], |k, beta| {
@@ -433,14 +564,23 @@ pub fn peer(runs: &[Run]) -> PeerReport {
         let mut cols: Vec<&[f64]> = t.base.iter().map(Vec::as_slice).collect();
         cols.extend(model.iter().map(|&k| t.lib[k].1.as_slice()));
         let r = residualise(&cols, &t.y, &all);
-        let z: Vec<Vec<f64>> = t.lib.iter().map(|(_, v)| residualise(&cols, v, &all)).collect();
+        let z: Vec<Vec<f64>> = t
+            .lib
+            .iter()
+            .map(|(_, v)| residualise(&cols, v, &all))
+            .collect();
         let p = sign_flip(&t, &r, &z, &pool, 0x5EED ^ model.len() as u64);
-        let best = (0..pool.len()).min_by(|a, b| p[*a].total_cmp(&p[*b])).unwrap_or(0);
+        let best = (0..pool.len())
+            .min_by(|a, b| p[*a].total_cmp(&p[*b]))
+            .unwrap_or(0);
         if p[best] >= ALPHA {
             break;
         }
         let j = pool.remove(best);
-        named.push(Named { label: t.lib[j].0.clone(), p_value: p[best] });
+        named.push(Named {
+            label: t.lib[j].0.clone(),
+            p_value: p[best],
+        });
         model.push(j);
     }
     named.sort_by(|a, b| a.p_value.total_cmp(&b.p_value));
