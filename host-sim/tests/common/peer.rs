@@ -188,6 +188,65 @@ fn column_features(
     f
 }
 
+/// Run-level features of run `ri`'s metadata: numeric values as they are, other values as
+/// level indicators (all but the first level in sorted order).
+fn meta_features(runs: &[Run], ri: usize, n: usize) -> Vec<(String, Vec<f64>)> {
+    let mut feats = Vec::new();
+    for (key, v) in &runs[ri].meta {
+        match v.trim().parse::<f64>() {
+            Ok(num) => feats.push((format!("# {key}"), vec![num; n])),
+            Err(_) => {
+                let mut all: Vec<&str> = runs.iter().filter_map(|r| r.meta_value(key)).collect();
+                all.sort_unstable();
+                all.dedup();
+                for l in all.iter().skip(1) {
+                    feats.push((
+                        format!("# {key}=={l}"),
+                        vec![f64::from(u8::from(v == l)); n],
+                    ));
+                }
+            }
+        }
+    }
+    feats
+}
+
+/// max(0, x - q) at the quartiles q of `x` (a linear spline basis beside the value).
+fn hinges(name: &str, x: &[f64]) -> Vec<(String, Vec<f64>)> {
+    quartiles(x)
+        .into_iter()
+        .map(|q| {
+            (
+                format!("{name}:hinge>{q:.3}"),
+                x.iter().map(|v| (v - q).max(0.0)).collect(),
+            )
+        })
+        .collect()
+}
+
+fn varies(v: &[f64]) -> bool {
+    let m = mean(v);
+    v.iter().any(|x| (x - m).abs() > 1e-9 * (1.0 + m.abs()))
+}
+
+/// One run's 10 s means: the drift, then per column its level indicators (all but the
+/// first level, as fractions of the window) and its value.
+fn binned_run(run: &Run, names: &[String], few: &[Option<Vec<f64>>]) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let mut raw: Vec<Vec<f64>> = vec![run.drift_dph()];
+    for (n, lv) in names.iter().zip(few) {
+        let x = run
+            .column(n)
+            .map_or_else(|| vec![0.0; run.len()], <[f64]>::to_vec);
+        for l in lv.iter().flatten().skip(1) {
+            raw.push(x.iter().map(|v| f64::from(u8::from(v == l))).collect());
+        }
+        raw.push(x);
+    }
+    let mut b = binned(run, &raw);
+    let y = b.remove(0);
+    (y, b)
+}
+
 /// Builds the stacked table: y (drift), the base (1, T, T^2, dT/dt) and the library.
 fn table(runs: &[Run]) -> Table {
     let names: Vec<String> = runs[0]
@@ -200,23 +259,8 @@ fn table(runs: &[Run]) -> Table {
         .iter()
         .map(|n| if n == "t_s" { None } else { levels(runs, n) })
         .collect();
-    // per run: binned drift, columns, level fractions
-    let mut per_run: Vec<(Vec<f64>, Vec<Vec<f64>>)> = Vec::new();
-    for run in runs {
-        let mut raw: Vec<Vec<f64>> = vec![run.drift_dph()];
-        for (n, lv) in names.iter().zip(&few) {
-            let x = run
-                .column(n)
-                .map_or_else(|| vec![0.0; run.len()], <[f64]>::to_vec);
-            for l in lv.iter().flatten().skip(1) {
-                raw.push(x.iter().map(|v| f64::from(u8::from(v == l))).collect());
-            }
-            raw.push(x);
-        }
-        let mut b = binned(run, &raw);
-        let y = b.remove(0);
-        per_run.push((y, b));
-    }
+    let per_run: Vec<(Vec<f64>, Vec<Vec<f64>>)> =
+        runs.iter().map(|r| binned_run(r, &names, &few)).collect();
     let ti = names.iter().position(|n| n == "t_s").unwrap_or(0);
     let temp_i = names.iter().position(|n| n == "temp_c").unwrap_or(0);
     // column index in the binned set: levels come before each column's value
@@ -264,23 +308,7 @@ fn table(runs: &[Run]) -> Table {
             }
             feats.push((format!("{name}:run_mean"), vec![mean(&x); n]));
         }
-        for (key, v) in &runs[ri].meta {
-            match v.trim().parse::<f64>() {
-                Ok(num) => feats.push((format!("# {key}"), vec![num; n])),
-                Err(_) => {
-                    let mut all: Vec<&str> =
-                        runs.iter().filter_map(|r| r.meta_value(key)).collect();
-                    all.sort_unstable();
-                    all.dedup();
-                    for l in all.iter().skip(1) {
-                        feats.push((
-                            format!("# {key}=={l}"),
-                            vec![f64::from(u8::from(v == l)); n],
-                        ));
-                    }
-                }
-            }
-        }
+        feats.extend(meta_features(runs, ri, n));
         for (b, v) in base.iter_mut().zip([
             vec![1.0; n],
             temp.iter().map(|x| x - tm).collect(),
@@ -300,22 +328,11 @@ fn table(runs: &[Run]) -> Table {
         run_rows.push(start..y.len());
     }
     // hinges at the campaign's quartiles of every many-valued column
-    for (i, name) in names.iter().enumerate() {
-        if few[i].is_some() {
-            continue;
-        }
+    for (i, name) in names.iter().enumerate().filter(|(i, _)| few[*i].is_none()) {
         let x: Vec<f64> = per_run.iter().flat_map(|r| value(r, i)).collect();
-        for q in quartiles(&x) {
-            lib.push((
-                format!("{name}:hinge>{q:.3}"),
-                x.iter().map(|v| (v - q).max(0.0)).collect(),
-            ));
-        }
+        lib.extend(hinges(name, &x));
     }
-    lib.retain(|(_, v)| {
-        let m = mean(v);
-        v.iter().any(|x| (x - m).abs() > 1e-9 * (1.0 + m.abs()))
-    });
+    lib.retain(|(_, v)| varies(v));
     Table {
         run_rows,
         y,
@@ -337,8 +354,8 @@ fn ols(cols: &[&[f64]], x: &[f64], rows: &[usize]) -> Vec<f64> {
             }
         }
     }
-    for i in 0..p {
-        a[i][i] += 1e-10 * a[i][i] + 1e-300;
+    for (i, row) in a.iter_mut().enumerate() {
+        row[i] += 1e-10 * row[i] + 1e-300;
     }
     // Cholesky in place (lower)
     for j in 0..p {
