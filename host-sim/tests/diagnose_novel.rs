@@ -5,7 +5,7 @@
 //! are run side by side; one table row per case. The assertions hold what both achieve on
 //! the CI seeds (see docs/diagnose.md, "Effects the library was not written around"); the
 //! rest is printed. Full table: `DIAG_SEEDS=11,22,33,44,55,66 cargo test -p fog-sim --test
-//! diagnose_novel -- --nocapture --test-threads=1`.
+//! diagnose_novel -- --nocapture --test-threads=2`.
 
 #[path = "common/novel.rs"]
 mod novel;
