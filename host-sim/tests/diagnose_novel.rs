@@ -1,0 +1,250 @@
+//! Effects `diagnose` was not written around (issue 18): for every family of
+//! `common/novel.rs` (its effect, a twin of another physical law, the null twin) and every
+//! seed, `fog_sim::diagnose` (through its public entry point and the JSON of its report, so
+//! that a restructured engine still runs here) and the generic peer of `common/peer.rs`
+//! are run side by side; one table row per case. The assertions hold what both achieve on
+//! the CI seeds (see docs/diagnose.md, "Effects the library was not written around"); the
+//! rest is printed. Full table: `DIAG_SEEDS=11,22,33,44,55,66 cargo test -p fog-sim --test
+//! diagnose_novel -- --nocapture --test-threads=2`.
+
+#[path = "common/novel.rs"]
+mod novel;
+#[path = "common/peer.rs"]
+mod peer;
+#[path = "common/seeds.rs"]
+mod seeds;
+
+use novel::{campaign, Family, Shape, Variant, VARIANTS};
+use serde_json::Value;
+
+/// Campaign shape of every case: 12 runs x 40 min, each planted cause at 1 sigma.
+const SHAPE: Shape = Shape {
+    runs: 12,
+    minutes: 40.0,
+    sigmas: 1.0,
+};
+
+/// The CI seed: one, since `diagnose` itself takes ~1-3 s a case and there are 18 cases.
+const CI_SEED: u64 = seeds::SEEDS[0];
+
+/// `DIAG_SEEDS` when set, else the CI seed.
+fn case_seeds() -> Vec<u64> {
+    if std::env::var("DIAG_SEEDS").is_ok() {
+        seeds::seeds()
+    } else {
+        vec![CI_SEED]
+    }
+}
+
+/// What `diagnose` names: every named cause's label (the report's `named_causes` when it
+/// has them, else `named_cause` plus the between-run `named`), the extended model's
+/// held-out gain and the p of the first named cause.
+struct Engine {
+    named: Vec<String>,
+    gain_pct: f64,
+    p_value: Option<f64>,
+}
+
+fn label_of(v: &Value) -> Option<String> {
+    if let Some(s) = v.as_str() {
+        return Some(s.to_owned());
+    }
+    if let Some(l) = v.get("label").and_then(Value::as_str) {
+        return Some(l.to_owned());
+    }
+    let col = v.get("column")?.as_str()?;
+    let tr = v.get("transform").and_then(Value::as_str).unwrap_or("?");
+    Some(match v.get("tau_s").and_then(Value::as_f64) {
+        Some(tau) => format!("{col}:{tr}(tau_s={tau})"),
+        None => format!("{col}:{tr}"),
+    })
+}
+
+/// p of a named label: its candidate or between-run row.
+fn p_of(report: &Value, label: &str) -> Option<f64> {
+    let col = label.split(':').next().unwrap_or("");
+    let tr = label
+        .split(':')
+        .nth(1)
+        .unwrap_or("")
+        .split('(')
+        .next()
+        .unwrap_or("");
+    let within = report.get("candidates")?.as_array()?.iter().find(|c| {
+        c.get("column").and_then(Value::as_str) == Some(col)
+            && c.get("transform").and_then(Value::as_str) == Some(tr)
+    });
+    let between = || {
+        report
+            .pointer("/between_run/rows")?
+            .as_array()?
+            .iter()
+            .find(|r| r.get("label").and_then(Value::as_str) == Some(label))
+            .cloned()
+    };
+    within.cloned().or_else(between)?.get("p_value")?.as_f64()
+}
+
+fn engine(runs: &[fog_sim::io::runs::Run]) -> Engine {
+    let d = fog_sim::diagnose::diagnose(runs).expect("diagnose runs on the generated campaign");
+    let v = serde_json::to_value(&d.report).expect("report serialises");
+    let named: Vec<String> = match v.get("named_causes").and_then(Value::as_array) {
+        Some(list) => list.iter().filter_map(label_of).collect(),
+        None => v
+            .get("named_cause")
+            .and_then(label_of)
+            .into_iter()
+            .chain(v.pointer("/between_run/named").and_then(label_of))
+            .collect(),
+    };
+    let first_p = v.pointer("/named_causes/0/p_value").and_then(Value::as_f64);
+    Engine {
+        gain_pct: v
+            .pointer("/extended/gain_pct")
+            .and_then(Value::as_f64)
+            .unwrap_or(0.0),
+        p_value: first_p.or_else(|| named.first().and_then(|l| p_of(&v, l))),
+        named,
+    }
+}
+
+/// Columns (or metadata keys) a label speaks of: `supply_v*temp_c:rate` -> supply_v,
+/// temp_c; `# mount==B` -> mount; `heading_deg:run_harmonic` -> heading_deg.
+fn columns_of(label: &str) -> Vec<String> {
+    label
+        .split('*')
+        .map(|p| {
+            let p = p.trim_start_matches("# ");
+            p.split([':', '=', '(', '>']).next().unwrap_or(p).to_owned()
+        })
+        .collect()
+}
+
+/// right: every planted column named, nothing else (temp_c, the base's own column, aside);
+/// partial: some planted column named; wrong: only other columns; miss / none: nothing.
+fn verdict(truth: &[&str], named: &[String]) -> &'static str {
+    let cols: Vec<String> = named.iter().flat_map(|l| columns_of(l)).collect();
+    let hits = truth
+        .iter()
+        .filter(|c| cols.iter().any(|n| n == *c))
+        .count();
+    let extra = cols
+        .iter()
+        .any(|c| c != "temp_c" && !truth.contains(&c.as_str()));
+    match (named.is_empty(), truth.is_empty()) {
+        (true, true) => "none",
+        (true, false) => "miss",
+        (false, true) => "FALSE",
+        _ if hits == truth.len() && !extra => "right",
+        _ if hits > 0 => "partial",
+        _ => "wrong",
+    }
+}
+
+struct Row {
+    variant: Variant,
+    seed: u64,
+    engine: &'static str,
+    peer: &'static str,
+    line: String,
+}
+
+fn run_family(family: Family) -> Vec<Row> {
+    let cases: Vec<(Variant, u64)> = VARIANTS
+        .iter()
+        .flat_map(|v| case_seeds().into_iter().map(move |s| (*v, s)))
+        .collect();
+    cases
+        .into_iter()
+        .map(|(variant, seed)| {
+            let (runs, truth) = campaign(family, variant, seed, SHAPE);
+            let e = engine(&runs);
+            let p = peer::peer(&runs);
+            let peer_named: Vec<String> = p.named.iter().map(|n| format!("{} p{:.3}", n.label, n.p_value)).collect();
+            let peer_labels: Vec<String> = p.named.iter().map(|n| n.label.clone()).collect();
+            let (ev, pv) = (verdict(&truth.columns, &e.named), verdict(&truth.columns, &peer_labels));
+            let line = format!(
+                "| {family:?} | {variant:?} | {seed} | {} | {} {ev} | {:+.1} | {} | {} {pv} | {:+.1} ({} of {}) |",
+                truth.law,
+                if e.named.is_empty() { "-".to_owned() } else { e.named.join(", ") },
+                e.gain_pct,
+                e.p_value.map_or("-".to_owned(), |p| format!("{p:.4}")),
+                if peer_named.is_empty() { "-".to_owned() } else { peer_named.join(", ") },
+                p.cv_gain_pct,
+                p.selected,
+                p.library_size,
+            );
+            println!("{line}");
+            Row { variant, seed, engine: ev, peer: pv, line }
+        })
+        .collect()
+}
+
+/// Asserts `holds` on the CI seed's row of `variant` (other seeds are printed only; the
+/// 6-seed table in docs/diagnose.md says how often each claim holds there).
+fn assert_ci(rows: &[Row], variant: Variant, what: &str, holds: impl Fn(&Row) -> bool) {
+    let bad: Vec<&str> = rows
+        .iter()
+        .filter(|r| r.seed == CI_SEED && r.variant == variant && !holds(r))
+        .map(|r| r.line.as_str())
+        .collect();
+    assert!(bad.is_empty(), "{what}: {bad:#?}");
+}
+
+/// Neither names anything on the null twin.
+fn nulls_name_nothing(rows: &[Row]) {
+    assert_ci(rows, Variant::Null, "null twin: nothing named", |r| {
+        r.engine == "none" && r.peer == "none"
+    });
+}
+
+#[test]
+fn product_of_two_columns() {
+    let rows = run_family(Family::Product);
+    nulls_name_nothing(&rows);
+    assert_ci(&rows, Variant::Effect, "peer names supply_v x dT/dt", |r| {
+        r.peer == "right"
+    });
+}
+
+#[test]
+fn categorical_column() {
+    let rows = run_family(Family::Categorical);
+    nulls_name_nothing(&rows);
+    assert_ci(&rows, Variant::Effect, "peer names the mode levels", |r| {
+        r.peer == "right"
+    });
+}
+
+#[test]
+fn smooth_nonlinear_function_of_a_column() {
+    let rows = run_family(Family::Smooth);
+    nulls_name_nothing(&rows);
+    assert_ci(&rows, Variant::Effect, "both name cabinet_c", |r| {
+        r.engine == "right" && r.peer == "right"
+    });
+}
+
+#[test]
+fn rate_independent_memory() {
+    let rows = run_family(Family::Memory);
+    nulls_name_nothing(&rows);
+    assert_ci(&rows, Variant::Twin, "both name a temp_c lag", |r| {
+        r.engine == "right" && r.peer == "right"
+    });
+}
+
+#[test]
+fn between_run_effect_of_metadata() {
+    let rows = run_family(Family::Metadata);
+    nulls_name_nothing(&rows);
+    assert_ci(&rows, Variant::Effect, "peer names # mount", |r| {
+        r.peer == "right"
+    });
+}
+
+#[test]
+fn two_causes_at_once() {
+    let rows = run_family(Family::Stacked);
+    nulls_name_nothing(&rows);
+}
