@@ -52,8 +52,8 @@ pub struct Args {
     /// Input axis azimuth of the whole log, deg (becomes a `heading_deg` column).
     #[arg(long, allow_hyphen_values = true)]
     pub heading_deg: Option<f64>,
-    /// A time step longer than this starts a new run, s (default: ten median sample
-    /// spacings of the log, at least 60 s).
+    /// A time step longer than this starts a new run, s [default: ten median sample
+    /// spacings of the log, at least 60 s].
     #[arg(long)]
     pub split_gap_s: Option<f64>,
 }

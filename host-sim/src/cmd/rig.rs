@@ -51,7 +51,7 @@ pub struct Args {
     /// Sample time per real time (QEMU's serial link cannot take more than about 10x20 Hz).
     #[arg(long, default_value_t = 10.0)]
     pub speed: f64,
-    /// Stop after this many seconds of sample time (default: until a link closes).
+    /// Stop after this many seconds of sample time [default: until a link closes]
     #[arg(long)]
     pub duration_s: Option<f64>,
     /// Wait at most this many seconds for each link to connect.
