@@ -996,6 +996,81 @@ mod tests {
         );
     }
 
+    /// The default model of `north-seek --ambient 20 --seed 1` (3 runs at 20 degC).
+    fn model_at_20c() -> RbfModel {
+        use crate::pipeline::campaign_steps::{simulate_checked, train_default, CampaignSpec};
+        let plan = CampaignSpec {
+            ambients_c: vec![20.0],
+            runs_per_ambient: 3,
+            ..CampaignSpec::paper(1)
+        };
+        let campaign = simulate_checked(&GyroParams::paper_default(), &plan).unwrap();
+        let runs: Vec<_> = campaign.iter().map(|c| &c.run).collect();
+        train_default(&runs, &crate::train::default_specs(), "sim")
+            .unwrap()
+            .model
+    }
+
+    #[test]
+    fn a_cold_start_warming_faster_than_the_training_runs_is_not_refused() {
+        // Start 64 of `north-seek --starts 200`: its warm-up peaks at dT/dt = 0.0129 degC/s,
+        // above the 3 training runs' envelope (+5 %), which flagged 4 windows of its first
+        // position and refused the seek. The declared range (run-to-run spread of the
+        // training runs' extremes) covers it.
+        let cfg = MonteCarloConfig {
+            seeks_per_start: 1,
+            ..MonteCarloConfig::paper(1)
+        };
+        let model = model_at_20c();
+        let arm = Arm {
+            model: Some(&model),
+            feed_tilt: true,
+            heading: None,
+        };
+        let seed = cfg.start_seed(63);
+        assert_eq!(seed, 9_851_787_880_037_274_203);
+        let out = run_seeks(&GyroParams::paper_default(), &cfg, arm, seed).unwrap();
+        assert_eq!(out.refusals, Vec::new());
+        assert_eq!(out.seeks.len(), 1);
+    }
+
+    #[test]
+    fn a_model_from_another_ambient_is_refused_recorded_and_retried_not_aborted() {
+        // Twin: the same 20 degC model at -40 degC, where T is 60 degC outside anything
+        // trained: every attempt is refused with the finder's reason, the seek is given up
+        // after MAX_ATTEMPTS_PER_SEEK attempts, and the Monte Carlo goes on.
+        let cfg = MonteCarloConfig {
+            seeks_per_start: 1,
+            ambient_c: -40.0,
+            ..MonteCarloConfig::paper(1)
+        };
+        let model = model_at_20c();
+        let arm = Arm {
+            model: Some(&model),
+            feed_tilt: true,
+            heading: None,
+        };
+        let out = run_seeks(&GyroParams::paper_default(), &cfg, arm, 5).unwrap();
+        assert_eq!(out.seeks.len(), 0);
+        assert_eq!(out.failed_seeks, 1);
+        assert_eq!(out.refusals.len(), MAX_ATTEMPTS_PER_SEEK);
+        assert!(out.refusals.iter().all(|r| r.index == 0
+            && matches!(
+                r.reason,
+                QualityError::Finder(fog_core::seek_quality::FinderFault::TooManyInvalidWindows {
+                    position: 0
+                })
+            )));
+        let st = seek_stats(&[out], cfg.true_azimuth_deg);
+        assert_eq!(st.reliability.refusal_rate, 1.0);
+        assert_eq!(
+            st.reliability
+                .refusal_reasons
+                .get("Finder(TooManyInvalidWindows)"),
+            Some(&MAX_ATTEMPTS_PER_SEEK)
+        );
+    }
+
     #[test]
     fn start_seeds_differ_and_repeat() {
         let cfg = MonteCarloConfig::paper(7);

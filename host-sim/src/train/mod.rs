@@ -17,6 +17,7 @@ mod assemble;
 mod candidates;
 mod config;
 mod dataset;
+pub mod declared_range;
 mod design;
 mod error;
 mod fit;
@@ -93,6 +94,9 @@ pub struct TrainReport {
     pub design_bytes: usize,
     /// Bytes of the final fit's Gram matrices (what it holds).
     pub gram_bytes: usize,
+    /// How the model's declared input range (`input_min`/`input_max`, what the device
+    /// checks each window against) was set from the training runs.
+    pub declared_range: Vec<declared_range::InputRange>,
     /// Wall time of width selection and of the final fit, s.
     pub validation_s: f64,
     pub final_fit_s: f64,
@@ -161,6 +165,8 @@ pub fn train_model(ds: &Dataset, cfg: &TrainConfig) -> Result<TrainOutcome> {
     )?;
     let final_fit_s = started.elapsed().as_secs_f64();
     fit.model.meta.heldout_rms_dph = cv.best.heldout_rms_dph as f32;
+    let ranges = declared_range::declared_ranges(ds);
+    declared_range::apply(&mut fit.model, &ranges);
     let pred = predict_batch(&fit.model, ds.rows())?;
     let resid: Vec<f64> = ds
         .targets_dph
@@ -198,6 +204,7 @@ pub fn train_model(ds: &Dataset, cfg: &TrainConfig) -> Result<TrainOutcome> {
         design_bytes: fit.design_bytes,
         gram_bytes: fit.gram_bytes,
         cross_validation: cv,
+        declared_range: ranges,
         validation_s,
         final_fit_s,
     };
