@@ -27,6 +27,7 @@ mod ols;
 mod orr;
 mod path;
 mod predict;
+pub mod seek_score;
 mod select;
 mod validate;
 
@@ -58,6 +59,8 @@ use std::time::Instant;
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TrainReport {
     pub method: Method,
+    /// The held-out score that chose the model's width and polynomial degree.
+    pub criterion: seek_score::Criterion,
     pub inputs: Vec<String>,
     pub linear_only_inputs: usize,
     /// Training points (= candidate centres of the final fit).
@@ -176,6 +179,7 @@ pub fn train_model(ds: &Dataset, cfg: &TrainConfig) -> Result<TrainOutcome> {
         .collect();
     let report = TrainReport {
         method: cfg.method,
+        criterion: cfg.criterion,
         inputs: ds.input_names.clone(),
         linear_only_inputs: cfg.linear_only_inputs,
         n_train: ds.len(),
