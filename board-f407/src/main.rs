@@ -36,10 +36,10 @@ use defmt_rtt as _;
 
 use cortex_m_rt::entry;
 use embedded_hal_nb::serial::{Read as _, Write as _};
-use fog_core::compensator::Compensator;
+use fog_core::compensation::compensator::Compensator;
 use fog_core::hal::{Gyro, TemperatureSensor};
-use fog_core::model::RbfModel;
-use fog_core::protocol::ResetRecord;
+use fog_core::link::upload::ResetRecord;
+use fog_core::model::format::RbfModel;
 use fog_firmware::app::{App, AppConfig};
 use fog_firmware::clock::Clock;
 use fog_firmware::drivers::fog_serial::FogSerialGyro;

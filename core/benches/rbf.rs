@@ -3,9 +3,9 @@
 //! (T, dT/dt). Run: `cargo bench -p fog-core --bench rbf`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use fog_core::fixed::FixedModel;
-use fog_core::rbf::{predict_f32, predict_f64};
-use fog_core::synthetic::{random_warmup_point, warmup_model, SplitMix64};
+use fog_core::model::fixed::FixedModel;
+use fog_core::model::rbf::{predict_f32, predict_f64};
+use fog_core::model::synthetic::{random_warmup_point, warmup_model, SplitMix64};
 use std::hint::black_box;
 
 fn inputs(n: usize) -> Vec<[f32; 2]> {

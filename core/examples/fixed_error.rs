@@ -4,9 +4,9 @@
 //!
 //! `cargo run -p fog-core --release --example fixed_error -- [MODEL]...`
 
-use fog_core::accuracy::worst_errors;
-use fog_core::model::RbfModel;
-use fog_core::synthetic::warmup_model;
+use fog_core::model::accuracy::worst_errors;
+use fog_core::model::format::RbfModel;
+use fog_core::model::synthetic::warmup_model;
 
 fn report(name: &str, m: &RbfModel) {
     match worst_errors(m, 250_000, 250_000, 1) {

@@ -5,25 +5,30 @@
 //! subtracts it, and runs the north-seeking routine on the compensated windows.
 //! `no_std`, no allocation, no `unsafe`; every fallible call returns a small `Copy`
 //! error enum instead of panicking on data.
+//!
+//! Map of the crate, one folder per concern (each `mod.rs` says what is in it):
+//! - [`model`]: the RBF drift model: its stored/wire `format`, and its evaluation paths
+//!   (`rbf` f32/f64, `fixed` integer-only, `accuracy` of one against the other, `synthetic`
+//!   models for benchmarks and tests);
+//! - [`compensation`]: sensor streams -> model inputs (`features`, named by `label`) ->
+//!   drift-free 10 s windows (`compensator`);
+//! - [`seeking`]: compensated windows -> azimuth (`northfinder`, `tilt`, `heading_cal`,
+//!   seek `quality`);
+//! - [`link`]: the host port: model `upload` and frame format, north-finder `messages`, the
+//!   built-in-test word (`bit`);
+//! - [`hal`]: the hardware traits the simulator and the firmware drivers both implement.
+//!
+//! Two small files stay at the root because more than one concern uses them and none owns
+//! them: [`consts`] (Earth rate, the 10 s window; used by compensation, seeking and the
+//! host) and [`numeric`] (exact float helpers that keep libm's f64 routines out of the
+//! firmware; used by compensation, seeking and `consts`).
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
 
-pub mod accuracy;
-pub mod bit;
-pub mod compensator;
+pub mod compensation;
 pub mod consts;
-pub mod exp_neg;
-pub mod features;
-pub mod fixed;
 pub mod hal;
-pub mod heading_cal;
 pub mod link;
 pub mod model;
-mod model_in_place;
-pub mod northfinder;
 pub mod numeric;
-pub mod protocol;
-pub mod rbf;
-pub mod seek_quality;
-pub mod synthetic;
-pub mod tilt;
+pub mod seeking;

@@ -1,14 +1,14 @@
 //! The 10 s pipeline end to end on a synthetic warm-up: window means, features identical to
 //! the trainer's helper, drift and compensated rate, and every validity status.
 
-use fog_core::compensator::{
+use fog_core::compensation::compensator::{
     Compensator, CompensatorConfig, CompensatorError, Evaluator, WindowResult, WindowStatus,
 };
-use fog_core::features::{features_for_series, FeatureVector};
+use fog_core::compensation::features::{features_for_series, FeatureVector};
 use fog_core::hal::{GyroSample, TempSample};
-use fog_core::model::RbfModel;
-use fog_core::rbf::predict_f32;
-use fog_core::synthetic::{warmup_inputs, warmup_model};
+use fog_core::model::format::RbfModel;
+use fog_core::model::rbf::predict_f32;
+use fog_core::model::synthetic::{warmup_inputs, warmup_model};
 
 const GYRO_HZ: f64 = 100.0;
 
@@ -260,7 +260,7 @@ fn bad_setup_is_rejected() {
         Some(CompensatorError::BadConfig)
     );
     let mut m = model();
-    m.inputs[1].kind = fog_core::model::FeatureKind::AuxValue(0);
+    m.inputs[1].kind = fog_core::model::format::FeatureKind::AuxValue(0);
     assert_eq!(
         Compensator::new(config(Evaluator::F32), Some(m)).err(),
         Some(CompensatorError::AuxNotConfigured { channel: 0 })
@@ -278,7 +278,7 @@ fn pipeline_state_fits_a_small_mcu() {
     // Everything the device keeps for compensation and seeking (model, fixed copy, averagers,
     // estimators): must stay well inside the firmware's 16 KiB static RAM budget.
     let comp = std::mem::size_of::<Compensator>();
-    let nf = std::mem::size_of::<fog_core::northfinder::NorthFinder>();
+    let nf = std::mem::size_of::<fog_core::seeking::northfinder::NorthFinder>();
     println!("Compensator {comp} B, NorthFinder {nf} B");
     assert!(comp + nf <= 10 * 1024, "{comp} + {nf}");
 }
@@ -293,7 +293,7 @@ proptest::proptest! {
     ) {
         let ev = if fixed { Evaluator::Fixed } else { Evaluator::F32 };
         let mut comp = Compensator::new(config(ev), Some(model())).unwrap();
-        let mut nf = fog_core::northfinder::NorthFinder::new(Default::default()).unwrap();
+        let mut nf = fog_core::seeking::northfinder::NorthFinder::new(Default::default()).unwrap();
         struct Table;
         impl fog_core::hal::Turntable for Table {
             type Error = ();

@@ -1,11 +1,11 @@
 //! Window averager against a naive mean, the least-squares rate estimator on quantised
 //! ramps (no spikes, documented delay), lags and the series helper.
 
-use fog_core::features::{
+use fog_core::compensation::features::{
     features_for_series, FeatureExtractor, FeatureVector, FirstOrderLag, TempRateEstimator,
     WindowAverager, DEFAULT_RATE_SPAN_S,
 };
-use fog_core::model::{FeatureKind, FeatureSpec};
+use fog_core::model::format::{FeatureKind, FeatureSpec};
 use proptest::prelude::*;
 
 /// Sample times at `rate_hz` over `duration_s`, minus the samples inside `gaps`
@@ -30,7 +30,7 @@ proptest! {
     ) {
         let duration_s = 40.0;
         let times = sample_times(rate_hz, duration_s, &gaps, phase);
-        let mut rng = fog_core::synthetic::SplitMix64::new(seed);
+        let mut rng = fog_core::model::synthetic::SplitMix64::new(seed);
         let values: Vec<f32> = times.iter().map(|_| (rng.range(-5.0, 5.0)) as f32).collect();
         let mut avg = WindowAverager::new(10.0, rate_hz as f32).unwrap();
         let mut closed = Vec::new();

@@ -3,11 +3,13 @@
 //! refused `set_model_from` leaves the old model and its history untouched, and
 //! `RbfModel::decode_into` replaces whatever the storage held before.
 
-use fog_core::compensator::{Compensator, CompensatorConfig, CompensatorError, Evaluator};
-use fog_core::fixed::FixedError;
+use fog_core::compensation::compensator::{
+    Compensator, CompensatorConfig, CompensatorError, Evaluator,
+};
 use fog_core::hal::{GyroSample, TempSample};
-use fog_core::model::RbfModel;
-use fog_core::synthetic::{warmup_inputs, warmup_model};
+use fog_core::model::fixed::FixedError;
+use fog_core::model::format::RbfModel;
+use fog_core::model::synthetic::{warmup_inputs, warmup_model};
 
 const GYRO_HZ: f64 = 100.0;
 

@@ -1,12 +1,12 @@
 //! Model format: round trip, size budget, and rejection of every kind of corrupted model
 //! with the matching typed error.
 
-use fog_core::heading_cal::HeadingHarmonic;
-use fog_core::model::{
+use fog_core::model::format::{
     crc32, FeatureKind, ModelError, ModelField, RbfModel, MAX_CENTERS, MAX_ENCODED_LEN,
     MODEL_MAGIC, MODEL_VERSION,
 };
-use fog_core::synthetic::warmup_model;
+use fog_core::model::synthetic::warmup_model;
+use fog_core::seeking::heading_cal::HeadingHarmonic;
 use serde::Serialize;
 
 fn encode(m: &RbfModel) -> Vec<u8> {
@@ -20,7 +20,7 @@ fn encode(m: &RbfModel) -> Vec<u8> {
 #[derive(Serialize)]
 struct LooseModel {
     n_rbf_inputs: u8,
-    inputs: Vec<fog_core::model::FeatureSpec>,
+    inputs: Vec<fog_core::model::format::FeatureSpec>,
     input_offset: Vec<f32>,
     input_scale: Vec<f32>,
     input_min: Vec<f32>,
@@ -30,7 +30,7 @@ struct LooseModel {
     widths: Vec<f32>,
     weights: Vec<f32>,
     bias_dph: f32,
-    meta: fog_core::model::TrainingMeta,
+    meta: fog_core::model::format::TrainingMeta,
     poly: Vec<f32>,
     heading: Option<HeadingHarmonic>,
 }
@@ -314,7 +314,7 @@ fn encode_refuses_invalid_models() {
 
 #[test]
 fn random_bytes_never_panic() {
-    let mut rng = fog_core::synthetic::SplitMix64::new(99);
+    let mut rng = fog_core::model::synthetic::SplitMix64::new(99);
     let good = encode(&warmup_model(35, 2, 2.0, 5));
     for _ in 0..20_000 {
         let len = (rng.next_u64() % 2100) as usize;
@@ -368,7 +368,7 @@ fn v1_fields(
     loose: &LooseModel,
 ) -> (
     u8,
-    &Vec<fog_core::model::FeatureSpec>,
+    &Vec<fog_core::model::format::FeatureSpec>,
     &Vec<f32>,
     &Vec<f32>,
     &Vec<f32>,
@@ -378,7 +378,7 @@ fn v1_fields(
     &Vec<f32>,
     &Vec<f32>,
     f32,
-    &fog_core::model::TrainingMeta,
+    &fog_core::model::format::TrainingMeta,
 ) {
     (
         loose.n_rbf_inputs,
@@ -422,7 +422,7 @@ fn polynomial_base_round_trips() {
 /// infinite drift is now refused.
 #[test]
 fn models_that_could_give_huge_or_infinite_drift_are_refused() {
-    use fog_core::rbf::predict_f32;
+    use fog_core::model::rbf::predict_f32;
     let good = warmup_model(35, 2, 2.0, 5);
     let mut huge_weight = good.clone();
     huge_weight.weights[0] = 3.0e38;

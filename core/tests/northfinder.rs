@@ -2,13 +2,15 @@
 //! around the circle, bias steps between dwells, white noise against the analytic floor,
 //! four positions, timeouts and invalid windows.
 
-use fog_core::compensator::{WindowResult, WindowStatus};
+use fog_core::compensation::compensator::{WindowResult, WindowStatus};
 use fog_core::consts::earth_rate_horizontal_dph;
 use fog_core::hal::{TableState, Turntable};
-use fog_core::heading_cal::HeadingHarmonic;
-use fog_core::northfinder::{NorthFinder, SeekConfig, SeekError, SeekMode, SeekResult, SeekStatus};
-use fog_core::synthetic::SplitMix64;
-use fog_core::tilt::{earth_rate_on_axis_dph, Tilt};
+use fog_core::model::synthetic::SplitMix64;
+use fog_core::seeking::heading_cal::HeadingHarmonic;
+use fog_core::seeking::northfinder::{
+    NorthFinder, SeekConfig, SeekError, SeekMode, SeekResult, SeekStatus,
+};
+use fog_core::seeking::tilt::{earth_rate_on_axis_dph, Tilt};
 
 const LAT_DEG: f64 = 39.9;
 

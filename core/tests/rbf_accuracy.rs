@@ -1,11 +1,11 @@
 //! Evaluation paths against each other: f32 vs the f64 reference, fixed point vs f32,
 //! and the fixed-point worst error over a realistic model's input range.
 
-use fog_core::accuracy::worst_errors as worst_errors_in_box;
-use fog_core::fixed::{exp_neg_q30, f32_to_fixed, fixed_to_f32, FixedModel};
-use fog_core::model::{FeatureKind, FeatureSpec, RbfModel, TrainingMeta};
-use fog_core::rbf::{predict_f32, predict_f64, RbfError};
-use fog_core::synthetic::{random_warmup_point, warmup_model, SplitMix64};
+use fog_core::model::accuracy::worst_errors as worst_errors_in_box;
+use fog_core::model::fixed::{exp_neg_q30, f32_to_fixed, fixed_to_f32, FixedModel};
+use fog_core::model::format::{FeatureKind, FeatureSpec, RbfModel, TrainingMeta};
+use fog_core::model::rbf::{predict_f32, predict_f64, RbfError};
+use fog_core::model::synthetic::{random_warmup_point, warmup_model, SplitMix64};
 use proptest::prelude::*;
 
 /// A model from proptest-chosen parameters, already in normalised space.
@@ -180,7 +180,7 @@ fn exp_kernel_is_within_3e_9_of_exp() {
     assert_eq!(exp_neg_q30(23 << 28), 0);
 }
 
-/// Worst errors over the trained input box (grid + random points, `fog_core::accuracy`)
+/// Worst errors over the trained input box (grid + random points, `fog_core::model::accuracy`)
 /// and along the warm-up trajectories the synthetic model was built from.
 fn worst_errors(m: &RbfModel) -> (f64, f64) {
     let rep = worst_errors_in_box(m, 90_000, 50_000, 1234).unwrap();
@@ -272,7 +272,7 @@ fn q16_output_agrees_with_f32_output() {
 /// uses (u = d^2/(2 s^2) in [0, 87]; beyond it the result is 0, as f32 underflows).
 #[test]
 fn exp_neg_f32_relative_error() {
-    use fog_core::rbf::exp_neg_f32;
+    use fog_core::model::rbf::exp_neg_f32;
     let mut worst = 0.0f64;
     for i in 0..=870_000 {
         let u = i as f32 * 1e-4;

@@ -2,7 +2,7 @@
 //! the current window) must give exactly `floor(t / w)`, including right at window
 //! boundaries, after long runs and for windows of awkward lengths.
 
-use fog_core::features::WindowAverager;
+use fog_core::compensation::features::WindowAverager;
 use fog_core::numeric::floor_i64;
 use proptest::prelude::*;
 

@@ -16,19 +16,21 @@
 
 use core::borrow::BorrowMut;
 
-use fog_core::bit::BitWord;
-use fog_core::compensator::{Compensator, CompensatorConfig, CompensatorError, WindowResult};
+use fog_core::compensation::compensator::{
+    Compensator, CompensatorConfig, CompensatorError, WindowResult,
+};
 use fog_core::hal::{GyroSample, TableState, TempSample, Turntable};
-use fog_core::heading_cal::HeadingHarmonic;
-use fog_core::link::{
+use fog_core::link::bit::BitWord;
+use fog_core::link::messages::{
     Command, DeviceMessage, Refusal, ResetReason, SeekReport, Status, LINK_VERSION,
 };
-use fog_core::model::RbfModel;
-use fog_core::northfinder::{NorthFinder, SeekConfig, SeekError, SeekMode, SeekResult};
-use fog_core::seek_quality::{
+use fog_core::model::format::RbfModel;
+use fog_core::seeking::heading_cal::HeadingHarmonic;
+use fog_core::seeking::northfinder::{NorthFinder, SeekConfig, SeekError, SeekMode, SeekResult};
+use fog_core::seeking::quality::{
     MotionReason, QualityConfig, QualityError, SeekSupervisor, SupervisorEvent, Validity,
 };
-use fog_core::tilt::Tilt;
+use fog_core::seeking::tilt::Tilt;
 
 /// Application settings.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -6,7 +6,7 @@
 //! second and after each command, a result per seek) and this module how; the queue never
 //! takes half a frame (a frame that does not fit is dropped whole and the caller counts it).
 
-use fog_core::link::{encode, DeviceFrame, DeviceMessage, MAX_LINK_FRAME_LEN};
+use fog_core::link::messages::{encode, DeviceFrame, DeviceMessage, MAX_LINK_FRAME_LEN};
 use heapless::Deque;
 
 /// One encoded link frame.

@@ -15,10 +15,10 @@ use core::fmt::Write;
 
 use embedded_hal_nb::nb;
 use embedded_hal_nb::serial::{ErrorKind, ErrorType, Read as SerialRead};
-use fog_core::compensator::{Compensator, WindowResult, WindowStatus};
+use fog_core::compensation::compensator::{Compensator, WindowResult, WindowStatus};
 use fog_core::hal::{Gyro, TableState, Turntable};
-use fog_core::model::RbfModel;
-use fog_core::seek_quality::{FinderFault, QualityError};
+use fog_core::model::format::RbfModel;
+use fog_core::seeking::quality::{FinderFault, QualityError};
 
 use crate::app::{App, AppConfig, AppError, SeekOutcome};
 use crate::drivers::fog_serial::{FogSerialGyro, GyroStats};

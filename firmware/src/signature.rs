@@ -5,7 +5,7 @@
 //! `verify_model` is also what the budget scripts time under QEMU (instruction count).
 
 use ed25519_compact::{Error, PublicKey, Signature};
-use fog_core::protocol::SIGNATURE_LEN;
+use fog_core::link::upload::SIGNATURE_LEN;
 
 /// The repository's TEST public key (`keys/TEST-ONLY-public-key.bin`).
 /// Its secret seed is public: a production build must pass its own key to the server.

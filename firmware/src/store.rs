@@ -26,8 +26,8 @@ pub mod mirrored;
 pub mod ram_flash;
 
 use embedded_storage::nor_flash::NorFlash;
-use fog_core::model::MAX_ENCODED_LEN;
-use fog_core::protocol::{CRC32, SIGNATURE_LEN};
+use fog_core::link::upload::{CRC32, SIGNATURE_LEN};
+use fog_core::model::format::MAX_ENCODED_LEN;
 
 /// Slot magic "FOGS".
 const SLOT_MAGIC: u32 = 0x5347_4F46;

@@ -2,7 +2,7 @@
 //!
 //! The application feeds every received UART byte to [`UploadServer::push_byte`] and
 //! queues the returned response frame for sending. The host port carries
-//! `fog_core::link::HostFrame`s: upload requests are handled here, north-finder commands
+//! `fog_core::link::messages::HostFrame`s: upload requests are handled here, north-finder commands
 //! are handed to the application (they share the framing and the reply budget); nothing here touches hardware, so
 //! the same code runs in host tests and in the firmware. A model becomes active only
 //! after its CRC, its security counter (no rollback), its Ed25519 signature over
@@ -24,14 +24,14 @@
 //! (another key, tampered flash) is not used and the other slot is tried.
 
 use embedded_storage::nor_flash::NorFlash;
-use fog_core::link::{Command, DeviceFrame, HostFrame};
-use fog_core::model::{ModelError, RbfModel, MAX_ENCODED_LEN};
-use fog_core::protocol::{
+use fog_core::link::messages::{Command, DeviceFrame, HostFrame};
+use fog_core::link::upload::{
     decode_message, encode_frame, signed_prefix, DeviceStatus, FrameReceiver, ModelInfo,
     ModelRejection, Request, ResetRecord, Response, UploadError, UploadPhase, GYRO_ID_LEN,
     MAX_CHUNK_LEN, MAX_WIRE_FRAME_LEN, PROTOCOL_VERSION, SESSION_IDLE_TIMEOUT_S, SIGNATURE_LEN,
     SIGNED_PREFIX_LEN,
 };
+use fog_core::model::format::{ModelError, RbfModel, MAX_ENCODED_LEN};
 use heapless::String;
 
 use crate::signature::verify_model;
@@ -585,7 +585,7 @@ fn commit<F: NorFlash>(
     }
     *s.session = Session::Idle;
     let end = SIGNED_PREFIX_LEN + model_len as usize;
-    if fog_core::protocol::crc32(&s.buf[SIGNED_PREFIX_LEN..end]) != model_crc32 {
+    if fog_core::link::upload::crc32(&s.buf[SIGNED_PREFIX_LEN..end]) != model_crc32 {
         return Err(UploadError::ModelCrcMismatch);
     }
     let signature: &[u8; SIGNATURE_LEN] = signature

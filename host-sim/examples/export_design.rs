@@ -89,7 +89,7 @@ fn main() -> anyhow::Result<()> {
         "n_train": ds_train.len(), "n_test": ds_test.len(), "width": width,
         "ours": {
             "method": "OLS (Chen-Cowan-Grant), every sample a candidate, bias forced",
-            "final_fit_s": outcome.report.final_fit_s,
+            "final_fit_s": outcome.report.timings.final_fit_s,
             "pipeline_s": pipeline_s,
             "n_centers": model.centers.len(),
             "train_rms_dph": outcome.report.train_rms_dph,
@@ -99,7 +99,7 @@ fn main() -> anyhow::Result<()> {
     std::fs::write(out.join("meta.json"), serde_json::to_vec_pretty(&meta)?)?;
     println!(
         "exported {} train x {} candidates, {} test rows at width {width}; ours: {} centres, fit {:.2} s, held-out rms {heldout:.4} dph",
-        ds_train.len(), ds_train.len(), ds_test.len(), model.centers.len(), outcome.report.final_fit_s
+        ds_train.len(), ds_train.len(), ds_test.len(), model.centers.len(), outcome.report.timings.final_fit_s
     );
     Ok(())
 }

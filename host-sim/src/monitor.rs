@@ -1,4 +1,4 @@
-//! `fogsim monitor`: the PC side of the north finder's host link (`fog_core::link`).
+//! `fogsim monitor`: the PC side of the north finder's host link (`fog_core::link::messages`).
 //!
 //! Exists so an operator sees the device's live status (state, progress, predicted accuracy,
 //! BIT) and gets every seek result in a CSV. Frames are decoded with fog-core's
@@ -17,11 +17,11 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context, Result};
-use fog_core::link::{
+use fog_core::link::messages::{
     decode, encode, Command, DeviceFrame, DeviceMessage, HostFrame, SeekReport, Status,
 };
-use fog_core::protocol::{FrameReceiver, MAX_WIRE_FRAME_LEN, STATUS_REQUEST_PADDING};
-use fog_core::seek_quality::Validity;
+use fog_core::link::upload::{FrameReceiver, MAX_WIRE_FRAME_LEN, STATUS_REQUEST_PADDING};
+use fog_core::seeking::quality::Validity;
 
 /// Header of the results CSV.
 pub const CSV_HEADER: &str =
@@ -202,10 +202,10 @@ fn handle(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use fog_core::bit::BitWord;
-    use fog_core::link::{ResetReason, LINK_VERSION};
-    use fog_core::seek_quality::SeekState;
-    use fog_core::tilt::Tilt;
+    use fog_core::link::bit::BitWord;
+    use fog_core::link::messages::{ResetReason, LINK_VERSION};
+    use fog_core::seeking::quality::SeekState;
+    use fog_core::seeking::tilt::Tilt;
     use std::net::{TcpListener, TcpStream};
 
     fn status(progress: f32) -> Status {

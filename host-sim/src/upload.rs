@@ -1,6 +1,6 @@
 //! The training PC's side of the model upload: sign a model and send it to the device.
 //!
-//! Speaks `fog_core::protocol` inside `fog_core::link::HostFrame::Upload` (the host port
+//! Speaks `fog_core::link::upload` inside `fog_core::link::messages::HostFrame::Upload` (the host port
 //! also carries the north finder's messages, which this client skips) over any byte
 //! link (`Read + Write`): a serial port
 //! (`serialport` crate) for real hardware, or TCP for QEMU's `-serial tcp:...`.
@@ -14,8 +14,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use ed25519_compact::{KeyPair, Seed};
-use fog_core::link::{DeviceFrame, HostFrame};
-use fog_core::protocol::{
+use fog_core::link::messages::{DeviceFrame, HostFrame};
+use fog_core::link::upload::{
     crc32, decode_message, encode_frame, signed_prefix, DeviceStatus, FrameError, FrameReceiver,
     ModelInfo, Request, Response, UploadError, MAX_CHUNK_LEN, MAX_WIRE_FRAME_LEN, PROTOCOL_VERSION,
     SIGNATURE_LEN, STATUS_REQUEST_PADDING,

@@ -86,7 +86,7 @@ fn malformed_files_and_impossible_options_are_rejected() {
     rejects(
         &dir,
         &[&["reproduce", "--minutes", "-5"][..], &json].concat(),
-        &["--minutes"],
+        &["--duration-min"],
     );
     rejects(
         &dir,

@@ -8,14 +8,14 @@ mod app_support;
 mod independent;
 
 use app_support::{fogsim, scratch_dir, stderr};
-use fog_core::model::RbfModel;
-use fog_core::synthetic::warmup_model;
+use fog_core::model::format::RbfModel;
+use fog_core::model::synthetic::warmup_model;
 use fog_sim::diagnose::diagnose;
 use independent::{campaign, Hidden, REPEATABILITY_DPH};
 
 fn write_model(dir: &std::path::Path) -> RbfModel {
     let m = warmup_model(16, 2, 1.0, 7);
-    let mut buf = [0u8; fog_core::model::MAX_ENCODED_LEN];
+    let mut buf = [0u8; fog_core::model::format::MAX_ENCODED_LEN];
     let n = m.encode(&mut buf).unwrap();
     std::fs::write(dir.join("model.bin"), &buf[..n]).unwrap();
     m

@@ -51,7 +51,7 @@ fn per_seed(hidden: Hidden) -> Vec<(bool, String)> {
                 accel.map_or(f64::NAN, |a| a.1.p_value),
                 r.base.name,
                 r.base.rate_half_width_s,
-                r.candidates.first().map(|c| fog_sim::report::feature_label(&c.column, c.transform.name(), c.tau_s)),
+                r.candidates.first().map(|c| fog_core::compensation::label::feature_label(&c.column, c.transform.name(), c.tau_s).to_string()),
                 r.candidates.first().map_or(f64::NAN, |c| c.gain_pct),
                 r.candidates.first().map_or(f64::NAN, |c| c.p_value),
             );

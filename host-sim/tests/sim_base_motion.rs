@@ -2,12 +2,12 @@
 //! base, a 12.5 s rocking episode (+-1 deg of pitch, 2.5 cycles) in the middle of the first dwell; the supervisor restarts the
 //! seek with the reason and still finds the azimuth afterwards. Same seed, same outcome.
 
-use fog_core::bit::BitWord;
-use fog_core::compensator::{Compensator, CompensatorConfig};
+use fog_core::compensation::compensator::{Compensator, CompensatorConfig};
 use fog_core::hal::GyroSample;
-use fog_core::northfinder::{NorthFinder, SeekConfig, SeekMode};
-use fog_core::seek_quality::{MotionReason, QualityConfig, SeekSupervisor, SupervisorEvent};
-use fog_core::tilt::Tilt;
+use fog_core::link::bit::BitWord;
+use fog_core::seeking::northfinder::{NorthFinder, SeekConfig, SeekMode};
+use fog_core::seeking::quality::{MotionReason, QualityConfig, SeekSupervisor, SupervisorEvent};
+use fog_core::seeking::tilt::Tilt;
 use fog_sim::sim::{
     rig, BaseMotion, Disturbance, GyroParams, RunSpec, StartState, TurntableParams,
 };

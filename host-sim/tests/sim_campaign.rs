@@ -95,7 +95,7 @@ fn impossible_options_fail_with_one_line_and_no_output() {
     let o = out.to_str().unwrap();
     for (args, needle) in [
         (vec!["--runs", "0"], "--runs"),
-        (vec!["--minutes", "-5"], "--minutes"),
+        (vec!["--minutes", "-5"], "--duration-min"),
         (vec!["--latitude", "100"], "--latitude"),
         (vec!["--ambient", "-40,200"], "--ambient"),
         (vec!["--ambient", "-40,abc"], "--ambient"),

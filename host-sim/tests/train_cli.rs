@@ -3,7 +3,7 @@
 
 mod app_support;
 
-use fog_core::model::RbfModel;
+use fog_core::model::format::RbfModel;
 use std::path::Path;
 
 /// Writes one fog-runs v1 file of a warm-up whose drift follows dT/dt.

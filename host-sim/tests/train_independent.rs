@@ -6,7 +6,7 @@
 //! 4-5 are held out. A twin of the same generator with a different physical law (linear
 //! static bias, no Shupe term, a sinusoidal gradient response) checks the same claims.
 
-use fog_core::model::PAPER_INPUTS;
+use fog_core::model::format::PAPER_INPUTS;
 use fog_sim::diagnose::linalg::solve_spd;
 use fog_sim::train::{pooled_std, predict_batch, train_model, Dataset, TrainConfig, Verdict};
 

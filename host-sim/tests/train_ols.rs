@@ -4,7 +4,7 @@
 
 mod train_support;
 
-use fog_core::model::RbfModel;
+use fog_core::model::format::RbfModel;
 use fog_sim::train::{
     fit_width, predict_batch, rms, train_model, Dataset, Method, StopReason, TrainConfig,
     TrainError,
@@ -140,8 +140,8 @@ fn linear_only_input_is_fitted_jointly_with_the_rbf() {
         vec![
             specs_t_rate()[0],
             specs_t_rate()[1],
-            fog_core::model::FeatureSpec {
-                kind: fog_core::model::FeatureKind::AuxValue(0),
+            fog_core::model::format::FeatureSpec {
+                kind: fog_core::model::format::FeatureKind::AuxValue(0),
                 tau_s: 0.0,
             },
         ],
@@ -210,7 +210,7 @@ fn same_data_gives_the_same_model_bytes_whatever_the_thread_count() {
             ..TrainConfig::default()
         };
         let out = train_model(&ds, &cfg).unwrap();
-        let mut buf = [0u8; fog_core::model::MAX_ENCODED_LEN];
+        let mut buf = [0u8; fog_core::model::format::MAX_ENCODED_LEN];
         let n = out.model.encode(&mut buf).unwrap();
         buf[..n].to_vec()
     };

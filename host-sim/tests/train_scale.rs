@@ -4,7 +4,7 @@
 
 mod train_support;
 
-use fog_core::model::MAX_CENTERS;
+use fog_core::model::format::MAX_CENTERS;
 use fog_sim::train::{fit_width, train_model, TrainConfig, TrainError};
 use train_support::{campaign, shupe_like};
 

@@ -8,6 +8,7 @@
 //! twin with a different law plants a d2T/dt2 term the inputs cannot see.
 
 #[path = "common/independent.rs"]
+#[allow(dead_code)] // only the null and d2T/dt2 campaigns are used here
 mod independent;
 
 use fog_sim::io::bin::WindowBinner;

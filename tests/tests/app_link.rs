@@ -5,11 +5,11 @@
 mod app_support;
 
 use app_support::InstantTable;
-use fog_core::bit::{BitItem, BitLimits, BitWord};
 use fog_core::hal::{GyroSample, TempSample};
-use fog_core::link::{Command, DeviceMessage, Refusal, ResetReason, SeekReport};
-use fog_core::seek_quality::{QualityError, SeekState, Validity};
-use fog_core::tilt::{earth_rate_on_axis_dph, Tilt};
+use fog_core::link::bit::{BitItem, BitLimits, BitWord};
+use fog_core::link::messages::{Command, DeviceMessage, Refusal, ResetReason, SeekReport};
+use fog_core::seeking::quality::{QualityError, SeekState, Validity};
+use fog_core::seeking::tilt::{earth_rate_on_axis_dph, Tilt};
 use fog_firmware::app::{App, AppConfig, BoardStatus, SeekOutcome};
 use fog_firmware::bit_monitor::{BitCounters, BitMonitor, TABLE_FAULT_HOLD_S};
 
@@ -303,7 +303,7 @@ fn the_bit_word_follows_each_counter() {
 /// cleared by a model without one or by running without a model.
 #[test]
 fn the_heading_correction_follows_the_active_model() {
-    use fog_core::heading_cal::HeadingHarmonic;
+    use fog_core::seeking::heading_cal::HeadingHarmonic;
     let harmonic = HeadingHarmonic {
         cos_dph: -0.04,
         sin_dph: 0.07,
@@ -312,7 +312,7 @@ fn the_heading_correction_follows_the_active_model() {
         correlation: 0.1,
         n_headings: 12,
     };
-    let plain = fog_core::synthetic::warmup_model(8, 2, 1.0, 3);
+    let plain = fog_core::model::synthetic::warmup_model(8, 2, 1.0, 3);
     let mut calibrated = plain.clone();
     calibrated.heading = Some(harmonic);
     let mut cfg = AppConfig::for_rate(RATE_HZ as f32);

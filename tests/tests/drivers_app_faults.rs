@@ -10,9 +10,9 @@ use std::cell::Cell;
 use app_support::InstantTable;
 use embedded_hal_mock::eh1::serial::{Mock, Transaction};
 use embedded_hal_nb::nb;
-use fog_core::compensator::WindowStatus;
+use fog_core::compensation::compensator::WindowStatus;
 use fog_core::hal::{GyroSample, TempSample};
-use fog_core::seek_quality::{FinderFault, QualityError, Validity};
+use fog_core::seeking::quality::{FinderFault, QualityError, Validity};
 use fog_firmware::app::{App, AppConfig, SeekOutcome};
 use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig, TurntableError};
 

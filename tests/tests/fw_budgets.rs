@@ -94,8 +94,8 @@ fn firmware_fits_its_budgets() {
     let dir = scratch_dir("bench");
     let key =
         fog_sim::upload::load_signing_key(&fog_sim::upload::test_key_path()).expect("test key");
-    let model = fog_core::synthetic::warmup_model(35, 2, 0.05, 35);
-    let mut buf = [0u8; fog_core::model::MAX_ENCODED_LEN];
+    let model = fog_core::model::synthetic::warmup_model(35, 2, 0.05, 35);
+    let mut buf = [0u8; fog_core::model::format::MAX_ENCODED_LEN];
     let n = model.encode(&mut buf).expect("encode");
     std::fs::write(dir.join("model.bin"), &buf[..n]).unwrap();
     std::fs::write(

@@ -9,8 +9,8 @@ mod upload_support;
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use fog_core::link::{DeviceFrame, HostFrame};
-use fog_core::protocol::{
+use fog_core::link::messages::{DeviceFrame, HostFrame};
+use fog_core::link::upload::{
     decode_frame, decode_message, encode_frame, FrameReceiver, Request, Response, UploadError,
     MAX_CHUNK_LEN, MAX_WIRE_FRAME_LEN,
 };

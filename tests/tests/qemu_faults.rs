@@ -21,7 +21,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use fog_core::protocol::ResetCause;
+use fog_core::link::upload::ResetCause;
 use fog_sim::upload::{ClientError, UploadClient};
 use fog_tests::console::wait_line;
 use fog_tests::qemu_ready;
@@ -76,7 +76,7 @@ fn qemu_panic_resets_reports_its_line_and_keeps_the_model() {
         .expect("the committed model survived the reset");
     assert_eq!(
         (active.security_counter, active.model_crc32),
-        (counter, fog_core::protocol::crc32(&bytes))
+        (counter, fog_core::link::upload::crc32(&bytes))
     );
 }
 

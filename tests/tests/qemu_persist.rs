@@ -20,7 +20,7 @@ use std::path::Path;
 use std::sync::mpsc::Receiver;
 use std::time::Duration;
 
-use fog_core::protocol::{DeviceStatus, ModelInfo, ResetCause};
+use fog_core::link::upload::{DeviceStatus, ModelInfo, ResetCause};
 use fog_sim::upload::UploadClient;
 use fog_tests::console::{start_with_console, wait_line};
 use fog_tests::{firmware_elf, qemu_ready, scratch_dir, KillOnDrop, QemuOptions};

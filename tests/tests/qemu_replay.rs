@@ -21,9 +21,9 @@
 use std::cell::RefCell;
 use std::time::Duration;
 
-use fog_core::compensator::Evaluator;
-use fog_core::model::{RbfModel, MAX_ENCODED_LEN};
-use fog_core::synthetic::warmup_model;
+use fog_core::compensation::compensator::Evaluator;
+use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
+use fog_core::model::synthetic::warmup_model;
 use fog_firmware::app::{App, AppConfig};
 use fog_firmware::drivers::fog_serial::FogSerialGyro;
 use fog_firmware::drivers::gyro_frame::{FrameDecoder, GyroFrame, STATUS_TEMP_INVALID};

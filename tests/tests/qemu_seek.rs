@@ -10,7 +10,7 @@
 //! same base tilt as the gyro generator (`tilt-mdeg=`), so the tilt compensation is in the
 //! loop end to end.
 //!
-//! Gyro law: Earth rate on the tilted input axis (`fog_core::tilt::earth_rate_on_axis_dph`,
+//! Gyro law: Earth rate on the tilted input axis (`fog_core::seeking::tilt::earth_rate_on_axis_dph`,
 //! true azimuth of table zero `TRUE_AZIMUTH_DEG`) + a constant bias + a heading-dependent
 //! bias a cos(alpha) + b sin(alpha) of the axis azimuth alpha (`HEADING`) + white noise of
 //! ARW `ARW_DPSH`; 25 degC. The heading harmonic's calibration travels inside the model
@@ -38,12 +38,12 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use fog_core::bit::{BitItem, BitWord};
 use fog_core::consts::EARTH_RATE_DPH;
-use fog_core::heading_cal::HeadingHarmonic;
-use fog_core::link::{Command, ResetReason, SeekReport, Status};
-use fog_core::seek_quality::{SeekState, Validity};
-use fog_core::tilt::{earth_rate_on_axis_dph, Tilt};
+use fog_core::link::bit::{BitItem, BitWord};
+use fog_core::link::messages::{Command, ResetReason, SeekReport, Status};
+use fog_core::seeking::heading_cal::HeadingHarmonic;
+use fog_core::seeking::quality::{SeekState, Validity};
+use fog_core::seeking::tilt::{earth_rate_on_axis_dph, Tilt};
 use fog_sim::monitor::{monitor, MonitorOptions, MonitorSummary, ResultLog};
 use fog_sim::upload::UploadClient;
 use fog_tests::console::{wait_line, wait_line_where};

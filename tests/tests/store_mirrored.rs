@@ -7,7 +7,7 @@
 mod upload_support;
 
 use embedded_storage::nor_flash::NorFlash;
-use fog_core::model::MAX_ENCODED_LEN;
+use fog_core::model::format::MAX_ENCODED_LEN;
 use fog_firmware::store::mirrored::{
     load_image, Backing, BackingFailed, ImageError, MirroredFlash,
 };

@@ -9,7 +9,7 @@
 mod upload_support;
 
 use embedded_storage::nor_flash::{NorFlash, ReadNorFlash};
-use fog_core::model::MAX_ENCODED_LEN;
+use fog_core::model::format::MAX_ENCODED_LEN;
 use fog_firmware::store::ram_flash::RamNorFlash;
 use fog_firmware::store::{store_len, ModelStore};
 use upload_support::{encode, sample_model, sign_with_test_key};

@@ -5,10 +5,10 @@
 
 mod upload_support;
 
-use fog_core::model::MAX_ENCODED_LEN;
-use fog_core::protocol::{
+use fog_core::link::upload::{
     crc32, ModelInfo, ModelRejection, Request, Response, UploadError, UploadPhase, MAX_CHUNK_LEN,
 };
+use fog_core::model::format::MAX_ENCODED_LEN;
 use fog_firmware::signature::TEST_PUBLIC_KEY;
 use fog_sim::upload::{key_from_seed, sign_upload, ClientError};
 use rand::{Rng, SeedableRng};
@@ -109,10 +109,10 @@ fn every_bad_upload_is_refused_with_its_typed_error_and_the_model_stays() {
     let mut v2 = bytes.clone();
     assert_eq!(
         u16::from(v2[5]),
-        fog_core::model::MODEL_VERSION,
+        fog_core::model::format::MODEL_VERSION,
         "version byte"
     );
-    v2[5] = (fog_core::model::MODEL_VERSION + 1) as u8;
+    v2[5] = (fog_core::model::format::MODEL_VERSION + 1) as u8;
     let sig_v2 = sign_with_test_key(2, &v2);
     expect_rejected(
         c.upload(&v2, 2, &sig_v2, |_, _| {}),

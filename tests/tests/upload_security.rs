@@ -6,8 +6,8 @@
 
 mod upload_support;
 
-use fog_core::link::HostFrame;
-use fog_core::protocol::{
+use fog_core::link::messages::HostFrame;
+use fog_core::link::upload::{
     encode_frame, Request, Response, UploadError, UploadPhase, MAX_WIRE_FRAME_LEN,
     SESSION_IDLE_TIMEOUT_S,
 };
@@ -16,7 +16,7 @@ use fog_firmware::upload::{SlotVerdict, UploadServer};
 use fog_sim::upload::{key_from_seed, ClientError};
 use upload_support::*;
 
-fn rejected(result: Result<fog_core::protocol::ModelInfo, ClientError>) -> UploadError {
+fn rejected(result: Result<fog_core::link::upload::ModelInfo, ClientError>) -> UploadError {
     match result {
         Err(ClientError::Rejected(e)) => e,
         other => panic!("expected a rejection, got {other:?}"),
@@ -179,7 +179,7 @@ fn tamper_newest_signature(flash: EmulatedModelFlash) -> EmulatedModelFlash {
     let seq = |base: usize| u32::from_le_bytes(raw[base + 8..base + 12].try_into().unwrap());
     let base = if seq(slot_len) > seq(0) { slot_len } else { 0 };
     raw[base + 30] ^= 0x01;
-    let crc = fog_core::protocol::crc32(&raw[base..base + 88]);
+    let crc = fog_core::link::upload::crc32(&raw[base..base + 88]);
     raw[base + 88..base + 92].copy_from_slice(&crc.to_le_bytes());
     let mut out = EmulatedModelFlash::new();
     out.write(0, &raw).unwrap();
@@ -258,7 +258,7 @@ fn a_signed_model_with_an_unbounded_weight_is_refused_on_upload() {
     let e = rejected(c.upload(&huge, 2, &sign_with_test_key(2, &huge), |_, _| {}));
     assert_eq!(
         e,
-        UploadError::ModelInvalid(fog_core::protocol::ModelRejection::InvalidContent)
+        UploadError::ModelInvalid(fog_core::link::upload::ModelRejection::InvalidContent)
     );
     assert_eq!(c.status().unwrap().active, Some(active));
 }

@@ -2,7 +2,7 @@
 //!
 //! Wiring (a real board changes only this file and `target/`):
 //! - UART0 (0x4000_4000, QEMU's first `-serial`): the host port (RS-422 on the product),
-//!   carrying `fog_core::link::HostFrame`s: model uploads, handled by
+//!   carrying `fog_core::link::messages::HostFrame`s: model uploads, handled by
 //!   `fog_firmware::upload::UploadServer`, and north-finder commands (StartSeek,
 //!   SetLatitude, Abort, GetStatus), answered by the application; the device sends a
 //!   `Status` about once per second and after each command, and a `Result` per seek;
@@ -57,13 +57,13 @@ use defmt_semihosting as _;
 
 use cortex_m_rt::entry;
 use embedded_hal_nb::serial::{Read as _, Write as _};
-use fog_core::bit::BitLimits;
-use fog_core::compensator::Compensator;
+use fog_core::compensation::compensator::Compensator;
 use fog_core::hal::Gyro;
-use fog_core::link::{DeviceMessage, ResetReason};
-use fog_core::model::RbfModel;
-use fog_core::protocol::ResetRecord;
-use fog_core::tilt::Tilt;
+use fog_core::link::bit::BitLimits;
+use fog_core::link::messages::{DeviceMessage, ResetReason};
+use fog_core::link::upload::ResetRecord;
+use fog_core::model::format::RbfModel;
+use fog_core::seeking::tilt::Tilt;
 use fog_firmware::app::{App, AppConfig, BoardStatus, SeekOutcome};
 use fog_firmware::bit_monitor::{BitCounters, BitMonitor};
 use fog_firmware::clock::Clock;
@@ -366,7 +366,7 @@ fn answer_link(server: &mut Server, tx: &mut TxQueue, msg: DeviceMessage) {
 }
 
 /// A finished seek as one plain-text line on the semihosting console (QEMU tests).
-fn seek_line(r: &fog_core::link::SeekReport) {
+fn seek_line(r: &fog_core::link::messages::SeekReport) {
     #[cfg(feature = "log-semihosting")]
     semihosting::eprintln!(
         "FOG-SEEK sequence={} azimuth_mdeg={} sigma_mdeg={} positions={}",
@@ -434,7 +434,11 @@ fn report_slots(report: [fog_firmware::upload::SlotVerdict; 2]) {
 }
 
 /// A closed window as one plain-text line on the semihosting console (QEMU tests).
-fn window_line(w: &fog_core::compensator::WindowResult, frames_lost: u32, bytes_dropped: u32) {
+fn window_line(
+    w: &fog_core::compensation::compensator::WindowResult,
+    frames_lost: u32,
+    bytes_dropped: u32,
+) {
     #[cfg(feature = "log-semihosting")]
     semihosting::eprintln!(
         "FOG-WINDOW t_end_ms={} status={:?} valid={} n_samples={} frames_lost={} gyro_bytes_dropped={}",

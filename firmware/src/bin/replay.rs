@@ -20,9 +20,9 @@ use core::ffi::CStr;
 use core::fmt::Write as _;
 
 use cortex_m_rt::entry;
-use fog_core::compensator::Compensator;
-use fog_core::compensator::Evaluator;
-use fog_core::model::{RbfModel, MAX_ENCODED_LEN};
+use fog_core::compensation::compensator::Compensator;
+use fog_core::compensation::compensator::Evaluator;
+use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
 use fog_firmware::app::AppConfig;
 use fog_firmware::replay;
 

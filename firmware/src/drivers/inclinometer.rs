@@ -7,8 +7,8 @@
 //! value `fogsim north-seek` uses), from a seeded generator: same seed, same readings.
 
 use embedded_hal::spi::SpiDevice;
-use fog_core::synthetic::SplitMix64;
-use fog_core::tilt::Tilt;
+use fog_core::model::synthetic::SplitMix64;
+use fog_core::seeking::tilt::Tilt;
 
 use super::scl3300::{Scl3300, Scl3300Error};
 

@@ -1,5 +1,5 @@
 //! Murata SCL3300 inclinometer over SPI (embedded-hal 1.0 `SpiDevice`): the base tilt for the
-//! north finder's tilt maths (`fog_core::tilt`).
+//! north finder's tilt maths (`fog_core::seeking::tilt`).
 //!
 //! Datasheet protocol: 32-bit frames `[OP 8 | DATA 16 | CRC 8]`, OP = RW, 5-bit address and
 //! (in responses) the 2-bit return status RS; CRC-8 over the upper 24 bits, polynomial 0x1D,
@@ -14,11 +14,11 @@
 //!
 //! Angles: ANG = raw / 2^14 x 90 deg, the elevation of the sensor axis (positive up). With
 //! the sensor's x on table heading 0 and y on heading 90 (mounted on the base), pitch is
-//! ANG_X and roll is -asin(sin ANG_Y / cos ANG_X) (see `fog_core::tilt` for the frames).
+//! ANG_X and roll is -asin(sin ANG_Y / cos ANG_X) (see `fog_core::seeking::tilt` for the frames).
 
 use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::SpiDevice;
-use fog_core::tilt::Tilt;
+use fog_core::seeking::tilt::Tilt;
 
 pub const SW_RESET: u32 = 0xB400_2098;
 pub const MODE_4: u32 = 0xB400_0338;

@@ -14,20 +14,21 @@ pub struct Args {
     /// Output directory (created if missing).
     #[arg(long)]
     pub out: PathBuf,
-    /// Chamber temperatures, degC, comma separated [default: -40,-30,...,60].
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
-    pub ambient: Option<Vec<f64>>,
+    /// Chamber temperatures, degC, comma separated.
+    #[arg(long = "ambient-c", alias = "ambient", value_delimiter = ',', allow_hyphen_values = true,
+          default_values_t = PAPER_AMBIENTS_C.to_vec())]
+    pub ambient: Vec<f64>,
     /// Power-ons per temperature.
     #[arg(long, default_value_t = PAPER_RUNS)]
     pub runs: usize,
     /// Record length from power-on, min.
-    #[arg(long, default_value_t = PAPER_MINUTES, allow_hyphen_values = true)]
+    #[arg(long = "duration-min", alias = "minutes", default_value_t = PAPER_MINUTES, allow_hyphen_values = true)]
     pub minutes: f64,
     /// Seed; the same seed gives the same bytes.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Site latitude, deg.
-    #[arg(long, default_value_t = DEFAULT_LATITUDE_DEG, allow_hyphen_values = true)]
+    #[arg(long = "latitude-deg", alias = "latitude", default_value_t = DEFAULT_LATITUDE_DEG, allow_hyphen_values = true)]
     pub latitude: f64,
     /// Raw gyro sample rate, Hz.
     #[arg(long, default_value_t = 100.0)]
@@ -37,27 +38,27 @@ pub struct Args {
 impl Args {
     /// Checks the options and turns them into a campaign specification.
     pub fn to_spec(&self) -> anyhow::Result<CampaignSpec> {
-        let ambients = self
-            .ambient
-            .clone()
-            .unwrap_or_else(|| PAPER_AMBIENTS_C.to_vec());
+        let ambients = self.ambient.clone();
         if ambients.is_empty() {
-            bail!("--ambient: empty list");
+            bail!("--ambient-c: empty list");
         }
         if let Some(a) = ambients.iter().find(|a| !(-60.0..=100.0).contains(*a)) {
-            bail!("--ambient {a}: must be within -60..=100 degC");
+            bail!("--ambient-c {a}: must be within -60..=100 degC");
         }
         if !(1..=1000).contains(&self.runs) {
             bail!("--runs {}: must be within 1..=1000", self.runs);
         }
         if !(self.minutes.is_finite() && (10.0 / 60.0..=24.0 * 60.0).contains(&self.minutes)) {
             bail!(
-                "--minutes {}: must be within 1/6 (one 10 s mean) ..= 1440",
+                "--duration-min {}: must be within 1/6 (one 10 s mean) ..= 1440",
                 self.minutes
             );
         }
         if !(-90.0..=90.0).contains(&self.latitude) {
-            bail!("--latitude {}: must be within -90..=90 deg", self.latitude);
+            bail!(
+                "--latitude-deg {}: must be within -90..=90 deg",
+                self.latitude
+            );
         }
         let per_window = self.raw_rate_hz * 10.0;
         if !(0.1..=20_000.0).contains(&self.raw_rate_hz)

@@ -16,15 +16,15 @@ pub mod upload;
 use crate::io::OutputGuard;
 use std::path::{Path, PathBuf};
 
-/// Names the flag of a campaign-plan error (`--ambient`, `--minutes`, `--runs`); other
+/// Names the flag of a campaign-plan error (`--ambient-c`, `--duration-min`, `--runs`); other
 /// errors pass unchanged.
 pub(crate) fn with_plan_flag(e: anyhow::Error) -> anyhow::Error {
     use crate::pipeline::campaign_steps::{PlanError, PlanSetting};
     match e.downcast_ref::<PlanError>() {
         Some(p) => {
             let flag = match p.setting() {
-                PlanSetting::Ambients => "--ambient",
-                PlanSetting::Minutes => "--minutes",
+                PlanSetting::Ambients => "--ambient-c",
+                PlanSetting::Minutes => "--duration-min",
                 PlanSetting::RunsPerAmbient => "--runs",
             };
             anyhow::anyhow!("{flag}: {p}")

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::{bail, Result};
-use fog_core::link::Command;
+use fog_core::link::messages::Command;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::upload::LinkArgs;
@@ -20,10 +20,14 @@ pub struct Args {
     #[arg(long)]
     pub csv: PathBuf,
     /// Send the site latitude first, deg.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(
+        long = "latitude-deg",
+        alias = "latitude",
+        allow_negative_numbers = true
+    )]
     pub latitude: Option<f32>,
-    /// Start a seek with 2 or 4 positions.
-    #[arg(long)]
+    /// Start a seek with this many table positions (2 or 4).
+    #[arg(long = "positions", alias = "start", value_name = "POSITIONS")]
     pub start: Option<u8>,
     /// Stop after this many results.
     #[arg(long, default_value_t = 1)]
@@ -37,13 +41,13 @@ pub struct Args {
 pub fn run(a: Args) -> Result<()> {
     if let Some(p) = a.start {
         if p != 2 && p != 4 {
-            bail!("--start {p}: must be 2 or 4 positions");
+            bail!("--positions {p}: must be 2 or 4");
         }
     }
     let mut commands = Vec::new();
     if let Some(l) = a.latitude {
         if !(l.is_finite() && l.abs() < 85.0) {
-            bail!("--latitude {l}: must be within -85..85 deg");
+            bail!("--latitude-deg {l}: must be within -85..85 deg");
         }
         commands.push(Command::SetLatitude { latitude_deg: l });
     }

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Result};
-use fog_core::northfinder::SeekMode;
+use fog_core::seeking::northfinder::SeekMode;
 
 use super::check_output_file;
 use crate::io::model::read_model;
@@ -21,7 +21,7 @@ use crate::sim::GyroParams;
 /// Options of `fogsim north-seek`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Drift model (fog-core postcard, from `fogsim train`); default: train one on a simulated campaign.
+    /// Drift model (fog-core postcard, from `fogsim train`) [default: train one on a simulated campaign].
     #[arg(long)]
     pub model: Option<PathBuf>,
     /// Cold starts (power-ons).
@@ -34,22 +34,27 @@ pub struct Args {
     #[arg(long, default_value_t = 2)]
     pub positions: u8,
     /// Site latitude, deg (north positive).
-    #[arg(long, default_value_t = crate::sim::DEFAULT_LATITUDE_DEG, allow_negative_numbers = true)]
+    #[arg(long = "latitude-deg", alias = "latitude", default_value_t = crate::sim::DEFAULT_LATITUDE_DEG, allow_negative_numbers = true)]
     pub latitude: f64,
     /// Ambient (room) temperature, degC.
-    #[arg(long, default_value_t = 20.0, allow_negative_numbers = true)]
+    #[arg(
+        long = "ambient-c",
+        alias = "ambient",
+        default_value_t = 20.0,
+        allow_negative_numbers = true
+    )]
     pub ambient: f64,
     /// True azimuth of the table's zero, deg (the paper's was about 108.4).
-    #[arg(long, default_value_t = crate::pipeline::northseek::PAPER_AZIMUTH_DEG, allow_negative_numbers = true)]
+    #[arg(long = "azimuth-deg", alias = "azimuth", default_value_t = crate::pipeline::northseek::PAPER_AZIMUTH_DEG, allow_negative_numbers = true)]
     pub azimuth: f64,
-    /// Measuring time per main position, s (default: 110 for two positions, 60 for four,
-    /// so that one seek fits the paper's 4 min 56 s).
-    #[arg(long, allow_negative_numbers = true)]
+    /// Measuring time per main position, s, so that one seek fits the paper's 4 min 56 s
+    /// [default: 110 for two positions, 60 for four].
+    #[arg(long = "dwell-s", alias = "dwell", allow_negative_numbers = true)]
     pub dwell: Option<f32>,
     /// Seed of the whole Monte Carlo (and of the default training campaign).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Worker threads (default: available cores).
+    /// Worker threads [default: available cores].
     #[arg(long)]
     pub threads: Option<usize>,
     /// Base tilt, deg (0..=30): the table stands on a base tilted by this much towards a
@@ -77,7 +82,7 @@ pub fn config_from_args(a: &Args) -> Result<MonteCarloConfig> {
         p => bail!("--positions {p}: must be 2 or 4"),
     };
     if !(a.ambient.is_finite() && (-60.0..=100.0).contains(&a.ambient)) {
-        bail!("--ambient {}: must be within -60..=100 degC", a.ambient);
+        bail!("--ambient-c {}: must be within -60..=100 degC", a.ambient);
     }
     let cfg = MonteCarloConfig {
         starts: a.starts,

@@ -25,19 +25,24 @@ pub struct Args {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Ambient temperatures, degC (comma separated).
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true,
+    #[arg(long = "ambient-c", alias = "ambient", value_delimiter = ',', allow_hyphen_values = true,
           default_values_t = crate::pipeline::campaign::PAPER_AMBIENTS_C.to_vec())]
     pub ambient: Vec<f64>,
     /// Runs per temperature (runs 1-3 train, the rest validate).
     #[arg(long, default_value_t = 5)]
     pub runs: usize,
     /// Record length from power-on, min.
-    #[arg(long, default_value_t = 45.0, allow_negative_numbers = true)]
+    #[arg(
+        long = "duration-min",
+        alias = "minutes",
+        default_value_t = 45.0,
+        allow_negative_numbers = true
+    )]
     pub minutes: f64,
     /// Cold starts of the north-seek Monte Carlo (6 seeks each).
     #[arg(long, default_value_t = 30)]
     pub starts: usize,
-    /// Worker threads (default: available cores).
+    /// Worker threads [default: available cores].
     #[arg(long)]
     pub threads: Option<usize>,
 }
@@ -59,7 +64,7 @@ pub fn options(
     }
     if campaign.minutes < 30.0 {
         bail!(
-            "--minutes {}: a record must reach the settled state (>= 30 min; the paper records 45)",
+            "--duration-min {}: a record must reach the settled state (>= 30 min; the paper records 45)",
             campaign.minutes
         );
     }

@@ -11,7 +11,7 @@ use crate::train::{
     WidthSearch, GUARD_RATIO,
 };
 use anyhow::Context;
-use fog_core::model::MAX_ENCODED_LEN;
+use fog_core::model::format::MAX_ENCODED_LEN;
 use std::path::PathBuf;
 
 /// Options of `fogsim train`.
@@ -245,12 +245,12 @@ pub fn summary(outcome: &TrainOutcome, n_runs: usize, model_bytes: usize) -> Str
         r.cross_validation.raw_std_dph, r.cross_validation.compensated_std_dph, r.verdict
     );
     s += &format!(
-        "final: {} centres (stop: {:?}), sum(err) = {:.4}, training rms {:.4} dph, held-out rms {:.4} dph\n",
-        r.n_centers, r.stop, r.err_sum, r.train_rms_dph, r.heldout_rms_dph
+        "final: {} centres ({}), sum(err) = {:.4}, training rms {:.4} dph, held-out rms {:.4} dph\n",
+        r.n_centers, r.size_chosen_by, r.err_sum, r.train_rms_dph, r.heldout_rms_dph
     );
     s += &format!(
         "time: width selection {:.2} s, final fit {:.2} s; model {} bytes\n",
-        r.validation_s, r.final_fit_s, model_bytes
+        r.timings.validation_s, r.timings.final_fit_s, model_bytes
     );
     s
 }

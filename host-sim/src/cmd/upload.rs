@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::{bail, Context};
-use fog_core::model::RbfModel;
-use fog_core::protocol::SIGNATURE_LEN;
+use fog_core::link::upload::SIGNATURE_LEN;
+use fog_core::model::format::RbfModel;
 
 use crate::upload::{
     describe_model, load_signing_key, open_link, sign_upload, test_key_path, UploadClient,
@@ -41,7 +41,7 @@ impl LinkArgs {
 pub struct Args {
     #[command(flatten)]
     pub link: LinkArgs,
-    /// Ed25519 signing seed (64 hex digits). Default: the repository's public TEST key.
+    /// Ed25519 signing seed (64 hex digits) [default: the repository's public TEST key].
     #[arg(long)]
     pub key: Option<PathBuf>,
     /// Seconds to wait for each response.
@@ -97,7 +97,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .as_ref()
         .filter(|a| a.security_counter >= counter)
     {
-        if active.model_crc32 != fog_core::protocol::crc32(&bytes) {
+        if active.model_crc32 != fog_core::link::upload::crc32(&bytes) {
             bail!(
                 "--security-counter {counter} is not above the device's {}: the device would refuse it as a rollback",
                 active.security_counter

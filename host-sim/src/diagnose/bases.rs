@@ -93,7 +93,7 @@ pub const RATE_WINDOW_ALPHA: f64 = 0.05;
 
 /// Half-width of the base's default dT/dt window: the device's least-squares span, centred, s.
 pub fn device_rate_half_s() -> f64 {
-    fog_core::features::DEFAULT_RATE_SPAN_S / 2.0
+    fog_core::compensation::features::DEFAULT_RATE_SPAN_S / 2.0
 }
 
 /// The base and the window of its dT/dt. By default dT/dt is the device's least-squares

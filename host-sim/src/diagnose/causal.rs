@@ -14,11 +14,11 @@ use super::bases::BaseFit;
 use super::cv::Folds;
 use super::input::Campaign;
 use super::transforms::{Candidate, Source, Transform};
-use fog_core::features::{
+use fog_core::compensation::features::{
     features_for_series, FeatureVector, TempRateEstimator, DEFAULT_ACCEL_SPAN_S,
     DEFAULT_RATE_SPAN_S, EXTRACTOR_RATE_POINTS,
 };
-use fog_core::model::{FeatureKind, FeatureSpec};
+use fog_core::model::format::{FeatureKind, FeatureSpec};
 use serde::Serialize;
 
 /// Points the trailing fit keeps when the device has no feature (spans up to 1270 s of

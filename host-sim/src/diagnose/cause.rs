@@ -26,9 +26,14 @@ impl From<&Candidate> for Cause {
 
 impl Cause {
     /// The report name, e.g. `temp_c:lag(tau_s=240)` (the one label format,
-    /// `crate::report::feature_label`, also used by `Candidate::label`).
+    /// `fog_core::compensation::label::feature_label`, also used by `Candidate::label`).
     pub fn label(&self) -> String {
-        crate::report::feature_label(&self.column, self.transform.name(), self.tau_s)
+        fog_core::compensation::label::feature_label(
+            &self.column,
+            self.transform.name(),
+            self.tau_s,
+        )
+        .to_string()
     }
 
     /// The cause in words (physics reading of the column and transform); `coef` are the

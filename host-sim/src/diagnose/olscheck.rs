@@ -8,7 +8,7 @@ use super::cause::Cause;
 use super::transforms::Transform;
 use crate::io::runs::Run;
 use crate::train::{cross_validate, dataset_from_runs_with_aux, TrainConfig};
-use fog_core::model::{FeatureKind, FeatureSpec};
+use fog_core::model::format::{FeatureKind, FeatureSpec};
 use serde::Serialize;
 
 /// Held-out result of one trainer model.
@@ -84,7 +84,7 @@ fn score(
 pub fn ols_check(runs: &[Run], cause: Option<&Cause>) -> anyhow::Result<OlsCheck> {
     let folds = runs.len().min(5);
     anyhow::ensure!(folds >= 4, "the trainer cross-check needs at least 4 runs");
-    let base_specs = fog_core::model::PAPER_INPUTS;
+    let base_specs = fog_core::model::format::PAPER_INPUTS;
     let baseline = score(runs, &base_specs, &[], 0, folds)?;
     let (extended, note) = match cause.map(|c| (c, cause_specs(c))) {
         None => (None, None),

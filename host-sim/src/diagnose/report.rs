@@ -381,7 +381,12 @@ fn write_candidates(s: &mut String, r: &Report) {
     let _ = writeln!(s, "\n3. Candidate causes (ranked by held-out rms; p = family-wise sign-flip test over whole validation units)");
     write_derivative_widths(s, &r.derivative_widths);
     for row in r.candidates.iter().take(8) {
-        let label = crate::report::feature_label(&row.column, row.transform.name(), row.tau_s);
+        let label = fog_core::compensation::label::feature_label(
+            &row.column,
+            row.transform.name(),
+            row.tau_s,
+        )
+        .to_string();
         let _ = writeln!(
             s,
             "  {:<28} {:>9} rms {:.4}  gain {:+6.2}%  p {:.4}  units improved {:>3.0}%{}",

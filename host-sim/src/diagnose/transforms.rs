@@ -75,9 +75,14 @@ pub struct Candidate {
 }
 
 impl Candidate {
-    /// The report name, e.g. `temp_c:lag(tau_s=240)` (see `crate::report::feature_label`).
+    /// The report name, e.g. `temp_c:lag(tau_s=240)` (see `fog_core::compensation::label::feature_label`).
     pub fn label(&self) -> String {
-        crate::report::feature_label(&self.column, self.transform.name(), self.tau_s)
+        fog_core::compensation::label::feature_label(
+            &self.column,
+            self.transform.name(),
+            self.tau_s,
+        )
+        .to_string()
     }
 
     /// Parsimony rank within a column (see `Transform::complexity`), except that for an

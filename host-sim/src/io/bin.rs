@@ -4,7 +4,7 @@
 //!
 //! Convention (the one `compensate` feeds fog-core's compensator with): a row stamped `t`
 //! covers `(t - period, t]`; its midpoint `t - period/2` falls in window
-//! `k = floor(mid / WINDOW_S)`, i.e. `[k W, (k+1) W)` as in `fog_core::features::
+//! `k = floor(mid / WINDOW_S)`, i.e. `[k W, (k+1) W)` as in `fog_core::compensation::features::
 //! WindowAverager`; the window's row is stamped with its end `(k+1) W` and holds the mean
 //! of every other column. `period` is the median spacing of the first [`LEAD_ROWS`]
 //! rows. A record whose period is already >= 0.95 W is a record of window means: its rows

@@ -5,7 +5,7 @@ use std::fmt;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
-use fog_core::model::{ModelError, RbfModel, MAX_ENCODED_LEN};
+use fog_core::model::format::{ModelError, RbfModel, MAX_ENCODED_LEN};
 
 /// Why a model file cannot be used.
 #[derive(Debug)]

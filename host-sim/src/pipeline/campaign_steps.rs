@@ -4,7 +4,7 @@
 //! temperature) and held-out runs (4-5).
 
 use anyhow::{anyhow, Context, Result};
-use fog_core::model::FeatureSpec;
+use fog_core::model::format::FeatureSpec;
 
 use crate::io::runs::Run;
 pub use crate::pipeline::campaign::{CampaignRun, CampaignSpec};

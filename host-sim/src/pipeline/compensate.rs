@@ -17,7 +17,7 @@ use crate::stats::SPEC_DPH;
 /// Compensates every run and builds the report (series kept for plots).
 pub fn compensate_all(
     runs: &[Run],
-    model: &fog_core::model::RbfModel,
+    model: &fog_core::model::format::RbfModel,
 ) -> Result<(CompensateReport, Vec<CompensatedSeries>)> {
     let mut series = Vec::with_capacity(runs.len());
     let mut rows = Vec::with_capacity(runs.len());

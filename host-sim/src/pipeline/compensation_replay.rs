@@ -11,10 +11,10 @@
 //! trained range are compensated at the range edge and counted.
 
 use anyhow::{bail, Result};
-use fog_core::compensator::{Compensator, CompensatorConfig};
+use fog_core::compensation::compensator::{Compensator, CompensatorConfig};
 use fog_core::consts::WINDOW_S;
 use fog_core::hal::{GyroSample, TempSample};
-use fog_core::model::RbfModel;
+use fog_core::model::format::RbfModel;
 
 use crate::io::runs::Run;
 use crate::report::DriftStats;
@@ -98,7 +98,8 @@ pub fn compensate_run(run: &Run, model: Option<&RbfModel>) -> Result<Compensated
         Compensator::new(cfg, model.cloned()).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
     let drift = run.drift_dph();
     let mut out = CompensatedSeries::default();
-    let take = |w: fog_core::compensator::WindowResult, out: &mut CompensatedSeries| {
+    let take = |w: fog_core::compensation::compensator::WindowResult,
+                out: &mut CompensatedSeries| {
         if w.n_samples == 0 || !w.mean_rate_dph.is_finite() {
             return;
         }
@@ -111,7 +112,7 @@ pub fn compensate_run(run: &Run, model: Option<&RbfModel>) -> Result<Compensated
             out.predicted_dph.push(w.drift_dph as f64);
             if matches!(
                 w.status,
-                fog_core::compensator::WindowStatus::InputOutOfRange { .. }
+                fog_core::compensation::compensator::WindowStatus::InputOutOfRange { .. }
             ) {
                 out.out_of_range_windows += 1;
             }

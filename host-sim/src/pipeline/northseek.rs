@@ -15,21 +15,21 @@
 //! same seeds with the model but without the tilt (`tilt_uncompensated`). With
 //! `heading_bias_dph` != 0 the gyro has a bias A cos(alpha) of its input axis azimuth; the
 //! heading harmonic is first calibrated over 8 headings on a warm, level gyro at the known
-//! azimuth (`fog_core::heading_cal`), applied in the compensated arm, and a fourth arm runs
+//! azimuth (`fog_core::seeking::heading_cal`), applied in the compensated arm, and a fourth arm runs
 //! without it (`heading_uncalibrated`).
 
 use anyhow::{anyhow, bail, Context, Result};
-use fog_core::bit::{evaluate, BitInputs, BitLimits, BitWord};
-use fog_core::compensator::{Compensator, CompensatorConfig};
+use fog_core::compensation::compensator::{Compensator, CompensatorConfig};
 use fog_core::consts::earth_rate_horizontal_dph;
 use fog_core::hal::{GyroSample, TempSample};
-use fog_core::heading_cal::{calibrate, HeadingDwell, HeadingHarmonic};
-use fog_core::model::RbfModel;
-use fog_core::northfinder::{NorthFinder, SeekConfig, SeekMode};
-use fog_core::seek_quality::{
+use fog_core::link::bit::{evaluate, BitInputs, BitLimits, BitWord};
+use fog_core::model::format::RbfModel;
+use fog_core::seeking::heading_cal::{calibrate, HeadingDwell, HeadingHarmonic};
+use fog_core::seeking::northfinder::{NorthFinder, SeekConfig, SeekMode};
+use fog_core::seeking::quality::{
     QualityConfig, QualityError, SeekSupervisor, SupervisorEvent, Validity,
 };
-use fog_core::tilt::Tilt;
+use fog_core::seeking::tilt::Tilt;
 use serde::Serialize;
 
 use crate::report::{NorthSeekReport, SeekReliability, SeekStats, Table};
@@ -122,18 +122,21 @@ impl MonteCarloConfig {
         }
         if !self.latitude_deg.is_finite() || self.latitude_deg.abs() > 90.0 {
             bail!(
-                "--latitude {}: must be within -90..=90 deg",
+                "--latitude-deg {}: must be within -90..=90 deg",
                 self.latitude_deg
             );
         }
         if self.latitude_deg.abs() >= 85.0 {
-            bail!("--latitude {}: north seeking needs |latitude| < 85 deg (horizontal Earth rate too small)", self.latitude_deg);
+            bail!("--latitude-deg {}: north seeking needs |latitude| < 85 deg (horizontal Earth rate too small)", self.latitude_deg);
         }
         if !self.true_azimuth_deg.is_finite() {
-            bail!("--azimuth: must be a finite angle in degrees");
+            bail!("--azimuth-deg: must be a finite angle in degrees");
         }
         if !(self.dwell_s.is_finite() && self.dwell_s >= 10.0) {
-            bail!("--dwell {}: must be at least one 10 s window", self.dwell_s);
+            bail!(
+                "--dwell-s {}: must be at least one 10 s window",
+                self.dwell_s
+            );
         }
         if self.threads == 0 {
             bail!("--threads: must be at least 1");
@@ -1057,9 +1060,9 @@ mod tests {
         assert!(out.refusals.iter().all(|r| r.index == 0
             && matches!(
                 r.reason,
-                QualityError::Finder(fog_core::seek_quality::FinderFault::TooManyInvalidWindows {
-                    position: 0
-                })
+                QualityError::Finder(
+                    fog_core::seeking::quality::FinderFault::TooManyInvalidWindows { position: 0 }
+                )
             )));
         let st = seek_stats(&[out], cfg.true_azimuth_deg);
         assert_eq!(st.reliability.refusal_rate, 1.0);

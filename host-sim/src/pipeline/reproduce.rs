@@ -25,7 +25,7 @@ use crate::report::{
 use crate::sim::{GyroParams, RunSpec, SimGyro, StartState};
 use crate::stats::{self, SPEC_DPH};
 use crate::train::{default_specs, TrainReport};
-use fog_core::model::{FeatureKind, FeatureSpec};
+use fog_core::model::format::{FeatureKind, FeatureSpec};
 
 /// Everything a reproduce run needs.
 #[derive(Clone, Debug)]

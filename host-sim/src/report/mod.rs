@@ -2,10 +2,6 @@
 //! the JSON report structures (their shape is the contract of issue 3), JSON output through
 //! the one atomic writer ([`crate::io::atomic`]) and a plain-text table for the terminal.
 
-pub mod label;
-
-pub use label::feature_label;
-
 use std::fmt::Write as _;
 use std::path::Path;
 

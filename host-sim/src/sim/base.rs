@@ -4,7 +4,7 @@
 //!
 //! Exists so that north-seek simulations can test the tilt maths and the motion detection.
 //! The Earth rate on the tilted input axis is computed here by rotating the NED Earth-rate
-//! vector with explicit 3x3 matrices (C = Rz(A) Ry(pitch) Rx(roll), see `fog_core::tilt`),
+//! vector with explicit 3x3 matrices (C = Rz(A) Ry(pitch) Rx(roll), see `fog_core::seeking::tilt`),
 //! not with fog-core's closed form, so the two are independent; the rocking also adds its own
 //! angular rate d(pitch)/dt about the base y axis, seen by the input axis as sin(h) dp/dt.
 
@@ -15,7 +15,7 @@ use rand_distr::StandardNormal;
 use super::checks::{finite, non_negative, positive};
 use super::error::SimError;
 use fog_core::consts::EARTH_RATE_DPH;
-use fog_core::tilt::Tilt;
+use fog_core::seeking::tilt::Tilt;
 
 /// A rocking episode: pitch += amplitude sin(2 pi (t - start) / period) during it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -152,7 +152,7 @@ fn matmul(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use fog_core::tilt::earth_rate_on_axis_dph;
+    use fog_core::seeking::tilt::earth_rate_on_axis_dph;
 
     #[test]
     fn matrices_agree_with_fog_cores_closed_form() {

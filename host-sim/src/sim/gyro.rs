@@ -159,11 +159,11 @@ impl SimGyro {
     }
 
     /// One inclinometer reading of the base now (level and noiseless without a base).
-    pub fn read_inclinometer(&mut self) -> fog_core::tilt::Tilt {
+    pub fn read_inclinometer(&mut self) -> fog_core::seeking::tilt::Tilt {
         let t = self.now_s();
         match &self.base {
             Some(b) => b.read_inclinometer(t, &mut self.rng_inclinometer),
-            None => fog_core::tilt::Tilt::LEVEL,
+            None => fog_core::seeking::tilt::Tilt::LEVEL,
         }
     }
 

@@ -5,7 +5,7 @@
 
 use super::error::{Result, TrainError};
 use super::normalize::Normalizer;
-use fog_core::model::{FeatureSpec, RbfModel, TrainingMeta, MAX_INPUTS};
+use fog_core::model::format::{FeatureSpec, RbfModel, TrainingMeta, MAX_INPUTS};
 
 /// What a forced (always-present) regressor is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

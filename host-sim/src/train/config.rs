@@ -1,7 +1,7 @@
 //! Training options (`TrainConfig`) with the defaults `fogsim train` uses, and their checks.
 
 use super::error::{Result, TrainError};
-use fog_core::model::MAX_CENTERS;
+use fog_core::model::format::MAX_CENTERS;
 use serde::Serialize;
 
 /// Which forward-selection algorithm picks the centres.
@@ -104,14 +104,14 @@ impl TrainConfig {
             || self
                 .poly_degrees
                 .iter()
-                .any(|&k| k > fog_core::model::MAX_POLY_DEGREE)
+                .any(|&k| k > fog_core::model::format::MAX_POLY_DEGREE)
         {
             return bad(
                 "poly-degrees",
                 format!(
                     "{:?}: give degrees in 0..={}",
                     self.poly_degrees,
-                    fog_core::model::MAX_POLY_DEGREE
+                    fog_core::model::format::MAX_POLY_DEGREE
                 ),
             );
         }

@@ -3,7 +3,7 @@
 //! out whole runs. Validation happens here once, so the fitting code can trust it.
 
 use super::error::{Result, TrainError};
-use fog_core::model::{FeatureSpec, MAX_INPUTS};
+use fog_core::model::format::{FeatureSpec, MAX_INPUTS};
 
 /// Rows of model inputs with their targets and run ids.
 #[derive(Clone, Debug, PartialEq)]

@@ -21,7 +21,7 @@
 
 use super::dataset::Dataset;
 use crate::stats::student_t::upper_quantile;
-use fog_core::model::RbfModel;
+use fog_core::model::format::RbfModel;
 use serde::Serialize;
 
 /// Chance that a healthy new run leaves the declared range somewhere (any input, either
@@ -140,7 +140,7 @@ pub fn apply(model: &mut RbfModel, ranges: &[InputRange]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use fog_core::model::{FeatureKind, FeatureSpec};
+    use fog_core::model::format::{FeatureKind, FeatureSpec};
 
     /// Runs of one input whose maxima scatter by `spread`, at the given ambients.
     fn dataset(maxima: &[f64], ambients: &[Option<f64>]) -> Dataset {

@@ -137,7 +137,7 @@ impl GaussianDesign {
 #[inline]
 pub fn gauss_exp(x: f32) -> f32 {
     let keep = u32::from(x >= MIN_EXP_ARG).wrapping_neg();
-    f32::from_bits(fog_core::rbf::exp_neg_f32(-x).to_bits() & keep)
+    f32::from_bits(fog_core::model::rbf::exp_neg_f32(-x).to_bits() & keep)
 }
 
 /// Dot product of two f32 vectors: 16 f32 lanes within blocks of 512 values (so the

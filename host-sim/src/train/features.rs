@@ -5,13 +5,13 @@
 use super::dataset::Dataset;
 use super::error::{Result, TrainError};
 use crate::io::runs::Run;
-use crate::report::feature_label;
-use fog_core::features::{features_for_series, FeatureVector};
-use fog_core::model::{FeatureKind, FeatureSpec, MAX_INPUTS};
+use fog_core::compensation::features::{features_for_series, FeatureVector};
+use fog_core::compensation::label::feature_label;
+use fog_core::model::format::{FeatureKind, FeatureSpec, MAX_INPUTS};
 
 /// The paper's inputs: gyro temperature and its rate.
 pub fn default_specs() -> Vec<FeatureSpec> {
-    fog_core::model::PAPER_INPUTS.to_vec()
+    fog_core::model::format::PAPER_INPUTS.to_vec()
 }
 
 /// Report name of an input, `<column>:<transform>` as in the fog-runs format notes.
@@ -20,8 +20,12 @@ pub fn feature_name(spec: &FeatureSpec) -> String {
         FeatureKind::TempC => "temp_c:value".into(),
         FeatureKind::TempRateCps => "temp_c:rate".into(),
         FeatureKind::TempAccelCps2 => "temp_c:accel".into(),
-        FeatureKind::TempLagC => feature_label("temp_c", "lag", Some(f64::from(spec.tau_s))),
-        FeatureKind::PowerOnDecay => feature_label("t_s", "decay", Some(f64::from(spec.tau_s))),
+        FeatureKind::TempLagC => {
+            feature_label("temp_c", "lag", Some(f64::from(spec.tau_s))).to_string()
+        }
+        FeatureKind::PowerOnDecay => {
+            feature_label("t_s", "decay", Some(f64::from(spec.tau_s))).to_string()
+        }
         FeatureKind::AuxValue(n) => format!("aux{n}:value"),
         FeatureKind::AuxRate(n) => format!("aux{n}:rate"),
         FeatureKind::AuxCos(n) => format!("aux{n}:cos"),

@@ -18,7 +18,7 @@ use super::orr::select_orr;
 use super::path::PathSummary;
 use super::select::{Added, Selection};
 use crate::fanout::thread_count;
-use fog_core::model::RbfModel;
+use fog_core::model::format::RbfModel;
 
 /// A model trained at one width, with what its selection did.
 #[derive(Clone, Debug)]

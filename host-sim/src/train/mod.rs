@@ -51,7 +51,7 @@ pub use validate::{
     cross_validate, fold_of_rows, pooled_std, rms, std_within_groups, CvReport, WidthScore,
 };
 
-use fog_core::model::RbfModel;
+use fog_core::model::format::RbfModel;
 use serde::Serialize;
 use std::time::Instant;
 
@@ -76,6 +76,9 @@ pub struct TrainReport {
     /// uncompensated one, else `not_better` (the model does not clearly help).
     pub verdict: Verdict,
     pub stop: StopReason,
+    /// What chose the number of centres, in words, e.g. `cross-validation: 22 of 64 centres`
+    /// (`stop` is where the final fit's selection path ended, which is not always it).
+    pub size_chosen_by: String,
     /// Sum of the error-reduction ratios of the final fit (bias and linear terms included).
     pub err_sum: f64,
     /// Error-reduction ratio of each centre, in selection order.
@@ -100,9 +103,48 @@ pub struct TrainReport {
     /// How the model's declared input range (`input_min`/`input_max`, what the device
     /// checks each window against) was set from the training runs.
     pub declared_range: Vec<declared_range::InputRange>,
-    /// Wall time of width selection and of the final fit, s.
+    /// Wall times, left out of the JSON (see `TrainTimings`).
+    #[serde(skip)]
+    pub timings: TrainTimings,
+}
+
+/// Wall times of one training, s. They depend on the machine and its load, so they are
+/// kept out of every JSON report (the same seed gives the same report bytes); `fogsim
+/// train` prints them, and performance figures come from benchmarks and whole-process
+/// timings.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TrainTimings {
+    /// Width and size selection by grouped cross-validation, s.
     pub validation_s: f64,
+    /// The final fit on every run, s.
     pub final_fit_s: f64,
+}
+
+/// What chose the final number of centres `n`: with OLS, grouped cross-validation picks
+/// `cv_centers` and the final selection path runs to that many (so it ends at the count,
+/// `StopReason::MaxCenters`) unless its own stop (`--rho`, `--target-dph`, no candidate
+/// left) ends it first; with Orr, the path's GCV stop. Names the `--max-centers` cap.
+fn size_chosen_by(
+    cfg: &TrainConfig,
+    cv_centers: Option<usize>,
+    stop: StopReason,
+    n: usize,
+) -> String {
+    let of = format!("{n} of {} centres", cfg.max_centers);
+    let path_stop = match stop {
+        StopReason::Rho => "--rho stop (residual energy below rho * y'y)",
+        StopReason::Target => "--target-dph stop (training rms reached the target)",
+        StopReason::MaxCenters => "the --max-centers cap",
+        StopReason::NoCandidate => "no candidate left outside the span of the selection",
+        StopReason::GcvMinimum => "generalised cross-validation (Orr)",
+    };
+    match cv_centers {
+        Some(_) if stop == StopReason::MaxCenters && n == cfg.max_centers => {
+            format!("cross-validation: {of}, the --max-centers cap")
+        }
+        Some(_) if stop == StopReason::MaxCenters => format!("cross-validation: {of}"),
+        _ => format!("{path_stop}: {of}"),
+    }
 }
 
 /// Upper bound of the memory training takes besides the dataset itself: the Gram
@@ -193,6 +235,12 @@ pub fn train_model(ds: &Dataset, cfg: &TrainConfig) -> Result<TrainOutcome> {
             Verdict::NotBetter
         },
         stop: fit.path.stop,
+        size_chosen_by: size_chosen_by(
+            cfg,
+            cv.best.centers,
+            fit.path.stop,
+            fit.model.centers.len(),
+        ),
         err_sum: fit.path.err_sum,
         center_err: fit.path.center_err.clone(),
         lambda: fit.path.lambda,
@@ -209,11 +257,41 @@ pub fn train_model(ds: &Dataset, cfg: &TrainConfig) -> Result<TrainOutcome> {
         gram_bytes: fit.gram_bytes,
         cross_validation: cv,
         declared_range: ranges,
-        validation_s,
-        final_fit_s,
+        timings: TrainTimings {
+            validation_s,
+            final_fit_s,
+        },
     };
     Ok(TrainOutcome {
         model: fit.model,
         report,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_stop_reason_names_what_chose_the_size() {
+        let cfg = TrainConfig::default();
+        let cap = cfg.max_centers;
+        let cv = |stop, n| size_chosen_by(&cfg, Some(22), stop, n);
+        assert_eq!(
+            cv(StopReason::MaxCenters, 22),
+            format!("cross-validation: 22 of {cap} centres")
+        );
+        assert_eq!(
+            size_chosen_by(&cfg, Some(cap), StopReason::MaxCenters, cap),
+            format!("cross-validation: {cap} of {cap} centres, the --max-centers cap")
+        );
+        // The path's own stop came before cross-validation's pick.
+        assert!(cv(StopReason::Target, 5).starts_with("--target-dph stop"));
+        assert!(cv(StopReason::Rho, 5).starts_with("--rho stop"));
+        assert!(cv(StopReason::NoCandidate, 5).starts_with("no candidate left"));
+        assert_eq!(
+            size_chosen_by(&cfg, None, StopReason::GcvMinimum, 15),
+            format!("generalised cross-validation (Orr): 15 of {cap} centres")
+        );
+    }
 }

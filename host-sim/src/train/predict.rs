@@ -2,14 +2,14 @@
 //! is the rms the device would achieve on the same inputs.
 
 use super::error::{Result, TrainError};
-use fog_core::model::RbfModel;
+use fog_core::model::format::RbfModel;
 
 /// Predicted drift (deg/h) for each row of raw inputs (in `model.inputs` order).
 pub fn predict_batch<'r>(
     model: &RbfModel,
     rows: impl IntoIterator<Item = &'r [f64]>,
 ) -> Result<Vec<f64>> {
-    let mut x = [0.0f32; fog_core::model::MAX_INPUTS];
+    let mut x = [0.0f32; fog_core::model::format::MAX_INPUTS];
     rows.into_iter()
         .enumerate()
         .map(|(i, row)| {
@@ -23,7 +23,7 @@ pub fn predict_batch<'r>(
             for (xj, &v) in x.iter_mut().zip(row) {
                 *xj = v as f32;
             }
-            fog_core::rbf::predict_f32(model, &x[..row.len()])
+            fog_core::model::rbf::predict_f32(model, &x[..row.len()])
                 .map(f64::from)
                 .map_err(|e| TrainError::Predict {
                     row: i,

@@ -19,7 +19,7 @@ use super::normalize::Normalizer;
 use super::seek_score::{seek_azimuth_rms_deg, Criterion};
 use crate::fanout::{map_in_order, thread_count};
 pub use crate::stats::rms;
-use fog_core::model::WIDTH_RANGE;
+use fog_core::model::format::WIDTH_RANGE;
 use serde::Serialize;
 use std::time::Instant;
 

@@ -50,7 +50,7 @@ pub fn campaign_and_model(dir: &Path, runs: usize) -> Vec<PathBuf> {
     let model = train_default(&train, &fog_sim::train::default_specs(), "test")
         .unwrap()
         .model;
-    let mut buf = [0u8; fog_core::model::MAX_ENCODED_LEN];
+    let mut buf = [0u8; fog_core::model::format::MAX_ENCODED_LEN];
     let n = model.encode(&mut buf).unwrap();
     std::fs::write(dir.join("model.bin"), &buf[..n]).unwrap();
     std::fs::create_dir_all(dir.join("runs")).unwrap();

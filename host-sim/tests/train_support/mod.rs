@@ -3,7 +3,7 @@
 //! of the inputs plus seeded white noise.
 #![allow(dead_code)]
 
-use fog_core::model::FeatureSpec;
+use fog_core::model::format::FeatureSpec;
 use fog_sim::train::Dataset;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -21,7 +21,7 @@ pub fn warmup(ambient_c: f64, t_s: f64) -> (f64, f64) {
 
 /// The paper's two inputs.
 pub fn specs_t_rate() -> Vec<FeatureSpec> {
-    fog_core::model::PAPER_INPUTS.to_vec()
+    fog_core::model::format::PAPER_INPUTS.to_vec()
 }
 
 /// `runs_per_ambient` runs at each ambient; drift = f(T, dT/dt, run index) + N(0, noise).

@@ -7,7 +7,7 @@ use std::collections::VecDeque;
 use std::io::{Read, Write};
 use std::time::Duration;
 
-use fog_core::model::{RbfModel, TrainingMeta, MAX_ENCODED_LEN};
+use fog_core::model::format::{RbfModel, TrainingMeta, MAX_ENCODED_LEN};
 use fog_firmware::signature::TEST_PUBLIC_KEY;
 use fog_firmware::store::EmulatedModelFlash;
 use fog_firmware::upload::UploadServer;
@@ -18,7 +18,7 @@ pub const TEST_GYRO: &str = "FOG-A17";
 
 /// A valid 2-input model (T, dT/dt) with `n_centers` centres for gyro `gyro_id`.
 pub fn sample_model(gyro_id: &str, n_centers: usize, weight_scale: f32) -> RbfModel {
-    let inputs = fog_core::model::PAPER_INPUTS;
+    let inputs = fog_core::model::format::PAPER_INPUTS;
     let mut m = RbfModel {
         n_rbf_inputs: 2,
         inputs: inputs.iter().copied().collect(),
@@ -76,7 +76,7 @@ pub fn patch_body(encoded: &[u8], patch: impl FnOnce(&mut Vec<u8>)) -> Vec<u8> {
         postcard::from_bytes(encoded).expect("envelope decodes");
     let mut body = body.to_vec();
     patch(&mut body);
-    let crc = fog_core::model::crc32(&body);
+    let crc = fog_core::model::format::crc32(&body);
     postcard::to_allocvec(&(magic, version, body.as_slice(), crc)).expect("re-encodes")
 }
 

@@ -3,7 +3,7 @@
 //! checked for panicking paths (tests/tests/fw_budgets.rs); this is the last line.
 //! (The QEMU tools `replay` and `bench` use `panic.rs`: a failing exit, not a reset.)
 
-use fog_core::protocol::ResetCause;
+use fog_core::link::upload::ResetCause;
 
 use super::resets;
 

@@ -10,7 +10,7 @@
 use core::mem::MaybeUninit;
 use core::ptr::{addr_of_mut, read_volatile, write_volatile};
 
-use fog_core::protocol::{ResetCause, ResetRecord};
+use fog_core::link::upload::{ResetCause, ResetRecord};
 
 const MAGIC: u32 = 0xF0C5_12E5;
 

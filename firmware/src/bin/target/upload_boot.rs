@@ -4,7 +4,7 @@
 //! store that cannot be used is a fatal boot error (recorded, reset), never a halt.
 
 use embedded_storage::nor_flash::NorFlash;
-use fog_core::protocol::ResetRecord;
+use fog_core::link::upload::ResetRecord;
 use fog_firmware::upload::UploadServer;
 
 use crate::resets::{self, BootFault};

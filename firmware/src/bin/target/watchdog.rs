@@ -8,7 +8,7 @@
 
 use core::ptr::write_volatile;
 
-use fog_core::protocol::ResetCause;
+use fog_core::link::upload::ResetCause;
 
 use super::resets;
 

@@ -25,12 +25,12 @@
 //! preceded by [`STATUS_REQUEST_PADDING`] zero bytes (empty frames, ignored), which pay
 //! for the longer status reply.
 
-use crate::model::ModelError;
+use crate::model::format::ModelError;
 use heapless::String;
 use serde::{Deserialize, Serialize};
 
 /// Protocol version spoken by this build (sent in `Hello` and `DeviceStatus`). 3: every
-/// frame is wrapped in `link::HostFrame` / `link::DeviceFrame` (one host port for the
+/// frame is wrapped in `link::messages::HostFrame` / `link::messages::DeviceFrame` (one host port for the
 /// upload and the north-finder link); the messages themselves are those of version 2.
 pub const PROTOCOL_VERSION: u16 = 3;
 /// Most model bytes in one `Chunk`.
@@ -212,7 +212,7 @@ pub struct ModelInfo {
     pub heldout_rms_dph: f32,
 }
 
-/// Why the model bytes were refused by `fog_core::model::RbfModel::decode`.
+/// Why the model bytes were refused by `fog_core::model::format::RbfModel::decode`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ModelRejection {
@@ -548,9 +548,9 @@ mod tests {
             },
         };
         // The padding before a status request pays for the largest status reply, as sent
-        // on the host port (inside `link::DeviceFrame`).
+        // on the host port (inside `link::messages::DeviceFrame`).
         let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
-        let framed = crate::link::DeviceFrame::Upload(Response::Status(status.clone()));
+        let framed = crate::link::messages::DeviceFrame::Upload(Response::Status(status.clone()));
         let n = encode_frame(&framed, &mut wire).unwrap();
         assert!(n <= STATUS_REQUEST_PADDING, "status reply {n} B");
         let mut wire = [0u8; MAX_WIRE_FRAME_LEN];

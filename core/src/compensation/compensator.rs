@@ -8,14 +8,14 @@
 //! Inputs outside the model's trained range are flagged (and the drift is evaluated at
 //! the range edge, never extrapolated).
 
-use crate::features::{
+use crate::compensation::features::{
     FeatureError, FeatureExtractor, TempRateEstimator, WindowAverager, WindowMean,
     DEFAULT_RATE_SPAN_S, EXTRACTOR_RATE_POINTS,
 };
-use crate::fixed::{FixedError, FixedModel};
 use crate::hal::{GyroSample, TempSample};
-use crate::model::{FeatureSpec, ModelError, RbfModel, MAX_AUX, MAX_INPUTS};
-use crate::rbf::{predict_f32, RbfError};
+use crate::model::fixed::{FixedError, FixedModel};
+use crate::model::format::{FeatureSpec, ModelError, RbfModel, MAX_AUX, MAX_INPUTS};
+use crate::model::rbf::{predict_f32, RbfError};
 
 /// Which evaluator computes the drift.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -166,7 +166,7 @@ pub struct Compensator {
     fault_windows: Option<(i64, i64)>,
 }
 
-const DEFAULT_SPECS: [FeatureSpec; 2] = crate::model::PAPER_INPUTS;
+const DEFAULT_SPECS: [FeatureSpec; 2] = crate::model::format::PAPER_INPUTS;
 
 /// The default configuration as a constant.
 const DEFAULT_CONFIG: CompensatorConfig = CompensatorConfig {

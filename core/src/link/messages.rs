@@ -3,7 +3,7 @@
 //! port with the model upload.
 //!
 //! Exists so that the firmware, `fogsim monitor` and `fogsim upload` build against one set
-//! of types. Frames are exactly the upload's: `fog_core::protocol::encode_frame` /
+//! of types. Frames are exactly the upload's: `fog_core::link::upload::encode_frame` /
 //! `decode_frame` / `FrameReceiver` (postcard, CRC-32, COBS, 0x00 delimiter). Every frame
 //! on the host port carries one [`HostFrame`] (PC -> device) or [`DeviceFrame`]
 //! (device -> PC): the outer postcard tag (0 upload, 1 link) comes first, then the inner
@@ -12,10 +12,12 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::bit::BitWord;
-use crate::protocol::{decode_message, encode_frame, FrameError, Request, ResetCause, Response};
-use crate::seek_quality::{MotionReason, QualityError, SeekState, Validity};
-use crate::tilt::Tilt;
+use crate::link::bit::BitWord;
+use crate::link::upload::{
+    decode_message, encode_frame, FrameError, Request, ResetCause, Response,
+};
+use crate::seeking::quality::{MotionReason, QualityError, SeekState, Validity};
+use crate::seeking::tilt::Tilt;
 
 /// Version of these messages (in every `Status`).
 pub const LINK_VERSION: u16 = 1;
@@ -124,7 +126,7 @@ pub struct SeekReport {
 /// Everything the PC sends on the host port.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum HostFrame<'a> {
-    /// Model upload (`fog_core::protocol`), answered with `DeviceFrame::Upload`.
+    /// Model upload (`fog_core::link::upload`), answered with `DeviceFrame::Upload`.
     Upload(#[serde(borrow)] Request<'a>),
     /// North-finder command, answered with `DeviceFrame::Link` (`Accepted`/`Refused`,
     /// then a `Status`).
@@ -154,10 +156,10 @@ pub fn decode<'a, T: Deserialize<'a>>(payload: &'a [u8]) -> Result<T, FrameError
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bit::BitItem;
-    use crate::protocol::{FrameReceiver, MAX_WIRE_FRAME_LEN};
-    use crate::seek_quality::FinderFault;
-    use crate::synthetic::SplitMix64;
+    use crate::link::bit::BitItem;
+    use crate::link::upload::{FrameReceiver, MAX_WIRE_FRAME_LEN};
+    use crate::model::synthetic::SplitMix64;
+    use crate::seeking::quality::FinderFault;
 
     fn status(bit: u16) -> Status {
         Status {
@@ -238,7 +240,7 @@ mod tests {
             Command::GetStatus,
         ] {
             let n = encode(&HostFrame::Link(c), &mut wire).unwrap();
-            let p = crate::protocol::decode_frame(&mut wire[..n - 1]).unwrap();
+            let p = crate::link::upload::decode_frame(&mut wire[..n - 1]).unwrap();
             assert_eq!(decode::<HostFrame>(p).unwrap(), HostFrame::Link(c));
         }
     }

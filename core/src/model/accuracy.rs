@@ -2,10 +2,10 @@
 //! model's whole trained input box: the measurement behind the fixed-point accuracy claim,
 //! usable on any model (synthetic in the tests, trained ones via `examples/fixed_error.rs`).
 
-use crate::fixed::{FixedError, FixedModel};
-use crate::model::{RbfModel, MAX_INPUTS};
-use crate::rbf::{predict_f32, predict_f64};
-use crate::synthetic::SplitMix64;
+use crate::model::fixed::{FixedError, FixedModel};
+use crate::model::format::{RbfModel, MAX_INPUTS};
+use crate::model::rbf::{predict_f32, predict_f64};
+use crate::model::synthetic::SplitMix64;
 
 /// Result of `worst_errors`.
 #[derive(Clone, Copy, Debug, PartialEq)]

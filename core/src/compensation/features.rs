@@ -16,7 +16,7 @@
 //!   10 s rows of a fog-runs file. Same code, same inputs, so trained and deployed features
 //!   are identical. Every feature is causal: row k only uses rows 0..=k.
 
-use crate::model::{FeatureKind, FeatureSpec, MAX_AUX, MAX_INPUTS};
+use crate::model::format::{FeatureKind, FeatureSpec, MAX_AUX, MAX_INPUTS};
 use heapless::{Deque, Vec};
 
 /// Default least-squares span of `TempRateCps` / `AuxRate` when `tau_s` is 0, s.

@@ -20,8 +20,8 @@
 //! Worst error against the f64 reference: see `docs/core.md` (measured by the
 //! `fixed_worst_error_*` tests: `cargo test -p fog-core --test rbf_accuracy fixed_worst -- --nocapture`).
 
-use crate::model::{ModelError, RbfModel, MAX_CENTERS, MAX_INPUTS, MAX_POLY_DEGREE};
-use crate::rbf::RbfError;
+use crate::model::format::{ModelError, RbfModel, MAX_CENTERS, MAX_INPUTS, MAX_POLY_DEGREE};
+use crate::model::rbf::RbfError;
 
 /// Fraction bits of normalised inputs and centres.
 pub const XN_FRAC: u32 = 28;

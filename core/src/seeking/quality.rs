@@ -14,12 +14,14 @@
 //! A tilt change d of the base moves the vertical leak by Omega_V d, i.e. the azimuth by
 //! about tan(latitude) d: 0.05 deg of tilt change is 0.04 deg of azimuth at 40 deg N.
 
-use crate::bit::{BitItem, BitWord};
-use crate::compensator::WindowResult;
+use crate::compensation::compensator::WindowResult;
 use crate::consts::{EARTH_RATE_DPH, WINDOW_S};
 use crate::hal::Turntable;
-use crate::northfinder::{NorthFinder, SeekConfig, SeekError, SeekMode, SeekResult, SeekStatus};
-use crate::tilt::Tilt;
+use crate::link::bit::{BitItem, BitWord};
+use crate::seeking::northfinder::{
+    NorthFinder, SeekConfig, SeekError, SeekMode, SeekResult, SeekStatus,
+};
+use crate::seeking::tilt::Tilt;
 use serde::{Deserialize, Serialize};
 
 /// Limits of the supervisor.
@@ -494,11 +496,11 @@ impl SeekSupervisor {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bit::BitItem;
-    use crate::compensator::WindowStatus;
+    use crate::compensation::compensator::WindowStatus;
     use crate::hal::TableState;
-    use crate::synthetic::SplitMix64;
-    use crate::tilt::earth_rate_on_axis_dph;
+    use crate::link::bit::BitItem;
+    use crate::model::synthetic::SplitMix64;
+    use crate::seeking::tilt::earth_rate_on_axis_dph;
 
     /// Table that settles 5 s after every command.
     struct Table {
@@ -531,7 +533,7 @@ mod tests {
             mean_rate_dph: rate as f32,
             temp_c: 25.0,
             temp_rate_cps: 0.0,
-            inputs: [0.0; crate::model::MAX_INPUTS],
+            inputs: [0.0; crate::model::format::MAX_INPUTS],
             n_inputs: 0,
             drift_dph: 0.0,
             compensated_dph: rate as f32,

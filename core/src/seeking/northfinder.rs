@@ -17,7 +17,7 @@
 //! w(h) = Omega_H (cos A P(h) + sin A Q(h)) + V(h) + bias; both modes solve the two bias-free
 //! combinations (opposite dwells, quadrature dwells), linear in Omega_H (cos A, sin A), with
 //! the seek's mean measured tilt (`on_window_tilted`). The magnitude of that solution is the
-//! observed horizontal Earth rate, reported for the latitude check (`seek_quality`).
+//! observed horizontal Earth rate, reported for the latitude check (`quality`).
 //! A heading-dependent bias a cos(alpha) + b sin(alpha) of the input axis azimuth alpha
 //! (`heading_cal`) is the same harmonic as Earth rate: with it the seek sees
 //! R cos(A - phi + h), R = |(Omega_H + a, b)|, phi = atan2(b, Omega_H + a), so a stored
@@ -28,12 +28,12 @@
 //! windows are skipped (too many abort the seek). The 1-sigma uncertainty comes from the
 //! scatter of the window means observed in each dwell.
 
-use crate::compensator::WindowResult;
+use crate::compensation::compensator::WindowResult;
 use crate::consts::earth_rate_horizontal_dph;
 use crate::hal::{TableState, Turntable};
-use crate::heading_cal::HeadingHarmonic;
 use crate::numeric::wrap_360_deg as wrap_360;
-use crate::tilt::{axis_coefficients, AxisCoefficients, Tilt};
+use crate::seeking::heading_cal::HeadingHarmonic;
+use crate::seeking::tilt::{axis_coefficients, AxisCoefficients, Tilt};
 
 /// Most table positions in one seek.
 pub const MAX_POSITIONS: usize = 4;
@@ -441,7 +441,7 @@ impl NorthFinder {
     }
 
     /// Feed one 10 s result with the base tilt averaged over the same window (the range and
-    /// steadiness of the tilt are checked by `seek_quality::SeekSupervisor`).
+    /// steadiness of the tilt are checked by `quality::SeekSupervisor`).
     pub fn on_window_tilted<T: Turntable>(
         &mut self,
         w: &WindowResult,

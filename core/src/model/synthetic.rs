@@ -3,7 +3,9 @@
 //! Not a trained model: centres lie on simulated warm-up trajectories, weights are
 //! pseudo-random. No RNG crate: a SplitMix64 sequence keeps it `no_std` and seedable.
 
-use crate::model::{FeatureKind, FeatureSpec, RbfModel, TrainingMeta, MAX_CENTERS, MAX_INPUTS};
+use crate::model::format::{
+    FeatureKind, FeatureSpec, RbfModel, TrainingMeta, MAX_CENTERS, MAX_INPUTS,
+};
 
 /// Ambient temperatures of the synthetic campaign, degC.
 const AMBIENTS_C: [f64; 11] = [

@@ -19,7 +19,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::numeric::sin_cos_deg;
-use crate::tilt::{earth_rate_on_axis_dph, Tilt};
+use crate::seeking::tilt::{earth_rate_on_axis_dph, Tilt};
 
 /// Fewest headings a calibration accepts (three unknowns plus one degree of freedom).
 pub const MIN_HEADINGS: usize = 4;

@@ -9,9 +9,9 @@
 //! the Gaussian distance (see `model`).
 //! No range check happens here: the compensator flags inputs outside the trained range.
 
-pub use crate::exp_neg::exp_neg_f32;
-use crate::exp_neg::{twice_exp_neg_half, GAUSS_MAX_V};
-use crate::model::{RbfModel, MAX_INPUTS, XN_CLAMP};
+pub use crate::model::exp_neg::exp_neg_f32;
+use crate::model::exp_neg::{twice_exp_neg_half, GAUSS_MAX_V};
+use crate::model::format::{RbfModel, MAX_INPUTS, XN_CLAMP};
 
 /// Why an RBF evaluation was refused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

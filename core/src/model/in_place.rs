@@ -13,7 +13,7 @@ use heapless::Vec;
 use serde::de::{self, DeserializeSeed, Deserializer, SeqAccess, Visitor};
 use serde::Deserialize;
 
-use crate::model::RbfModel;
+use crate::model::format::RbfModel;
 
 /// The struct's field names (postcard only uses their count).
 const FIELDS: &[&str] = &[
@@ -148,7 +148,7 @@ impl<'de, T: Deserialize<'de>, const N: usize> Visitor<'de> for VecInPlace<'_, T
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synthetic;
+    use crate::model::synthetic;
 
     /// The in-place reader and the derived `Deserialize` agree on the wire format.
     #[test]
@@ -163,7 +163,7 @@ mod tests {
         let mut de = postcard::Deserializer::from_bytes(bytes);
         ModelInPlace {
             model: &mut target,
-            version: crate::model::MODEL_VERSION,
+            version: crate::model::format::MODEL_VERSION,
         }
         .deserialize(&mut de)
         .expect("in place");
@@ -183,7 +183,7 @@ mod tests {
             let mut de = postcard::Deserializer::from_bytes(&bytes[..len]);
             let seed = ModelInPlace {
                 model: &mut target,
-                version: crate::model::MODEL_VERSION,
+                version: crate::model::format::MODEL_VERSION,
             };
             assert!(
                 seed.deserialize(&mut de).is_err(),

@@ -22,7 +22,7 @@ use heapless::{String, Vec};
 use serde::de::DeserializeSeed as _;
 use serde::{Deserialize, Serialize};
 
-use crate::heading_cal::{HeadingHarmonic, MIN_HEADINGS};
+use crate::seeking::heading_cal::{HeadingHarmonic, MIN_HEADINGS};
 
 /// Most RBF centres a model may hold.
 pub const MAX_CENTERS: usize = 64;
@@ -340,7 +340,7 @@ struct WireModel<'a> {
 }
 
 /// CRC-32 (IEEE 802.3, as zlib/PNG) used for the model body: the protocol's, one copy.
-pub use crate::protocol::crc32;
+pub use crate::link::upload::crc32;
 
 fn check_finite(field: ModelField, values: &[f32]) -> Result<(), ModelError> {
     match values.iter().position(|v| !v.is_finite()) {
@@ -715,7 +715,7 @@ impl RbfModel {
     }
 
     /// `decode` into `self`, in place: the model is read element by element into the
-    /// existing storage (`model_in_place`), never built on the stack, so a device can
+    /// existing storage (`model::in_place`), never built on the stack, so a device can
     /// decode into a `static`. On error `self` holds a partly decoded model: decode again
     /// or discard it.
     pub fn decode_into(&mut self, bytes: &[u8]) -> Result<(), ModelError> {
@@ -760,7 +760,7 @@ impl RbfModel {
             });
         }
         let mut de = postcard::Deserializer::from_bytes(model_bytes);
-        crate::model_in_place::ModelInPlace {
+        crate::model::in_place::ModelInPlace {
             model: self,
             version,
         }

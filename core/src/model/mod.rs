@@ -1,0 +1,20 @@
+//! The drift model: what is stored in flash and sent over the wire, and every way of evaluating it.
+//!
+//! One concern, one folder: the trainer writes a model, the upload carries it, the firmware
+//! decodes and evaluates it, and the evaluation paths are measured against each other here.
+//! - `format`: the `RbfModel` layout, its postcard/CRC encoding and validation (the contract
+//!   shared by trainer, diagnose and firmware); `in_place` decodes it without a large stack frame;
+//! - `rbf`: Gaussian RBF evaluation in f32 (device) and f64 (reference), with `exp_neg`'s
+//!   exponential kernels;
+//! - `fixed`: integer-only evaluation for FPU-less parts;
+//! - `accuracy`: worst error of the f32 and fixed-point paths against the f64 reference;
+//! - `synthetic`: seeded models shaped like a trained one, for benchmarks, error measurements
+//!   and tests (they exercise the evaluation paths, so they live beside them).
+
+pub mod accuracy;
+pub mod exp_neg;
+pub mod fixed;
+pub mod format;
+mod in_place;
+pub mod rbf;
+pub mod synthetic;

@@ -1,0 +1,12 @@
+//! North seeking: turning compensated windows at known table headings into an azimuth.
+//!
+//! - `northfinder`: the two- and four-position seek as a non-blocking state machine;
+//! - `tilt`: the Earth rate seen by a gyro on a tilted turntable (shared by the seek and the
+//!   heading calibration);
+//! - `heading_cal`: the heading-dependent bias harmonic, estimated from dwells at known headings;
+//! - `quality`: what surrounds a seek (refusal, base-motion restarts, progress, predicted sigma).
+
+pub mod heading_cal;
+pub mod northfinder;
+pub mod quality;
+pub mod tilt;
