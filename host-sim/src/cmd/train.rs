@@ -73,14 +73,14 @@ pub struct Args {
     #[arg(long, default_value = "sim")]
     pub gyro_id: String,
     /// Held-out score that chooses the model: `seek` (azimuth error of two-position seeks
-    /// of `--seek-dwell` s at `--seek-latitude`) or `rms10s` (10 s residual rms).
+    /// of `--seek-dwell-s` at `--seek-latitude-deg`) or `rms10s` (10 s residual rms).
     #[arg(long, default_value = crate::train::seek_score::DEFAULT_CRITERION_NAME)]
     pub criterion: String,
     /// Dwell per position of the seeks the `seek` criterion scores, s.
-    #[arg(long, default_value_t = crate::train::seek_score::DEFAULT_SEEK_DWELL_S)]
+    #[arg(long = "seek-dwell-s", default_value_t = crate::train::seek_score::DEFAULT_SEEK_DWELL_S)]
     pub seek_dwell: f64,
     /// Site latitude of the seeks the `seek` criterion scores, deg.
-    #[arg(long, default_value_t = crate::sim::DEFAULT_LATITUDE_DEG, allow_negative_numbers = true)]
+    #[arg(long = "seek-latitude-deg", default_value_t = crate::sim::DEFAULT_LATITUDE_DEG, allow_negative_numbers = true)]
     pub seek_latitude: f64,
     /// Write the training report as JSON here.
     #[arg(long)]
