@@ -333,9 +333,26 @@ impl SeekLedger {
         }
     }
 
-    fn finish(&mut self, o: SeekOutcome) {
-        self.out.seeks.push(o);
-        self.next();
+    /// Records what the supervisor made of one window (`restarts` of the running seek).
+    fn record(&mut self, event: Result<SupervisorEvent, QualityError>, t_s: f64, restarts: u8) {
+        match event {
+            Ok(SupervisorEvent::Done(r, validity)) => {
+                let n_main = r.positions[0].n_windows as f64;
+                self.out.seeks.push(SeekOutcome {
+                    index: self.index,
+                    restarts,
+                    latitude_valid: validity == Validity::Valid,
+                    azimuth_deg: r.azimuth_deg,
+                    sigma_deg: r.sigma_deg,
+                    t_start_s: r.t_start_s,
+                    duration_s: r.duration_s,
+                    main_dwell_s: n_main * fog_core::consts::WINDOW_S as f64,
+                });
+                self.next();
+            }
+            Ok(_) => {}
+            Err(e) => self.refuse(t_s, e),
+        }
     }
 
     fn next(&mut self) {
@@ -456,25 +473,9 @@ pub fn run_seeks(
         let tilt = inclinometer.take(arm.feed_tilt);
         window_tilt = Some(tilt);
         temp_rate_cps = w.temp_rate_cps;
-        if !sup.is_seeking() {
-            continue;
-        }
-        match sup.on_window(&w, tilt, &mut table) {
-            Ok(SupervisorEvent::Done(r, validity)) => {
-                let n_main = r.positions[0].n_windows as f64;
-                ledger.finish(SeekOutcome {
-                    index: ledger.index,
-                    restarts: sup.restarts().0,
-                    latitude_valid: validity == Validity::Valid,
-                    azimuth_deg: r.azimuth_deg,
-                    sigma_deg: r.sigma_deg,
-                    t_start_s: r.t_start_s,
-                    duration_s: r.duration_s,
-                    main_dwell_s: n_main * fog_core::consts::WINDOW_S as f64,
-                });
-            }
-            Ok(_) => {}
-            Err(e) => ledger.refuse(w.t_end_s, e),
+        if sup.is_seeking() {
+            let event = sup.on_window(&w, tilt, &mut table);
+            ledger.record(event, w.t_end_s, sup.restarts().0);
         }
     }
     Ok(ledger.out)
