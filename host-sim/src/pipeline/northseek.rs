@@ -1015,14 +1015,14 @@ mod tests {
             .model
     }
 
-    #[test]
-    fn a_cold_start_warming_faster_than_the_training_runs_is_not_refused() {
-        // Start 64 of `north-seek --starts 200`: its warm-up peaks at dT/dt = 0.0129 degC/s,
-        // above the 3 training runs' envelope (+5 %), which flagged 4 windows of its first
-        // position and refused the seek. The declared range (run-to-run spread of the
-        // training runs' extremes) covers it.
+    /// One seek after a cold start at `ambient_c` with `model_at_20c`, tilt fed.
+    fn one_seek_with_the_20c_model(
+        ambient_c: f64,
+        seed: impl Fn(&MonteCarloConfig) -> u64,
+    ) -> ArmOutcome {
         let cfg = MonteCarloConfig {
             seeks_per_start: 1,
+            ambient_c,
             ..MonteCarloConfig::paper(1)
         };
         let model = model_at_20c();
@@ -1031,9 +1031,20 @@ mod tests {
             feed_tilt: true,
             heading: None,
         };
-        let seed = cfg.start_seed(63);
-        assert_eq!(seed, 9_851_787_880_037_274_203);
-        let out = run_seeks(&GyroParams::paper_default(), &cfg, arm, seed).unwrap();
+        run_seeks(&GyroParams::paper_default(), &cfg, arm, seed(&cfg)).unwrap()
+    }
+
+    #[test]
+    fn a_cold_start_warming_faster_than_the_training_runs_is_not_refused() {
+        // Start 64 of `north-seek --starts 200`: its warm-up peaks at dT/dt = 0.0129 degC/s,
+        // above the 3 training runs' envelope (+5 %), which flagged 4 windows of its first
+        // position and refused the seek. The declared range (run-to-run spread of the
+        // training runs' extremes) covers it.
+        let out = one_seek_with_the_20c_model(20.0, |cfg| {
+            let seed = cfg.start_seed(63);
+            assert_eq!(seed, 9_851_787_880_037_274_203);
+            seed
+        });
         assert_eq!(out.refusals, Vec::new());
         assert_eq!(out.seeks.len(), 1);
     }
@@ -1043,18 +1054,7 @@ mod tests {
         // Twin: the same 20 degC model at -40 degC, where T is 60 degC outside anything
         // trained: every attempt is refused with the finder's reason, the seek is given up
         // after MAX_ATTEMPTS_PER_SEEK attempts, and the Monte Carlo goes on.
-        let cfg = MonteCarloConfig {
-            seeks_per_start: 1,
-            ambient_c: -40.0,
-            ..MonteCarloConfig::paper(1)
-        };
-        let model = model_at_20c();
-        let arm = Arm {
-            model: Some(&model),
-            feed_tilt: true,
-            heading: None,
-        };
-        let out = run_seeks(&GyroParams::paper_default(), &cfg, arm, 5).unwrap();
+        let out = one_seek_with_the_20c_model(-40.0, |_| 5);
         assert_eq!(out.seeks.len(), 0);
         assert_eq!(out.failed_seeks, 1);
         assert_eq!(out.refusals.len(), MAX_ATTEMPTS_PER_SEEK);
@@ -1065,7 +1065,7 @@ mod tests {
                     fog_core::seeking::quality::FinderFault::TooManyInvalidWindows { position: 0 }
                 )
             )));
-        let st = seek_stats(&[out], cfg.true_azimuth_deg);
+        let st = seek_stats(&[out], PAPER_AZIMUTH_DEG);
         assert_eq!(st.reliability.refusal_rate, 1.0);
         assert_eq!(
             st.reliability
