@@ -10,7 +10,7 @@ use fog_core::seeking::northfinder::SeekMode;
 use super::check_output_file;
 use crate::io::model::read_model;
 use crate::io::OutputGuard;
-use crate::pipeline::campaign_steps::{simulate_checked, train_default, CampaignSpec};
+use crate::pipeline::campaign_steps::{simulate_checked, train_with, CampaignSpec};
 use crate::pipeline::northseek::{
     build_product_report, default_threads, run_monte_carlo_with_calibration, seek_table,
     MonteCarloConfig,
@@ -68,6 +68,10 @@ pub struct Args {
     /// Write the JSON report here.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Held-out score that chooses the default model (as `train --criterion`; its seek
+    /// dwell and latitude are this Monte Carlo's).
+    #[arg(long, default_value = crate::train::seek_score::DEFAULT_CRITERION_NAME)]
+    pub criterion: String,
 }
 
 /// Turns the options into a Monte Carlo configuration, rejecting impossible values.
@@ -124,14 +128,22 @@ pub fn run(args: Args) -> Result<()> {
             };
             let campaign = simulate_checked(&params, &plan).map_err(super::with_plan_flag)?;
             let runs: Vec<_> = campaign.iter().map(|c| &c.run).collect();
-            let trained = train_default(&runs, &crate::train::default_specs(), "sim")?;
+            let criterion = crate::train::seek_score::Criterion::parse(
+                &args.criterion,
+                cfg.dwell_s as f64,
+                cfg.latitude_deg,
+            )
+            .map_err(|e| anyhow::anyhow!("--criterion {e}"))?;
+            let trained = train_with(&runs, &crate::train::default_specs(), "sim", criterion)?;
             eprintln!(
-                "trained the default model on {} simulated {} degC runs (seed {}): {} centres, held-out rms {:.4} deg/h",
+                "trained the default model on {} simulated {} degC runs (seed {}): {} centres, held-out rms {:.4} deg/h, seek {:.4} deg, chosen by held-out {}",
                 runs.len(),
                 cfg.ambient_c,
                 cfg.seed,
                 trained.report.n_centers,
-                trained.report.heldout_rms_dph
+                trained.report.heldout_rms_dph,
+                trained.report.cross_validation.best.heldout_seek_deg,
+                trained.report.criterion.name()
             );
             (
                 trained.model,

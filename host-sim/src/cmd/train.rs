@@ -82,6 +82,16 @@ pub struct Args {
     /// Gyro id stored in the model (at most 16 bytes).
     #[arg(long, default_value = "sim")]
     pub gyro_id: String,
+    /// Held-out score that chooses the model: `seek` (azimuth error of two-position seeks
+    /// of `--seek-dwell-s` at `--seek-latitude-deg`) or `rms10s` (10 s residual rms).
+    #[arg(long, default_value = crate::train::seek_score::DEFAULT_CRITERION_NAME)]
+    pub criterion: String,
+    /// Dwell per position of the seeks the `seek` criterion scores, s.
+    #[arg(long = "seek-dwell-s", default_value_t = crate::train::seek_score::DEFAULT_SEEK_DWELL_S)]
+    pub seek_dwell: f64,
+    /// Site latitude of the seeks the `seek` criterion scores, deg.
+    #[arg(long = "seek-latitude-deg", default_value_t = crate::sim::DEFAULT_LATITUDE_DEG, allow_negative_numbers = true)]
+    pub seek_latitude: f64,
     /// Write the training report as JSON here.
     #[arg(long)]
     pub json: Option<PathBuf>,
@@ -107,8 +117,15 @@ fn parse_method(s: &str) -> Result<Method, String> {
 
 impl Args {
     /// The training configuration these options ask for.
-    pub fn config(&self) -> TrainConfig {
-        TrainConfig {
+    pub fn config(&self) -> anyhow::Result<TrainConfig> {
+        let criterion = crate::train::seek_score::Criterion::parse(
+            &self.criterion,
+            self.seek_dwell,
+            self.seek_latitude,
+        )
+        .map_err(|e| anyhow::anyhow!("--criterion {e}"))?;
+        Ok(TrainConfig {
+            criterion,
             method: self.method,
             rho: self.rho,
             target_dph: self.target_dph,
@@ -122,7 +139,7 @@ impl Args {
             linear_on_rbf_inputs: self.linear_inputs,
             gyro_id: self.gyro_id.clone(),
             ..TrainConfig::default()
-        }
+        })
     }
 }
 
@@ -163,7 +180,7 @@ fn stage(staged: &mut StagedFiles, path: &Path, bytes: &[u8]) -> anyhow::Result<
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let cfg = args.config();
+    let cfg = args.config()?;
     let candidates = args.inputs.candidates();
     let most_inputs = candidates
         .iter()
@@ -291,7 +308,8 @@ pub fn summary(outcome: &TrainOutcome, n_runs: usize, model_bytes: usize) -> Str
         n_runs,
         r.inputs.join(", ")
     );
-    s += "width (sigma, normalised)  poly degree  held-out rms dph  held-out std dph  centres\n";
+    s += &format!("model chosen by held-out {}\n", r.criterion.name());
+    s += "width (sigma, normalised)  poly degree  held-out rms dph  held-out std dph  held-out seek deg  centres\n";
     for w in &r.cross_validation.scan {
         let mark = if w.width == r.width && w.degree == r.poly_degree {
             " <- chosen"
@@ -299,8 +317,13 @@ pub fn summary(outcome: &TrainOutcome, n_runs: usize, model_bytes: usize) -> Str
             ""
         };
         s += &format!(
-            "{:>25.3}  {:>11}  {:>16.4}  {:>16.4}  {:>7.1}{mark}\n",
-            w.width, w.degree, w.heldout_rms_dph, w.heldout_std_dph, w.mean_centers
+            "{:>25.3}  {:>11}  {:>16.4}  {:>16.4}  {:>17.4}  {:>7.1}{mark}\n",
+            w.width,
+            w.degree,
+            w.heldout_rms_dph,
+            w.heldout_std_dph,
+            w.heldout_seek_deg,
+            w.mean_centers
         );
     }
     s += &format!(

@@ -111,10 +111,21 @@ pub fn split_train_validate(
 /// Trains a model on `specs` (e.g. the paper's T and dT/dt, `train::default_specs`) with the
 /// trainer's defaults (OLS, width by grouped validation, rho stop, at most 64 centres).
 pub fn train_default(runs: &[&Run], specs: &[FeatureSpec], gyro_id: &str) -> Result<TrainOutcome> {
+    train_with(runs, specs, gyro_id, TrainConfig::default().criterion)
+}
+
+/// `train_default` with another model-choosing criterion.
+pub fn train_with(
+    runs: &[&Run],
+    specs: &[FeatureSpec],
+    gyro_id: &str,
+    criterion: crate::train::seek_score::Criterion,
+) -> Result<TrainOutcome> {
     let owned: Vec<Run> = runs.iter().map(|r| (*r).clone()).collect();
     let ds = dataset_from_runs(&owned, specs).map_err(|e| anyhow!("training: {e}"))?;
     let cfg = TrainConfig {
         gyro_id: gyro_id.chars().take(16).collect(),
+        criterion,
         ..TrainConfig::default()
     };
     train_model(&ds, &cfg)

@@ -109,8 +109,14 @@ pub struct ModelResult {
     pub per_ambient: Vec<AmbientResult>,
     pub validation: CompensateReport,
     pub north_seek: NorthSeekReport,
+    /// The same Monte Carlo at the other `SEEK_AMBIENTS_C` (cold starts at -40 and +60 degC
+    /// with the one global model).
+    pub north_seek_other_ambients: Vec<NorthSeekReport>,
     pub targets: Targets,
 }
+
+/// Ambients the global model's north seek is run at, degC (the campaign's ends and 20 degC).
+pub const SEEK_AMBIENTS_C: [f64; 3] = [-40.0, 20.0, 60.0];
 
 /// `reproduce --json` / `demo` output: one `ModelResult` per input variant (paper first).
 #[derive(Clone, Debug, Serialize)]
@@ -169,6 +175,8 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
             opts.n_train
         );
         let north_seek = build_report(params, &opts.north_seek, &outcomes, &source);
+        let north_seek_other_ambients =
+            seek_other_ambients(params, &opts.north_seek, &trained.model, &source)?;
         if let Some(dir) = &opts.plots {
             let tag = if k == 0 { "" } else { "_extended" };
             write_model_plots(
@@ -188,6 +196,7 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
             per_ambient,
             validation,
             north_seek,
+            north_seek_other_ambients,
             targets,
         });
     }
@@ -207,6 +216,27 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
 }
 
 /// Held-out figures per ambient, the runs of one temperature pooled.
+/// The north-seek Monte Carlo of `cfg` at the other `SEEK_AMBIENTS_C`.
+fn seek_other_ambients(
+    params: &GyroParams,
+    cfg: &MonteCarloConfig,
+    model: &fog_core::model::format::RbfModel,
+    source: &str,
+) -> Result<Vec<NorthSeekReport>> {
+    SEEK_AMBIENTS_C
+        .iter()
+        .filter(|&&a| a != cfg.ambient_c)
+        .map(|&ambient_c| {
+            let cfg = MonteCarloConfig {
+                ambient_c,
+                ..cfg.clone()
+            };
+            let outcomes = run_monte_carlo(params, &cfg, model, &|| {})?;
+            Ok(build_report(params, &cfg, &outcomes, source))
+        })
+        .collect()
+}
+
 fn per_ambient_results(
     ambients_c: &[f64],
     heldout: &[&CampaignRun],
@@ -378,7 +408,7 @@ fn model_summary(m: &ModelResult) -> String {
     let ok = |b: bool| if b { "MET" } else { "MISSED" };
     format!(
         "=== {}: {} centres, width {:.2}, cross-validated rms {:.4} deg/h\n\
-         held-out drift of 10 s means, deg/h (spec {SPEC_DPH}):\n{}\nnorth seek at {} degC:\n{}\
+         held-out drift of 10 s means, deg/h (spec {SPEC_DPH}):\n{}\nnorth seek at {} degC:\n{}{}\
          targets:\n\
          - held-out compensated std <= {SPEC_DPH} deg/h at every ambient: worst {:.4} -> {}\n\
          - time to spec: worst before {}, worst after {}\n\
@@ -392,6 +422,10 @@ fn model_summary(m: &ModelResult) -> String {
         amb.render(),
         m.north_seek.ambient_c,
         seek_table(&m.north_seek),
+        m.north_seek_other_ambients
+            .iter()
+            .map(|r| format!("north seek at {} degC:\n{}", r.ambient_c, seek_table(r)))
+            .collect::<String>(),
         t.worst_heldout_after_std_dph,
         ok(t.heldout_std_within_spec_everywhere),
         fmt_minutes(t.worst_time_to_spec_before_s),

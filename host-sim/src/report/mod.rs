@@ -84,6 +84,32 @@ pub struct SeekStats {
     pub mean_reported_sigma_deg: f64,
     /// Every azimuth, `[start][seek]`, deg (0..360).
     pub azimuths_deg: Vec<Vec<f64>>,
+    /// How often seeks were refused, restarted or flagged.
+    pub reliability: SeekReliability,
+}
+
+/// Refusals and restarts of the seeks of one arm (a refusal is an attempt that ended
+/// without a result: blocked at its start, stopped by the finder or by too much motion).
+#[derive(Clone, Debug, Serialize)]
+pub struct SeekReliability {
+    /// Seek attempts: finished + refused.
+    pub attempts: usize,
+    pub finished: usize,
+    pub refused: usize,
+    /// Seeks given up after every allowed attempt was refused.
+    pub failed_seeks: usize,
+    /// refused / attempts.
+    pub refusal_rate: f64,
+    /// Finished seeks that the supervisor restarted at least once for motion, and the
+    /// restarts in total.
+    pub restarted_seeks: usize,
+    pub restarts: usize,
+    /// restarted_seeks / attempts.
+    pub restart_rate: f64,
+    /// Finished seeks the latitude check flagged.
+    pub latitude_flags: usize,
+    /// Refusals by reason.
+    pub refusal_reasons: std::collections::BTreeMap<String, usize>,
 }
 
 /// `fogsim north-seek --json` output.

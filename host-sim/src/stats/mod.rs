@@ -5,6 +5,8 @@
 
 pub mod allan;
 
+pub mod student_t;
+
 /// The gyro's bias spec, deg/h (1 sigma of 10 s means; gyro 008 in the paper).
 pub const SPEC_DPH: f64 = 0.021;
 /// The paper's "stable" point: the settled (nominal) mean is taken after this, s.

@@ -63,6 +63,8 @@ pub struct TrainConfig {
     pub gyro_id: String,
     /// Worker threads for the design matrix (None: all cores).
     pub threads: Option<usize>,
+    /// Which held-out score chooses the width and polynomial degree.
+    pub criterion: super::seek_score::Criterion,
 }
 
 impl Default for TrainConfig {
@@ -83,6 +85,7 @@ impl Default for TrainConfig {
             collinearity_tol: 1e-4,
             gyro_id: String::from("sim"),
             threads: None,
+            criterion: super::seek_score::Criterion::training_default(),
         }
     }
 }
@@ -159,6 +162,12 @@ impl TrainConfig {
             return bad(
                 "gyro id",
                 format!("`{}` is longer than 16 bytes", self.gyro_id),
+            );
+        }
+        if !self.criterion.is_valid() {
+            return bad(
+                "criterion",
+                "seek dwell must be positive and |latitude| < 85 deg".into(),
             );
         }
         if self.threads == Some(0) {

@@ -22,6 +22,9 @@ pub struct Dataset {
     pub t_s: Vec<f64>,
     /// Name of each group id (e.g. the run's file name), indexed by id.
     pub group_names: Vec<String>,
+    /// Ambient (chamber) temperature of each group, degC, when the run says it: runs at
+    /// one ambient are replicates for the declared input range (`declared_range`).
+    pub group_ambient_c: Vec<Option<f64>>,
 }
 
 impl Dataset {
@@ -54,6 +57,7 @@ impl Dataset {
             groups: Vec::new(),
             t_s: Vec::new(),
             group_names: Vec::new(),
+            group_ambient_c: Vec::new(),
         })
     }
 
@@ -99,6 +103,7 @@ impl Dataset {
         }
         let id = self.group_names.len() as u32;
         self.group_names.push(name.to_string());
+        self.group_ambient_c.push(None);
         for ((row, &y), &t) in rows.iter().zip(targets_dph).zip(t_s) {
             self.inputs.extend_from_slice(row);
             self.targets_dph.push(y);
@@ -106,6 +111,13 @@ impl Dataset {
             self.t_s.push(t);
         }
         Ok(id)
+    }
+
+    /// Sets the ambient of group `id` (ignored for an unknown id).
+    pub fn set_group_ambient(&mut self, id: u32, ambient_c: Option<f64>) {
+        if let Some(a) = self.group_ambient_c.get_mut(id as usize) {
+            *a = ambient_c.filter(|v| v.is_finite());
+        }
     }
 
     /// Number of rows (10 s points).
@@ -149,6 +161,7 @@ impl Dataset {
             groups: Vec::with_capacity(indices.len()),
             t_s: Vec::with_capacity(indices.len()),
             group_names: self.group_names.clone(),
+            group_ambient_c: self.group_ambient_c.clone(),
         };
         for &i in indices {
             out.inputs.extend_from_slice(self.row(i));

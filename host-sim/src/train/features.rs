@@ -90,8 +90,10 @@ pub fn dataset_from_runs_with_aux(
             targets.push(drift[i]);
             times.push(run.t_s()[i]);
         }
-        ds.push_group(&name, &rows, &targets, &times)
+        let id = ds
+            .push_group(&name, &rows, &targets, &times)
             .map_err(|e| fail(e.to_string()))?;
+        ds.set_group_ambient(id, run.ambient_c());
     }
     if ds.is_empty() {
         return Err(TrainError::EmptyDataset);

@@ -17,6 +17,7 @@ mod assemble;
 mod candidates;
 mod config;
 mod dataset;
+pub mod declared_range;
 mod design;
 mod error;
 mod fit;
@@ -27,6 +28,7 @@ mod ols;
 mod orr;
 mod path;
 mod predict;
+pub mod seek_score;
 mod select;
 mod validate;
 
@@ -62,6 +64,8 @@ use std::time::Instant;
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TrainReport {
     pub method: Method,
+    /// The held-out score that chose the model's width and polynomial degree.
+    pub criterion: seek_score::Criterion,
     pub inputs: Vec<String>,
     pub linear_only_inputs: usize,
     /// Training points (= candidate centres of the final fit).
@@ -101,6 +105,9 @@ pub struct TrainReport {
     pub design_bytes: usize,
     /// Bytes of the final fit's Gram matrices (what it holds).
     pub gram_bytes: usize,
+    /// How the model's declared input range (`input_min`/`input_max`, what the device
+    /// checks each window against) was set from the training runs.
+    pub declared_range: Vec<declared_range::InputRange>,
     /// Wall times, left out of the JSON (see `TrainTimings`).
     #[serde(skip)]
     pub timings: TrainTimings,
@@ -208,6 +215,8 @@ pub fn train_model(ds: &Dataset, cfg: &TrainConfig) -> Result<TrainOutcome> {
     )?;
     let final_fit_s = started.elapsed().as_secs_f64();
     fit.model.meta.heldout_rms_dph = cv.best.heldout_rms_dph as f32;
+    let ranges = declared_range::declared_ranges(ds);
+    declared_range::apply(&mut fit.model, &ranges);
     let pred = predict_batch(&fit.model, ds.rows())?;
     let resid: Vec<f64> = ds
         .targets_dph
@@ -217,6 +226,7 @@ pub fn train_model(ds: &Dataset, cfg: &TrainConfig) -> Result<TrainOutcome> {
         .collect();
     let report = TrainReport {
         method: cfg.method,
+        criterion: cfg.criterion,
         inputs: ds.input_names.clone(),
         linear_only_inputs: cfg.linear_only_inputs,
         n_train: ds.len(),
@@ -251,6 +261,7 @@ pub fn train_model(ds: &Dataset, cfg: &TrainConfig) -> Result<TrainOutcome> {
         design_bytes: fit.design_bytes,
         gram_bytes: fit.gram_bytes,
         cross_validation: cv,
+        declared_range: ranges,
         timings: TrainTimings {
             validation_s,
             final_fit_s,

@@ -16,6 +16,7 @@ use super::error::{Result, TrainError};
 use super::fit::{path_on_gram, select_path, PathFit, SelectedPath, Shape, WidthDesign};
 use super::gram::FoldGrams;
 use super::normalize::Normalizer;
+use super::seek_score::{seek_azimuth_rms_deg, Criterion};
 use crate::fanout::{map_in_order, thread_count};
 pub use crate::stats::rms;
 use fog_core::model::format::WIDTH_RANGE;
@@ -35,6 +36,9 @@ pub struct WidthScore {
     pub heldout_rms_dph: f64,
     /// Same with each held-out run's mean residual removed (the 10 s drift std), deg/h.
     pub heldout_std_dph: f64,
+    /// rms azimuth error of back-to-back seeks on the held-out residuals, deg
+    /// (`seek_score`; at the seek criterion's dwell and latitude, or its defaults).
+    pub heldout_seek_deg: f64,
     /// Mean number of centres over the folds.
     pub mean_centers: f64,
     /// Candidate centres at this width (grid over the normalised inputs).
@@ -143,9 +147,9 @@ fn search(ds: &Dataset, cfg: &TrainConfig, folds: usize) -> Result<Search> {
             let scored = score_width(&ctx, cfg, width);
             let mut improved = false;
             for (score, residuals) in scored.scores {
-                let better = best
-                    .as_ref()
-                    .is_none_or(|(b, _)| score.heldout_rms_dph < scan[*b].heldout_rms_dph);
+                let better = best.as_ref().is_none_or(|(b, _)| {
+                    criterion_key(cfg, &score) < criterion_key(cfg, &scan[*b])
+                });
                 scan.push(score);
                 if better {
                     best = Some((scan.len() - 1, residuals));
@@ -211,6 +215,29 @@ fn next_widths(grid: &mut Vec<f64>, tried: &[f64], w: f64, widenings: &mut usize
     grid.push(beyond);
     grid.sort_by(f64::total_cmp);
     vec![beyond]
+}
+
+/// The score `cfg.criterion` minimises.
+fn criterion_key(cfg: &TrainConfig, s: &WidthScore) -> f64 {
+    match cfg.criterion {
+        Criterion::Rms10s => s.heldout_rms_dph,
+        Criterion::Seek { .. } => s.heldout_seek_deg,
+    }
+}
+
+/// Held-out seek score at the criterion's dwell and latitude (the defaults under `Rms10s`).
+fn seek_score_of(cfg: &TrainConfig, res: &[f64], ds: &Dataset) -> f64 {
+    let Criterion::Seek {
+        dwell_s,
+        latitude_deg,
+    } = (match cfg.criterion {
+        Criterion::Rms10s => Criterion::seek_default(),
+        c => c,
+    })
+    else {
+        return f64::NAN;
+    };
+    seek_azimuth_rms_deg(res, &ds.groups, &ds.t_s, dwell_s, latitude_deg)
 }
 
 /// Std around the overall mean.
@@ -329,6 +356,7 @@ fn score_width(ctx: &FoldContext<'_>, cfg: &TrainConfig, width: f64) -> ScoredWi
             centers: m_best,
             heldout_rms_dph: rms(&res),
             heldout_std_dph: std_within_groups(&res, &ds.groups),
+            heldout_seek_deg: seek_score_of(cfg, &res, ds),
             mean_centers: m_best.map_or(centers as f64 / folds as f64, |m| m as f64),
             candidates: design.candidates.len(),
         };
