@@ -134,7 +134,18 @@ pub fn run(args: Args) -> Result<()> {
                 cfg.latitude_deg,
             )
             .map_err(|e| anyhow::anyhow!("--criterion {e}"))?;
-            let trained = train_with(&runs, &crate::train::default_specs(), "sim", criterion)?;
+            // The same defaults as `fogsim train`: the inputs chosen by grouped
+            // validation over whole runs (d2T/dt2 kept where it wins), then the model.
+            let owned: Vec<_> = runs.iter().map(|r| (*r).clone()).collect();
+            let (selection, _) = crate::train::choose_inputs(
+                &owned,
+                &crate::train::InputSet::ALL,
+                &crate::train::TrainConfig::default(),
+                &crate::train::GroupedCvRms,
+            )
+            .map_err(|e| anyhow::anyhow!("choosing the default model's inputs: {e}"))?;
+            eprint!("{}", selection.summary());
+            let trained = train_with(&runs, &selection.chosen.specs(), "sim", criterion)?;
             eprintln!(
                 "trained the default model on {} simulated {} degC runs (seed {}): {} centres, held-out rms {:.4} deg/h, seek {:.4} deg, chosen by held-out {}",
                 runs.len(),
