@@ -63,9 +63,11 @@ pub struct ArgError<'a> {
 
 impl core::fmt::Display for ArgError<'_> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        // Quoted by hand: `{:?}` would pull the char-escaping code (and its panic paths)
+        // into the image; an argument is printable text anyway.
         write!(
             f,
-            "argument {:?}: {} (known: {})",
+            "argument \"{}\": {} (known: {})",
             self.arg, self.why, KNOWN
         )
     }
