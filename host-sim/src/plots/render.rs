@@ -230,7 +230,7 @@ where
                 if !(plottable(chart, (p.0, *lo)) && plottable(chart, (p.0, *hi))) {
                     continue;
                 }
-                let stroke = color.stroke_width(1);
+                let stroke = color.stroke_width(style::ERROR_BAR_WIDTH_PX);
                 ctx.draw_series(LineSeries::new([(p.0, *lo), (p.0, *hi)], stroke))
                     .map_err(|e| draw_err(chart, e))?;
                 let cap = |y: f64| {
@@ -273,6 +273,15 @@ where
                         .into_iter()
                         .map(|p| Circle::new(p, style::POINT_RADIUS_PX, color.filled())),
                 )
+                .map(|_| ()),
+            Mark::FaintPoints => ctx
+                .draw_series(points.into_iter().map(|p| {
+                    Circle::new(
+                        p,
+                        style::POINT_RADIUS_PX - 1,
+                        color.mix(style::FAINT_OPACITY).filled(),
+                    )
+                }))
                 .map(|_| ()),
         }
         .map_err(|e| draw_err(chart, e))?;
@@ -327,6 +336,11 @@ fn draw_legend(
     for s in chart.series.iter().filter(|s| !s.label.is_empty()) {
         let c = rgb(s.color);
         match s.mark {
+            Mark::FaintPoints => area.draw(&Circle::new(
+                (x0 + 14, y),
+                style::POINT_RADIUS_PX,
+                c.mix(style::FAINT_OPACITY).filled(),
+            ))?,
             Mark::Points => area.draw(&Circle::new(
                 (x0 + 14, y),
                 style::POINT_RADIUS_PX + 1,
@@ -358,10 +372,13 @@ fn draw_legend(
         y += text(&b.label, y)?;
     }
     for r in chart.ref_lines.iter().filter(|r| !r.label.is_empty()) {
-        area.draw(&PathElement::new(
-            vec![(x0, y), (x0 + 28, y)],
-            style::REFERENCE.stroke_width(1),
-        ))?;
+        // Dashed like the line it stands for.
+        for k in 0..3 {
+            area.draw(&PathElement::new(
+                vec![(x0 + 11 * k, y), (x0 + 11 * k + 6, y)],
+                style::REFERENCE.stroke_width(1),
+            ))?;
+        }
         y += text(&r.label, y)?;
     }
     Ok(())
