@@ -469,10 +469,10 @@ pub fn summary(r: &ReproduceReport) -> String {
     )
 }
 
-/// Allan analysis of a steady (warm) record: 2 h at 10 Hz, input axis vertical.
+/// Allan analysis of a steady (warm) record: 6 h at 10 Hz (long enough to reach the bias-instability floor), input axis vertical.
 fn steady_allan(params: &GyroParams, seed: u64) -> Result<allan::Analysis> {
     let spec = RunSpec {
-        minutes: 120.0,
+        minutes: 360.0,
         raw_rate_hz: 10.0,
         start: StartState::Warm,
         ..RunSpec::paper(20.0, seed)
@@ -557,7 +557,10 @@ fn write_campaign_plots(dir: &Path, params: &GyroParams, campaign: &[CampaignRun
     let analysis = steady_allan(params, 7)?;
     write_svg(
         &dir.join("allan.svg"),
-        &allan_chart("Allan deviation, steady 2 h record (20 degC)", &analysis),
+        &allan_chart(
+            "Allan deviation, steady 6 h record at 10 Hz (20 degC)",
+            &analysis,
+        ),
     )?;
     Ok(())
 }

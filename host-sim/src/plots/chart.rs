@@ -13,6 +13,8 @@ pub enum Mark {
     Dashed,
     /// Unconnected dots.
     Points,
+    /// Small, light dots (a dense scatter under its summary bars).
+    FaintPoints,
 }
 
 /// Colour of a series: a palette index or an ambient temperature.

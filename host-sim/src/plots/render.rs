@@ -230,7 +230,7 @@ where
                 if !(plottable(chart, (p.0, *lo)) && plottable(chart, (p.0, *hi))) {
                     continue;
                 }
-                let stroke = color.stroke_width(1);
+                let stroke = color.stroke_width(style::ERROR_BAR_WIDTH_PX);
                 ctx.draw_series(LineSeries::new([(p.0, *lo), (p.0, *hi)], stroke))
                     .map_err(|e| draw_err(chart, e))?;
                 let cap = |y: f64| {
@@ -274,10 +274,39 @@ where
                         .map(|p| Circle::new(p, style::POINT_RADIUS_PX, color.filled())),
                 )
                 .map(|_| ()),
+            Mark::FaintPoints => ctx
+                .draw_series(points.into_iter().map(|p| {
+                    Circle::new(
+                        p,
+                        style::POINT_RADIUS_PX - 1,
+                        color.mix(style::FAINT_OPACITY).filled(),
+                    )
+                }))
+                .map(|_| ()),
         }
         .map_err(|e| draw_err(chart, e))?;
     }
     Ok(())
+}
+
+/// Characters per legend line before it wraps.
+const LEGEND_WRAP_CHARS: usize = 28;
+
+/// Splits `label` into lines of at most `width` characters at spaces (a longer word stays whole).
+fn wrap(label: &str, width: usize) -> Vec<String> {
+    let mut lines = vec![String::new()];
+    for word in label.split(' ') {
+        let last = lines.last_mut().expect("one line");
+        if !last.is_empty() && last.len() + 1 + word.len() > width {
+            lines.push(word.to_owned());
+        } else {
+            if !last.is_empty() {
+                last.push(' ');
+            }
+            last.push_str(word);
+        }
+    }
+    lines
 }
 
 /// The legend panel: one row per labelled band, reference line and series.
@@ -291,31 +320,27 @@ fn draw_legend(
     let row_px = style::LEGEND_FONT_PX as i32 + 10;
     let mut y = 60;
     let x0 = 8;
-    let text = |label: &str, y: i32| -> Result<(), DrawingAreaErrorKind<std::io::Error>> {
-        // Long labels wrap at about 26 characters.
-        let mut line = String::new();
-        let mut dy = 0;
-        for word in label.split(' ') {
-            if line.len() + word.len() > 26 && !line.is_empty() {
-                area.draw(&Text::new(
-                    line.clone(),
-                    (x0 + 34, y - 7 + dy),
-                    font.clone(),
-                ))?;
-                line.clear();
-                dy += style::LEGEND_FONT_PX as i32 + 2;
-            }
-            if !line.is_empty() {
-                line.push(' ');
-            }
-            line.push_str(word);
+    let line_px = style::LEGEND_FONT_PX as i32 + 3;
+    // Draws a label wrapped at LEGEND_WRAP_CHARS; returns the height it took.
+    let text = |label: &str, y: i32| -> Result<i32, DrawingAreaErrorKind<std::io::Error>> {
+        let lines = wrap(label, LEGEND_WRAP_CHARS);
+        for (k, l) in lines.iter().enumerate() {
+            area.draw(&Text::new(
+                l.clone(),
+                (x0 + 34, y - 7 + k as i32 * line_px),
+                font.clone(),
+            ))?;
         }
-        area.draw(&Text::new(line, (x0 + 34, y - 7 + dy), font.clone()))
+        Ok(row_px + (lines.len() as i32 - 1) * line_px)
     };
-    let extra = |label: &str| (label.len() as i32 / 27) * (style::LEGEND_FONT_PX as i32 + 2);
     for s in chart.series.iter().filter(|s| !s.label.is_empty()) {
         let c = rgb(s.color);
         match s.mark {
+            Mark::FaintPoints => area.draw(&Circle::new(
+                (x0 + 14, y),
+                style::POINT_RADIUS_PX,
+                c.mix(style::FAINT_OPACITY).filled(),
+            ))?,
             Mark::Points => area.draw(&Circle::new(
                 (x0 + 14, y),
                 style::POINT_RADIUS_PX + 1,
@@ -336,8 +361,7 @@ fn draw_legend(
                 c.stroke_width(1),
             ))?;
         }
-        text(&s.label, y)?;
-        y += row_px + extra(&s.label);
+        y += text(&s.label, y)?;
     }
     for b in chart.bands.iter().filter(|b| !b.label.is_empty()) {
         let c = rgb(b.color);
@@ -345,16 +369,17 @@ fn draw_legend(
             [(x0, y - 6), (x0 + 28, y + 6)],
             c.mix(style::BAND_OPACITY * 2.0).filled(),
         ))?;
-        text(&b.label, y)?;
-        y += row_px + extra(&b.label);
+        y += text(&b.label, y)?;
     }
     for r in chart.ref_lines.iter().filter(|r| !r.label.is_empty()) {
-        area.draw(&PathElement::new(
-            vec![(x0, y), (x0 + 28, y)],
-            style::REFERENCE.stroke_width(1),
-        ))?;
-        text(&r.label, y)?;
-        y += row_px + extra(&r.label);
+        // Dashed like the line it stands for.
+        for k in 0..3 {
+            area.draw(&PathElement::new(
+                vec![(x0 + 11 * k, y), (x0 + 11 * k + 6, y)],
+                style::REFERENCE.stroke_width(1),
+            ))?;
+        }
+        y += text(&r.label, y)?;
     }
     Ok(())
 }

@@ -18,6 +18,10 @@ pub const POINT_RADIUS_PX: u32 = 3;
 pub const BAND_OPACITY: f64 = 0.18;
 /// Opacity of thin (secondary) lines.
 pub const THIN_OPACITY: f64 = 0.55;
+/// Opacity of faint scatter points.
+pub const FAINT_OPACITY: f64 = 0.35;
+/// Width of error bars, px.
+pub const ERROR_BAR_WIDTH_PX: u32 = 2;
 /// Grey of reference lines.
 pub const REFERENCE: RGBColor = RGBColor(90, 90, 90);
 

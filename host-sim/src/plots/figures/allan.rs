@@ -41,7 +41,29 @@ pub fn allan_chart(title: &str, analysis: &Analysis) -> Chart {
         chart.title = format!("{title} (IEEE 952 terms: see the ADEV)");
         return chart;
     }
-    let taus: Vec<f64> = c.points.iter().map(|p| p.tau_s).collect();
+    // Fitted lines on 8 taus per octave over the measured span.
+    let (t_first, t_last) = match (c.points.first(), c.points.last()) {
+        (Some(a), Some(b)) => (a.tau_s, b.tau_s),
+        _ => return chart,
+    };
+    let steps = (8.0 * (t_last / t_first).log2()).ceil().max(1.0) as usize;
+    let grid: Vec<f64> = (0..=steps)
+        .map(|i| t_first * (t_last / t_first).powf(i as f64 / steps as f64))
+        .collect();
+    // The y axis is the data's (points and band); fitted lines are cut to it.
+    let (lo, hi) = c
+        .points
+        .iter()
+        .flat_map(|p| [p.dev_lo, p.dev_hi, p.dev])
+        .filter(|v| *v > 0.0 && v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    let (lo, hi) = (lo / 1.5, hi * 1.5);
+    chart.y_range = (lo < hi).then_some((lo, hi));
+    let inside = |pts: Vec<(f64, f64)>| -> Vec<(f64, f64)> {
+        pts.into_iter().filter(|p| p.1 >= lo && p.1 <= hi).collect()
+    };
     let colors = [
         (Term::Q, 4),
         (Term::N, 1),
@@ -53,10 +75,11 @@ pub fn allan_chart(title: &str, analysis: &Analysis) -> Chart {
         let Some(t) = analysis.noise.detected(term) else {
             continue;
         };
-        let line = taus
-            .iter()
-            .map(|&tau| (tau, term.deviation(t.value, tau)))
-            .collect();
+        let line = inside(
+            grid.iter()
+                .map(|&tau| (tau, term.deviation(t.value, tau)))
+                .collect(),
+        );
         chart.series.push(Series::styled(
             term_label(t),
             line,
@@ -65,10 +88,11 @@ pub fn allan_chart(title: &str, analysis: &Analysis) -> Chart {
         ));
     }
     if analysis.noise.terms.iter().any(|t| t.detected) {
-        let model = taus
-            .iter()
-            .map(|&tau| (tau, analysis.noise.model_adev(tau)))
-            .collect();
+        let model = inside(
+            grid.iter()
+                .map(|&tau| (tau, analysis.noise.model_adev(tau)))
+                .collect(),
+        );
         chart.series.push(Series::styled(
             "sum of the fitted terms",
             model,

@@ -39,7 +39,7 @@ fn group(label: &str, pts: &[(usize, f64)], true_deg: f64, dx: f64, color: usize
         Series::styled(
             format!("{label}: each seek"),
             scatter,
-            Mark::Points,
+            Mark::FaintPoints,
             Color::Palette(color),
         ),
         Series::styled(
