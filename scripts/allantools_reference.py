@@ -17,7 +17,9 @@ from allantools import ci
 d = sys.argv[1]
 kinds = [("Adev", at.oadev), ("Mdev", at.mdev), ("Hdev", at.ohdev), ("Tdev", at.tdev), ("Totdev", at.totdev)]
 print(f"// allantools {at.__version__}, numpy {np.__version__}")
-print("pub const DEVS: &[(usize, Kind, &[(f64, f64)])] = &[")
+print("/// (series, kind, octave (tau_s, dev) pairs).")
+print("pub type Curve = (usize, Kind, &'static [(f64, f64)]);")
+print("pub const DEVS: &[Curve] = &[")
 for i in range(3):
     y = np.loadtxt(f"{d}/series{i}.txt")
     for name, f in kinds:

@@ -83,13 +83,16 @@ fn fitted(y: &[f64], term: Term) -> (f64, f64, bool) {
     (t.value, t.sigma, t.detected)
 }
 
+/// A seeded series generator: (scale, seed) -> rate, deg/h.
+type Generator = fn(f64, u64) -> Vec<f64>;
+
 struct Case {
     term: Term,
     truth: f64,
     /// The law itself, seeded.
-    law: fn(f64, u64) -> Vec<f64>,
+    law: Generator,
     /// Twin: another law at a matched scale, and the term it must be read as.
-    twin: (fn(f64, u64) -> Vec<f64>, f64, Term),
+    twin: (Generator, f64, Term),
     /// Largest relative error of the recovered value (measured, with margin).
     tolerance: f64,
 }

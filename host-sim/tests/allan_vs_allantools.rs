@@ -117,7 +117,9 @@ fn edfs_intervals_and_noise_ids_match_allantools() {
 mod reference {
     use fog_sim::stats::allan::Kind;
     // allantools 2024.06, numpy 2.4.6
-    pub const DEVS: &[(usize, Kind, &[(f64, f64)])] = &[
+    /// (series, kind, octave (tau_s, dev) pairs).
+    pub type Curve = (usize, Kind, &'static [(f64, f64)]);
+    pub const DEVS: &[Curve] = &[
         (
             0,
             Kind::Adev,

@@ -149,6 +149,43 @@ fn number_label(v: &f64) -> String {
     }
 }
 
+/// The plottable error bars of a series: ((x, y), (low, high)).
+fn error_bars(chart: &Chart, s: &super::chart::Series) -> Vec<((f64, f64), (f64, f64))> {
+    let Some(err) = &s.y_err else {
+        return vec![];
+    };
+    s.points
+        .iter()
+        .zip(err)
+        .filter(|(p, (lo, hi))| plottable(chart, (p.0, *lo)) && plottable(chart, (p.0, *hi)))
+        .map(|(p, e)| (*p, *e))
+        .collect()
+}
+
+/// Smallest and largest plottable x.
+fn x_span(chart: &Chart) -> (f64, f64) {
+    chart
+        .x_values()
+        .filter(|v| v.is_finite() && (!chart.x_log || *v > 0.0))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        })
+}
+
+/// A band as one polygon: along its lower edge, back along its upper edge.
+fn band_outline(chart: &Chart, b: &super::chart::Band) -> Vec<(f64, f64)> {
+    let pts: Vec<(f64, f64, f64)> = b
+        .points
+        .iter()
+        .copied()
+        .filter(|p| plottable(chart, (p.0, p.1)) && plottable(chart, (p.0, p.2)))
+        .collect();
+    pts.iter()
+        .map(|p| (p.0, p.1))
+        .chain(pts.iter().rev().map(|p| (p.0, p.2)))
+        .collect()
+}
+
 fn draw_on<XR, YR>(
     root: &DrawingArea<SVGBackend<'_>, Shift>,
     chart: &Chart,
@@ -168,15 +205,7 @@ where
         .y_label_area_size(84)
         .build_cartesian_2d(x_range, y_range)
         .map_err(|e| draw_err(chart, e))?;
-    let x_span = {
-        let (lo, hi) = chart
-            .x_values()
-            .filter(|v| v.is_finite() && (!chart.x_log || *v > 0.0))
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-                (lo.min(v), hi.max(v))
-            });
-        (lo, hi)
-    };
+    let x_span = x_span(chart);
     {
         let mut mesh = ctx.configure_mesh();
         mesh.x_desc(chart.x_label.as_str())
@@ -195,21 +224,9 @@ where
         mesh.draw().map_err(|e| draw_err(chart, e))?;
     }
     for b in &chart.bands {
-        let c = rgb(b.color);
-        let pts: Vec<(f64, f64, f64)> = b
-            .points
-            .iter()
-            .copied()
-            .filter(|p| plottable(chart, (p.0, p.1)) && plottable(chart, (p.0, p.2)))
-            .collect();
-        let outline: Vec<(f64, f64)> = pts
-            .iter()
-            .map(|p| (p.0, p.1))
-            .chain(pts.iter().rev().map(|p| (p.0, p.2)))
-            .collect();
         ctx.draw_series(std::iter::once(Polygon::new(
-            outline,
-            c.mix(style::BAND_OPACITY).filled(),
+            band_outline(chart, b),
+            rgb(b.color).mix(style::BAND_OPACITY).filled(),
         )))
         .map_err(|e| draw_err(chart, e))?;
     }
@@ -224,21 +241,16 @@ where
     }
     for s in &chart.series {
         let color = rgb(s.color);
-        if let Some(err) = &s.y_err {
-            // Vertical bar in data coordinates, 8 px caps at both ends.
-            for (p, (lo, hi)) in s.points.iter().zip(err) {
-                if !(plottable(chart, (p.0, *lo)) && plottable(chart, (p.0, *hi))) {
-                    continue;
-                }
-                let stroke = color.stroke_width(style::ERROR_BAR_WIDTH_PX);
-                ctx.draw_series(LineSeries::new([(p.0, *lo), (p.0, *hi)], stroke))
-                    .map_err(|e| draw_err(chart, e))?;
-                let cap = |y: f64| {
-                    EmptyElement::at((p.0, y)) + PathElement::new(vec![(-4, 0), (4, 0)], stroke)
-                };
-                ctx.draw_series([cap(*lo), cap(*hi)])
-                    .map_err(|e| draw_err(chart, e))?;
-            }
+        // Vertical bar in data coordinates, 8 px caps at both ends.
+        for (p, (lo, hi)) in error_bars(chart, s) {
+            let stroke = color.stroke_width(style::ERROR_BAR_WIDTH_PX);
+            ctx.draw_series(LineSeries::new([(p.0, lo), (p.0, hi)], stroke))
+                .map_err(|e| draw_err(chart, e))?;
+            let cap = |y: f64| {
+                EmptyElement::at((p.0, y)) + PathElement::new(vec![(-4, 0), (4, 0)], stroke)
+            };
+            ctx.draw_series([cap(lo), cap(hi)])
+                .map_err(|e| draw_err(chart, e))?;
         }
         let points: Vec<(f64, f64)> = s
             .points

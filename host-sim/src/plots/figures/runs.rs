@@ -42,8 +42,11 @@ fn by_ambient(curves: &[RunCurve]) -> Vec<(f64, Vec<&RunCurve>)> {
     groups
 }
 
+/// (minutes, min, max) at each step, and (minutes, median).
+type Envelope = (Vec<(f64, f64, f64)>, Vec<(f64, f64)>);
+
 /// Min, median and max over runs at each time step of the shortest run.
-fn envelope(runs: &[&RunCurve]) -> (Vec<(f64, f64, f64)>, Vec<(f64, f64)>) {
+fn envelope(runs: &[&RunCurve]) -> Envelope {
     let len = runs
         .iter()
         .map(|r| r.t_s.len().min(r.y.len()))

@@ -164,6 +164,71 @@ fn solve(
     Some((coef, cov, ssr))
 }
 
+/// The best non-negative fit: its terms, coefficients (value^2), covariance and SSR.
+struct Best {
+    subset: Vec<Term>,
+    coef: Vec<f64>,
+    cov: DMatrix<f64>,
+    ssr: f64,
+}
+
+impl Best {
+    /// The fitted Allan variance at `tau_s`.
+    fn variance(&self, tau_s: f64) -> f64 {
+        self.subset
+            .iter()
+            .zip(&self.coef)
+            .map(|(t, c)| c * t.unit_variance(tau_s))
+            .sum()
+    }
+}
+
+/// Solves every subset of the five terms; keeps the lowest SSR with all coefficients positive.
+fn best_subset(rows: &[(f64, f64, f64)], denom: &[f64]) -> Option<Best> {
+    let mut best: Option<Best> = None;
+    for mask in 1u32..32 {
+        let subset: Vec<Term> = Term::ALL
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| mask & (1 << i) != 0)
+            .map(|(_, t)| *t)
+            .collect();
+        if subset.len() > rows.len() {
+            continue;
+        }
+        let Some((coef, cov, ssr)) = solve(rows, &subset, denom) else {
+            continue;
+        };
+        if coef.iter().all(|c| *c > 0.0) && best.as_ref().is_none_or(|b| ssr < b.ssr) {
+            best = Some(Best {
+                subset,
+                coef,
+                cov,
+                ssr,
+            });
+        }
+    }
+    best
+}
+
+/// Where a fitted term is read from: the taus where it carries >= half of `model`,
+/// else the one tau where its share peaks.
+fn read_range(taus: &[f64], share: impl Fn(f64) -> f64) -> Option<(f64, f64)> {
+    let dominant: Vec<f64> = taus
+        .iter()
+        .copied()
+        .filter(|&tau| share(tau) >= 0.5)
+        .collect();
+    match (dominant.first(), dominant.last()) {
+        (Some(a), Some(b)) => Some((*a, *b)),
+        _ => taus
+            .iter()
+            .copied()
+            .max_by(|a, b| share(*a).total_cmp(&share(*b)))
+            .map(|p| (p, p)),
+    }
+}
+
 /// Fits the five terms to an overlapping Allan deviation curve (deg/h).
 pub fn fit(points: &[Point]) -> NoiseFit {
     let rows: Vec<(f64, f64, f64)> = points
@@ -195,44 +260,21 @@ pub fn fit(points: &[Point]) -> NoiseFit {
     }
     // Pass 1 weighs by the measured variance, pass 2 by the pass-1 model (less biased).
     let mut denom: Vec<f64> = rows.iter().map(|r| r.1).collect();
-    let mut best: Option<(Vec<Term>, Vec<f64>, DMatrix<f64>, f64)> = None;
+    let mut best = None;
     for _pass in 0..2 {
-        best = None;
-        for mask in 1u32..32 {
-            let subset: Vec<Term> = Term::ALL
-                .iter()
-                .enumerate()
-                .filter(|(i, _)| mask & (1 << i) != 0)
-                .map(|(_, t)| *t)
-                .collect();
-            if subset.len() > rows.len() {
-                continue;
-            }
-            let Some((coef, cov, ssr)) = solve(&rows, &subset, &denom) else {
-                continue;
-            };
-            if coef.iter().any(|c| *c <= 0.0) {
-                continue;
-            }
-            if best.as_ref().is_none_or(|b| ssr < b.3) {
-                best = Some((subset, coef, cov, ssr));
-            }
-        }
-        let Some((subset, coef, _, _)) = &best else {
+        best = best_subset(&rows, &denom);
+        let Some(b) = &best else {
             break;
         };
-        denom = rows
-            .iter()
-            .map(|r| {
-                subset
-                    .iter()
-                    .zip(coef)
-                    .map(|(t, c)| c * t.unit_variance(r.0))
-                    .sum()
-            })
-            .collect();
+        denom = rows.iter().map(|r| b.variance(r.0)).collect();
     }
-    let Some((subset, coef, cov, ssr)) = best else {
+    let Some(Best {
+        subset,
+        coef,
+        cov,
+        ssr,
+    }) = best
+    else {
         return empty("no combination of the five terms fits with positive coefficients");
     };
     let dof = rows.len().saturating_sub(subset.len());
@@ -245,6 +287,7 @@ pub fn fit(points: &[Point]) -> NoiseFit {
             .map(|(t, c)| c * t.unit_variance(tau))
             .sum()
     };
+    let taus: Vec<f64> = rows.iter().map(|r| r.0).collect();
     let terms = Term::ALL
         .iter()
         .map(|&t| {
@@ -253,21 +296,7 @@ pub fn fit(points: &[Point]) -> NoiseFit {
                 Some(j) => {
                     let c = coef[j];
                     let sc = (cov[(j, j)] * inflate).max(0.0).sqrt();
-                    let share = |tau: f64| c * t.unit_variance(tau) / model(tau);
-                    let dominant: Vec<f64> = rows
-                        .iter()
-                        .map(|r| r.0)
-                        .filter(|&tau| share(tau) >= 0.5)
-                        .collect();
-                    let range = if dominant.is_empty() {
-                        let peak = rows
-                            .iter()
-                            .map(|r| r.0)
-                            .max_by(|a, b| share(*a).total_cmp(&share(*b)));
-                        peak.map(|p| (p, p))
-                    } else {
-                        Some((dominant[0], dominant[dominant.len() - 1]))
-                    };
+                    let range = read_range(&taus, |tau| c * t.unit_variance(tau) / model(tau));
                     (c.sqrt(), sc / (2.0 * c.sqrt()), c > 2.0 * sc, range)
                 }
                 None => (
