@@ -111,6 +111,12 @@ impl InputCriterion for GroupedCvRms {
     }
 
     fn score(&self, ds: &Dataset, cfg: &TrainConfig) -> Result<SetScore> {
+        // Each set's shape is validated on the same metric this criterion scores (the
+        // 10 s rms), whatever criterion later chooses the final model's shape.
+        let cfg = &TrainConfig {
+            criterion: super::seek_score::Criterion::Rms10s,
+            ..cfg.clone()
+        };
         let cv = cross_validate(ds, cfg, cfg.folds)?;
         let mut sum = vec![0.0; ds.n_groups()];
         let mut count = vec![0usize; ds.n_groups()];
