@@ -5,6 +5,7 @@
 
 pub mod allan;
 
+pub mod special;
 pub mod student_t;
 
 /// The gyro's bias spec, deg/h (1 sigma of 10 s means; gyro 008 in the paper).

@@ -4,32 +4,7 @@
 //! P(T > t) = I_x(nu / 2, 1 / 2) / 2 with x = nu / (nu + t^2) (regularised incomplete beta
 //! by its continued fraction, Lentz's method); the quantile by bisection on that tail.
 
-/// ln Gamma(x) for x > 0 (Lanczos, g = 7, 9 terms: ~1e-15 relative).
-fn ln_gamma(x: f64) -> f64 {
-    const G: [f64; 9] = [
-        0.999_999_999_999_809_9,
-        676.520_368_121_885_1,
-        -1_259.139_216_722_402_8,
-        771.323_428_777_653_1,
-        -176.615_029_162_140_6,
-        12.507_343_278_686_905,
-        -0.138_571_095_265_720_12,
-        9.984_369_578_019_572e-6,
-        1.505_632_735_149_311_6e-7,
-    ];
-    if x < 0.5 {
-        // Reflection: Gamma(x) Gamma(1 - x) = pi / sin(pi x).
-        let pi = std::f64::consts::PI;
-        return (pi / (pi * x).sin()).ln() - ln_gamma(1.0 - x);
-    }
-    let x = x - 1.0;
-    let t = x + 7.5;
-    let sum = G[1..]
-        .iter()
-        .enumerate()
-        .fold(G[0], |acc, (i, g)| acc + g / (x + i as f64 + 1.0));
-    0.5 * (2.0 * std::f64::consts::PI).ln() + (x + 0.5) * t.ln() - t + sum.ln()
-}
+use crate::stats::special::ln_gamma;
 
 /// Continued fraction of the incomplete beta (converges for x < (a + 1) / (a + b + 2)).
 fn beta_cf(a: f64, b: f64, x: f64) -> f64 {

@@ -3,35 +3,10 @@
 //! (NIST SP 1065 eq. 45: edf s^2 / chi2(p, edf) bounds sigma^2). Regularized lower
 //! incomplete gamma (series below a + 1, continued fraction above) and a bisection on it.
 
+use crate::stats::special::ln_gamma;
+
 /// Probability that a standard normal lies within +/- 1: the 1-sigma confidence level.
 pub const ONE_SIGMA_CONFIDENCE: f64 = 0.682_689_492_137_085_9;
-
-/// ln Gamma(x) for x > 0 (Lanczos, g = 7, 9 terms; relative error < 1e-14).
-fn ln_gamma(x: f64) -> f64 {
-    const C: [f64; 9] = [
-        0.999_999_999_999_809_9,
-        676.520_368_121_885_1,
-        -1_259.139_216_722_402_8,
-        771.323_428_777_653_1,
-        -176.615_029_162_140_6,
-        12.507_343_278_686_905,
-        -0.138_571_095_265_720_12,
-        9.984_369_578_019_572e-6,
-        1.505_632_735_149_311_6e-7,
-    ];
-    if x < 0.5 {
-        // Reflection: Gamma(x) Gamma(1 - x) = pi / sin(pi x).
-        let pi = std::f64::consts::PI;
-        return (pi / (pi * x).sin()).ln() - ln_gamma(1.0 - x);
-    }
-    let x = x - 1.0;
-    let mut a = C[0];
-    let t = x + 7.5;
-    for (i, c) in C.iter().enumerate().skip(1) {
-        a += c / (x + i as f64);
-    }
-    0.5 * (2.0 * std::f64::consts::PI).ln() + (x + 0.5) * t.ln() - t + a.ln()
-}
 
 /// Regularized lower incomplete gamma P(a, x).
 fn gamma_p(a: f64, x: f64) -> f64 {
