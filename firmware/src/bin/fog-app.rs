@@ -10,10 +10,12 @@
 //!   the gyro's internal coil temperature comes with every frame and is read at 1 Hz
 //!   (a board with a TMP117 on I2C uses `drivers::tmp117` instead);
 //! - UART2 (0x4000_6000): the turntable controller (`SerialTurntable`);
-//! - the inclinometer: the MPS2 board (and QEMU) has no SPI SCL3300, so this binary reads
-//!   a `SimulatedInclinometer` (the same `Inclinometer` trait the SCL3300 driver
-//!   implements) at 1 Hz of sample time; its tilt comes from the semihosting argument
-//!   `tilt-mdeg=PITCH:ROLL` (millidegrees, default level);
+//! - UART3 (0x4000_7000, QEMU's fourth `-serial`): the inclinometer's `tilt_frame`
+//!   stream (`SerialInclinometer`; the MPS2 board has no SPI SCL3300), drained every pass
+//!   and read at 1 Hz of sample time (the mean of the readings since the last one); with
+//!   the semihosting argument `tilt-mdeg=PITCH:ROLL` a `SimulatedInclinometer` at that
+//!   tilt instead (QEMU runs without an inclinometer link). Both are the `Inclinometer`
+//!   trait the SCL3300 driver implements;
 //! - SysTick: 1 kHz time base for turntable timeouts and the gyro's frame time base
 //!   (counter wraps during a stall are recovered from it);
 //! - the CMSDK watchdog (0x4000_8000): 500 ms, fed only while the gyro path is serviced;
@@ -72,8 +74,9 @@ use fog_firmware::boot_args::{BootArgs, Inject};
 use fog_firmware::clock::Clock;
 use fog_firmware::drivers::fog_serial::FogSerialGyro;
 use fog_firmware::drivers::inclinometer::{
-    Inclinometer, SimulatedInclinometer, SIMULATED_NOISE_DEG,
+    BaseInclinometer, Inclinometer, SimulatedInclinometer, SIMULATED_NOISE_DEG,
 };
+use fog_firmware::drivers::serial_inclinometer::SerialInclinometer;
 use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig};
 use fog_firmware::fault_record::{CleanRun, FaultRecord};
 use fog_firmware::health::{GyroWatch, StuckEvent, DEFAULT_STUCK_RUN};
@@ -90,6 +93,7 @@ const GYRO_RATE_HZ: u32 = 2000;
 const HOST_BAUD: u32 = 115_200;
 const GYRO_BAUD: u32 = 460_800;
 const TABLE_BAUD: u32 = 115_200;
+const INCL_BAUD: u32 = 115_200;
 /// Watchdog deadline between feeds, ms.
 const WATCHDOG_TIMEOUT_MS: u32 = 500;
 /// Host bytes handled per main-loop pass (the gyro ring is drained in between).
@@ -133,11 +137,12 @@ fn main() -> ! {
     inject_fault_at_boot(options);
     let gyro_rate_hz = options.gyro_rate_hz;
     // SAFETY: each UART block and the model region are taken exactly once, here.
-    let (mut host, gyro_uart, table_uart, flash) = unsafe {
+    let (mut host, gyro_uart, table_uart, incl_uart, flash) = unsafe {
         (
             uart::CmsdkUart::new(0, HOST_BAUD),
             uart::CmsdkUart::new(1, GYRO_BAUD),
             uart::CmsdkUart::new(2, TABLE_BAUD),
+            uart::CmsdkUart::new(3, INCL_BAUD),
             flash::take_app_flash(),
         )
     };
@@ -200,8 +205,15 @@ fn main() -> ! {
     let mut gyro = FogSerialGyro::with_clock(gyro_uart, gyro_rate_hz, millis::MillisClock);
     // Clock reading at the last gyro sample (`None` until the gyro starts).
     let mut watch = GyroWatch::new(GYRO_SILENCE_S, DEFAULT_STUCK_RUN);
-    let mut inclinometer =
-        SimulatedInclinometer::new(options.tilt, SIMULATED_NOISE_DEG, TILT_NOISE_SEED);
+    let mut inclinometer = match options.tilt {
+        Some(tilt) => BaseInclinometer::Simulated(SimulatedInclinometer::new(
+            tilt,
+            SIMULATED_NOISE_DEG,
+            TILT_NOISE_SEED,
+        )),
+        None => BaseInclinometer::Serial(SerialInclinometer::new(incl_uart)),
+    };
+    let mut tilt_ok = true;
     let mut next_tilt_s = 0.0;
     let mut last_tilt_clock_s: Option<f64> = None;
     let mut last_table_error_s: Option<f64> = None;
@@ -252,8 +264,14 @@ fn main() -> ! {
                             Ok(t) => {
                                 app.on_tilt(t);
                                 last_tilt_clock_s = Some(now_s);
+                                tilt_ok = true;
                             }
-                            Err(e) => defmt::warn!("inclinometer: {}", e),
+                            // Once per dropout; the BIT sees the silence.
+                            Err(e) if tilt_ok => {
+                                tilt_ok = false;
+                                defmt::warn!("t={} s: inclinometer: {}", s.t_s, e)
+                            }
+                            Err(_) => {}
                         }
                     }
                     let step = app.on_gyro(s);
@@ -281,6 +299,7 @@ fn main() -> ! {
                 }
             }
         }
+        inclinometer.poll();
         if watch.became_silent(now_s) {
             defmt::warn!(
                 "t={} s: gyro silent (dead sensor or cable): window invalid",
@@ -533,8 +552,9 @@ fn window_line(
 struct TestOptions {
     inject: Inject,
     gyro_rate_hz: u32,
-    /// `tilt-mdeg=PITCH:ROLL`: the simulated inclinometer's base tilt.
-    tilt: Tilt,
+    /// `tilt-mdeg=PITCH:ROLL`: a simulated inclinometer at this base tilt instead of the
+    /// UART3 link.
+    tilt: Option<Tilt>,
     /// `seek-dwell-s=N`: dwell per main position (QEMU runs a short seek).
     seek_dwell_s: Option<u32>,
 }
@@ -550,7 +570,7 @@ fn test_options(reset: &ResetRecord) -> TestOptions {
     let mut o = TestOptions {
         inject: args.inject,
         gyro_rate_hz: args.gyro_rate_hz.unwrap_or(GYRO_RATE_HZ),
-        tilt: args.tilt_mdeg.map_or(Tilt::LEVEL, |(p, r)| Tilt {
+        tilt: args.tilt_mdeg.map(|(p, r)| Tilt {
             pitch_deg: p as f32 / 1000.0,
             roll_deg: r as f32 / 1000.0,
         }),

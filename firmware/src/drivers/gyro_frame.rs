@@ -15,7 +15,8 @@
 //!
 //! At 2 kHz this is 24,000 B/s, i.e. 240 kbaud with 8N1 framing (460,800 baud link).
 
-use crc::{Crc, CRC_16_IBM_3740};
+pub use super::sync_frame::FrameStats;
+use super::sync_frame::{round_sat_i32, seal, SyncDecoder};
 
 /// Frame start marker.
 pub const SYNC: [u8; 2] = [0xA5, 0x5A];
@@ -32,8 +33,6 @@ pub const STATUS_SOURCE_FAULT: u8 = 0x02;
 /// Status bit: the gyro's internal temperature sensor is not valid.
 pub const STATUS_TEMP_INVALID: u8 = 0x04;
 
-const CRC16: Crc<u16> = Crc::<u16>::new(&CRC_16_IBM_3740);
-
 /// One decoded frame, raw units.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct GyroFrame {
@@ -48,15 +47,12 @@ pub struct GyroFrame {
 impl GyroFrame {
     /// The frame as it appears on the wire.
     pub fn encode(&self) -> [u8; FRAME_LEN] {
-        let mut out = [0u8; FRAME_LEN];
-        out[0..2].copy_from_slice(&SYNC);
-        out[2] = self.seq;
-        out[3] = self.status;
-        out[4..8].copy_from_slice(&self.dtheta_lsb.to_le_bytes());
-        out[8..10].copy_from_slice(&self.temp_lsb.to_le_bytes());
-        let crc = CRC16.checksum(&out[2..10]);
-        out[10..12].copy_from_slice(&crc.to_le_bytes());
-        out
+        let mut body = [0u8; FRAME_LEN - 4];
+        body[0] = self.seq;
+        body[1] = self.status;
+        body[2..6].copy_from_slice(&self.dtheta_lsb.to_le_bytes());
+        body[6..8].copy_from_slice(&self.temp_lsb.to_le_bytes());
+        seal(SYNC, &body)
     }
 
     /// Internal temperature, degC.
@@ -88,34 +84,9 @@ impl GyroFrame {
     }
 }
 
-fn round_sat_i32(x: f64) -> i32 {
-    // `as` saturates and maps NaN to 0; add 0.5 away from zero for round-half-away.
-    if x >= 0.0 {
-        (x + 0.5) as i32
-    } else {
-        (x - 0.5) as i32
-    }
-}
-
-/// Decoder counters: what was lost, so faults are visible rather than silent.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct FrameStats {
-    /// Frames with a good CRC.
-    pub frames_ok: u32,
-    /// Candidate frames whose CRC failed (skipped).
-    pub crc_errors: u32,
-    /// Bytes discarded while hunting for the sync marker.
-    pub bytes_skipped: u32,
-}
-
-/// Byte-at-a-time frame decoder with resynchronisation.
+/// Byte-at-a-time frame decoder with resynchronisation (`sync_frame`).
 #[derive(Clone, Debug)]
-pub struct FrameDecoder {
-    buf: [u8; FRAME_LEN],
-    len: usize,
-    stats: FrameStats,
-}
+pub struct FrameDecoder(SyncDecoder<FRAME_LEN>);
 
 impl Default for FrameDecoder {
     fn default() -> Self {
@@ -125,71 +96,21 @@ impl Default for FrameDecoder {
 
 impl FrameDecoder {
     pub const fn new() -> Self {
-        Self {
-            buf: [0; FRAME_LEN],
-            len: 0,
-            stats: FrameStats {
-                frames_ok: 0,
-                crc_errors: 0,
-                bytes_skipped: 0,
-            },
-        }
+        Self(SyncDecoder::new(SYNC))
     }
 
     pub fn stats(&self) -> FrameStats {
-        self.stats
+        self.0.stats()
     }
 
     /// Feed one byte; returns a frame when one with a good CRC completes.
     pub fn push(&mut self, byte: u8) -> Option<GyroFrame> {
-        // Hunting for sync: byte 0 must be SYNC[0], byte 1 SYNC[1].
-        if self.len < SYNC.len() && byte != SYNC[self.len] {
-            self.stats.bytes_skipped += self.len as u32;
-            self.len = 0;
-            if byte != SYNC[0] {
-                self.stats.bytes_skipped += 1;
-                return None;
-            }
-        }
-        // `len < FRAME_LEN` here (a full frame resets it below); `get_mut` keeps the
-        // panic path out of the 2 kHz loop.
-        let Some(slot) = self.buf.get_mut(self.len) else {
-            self.len = 0;
-            return None;
-        };
-        *slot = byte;
-        self.len += 1;
-        if self.len < FRAME_LEN {
-            return None;
-        }
-        let crc = u16::from_le_bytes([self.buf[10], self.buf[11]]);
-        if CRC16.checksum(&self.buf[2..10]) == crc {
-            self.len = 0;
-            self.stats.frames_ok += 1;
-            return Some(GyroFrame {
-                seq: self.buf[2],
-                status: self.buf[3],
-                dtheta_lsb: i32::from_le_bytes([
-                    self.buf[4],
-                    self.buf[5],
-                    self.buf[6],
-                    self.buf[7],
-                ]),
-                temp_lsb: i16::from_le_bytes([self.buf[8], self.buf[9]]),
-            });
-        }
-        self.stats.crc_errors += 1;
-        self.resync();
-        None
-    }
-
-    /// After a CRC failure, restart at the next sync marker inside the buffered bytes.
-    fn resync(&mut self) {
-        let start = (1..FRAME_LEN)
-            .find(|&i| self.buf[i] == SYNC[0] && (i + 1 == FRAME_LEN || self.buf[i + 1] == SYNC[1]))
-            .unwrap_or(FRAME_LEN);
-        self.stats.bytes_skipped += start as u32;
-        self.buf.copy_within(start.., 0);
-        self.len = FRAME_LEN - start;
+        let b = self.0.push(byte)?;
+        Some(GyroFrame {
+            seq: b[2],
+            status: b[3],
+            dtheta_lsb: i32::from_le_bytes([b[4], b[5], b[6], b[7]]),
+            temp_lsb: i16::from_le_bytes([b[8], b[9]]),
+        })
     }
 }

@@ -6,5 +6,8 @@ pub mod fog_serial;
 pub mod gyro_frame;
 pub mod inclinometer;
 pub mod scl3300;
+pub mod serial_inclinometer;
+pub mod sync_frame;
+pub mod tilt_frame;
 pub mod tmp117;
 pub mod turntable;

@@ -2,8 +2,12 @@
 //! campaign (a `SimGyro` cold-started at the rig's power-on, on a `SimTurntable`, on a
 //! possibly tilted base) served on the firmware's own links: the FOG's 12-byte frames
 //! (`fog_firmware::drivers::gyro_frame`, the one encoder) on the gyro link, the ASCII
-//! turntable protocol (`table`) on the table link. A link is a serial device (a board on
-//! the bench) or a TCP port the rig listens on (QEMU's `-serial tcp:...` client).
+//! turntable protocol (`table`) on the table link, and the base inclinometer's readings
+//! of the same base (`sim::BaseMotion`, SCL3300-like noise) as 14-byte
+//! `fog_firmware::drivers::tilt_frame`s at 10 Hz of sample time on the inclinometer link.
+//! A link is a serial device (a board on the bench) or a TCP port the rig listens on
+//! (QEMU's `-serial tcp:...` client). The QEMU tests drive `fog-app` through this same
+//! server (`Rig::serve` on their sockets), so there is one simulated bench.
 //!
 //! Time: the firmware's time base is the frame count, so the rig sends `rate_hz` frames
 //! per second of sample time, `speed` times faster than real time (QEMU cannot take a
@@ -20,6 +24,7 @@ use anyhow::{Context, Result};
 use fog_core::hal::Turntable;
 use fog_core::seeking::tilt::Tilt;
 use fog_firmware::drivers::gyro_frame::GyroFrame;
+use fog_firmware::drivers::tilt_frame::{TiltFrame, TILT_FRAME_RATE_HZ};
 
 use crate::sim::{rig, BaseMotion, GyroParams, RunSpec, SimGyro, StartState, TurntableParams};
 use crate::upload::Link;
@@ -35,8 +40,12 @@ pub struct RigConfig {
     pub latitude_deg: f64,
     /// True azimuth of the table's zero, deg from north (what a seek measures).
     pub azimuth_deg: f64,
-    /// Base tilt (the firmware's inclinometer must read the same: `tilt-mdeg=`).
+    /// Base tilt: served on the inclinometer link, or given to the firmware's simulated
+    /// inclinometer (`tilt-mdeg=`) when there is none.
     pub tilt: Tilt,
+    /// The gyro's state at power-on: `Soaked` (a cold start, `fogsim rig`) or `Warm`
+    /// (already at equilibrium, no warm-up drift).
+    pub start: StartState,
     /// Gyro frames per second of sample time.
     pub rate_hz: f64,
     /// Sample time per real time.
@@ -49,6 +58,8 @@ pub struct RigConfig {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct RigSummary {
     pub frames: u64,
+    /// Inclinometer frames sent.
+    pub tilt_frames: u64,
     pub sample_time_s: f64,
     pub table_commands: u64,
     pub moves: u64,
@@ -75,7 +86,7 @@ impl Rig {
             input_axis_vertical: false,
             raw_rate_hz: cfg.rate_hz,
             seed: cfg.seed,
-            start: StartState::Soaked,
+            start: cfg.start,
         };
         let (mut gyro, table) = rig(&cfg.params, &spec, TurntableParams::default())?;
         let mut base = BaseMotion::tilted(0.0, 0.0);
@@ -106,11 +117,28 @@ impl Rig {
         (frame, s)
     }
 
-    /// Serves the gyro and table links until `stop`, the duration, or a link closing.
+    /// The inclinometer's frame after gyro frame `n`, if one is due (10 Hz of sample time).
+    pub fn tilt_frame_after(&mut self, n: u64) -> Option<TiltFrame> {
+        let per_reading = (self.cfg.rate_hz / TILT_FRAME_RATE_HZ).max(1.0);
+        let reading = |k: u64| (k as f64 / per_reading).floor() as u64;
+        if reading(n + 1) == reading(n) {
+            return None;
+        }
+        let t = self.gyro.read_inclinometer();
+        Some(TiltFrame::from_physical(
+            reading(n) as u8,
+            f64::from(t.pitch_deg),
+            f64::from(t.roll_deg),
+        ))
+    }
+
+    /// Serves the gyro, table and (if given) inclinometer links until `stop`, the
+    /// duration, or a link closing.
     pub fn serve(
         &mut self,
         gyro_link: &mut dyn Link,
         table_link: &mut dyn Link,
+        mut incl_link: Option<&mut dyn Link>,
         stop: &AtomicBool,
     ) -> Result<RigSummary> {
         let mut sum = RigSummary::default();
@@ -118,6 +146,7 @@ impl Rig {
         let start = Instant::now();
         let mut temp_c = f64::NAN;
         let mut batch = Vec::new();
+        let mut tilt_batch = Vec::new();
         loop {
             if stop.load(Ordering::Relaxed) {
                 sum.ended = "stopped".into();
@@ -132,14 +161,25 @@ impl Rig {
                 }
             }
             batch.clear();
+            tilt_batch.clear();
             while sum.frames < due {
                 let (frame, _) = self.next_frame(sum.frames, &mut temp_c);
                 batch.extend_from_slice(&frame.encode());
+                if let Some(t) = self.tilt_frame_after(sum.frames) {
+                    tilt_batch.extend_from_slice(&t.encode());
+                    sum.tilt_frames += 1;
+                }
                 sum.frames += 1;
             }
             if let Err(e) = gyro_link.write_all(&batch).and_then(|()| gyro_link.flush()) {
                 sum.ended = format!("gyro link closed: {e}");
                 break;
+            }
+            if let Some(link) = incl_link.as_deref_mut() {
+                if let Err(e) = link.write_all(&tilt_batch).and_then(|()| link.flush()) {
+                    sum.ended = format!("inclinometer link closed: {e}");
+                    break;
+                }
             }
             match self.table.serve(table_link) {
                 Ok(n) => sum.table_commands += n,
@@ -179,10 +219,7 @@ pub fn open_rig_link(port: &str, baud: u32, accept_within: Duration) -> Result<B
                 Err(e) => return Err(e).with_context(|| format!("{port}: accept")),
             }
         };
-        stream.set_nonblocking(false)?;
-        stream.set_nodelay(true)?;
-        stream.set_read_timeout(Some(Duration::from_millis(1)))?;
-        Ok(Box::new(stream))
+        tcp_link(stream)
     } else {
         let serial = serialport::new(port, baud)
             .timeout(Duration::from_millis(1))
@@ -190,6 +227,15 @@ pub fn open_rig_link(port: &str, baud: u32, accept_within: Duration) -> Result<B
             .with_context(|| format!("opening serial port {port} at {baud} Bd"))?;
         Ok(Box::new(serial))
     }
+}
+
+/// A connected TCP stream as a rig link: blocking writes, reads that wait at most 1 ms
+/// (the table server polls), no Nagle delay.
+pub fn tcp_link(stream: std::net::TcpStream) -> Result<Box<dyn Link>> {
+    stream.set_nonblocking(false)?;
+    stream.set_nodelay(true)?;
+    stream.set_read_timeout(Some(Duration::from_millis(1)))?;
+    Ok(Box::new(stream))
 }
 
 #[cfg(test)]
@@ -204,7 +250,11 @@ mod tests {
             ambient_c: 20.0,
             latitude_deg: 39.9,
             azimuth_deg: 108.4,
-            tilt: Tilt::LEVEL,
+            tilt: Tilt {
+                pitch_deg: 2.0,
+                roll_deg: -1.5,
+            },
+            start: StartState::Soaked,
             rate_hz: 20.0,
             speed: 10.0,
             duration_s: None,
@@ -230,6 +280,43 @@ mod tests {
         assert!(decoded.iter().all(|f| f.rate_ok() && f.temp_ok()));
         // A cold start soaked at 20 degC: the coil is within a few degC of the chamber.
         assert!(decoded.iter().all(|f| (f.temp_c() - 20.0).abs() < 5.0));
+    }
+
+    #[test]
+    fn the_inclinometer_link_carries_the_base_tilt_at_10_hz_seeded() {
+        use fog_firmware::drivers::tilt_frame::TiltFrameDecoder;
+        let tilts = |seed: u64| -> Vec<u8> {
+            let mut rig = Rig::new(cfg(seed)).unwrap();
+            let mut temp = f64::NAN;
+            let mut out = Vec::new();
+            for n in 0..2000 {
+                rig.next_frame(n, &mut temp);
+                if let Some(t) = rig.tilt_frame_after(n) {
+                    out.extend(t.encode());
+                }
+            }
+            out
+        };
+        let a = tilts(3);
+        assert_eq!(a, tilts(3));
+        assert_ne!(a, tilts(4));
+        let mut dec = TiltFrameDecoder::new();
+        let frames: Vec<TiltFrame> = a.iter().filter_map(|&b| dec.push(b)).collect();
+        // 2,000 gyro frames at 20 Hz = 100 s of sample time: 1,000 readings at 10 Hz.
+        assert_eq!(frames.len(), 1000);
+        let n = frames.len() as f64;
+        let mean =
+            |f: fn(&Tilt) -> f32| frames.iter().map(|x| f64::from(f(&x.tilt()))).sum::<f64>() / n;
+        let (p, r) = (mean(|t| t.pitch_deg), mean(|t| t.roll_deg));
+        // The base's tilt, with 0.003 deg per-reading noise: the mean of 1,000 within 4e-4.
+        assert!((p - 2.0).abs() < 4e-4 && (r + 1.5).abs() < 4e-4, "{p} {r}");
+        let sd = (frames
+            .iter()
+            .map(|x| (f64::from(x.tilt().pitch_deg) - p).powi(2))
+            .sum::<f64>()
+            / n)
+            .sqrt();
+        assert!((0.002..0.004).contains(&sd), "pitch noise {sd} deg");
     }
 
     #[test]

@@ -6,8 +6,11 @@
 //! Sending is non-blocking (`WouldBlock` while the TX holding register is full).
 //! Registers: DATA +0x0, STATE +0x4 (bit0 TX full, bit1 RX full, bit3 RX overrun),
 //! CTRL +0x8 (bit0 TX en, bit1 RX en, bit3 RX int en, bit5 RX overrun int en),
-//! INTSTATUS/INTCLEAR +0xC, BAUDDIV +0x10. Interrupts on mps2-an386 (QEMU's mps2.c):
-//! UARTn RX = IRQ 2n, the combined overrun interrupt = IRQ 12.
+//! INTSTATUS/INTCLEAR +0xC, BAUDDIV +0x10. mps2-an386 (QEMU 7.2's hw/arm/mps2.c) has
+//! five: UART0-2 at 0x4000_4000/5000/6000 with RX = IRQ 0, 2, 4 and their overruns ORed
+//! into IRQ 12; UART3 at 0x4000_7000 with RX = IRQ 18 and no overrun interrupt (its
+//! overrun flag is checked in its RX handler); UART4 (0x4000_9000) is unused. QEMU's n-th
+//! `-serial` is UART n-1.
 //! A real board replaces this file with its HAL's UART (DMA into a ring).
 
 use core::cell::UnsafeCell;
@@ -94,9 +97,12 @@ impl RxRing {
     }
 }
 
-/// The three UARTs the application uses, by index (0 host, 1 gyro, 2 turntable).
-pub static RINGS: [RxRing; 3] = [RxRing::new(), RxRing::new(), RxRing::new()];
-const BASES: [usize; 3] = [0x4000_4000, 0x4000_5000, 0x4000_6000];
+/// The UARTs the application uses, by index (0 host, 1 gyro, 2 turntable, 3 inclinometer).
+pub static RINGS: [RxRing; UARTS] = [RxRing::new(), RxRing::new(), RxRing::new(), RxRing::new()];
+const UARTS: usize = 4;
+const BASES: [usize; UARTS] = [0x4000_4000, 0x4000_5000, 0x4000_6000, 0x4000_7000];
+/// RX interrupt of each UART.
+const RX_IRQS: [u16; UARTS] = [0, 2, 4, 18];
 
 #[derive(Clone, Copy)]
 struct Irq(u16);
@@ -126,12 +132,13 @@ fn write_reg(base: usize, off: usize, v: u32) {
 }
 
 impl CmsdkUart {
-    /// UART `index` (0..3) at `baud`, RX interrupt on.
+    /// UART `index` (0..4) at `baud`, RX interrupt on.
     ///
     /// # Safety
     /// Each index may be taken once.
     pub unsafe fn new(index: usize, baud: u32) -> Self {
-        let base = BASES[index % 3];
+        let index = index % UARTS;
+        let base = BASES[index];
         write_reg(base, BAUDDIV, (PCLK_HZ / baud.max(1)).max(16));
         write_reg(
             base,
@@ -140,12 +147,12 @@ impl CmsdkUart {
         );
         // SAFETY: the handlers below only touch this UART's ring and registers.
         unsafe {
-            NVIC::unmask(Irq(2 * (index % 3) as u16));
+            NVIC::unmask(Irq(RX_IRQS[index]));
             NVIC::unmask(Irq(OVERRUN_IRQ));
         }
         Self {
             base,
-            ring: &RINGS[index % 3],
+            ring: &RINGS[index],
             dropped_seen: 0,
         }
     }
@@ -166,16 +173,24 @@ fn on_rx(index: usize) {
     while read_reg(base, STATE) & STATE_RX_FULL != 0 {
         RINGS[index].push(read_reg(base, DATA) as u8);
     }
+    if index == 3 {
+        // UART3's overrun raises no interrupt: count it here.
+        overrun(&RINGS[3], base);
+    }
 }
 
-/// The combined overrun interrupt: count and clear on every UART.
+fn overrun(ring: &RxRing, base: usize) {
+    if read_reg(base, STATE) & STATE_RX_OVERRUN != 0 {
+        ring.dropped.fetch_add(1, Ordering::Relaxed);
+        write_reg(base, STATE, STATE_RX_OVERRUN);
+        write_reg(base, INTCLEAR, INT_RX_OVERRUN);
+    }
+}
+
+/// The combined overrun interrupt of UART0-2: count and clear.
 fn on_overrun() {
-    for (ring, &base) in RINGS.iter().zip(&BASES) {
-        if read_reg(base, STATE) & STATE_RX_OVERRUN != 0 {
-            ring.dropped.fetch_add(1, Ordering::Relaxed);
-            write_reg(base, STATE, STATE_RX_OVERRUN);
-            write_reg(base, INTCLEAR, INT_RX_OVERRUN);
-        }
+    for (ring, &base) in RINGS.iter().zip(&BASES).take(3) {
+        overrun(ring, base);
     }
 }
 
@@ -186,6 +201,7 @@ unsafe fn DefaultHandler(irqn: i16) {
         0 => on_rx(0),
         2 => on_rx(1),
         4 => on_rx(2),
+        18 => on_rx(3),
         12 => on_overrun(),
         _ => {}
     }
