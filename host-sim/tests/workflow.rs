@@ -1,11 +1,14 @@
 //! docs/workflow.md, run as written (issue 16.4): every fenced `sh` block of the page, in
 //! order, each line one command. `fogsim` is the binary under test; `cargo fw-run -- ARGS`
 //! is its runner (`scripts/fw-qemu.sh`) on the firmware the QEMU tests build; a trailing
-//! `&` starts a background job (killed when the test ends); the ports 4444-4446 become
+//! `&` starts a background job (killed when the test ends); the ports 4444-4447 become
 //! free loopback ports; the default registry lives in a scratch `XDG_DATA_HOME`.
 //!
-//! Checked: every command succeeds; the seek's azimuth is within 3 of its reported
-//! sigma of the rig's truth (both read from the commands' own output lines); the
+//! Checked: every command succeeds, the path's steps all among them (import, train,
+//! compensate, heading-cal, upload, rig, monitor, registry); the seek's azimuth is within
+//! 3 of its reported sigma of the rig's truth and its tilt (measured over the
+//! inclinometer link, no `tilt-mdeg=`) within 0.01 deg of the rig's base (all read from
+//! the commands' own output lines); the model carries the heading calibration; the
 //! registry shows the upload and the result. Prints the error, sigma and wall time.
 //!
 //! Skips loudly without QEMU / the target unless FOG_REQUIRE_QEMU=1.
@@ -40,7 +43,7 @@ fn words(line: &str) -> Vec<String> {
 
 struct Walk {
     dir: PathBuf,
-    ports: [(String, String); 3],
+    ports: [(String, String); 4],
     jobs: Vec<(String, KillOnDrop, PathBuf)>,
     outputs: Vec<(String, String)>,
 }
@@ -64,6 +67,7 @@ impl Walk {
             .env("FOG_HOST_PORT", &self.ports[0].1)
             .env("FOG_GYRO_PORT", &self.ports[1].1)
             .env("FOG_TABLE_PORT", &self.ports[2].1)
+            .env("FOG_INCL_PORT", &self.ports[3].1)
             .stdin(Stdio::null());
         cmd
     }
@@ -142,7 +146,8 @@ fn the_workflow_page_runs_as_written_and_finds_north() {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let page = std::fs::read_to_string(workspace_root().join("docs/workflow.md")).unwrap();
-    let ports = ["4444", "4445", "4446"].map(|p| (p.to_string(), free_loopback_port().to_string()));
+    let ports =
+        ["4444", "4445", "4446", "4447"].map(|p| (p.to_string(), free_loopback_port().to_string()));
     let mut walk = Walk {
         dir: dir.clone(),
         ports,
@@ -151,7 +156,26 @@ fn the_workflow_page_runs_as_written_and_finds_north() {
     };
     let t0 = Instant::now();
     let commands = page_commands(&page);
-    assert!(commands.len() >= 8, "{commands:#?}");
+    for step in [
+        "fogsim import",
+        "fogsim train",
+        "fogsim compensate",
+        "fogsim heading-cal --from-runs",
+        "cargo fw-run",
+        "fogsim rig",
+        "fogsim upload",
+        "fogsim monitor",
+        "fogsim registry show",
+    ] {
+        assert!(
+            commands.iter().any(|c| c.starts_with(step)),
+            "docs/workflow.md lost its `{step}` step"
+        );
+    }
+    assert!(
+        !commands.iter().any(|c| c.contains("tilt-mdeg=")),
+        "the walk's tilt comes over the inclinometer link"
+    );
     for c in &commands {
         walk.run(c);
     }
@@ -183,6 +207,19 @@ fn the_workflow_page_runs_as_written_and_finds_north() {
     );
     assert!(result.contains("verdict=valid"), "{result}");
     assert!(sigma > 0.0 && err.abs() <= 3.0 * sigma, "{result}");
+    for axis in ["pitch_deg", "roll_deg"] {
+        let (measured, base) = (field(result, axis), field(truth_line, axis));
+        assert!(
+            (measured - base).abs() <= 0.01,
+            "{axis}: device {measured} over the inclinometer link, rig base {base}"
+        );
+    }
+    assert!(
+        walk.output_of("fogsim heading-cal")
+            .contains("heading calibration a ="),
+        "{}",
+        walk.output_of("fogsim heading-cal")
+    );
     let show = walk.output_of("fogsim registry show");
     assert!(
         show.contains("committed") && show.contains("seek results: 1"),

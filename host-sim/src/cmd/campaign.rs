@@ -1,12 +1,15 @@
 //! `fogsim campaign`: simulate the paper's test campaign into a directory of fog-runs
 //! v1 files (one per power-on, 10 s means, Earth rate in `earth_dph`).
 
+use super::check_output_file;
+use crate::io::logger_csv::write_logger_csv;
+use crate::io::OutputGuard;
 use crate::pipeline::campaign::{
     simulate_campaign, write_campaign, CampaignSpec, PAPER_AMBIENTS_C, PAPER_MINUTES, PAPER_RUNS,
 };
 use crate::pipeline::heading_campaign::{check_headings, simulate_heading_campaign};
 use crate::sim::{GyroParams, DEFAULT_LATITUDE_DEG};
-use anyhow::bail;
+use anyhow::{bail, Context};
 use std::path::PathBuf;
 
 /// Options of `fogsim campaign`.
@@ -48,6 +51,11 @@ pub struct Args {
         requires = "headings_deg"
     )]
     pub heading_bias_dph: f64,
+    /// Also write every run into this one file as a lab logger would log them
+    /// (semicolon, decimal comma, ISO time, deg/s, degF; `io::logger_csv`): the input of
+    /// `fogsim import` in docs/workflow.md.
+    #[arg(long)]
+    pub logger_csv: Option<PathBuf>,
 }
 
 impl Args {
@@ -98,6 +106,11 @@ impl Args {
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let spec = args.to_spec()?;
+    check_output_file(
+        &OutputGuard::default(),
+        args.logger_csv.as_deref(),
+        "--logger-csv",
+    )?;
     if !(args.heading_bias_dph.is_finite() && args.heading_bias_dph.abs() <= 1.0) {
         bail!(
             "--heading-bias-dph {:.4e}: must be within -1..=1 deg/h",
@@ -113,6 +126,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         None => simulate_campaign(&GyroParams::paper_default(), &spec)?,
     };
     let files = write_campaign(&args.out, &runs)?;
+    if let Some(log) = &args.logger_csv {
+        let all: Vec<_> = runs.iter().map(|r| &r.run).collect();
+        write_logger_csv(log, &all).with_context(|| format!("--logger-csv {}", log.display()))?;
+        println!(
+            "fogsim campaign: logged the {} runs one after another in {} (timestamp;rate_dps;coil_temp_f)",
+            all.len(),
+            log.display()
+        );
+    }
     println!(
         "fogsim campaign: wrote {} runs ({} ambients x {}{} power-ons, {} min, seed {}) to {}",
         files.len(),

@@ -8,6 +8,7 @@ pub mod bounded;
 pub mod guard;
 pub mod import;
 pub mod lock;
+pub mod logger_csv;
 pub mod model;
 pub mod reader;
 pub mod runs;
