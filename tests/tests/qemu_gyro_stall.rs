@@ -58,6 +58,8 @@ fn qemu_gyro_stall_mid_seek_keeps_time_counts_losses_and_restarts_with_reason() 
     let args = [
         format!("gyro-rate={RATE_HZ}"),
         "seek-dwell-s=60".to_string(),
+        // No inclinometer link in this scenario: the simulated one, level.
+        "tilt-mdeg=0:0".to_string(),
     ];
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let (_qemu, mut streams, console) = start(&args, 3);
