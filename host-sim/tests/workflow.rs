@@ -209,6 +209,7 @@ fn the_workflow_page_runs_as_written_and_finds_north() {
     assert!(sigma > 0.0 && err.abs() <= 3.0 * sigma, "{result}");
     for axis in ["pitch_deg", "roll_deg"] {
         let (measured, base) = (field(result, axis), field(truth_line, axis));
+        eprintln!("workflow: {axis} {measured} over the inclinometer link, rig base {base}");
         assert!(
             (measured - base).abs() <= 0.01,
             "{axis}: device {measured} over the inclinometer link, rig base {base}"
