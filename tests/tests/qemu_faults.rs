@@ -5,9 +5,9 @@
 //!   its reset reason on the semihosting console (`FOG-BOOT n reset=...`, counted per
 //!   boot: QEMU runs without `-no-reboot`, so a reset restarts the guest) and reports
 //!   it in `DeviceStatus`; a model committed before the reset is still active after it.
-//! - The host port is flooded with garbage while the gyro streams 2 kHz frames on
-//!   UART1 (at 200 Hz: see `FLOOD_GYRO_HZ`): every 10 s window stays valid and no
-//!   gyro frame or byte is lost.
+//! - The host port is flooded with garbage while the rig's gyro (`fog_sim::rig`, the
+//!   bench `fogsim rig` serves) streams frames on UART1 in real time (at 200 Hz: see
+//!   `FLOOD_GYRO_HZ`): every 10 s window stays valid and no gyro frame or byte is lost.
 //!
 //! - A HardFault (an undefined instruction) resets the chip; the next boot reports
 //!   `Exception` with the faulting address, counts one fault in a row, and a clean run
@@ -30,11 +30,14 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use fog_core::link::upload::ResetCause;
+use fog_core::seeking::tilt::Tilt;
 use fog_firmware::fault_record::{BootFault, CLEAN_RUN_S};
+use fog_sim::rig::{tcp_link, Rig, RigConfig};
+use fog_sim::sim::{GyroParams, StartState};
 use fog_sim::upload::{ClientError, UploadClient};
 use fog_tests::console::wait_line;
 use fog_tests::qemu_ready;
-use qemu_support::{polled, start, stream_gyro_frames, wait_boot, wait_status};
+use qemu_support::{polled, start, wait_boot, wait_status};
 use upload_support::*;
 
 #[test]
@@ -97,16 +100,26 @@ const FLOOD_GYRO_HZ: u32 = 200;
 /// Bytes per second a 115,200 baud 8N1 host link carries.
 const HOST_LINE_BYTES_PER_S: f64 = 115_200.0 / 10.0;
 
-/// Gyro frames at `FLOOD_GYRO_HZ`, paced in real time, until `stop`.
-fn stream_gyro(link: TcpStream, stop: Arc<AtomicBool>) -> u64 {
-    let period_s = 1.0 / f64::from(FLOOD_GYRO_HZ);
-    // White rate noise of a FOG with ARW 0.005 deg/sqrt(h) at this rate, deg/h.
-    let noise = rand_distr::Normal::new(0.0, 0.005 * 60.0 / period_s.sqrt()).unwrap();
-    let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(7);
-    stream_gyro_frames(link, FLOOD_GYRO_HZ, 1.0, &stop, |n| {
-        // Earth rate component plus a slow ripple plus the gyro's white noise.
-        9.7 + 0.3 * (n as f64 * 0.001).sin() + rand_distr::Distribution::sample(&noise, &mut rng)
+/// The bench (`fogsim rig`'s server: the `sim/` FOG, warm, and its table) with gyro
+/// frames at `FLOOD_GYRO_HZ` paced in real time, until `stop`; returns frames sent.
+fn serve_rig(gyro: TcpStream, table: TcpStream, stop: Arc<AtomicBool>) -> u64 {
+    let mut rig = Rig::new(RigConfig {
+        params: GyroParams::paper_default(),
+        seed: 7,
+        ambient_c: 25.0,
+        latitude_deg: 39.9,
+        azimuth_deg: 108.4,
+        tilt: Tilt::LEVEL,
+        start: StartState::Warm,
+        rate_hz: f64::from(FLOOD_GYRO_HZ),
+        speed: 1.0,
+        duration_s: None,
     })
+    .expect("rig");
+    let (mut g, mut t) = (tcp_link(gyro).unwrap(), tcp_link(table).unwrap());
+    rig.serve(g.as_mut(), t.as_mut(), None, &stop)
+        .expect("rig")
+        .frames
 }
 
 #[test]
@@ -115,14 +128,15 @@ fn qemu_host_flood_never_costs_a_gyro_window() {
         return;
     }
     let rate_arg = format!("gyro-rate={FLOOD_GYRO_HZ}");
-    let (_qemu, mut streams, console) = start(&[&rate_arg], 2);
+    let (_qemu, mut streams, console) = start(&[&rate_arg], 3);
+    let table_link = streams.pop().expect("table link");
     let gyro_link = streams.pop().expect("gyro link");
     let mut host_link = streams.pop().expect("host link");
     wait_boot(&console, 1, "PowerOn");
     let stop = Arc::new(AtomicBool::new(false));
     let gyro = {
         let stop = stop.clone();
-        std::thread::spawn(move || stream_gyro(gyro_link, stop))
+        std::thread::spawn(move || serve_rig(gyro_link, table_link, stop))
     };
     // Flood: short garbage frames as fast as the link takes them, replies drained.
     let flood = {

@@ -1,10 +1,11 @@
 //! QEMU scenario (issue 17 item 6): the gyro link stalls in the middle of a north seek.
 //!
 //! `fog-app` runs a two-position seek (started by `Command::StartSeek` over the host
-//! link, turntable simulated on UART2) while a simulated FOG streams frames on UART1 at
-//! `RATE_HZ` of sample time, `SPEED` times faster than real time. One window into the
-//! seek the link goes dead for `STALL_FRAMES` frames (the gyro keeps sampling, so its
-//! frame counter jumps), then frames come again. Checked:
+//! link) on the bench `fogsim rig` serves (`fog_sim::rig::Rig::serve` on the test's
+//! sockets: the `sim/` FOG on UART1 at `RATE_HZ` of sample time, `SPEED` times faster
+//! than real time, its turntable on UART2, the base inclinometer on UART3). One window
+//! into the seek the rig's gyro cable is pulled (`GyroCut`) for `STALL_FRAMES` frames
+//! (the gyro keeps sampling, so its frame counter jumps), then frames come again. Checked:
 //! - the time base stays exact: every window ends on the 10 s grid of sample time, none
 //!   is skipped or shifted, and the window holding the stall has exactly the samples
 //!   that arrived (`10 s * RATE_HZ - STALL_FRAMES`);
@@ -22,12 +23,14 @@ mod qemu_support;
 mod upload_support;
 
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use std::time::Duration;
 
 use fog_core::link::messages::{Command, DeviceMessage};
 use fog_core::seeking::quality::{MotionReason, SeekState};
-use fog_core::seeking::tilt::{earth_rate_on_axis_dph, Tilt};
+use fog_core::seeking::tilt::Tilt;
+use fog_sim::rig::{tcp_link, GyroCut, Rig, RigConfig};
+use fog_sim::sim::{GyroParams, StartState};
 use fog_sim::upload::UploadClient;
 use fog_tests::console::{wait_line, wait_line_where};
 use fog_tests::qemu_ready;
@@ -58,36 +61,35 @@ fn qemu_gyro_stall_mid_seek_keeps_time_counts_losses_and_restarts_with_reason() 
     let args = [
         format!("gyro-rate={RATE_HZ}"),
         "seek-dwell-s=60".to_string(),
-        // No inclinometer link in this scenario: the simulated one, level.
-        "tilt-mdeg=0:0".to_string(),
     ];
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let (_qemu, mut streams, console) = start(&args, 3);
-    let table_link = streams.pop().unwrap();
-    let gyro_link = streams.pop().unwrap();
-    let mut host = polled(streams.pop().unwrap());
+    let (_qemu, streams, console) = start(&args, 4);
+    let [host, gyro_link, table_link, incl_link]: [_; 4] = streams.try_into().expect("four links");
+    let mut host = polled(host);
     wait_boot(&console, 1, "PowerOn");
 
-    let heading: Heading = Arc::new(Mutex::new(0.0));
     let stop = Arc::new(AtomicBool::new(false));
-    let stall = Arc::new(Stall {
-        frames: STALL_FRAMES,
-        ..Stall::default()
-    });
-    let table = {
-        let (h, s) = (heading.clone(), stop.clone());
-        std::thread::spawn(move || serve_table(table_link, h, s))
-    };
-    let gyro = {
-        let (h, s, st) = (heading.clone(), stop.clone(), stall.clone());
-        let noise =
-            rand_distr::Normal::new(0.0, 0.0011 * 60.0 * f64::from(RATE_HZ).sqrt()).unwrap();
-        let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(17);
+    let stall = Arc::new(GyroCut::new(STALL_FRAMES));
+    let rig = {
+        let (s, st) = (stop.clone(), stall.clone());
         std::thread::spawn(move || {
-            stream_gyro_frames_with_stall(gyro_link, RATE_HZ, SPEED, &s, &st, |_| {
-                earth_rate_on_axis_dph(40.0, 108.4, Tilt::LEVEL, *h.lock().unwrap())
-                    + rand_distr::Distribution::sample(&noise, &mut rng)
+            let mut rig = Rig::new(RigConfig {
+                params: GyroParams::paper_default(),
+                seed: 17,
+                ambient_c: 25.0,
+                latitude_deg: 40.0,
+                azimuth_deg: 108.4,
+                tilt: Tilt::LEVEL,
+                start: StartState::Warm,
+                rate_hz: f64::from(RATE_HZ),
+                speed: SPEED,
+                duration_s: None,
             })
+            .expect("rig")
+            .with_gyro_cut(st);
+            let [mut g, mut t, mut i] =
+                [gyro_link, table_link, incl_link].map(|l| tcp_link(l).expect("rig link"));
+            rig.serve(g.as_mut(), t.as_mut(), Some(i.as_mut()), &s)
         })
     };
 
@@ -162,5 +164,6 @@ fn qemu_gyro_stall_mid_seek_keeps_time_counts_losses_and_restarts_with_reason() 
         DeviceMessage::Accepted
     );
     stop.store(true, Ordering::Relaxed);
-    let _ = (gyro.join(), table.join());
+    let sum = rig.join().unwrap().expect("rig");
+    eprintln!("rig: {sum:?}");
 }

@@ -17,7 +17,8 @@
 
 mod table;
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
@@ -72,6 +73,35 @@ pub struct Rig {
     gyro: SimGyro,
     table: TableServer,
     cfg: RigConfig,
+    cut: Option<Arc<GyroCut>>,
+}
+
+/// A pulled gyro cable, armed while the rig runs (a bench test of the device's stall
+/// handling): the frames from `from` (frame index; `u64::MAX`: not armed) for `frames`
+/// frames are sampled but never sent, so the counter in later frames goes on as if they
+/// had been (the gyro kept sampling). `next` is the index of the next frame due, for
+/// choosing `from`.
+#[derive(Debug)]
+pub struct GyroCut {
+    pub from: AtomicU64,
+    pub frames: u64,
+    pub next: AtomicU64,
+}
+
+impl GyroCut {
+    /// A cut of `frames` frames, not armed yet.
+    pub fn new(frames: u64) -> Self {
+        Self {
+            from: AtomicU64::new(u64::MAX),
+            frames,
+            next: AtomicU64::new(0),
+        }
+    }
+
+    fn drops(&self, n: u64) -> bool {
+        let from = self.from.load(Ordering::Relaxed);
+        (from..from.saturating_add(self.frames)).contains(&n)
+    }
 }
 
 impl Rig {
@@ -97,7 +127,14 @@ impl Rig {
             gyro,
             table: TableServer::new(table),
             cfg,
+            cut: None,
         })
+    }
+
+    /// The rig with a gyro cable the caller can pull (`GyroCut`).
+    pub fn with_gyro_cut(mut self, cut: Arc<GyroCut>) -> Self {
+        self.cut = Some(cut);
+        self
     }
 
     /// The table, for tests that drive it directly.
@@ -164,12 +201,17 @@ impl Rig {
             tilt_batch.clear();
             while sum.frames < due {
                 let (frame, _) = self.next_frame(sum.frames, &mut temp_c);
-                batch.extend_from_slice(&frame.encode());
+                if !self.cut.as_ref().is_some_and(|c| c.drops(sum.frames)) {
+                    batch.extend_from_slice(&frame.encode());
+                }
                 if let Some(t) = self.tilt_frame_after(sum.frames) {
                     tilt_batch.extend_from_slice(&t.encode());
                     sum.tilt_frames += 1;
                 }
                 sum.frames += 1;
+            }
+            if let Some(c) = &self.cut {
+                c.next.store(sum.frames, Ordering::Relaxed);
             }
             if let Err(e) = gyro_link.write_all(&batch).and_then(|()| gyro_link.flush()) {
                 sum.ended = format!("gyro link closed: {e}");

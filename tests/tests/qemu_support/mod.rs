@@ -1,20 +1,19 @@
 //! Shared by the QEMU scenarios that run the real `fog-app` with its UARTs on loopback
-//! sockets (qemu_faults.rs, qemu_seek.rs): start it, and wait for its tagged
-//! semihosting console lines (`FOG-...`); stream simulated gyro frames to its UART1.
+//! sockets (qemu_faults.rs, qemu_seek.rs, ...): start it, wait for its tagged semihosting
+//! console lines (`FOG-...`), talk on its host link. The gyro, table and inclinometer on
+//! the other UARTs are always the bench simulator's (`fog_sim::rig`).
 #![allow(dead_code)]
 
 use std::io::Write;
 use std::net::TcpStream;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::Receiver;
 use std::time::{Duration, Instant};
 
-use fog_firmware::drivers::gyro_frame::GyroFrame;
 use fog_tests::console::start_with_console;
 use fog_tests::{firmware_elf, KillOnDrop, QemuOptions};
 
 /// Starts fog-app with `args` and `serial_ports` UARTs (UART0 = host, UART1 = gyro,
-/// UART2 = turntable) on loopback servers; returns QEMU, the connected streams and the
+/// UART2 = turntable, UART3 = inclinometer) on loopback servers; returns QEMU, the connected streams and the
 /// semihosting console lines.
 pub fn start(args: &[&str], serial_ports: usize) -> (KillOnDrop, Vec<TcpStream>, Receiver<String>) {
     start_with(args, serial_ports, Vec::new())
@@ -49,114 +48,6 @@ pub fn polled(link: TcpStream) -> TcpStream {
     link.set_read_timeout(Some(Duration::from_millis(50)))
         .expect("read timeout on a loopback socket");
     link
-}
-
-/// A simulated FOG on `link`: frames at `rate_hz` of sample time, sent `speed` times
-/// faster than real time (the firmware's time base is the frame count) in 5 ms batches,
-/// 25 degC, the rate of frame `n` from `rate_dph(n)`, until `stop`. Returns frames sent.
-pub fn stream_gyro_frames(
-    link: TcpStream,
-    rate_hz: u32,
-    speed: f64,
-    stop: &AtomicBool,
-    rate_dph: impl FnMut(u64) -> f64,
-) -> u64 {
-    stream_gyro_frames_with_stall(link, rate_hz, speed, stop, &Stall::default(), rate_dph)
-}
-
-/// A gyro link stall the test arms while frames stream: the frames from `from` (frame
-/// index; `u64::MAX`: none yet) for `frames` frames are never sent, as when the cable is
-/// pulled; the counter in later frames goes on as if they had been (the gyro kept
-/// sampling). `next` is the index of the next frame due, for choosing `from`.
-#[derive(Debug)]
-pub struct Stall {
-    pub from: std::sync::atomic::AtomicU64,
-    pub frames: u64,
-    pub next: std::sync::atomic::AtomicU64,
-}
-
-impl Default for Stall {
-    fn default() -> Self {
-        Self {
-            from: std::sync::atomic::AtomicU64::new(u64::MAX),
-            frames: 0,
-            next: std::sync::atomic::AtomicU64::new(0),
-        }
-    }
-}
-
-/// `stream_gyro_frames` with the frames of `stall` left out; returns frames sent.
-pub fn stream_gyro_frames_with_stall(
-    mut link: TcpStream,
-    rate_hz: u32,
-    speed: f64,
-    stop: &AtomicBool,
-    stall: &Stall,
-    mut rate_dph: impl FnMut(u64) -> f64,
-) -> u64 {
-    let period_s = 1.0 / f64::from(rate_hz);
-    let start = Instant::now();
-    let (mut next, mut sent) = (0u64, 0u64);
-    while !stop.load(Ordering::Relaxed) {
-        let due = (start.elapsed().as_secs_f64() * speed / period_s) as u64;
-        let from = stall.from.load(Ordering::Relaxed);
-        let mut batch = Vec::new();
-        while next < due {
-            let rate = rate_dph(next);
-            if !(from..from.saturating_add(stall.frames)).contains(&next) {
-                let frame = GyroFrame::from_physical(next as u8, rate, 25.0, period_s);
-                batch.extend(frame.encode());
-                sent += 1;
-            }
-            next += 1;
-        }
-        stall.next.store(next, Ordering::Relaxed);
-        if link.write_all(&batch).is_err() {
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    sent
-}
-
-/// The simulated table's heading, deg (table frame).
-pub type Heading = std::sync::Arc<std::sync::Mutex<f64>>;
-
-/// A turntable controller on `link`: `MOV h` -> `ACK` (the heading changes at once),
-/// `POS?` -> `POS h S`. Ends when the link closes or `stop` is set.
-pub fn serve_table(link: TcpStream, heading: Heading, stop: std::sync::Arc<AtomicBool>) {
-    use std::io::BufRead;
-    let link = polled(link);
-    let mut out = link.try_clone().unwrap();
-    let mut reader = std::io::BufReader::new(link);
-    let mut line = Vec::new();
-    while !stop.load(Ordering::Relaxed) {
-        match reader.read_until(b'\r', &mut line) {
-            Ok(0) => return,
-            Ok(_) if line.ends_with(b"\r") => {
-                let text = String::from_utf8_lossy(&line).trim().to_string();
-                line.clear();
-                let reply = if let Some(h) = text.strip_prefix("MOV ") {
-                    match h.parse::<f64>() {
-                        Ok(h) => {
-                            *heading.lock().unwrap() = h;
-                            "ACK".to_string()
-                        }
-                        Err(_) => "NAK".to_string(),
-                    }
-                } else if text == "POS?" {
-                    format!("POS {:.3} S", *heading.lock().unwrap())
-                } else {
-                    continue;
-                };
-                if out.write_all(format!("{reply}\r").as_bytes()).is_err() {
-                    return;
-                }
-            }
-            // A timeout may leave a partial line in `line`: keep reading.
-            _ => {}
-        }
-    }
 }
 
 /// Sends one link command, preceded by the zero bytes that pay for its answer under
