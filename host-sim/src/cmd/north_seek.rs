@@ -10,11 +10,11 @@ use fog_core::seeking::northfinder::SeekMode;
 use super::check_output_file;
 use crate::io::model::read_model;
 use crate::io::OutputGuard;
-use crate::pipeline::campaign_steps::{simulate_checked, train_with, CampaignSpec};
 use crate::pipeline::northseek::{
     build_product_report, default_threads, run_monte_carlo_with_calibration, seek_table,
     MonteCarloConfig,
 };
+use crate::pipeline::own_model::{train_own_model, OwnModelPlan};
 use crate::report::{progress_bar, write_json};
 use crate::sim::GyroParams;
 
@@ -120,35 +120,29 @@ pub fn run(args: Args) -> Result<()> {
             p.display().to_string(),
         ),
         None => {
-            let plan = CampaignSpec {
-                ambients_c: vec![cfg.ambient_c],
-                runs_per_ambient: 3,
-                latitude_deg: cfg.latitude_deg,
-                ..CampaignSpec::paper(cfg.seed)
-            };
-            let campaign = simulate_checked(&params, &plan).map_err(super::with_plan_flag)?;
-            let runs: Vec<_> = campaign.iter().map(|c| &c.run).collect();
             let criterion = crate::train::seek_score::Criterion::parse(
                 &args.criterion,
                 cfg.dwell_s as f64,
                 cfg.latitude_deg,
             )
             .map_err(|e| anyhow::anyhow!("--criterion {e}"))?;
-            // The same defaults as `fogsim train`: the inputs chosen by grouped
-            // validation over whole runs (d2T/dt2 kept where it wins), then the model.
-            let owned: Vec<_> = runs.iter().map(|r| (*r).clone()).collect();
-            let (selection, _) = crate::train::choose_inputs(
-                &owned,
-                &crate::train::InputSet::ALL,
-                &crate::train::TrainConfig::default(),
-                &crate::train::GroupedCvRms,
-            )
-            .map_err(|e| anyhow::anyhow!("choosing the default model's inputs: {e}"))?;
-            eprint!("{}", selection.summary());
-            let trained = train_with(&runs, &selection.chosen.specs(), "sim", criterion)?;
+            // The same defaults as `fogsim train` (inputs chosen by grouped validation
+            // over whole runs, d2T/dt2 kept where it wins), on as many runs at the
+            // ambient as the half-split learned seek error needs.
+            let plan = OwnModelPlan {
+                ambient_c: cfg.ambient_c,
+                latitude_deg: cfg.latitude_deg,
+                dwell_s: cfg.dwell_s as f64,
+                seed: cfg.seed,
+                criterion,
+            };
+            let own = train_own_model(&params, &plan)?;
+            eprint!("{}", own.selection.summary());
+            eprint!("{}", own.summary());
+            let trained = own.trained;
             eprintln!(
                 "trained the default model on {} simulated {} degC runs (seed {}): {} centres, held-out rms {:.4} deg/h, seek {:.4} deg, chosen by held-out {}",
-                runs.len(),
+                own.runs,
                 cfg.ambient_c,
                 cfg.seed,
                 trained.report.n_centers,
@@ -160,9 +154,7 @@ pub fn run(args: Args) -> Result<()> {
                 trained.model,
                 format!(
                     "trained on {} simulated runs at {} degC, seed {}",
-                    runs.len(),
-                    cfg.ambient_c,
-                    cfg.seed
+                    own.runs, cfg.ambient_c, cfg.seed
                 ),
             )
         }

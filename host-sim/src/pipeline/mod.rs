@@ -10,4 +10,5 @@ pub mod compensation_replay;
 pub mod heading_campaign;
 pub mod heading_fit;
 pub mod northseek;
+pub mod own_model;
 pub mod reproduce;
