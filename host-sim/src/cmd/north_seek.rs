@@ -108,6 +108,13 @@ pub fn config_from_args(a: &Args) -> Result<MonteCarloConfig> {
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
     let cfg = config_from_args(&args)?;
+    // Checked even when `--model` leaves it unused: a bad flag is never ignored.
+    let criterion = crate::train::seek_score::Criterion::parse(
+        &args.criterion,
+        cfg.dwell_s as f64,
+        cfg.latitude_deg,
+    )
+    .map_err(|e| anyhow::anyhow!("--criterion {e}"))?;
     let guard = match &args.model {
         Some(m) => OutputGuard::new(&[m]),
         None => OutputGuard::default(),
@@ -128,12 +135,6 @@ pub fn run(args: Args) -> Result<()> {
             };
             let campaign = simulate_checked(&params, &plan).map_err(super::with_plan_flag)?;
             let runs: Vec<_> = campaign.iter().map(|c| &c.run).collect();
-            let criterion = crate::train::seek_score::Criterion::parse(
-                &args.criterion,
-                cfg.dwell_s as f64,
-                cfg.latitude_deg,
-            )
-            .map_err(|e| anyhow::anyhow!("--criterion {e}"))?;
             // The same defaults as `fogsim train`: the inputs chosen by grouped
             // validation over whole runs (d2T/dt2 kept where it wins), then the model.
             let owned: Vec<_> = runs.iter().map(|r| (*r).clone()).collect();
