@@ -723,17 +723,18 @@ fn violations(case: &Case, o: &Outcome) -> Vec<String> {
     v
 }
 
-fn env_count(var: &str, default: u64) -> u64 {
-    std::env::var(var).ok().map_or(default, |s| {
-        s.parse()
-            .unwrap_or_else(|_| panic!("{var}={s}: not a count"))
-    })
+/// `FOG_PROBE_*` from the environment, else `default`.
+fn count_from_env(var: &str, default: u64) -> u64 {
+    match std::env::var(var) {
+        Ok(text) => text.parse().expect("FOG_PROBE_* must be a count"),
+        Err(_) => default,
+    }
 }
 
 #[test]
 fn bad_invocations_fail_with_one_line_naming_the_fault_and_change_no_input() {
-    let n = env_count("FOG_PROBE_INVOCATIONS", 60) as usize;
-    let seed = env_count("FOG_PROBE_SEED", 17);
+    let n = count_from_env("FOG_PROBE_INVOCATIONS", 60) as usize;
+    let seed = count_from_env("FOG_PROBE_SEED", 17);
     let fx = fixtures();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut cases = catalogue(&fx);
@@ -750,7 +751,7 @@ fn bad_invocations_fail_with_one_line_naming_the_fault_and_change_no_input() {
         } else {
             random_case(&fx, &mut rng, i)
         };
-        let before = walk(&fx.dir);
+        let before: std::collections::HashSet<PathBuf> = walk(&fx.dir).into_iter().collect();
         std::fs::create_dir_all(fx.dir.join("out")).unwrap();
         let o = run(&fx.dir, &case.args);
         if o.elapsed > slowest {
@@ -766,9 +767,13 @@ fn bad_invocations_fail_with_one_line_naming_the_fault_and_change_no_input() {
             }
         }
         let _ = std::fs::remove_dir_all(fx.dir.join("out"));
-        // What a failed run left (e.g. a registry created before the link failed).
+        // What a failed run left (e.g. a registry created before the link failed), and
+        // this case's random file.
         for p in walk(&fx.dir) {
-            if !before.contains(&p) {
+            if !before.contains(&p)
+                || p.file_name()
+                    .is_some_and(|n| n.to_string_lossy().starts_with("random-"))
+            {
                 let _ = std::fs::remove_file(&p);
             }
         }

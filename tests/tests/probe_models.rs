@@ -27,13 +27,6 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use upload_support::*;
 
-fn env_count(var: &str, default: u64) -> u64 {
-    std::env::var(var).ok().map_or(default, |s| {
-        s.parse()
-            .unwrap_or_else(|_| panic!("{var}={s}: not a count"))
-    })
-}
-
 /// Special f32 bit patterns a field edit writes.
 const SPECIAL_F32: [f32; 7] = [
     f32::NAN,
@@ -116,8 +109,8 @@ fn decode_checked(bytes: &[u8]) -> Option<RbfModel> {
 
 #[test]
 fn model_mutants_are_never_accepted_unless_valid_by_decoder_or_device() {
-    let n = env_count("FOG_PROBE_MODEL_MUTANTS", 3_000);
-    let seed = env_count("FOG_PROBE_SEED", 17);
+    let n = fog_tests::env_count("FOG_PROBE_MODEL_MUTANTS", 3_000);
+    let seed = fog_tests::env_count("FOG_PROBE_SEED", 17);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let models: Vec<Vec<u8>> = [(8, 1.0), (35, 0.7), (64, 1.3), (1, 0.1)]
         .iter()

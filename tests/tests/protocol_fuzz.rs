@@ -127,17 +127,10 @@ fn feed_gyro_decoder(bytes: &[u8]) -> u64 {
     frames
 }
 
-fn env_count(var: &str, default: u64) -> u64 {
-    std::env::var(var).ok().map_or(default, |s| {
-        s.parse()
-            .unwrap_or_else(|_| panic!("{var}={s}: not a count"))
-    })
-}
-
 #[test]
 fn probe_frame_streams_through_the_link_and_gyro_decoders_never_panic() {
-    let n = env_count("FOG_PROBE_FRAME_STREAMS", 5_000);
-    let seed = env_count("FOG_PROBE_SEED", 17);
+    let n = fog_tests::env_count("FOG_PROBE_FRAME_STREAMS", 5_000);
+    let seed = fog_tests::env_count("FOG_PROBE_SEED", 17);
     let cases = u32::try_from(n).expect("at most 2^32 streams");
     let mut runner = TestRunner::new(config(cases, 0xF0C0_0003 ^ seed));
     let streams = prop_oneof![noisy_bytes(1200), mutated_request(), gyro_stream()];

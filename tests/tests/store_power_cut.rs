@@ -96,26 +96,50 @@ fn cut_everywhere<const N: usize, const W: usize, const E: usize>(
 
     let (mut to_old, mut to_new) = (0, 0);
     for cut in 0..total_ops {
-        let mut flash = base.clone();
-        flash.cut_power_after(cut);
-        let (ok, mut flash) = commit(flash, new);
-        assert!(!ok, "cut {cut}/{total_ops}: commit must report the failure");
-        assert!(flash.power_lost());
-        flash.power_cycle();
+        let what = format!("cut {cut}/{total_ops}");
+        let flash = cut_during(&base, cut, |f| commit(f, new), &what);
         let (found, _) = reboot(flash);
-        if found == old {
-            to_old += 1;
-        } else if found == want_new {
-            to_new += 1;
-        } else {
-            panic!("cut {cut}/{total_ops}: torn state after reboot: {found:?}");
-        }
+        tally(found, &old, &want_new, (&mut to_old, &mut to_new), &what);
     }
     println!(
         "W={W} E={E} history={}: {total_ops} cut points -> old model {to_old}, new model {to_new}",
         history.len()
     );
     (total_ops, to_old, to_new)
+}
+
+/// `base` with the power cut at operation `cut` of `op` (which must then fail), after
+/// the power came back.
+fn cut_during<const N: usize, const W: usize, const E: usize>(
+    base: &RamNorFlash<N, W, E>,
+    cut: u32,
+    op: impl FnOnce(RamNorFlash<N, W, E>) -> (bool, RamNorFlash<N, W, E>),
+    what: &str,
+) -> RamNorFlash<N, W, E> {
+    let mut flash = base.clone();
+    flash.cut_power_after(cut);
+    let (ok, mut flash) = op(flash);
+    assert!(!ok, "{what}: the cut operation must report the failure");
+    assert!(flash.power_lost(), "{what}");
+    flash.power_cycle();
+    flash
+}
+
+/// Counts what a reboot found as the old or the new model; anything else is torn.
+fn tally<T: PartialEq + std::fmt::Debug>(
+    found: T,
+    old: &T,
+    new: &T,
+    (to_old, to_new): (&mut u32, &mut u32),
+    what: &str,
+) {
+    if found == *old {
+        *to_old += 1;
+    } else if found == *new {
+        *to_new += 1;
+    } else {
+        panic!("{what}: torn state after reboot: {found:?}");
+    }
 }
 
 fn models() -> (Vec<u8>, Vec<u8>, Vec<u8>) {
@@ -233,17 +257,10 @@ fn upload_to(flash: EmulatedModelFlash, bytes: &[u8], counter: u32) -> (bool, Em
     (ok, server.into_flash())
 }
 
-fn env_count(var: &str, default: u64) -> u64 {
-    std::env::var(var).ok().map_or(default, |s| {
-        s.parse()
-            .unwrap_or_else(|_| panic!("{var}={s}: not a count"))
-    })
-}
-
 #[test]
 fn probe_power_cut_at_every_flash_operation_of_uploads_to_the_server() {
-    let target = env_count("FOG_PROBE_POWER_CUTS", 400);
-    let seed = env_count("FOG_PROBE_SEED", 17);
+    let target = fog_tests::env_count("FOG_PROBE_POWER_CUTS", 400);
+    let seed = fog_tests::env_count("FOG_PROBE_SEED", 17);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let random_model = |rng: &mut ChaCha8Rng| {
         encode(&sample_model(
@@ -252,7 +269,7 @@ fn probe_power_cut_at_every_flash_operation_of_uploads_to_the_server() {
             rng.random_range(0.1..2.0),
         ))
     };
-    let (mut cuts, mut uploads, mut to_old, mut to_new) = (0u64, 0u64, 0u64, 0u64);
+    let (mut cuts, mut uploads, mut to_old, mut to_new) = (0u64, 0u64, 0u32, 0u32);
     let t0 = std::time::Instant::now();
     while cuts < target {
         let history: Vec<Vec<u8>> = (0..rng.random_range(0..=3))
@@ -274,25 +291,15 @@ fn probe_power_cut_at_every_flash_operation_of_uploads_to_the_server() {
         let want_new = server_after_reboot(done);
         assert_ne!(want_new, old);
         for cut in 0..ops {
-            let mut flash = base.clone();
-            flash.cut_power_after(cut);
-            let (ok, mut flash) = upload_to(flash, &new, counter);
-            assert!(!ok, "cut {cut}/{ops}: the upload must fail");
-            assert!(flash.power_lost());
-            flash.power_cycle();
+            let what = format!("upload {uploads}, cut {cut}/{ops}");
+            let flash = cut_during(&base, cut, |f| upload_to(f, &new, counter), &what);
             let after = server_after_reboot(flash);
-            if after == old {
-                to_old += 1;
-            } else if after == want_new {
-                to_new += 1;
-            } else {
-                panic!("cut {cut}/{ops}: torn state after reboot: {after:?}");
-            }
+            tally(after, &old, &want_new, (&mut to_old, &mut to_new), &what);
             cuts += 1;
         }
         uploads += 1;
     }
-    assert_eq!(to_old + to_new, cuts);
+    assert_eq!(u64::from(to_old + to_new), cuts);
     println!(
         "probe_power_cuts: seed {seed}: {cuts} cuts over {uploads} uploads in {:.1} s: old \
          model after the reboot {to_old}, new model {to_new}, torn 0",
