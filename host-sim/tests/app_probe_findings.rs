@@ -117,3 +117,23 @@ fn train_config_errors_name_the_flag() {
         assert!(err.contains(flag), "{flag}: {err}");
     }
 }
+
+#[test]
+fn a_one_byte_file_is_not_taken_for_an_empty_registry() {
+    // SQLite opened it as an empty database and wrote a 28 KB registry over it.
+    let dir = scratch_dir("probe-findings-registry");
+    std::fs::write(dir.join("one.bin"), [0u8]).unwrap();
+    one_line_naming(
+        &dir,
+        &[
+            "registry",
+            "--registry",
+            "one.bin",
+            "export",
+            "--csv",
+            "o.csv",
+        ],
+        "one.bin",
+    );
+    assert_eq!(std::fs::read(dir.join("one.bin")).unwrap(), [0u8]);
+}

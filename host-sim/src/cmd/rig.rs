@@ -89,7 +89,7 @@ pub fn run(a: Args) -> Result<()> {
     if !(a.ambient_c.is_finite() && (-60.0..=100.0).contains(&a.ambient_c)) {
         bail!("--ambient-c {}: must be within -60..=100 degC", a.ambient_c);
     }
-    if !(a.latitude_deg.abs() <= 90.0) {
+    if a.latitude_deg.is_nan() || a.latitude_deg.abs() > 90.0 {
         bail!(
             "--latitude-deg {}: must be within -90..=90 deg",
             a.latitude_deg

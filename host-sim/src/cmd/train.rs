@@ -126,7 +126,7 @@ impl Args {
                 self.seek_dwell
             );
         }
-        if !(self.seek_latitude.abs() < 85.0) {
+        if self.seek_latitude.is_nan() || self.seek_latitude.abs() >= 85.0 {
             anyhow::bail!(
                 "--seek-latitude-deg {}: must be within -85..85 deg",
                 self.seek_latitude
