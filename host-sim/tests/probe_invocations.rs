@@ -16,7 +16,7 @@
 //!
 //! `cargo test` runs `FOG_PROBE_INVOCATIONS` invocations (default 60, a few seconds);
 //! the figures in docs/robustness.md come from
-//! `cargo build --release -p fog-sim` then `FOG_PROBE_INVOCATIONS=6000
+//! `cargo build --release -p fog-sim` then `FOG_PROBE_INVOCATIONS=5600
 //! FOG_PROBE_FOGSIM=target/release/fogsim cargo test -p fog-sim --test probe_invocations --
 //! --nocapture` (the release binary probed).
 //! `FOG_PROBE_SEED` changes the order and the random faults; `FOG_PROBE_FOGSIM=PATH`
