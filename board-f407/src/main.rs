@@ -13,6 +13,8 @@
 //! - IWDG, 3 s, fed only while the gyro ring is drained without loss (and before each
 //!   sector erase); a silent or stuck gyro marks its windows invalid (`health`); panics and fatal boot errors record their reason in no-init RAM and
 //!   reset (the QEMU build's `resets`), reported by the next boot and in `DeviceStatus`;
+//!   after `SAFE_MODE_AFTER` faults in a row the board boots into the QEMU build's safe
+//!   mode (`safe_loop`): host link and upload server only, until a good upload;
 //! - clocks: 168 MHz from the 8 MHz crystal, or from the internal RC oscillator if the
 //!   crystal does not start within 100 ms (`clocks`);
 //! - SysTick at 1 kHz: the clock for timeouts and the gyro time base;
@@ -28,6 +30,11 @@ mod millis;
 mod panic_reset;
 #[path = "../../firmware/src/bin/target/resets.rs"]
 mod resets;
+// fog-app's safe mode, the same loop (its `log-semihosting` lines are QEMU-only and
+// never built here).
+#[allow(unexpected_cfgs)]
+#[path = "../../firmware/src/bin/target/safe_loop.rs"]
+mod safe_loop;
 mod sector_flash;
 #[path = "../../firmware/src/bin/target/upload_boot.rs"]
 mod upload_boot;
@@ -38,7 +45,6 @@ use cortex_m_rt::entry;
 use embedded_hal_nb::serial::{Read as _, Write as _};
 use fog_core::compensation::compensator::Compensator;
 use fog_core::hal::{Gyro, TemperatureSensor};
-use fog_core::link::upload::ResetRecord;
 use fog_core::model::format::RbfModel;
 use fog_firmware::app::{App, AppConfig};
 use fog_firmware::clock::Clock;
@@ -158,6 +164,34 @@ fn main() -> ! {
         rx: table_rx,
         tx: table_tx,
     };
+    // SAFETY: the model sectors are taken once, here.
+    let model_flash = unsafe { SectorFlash::take() };
+    if model_flash.is_none() {
+        defmt::error!("memory.x MODELS region is not flash sectors 10-11");
+    }
+    let server = if record.safe_mode() {
+        // A reset loop (fault_record.rs): host link and upload server only, until a good
+        // upload; the TMP117, the gyro path and the turntable are not started.
+        let mut server = model_flash
+            .and_then(|f| upload_boot::try_new_upload_server(f, VERIFY_KEY, GYRO_ID, reset).ok())
+            .map(keep_server);
+        let faults = record.state(true);
+        let feed = || watchdog.feed();
+        safe_loop::run(&mut host, server.as_deref_mut(), tx_queue, faults, feed);
+        // `run` returns only after a good upload, which needs the store.
+        server.unwrap_or_else(|| resets::fatal_boot(BootFault::StoreGeometry))
+    } else {
+        let Some(model_flash) = model_flash else {
+            resets::fatal_boot(BootFault::StoreGeometry)
+        };
+        keep_server(upload_boot::new_upload_server(
+            model_flash,
+            VERIFY_KEY,
+            GYRO_ID,
+            reset,
+        ))
+    };
+
     let i2c = I2c::new(dp.I2C1, (gpiob.pb6, gpiob.pb7), 400.kHz(), &mut rcc);
     let mut tmp117 = match Tmp117::new(i2c, TMP117_ADDRESS, millis::MillisClock) {
         Ok(t) => Some(t),
@@ -167,12 +201,6 @@ fn main() -> ! {
         }
     };
 
-    // SAFETY: the model sectors are taken once, here.
-    let Some(model_flash) = (unsafe { SectorFlash::take() }) else {
-        defmt::error!("memory.x MODELS region is not flash sectors 10-11");
-        resets::fatal_boot(BootFault::StoreGeometry)
-    };
-    let server = start_upload_server(model_flash, reset);
     let stored = server.load_active_model_into(model).unwrap_or_else(|e| {
         defmt::warn!("stored model not loaded ({}): running uncompensated", e);
         false
@@ -288,9 +316,8 @@ fn or_reset<T, E>(r: Result<T, E>) -> T {
     r.unwrap_or_else(|_| resets::fatal_boot(BootFault::Configuration))
 }
 
-/// The upload server, in a static (`upload_boot.rs` builds it).
-fn start_upload_server(flash: SectorFlash, reset: ResetRecord) -> &'static mut Server {
-    let server = upload_boot::new_upload_server(flash, VERIFY_KEY, GYRO_ID, reset);
+/// Moves the upload server (`upload_boot.rs` builds it) into its static (once).
+fn keep_server(server: Server) -> &'static mut Server {
     let Some(server) = cortex_m::singleton!(: Server = server) else {
         resets::fatal_boot(BootFault::Singleton)
     };

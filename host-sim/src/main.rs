@@ -47,7 +47,7 @@ enum Command {
 }
 
 fn main() {
-    let cli = Cli::parse();
+    let cli = Cli::try_parse().unwrap_or_else(|e| cmd::cli_error::exit(e));
     let result = match cli.command {
         Command::Allan(a) => cmd::allan::run(a),
         Command::Campaign(a) => cmd::campaign::run(a),

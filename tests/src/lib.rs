@@ -155,6 +155,15 @@ fn build_target_once(
     result
 }
 
+/// A count from the environment (`FOG_PROBE_*`: the probes' full runs), else `default`;
+/// a value that is not a count stops the test with its name.
+pub fn env_count(var: &str, default: u64) -> u64 {
+    std::env::var(var).ok().map_or(default, |s| {
+        s.parse()
+            .unwrap_or_else(|_| panic!("{var}={s}: not a count"))
+    })
+}
+
 /// Path of one firmware ELF (building first if needed).
 pub fn firmware_elf(bin: &str) -> PathBuf {
     match build_firmware() {

@@ -4,6 +4,13 @@
 //!
 //! Case counts and RNG seeds are fixed below (same cases every run); a test prints how
 //! many executions it ran, for the report.
+//!
+//! The probe of issue 17 (`probe_frame_streams_...`) runs the same streams, plus gyro
+//! frame streams with bytes flipped, dropped and inserted, through the host-link and
+//! the gyro-frame decoders: `FOG_PROBE_FRAME_STREAMS` streams (default 5,000; the
+//! figures in docs/robustness.md come from `FOG_PROBE_FRAME_STREAMS=1000000 cargo test
+//! --release -p fog-tests --test protocol_fuzz probe -- --nocapture`), seeded by
+//! `FOG_PROBE_SEED`.
 
 mod upload_support;
 
@@ -14,7 +21,9 @@ use fog_core::link::upload::{
     decode_frame, decode_message, encode_frame, FrameReceiver, Request, Response, UploadError,
     MAX_CHUNK_LEN, MAX_WIRE_FRAME_LEN,
 };
+use fog_firmware::drivers::gyro_frame::{FrameDecoder, GyroFrame, FRAME_LEN};
 use proptest::prelude::*;
+use proptest::test_runner::TestRunner;
 use upload_support::*;
 
 /// Arbitrary bytes with delimiters sprinkled in, so many short frames form.
@@ -61,6 +70,87 @@ fn mutated_request() -> impl Strategy<Value = Vec<u8>> {
             wire.push(0);
             wire
         })
+}
+
+/// A gyro frame stream (up to 100 frames of any content) with up to 8 bytes flipped,
+/// dropped or inserted.
+fn gyro_stream() -> impl Strategy<Value = Vec<u8>> {
+    let frames = prop::collection::vec(any::<(u8, u8, i32, i16)>(), 0..100);
+    let edits = prop::collection::vec((any::<usize>(), 0u8..3, any::<u8>()), 0..8);
+    (frames, edits).prop_map(|(frames, edits)| {
+        let mut bytes: Vec<u8> = frames
+            .iter()
+            .flat_map(|&(seq, status, dtheta_lsb, temp_lsb)| {
+                GyroFrame {
+                    seq,
+                    status,
+                    dtheta_lsb,
+                    temp_lsb,
+                }
+                .encode()
+            })
+            .collect();
+        for (at, op, value) in edits {
+            if bytes.is_empty() {
+                break;
+            }
+            let i = at % bytes.len();
+            match op {
+                0 => bytes[i] ^= value | 1,
+                1 => {
+                    bytes.remove(i);
+                }
+                _ => bytes.insert(i, value),
+            }
+        }
+        bytes
+    })
+}
+
+/// The gyro-frame decoder on `bytes`: every frame it returns is the 12 bytes that just
+/// arrived (good CRC, never stitched from elsewhere), and it counts each. Returns the
+/// frames decoded.
+fn feed_gyro_decoder(bytes: &[u8]) -> u64 {
+    let mut rx = FrameDecoder::new();
+    let mut frames = 0;
+    for (i, &b) in bytes.iter().enumerate() {
+        if let Some(f) = rx.push(b) {
+            assert_eq!(
+                f.encode()[..],
+                bytes[i + 1 - FRAME_LEN..=i],
+                "frame at byte {i}"
+            );
+            frames += 1;
+        }
+    }
+    assert_eq!(u64::from(rx.stats().frames_ok), frames);
+    frames
+}
+
+#[test]
+fn probe_frame_streams_through_the_link_and_gyro_decoders_never_panic() {
+    let n = fog_tests::env_count("FOG_PROBE_FRAME_STREAMS", 5_000);
+    let seed = fog_tests::env_count("FOG_PROBE_SEED", 17);
+    let cases = u32::try_from(n).expect("at most 2^32 streams");
+    let mut runner = TestRunner::new(config(cases, 0xF0C0_0003 ^ seed));
+    let streams = prop_oneof![noisy_bytes(1200), mutated_request(), gyro_stream()];
+    let (bytes_in, gyro_frames) = (AtomicU64::new(0), AtomicU64::new(0));
+    let t0 = std::time::Instant::now();
+    runner
+        .run(&streams, |bytes| {
+            feed_decoder(&bytes);
+            gyro_frames.fetch_add(feed_gyro_decoder(&bytes), Ordering::Relaxed);
+            bytes_in.fetch_add(bytes.len() as u64, Ordering::Relaxed);
+            Ok(())
+        })
+        .unwrap();
+    println!(
+        "probe_frame_streams: seed {seed}: {n} streams, {:.1} MB, through both decoders in \
+         {:.1} s: {} gyro frames decoded (each verified), 0 panics",
+        bytes_in.load(Ordering::Relaxed) as f64 / 1e6,
+        t0.elapsed().as_secs_f64(),
+        gyro_frames.load(Ordering::Relaxed)
+    );
 }
 
 static DECODER_RUNS: AtomicU64 = AtomicU64::new(0);

@@ -13,6 +13,7 @@
 //! Skips loudly without QEMU / the target unless FOG_REQUIRE_QEMU=1. Every wait is
 //! bounded; QEMU is killed when each run ends.
 
+mod qemu_support;
 mod upload_support;
 
 use std::net::TcpStream;
@@ -22,8 +23,9 @@ use std::time::Duration;
 
 use fog_core::link::upload::{DeviceStatus, ModelInfo, ResetCause};
 use fog_sim::upload::UploadClient;
-use fog_tests::console::{start_with_console, wait_line};
-use fog_tests::{firmware_elf, qemu_ready, scratch_dir, KillOnDrop, QemuOptions};
+use fog_tests::console::wait_line;
+use fog_tests::{qemu_ready, scratch_dir, KillOnDrop};
+use qemu_support::boot_in;
 use upload_support::*;
 
 /// The model region of the QEMU build: the last 16 KiB of flash (memory.x).
@@ -32,15 +34,7 @@ const WAIT: Duration = Duration::from_secs(30);
 
 /// One QEMU process on `file` (relative to `dir`): QEMU, the host link, the console.
 fn boot(dir: &Path, file: &str) -> (KillOnDrop, UploadClient<TcpStream>, Receiver<String>) {
-    let opts = QemuOptions {
-        args: vec![format!("flash-file={file}")],
-        cwd: Some(dir.to_path_buf()),
-        ..QemuOptions::default()
-    };
-    let (qemu, mut streams, console) = start_with_console(&firmware_elf("fog-app"), opts, 1);
-    let link = streams.remove(0);
-    link.set_read_timeout(Some(Duration::from_millis(50)))
-        .unwrap();
+    let (qemu, link, console) = boot_in(dir, vec![format!("flash-file={file}")]);
     (
         qemu,
         UploadClient::new(link, Duration::from_secs(20)),

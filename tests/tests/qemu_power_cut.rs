@@ -14,6 +14,7 @@
 //! Skips loudly without QEMU / the target unless FOG_REQUIRE_QEMU=1. Every wait is
 //! bounded; QEMU is killed when each run ends.
 
+mod qemu_support;
 mod upload_support;
 
 use std::net::TcpStream;
@@ -23,8 +24,9 @@ use std::time::Duration;
 
 use fog_core::link::upload::{crc32, ModelInfo};
 use fog_sim::upload::UploadClient;
-use fog_tests::console::{start_with_console, wait_line};
-use fog_tests::{firmware_elf, qemu_ready, scratch_dir, KillOnDrop, QemuOptions};
+use fog_tests::console::wait_line;
+use fog_tests::{qemu_ready, scratch_dir, KillOnDrop};
+use qemu_support::boot_in;
 use upload_support::*;
 
 const WAIT: Duration = Duration::from_secs(30);
@@ -33,16 +35,7 @@ const WAIT: Duration = Duration::from_secs(30);
 fn boot(dir: &Path, extra: &[String]) -> (KillOnDrop, TcpStream, Receiver<String>) {
     let mut args = vec!["flash-file=models.img".to_string()];
     args.extend_from_slice(extra);
-    let opts = QemuOptions {
-        args,
-        cwd: Some(dir.to_path_buf()),
-        ..QemuOptions::default()
-    };
-    let (qemu, mut streams, console) = start_with_console(&firmware_elf("fog-app"), opts, 1);
-    let link = streams.remove(0);
-    link.set_read_timeout(Some(Duration::from_millis(50)))
-        .unwrap();
-    (qemu, link, console)
+    boot_in(dir, args)
 }
 
 fn upload(link: &TcpStream, bytes: &[u8], counter: u32) -> ModelInfo {

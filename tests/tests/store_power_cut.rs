@@ -5,14 +5,27 @@
 //! A cut point is one word write or one page erase of `RamNorFlash` (a cut write leaves
 //! its word half-programmed, a cut erase its page half-erased). Three geometries, three
 //! situations (first commit on an empty device, A -> B, B -> A over an older model).
+//!
+//! The probe of issue 17 (`probe_power_cut_...`) cuts power at every flash operation
+//! of whole uploads to the upload server (real client, `UploadServer`, reboot on the
+//! cut flash), over seeded random models and histories, until `FOG_PROBE_POWER_CUTS`
+//! cuts (default 400, one upload; the figures in docs/robustness.md come from
+//! `FOG_PROBE_POWER_CUTS=9000 cargo test --release -p fog-tests --test store_power_cut
+//! probe -- --nocapture`), seeded by `FOG_PROBE_SEED`.
 
 mod upload_support;
 
 use embedded_storage::nor_flash::{NorFlash, ReadNorFlash};
+use fog_core::link::upload::ModelInfo;
 use fog_core::model::format::MAX_ENCODED_LEN;
 use fog_firmware::store::ram_flash::RamNorFlash;
+use fog_firmware::store::EmulatedModelFlash;
 use fog_firmware::store::{store_len, ModelStore};
-use upload_support::{encode, sample_model, sign_with_test_key};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use upload_support::{
+    client, encode, reboot as boot_server, sample_model, sign_with_test_key, TEST_GYRO,
+};
 
 /// What the store holds after a reboot.
 #[derive(Debug, PartialEq)]
@@ -83,26 +96,50 @@ fn cut_everywhere<const N: usize, const W: usize, const E: usize>(
 
     let (mut to_old, mut to_new) = (0, 0);
     for cut in 0..total_ops {
-        let mut flash = base.clone();
-        flash.cut_power_after(cut);
-        let (ok, mut flash) = commit(flash, new);
-        assert!(!ok, "cut {cut}/{total_ops}: commit must report the failure");
-        assert!(flash.power_lost());
-        flash.power_cycle();
+        let what = format!("cut {cut}/{total_ops}");
+        let flash = cut_during(&base, cut, |f| commit(f, new), &what);
         let (found, _) = reboot(flash);
-        if found == old {
-            to_old += 1;
-        } else if found == want_new {
-            to_new += 1;
-        } else {
-            panic!("cut {cut}/{total_ops}: torn state after reboot: {found:?}");
-        }
+        tally(found, &old, &want_new, (&mut to_old, &mut to_new), &what);
     }
     println!(
         "W={W} E={E} history={}: {total_ops} cut points -> old model {to_old}, new model {to_new}",
         history.len()
     );
     (total_ops, to_old, to_new)
+}
+
+/// `base` with the power cut at operation `cut` of `op` (which must then fail), after
+/// the power came back.
+fn cut_during<const N: usize, const W: usize, const E: usize>(
+    base: &RamNorFlash<N, W, E>,
+    cut: u32,
+    op: impl FnOnce(RamNorFlash<N, W, E>) -> (bool, RamNorFlash<N, W, E>),
+    what: &str,
+) -> RamNorFlash<N, W, E> {
+    let mut flash = base.clone();
+    flash.cut_power_after(cut);
+    let (ok, mut flash) = op(flash);
+    assert!(!ok, "{what}: the cut operation must report the failure");
+    assert!(flash.power_lost(), "{what}");
+    flash.power_cycle();
+    flash
+}
+
+/// Counts what a reboot found as the old or the new model; anything else is torn.
+fn tally<T: PartialEq + std::fmt::Debug>(
+    found: T,
+    old: &T,
+    new: &T,
+    (to_old, to_new): (&mut u32, &mut u32),
+    what: &str,
+) {
+    if found == *old {
+        *to_old += 1;
+    } else if found == *new {
+        *to_new += 1;
+    } else {
+        panic!("{what}: torn state after reboot: {found:?}");
+    }
 }
 
 fn models() -> (Vec<u8>, Vec<u8>, Vec<u8>) {
@@ -198,4 +235,74 @@ fn the_flash_mock_obeys_nor_rules_and_tears_cut_operations() {
     assert_eq!(&f.contents()[200..204], &[1, 2, 3, 4]);
     f.erase(0, 256).unwrap();
     assert!(f.contents().iter().all(|&b| b == 0xFF));
+}
+
+/// What the upload server runs after a reboot on `flash`: its model info and the model
+/// it loads (a torn model would fail to load or differ from the info's bytes).
+fn server_after_reboot(flash: EmulatedModelFlash) -> Option<ModelInfo> {
+    let mut server = boot_server(flash);
+    let info = server.active_info().cloned();
+    let loaded = server.load_active_model().expect("the active model loads");
+    assert_eq!(info.is_some(), loaded.is_some(), "info and model agree");
+    info
+}
+
+/// `flash` after the upload of `bytes` with `counter` (cut if `flash` is set to cut).
+fn upload_to(flash: EmulatedModelFlash, bytes: &[u8], counter: u32) -> (bool, EmulatedModelFlash) {
+    let mut server = boot_server(flash);
+    let sig = sign_with_test_key(counter, bytes);
+    let ok = client(&mut server)
+        .upload(bytes, counter, &sig, |_, _| {})
+        .is_ok();
+    (ok, server.into_flash())
+}
+
+#[test]
+fn probe_power_cut_at_every_flash_operation_of_uploads_to_the_server() {
+    let target = fog_tests::env_count("FOG_PROBE_POWER_CUTS", 400);
+    let seed = fog_tests::env_count("FOG_PROBE_SEED", 17);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let random_model = |rng: &mut ChaCha8Rng| {
+        encode(&sample_model(
+            TEST_GYRO,
+            rng.random_range(1..=64),
+            rng.random_range(0.1..2.0),
+        ))
+    };
+    let (mut cuts, mut uploads, mut to_old, mut to_new) = (0u64, 0u64, 0u32, 0u32);
+    let t0 = std::time::Instant::now();
+    while cuts < target {
+        let history: Vec<Vec<u8>> = (0..rng.random_range(0..=3))
+            .map(|_| random_model(&mut rng))
+            .collect();
+        let mut base = EmulatedModelFlash::new();
+        for (k, m) in history.iter().enumerate() {
+            let (ok, f) = upload_to(base, m, k as u32 + 1);
+            assert!(ok, "history upload {k}");
+            base = f;
+        }
+        let counter = history.len() as u32 + 1;
+        let new = random_model(&mut rng);
+        let old = server_after_reboot(base.clone());
+        let before = base.ops_done();
+        let (ok, done) = upload_to(base.clone(), &new, counter);
+        assert!(ok, "uncut upload");
+        let ops = done.ops_done() - before;
+        let want_new = server_after_reboot(done);
+        assert_ne!(want_new, old);
+        for cut in 0..ops {
+            let what = format!("upload {uploads}, cut {cut}/{ops}");
+            let flash = cut_during(&base, cut, |f| upload_to(f, &new, counter), &what);
+            let after = server_after_reboot(flash);
+            tally(after, &old, &want_new, (&mut to_old, &mut to_new), &what);
+            cuts += 1;
+        }
+        uploads += 1;
+    }
+    assert_eq!(u64::from(to_old + to_new), cuts);
+    println!(
+        "probe_power_cuts: seed {seed}: {cuts} cuts over {uploads} uploads in {:.1} s: old \
+         model after the reboot {to_old}, new model {to_new}, torn 0",
+        t0.elapsed().as_secs_f64()
+    );
 }

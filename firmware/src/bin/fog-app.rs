@@ -328,13 +328,7 @@ fn main() -> ! {
                 flash_ok: server.slots_refused_at_boot() == 0,
             };
             app.set_bit(bit_monitor.evaluate(&counters));
-            let board = board_status(
-                watch.last_t_s(),
-                gyro.latest_temp(),
-                server,
-                reset_reason,
-                faults,
-            );
+            let board = board_status(&watch, &gyro, server, reset_reason, faults);
             send_link(tx_queue, DeviceMessage::Status(app.status(board)));
         }
 
@@ -351,13 +345,7 @@ fn main() -> ! {
             }
             if let Some(cmd) = command {
                 let answer = app.command(cmd, watch.last_t_s());
-                let board = board_status(
-                    watch.last_t_s(),
-                    gyro.latest_temp(),
-                    server,
-                    reset_reason,
-                    faults,
-                );
+                let board = board_status(&watch, &gyro, server, reset_reason, faults);
                 let status = DeviceMessage::Status(app.status(board));
                 for msg in answer.into_iter().chain(core::iter::once(status)) {
                     answer_link(server, tx_queue, msg);
@@ -400,17 +388,18 @@ where
     semihosting::eprintln!("FOG-HEADING-CAL n_headings={}", n_headings);
 }
 
-/// The board's part of a status message.
-fn board_status(
-    t_s: f64,
-    temp: Option<fog_core::hal::TempSample>,
+/// The board's part of a status message: the gyro's time and temperature, the model
+/// in flash, why the last reset happened.
+fn board_status<S: embedded_hal_nb::serial::Read<u8>, C: Clock>(
+    watch: &GyroWatch,
+    gyro: &FogSerialGyro<S, C>,
     server: &Server,
     reset_reason: ResetReason,
     faults: FaultState,
 ) -> BoardStatus {
     BoardStatus {
-        t_s,
-        temp_c: temp.map_or(f32::NAN, |t| t.temp_c),
+        t_s: watch.last_t_s(),
+        temp_c: gyro.latest_temp().map_or(f32::NAN, |t| t.temp_c),
         model_crc32: server.active_info().map(|i| i.model_crc32),
         reset_reason,
         faults,

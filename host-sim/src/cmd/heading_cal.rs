@@ -115,6 +115,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             let sigma = args
                 .sigma_dph
                 .context("--sigma-dph is required with --a-dph")?;
+            for (flag, v) in [("--a-dph", a), ("--b-dph", b), ("--sigma-dph", sigma)] {
+                if !v.is_finite() {
+                    bail!("{flag} {v}: not a finite number of deg/h");
+                }
+            }
             HeadingHarmonic {
                 cos_dph: a,
                 sin_dph: b,

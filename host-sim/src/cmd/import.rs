@@ -91,6 +91,13 @@ impl Args {
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    // Checked whatever the layout: a bad flag is never ignored.
+    if !["x", "y", "z", "all"].contains(&args.axis.as_str()) {
+        anyhow::bail!("--axis {}: expected x, y, z or all", args.axis);
+    }
+    if args.columns.iter().flatten().any(|c| c.trim().is_empty()) {
+        anyhow::bail!("--columns: an empty column name");
+    }
     match (args.logger_spec()?, args.preset.as_deref()) {
         (Some(spec), _) => {
             let guard = OutputGuard::new(&args.input);

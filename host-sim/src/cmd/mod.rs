@@ -3,6 +3,7 @@
 
 pub mod allan;
 pub mod campaign;
+pub mod cli_error;
 pub mod compensate;
 pub mod demo;
 pub mod diagnose;

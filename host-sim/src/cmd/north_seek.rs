@@ -108,6 +108,13 @@ pub fn config_from_args(a: &Args) -> Result<MonteCarloConfig> {
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
     let cfg = config_from_args(&args)?;
+    // Checked even when `--model` leaves it unused: a bad flag is never ignored.
+    let criterion = crate::train::seek_score::Criterion::parse(
+        &args.criterion,
+        cfg.dwell_s as f64,
+        cfg.latitude_deg,
+    )
+    .map_err(|e| anyhow::anyhow!("--criterion {e}"))?;
     let guard = match &args.model {
         Some(m) => OutputGuard::new(&[m]),
         None => OutputGuard::default(),
@@ -120,12 +127,6 @@ pub fn run(args: Args) -> Result<()> {
             p.display().to_string(),
         ),
         None => {
-            let criterion = crate::train::seek_score::Criterion::parse(
-                &args.criterion,
-                cfg.dwell_s as f64,
-                cfg.latitude_deg,
-            )
-            .map_err(|e| anyhow::anyhow!("--criterion {e}"))?;
             // The same defaults as `fogsim train` (inputs chosen by grouped validation
             // over whole runs, d2T/dt2 kept where it wins), on as many runs at the
             // ambient as the half-split learned seek error needs.

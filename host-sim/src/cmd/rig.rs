@@ -72,6 +72,19 @@ pub struct Args {
     pub connect_timeout_s: u64,
 }
 
+/// A link the rig can open: `tcp:` with a socket address, or a device that exists.
+fn check_port(flag: &str, port: &str) -> Result<()> {
+    match port.strip_prefix("tcp:") {
+        Some(addr) if addr.parse::<std::net::SocketAddr>().is_err() => {
+            bail!("{flag} {port}: not a tcp:IP:PORT address")
+        }
+        None if !std::path::Path::new(port).exists() => {
+            bail!("{flag} {port}: no such serial device")
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Runs the subcommand.
 pub fn run(a: Args) -> Result<()> {
     if !(a.speed.is_finite() && a.speed > 0.0 && a.speed <= 1000.0) {
@@ -91,6 +104,24 @@ pub fn run(a: Args) -> Result<()> {
             "--heading-bias-dph {}: must be within -1..=1 deg/h",
             a.heading_bias_dph
         );
+    }
+    if !(a.ambient_c.is_finite() && (-60.0..=100.0).contains(&a.ambient_c)) {
+        bail!("--ambient-c {}: must be within -60..=100 degC", a.ambient_c);
+    }
+    if a.latitude_deg.is_nan() || a.latitude_deg.abs() > 90.0 {
+        bail!(
+            "--latitude-deg {}: must be within -90..=90 deg",
+            a.latitude_deg
+        );
+    }
+    if let Some(d) = a.duration_s.filter(|d| !(d.is_finite() && *d > 0.0)) {
+        bail!("--duration-s {d}: must be a positive number of seconds");
+    }
+    // Both links named before either waits for its peer.
+    check_port("--gyro-port", &a.gyro_port)?;
+    check_port("--table-port", &a.table_port)?;
+    if let Some(p) = &a.incl_port {
+        check_port("--incl-port", p)?;
     }
     let tilt = Tilt {
         pitch_deg: a.pitch_deg as f32,

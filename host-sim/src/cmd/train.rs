@@ -118,6 +118,20 @@ fn parse_method(s: &str) -> Result<Method, String> {
 impl Args {
     /// The training configuration these options ask for.
     pub fn config(&self) -> anyhow::Result<TrainConfig> {
+        // Each seek parameter named by its flag (checked also under `rms10s`, which does
+        // not use them: a bad flag is never ignored).
+        if !(self.seek_dwell.is_finite() && self.seek_dwell > 0.0) {
+            anyhow::bail!(
+                "--seek-dwell-s {}: must be a positive number of seconds",
+                self.seek_dwell
+            );
+        }
+        if self.seek_latitude.is_nan() || self.seek_latitude.abs() >= 85.0 {
+            anyhow::bail!(
+                "--seek-latitude-deg {}: must be within -85..85 deg",
+                self.seek_latitude
+            );
+        }
         let criterion = crate::train::seek_score::Criterion::parse(
             &self.criterion,
             self.seek_dwell,

@@ -37,7 +37,7 @@ pub struct LinkArgs {
 impl LinkArgs {
     /// Opens the link (see `upload::open_link`).
     pub fn open(&self) -> anyhow::Result<Box<dyn crate::upload::Link>> {
-        open_link(&self.port, self.baud)
+        open_link(&self.port, self.baud).map_err(|e| e.context(format!("--port {}", self.port)))
     }
 }
 

@@ -112,6 +112,32 @@ pub fn resolve(path: Option<&Path>) -> Result<PathBuf> {
     }
 }
 
+/// SQLite's file header.
+const SQLITE_HEADER: &[u8; 16] = b"SQLite format 3\0";
+
+/// Refuses an existing, non-empty file that does not start with SQLite's header: SQLite
+/// takes a one-byte file for an empty database and writes a new one over it (found by
+/// the bad-invocation probe). An empty file holds nothing to lose and stays accepted.
+fn refuse_non_sqlite(path: &Path) -> Result<()> {
+    use std::io::Read;
+    let Ok(meta) = std::fs::metadata(path) else {
+        return Ok(());
+    };
+    if meta.len() == 0 {
+        return Ok(());
+    }
+    let mut head = [0u8; 16];
+    let read = std::fs::File::open(path).and_then(|f| f.take(16).read(&mut head));
+    match read {
+        Ok(16) if &head == SQLITE_HEADER => Ok(()),
+        Ok(_) => bail!(
+            "registry {}: not a fogsim registry (no SQLite header), left as it is",
+            path.display()
+        ),
+        Err(e) => Err(e).with_context(|| format!("registry {}: cannot read", path.display())),
+    }
+}
+
 impl Registry {
     /// Opens (creating if absent, with its directory) the registry at `path`. A file that
     /// is not a fogsim registry is refused and left untouched.
@@ -120,6 +146,7 @@ impl Registry {
         if path.is_dir() {
             bail!("registry {shown}: is a directory");
         }
+        refuse_non_sqlite(path)?;
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir)
                 .with_context(|| format!("registry {shown}: cannot create its directory"))?;

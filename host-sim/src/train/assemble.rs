@@ -115,7 +115,7 @@ pub fn assemble(parts: &ModelParts<'_>) -> Result<RbfModel> {
         .gyro_id
         .push_str(parts.gyro_id)
         .map_err(|_| TrainError::BadConfig {
-            option: "gyro id",
+            option: "gyro-id",
             why: "longer than 16 bytes".into(),
         })?;
     model

@@ -145,7 +145,7 @@ impl TrainConfig {
         }
         if self.linear_only_inputs >= n_inputs {
             return bad(
-                "linear-only inputs",
+                "linear-inputs",
                 format!(
                     "{} of {n_inputs} inputs: at least one RBF input is needed",
                     self.linear_only_inputs
@@ -154,13 +154,13 @@ impl TrainConfig {
         }
         if !(self.collinearity_tol > 0.0 && self.collinearity_tol < 1.0) {
             return bad(
-                "collinearity tolerance",
+                "collinearity-tol",
                 format!("{} is outside (0, 1)", self.collinearity_tol),
             );
         }
         if self.gyro_id.len() > 16 {
             return bad(
-                "gyro id",
+                "gyro-id",
                 format!("`{}` is longer than 16 bytes", self.gyro_id),
             );
         }

@@ -86,7 +86,7 @@ impl fmt::Display for TrainError {
                 f,
                 "grouped validation needs at least {needed} runs, the data holds {found}"
             ),
-            Self::BadConfig { option, why } => write!(f, "option {option}: {why}"),
+            Self::BadConfig { option, why } => write!(f, "--{option}: {why}"),
             Self::Features { run, why } => write!(f, "{run}: computing model inputs: {why}"),
             Self::MissingColumn { run, column } => {
                 write!(

@@ -1,11 +1,14 @@
 //! Shared by the QEMU scenarios that run the real `fog-app` with its UARTs on loopback
 //! sockets (qemu_faults.rs, qemu_seek.rs, ...): start it, wait for its tagged semihosting
-//! console lines (`FOG-...`), talk on its host link. The gyro, table and inclinometer on
-//! the other UARTs are always the bench simulator's (`fog_sim::rig`).
+//! console lines (`FOG-...`), talk on its host link; boot it on a flash file in a directory
+//! (qemu_persist.rs, qemu_power_cut.rs). The gyro, table and inclinometer on the other
+//! UARTs are always the bench simulator's (`fog_sim::rig`).
 #![allow(dead_code)]
 
 use std::io::Write;
 use std::net::TcpStream;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::Receiver;
 use std::time::{Duration, Instant};
 
@@ -31,6 +34,18 @@ pub fn start_with(
         ..QemuOptions::default()
     };
     start_with_console(&firmware_elf("fog-app"), opts, serial_ports)
+}
+
+/// fog-app run in `dir` with `args` (e.g. `flash-file=models.img`, relative to `dir`)
+/// and only its host UART: QEMU, the host link (polled) and the console lines.
+pub fn boot_in(dir: &Path, args: Vec<String>) -> (KillOnDrop, TcpStream, Receiver<String>) {
+    let opts = QemuOptions {
+        args,
+        cwd: Some(dir.to_path_buf()),
+        ..QemuOptions::default()
+    };
+    let (qemu, mut streams, console) = start_with_console(&firmware_elf("fog-app"), opts, 1);
+    (qemu, polled(streams.remove(0)), console)
 }
 
 /// Waits (30 s at most) for boot `n`'s `FOG-BOOT n reset=<reason>` console line, which

@@ -1,0 +1,809 @@
+//! Probe (issue 17): bad invocations of `fogsim`, every subcommand. Each must exit with
+//! a non-zero status (not a signal), print exactly one line on stderr that names what
+//! was wrong and where (the flag, the value or the file), never panic, leave every input
+//! file as it was, and end within a time and an address-space limit.
+//!
+//! The invocations: each subcommand's good base command (on a small simulated campaign
+//! and a model trained on it) with one fault put in: an unknown flag; every value flag
+//! of its `--help` with the value missing, malformed (`abc`, empty, `nan`, `inf`,
+//! `1e400`, not UTF-8) or unknown (text flags); every input file replaced by a bad file
+//! (missing, empty, binary, truncated inside its last row, a 3 GiB sparse file, a
+//! directory, `/dev/zero`, not UTF-8, a non-UTF-8 name); every output pointed at an input.
+//! That catalogue is run first (in a seeded order); past it, seeded random faults of
+//! the same kinds (random garbage, random overflowing exponents, random bytes, random
+//! cuts and bit flips). The flags come from each subcommand's `--help`, so a new flag
+//! is probed too (as a number unless listed below as a file, name or text flag).
+//!
+//! `cargo test` runs `FOG_PROBE_INVOCATIONS` invocations (default 60, a few seconds);
+//! the figures in docs/robustness.md come from
+//! `cargo build --release -p fog-sim` then `FOG_PROBE_INVOCATIONS=5600
+//! FOG_PROBE_FOGSIM=target/release/fogsim cargo test -p fog-sim --test probe_invocations --
+//! --nocapture` (the release binary probed).
+//! `FOG_PROBE_SEED` changes the order and the random faults; `FOG_PROBE_FOGSIM=PATH`
+//! probes another `fogsim` binary (the release build, or main's).
+
+mod app_support;
+
+use std::ffi::{OsStr, OsString};
+use std::os::unix::ffi::{OsStrExt, OsStringExt};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use app_support::{campaign_and_model, scratch_dir};
+use rand::seq::SliceRandom;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// Wall time one invocation may take.
+const TIME_LIMIT: Duration = Duration::from_secs(30);
+/// Address space one invocation may map (`ulimit -v`, KiB): 4 GiB.
+const ADDRESS_SPACE_KIB: u64 = 4 * 1024 * 1024;
+/// Size of the sparse "huge" input file (no disk used).
+const HUGE_SPARSE_BYTES: u64 = 3 << 30;
+
+/// Flags whose value is a file the command reads.
+const INPUT_FLAGS: &[&str] = &["--model", "--key", "--from-diagnose", "--from-runs"];
+/// Flags whose value is a file or directory the command writes.
+const OUTPUT_FLAGS: &[&str] = &[
+    "--out",
+    "--json",
+    "--plot",
+    "--plots",
+    "--export-design",
+    "--csv",
+];
+/// Flags with a free-text value: only a missing or non-UTF-8 value is bad for certain.
+const FREE_TEXT_FLAGS: &[&str] = &["--gyro-id", "--gyro"];
+/// Flags naming a store the command creates if absent (a missing or non-UTF-8 path is
+/// a new registry): only a missing value and files that are not databases are bad.
+const STORE_FLAGS: &[&str] = &["--registry"];
+/// Flags whose value is a name from a set (an enum, a column, a port): an unknown name
+/// is bad.
+const NAME_FLAGS: &[&str] = &[
+    "--column",
+    "--taus",
+    "--kind",
+    "--method",
+    "--criterion",
+    "--inputs",
+    "--preset",
+    "--axis",
+    "--time",
+    "--rate",
+    "--temp",
+    "--keep",
+    "--columns",
+    "--heading-col",
+    "--port",
+    "--gyro-port",
+    "--table-port",
+    "--width-search",
+];
+/// Malformed numbers: bad for every numeric flag.
+const BAD_NUMBERS: &[&str] = &["abc", "", "nan", "inf", "-inf", "1e400", "-1e400", "0x10"];
+
+/// One subcommand: its words and a good base command. In `base`, `@path` marks an input
+/// file the probe replaces by bad files and `!path` an output it points at an input.
+struct Sub {
+    words: &'static [&'static str],
+    base: &'static [&'static str],
+}
+
+const SUBS: &[Sub] = &[
+    Sub {
+        words: &["allan"],
+        base: &["@runs/run4.csv", "--json", "!out/allan.json"],
+    },
+    Sub {
+        words: &["campaign"],
+        base: &[
+            "--out",
+            "!out/campaign",
+            "--runs",
+            "1",
+            "--duration-min",
+            "1",
+            "--headings-deg",
+            "0,180",
+        ],
+    },
+    Sub {
+        words: &["train"],
+        base: &[
+            "--out",
+            "!out/m.bin",
+            "@runs/run4.csv",
+            "@runs/run5.csv",
+            "@runs/run6.csv",
+        ],
+    },
+    Sub {
+        words: &["compensate"],
+        base: &[
+            "--model",
+            "@model.bin",
+            "@runs/run4.csv",
+            "--json",
+            "!out/c.json",
+        ],
+    },
+    Sub {
+        words: &["north-seek"],
+        base: &["--model", "@model.bin", "--starts", "1", "--seeks", "1"],
+    },
+    Sub {
+        words: &["reproduce"],
+        base: &["--runs", "1", "--duration-min", "1", "--starts", "1"],
+    },
+    Sub {
+        words: &["demo"],
+        base: &["--out", "!out/demo", "--starts", "1"],
+    },
+    Sub {
+        words: &["diagnose"],
+        base: &["@runs/run4.csv", "--json", "!out/d.json"],
+    },
+    Sub {
+        words: &["import"],
+        base: &[
+            "@logger.csv",
+            "--out",
+            "!out/imported",
+            "--time",
+            "t",
+            "--rate",
+            "r:dph",
+            "--temp",
+            "T:c",
+        ],
+    },
+    Sub {
+        words: &["upload"],
+        base: &[
+            "--port",
+            "tcp:127.0.0.1:9",
+            "--security-counter",
+            "1",
+            "--timeout-s",
+            "1",
+            "@model.bin",
+        ],
+    },
+    Sub {
+        words: &["heading-cal"],
+        base: &[
+            "--model",
+            "@model.bin",
+            "--out",
+            "!out/hc.bin",
+            "--a-dph",
+            "0.01",
+            "--b-dph",
+            "0",
+            "--sigma-dph",
+            "0.002",
+            "--n-headings",
+            "4",
+        ],
+    },
+    Sub {
+        words: &["monitor"],
+        base: &[
+            "--port",
+            "tcp:127.0.0.1:9",
+            "--duration-s",
+            "1",
+            "--registry",
+            "@reg.sqlite",
+            "--csv",
+            "!out/m.csv",
+        ],
+    },
+    Sub {
+        words: &["registry", "show"],
+        base: &["--registry", "@reg.sqlite", "FOG-A17"],
+    },
+    Sub {
+        words: &["registry", "export"],
+        base: &["--registry", "@reg.sqlite", "--csv", "!out/r.csv"],
+    },
+    Sub {
+        words: &["rig"],
+        base: &[
+            "--gyro-port",
+            "tcp:127.0.0.1:9",
+            "--table-port",
+            "tcp:127.0.0.1:9",
+            "--duration-s",
+            "1",
+            "--connect-timeout-s",
+            "1",
+        ],
+    },
+];
+
+/// The binary probed: this build's `fogsim`, or `FOG_PROBE_FOGSIM` (e.g. a release
+/// build, or main's binary to see what the probe finds there).
+fn fogsim_exe() -> PathBuf {
+    std::env::var_os("FOG_PROBE_FOGSIM")
+        .map_or_else(|| env!("CARGO_BIN_EXE_fogsim").into(), PathBuf::from)
+}
+
+/// What a flag of `--help` takes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum FlagKind {
+    Switch,
+    Number,
+    Name,
+    FreeText,
+    Input,
+    Output,
+    Store,
+}
+
+fn classify(flag: &str, takes_value: bool) -> FlagKind {
+    match () {
+        _ if !takes_value => FlagKind::Switch,
+        _ if INPUT_FLAGS.contains(&flag) => FlagKind::Input,
+        _ if OUTPUT_FLAGS.contains(&flag) => FlagKind::Output,
+        _ if FREE_TEXT_FLAGS.contains(&flag) => FlagKind::FreeText,
+        _ if STORE_FLAGS.contains(&flag) => FlagKind::Store,
+        _ if NAME_FLAGS.contains(&flag) => FlagKind::Name,
+        _ => FlagKind::Number,
+    }
+}
+
+/// The long flags of `fogsim <words> --help` and whether each takes a value.
+fn help_flags(words: &[&str]) -> Vec<(String, bool)> {
+    let out = Command::new(fogsim_exe())
+        .args(words)
+        .arg("--help")
+        .output()
+        .expect("fogsim --help runs");
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter_map(|l| {
+            let l = l.trim_start().trim_start_matches("-h, ");
+            let rest = l.strip_prefix("--")?;
+            let name: String = rest
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '-')
+                .collect();
+            let after = &rest[name.len()..];
+            (name != "help" && name != "version")
+                .then(|| (format!("--{name}"), after.starts_with(" <")))
+        })
+        .collect()
+}
+
+/// One bad invocation: its arguments and the words the error line must contain (any
+/// one of them).
+#[derive(Clone, Debug)]
+struct Case {
+    kind: &'static str,
+    args: Vec<OsString>,
+    names: Vec<String>,
+}
+
+/// The scratch directory with its good inputs and bad files.
+struct Fixtures {
+    dir: PathBuf,
+    /// Inputs that must never change: (path, bytes).
+    inputs: Vec<(PathBuf, Vec<u8>)>,
+    bad_files: Vec<(&'static str, PathBuf)>,
+}
+
+const LOGGER: &str = "t,r,T\n0,0.01,20.0\n0.1,0.02,20.0\n0.2,0.01,20.1\n0.3,0.03,20.1\n";
+
+fn fixtures() -> Fixtures {
+    let dir = scratch_dir("probe");
+    campaign_and_model(&dir, 6);
+    std::fs::write(dir.join("logger.csv"), LOGGER).unwrap();
+    // An empty calibration registry.
+    drop(fog_sim::registry::Registry::open(&dir.join("reg.sqlite")).unwrap());
+    let bad = dir.join("bad");
+    std::fs::create_dir_all(bad.join("a-directory")).unwrap();
+    let run = std::fs::read(dir.join("runs/run4.csv")).unwrap();
+    std::fs::write(bad.join("empty.csv"), b"").unwrap();
+    let mut binary = vec![0u8, 0xFF, 0x13, 0x37];
+    binary.extend((0..4000u32).map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8));
+    std::fs::write(bad.join("binary.bin"), &binary).unwrap();
+    std::fs::write(bad.join("truncated.csv"), cut_inside_last_row(&run)).unwrap();
+    let model = std::fs::read(dir.join("model.bin")).unwrap();
+    std::fs::write(bad.join("truncated-model.bin"), &model[..model.len() / 2]).unwrap();
+    let huge = std::fs::File::create(bad.join("huge-sparse.csv")).unwrap();
+    huge.set_len(HUGE_SPARSE_BYTES).unwrap();
+    let mut not_utf8 = run[..run.len() / 2].to_vec();
+    not_utf8.extend_from_slice(b"\n1\xFF\xFE,0.1,20\n");
+    std::fs::write(bad.join("not-utf8.csv"), not_utf8).unwrap();
+    let bad_files = vec![
+        ("missing file", bad.join("no-such-file.csv")),
+        ("empty file", bad.join("empty.csv")),
+        ("binary file", bad.join("binary.bin")),
+        ("truncated run", bad.join("truncated.csv")),
+        ("truncated model", bad.join("truncated-model.bin")),
+        ("huge sparse file", bad.join("huge-sparse.csv")),
+        ("directory", bad.join("a-directory")),
+        ("/dev/zero", PathBuf::from("/dev/zero")),
+        ("non-UTF-8 content", bad.join("not-utf8.csv")),
+        (
+            "non-UTF-8 name",
+            bad.join(OsStr::from_bytes(b"no-such-\xFF\xFE.csv")),
+        ),
+    ];
+    let mut inputs = Vec::new();
+    for p in walk(&dir) {
+        // The registry is a store the tools open read-write: not compared.
+        if !p.starts_with(&bad) && p.extension() != Some(OsStr::new("sqlite")) {
+            let bytes = std::fs::read(&p).unwrap();
+            inputs.push((p, bytes));
+        }
+    }
+    Fixtures {
+        dir,
+        inputs,
+        bad_files,
+    }
+}
+
+/// `run` cut inside its last row, before that row's last comma: one column short.
+fn cut_inside_last_row(run: &[u8]) -> Vec<u8> {
+    let body = run.strip_suffix(b"\n").unwrap_or(run);
+    let last_comma = body.iter().rposition(|&b| b == b',').unwrap();
+    run[..last_comma].to_vec()
+}
+
+fn walk(dir: &Path) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            files.extend(walk(&p));
+        } else {
+            files.push(p);
+        }
+    }
+    files
+}
+
+fn os(s: &str) -> OsString {
+    OsString::from(s)
+}
+
+/// The base command of `sub` as arguments (markers removed).
+fn base_args(sub: &Sub) -> Vec<OsString> {
+    sub.words
+        .iter()
+        .map(|w| os(w))
+        .chain(
+            sub.base
+                .iter()
+                .map(|a| os(a.trim_start_matches(['@', '!']))),
+        )
+        .collect()
+}
+
+/// `base` with `flag`'s value set to `value` (replaced if the base has it, else added),
+/// as `--flag=value` so that a value starting with `-` is a value.
+fn with_value(sub: &Sub, flag: &str, value: OsString) -> Vec<OsString> {
+    let mut args = base_args(sub);
+    if let Some(i) = args.iter().position(|a| a == flag) {
+        args.drain(i..i + 2);
+    }
+    let mut joined = OsString::from(format!("{flag}="));
+    joined.push(value);
+    args.push(joined);
+    args
+}
+
+/// `base` without `flag` (and its value), then `flag` last with no value.
+fn without_value(sub: &Sub, flag: &str) -> Vec<OsString> {
+    let mut args = base_args(sub);
+    if let Some(i) = args.iter().position(|a| a == flag) {
+        args.drain(i..i + 2);
+    }
+    args.push(os(flag));
+    args
+}
+
+fn lossy(s: &OsStr) -> String {
+    s.to_string_lossy().into_owned()
+}
+
+/// The flag in `args` just before position `i`, if `args[i]` is a flag's value.
+fn flag_before(sub: &Sub, i: usize) -> Option<String> {
+    let args = base_args(sub);
+    let prev = lossy(&args[i - 1]);
+    prev.starts_with("--").then_some(prev)
+}
+
+/// Every deterministic case of the catalogue.
+fn catalogue(fx: &Fixtures) -> Vec<Case> {
+    let mut cases = Vec::new();
+    for sub in SUBS {
+        let mut args = base_args(sub);
+        args.push(os("--no-such-flag"));
+        cases.push(Case {
+            kind: "unknown flag",
+            args,
+            names: vec!["--no-such-flag".into()],
+        });
+        for (flag, takes_value) in help_flags(sub.words) {
+            let kind = classify(&flag, takes_value);
+            if kind == FlagKind::Switch {
+                continue;
+            }
+            cases.push(Case {
+                kind: "missing value",
+                args: without_value(sub, &flag),
+                names: vec![flag.clone()],
+            });
+            if kind != FlagKind::Output && kind != FlagKind::Store {
+                cases.push(Case {
+                    kind: "non-UTF-8 value",
+                    args: with_value(sub, &flag, OsString::from_vec(b"v\xFF\xFE".to_vec())),
+                    names: vec![flag.clone(), "v\u{FFFD}\u{FFFD}".into()],
+                });
+            }
+            let bad_values: &[&str] = match kind {
+                FlagKind::Number => BAD_NUMBERS,
+                FlagKind::Name => &["no-such-name", ""],
+                _ => &[],
+            };
+            for v in bad_values {
+                cases.push(Case {
+                    kind: if kind == FlagKind::Number {
+                        "malformed number"
+                    } else {
+                        "unknown name"
+                    },
+                    args: with_value(sub, &flag, os(v)),
+                    names: vec![
+                        flag.clone(),
+                        (*v).to_string(),
+                        format!("'{v}'"),
+                        format!("`{v}`"),
+                    ],
+                });
+            }
+            if kind == FlagKind::Input && !sub.base.contains(&flag.as_str()) {
+                for (what, file) in &fx.bad_files {
+                    cases.push(Case {
+                        kind: what,
+                        args: with_value(sub, &flag, file.clone().into_os_string()),
+                        names: vec![flag.clone(), file_name(file)],
+                    });
+                }
+            }
+        }
+        let offset = sub.words.len();
+        for (i, a) in sub.base.iter().enumerate() {
+            let at = offset + i;
+            let mut names: Vec<String> = flag_before(sub, at).into_iter().collect();
+            if a.starts_with('@') {
+                // A registry that is absent is created, and SQLite takes an empty file
+                // for an empty database: neither is a bad file there.
+                let registry = a.ends_with(".sqlite");
+                for (what, file) in &fx.bad_files {
+                    let creates = ["empty file", "missing file", "non-UTF-8 name"];
+                    if registry && creates.contains(what) {
+                        continue;
+                    }
+                    let mut args = base_args(sub);
+                    args[at] = file.clone().into_os_string();
+                    let mut names = names.clone();
+                    names.push(file_name(file));
+                    cases.push(Case {
+                        kind: what,
+                        args,
+                        names,
+                    });
+                }
+            } else if a.starts_with('!') {
+                // The output pointed at each input of the base, then at the model.
+                let targets = sub.base.iter().filter_map(|b| b.strip_prefix('@'));
+                for target in targets {
+                    let mut args = base_args(sub);
+                    args[at] = os(target);
+                    names.push(file_name(Path::new(target)));
+                    cases.push(Case {
+                        kind: "output onto an input",
+                        args,
+                        names: names.clone(),
+                    });
+                }
+            }
+        }
+    }
+    cases
+}
+
+fn file_name(p: &Path) -> String {
+    p.file_name().map_or_else(|| lossy(p.as_os_str()), lossy)
+}
+
+/// A seeded random fault of the catalogue's kinds, on a random subcommand.
+fn random_case(fx: &Fixtures, rng: &mut ChaCha8Rng, n: usize) -> Case {
+    let sub = &SUBS[rng.random_range(0..SUBS.len())];
+    let flags: Vec<_> = help_flags(sub.words)
+        .into_iter()
+        .filter(|(f, v)| classify(f, *v) == FlagKind::Number)
+        .collect();
+    let file_slots: Vec<usize> = sub
+        .base
+        .iter()
+        .enumerate()
+        .filter(|(_, a)| a.starts_with('@'))
+        .map(|(i, _)| i + sub.words.len())
+        .collect();
+    if file_slots.is_empty() || rng.random_bool(0.5) && !flags.is_empty() {
+        let (flag, _) = &flags[rng.random_range(0..flags.len())];
+        let value = match rng.random_range(0..3) {
+            0 => {
+                let len = rng.random_range(1..12);
+                (0..len)
+                    .map(|_| rng.random_range(b'a'..=b'z') as char)
+                    .collect::<String>()
+            }
+            1 => format!(
+                "{}{}e{}",
+                if rng.random_bool(0.5) { "-" } else { "" },
+                rng.random_range(1..10),
+                rng.random_range(309..100_000)
+            ),
+            _ => [
+                "NaN",
+                "nan",
+                "+nan",
+                "-NaN",
+                "inf",
+                "+infinity",
+                "-Infinity",
+            ][rng.random_range(0..7)]
+            .to_string(),
+        };
+        return Case {
+            kind: "random malformed number",
+            args: with_value(sub, flag, os(&value)),
+            names: vec![flag.clone(), value],
+        };
+    }
+    let at = file_slots[rng.random_range(0..file_slots.len())];
+    let mut args = base_args(sub);
+    let good = fx.dir.join(lossy(&args[at]));
+    let path = fx.dir.join("bad").join(format!("random-{n}"));
+    let bytes = if good.is_dir() {
+        std::fs::read(good.join("run4.csv")).unwrap()
+    } else {
+        std::fs::read(&good).unwrap()
+    };
+    let is_model = good.extension() == Some(OsStr::new("bin"));
+    // A cut or a NUL inside a SQLite file may still be a database: random bytes only.
+    let is_registry = good.extension() == Some(OsStr::new("sqlite"));
+    let kind = if is_registry {
+        0
+    } else {
+        rng.random_range(0..3)
+    };
+    let bad: Vec<u8> = match kind {
+        // Random bytes, a NUL first (never text).
+        0 => std::iter::once(0)
+            .chain((0..rng.random_range(0..5000)).map(|_| rng.random()))
+            .collect(),
+        // A model cut anywhere / a run cut inside its last row.
+        1 if is_model => bytes[..rng.random_range(0..bytes.len())].to_vec(),
+        1 => cut_inside_last_row(&bytes[..rng.random_range(bytes.len() / 2..bytes.len())]),
+        // A model with a bit flipped (its CRC breaks) / a run with a NUL in a row.
+        _ if is_model => {
+            let mut b = bytes.clone();
+            let i = rng.random_range(0..b.len());
+            b[i] ^= 1 << rng.random_range(0..8);
+            b
+        }
+        _ => {
+            let mut b = bytes.clone();
+            let from = b.len() / 2;
+            let i = rng.random_range(from..b.len() - 1);
+            b[i] = 0;
+            b
+        }
+    };
+    std::fs::write(&path, bad).unwrap();
+    let mut names: Vec<String> = flag_before(sub, at).into_iter().collect();
+    names.push(file_name(&path));
+    args[at] = path.into_os_string();
+    Case {
+        kind: "random bad file",
+        args,
+        names,
+    }
+}
+
+/// What one invocation did.
+struct Outcome {
+    code: Option<i32>,
+    stderr: String,
+    elapsed: Duration,
+    peak_rss_kib: u64,
+    timed_out: bool,
+}
+
+fn run(dir: &Path, args: &[OsString]) -> Outcome {
+    let t0 = Instant::now();
+    let mut child = Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v {ADDRESS_SPACE_KIB} && exec \"$0\" \"$@\""
+        ))
+        .arg(fogsim_exe())
+        .args(args)
+        .current_dir(dir)
+        .env("XDG_DATA_HOME", dir.join("xdg"))
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("sh runs");
+    let mut stderr_pipe = child.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut buf = Vec::new();
+        let _ = std::io::Read::read_to_end(
+            &mut std::io::Read::take(&mut stderr_pipe, 1 << 20),
+            &mut buf,
+        );
+        buf
+    });
+    let status_path = format!("/proc/{}/status", child.id());
+    let mut peak_rss_kib = 0;
+    let mut timed_out = false;
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if let Some(kib) = std::fs::read_to_string(&status_path)
+            .ok()
+            .and_then(|s| vm_hwm_kib(&s))
+        {
+            peak_rss_kib = peak_rss_kib.max(kib);
+        }
+        if t0.elapsed() > TIME_LIMIT {
+            timed_out = true;
+            let _ = child.kill();
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    };
+    let stderr = String::from_utf8_lossy(&reader.join().unwrap()).into_owned();
+    Outcome {
+        code: status.code(),
+        stderr,
+        elapsed: t0.elapsed(),
+        peak_rss_kib,
+        timed_out,
+    }
+}
+
+fn vm_hwm_kib(status: &str) -> Option<u64> {
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    line.split_whitespace().nth(1)?.parse().ok()
+}
+
+/// The rules a bad invocation breaks, if any.
+fn violations(case: &Case, o: &Outcome) -> Vec<String> {
+    let mut v = Vec::new();
+    if o.timed_out {
+        v.push(format!("ran over {TIME_LIMIT:?}"));
+    }
+    match o.code {
+        None => v.push("killed by a signal (crash or out of memory)".into()),
+        Some(0) => v.push("exit status 0".into()),
+        Some(_) => {}
+    }
+    if o.stderr.contains("panicked") {
+        v.push("panicked".into());
+    }
+    // One error line; a warning printed before it (e.g. signing with the TEST key) is
+    // not part of the error.
+    let lines: Vec<&str> = o
+        .stderr
+        .lines()
+        .filter(|l| !l.trim().is_empty() && !l.contains("WARNING"))
+        .collect();
+    if lines.len() != 1 {
+        v.push(format!("{} lines on stderr", lines.len()));
+    }
+    if let Some(line) = lines.first() {
+        if !case.names.iter().any(|n| !n.is_empty() && line.contains(n)) {
+            v.push(format!("the error names none of {:?}", case.names));
+        }
+        if line.len() > 400 {
+            v.push(format!("error line of {} bytes", line.len()));
+        }
+    }
+    v
+}
+
+/// `FOG_PROBE_*` from the environment, else `default`.
+fn count_from_env(var: &str, default: u64) -> u64 {
+    match std::env::var(var) {
+        Ok(text) => text.parse().expect("FOG_PROBE_* must be a count"),
+        Err(_) => default,
+    }
+}
+
+#[test]
+fn bad_invocations_fail_with_one_line_naming_the_fault_and_change_no_input() {
+    let n = count_from_env("FOG_PROBE_INVOCATIONS", 60) as usize;
+    let seed = count_from_env("FOG_PROBE_SEED", 17);
+    let fx = fixtures();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut cases = catalogue(&fx);
+    let catalogue_len = cases.len();
+    cases.shuffle(&mut rng);
+    cases.truncate(n);
+    let mut failures = Vec::new();
+    let (mut slowest, mut peak_kib) = (Duration::ZERO, 0);
+    let mut slowest_case = String::new();
+    let t0 = Instant::now();
+    for i in 0..n {
+        let case = if i < cases.len() {
+            cases[i].clone()
+        } else {
+            random_case(&fx, &mut rng, i)
+        };
+        let before: std::collections::HashSet<PathBuf> = walk(&fx.dir).into_iter().collect();
+        std::fs::create_dir_all(fx.dir.join("out")).unwrap();
+        let o = run(&fx.dir, &case.args);
+        if o.elapsed > slowest {
+            slowest_case = format!("{} {:?}", case.kind, case.args);
+        }
+        slowest = slowest.max(o.elapsed);
+        peak_kib = peak_kib.max(o.peak_rss_kib);
+        let mut v = violations(&case, &o);
+        for (path, bytes) in &fx.inputs {
+            if std::fs::read(path).ok().as_deref() != Some(bytes.as_slice()) {
+                v.push(format!("input {} changed", path.display()));
+                std::fs::write(path, bytes).unwrap();
+            }
+        }
+        let _ = std::fs::remove_dir_all(fx.dir.join("out"));
+        // What a failed run left (e.g. a registry created before the link failed), and
+        // this case's random file.
+        for p in walk(&fx.dir) {
+            if !before.contains(&p)
+                || p.file_name()
+                    .is_some_and(|n| n.to_string_lossy().starts_with("random-"))
+            {
+                let _ = std::fs::remove_file(&p);
+            }
+        }
+        if !v.is_empty() {
+            let args: Vec<String> = case.args.iter().map(|a| lossy(a)).collect();
+            failures.push(format!(
+                "[{}] fogsim {}: {} | stderr: {}",
+                case.kind,
+                args.join(" "),
+                v.join("; "),
+                o.stderr.trim().chars().take(300).collect::<String>()
+            ));
+        }
+    }
+    println!(
+        "probe_invocations: seed {seed}: {n} invocations ({} of a catalogue of {catalogue_len}, \
+         {} random) in {:.1} s: {} broke a rule; slowest {:.2} s ({slowest_case}), peak RSS {:.1} MB",
+        cases.len().min(n),
+        n.saturating_sub(cases.len()),
+        t0.elapsed().as_secs_f64(),
+        failures.len(),
+        slowest.as_secs_f64(),
+        peak_kib as f64 / 1024.0
+    );
+    for f in failures.iter().take(300) {
+        println!("  {f}");
+    }
+    assert!(
+        failures.is_empty(),
+        "{} bad invocations broke a rule",
+        failures.len()
+    );
+}
