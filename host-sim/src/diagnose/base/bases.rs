@@ -5,10 +5,10 @@
 //! (T, dT/dt). Each is validated on held-out data the same way (same folds, ridge chosen
 //! from the same grid); the lowest held-out rms wins. Every score is reported.
 
-use super::cv::{CvResult, Folds, Prepared};
-use super::error::DiagnoseError;
-use super::levels::{score, Law, LevelSystems, Score};
-use super::models::{fit_rbf, Stacked, RIDGES};
+use crate::diagnose::base::levels::{score, Law, LevelSystems, Score};
+use crate::diagnose::base::models::{fit_rbf, Stacked, RIDGES};
+use crate::diagnose::error::DiagnoseError;
+use crate::diagnose::validation::cv::{CvResult, Folds, Prepared};
 use serde::Serialize;
 
 /// Highest polynomial degree in T tried.
@@ -55,7 +55,7 @@ pub struct BaseFit {
     pub width_factor: f64,
     pub ridge: f64,
     /// The RBF basis (None for polynomial and constant bases).
-    pub basis: Option<super::basis::RbfBasis>,
+    pub basis: Option<crate::diagnose::base::basis::RbfBasis>,
 }
 
 impl BaseFit {
@@ -160,7 +160,7 @@ pub fn device_rate_half_s() -> f64 {
 /// `device` is the campaign stacked with the device's span (`device_rate_half_s`) and the
 /// base chosen on it with `folds` (already computed when the folds were laid out).
 pub fn choose_with_rate_window(
-    campaign: &super::input::Campaign,
+    campaign: &crate::diagnose::input::Campaign,
     folds: &Folds,
     (st, device): (Stacked, BaseChoice),
 ) -> Result<(Stacked, BaseChoice), DiagnoseError> {
@@ -173,8 +173,11 @@ pub fn choose_with_rate_window(
     let Ok(loo) = choose(folds, &st_loo) else {
         return Ok((st, device));
     };
-    let gains = super::screen::unit_gains(&device.chosen.cv, &loo.chosen.cv);
-    let p = super::signflip::paired_pvalue(&gains, super::screen::FLIP_SEED);
+    let gains = crate::diagnose::selection::screen::unit_gains(&device.chosen.cv, &loo.chosen.cv);
+    let p = crate::diagnose::validation::signflip::paired_pvalue(
+        &gains,
+        crate::diagnose::selection::screen::FLIP_SEED,
+    );
     if loo.chosen.cv.rms() < device.chosen.cv.rms() && p < RATE_WINDOW_ALPHA {
         Ok((st_loo, loo))
     } else {
@@ -328,7 +331,7 @@ fn unit_score(folds: &Folds, cv: &CvResult) -> Score {
 
 /// Both level treatments of one base, scored leaving one run out (run-grouped layouts).
 fn level_scores(folds: &Folds, st: &Stacked, f: &BaseFit) -> Vec<LevelScore> {
-    if folds.offsets != super::cv::Offsets::PerUnit {
+    if folds.offsets != crate::diagnose::validation::cv::Offsets::PerUnit {
         return vec![];
     }
     let cols = f.raw_columns(st);

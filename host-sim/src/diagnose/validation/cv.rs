@@ -12,8 +12,8 @@
 //! autocorrelated noise in the neighbours cannot leak into the held-out score. The
 //! buffer is chosen from the data (`buffer.rs`); a run-grouped layout needs none.
 
-use super::error::DiagnoseError;
-use super::linalg::solve_spd;
+use crate::diagnose::error::DiagnoseError;
+use crate::diagnose::linalg::solve_spd;
 
 /// Fewest runs for validation grouped by run.
 pub const MIN_RUNS_GROUPED: usize = 4;
@@ -466,7 +466,10 @@ pub struct UnitSystems<'a> {
 
 impl UnitSystems<'_> {
     /// Weights of the ridge fit with unit u's data counted `counts[u]` times.
-    pub fn solve(&self, counts: &[f64]) -> Result<Vec<f64>, super::linalg::NotPositiveDefinite> {
+    pub fn solve(
+        &self,
+        counts: &[f64],
+    ) -> Result<Vec<f64>, crate::diagnose::linalg::NotPositiveDefinite> {
         let q = self.cols.len();
         let mut a = counted_sum(&self.grams, counts);
         let mut b = counted_sum(&self.xty, counts);

@@ -7,11 +7,13 @@
 //! bootstrap of `bootstrap` (whole runs or time blocks resampled). The simulator stage is
 //! conditional on its fitted thermal response (the thermal time constants are not redrawn).
 
-use super::bases::{zscore_params, BaseFit};
-use super::bootstrap::{draws, Estimate, REPLICATES};
-use super::cv::{Folds, Offsets, Prepared, UnitSystems};
-use super::input::Campaign;
-use super::models::Stacked;
+pub mod bootstrap;
+
+use crate::diagnose::base::bases::{zscore_params, BaseFit};
+use crate::diagnose::base::models::Stacked;
+use crate::diagnose::input::Campaign;
+use crate::diagnose::uncertainty::bootstrap::{draws, Estimate, REPLICATES};
+use crate::diagnose::validation::cv::{Folds, Offsets, Prepared, UnitSystems};
 use serde::Serialize;
 
 /// A measured coefficient against the simulator's value.
@@ -236,7 +238,7 @@ fn extension_estimates(
 
 /// Median row spacing within runs, s.
 fn row_spacing_s(folds: &Folds, t_s: &[f64]) -> f64 {
-    let mut d = super::simfit::within_run_differences(&folds.run_rows, t_s);
+    let mut d = crate::diagnose::simulator::simfit::within_run_differences(&folds.run_rows, t_s);
     d.sort_by(f64::total_cmp);
     d.get(d.len() / 2).copied().unwrap_or(f64::NAN)
 }
@@ -251,11 +253,11 @@ fn simulator_estimates(
     named: Option<&NamedFeature<'_>>,
     counts: &[Vec<f64>],
 ) -> (Vec<Estimate>, Vec<Ratio>) {
-    let (mut cols, t_mean) = super::simfit::design_columns(campaign);
-    let n_law = super::simfit::LAW_TERMS.len();
+    let (mut cols, t_mean) = crate::diagnose::simulator::simfit::design_columns(campaign);
+    let n_law = crate::diagnose::simulator::simfit::LAW_TERMS.len();
     let prepared = Prepared::new(folds, &cols, &st.y, 0.0);
     let extra: &[Vec<f64>] = named.map_or(&[], |n| n.cols);
-    let mut names: Vec<(String, &str)> = super::simfit::LAW_TERMS
+    let mut names: Vec<(String, &str)> = crate::diagnose::simulator::simfit::LAW_TERMS
         .iter()
         .map(|(n, u)| ((*n).to_owned(), *u))
         .collect();
@@ -266,10 +268,10 @@ fn simulator_estimates(
     }
     let sys = prepared.unit_systems(folds, extra);
     let shared = (folds.offsets == Offsets::PerUnit
-        && folds.run_rows.len() >= super::simfit::MIN_RUNS_SHARED)
+        && folds.run_rows.len() >= crate::diagnose::simulator::simfit::MIN_RUNS_SHARED)
         .then(|| {
             cols.extend(extra.iter().cloned());
-            super::simfit::fit_shared(&folds.run_rows, &cols, &st.y)
+            crate::diagnose::simulator::simfit::fit_shared(&folds.run_rows, &cols, &st.y)
         })
         .flatten();
     let mut out = match shared {

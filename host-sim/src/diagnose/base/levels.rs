@@ -19,7 +19,7 @@
 //! Everything is computed from per-run sums (Gram, X'y, means), so a leave-one-run-out fit
 //! or a bootstrap replicate is one small solve.
 
-use super::linalg::solve_spd;
+use crate::diagnose::linalg::solve_spd;
 use serde::Serialize;
 
 /// How a law treats the runs' levels.

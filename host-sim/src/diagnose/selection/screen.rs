@@ -13,13 +13,13 @@
 //!    imitate its column's value or derivatives). Significant candidates that lose their
 //!    gain once the named one is in the model are reported as competing with it.
 
-use super::bases::BaseFit;
-use super::cv::{CvResult, Folds};
-use super::error::DiagnoseError;
-use super::input::Campaign;
-use super::models::{fit_rbf_input, Stacked};
-use super::signflip::{max_t_pvalues, paired_pvalue};
-use super::transforms::Candidate;
+use crate::diagnose::base::bases::BaseFit;
+use crate::diagnose::base::models::{fit_rbf_input, Stacked};
+use crate::diagnose::error::DiagnoseError;
+use crate::diagnose::input::Campaign;
+use crate::diagnose::library::transforms::Candidate;
+use crate::diagnose::validation::cv::{CvResult, Folds};
+use crate::diagnose::validation::signflip::{max_t_pvalues, paired_pvalue};
 
 /// Family-wise significance level.
 pub const ALPHA: f64 = 0.01;
@@ -140,7 +140,7 @@ fn score_linear(
             skipped.push((cand.label(), "not finite".to_owned()));
             continue;
         }
-        if folds.offsets == super::cv::Offsets::PerUnit
+        if folds.offsets == crate::diagnose::validation::cv::Offsets::PerUnit
             && !cols.iter().any(|c| has_within_unit_variation(folds, c))
         {
             skipped.push((
