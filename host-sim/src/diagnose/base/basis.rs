@@ -50,7 +50,11 @@ impl RbfBasis {
         let d = inputs.len();
         let n = inputs.first().map_or(0, Vec::len);
         let inv = 1.0 / (2.0 * self.width * self.width);
-        let mut cols: Vec<Vec<f64>> = vec![Vec::with_capacity(n); self.centres.len() + d];
+        // One allocation of exactly n per column (`vec![Vec::with_capacity(n); k]` clones
+        // an empty Vec, so all but one column grew by doubling: up to 2x the design).
+        let mut cols: Vec<Vec<f64>> = (0..self.centres.len() + d)
+            .map(|_| Vec::with_capacity(n))
+            .collect();
         let mut x = vec![0.0; d];
         for i in 0..n {
             for (j, xj) in x.iter_mut().enumerate() {

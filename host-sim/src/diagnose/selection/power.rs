@@ -61,7 +61,7 @@ pub fn check(
     if !silent || !reachable || screening.scored.is_empty() {
         return Ok(None);
     }
-    let Some((label, planted)) = plantable(folds, st, base, screening)? else {
+    let Some((label, planted)) = plantable(campaign, folds, st, base, screening)? else {
         return Ok(Some(PowerCheck {
             planted: None,
             planted_rms_dph: 0.0,
@@ -109,6 +109,7 @@ const MIN_UNEXPLAINED: f64 = 0.5;
 /// The first of the `TRIED` best-ranked candidates whose feature the base leaves at
 /// least `MIN_UNEXPLAINED` unexplained, with the effect to plant.
 fn plantable(
+    campaign: &Campaign,
     folds: &Folds,
     st: &Stacked,
     base: &BaseFit,
@@ -116,7 +117,8 @@ fn plantable(
 ) -> Result<Option<(String, Vec<f64>)>, DiagnoseError> {
     let runs = &folds.run_rows;
     for scored in screening.scored.iter().take(TRIED) {
-        let Some(feature) = scored.cols.first() else {
+        let cols = scored.columns(campaign);
+        let Some(feature) = cols.first() else {
             continue;
         };
         let mut feature_as_target = st.clone();

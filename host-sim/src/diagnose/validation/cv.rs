@@ -218,14 +218,22 @@ fn range_system(
 pub struct CvResult {
     /// Held-out sum of squared residuals per unit.
     pub unit_sse: Vec<f64>,
-    /// Held-out residual per row (deg/h).
+    /// Held-out residual per row (deg/h); empty once [`CvResult::drop_residual`] freed it.
     pub residual: Vec<f64>,
+    /// Rows scored.
+    pub points: usize,
 }
 
 impl CvResult {
     /// Pooled held-out rms, deg/h.
     pub fn rms(&self) -> f64 {
-        (self.unit_sse.iter().sum::<f64>() / self.residual.len().max(1) as f64).sqrt()
+        (self.unit_sse.iter().sum::<f64>() / self.points.max(1) as f64).sqrt()
+    }
+
+    /// Frees the per-row residual (8 B a row), keeping the per-unit scores: a screened
+    /// candidate needs only those until it is named (memory).
+    pub fn drop_residual(&mut self) {
+        self.residual = Vec::new();
     }
 }
 
@@ -338,7 +346,11 @@ impl Prepared {
             }
             unit_sse.push(sse);
         }
-        Ok(CvResult { unit_sse, residual })
+        Ok(CvResult {
+            unit_sse,
+            points: residual.len(),
+            residual,
+        })
     }
 
     /// Fit on every unit: (weights, fitted values) for this design plus `extra`.
