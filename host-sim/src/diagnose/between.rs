@@ -93,19 +93,23 @@ fn mean(v: &[f64]) -> f64 {
 /// Run offsets left by the base fitted on every run: mean over the run of drift minus
 /// the base's prediction (the base itself carries no offset).
 pub fn run_offsets(folds: &Folds, st: &Stacked, base: &BaseFit) -> Vec<f64> {
-    let cols = base.raw_columns(st);
+    let design = base.raw_design();
     let w = base
         .prepared
         .fit_all(folds, &[])
         .map(|(w, _)| w)
         .unwrap_or_default();
+    let mut row = vec![0.0; design.width()];
     folds
         .run_rows
         .iter()
         .map(|r| {
             let resid: Vec<f64> = r
                 .clone()
-                .map(|i| st.y[i] - cols.iter().zip(&w).map(|(c, wj)| c[i] * wj).sum::<f64>())
+                .map(|i| {
+                    design.row(i, &mut row);
+                    st.y[i] - row.iter().zip(&w).map(|(c, wj)| c * wj).sum::<f64>()
+                })
                 .collect();
             mean(&resid)
         })

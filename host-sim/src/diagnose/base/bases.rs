@@ -9,6 +9,7 @@ use crate::diagnose::base::levels::{score, Law, LevelSystems, Score};
 use crate::diagnose::base::models::{fit_rbf, Stacked, RIDGES};
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::validation::cv::{CvResult, Folds, Prepared};
+use crate::diagnose::validation::design::Design;
 use serde::Serialize;
 
 /// Highest polynomial degree in T tried.
@@ -59,16 +60,9 @@ pub struct BaseFit {
 }
 
 impl BaseFit {
-    /// The base's design columns before run offsets are removed.
-    pub fn raw_columns(&self, st: &Stacked) -> Vec<Vec<f64>> {
-        match &self.basis {
-            Some(b) => b.columns(&[st.temp_c.clone(), st.temp_rate_cps.clone()]),
-            None => poly_columns(
-                st,
-                self.spec.poly_degree_t.unwrap_or(0),
-                self.spec.uses_rate,
-            ),
-        }
+    /// The base's design (rows computed on demand) before run offsets are removed.
+    pub fn raw_design(&self) -> std::sync::Arc<dyn Design> {
+        self.prepared.design()
     }
 }
 
@@ -334,8 +328,13 @@ fn level_scores(folds: &Folds, st: &Stacked, f: &BaseFit) -> Vec<LevelScore> {
     if folds.offsets != crate::diagnose::validation::cv::Offsets::PerUnit {
         return vec![];
     }
-    let cols = f.raw_columns(st);
-    let lv = std::sync::Arc::new(LevelSystems::new(&folds.run_rows, &cols, &st.y, f.ridge));
+    let design = f.raw_design();
+    let lv = std::sync::Arc::new(LevelSystems::new(
+        &folds.run_rows,
+        design.as_ref(),
+        &st.y,
+        f.ridge,
+    ));
     let pts = lv.run_points();
     let all = vec![1.0; lv.runs()];
     let mut out = Vec::new();
@@ -346,7 +345,7 @@ fn level_scores(folds: &Folds, st: &Stacked, f: &BaseFit) -> Vec<LevelScore> {
         out.push(LevelScore {
             law: Law::Shared,
             score: score(&sse, &pts),
-            parameters: cols.len() + 1,
+            parameters: design.width() + 1,
             offsets_left: lv.offsets_left(&fit.w),
             sigma_u_dph: fit.sigma_u_dph,
             theta: fit.theta,
@@ -357,7 +356,7 @@ fn level_scores(folds: &Folds, st: &Stacked, f: &BaseFit) -> Vec<LevelScore> {
         out.push(LevelScore {
             law: Law::Free,
             score: score(&sse, &pts),
-            parameters: cols.len() + lv.runs(),
+            parameters: design.width() + lv.runs(),
             offsets_left: lv.offsets_left(&w),
             sigma_u_dph: f64::NAN,
             theta: 1.0,

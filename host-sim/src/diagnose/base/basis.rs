@@ -43,32 +43,67 @@ impl RbfBasis {
         }
     }
 
-    /// The design columns: one Gaussian per centre, then the normalised inputs.
-    // Row-wise walk over column-major inputs: the row index is the natural loop variable.
-    #[allow(clippy::needless_range_loop)]
-    pub fn columns(&self, inputs: &[Vec<f64>]) -> Vec<Vec<f64>> {
-        let d = inputs.len();
-        let n = inputs.first().map_or(0, Vec::len);
+    /// Number of design columns: one per centre, then the inputs.
+    pub fn width(&self) -> usize {
+        self.centres.len() + self.mean.len()
+    }
+
+    /// Row `i` of the design into `out` (`width()` long): one Gaussian per centre, then
+    /// the normalised inputs.
+    pub fn row_into(&self, inputs: &[Vec<f64>], i: usize, out: &mut [f64]) {
+        self.row_with(|j| inputs[j][i], out);
+    }
+
+    /// The design's row at the raw input values `raw(j)` (j over the inputs) into `out`.
+    pub fn row_with(&self, raw: impl Fn(usize) -> f64, out: &mut [f64]) {
+        let k = self.centres.len();
+        let d = self.mean.len();
         let inv = 1.0 / (2.0 * self.width * self.width);
-        // One allocation of exactly n per column (`vec![Vec::with_capacity(n); k]` clones
-        // an empty Vec, so all but one column grew by doubling: up to 2x the design).
-        let mut cols: Vec<Vec<f64>> = (0..self.centres.len() + d)
-            .map(|_| Vec::with_capacity(n))
-            .collect();
-        let mut x = vec![0.0; d];
+        for (j, xj) in out[k..k + d].iter_mut().enumerate() {
+            *xj = (raw(j) - self.mean[j]) / self.scale[j];
+        }
+        let (gauss, x) = out.split_at_mut(k);
+        let x = &x[..d];
+        for (c, g) in self.centres.iter().zip(gauss) {
+            let r2: f64 = c.iter().zip(x).map(|(a, b)| (a - b) * (a - b)).sum();
+            *g = (-r2 * inv).exp();
+        }
+    }
+
+    /// The design columns: one Gaussian per centre, then the normalised inputs (use
+    /// [`RbfDesign`] where the rows can be streamed: n x columns is the memory's largest
+    /// item).
+    pub fn columns(&self, inputs: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        let n = inputs.first().map_or(0, Vec::len);
+        let mut cols: Vec<Vec<f64>> = (0..self.width()).map(|_| Vec::with_capacity(n)).collect();
+        let mut row = vec![0.0; self.width()];
         for i in 0..n {
-            for (j, xj) in x.iter_mut().enumerate() {
-                *xj = (inputs[j][i] - self.mean[j]) / self.scale[j];
-            }
-            for (c, col) in self.centres.iter().zip(cols.iter_mut()) {
-                let r2: f64 = c.iter().zip(&x).map(|(a, b)| (a - b) * (a - b)).sum();
-                col.push((-r2 * inv).exp());
-            }
-            for (col, xj) in cols[self.centres.len()..].iter_mut().zip(&x) {
-                col.push(*xj);
-            }
+            self.row_into(inputs, i, &mut row);
+            cols.iter_mut().zip(&row).for_each(|(c, v)| c.push(*v));
         }
         cols
+    }
+}
+
+/// An RBF design given by its rows: the basis on `inputs`, then `linear` columns.
+#[derive(Clone, Debug)]
+pub struct RbfDesign {
+    pub basis: RbfBasis,
+    pub inputs: std::sync::Arc<Vec<Vec<f64>>>,
+    pub linear: std::sync::Arc<Vec<Vec<f64>>>,
+}
+
+impl crate::diagnose::validation::design::Design for RbfDesign {
+    fn width(&self) -> usize {
+        self.basis.width() + self.linear.len()
+    }
+
+    fn row(&self, i: usize, out: &mut [f64]) {
+        let b = self.basis.width();
+        self.basis.row_into(&self.inputs, i, &mut out[..b]);
+        for (o, c) in out[b..].iter_mut().zip(self.linear.iter()) {
+            *o = c[i];
+        }
     }
 }
 

@@ -3,7 +3,7 @@
 //! as a linear term or as a further RBF input. Width and ridge are chosen on held-out
 //! data from a small grid, the same way for every model, so comparisons are fair.
 
-use crate::diagnose::base::basis::RbfBasis;
+use crate::diagnose::base::basis::{RbfBasis, RbfDesign};
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
 use crate::diagnose::library::derivatives;
@@ -70,14 +70,19 @@ pub fn fit_rbf(
     y: &[f64],
 ) -> Result<RbfFit, DiagnoseError> {
     let k_max = centre_count(y.len(), inputs.len());
-    // Only the best setting is remembered; its design is rebuilt once at the end, so at
-    // most one design (n x centres) is alive besides the one being scored (memory).
+    // Only the best setting is remembered and rebuilt at the end. Designs are rows
+    // computed on demand (`RbfDesign`): only the inputs are held, never n x centres.
     let mut best: Option<(usize, f64, f64, f64)> = None;
+    let shared_inputs = std::sync::Arc::new(inputs.to_vec());
+    let shared_linear = std::sync::Arc::new(linear.to_vec());
     let design = |k: usize, wf: f64| {
         let basis = RbfBasis::fit(inputs, k, wf);
-        let mut cols = basis.columns(inputs);
-        cols.extend(linear.iter().cloned());
-        let prepared = Prepared::from_owned(folds, cols, y, RIDGES[0]);
+        let rows = RbfDesign {
+            basis: basis.clone(),
+            inputs: shared_inputs.clone(),
+            linear: shared_linear.clone(),
+        };
+        let prepared = Prepared::from_design(folds, std::sync::Arc::new(rows), y, RIDGES[0]);
         (basis, prepared)
     };
     for frac in CENTRE_FRACTIONS {

@@ -123,22 +123,21 @@ fn mean_partials(base: &BaseFit, st: &Stacked) -> (Vec<f64>, Vec<f64>) {
                 &st.temp_rate_cps
             });
             let h = 1e-3 * sd;
-            let shifted = |d: f64| {
-                let mut inputs = [st.temp_c.clone(), st.temp_rate_cps.clone()];
-                inputs[which].iter_mut().for_each(|v| *v += d);
-                b.columns(&inputs)
-            };
-            let (p, m) = (shifted(h), shifted(-h));
-            p.iter()
-                .zip(&m)
-                .map(|(p, m)| {
-                    mean(
-                        &p.iter()
-                            .zip(m)
-                            .map(|(a, b)| (a - b) / (2.0 * h))
-                            .collect::<Vec<_>>(),
-                    )
-                })
+            // Row by row (the design is never held n x columns): central differences
+            // summed in row order, then averaged.
+            let inputs = [&st.temp_c, &st.temp_rate_cps];
+            let (mut p, mut m) = (vec![0.0; b.width()], vec![0.0; b.width()]);
+            let mut sums = vec![0.0; b.width()];
+            for i in 0..st.temp_c.len() {
+                let at = |d: f64| move |j: usize| inputs[j][i] + if j == which { d } else { 0.0 };
+                b.row_with(at(h), &mut p);
+                b.row_with(at(-h), &mut m);
+                sums.iter_mut()
+                    .zip(p.iter().zip(&m))
+                    .for_each(|(s, (a, b))| *s += (a - b) / (2.0 * h));
+            }
+            sums.iter()
+                .map(|s| s / st.temp_c.len().max(1) as f64)
                 .collect()
         };
         return (diff(0), diff(1));
@@ -311,16 +310,10 @@ fn arw_estimate(
     let ones = vec![1.0; folds.unit_rows.len()];
     let w = sys.solve(&ones).ok()?;
     let target = prepared.target();
-    let resid: Vec<f64> = (0..folds.rows())
-        .map(|row| {
-            target[row]
-                - sys
-                    .cols
-                    .iter()
-                    .zip(&w)
-                    .map(|(c, w)| c[row] * w)
-                    .sum::<f64>()
-        })
+    let resid: Vec<f64> = target
+        .iter()
+        .zip(sys.fitted(folds, &w))
+        .map(|(y, f)| y - f)
         .collect();
     let per_unit: Vec<(f64, f64)> = folds
         .unit_rows

@@ -3,4 +3,5 @@
 
 pub mod buffer;
 pub mod cv;
+pub mod design;
 pub mod signflip;
