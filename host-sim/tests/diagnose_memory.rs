@@ -34,7 +34,12 @@ fn fogsim(args: &[&str]) {
 /// Peak RSS of one `fogsim diagnose` child, bytes.
 fn diagnose_peak_rss_bytes(camp: &Path, json: &Path) -> f64 {
     let child = Command::new(env!("CARGO_BIN_EXE_fogsim"))
-        .args(["diagnose", camp.to_str().unwrap(), "--json", json.to_str().unwrap()])
+        .args([
+            "diagnose",
+            camp.to_str().unwrap(),
+            "--json",
+            json.to_str().unwrap(),
+        ])
         .stdout(std::process::Stdio::null())
         .spawn()
         .expect("spawn fogsim diagnose");

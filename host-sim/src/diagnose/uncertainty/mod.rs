@@ -128,6 +128,8 @@ fn mean_partials(base: &BaseFit, st: &Stacked) -> (Vec<f64>, Vec<f64>) {
             let inputs = [&st.temp_c, &st.temp_rate_cps];
             let (mut p, mut m) = (vec![0.0; b.width()], vec![0.0; b.width()]);
             let mut sums = vec![0.0; b.width()];
+            // The row index is the natural loop variable (two inputs read at row i).
+            #[allow(clippy::needless_range_loop)]
             for i in 0..st.temp_c.len() {
                 let at = |d: f64| move |j: usize| inputs[j][i] + if j == which { d } else { 0.0 };
                 b.row_with(at(h), &mut p);
