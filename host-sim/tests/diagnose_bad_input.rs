@@ -3,7 +3,7 @@
 #[allow(dead_code)]
 #[path = "common/planted.rs"]
 mod planted;
-use fog_sim::diagnose::power::PowerCheck;
+use fog_sim::diagnose::selection::power::PowerCheck;
 use fog_sim::diagnose::{diagnose, DiagnoseError};
 use fog_sim::io::runs::Run;
 use fog_sim::pipeline::campaign::{simulate_campaign, CampaignSpec};

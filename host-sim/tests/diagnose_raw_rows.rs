@@ -1,4 +1,4 @@
-//! The raw rows before averaging (`diagnose::rawrows`), on 1 Hz files from the
+//! The raw rows before averaging (`diagnose::input::rawrows`), on 1 Hz files from the
 //! independent generator (`common/independent.rs`: white rate noise of known level, a
 //! 0.0625 degC thermometer, a warm-up trend, no steps in the drift): the Allan deviation
 //! gives back the ARW, the thermometer's quantum is found, the warm-up is not called a
@@ -7,7 +7,7 @@
 #[path = "common/independent.rs"]
 #[allow(dead_code)] // the heading variant is used by diagnose_between
 mod independent;
-use fog_sim::diagnose::rawrows::read_runs;
+use fog_sim::diagnose::input::rawrows::read_runs;
 use fog_sim::io::runs::write_run;
 use independent::{campaign, Hidden, NOISE_10S_DPH};
 

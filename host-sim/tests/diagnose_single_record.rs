@@ -8,8 +8,8 @@
 
 #[path = "common/single_record.rs"]
 mod single_record;
-use fog_sim::diagnose::buffer::BufferRule;
 use fog_sim::diagnose::diagnose_with;
+use fog_sim::diagnose::validation::buffer::BufferRule;
 use single_record::{record, Law};
 
 /// Seeds for the null count (`SINGLE_SEEDS=N` for more).
@@ -118,7 +118,7 @@ fn tallies(sigmas: f64) -> Tally {
 /// Largest count of false names consistent with the family-wise level over `records`
 /// independent records: the 99 % quantile of Binomial(records, ALPHA).
 fn allowed_false_names(records: usize) -> usize {
-    let alpha = fog_sim::diagnose::screen::ALPHA;
+    let alpha = fog_sim::diagnose::selection::screen::ALPHA;
     let mut cdf = 0.0;
     for k in 0..=records {
         let ln_choose: f64 = (1..=k)

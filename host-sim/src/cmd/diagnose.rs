@@ -1,7 +1,9 @@
 //! `fogsim diagnose RUNS... [--json FILE] [--plots DIR]`: what the simulation and the
 //! paper's model get wrong on a measured campaign, the cause, the extension and its gain.
 
-use crate::diagnose::{diagnose, olscheck, plots, rawrows, report};
+use crate::diagnose::diagnose;
+use crate::diagnose::input::rawrows;
+use crate::diagnose::report::{self, olscheck, plots};
 use crate::io::{write_atomic, OutputGuard};
 use anyhow::Context;
 use std::path::PathBuf;

@@ -10,11 +10,11 @@
 //! family-wise decision); a run-level permutation test (features shuffled across runs)
 //! is reported next to it as a check.
 
-use super::bases::BaseFit;
-use super::cv::Folds;
-use super::input::Campaign;
-use super::linalg::solve_spd;
-use super::models::Stacked;
+use crate::diagnose::base::bases::BaseFit;
+use crate::diagnose::base::models::Stacked;
+use crate::diagnose::input::Campaign;
+use crate::diagnose::linalg::solve_spd;
+use crate::diagnose::validation::cv::Folds;
 use fog_core::consts::EARTH_RATE_DPH;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
@@ -93,19 +93,23 @@ fn mean(v: &[f64]) -> f64 {
 /// Run offsets left by the base fitted on every run: mean over the run of drift minus
 /// the base's prediction (the base itself carries no offset).
 pub fn run_offsets(folds: &Folds, st: &Stacked, base: &BaseFit) -> Vec<f64> {
-    let cols = base.raw_columns(st);
+    let design = base.raw_design();
     let w = base
         .prepared
         .fit_all(folds, &[])
         .map(|(w, _)| w)
         .unwrap_or_default();
+    let mut row = vec![0.0; design.width()];
     folds
         .run_rows
         .iter()
         .map(|r| {
             let resid: Vec<f64> = r
                 .clone()
-                .map(|i| st.y[i] - cols.iter().zip(&w).map(|(c, wj)| c[i] * wj).sum::<f64>())
+                .map(|i| {
+                    design.row(i, &mut row);
+                    st.y[i] - row.iter().zip(&w).map(|(c, wj)| c * wj).sum::<f64>()
+                })
                 .collect();
             mean(&resid)
         })
@@ -283,15 +287,19 @@ pub fn prepare(
     folds: &Folds,
     st: &Stacked,
     base: &BaseFit,
-    levels: Option<&super::bases::LevelChoice>,
+    levels: Option<&crate::diagnose::base::bases::LevelChoice>,
 ) -> Result<Prepared, String> {
-    if folds.offsets != super::cv::Offsets::PerUnit {
+    if folds.offsets != crate::diagnose::validation::cv::Offsets::PerUnit {
         return Err("between-run effects need >= 4 runs held out whole".into());
     }
     let (offsets, offsets_from) = match levels {
         Some(l) => (
             l.offsets_left.clone(),
-            format!("{} ({})", l.base, super::bases::law_name(l.law)),
+            format!(
+                "{} ({})",
+                l.base,
+                crate::diagnose::base::bases::law_name(l.law)
+            ),
         ),
         None => (
             run_offsets(folds, st, base),
@@ -311,7 +319,7 @@ pub fn prepare(
         rows: vec![],
     };
     let shared = levels
-        .filter(|l| l.law == super::levels::Law::Shared)
+        .filter(|l| l.law == crate::diagnose::base::levels::Law::Shared)
         .and_then(|l| Some((l.systems.clone()?, l.theta)));
     let base_errors = shared
         .as_ref()
@@ -351,7 +359,7 @@ pub fn prepare(
 /// and with it (`e0`: the law's own held-out level errors), and the coefficients fitted
 /// on every run (the law's intercept first, then the candidate's).
 fn inside_law(
-    lv: &super::levels::LevelSystems,
+    lv: &crate::diagnose::base::levels::LevelSystems,
     theta: f64,
     e0: &[f64],
     lens: &[usize],
@@ -377,7 +385,8 @@ pub fn finish(p: Prepared, family_p: &[f64], latitude_deg: f64) -> BetweenRun {
     let mut rows = p.rows;
     for (r, fp) in rows.iter_mut().zip(family_p) {
         r.p_value = *fp;
-        r.significant = *fp < super::screen::ALPHA && r.gain_pct > super::screen::MIN_GAIN_PCT;
+        r.significant = *fp < crate::diagnose::selection::screen::ALPHA
+            && r.gain_pct > crate::diagnose::selection::screen::MIN_GAIN_PCT;
     }
     let best = rows
         .iter()

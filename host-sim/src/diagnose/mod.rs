@@ -1,60 +1,43 @@
 //! `diagnose`: from a measured campaign to what the simulation and the paper's model get
-//! wrong, the cause, the extended model and its held-out gain (issues 4 and 9).
+//! wrong, the cause, the extended model and its held-out gain (issues 4, 9 and 18).
 //!
-//! Pipeline: [`input`] checks and averages the runs ([`rawrows`] streams the files and
-//! analyses the raw rows on the way); [`buffer`] sizes the time blocks and buffers of
-//! single records; [`bases`] chooses the base model on held-out data
-//! ([`cv`], [`models`]); [`simfit`] calibrates the simulator's physics; [`residuals`]
-//! and [`outliers`] describe what is left; [`transforms`] builds every candidate feature;
-//! [`screen`] ranks them by held-out gain with the family-wise sign-flip test of
-//! [`signflip`], [`between`] does the same for run-level effects; the named [`cause`] is
-//! mapped onto the simulator by [`simterm`]; [`uncertainty`] puts block-bootstrap
-//! ([`bootstrap`]) ranges on every coefficient; [`power`] plants a known effect when
-//! nothing is named, to say whether the record could have shown one; [`report`] states the result, [`plots`]
-//! draws it, [`azimuth`] translates it into north-seeking error.
+//! The pipeline, one folder per stage: [`input`] checks the runs and averages them to
+//! 10 s ([`input::rawrows`] streams the files and analyses the raw rows on the way);
+//! [`base`] chooses the base model on held-out data, with one temperature law across runs
+//! or free run levels; [`library`] builds every candidate feature from the record's
+//! columns; [`selection`] ranks them by held-out gain, tests them family-wise and checks
+//! the test's power when nothing is named; [`between`] does the same for run-level
+//! effects; [`simulator`] calibrates the simulator's physics and maps the named cause
+//! onto it; [`uncertainty`] puts block-bootstrap ranges on every coefficient; [`report`]
+//! states the result, plots it and translates it into north-seeking error.
+//! [`validation`] (folds over whole runs or buffered blocks, the sign-flip test) and
+//! [`linalg`] serve every stage.
 
-pub mod azimuth;
-pub mod bases;
-pub mod basis;
+pub mod base;
 pub mod between;
-pub mod bootstrap;
-pub mod buffer;
-pub mod causal;
-pub mod cause;
-pub mod cv;
-pub mod derivatives;
 pub mod error;
 pub mod input;
-pub mod levels;
+pub mod library;
 pub mod linalg;
-pub mod models;
-pub mod olscheck;
-pub mod outliers;
-pub mod plots;
-pub mod power;
-pub mod rawrows;
 pub mod report;
-pub mod residuals;
-pub mod screen;
-pub mod signflip;
-pub mod simfit;
-pub mod simterm;
-pub mod transforms;
+pub mod selection;
+pub mod simulator;
 pub mod uncertainty;
+pub mod validation;
 
-pub use cause::Cause;
 pub use error::DiagnoseError;
 pub use report::Report;
+pub use selection::cause::Cause;
 
 use crate::io::runs::Run;
-use cv::Folds;
+use base::models::Stacked;
 use input::Exclusion;
-use models::Stacked;
 use report::{
     Azimuth, CampaignSummary, CandidateRow, Competitor, DriftStd, Extended, ModelSummary,
     Simulation,
 };
-use screen::{Scored, Screening};
+use selection::screen::{Scored, Screening};
+use validation::cv::Folds;
 
 /// Everything the diagnosis computed: the report plus the series the plots need.
 #[derive(Clone, Debug)]
@@ -81,11 +64,14 @@ pub struct Diagnosis {
 
 /// Runs the whole diagnosis on a campaign.
 pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
-    diagnose_with(runs, buffer::BufferRule::default())
+    diagnose_with(runs, validation::buffer::BufferRule::default())
 }
 
 /// [`diagnose`] with a chosen rule for the buffers between time blocks of single records.
-pub fn diagnose_with(runs: &[Run], rule: buffer::BufferRule) -> Result<Diagnosis, DiagnoseError> {
+pub fn diagnose_with(
+    runs: &[Run],
+    rule: validation::buffer::BufferRule,
+) -> Result<Diagnosis, DiagnoseError> {
     let campaign = input::prepare(runs)?;
     let (folds, st, choice) = layout_and_base(&campaign, rule)?;
     let base = &choice.chosen;
@@ -94,11 +80,11 @@ pub fn diagnose_with(runs: &[Run], rule: buffer::BufferRule) -> Result<Diagnosis
         .runs
         .iter()
         .find_map(|s| s.latitude_deg)
-        .unwrap_or(azimuth::DEFAULT_LATITUDE_DEG);
+        .unwrap_or(report::azimuth::DEFAULT_LATITUDE_DEG);
     let (screening, between_run) = screen_both(&campaign, &folds, &st, &choice, latitude)?;
     let named = screening.named.map(|i| &screening.scored[i]);
     let cause = named.map(|s| Cause::from(&s.cand));
-    let sim = simfit::calibrate(
+    let sim = simulator::simfit::calibrate(
         &campaign,
         &folds.run_rows,
         &st.y,
@@ -106,7 +92,7 @@ pub fn diagnose_with(runs: &[Run], rule: buffer::BufferRule) -> Result<Diagnosis
     )?;
     let (extended, ext_resid) = extended_model(base, named, cause.as_ref());
     let causal_derivative =
-        named.and_then(|s| causal::check(&campaign, &folds, base, &s.cand, &s.cols));
+        named.and_then(|s| library::causal::check(&campaign, &folds, base, &s.cand, &s.cols));
     let uncertainty = uncertainty::estimate(
         &campaign,
         &folds,
@@ -122,12 +108,12 @@ pub fn diagnose_with(runs: &[Run], rule: buffer::BufferRule) -> Result<Diagnosis
     );
     let has_heading = campaign.extra_names.iter().any(|n| n.contains("heading"));
     let azimuth = has_heading.then(|| Azimuth {
-        baseline: azimuth::azimuth_effect(&folds, &st.t_s, &base.cv.residual, latitude),
-        extended: azimuth::azimuth_effect(&folds, &st.t_s, &ext_resid, latitude),
+        baseline: report::azimuth::azimuth_effect(&folds, &st.t_s, &base.cv.residual, latitude),
+        extended: report::azimuth::azimuth_effect(&folds, &st.t_s, &ext_resid, latitude),
     });
-    let smallest_attainable_p = signflip::smallest_p(folds.unit_rows.len());
+    let smallest_attainable_p = validation::signflip::smallest_p(folds.unit_rows.len());
     let silent = cause.is_none() && between_run.named.is_none();
-    let power_check = power::check(silent, &campaign, &folds, &st, base, &screening)?;
+    let power_check = selection::power::check(silent, &campaign, &folds, &st, base, &screening)?;
     let words = cause_in_words(
         cause.as_ref(),
         &between_run,
@@ -135,7 +121,7 @@ pub fn diagnose_with(runs: &[Run], rule: buffer::BufferRule) -> Result<Diagnosis
         smallest_attainable_p,
         power_check.as_ref(),
     );
-    let sim_terms = simterm::terms_per_run(runs, cause.as_ref(), &sim.effect_coef);
+    let sim_terms = simulator::simterm::terms_per_run(runs, cause.as_ref(), &sim.effect_coef);
     let cause_column = cause.as_ref().map(|c| c.column.clone());
     let report = Report {
         campaign: CampaignSummary {
@@ -148,8 +134,8 @@ pub fn diagnose_with(runs: &[Run], rule: buffer::BufferRule) -> Result<Diagnosis
             power_check,
         },
         base: base_summary(&choice, &st, &campaign),
-        residual_structure: residuals::structure(&campaign, &folds, &st, &base.cv.residual),
-        outliers: outliers::locate(&folds, &run_names, &st.t_s, &st.y, &base.cv.residual),
+        residual_structure: report::residuals::structure(&campaign, &folds, &st, &base.cv.residual),
+        outliers: report::outliers::locate(&folds, &run_names, &st.t_s, &st.y, &base.cv.residual),
         between_run,
         derivative_widths: campaign.derivative_widths.clone(),
         candidates: screening.scored.iter().map(candidate_row).collect(),
@@ -190,17 +176,17 @@ pub fn diagnose_with(runs: &[Run], rule: buffer::BufferRule) -> Result<Diagnosis
 
 /// The validation layout, the stacked campaign and the base: buffers between time blocks
 /// are sized on the base with the device's dT/dt span; the base and its dT/dt window are
-/// then chosen on that layout (`bases::choose_with_rate_window`).
+/// then chosen on that layout (`base::bases::choose_with_rate_window`).
 fn layout_and_base(
     campaign: &input::Campaign,
-    rule: buffer::BufferRule,
-) -> Result<(Folds, Stacked, bases::BaseChoice), DiagnoseError> {
-    let device_rate = Stacked::with_rate_half_width(campaign, bases::device_rate_half_s());
+    rule: validation::buffer::BufferRule,
+) -> Result<(Folds, Stacked, base::bases::BaseChoice), DiagnoseError> {
+    let device_rate = Stacked::with_rate_half_width(campaign, base::bases::device_rate_half_s());
     let run_lengths: Vec<usize> = campaign.runs.iter().map(|s| s.t_s.len()).collect();
     let (folds, device_choice) =
-        buffer::choose_buffered(Folds::new(&run_lengths)?, &device_rate, rule)?;
+        validation::buffer::choose_buffered(Folds::new(&run_lengths)?, &device_rate, rule)?;
     let (st, choice) =
-        bases::choose_with_rate_window(campaign, &folds, (device_rate, device_choice))?;
+        base::bases::choose_with_rate_window(campaign, &folds, (device_rate, device_choice))?;
     Ok((folds, st, choice))
 }
 
@@ -209,18 +195,18 @@ fn screen_both(
     campaign: &input::Campaign,
     folds: &Folds,
     st: &Stacked,
-    choice: &bases::BaseChoice,
+    choice: &base::bases::BaseChoice,
     latitude_deg: f64,
 ) -> Result<(Screening, between::BetweenRun), DiagnoseError> {
     let base = &choice.chosen;
     let run_level = between::prepare(campaign, folds, st, base, choice.levels.as_ref());
     let no_gains = Vec::new();
-    let screening = screen::screen(
+    let screening = selection::screen::screen(
         campaign,
         folds,
         st,
         base,
-        transforms::enumerate(campaign),
+        library::transforms::enumerate(campaign),
         run_level.as_ref().map_or(&no_gains, |p| &p.gains),
     )?;
     let between_run = match run_level {
@@ -241,7 +227,7 @@ fn screen_both(
 /// The base extended by the named cause (the base itself when nothing is named), and its
 /// held-out residual.
 fn extended_model(
-    base: &bases::BaseFit,
+    base: &base::bases::BaseFit,
     named: Option<&Scored>,
     cause: Option<&Cause>,
 ) -> (Extended, Vec<f64>) {
@@ -273,7 +259,7 @@ fn extended_model(
 
 /// The chosen base and every base tried, for the report.
 fn base_summary(
-    choice: &bases::BaseChoice,
+    choice: &base::bases::BaseChoice,
     st: &Stacked,
     campaign: &input::Campaign,
 ) -> ModelSummary {
@@ -283,7 +269,7 @@ fn base_summary(
         poly_degree_t: base.spec.poly_degree_t,
         uses_rate: base.spec.uses_rate,
         rate_half_width_s: st.temp_rate_half_s,
-        rate_effective_half_width_s: derivatives::effective_half_width_s(
+        rate_effective_half_width_s: library::derivatives::effective_half_width_s(
             &campaign
                 .runs
                 .iter()
@@ -328,7 +314,7 @@ fn drift_std(folds: &Folds, y: &[f64], base_resid: &[f64], ext_resid: &[f64]) ->
     }
 }
 
-fn to_exclusion((column, reason): &screen::Skipped) -> Exclusion {
+fn to_exclusion((column, reason): &selection::screen::Skipped) -> Exclusion {
     Exclusion {
         column: column.clone(),
         reason: reason.clone(),
@@ -341,7 +327,7 @@ fn cause_in_words(
     between_run: &between::BetweenRun,
     coef: &[f64],
     smallest_attainable_p: f64,
-    power_check: Option<&power::PowerCheck>,
+    power_check: Option<&selection::power::PowerCheck>,
 ) -> String {
     match (cause, &between_run.named) {
         (Some(c), _) => c.in_words(coef),
@@ -354,15 +340,15 @@ fn cause_in_words(
 
 /// The simulator before/after and the terms added (listed for the first run).
 fn simulation_summary(
-    sim: simfit::SimCalibration,
+    sim: simulator::simfit::SimCalibration,
     sim_terms: &[Vec<crate::sim::DriftTerm>],
     cause_column: Option<&str>,
 ) -> Simulation {
-    let terms: Vec<simterm::TermSummary> = sim_terms
+    let terms: Vec<simulator::simterm::TermSummary> = sim_terms
         .first()
         .into_iter()
         .flatten()
-        .map(|t| simterm::summarize(t, cause_column.unwrap_or("")))
+        .map(|t| simulator::simterm::summarize(t, cause_column.unwrap_or("")))
         .collect();
     Simulation {
         before_rms_dph: sim.before_rms_dph,

@@ -7,11 +7,13 @@
 //! bootstrap of `bootstrap` (whole runs or time blocks resampled). The simulator stage is
 //! conditional on its fitted thermal response (the thermal time constants are not redrawn).
 
-use super::bases::{zscore_params, BaseFit};
-use super::bootstrap::{draws, Estimate, REPLICATES};
-use super::cv::{Folds, Offsets, Prepared, UnitSystems};
-use super::input::Campaign;
-use super::models::Stacked;
+pub mod bootstrap;
+
+use crate::diagnose::base::bases::{zscore_params, BaseFit};
+use crate::diagnose::base::models::Stacked;
+use crate::diagnose::input::Campaign;
+use crate::diagnose::uncertainty::bootstrap::{draws, Estimate, REPLICATES};
+use crate::diagnose::validation::cv::{Folds, Offsets, Prepared, UnitSystems};
 use serde::Serialize;
 
 /// A measured coefficient against the simulator's value.
@@ -121,22 +123,23 @@ fn mean_partials(base: &BaseFit, st: &Stacked) -> (Vec<f64>, Vec<f64>) {
                 &st.temp_rate_cps
             });
             let h = 1e-3 * sd;
-            let shifted = |d: f64| {
-                let mut inputs = [st.temp_c.clone(), st.temp_rate_cps.clone()];
-                inputs[which].iter_mut().for_each(|v| *v += d);
-                b.columns(&inputs)
-            };
-            let (p, m) = (shifted(h), shifted(-h));
-            p.iter()
-                .zip(&m)
-                .map(|(p, m)| {
-                    mean(
-                        &p.iter()
-                            .zip(m)
-                            .map(|(a, b)| (a - b) / (2.0 * h))
-                            .collect::<Vec<_>>(),
-                    )
-                })
+            // Row by row (the design is never held n x columns): central differences
+            // summed in row order, then averaged.
+            let inputs = [&st.temp_c, &st.temp_rate_cps];
+            let (mut p, mut m) = (vec![0.0; b.width()], vec![0.0; b.width()]);
+            let mut sums = vec![0.0; b.width()];
+            // The row index is the natural loop variable (two inputs read at row i).
+            #[allow(clippy::needless_range_loop)]
+            for i in 0..st.temp_c.len() {
+                let at = |d: f64| move |j: usize| inputs[j][i] + if j == which { d } else { 0.0 };
+                b.row_with(at(h), &mut p);
+                b.row_with(at(-h), &mut m);
+                sums.iter_mut()
+                    .zip(p.iter().zip(&m))
+                    .for_each(|(s, (a, b))| *s += (a - b) / (2.0 * h));
+            }
+            sums.iter()
+                .map(|s| s / st.temp_c.len().max(1) as f64)
                 .collect()
         };
         return (diff(0), diff(1));
@@ -236,7 +239,7 @@ fn extension_estimates(
 
 /// Median row spacing within runs, s.
 fn row_spacing_s(folds: &Folds, t_s: &[f64]) -> f64 {
-    let mut d = super::simfit::within_run_differences(&folds.run_rows, t_s);
+    let mut d = crate::diagnose::simulator::simfit::within_run_differences(&folds.run_rows, t_s);
     d.sort_by(f64::total_cmp);
     d.get(d.len() / 2).copied().unwrap_or(f64::NAN)
 }
@@ -251,11 +254,11 @@ fn simulator_estimates(
     named: Option<&NamedFeature<'_>>,
     counts: &[Vec<f64>],
 ) -> (Vec<Estimate>, Vec<Ratio>) {
-    let (mut cols, t_mean) = super::simfit::design_columns(campaign);
-    let n_law = super::simfit::LAW_TERMS.len();
+    let (mut cols, t_mean) = crate::diagnose::simulator::simfit::design_columns(campaign);
+    let n_law = crate::diagnose::simulator::simfit::LAW_TERMS.len();
     let prepared = Prepared::new(folds, &cols, &st.y, 0.0);
     let extra: &[Vec<f64>] = named.map_or(&[], |n| n.cols);
-    let mut names: Vec<(String, &str)> = super::simfit::LAW_TERMS
+    let mut names: Vec<(String, &str)> = crate::diagnose::simulator::simfit::LAW_TERMS
         .iter()
         .map(|(n, u)| ((*n).to_owned(), *u))
         .collect();
@@ -266,10 +269,10 @@ fn simulator_estimates(
     }
     let sys = prepared.unit_systems(folds, extra);
     let shared = (folds.offsets == Offsets::PerUnit
-        && folds.run_rows.len() >= super::simfit::MIN_RUNS_SHARED)
+        && folds.run_rows.len() >= crate::diagnose::simulator::simfit::MIN_RUNS_SHARED)
         .then(|| {
             cols.extend(extra.iter().cloned());
-            super::simfit::fit_shared(&folds.run_rows, &cols, &st.y)
+            crate::diagnose::simulator::simfit::fit_shared(&folds.run_rows, &cols, &st.y)
         })
         .flatten();
     let mut out = match shared {
@@ -309,16 +312,10 @@ fn arw_estimate(
     let ones = vec![1.0; folds.unit_rows.len()];
     let w = sys.solve(&ones).ok()?;
     let target = prepared.target();
-    let resid: Vec<f64> = (0..folds.rows())
-        .map(|row| {
-            target[row]
-                - sys
-                    .cols
-                    .iter()
-                    .zip(&w)
-                    .map(|(c, w)| c[row] * w)
-                    .sum::<f64>()
-        })
+    let resid: Vec<f64> = target
+        .iter()
+        .zip(sys.fitted(folds, &w))
+        .map(|(y, f)| y - f)
         .collect();
     let per_unit: Vec<(f64, f64)> = folds
         .unit_rows

@@ -13,13 +13,13 @@
 //!    imitate its column's value or derivatives). Significant candidates that lose their
 //!    gain once the named one is in the model are reported as competing with it.
 
-use super::bases::BaseFit;
-use super::cv::{CvResult, Folds};
-use super::error::DiagnoseError;
-use super::input::Campaign;
-use super::models::{fit_rbf_input, Stacked};
-use super::signflip::{max_t_pvalues, paired_pvalue};
-use super::transforms::Candidate;
+use crate::diagnose::base::bases::BaseFit;
+use crate::diagnose::base::models::{fit_rbf_input, Stacked};
+use crate::diagnose::error::DiagnoseError;
+use crate::diagnose::input::Campaign;
+use crate::diagnose::library::transforms::Candidate;
+use crate::diagnose::validation::cv::{CvResult, Folds};
+use crate::diagnose::validation::signflip::{max_t_pvalues, paired_pvalue};
 
 /// Family-wise significance level.
 pub const ALPHA: f64 = 0.01;
@@ -42,7 +42,9 @@ pub enum Mode {
 #[derive(Clone, Debug)]
 pub struct Scored {
     pub cand: Candidate,
-    /// The feature's stacked columns.
+    /// The feature's stacked columns: kept for the named cause only (empty otherwise;
+    /// [`Scored::columns`] recomputes them), as is `cv.residual` (memory: 8 B a row per
+    /// column and per candidate).
     pub cols: Vec<Vec<f64>>,
     pub mode: Mode,
     pub cv: CvResult,
@@ -72,6 +74,13 @@ pub struct Screening {
     pub parsimony_note: Option<String>,
     /// Family-wise p-values of the between-run candidates (same max-T family).
     pub between_p: Vec<f64>,
+}
+
+impl Scored {
+    /// The feature's stacked columns, recomputed from the campaign.
+    pub fn columns(&self, campaign: &Campaign) -> Vec<Vec<f64>> {
+        stacked_columns(campaign, &self.cand)
+    }
 }
 
 fn has_within_unit_variation(folds: &Folds, col: &[f64]) -> bool {
@@ -106,11 +115,19 @@ pub fn screen(
     let (mut scored, skipped) = score_linear(campaign, folds, base, cands)?;
     let between_p = family_pvalues(base, &mut scored, between_gains);
     scored.sort_by(|a, b| a.heldout_rms_dph.total_cmp(&b.heldout_rms_dph));
-    refit_best_as_rbf_inputs(folds, st, base, &mut scored);
+    refit_best_as_rbf_inputs(campaign, folds, st, base, &mut scored);
     scored.sort_by(|a, b| a.heldout_rms_dph.total_cmp(&b.heldout_rms_dph));
     let (named, parsimony_note) = name_cause(&scored);
+    for (i, s) in scored.iter_mut().enumerate() {
+        if Some(i) != named {
+            s.cv.drop_residual();
+        }
+    }
     let competing = match named {
-        Some(i) => competitors(folds, base, &scored, i)?,
+        Some(i) => {
+            keep_named_data(campaign, folds, base, &mut scored[i])?;
+            competitors(campaign, folds, base, &scored, i)?
+        }
         None => vec![],
     };
     Ok(Screening {
@@ -140,7 +157,7 @@ fn score_linear(
             skipped.push((cand.label(), "not finite".to_owned()));
             continue;
         }
-        if folds.offsets == super::cv::Offsets::PerUnit
+        if folds.offsets == crate::diagnose::validation::cv::Offsets::PerUnit
             && !cols.iter().any(|c| has_within_unit_variation(folds, c))
         {
             skipped.push((
@@ -150,11 +167,12 @@ fn score_linear(
             ));
             continue;
         }
-        let cv = base.prepared.validate_with(folds, &cols)?;
+        let mut cv = base.prepared.validate_with(folds, &cols)?;
+        cv.drop_residual();
         let rms = cv.rms();
         scored.push(Scored {
             cand,
-            cols,
+            cols: Vec::new(),
             mode: Mode::Linear,
             heldout_rms_dph: rms,
             gain_pct: gain_pct(base_rms, rms),
@@ -197,14 +215,20 @@ fn family_pvalues(base: &BaseFit, scored: &mut [Scored], between_gains: &[Vec<f6
 
 /// Step 2: the best few (sorted) also tried as a further RBF input, keeping the better
 /// held-out form; then every candidate's improved-unit share and significance.
-fn refit_best_as_rbf_inputs(folds: &Folds, st: &Stacked, base: &BaseFit, scored: &mut [Scored]) {
+fn refit_best_as_rbf_inputs(
+    campaign: &Campaign,
+    folds: &Folds,
+    st: &Stacked,
+    base: &BaseFit,
+    scored: &mut [Scored],
+) {
     let base_rms = base.cv.rms();
     for s in scored
         .iter_mut()
         .take(REFIT_TOP)
         .filter(|s| s.gain_pct > 0.0)
     {
-        if let Ok(fit) = fit_rbf_input(folds, st, &base.spec, &s.cols) {
+        if let Ok(fit) = fit_rbf_input(folds, st, &base.spec, &s.columns(campaign)) {
             if fit.cv.rms() < s.heldout_rms_dph {
                 s.mode = Mode::RbfInput;
                 s.heldout_rms_dph = fit.cv.rms();
@@ -279,9 +303,26 @@ pub fn unit_gains(from: &CvResult, to: &CvResult) -> Vec<f64> {
         .collect()
 }
 
+/// The named cause's columns and held-out residual, the only candidate's kept (a linear
+/// one is validated again: same folds and ridge, same numbers; an RBF input kept its
+/// residual from the refit).
+fn keep_named_data(
+    campaign: &Campaign,
+    folds: &Folds,
+    base: &BaseFit,
+    s: &mut Scored,
+) -> Result<(), DiagnoseError> {
+    s.cols = s.columns(campaign);
+    if s.cv.residual.is_empty() {
+        s.cv = base.prepared.validate_with(folds, &s.cols)?;
+    }
+    Ok(())
+}
+
 /// Significant candidates of other columns whose held-out gain (as linear terms) mostly
 /// vanishes once the named cause is in the model: they explain the same thing.
 fn competitors(
+    campaign: &Campaign,
     folds: &Folds,
     base: &BaseFit,
     scored: &[Scored],
@@ -295,7 +336,7 @@ fn competitors(
             continue;
         }
         let mut both = scored[named].cols.clone();
-        both.extend(s.cols.iter().cloned());
+        both.extend(s.columns(campaign));
         let cv = base.prepared.validate_with(folds, &both)?;
         let cond = gain_pct(with_named.rms(), cv.rms());
         if cond < 0.5 * s.gain_pct {

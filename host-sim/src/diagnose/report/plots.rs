@@ -5,7 +5,7 @@
 //! in a panel right of the plot, never over the data; axes are padded so no point sits
 //! on the frame; the time axis says what the record's time is.
 
-use super::Diagnosis;
+use crate::diagnose::Diagnosis;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -113,7 +113,7 @@ fn xy_plot(
 }
 
 /// The Allan deviation, log-log, with the -1/2 line of the fitted ARW.
-fn allan_plot(path: &Path, raw: &super::rawrows::RawRows) -> anyhow::Result<()> {
+fn allan_plot(path: &Path, raw: &crate::diagnose::input::rawrows::RawRows) -> anyhow::Result<()> {
     let tau: Vec<f64> = raw.allan.iter().map(|p| p.tau_s).collect();
     let adev: Vec<f64> = raw.allan.iter().map(|p| p.adev_dph).collect();
     let arw_line: Vec<f64> = raw

@@ -15,14 +15,14 @@
 //! If the planted copy is not named, the report says "cannot decide: no test power at
 //! 1 sigma" instead of "no significant cause".
 
-use super::bases::{self, BaseFit};
-use super::cv::Folds;
-use super::error::DiagnoseError;
-use super::input::Campaign;
-use super::models::Stacked;
-use super::residuals::demeaned_by_run;
-use super::screen::{self, Screening};
-use super::transforms;
+use crate::diagnose::base::bases::{self, BaseFit};
+use crate::diagnose::base::models::Stacked;
+use crate::diagnose::error::DiagnoseError;
+use crate::diagnose::input::Campaign;
+use crate::diagnose::library::transforms;
+use crate::diagnose::report::residuals::demeaned_by_run;
+use crate::diagnose::selection::screen::{self, Screening};
+use crate::diagnose::validation::cv::Folds;
 use serde::Serialize;
 
 /// Size of the planted effect, in within-run rms of the base's held-out residual.
@@ -56,11 +56,12 @@ pub fn check(
     base: &BaseFit,
     screening: &Screening,
 ) -> Result<Option<PowerCheck>, DiagnoseError> {
-    let reachable = super::signflip::smallest_p(folds.unit_rows.len()) < screen::ALPHA;
+    let reachable =
+        crate::diagnose::validation::signflip::smallest_p(folds.unit_rows.len()) < screen::ALPHA;
     if !silent || !reachable || screening.scored.is_empty() {
         return Ok(None);
     }
-    let Some((label, planted)) = plantable(folds, st, base, screening)? else {
+    let Some((label, planted)) = plantable(campaign, folds, st, base, screening)? else {
         return Ok(Some(PowerCheck {
             planted: None,
             planted_rms_dph: 0.0,
@@ -108,6 +109,7 @@ const MIN_UNEXPLAINED: f64 = 0.5;
 /// The first of the `TRIED` best-ranked candidates whose feature the base leaves at
 /// least `MIN_UNEXPLAINED` unexplained, with the effect to plant.
 fn plantable(
+    campaign: &Campaign,
     folds: &Folds,
     st: &Stacked,
     base: &BaseFit,
@@ -115,7 +117,8 @@ fn plantable(
 ) -> Result<Option<(String, Vec<f64>)>, DiagnoseError> {
     let runs = &folds.run_rows;
     for scored in screening.scored.iter().take(TRIED) {
-        let Some(feature) = scored.cols.first() else {
+        let cols = scored.columns(campaign);
+        let Some(feature) = cols.first() else {
             continue;
         };
         let mut feature_as_target = st.clone();

@@ -12,8 +12,10 @@
 //! autocorrelated noise in the neighbours cannot leak into the held-out score. The
 //! buffer is chosen from the data (`buffer.rs`); a run-grouped layout needs none.
 
-use super::error::DiagnoseError;
-use super::linalg::solve_spd;
+use crate::diagnose::error::DiagnoseError;
+use crate::diagnose::linalg::solve_spd;
+use crate::diagnose::validation::design::{Columns, Design};
+use std::sync::Arc;
 
 /// Fewest runs for validation grouped by run.
 pub const MIN_RUNS_GROUPED: usize = 4;
@@ -177,10 +179,16 @@ impl Folds {
     }
 }
 
-/// A design prepared for validation: transformed columns, target, per-unit Grams.
+/// A design prepared for validation: the design's rows (computed on demand, never held
+/// n x columns), its per-unit means (run-grouped layouts remove them), the adjusted
+/// target and per-unit Grams.
 #[derive(Clone, Debug)]
 pub struct Prepared {
-    cols: Vec<Vec<f64>>,
+    design: Arc<dyn Design>,
+    /// Per-unit column means of the design (run-grouped layouts; empty for time blocks).
+    unit_means: Vec<Vec<f64>>,
+    /// Rows of each run, one dummy column each (time-block layouts; empty otherwise).
+    dummies: Vec<std::ops::Range<usize>>,
     y: Vec<f64>,
     grams: Vec<Vec<f64>>,
     xty: Vec<Vec<f64>>,
@@ -191,41 +199,27 @@ pub struct Prepared {
     ridge: f64,
 }
 
-/// Gram matrix and X'y of `cols` against `y` over `rows`.
-fn range_system(
-    cols: &[Vec<f64>],
-    y: &[f64],
-    rows: std::ops::Range<usize>,
-) -> (Vec<f64>, Vec<f64>) {
-    let p = cols.len();
-    let mut g = vec![0.0; p * p];
-    for i in 0..p {
-        for j in 0..=i {
-            let v = dot(&cols[i][rows.clone()], &cols[j][rows.clone()]);
-            g[i * p + j] = v;
-            g[j * p + i] = v;
-        }
-    }
-    let c = cols
-        .iter()
-        .map(|col| dot(&col[rows.clone()], &y[rows.clone()]))
-        .collect();
-    (g, c)
-}
-
 /// Held-out result.
 #[derive(Clone, Debug)]
 pub struct CvResult {
     /// Held-out sum of squared residuals per unit.
     pub unit_sse: Vec<f64>,
-    /// Held-out residual per row (deg/h).
+    /// Held-out residual per row (deg/h); empty once [`CvResult::drop_residual`] freed it.
     pub residual: Vec<f64>,
+    /// Rows scored.
+    pub points: usize,
 }
 
 impl CvResult {
     /// Pooled held-out rms, deg/h.
     pub fn rms(&self) -> f64 {
-        (self.unit_sse.iter().sum::<f64>() / self.residual.len().max(1) as f64).sqrt()
+        (self.unit_sse.iter().sum::<f64>() / self.points.max(1) as f64).sqrt()
+    }
+
+    /// Frees the per-row residual (8 B a row), keeping the per-unit scores: a screened
+    /// candidate needs only those until it is named (memory).
+    pub fn drop_residual(&mut self) {
+        self.residual = Vec::new();
     }
 }
 
@@ -256,40 +250,98 @@ impl Prepared {
         Self::from_owned(folds, cols.to_vec(), y, ridge)
     }
 
-    /// [`Prepared::new`] taking the columns by value (adjusted in place: no second copy).
-    pub fn from_owned(folds: &Folds, mut adj: Vec<Vec<f64>>, y: &[f64], ridge: f64) -> Self {
-        for c in &mut adj {
-            adjust_in_place(folds, c);
+    /// [`Prepared::new`] taking the columns by value.
+    pub fn from_owned(folds: &Folds, cols: Vec<Vec<f64>>, y: &[f64], ridge: f64) -> Self {
+        Self::from_design(folds, Arc::new(Columns(cols)), y, ridge)
+    }
+
+    /// Prepares a design given by its rows: the per-unit means and Grams are accumulated
+    /// row by row (the same sums, in the same order, as over materialised columns).
+    pub fn from_design(folds: &Folds, design: Arc<dyn Design>, y: &[f64], ridge: f64) -> Self {
+        let unit_means = if folds.offsets == Offsets::PerUnit {
+            let mut raw = vec![0.0; design.width()];
+            folds
+                .unit_rows
+                .iter()
+                .map(|r| {
+                    let mut sums = vec![0.0; design.width()];
+                    for row in r.clone() {
+                        design.row(row, &mut raw);
+                        sums.iter_mut().zip(&raw).for_each(|(s, v)| *s += v);
+                    }
+                    sums.iter().map(|s| s / r.len() as f64).collect()
+                })
+                .collect()
+        } else {
+            vec![]
+        };
+        let dummies = if folds.offsets == Offsets::RunDummies {
+            folds.run_rows.clone()
+        } else {
+            vec![]
+        };
+        let mut prepared = Self {
+            design,
+            unit_means,
+            dummies,
+            y: adjust(folds, y),
+            grams: vec![],
+            xty: vec![],
+            excluded_grams: vec![],
+            excluded_xty: vec![],
+            ridge,
+        };
+        (prepared.grams, prepared.xty) = (0..folds.unit_rows.len())
+            .map(|u| prepared.range_system(u, folds.unit_rows[u].clone()))
+            .unzip();
+        if folds.buffer_points > 0 {
+            (prepared.excluded_grams, prepared.excluded_xty) = (0..folds.unit_rows.len())
+                .map(|u| prepared.range_system(u, folds.excluded_rows(u)))
+                .unzip();
         }
-        if folds.offsets == Offsets::RunDummies {
-            for r in &folds.run_rows {
-                let mut d = vec![0.0; folds.rows()];
-                d[r.clone()].iter_mut().for_each(|x| *x = 1.0);
-                adj.push(d);
+        prepared
+    }
+
+    /// The raw design (no run offsets removed, no run dummies).
+    pub fn design(&self) -> Arc<dyn Design> {
+        self.design.clone()
+    }
+
+    /// Row `row` of the adjusted design (unit `unit`'s means removed in run-grouped
+    /// layouts, then the run dummies) into `out` (`width()` long).
+    fn adjusted_row(&self, unit: usize, row: usize, out: &mut [f64]) {
+        let p = self.design.width();
+        self.design.row(row, &mut out[..p]);
+        if let Some(m) = self.unit_means.get(unit) {
+            out[..p].iter_mut().zip(m).for_each(|(x, m)| *x -= m);
+        }
+        for (o, r) in out[p..].iter_mut().zip(&self.dummies) {
+            *o = if r.contains(&row) { 1.0 } else { 0.0 };
+        }
+    }
+
+    /// Gram matrix and X'y of the adjusted design against the target over `rows` (of
+    /// unit `unit`, whose means are removed), accumulated row by row.
+    fn range_system(&self, unit: usize, rows: std::ops::Range<usize>) -> (Vec<f64>, Vec<f64>) {
+        let p = self.width();
+        let mut g = vec![0.0; p * p];
+        let mut c = vec![0.0; p];
+        let mut a = vec![0.0; p];
+        for row in rows {
+            self.adjusted_row(unit, row, &mut a);
+            for i in 0..p {
+                for j in 0..=i {
+                    g[i * p + j] += a[i] * a[j];
+                }
+                c[i] += a[i] * self.y[row];
             }
         }
-        let y = adjust(folds, y);
-        let (grams, xty) = folds
-            .unit_rows
-            .iter()
-            .map(|r| range_system(&adj, &y, r.clone()))
-            .unzip();
-        let (excluded_grams, excluded_xty) = if folds.buffer_points > 0 {
-            (0..folds.unit_rows.len())
-                .map(|u| range_system(&adj, &y, folds.excluded_rows(u)))
-                .unzip()
-        } else {
-            (vec![], vec![])
-        };
-        Self {
-            cols: adj,
-            y,
-            grams,
-            xty,
-            excluded_grams,
-            excluded_xty,
-            ridge,
+        for i in 0..p {
+            for j in 0..i {
+                g[j * p + i] = g[i * p + j];
+            }
         }
+        (g, c)
     }
 
     /// Changes the relative ridge (the Gram matrices do not depend on it).
@@ -299,7 +351,7 @@ impl Prepared {
 
     /// Number of design columns (including run dummies).
     pub fn width(&self) -> usize {
-        self.cols.len()
+        self.design.width() + self.dummies.len()
     }
 
     /// Held-out validation of this design alone.
@@ -313,32 +365,60 @@ impl Prepared {
         folds: &Folds,
         extra: &[Vec<f64>],
     ) -> Result<CvResult, DiagnoseError> {
-        let (grams, xty, cols) = self.augmented(folds, extra);
-        let buffered = (folds.buffer_points > 0).then(|| self.augmented_excluded(folds, &cols));
+        let (grams, xty, ex) = self.augmented(folds, extra);
+        let buffered = (folds.buffer_points > 0).then(|| self.augmented_excluded(folds, &ex));
         let (excl_g, excl_c) = buffered.as_ref().map_or((&grams, &xty), |(g, c)| (g, c));
-        let q = cols.len();
+        let q = self.width() + ex.len();
         let total_g = sum_all(&grams);
         let total_c = sum_all(&xty);
         let diag_scale: Vec<f64> = (0..q).map(|i| total_g[i * q + i]).collect();
         let mut unit_sse = Vec::with_capacity(folds.unit_rows.len());
         let mut residual = vec![0.0; folds.rows()];
+        let mut a = vec![0.0; q];
         for (u, r) in folds.unit_rows.iter().enumerate() {
-            let mut a: Vec<f64> = total_g.iter().zip(&excl_g[u]).map(|(t, g)| t - g).collect();
+            let mut m: Vec<f64> = total_g.iter().zip(&excl_g[u]).map(|(t, g)| t - g).collect();
             let mut b: Vec<f64> = total_c.iter().zip(&excl_c[u]).map(|(t, g)| t - g).collect();
-            add_ridge(&mut a, &diag_scale, q, self.ridge);
-            solve_spd(&mut a, &mut b, q).map_err(|_| DiagnoseError::Singular {
+            add_ridge(&mut m, &diag_scale, q, self.ridge);
+            solve_spd(&mut m, &mut b, q).map_err(|_| DiagnoseError::Singular {
                 what: "held-out fit",
             })?;
             let mut sse = 0.0;
             for row in r.clone() {
-                let pred: f64 = cols.iter().zip(&b).map(|(c, w)| c[row] * w).sum();
-                let e = self.y[row] - pred;
+                let e = self.y[row] - self.predict(u, row, &ex, &b, &mut a);
                 residual[row] = e;
                 sse += e * e;
             }
             unit_sse.push(sse);
         }
-        Ok(CvResult { unit_sse, residual })
+        Ok(CvResult {
+            unit_sse,
+            points: residual.len(),
+            residual,
+        })
+    }
+
+    /// The fitted value at `row` (of unit `unit`) of this design plus the adjusted `ex`
+    /// columns with weights `w`; `a` is scratch (`w.len()` long).
+    fn predict(&self, unit: usize, row: usize, ex: &[Vec<f64>], w: &[f64], a: &mut [f64]) -> f64 {
+        let p = self.width();
+        self.adjusted_row(unit, row, &mut a[..p]);
+        for (o, e) in a[p..].iter_mut().zip(ex) {
+            *o = e[row];
+        }
+        a.iter().zip(w).map(|(c, w)| c * w).sum()
+    }
+
+    /// Fitted values of this design plus the adjusted `ex` columns with weights `w`, for
+    /// every row.
+    fn fitted(&self, folds: &Folds, ex: &[Vec<f64>], w: &[f64]) -> Vec<f64> {
+        let mut a = vec![0.0; w.len()];
+        let mut out = Vec::with_capacity(folds.rows());
+        for (u, r) in folds.unit_rows.iter().enumerate() {
+            for row in r.clone() {
+                out.push(self.predict(u, row, ex, w, &mut a));
+            }
+        }
+        out
     }
 
     /// Fit on every unit: (weights, fitted values) for this design plus `extra`.
@@ -351,20 +431,19 @@ impl Prepared {
         let b = systems
             .solve(&vec![1.0; folds.unit_rows.len()])
             .map_err(|_| DiagnoseError::Singular { what: "full fit" })?;
-        let fitted = (0..folds.rows())
-            .map(|row| systems.cols.iter().zip(&b).map(|(c, w)| c[row] * w).sum())
-            .collect();
+        let fitted = systems.fitted(folds, &b);
         Ok((b, fitted))
     }
 
     /// The per-unit normal equations of this design plus `extra`, ready to be solved with
     /// any unit multiplicities (all ones: the full fit; a bootstrap draw: resampled units).
     pub fn unit_systems<'a>(&'a self, folds: &Folds, extra: &[Vec<f64>]) -> UnitSystems<'a> {
-        let (grams, xty, cols) = self.augmented(folds, extra);
+        let (grams, xty, extra) = self.augmented(folds, extra);
         UnitSystems {
             grams,
             xty,
-            cols,
+            prepared: self,
+            extra,
             ridge: self.ridge,
         }
     }
@@ -374,36 +453,27 @@ impl Prepared {
         &self.y
     }
 
-    /// Per-unit Grams of the design augmented by `extra` columns (cross terms only).
-    fn augmented<'a>(&'a self, folds: &Folds, extra: &[Vec<f64>]) -> Augmented<'a> {
+    /// Per-unit Grams of the design augmented by `extra` columns (cross terms only), and
+    /// the adjusted extras.
+    fn augmented(&self, folds: &Folds, extra: &[Vec<f64>]) -> Augmented {
         let ex: Vec<Vec<f64>> = extra.iter().map(|c| adjust(folds, c)).collect();
         let ranges: Vec<_> = folds.unit_rows.clone();
         let (grams, xty) = self.augment_over(&ranges, &self.grams, &self.xty, &ex);
-        let mut cols: Vec<std::borrow::Cow<'a, [f64]>> = self
-            .cols
-            .iter()
-            .map(|c| std::borrow::Cow::Borrowed(c.as_slice()))
-            .collect();
-        cols.extend(ex.into_iter().map(std::borrow::Cow::Owned));
-        (grams, xty, cols)
+        (grams, xty, ex)
     }
 
-    /// Grams and X'y over every unit's excluded rows (unit plus buffer) for the
-    /// augmented design `cols` (this design's columns first, then the adjusted extras).
-    fn augmented_excluded(
-        &self,
-        folds: &Folds,
-        cols: &[std::borrow::Cow<'_, [f64]>],
-    ) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+    /// Grams and X'y over every unit's excluded rows (unit plus buffer) for this design
+    /// plus the adjusted extras `ex`.
+    fn augmented_excluded(&self, folds: &Folds, ex: &[Vec<f64>]) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
         let ranges: Vec<_> = (0..folds.unit_rows.len())
             .map(|u| folds.excluded_rows(u))
             .collect();
-        let ex: Vec<Vec<f64>> = cols[self.cols.len()..].iter().map(|c| c.to_vec()).collect();
-        self.augment_over(&ranges, &self.excluded_grams, &self.excluded_xty, &ex)
+        self.augment_over(&ranges, &self.excluded_grams, &self.excluded_xty, ex)
     }
 
     /// Per-range Grams and X'y of this design plus the adjusted `ex` columns, from this
-    /// design's own per-range systems (`base_g`, `base_c`) and the cross terms.
+    /// design's own per-range systems (`base_g`, `base_c`) and the cross terms (the
+    /// design's rows computed once per range row).
     fn augment_over(
         &self,
         ranges: &[std::ops::Range<usize>],
@@ -411,11 +481,12 @@ impl Prepared {
         base_c: &[Vec<f64>],
         ex: &[Vec<f64>],
     ) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
-        let p = self.cols.len();
+        let p = self.width();
         let m = ex.len();
         let q = p + m;
         let mut grams = Vec::with_capacity(ranges.len());
         let mut xty = Vec::with_capacity(ranges.len());
+        let mut a = vec![0.0; p];
         for (u, r) in ranges.iter().enumerate() {
             if m == 0 {
                 grams.push(base_g[u].clone());
@@ -426,10 +497,21 @@ impl Prepared {
             for i in 0..p {
                 g[i * q..i * q + p].copy_from_slice(&base_g[u][i * p..(i + 1) * p]);
             }
+            let mut cross = vec![0.0; m * p];
+            for row in r.clone() {
+                self.adjusted_row(u, row, &mut a);
+                for (k, e) in ex.iter().enumerate() {
+                    let ek = e[row];
+                    cross[k * p..(k + 1) * p]
+                        .iter_mut()
+                        .zip(&a)
+                        .for_each(|(s, ai)| *s += ai * ek);
+                }
+            }
             for (k, e) in ex.iter().enumerate() {
                 let e = &e[r.clone()];
                 for i in 0..p {
-                    let v = dot(&self.cols[i][r.clone()], e);
+                    let v = cross[k * p + i];
                     g[i * q + p + k] = v;
                     g[(p + k) * q + i] = v;
                 }
@@ -448,26 +530,36 @@ impl Prepared {
     }
 }
 
-/// Per-unit Grams, per-unit X'y and the (borrowed or new) design columns.
-type Augmented<'a> = (
-    Vec<Vec<f64>>,
-    Vec<Vec<f64>>,
-    Vec<std::borrow::Cow<'a, [f64]>>,
-);
+/// Per-unit Grams, per-unit X'y and the adjusted extra columns.
+type Augmented = (Vec<Vec<f64>>, Vec<Vec<f64>>, Vec<Vec<f64>>);
 
 /// Per-unit normal equations (see `Prepared::unit_systems`).
 pub struct UnitSystems<'a> {
     grams: Vec<Vec<f64>>,
     xty: Vec<Vec<f64>>,
-    /// The design columns (adjusted), base first, run dummies, then the extra columns.
-    pub cols: Vec<std::borrow::Cow<'a, [f64]>>,
+    prepared: &'a Prepared,
+    /// The extra columns (adjusted), after the design and its run dummies.
+    extra: Vec<Vec<f64>>,
     ridge: f64,
 }
 
 impl UnitSystems<'_> {
+    /// Number of columns: the design, its run dummies, the extras.
+    pub fn width(&self) -> usize {
+        self.prepared.width() + self.extra.len()
+    }
+
+    /// Fitted values for every row with weights `w` (`width()` long).
+    pub fn fitted(&self, folds: &Folds, w: &[f64]) -> Vec<f64> {
+        self.prepared.fitted(folds, &self.extra, w)
+    }
+
     /// Weights of the ridge fit with unit u's data counted `counts[u]` times.
-    pub fn solve(&self, counts: &[f64]) -> Result<Vec<f64>, super::linalg::NotPositiveDefinite> {
-        let q = self.cols.len();
+    pub fn solve(
+        &self,
+        counts: &[f64],
+    ) -> Result<Vec<f64>, crate::diagnose::linalg::NotPositiveDefinite> {
+        let q = self.width();
         let mut a = counted_sum(&self.grams, counts);
         let mut b = counted_sum(&self.xty, counts);
         let diag_scale: Vec<f64> = (0..q).map(|i| a[i * q + i]).collect();

@@ -200,7 +200,7 @@ pub struct WidthChoice {
 /// spacing) with the smallest leave-one-out mean square (the narrowest on a tie). `None`
 /// when no grid point can be validated (every run has fewer than `order + 3` samples).
 pub fn choose(column: &str, runs: &[(&[f64], &[f64])], order: usize) -> Option<WidthChoice> {
-    let dt = median_spacing_s(runs, super::input::WINDOW_S);
+    let dt = median_spacing_s(runs, crate::diagnose::input::WINDOW_S);
     let grid: Vec<GridScore> = HALF_WIDTHS_ROWS
         .iter()
         .map(|k| k * dt)

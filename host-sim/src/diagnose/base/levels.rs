@@ -19,7 +19,8 @@
 //! Everything is computed from per-run sums (Gram, X'y, means), so a leave-one-run-out fit
 //! or a bootstrap replicate is one small solve.
 
-use super::linalg::solve_spd;
+use crate::diagnose::linalg::solve_spd;
+use crate::diagnose::validation::design::Design;
 use serde::Serialize;
 
 /// How a law treats the runs' levels.
@@ -79,30 +80,31 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 impl LevelSystems {
-    /// Sums of `cols` (raw, not demeaned; the intercept is added here) and `y` over
-    /// `run_rows`; `ridge` relative as in `cv`.
-    pub fn new(
+    /// Sums of the `design`'s rows (raw, not demeaned; the intercept is added here) and
+    /// `y` over `run_rows`, accumulated row by row; `ridge` relative as in `cv`.
+    pub fn new<D: Design + ?Sized>(
         run_rows: &[std::ops::Range<usize>],
-        cols: &[Vec<f64>],
+        design: &D,
         y: &[f64],
         ridge: f64,
     ) -> Self {
-        let q = cols.len() + 1;
+        let q = design.width() + 1;
         let mut runs = Vec::with_capacity(run_rows.len());
         let mut diag_scale = vec![0.0; q];
+        let mut z = vec![1.0; q];
         for r in run_rows {
             let n = r.len() as f64;
-            let z = |i: usize, row: usize| if i == 0 { 1.0 } else { cols[i - 1][row] };
             let mut gram = vec![0.0; q * q];
             let mut zy = vec![0.0; q];
             let mut zbar = vec![0.0; q];
             for row in r.clone() {
+                design.row(row, &mut z[1..]);
                 for i in 0..q {
-                    let zi = z(i, row);
+                    let zi = z[i];
                     zbar[i] += zi;
                     zy[i] += zi * y[row];
                     for j in 0..=i {
-                        gram[i * q + j] += zi * z(j, row);
+                        gram[i * q + j] += zi * z[j];
                     }
                 }
             }
@@ -132,7 +134,7 @@ impl LevelSystems {
             diag_scale,
             noise_var_inflated: 0.0,
         };
-        s.noise_var_inflated = s.within_noise(run_rows, cols, y);
+        s.noise_var_inflated = s.within_noise(run_rows, design, y);
         s
     }
 
@@ -148,10 +150,10 @@ impl LevelSystems {
 
     /// White-noise variance of the free-offset fit's residual times its AR(1) inflation
     /// (1 + rho) / (1 - rho): n_r x the variance of a run mean of that noise.
-    fn within_noise(
+    fn within_noise<D: Design + ?Sized>(
         &self,
         run_rows: &[std::ops::Range<usize>],
-        cols: &[Vec<f64>],
+        design: &D,
         y: &[f64],
     ) -> f64 {
         let all = vec![1.0; self.runs.len()];
@@ -159,18 +161,14 @@ impl LevelSystems {
             return 0.0;
         };
         let (mut s0, mut s1, mut n) = (0.0, 0.0, 0.0);
+        let mut z = vec![0.0; design.width()];
         for (k, r) in run_rows.iter().enumerate() {
             let rs = &self.runs[k];
             let off = rs.ybar - dot(&rs.zbar[1..], &w[1..]);
             let mut prev: Option<f64> = None;
             for row in r.clone() {
-                let e = y[row]
-                    - off
-                    - cols
-                        .iter()
-                        .zip(&w[1..])
-                        .map(|(c, b)| c[row] * b)
-                        .sum::<f64>();
+                design.row(row, &mut z);
+                let e = y[row] - off - z.iter().zip(&w[1..]).map(|(c, b)| c * b).sum::<f64>();
                 s0 += e * e;
                 n += 1.0;
                 if let Some(p) = prev {
@@ -450,7 +448,7 @@ mod tests {
             }
         }
         let cols = vec![t.clone()];
-        let lv = LevelSystems::new(&rows, &cols, &y, 1e-8);
+        let lv = LevelSystems::new(&rows, cols.as_slice(), &y, 1e-8);
         let pts = lv.run_points();
         let (sse, theta) = lv.heldout_shared().unwrap();
         let shared = score(&sse, &pts);
@@ -466,7 +464,7 @@ mod tests {
             free_w[1] < 0.0,
             "the transient biases the within slope: {free_w:?}"
         );
-        let lv0 = LevelSystems::new(&rows, &cols, &y_null, 1e-8);
+        let lv0 = LevelSystems::new(&rows, cols.as_slice(), &y_null, 1e-8);
         let (_, theta0) = lv0.heldout_shared().unwrap();
         let null_fit = lv0.solve_shared(&vec![1.0; runs], theta0).unwrap();
         assert!(

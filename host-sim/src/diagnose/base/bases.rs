@@ -5,10 +5,11 @@
 //! (T, dT/dt). Each is validated on held-out data the same way (same folds, ridge chosen
 //! from the same grid); the lowest held-out rms wins. Every score is reported.
 
-use super::cv::{CvResult, Folds, Prepared};
-use super::error::DiagnoseError;
-use super::levels::{score, Law, LevelSystems, Score};
-use super::models::{fit_rbf, Stacked, RIDGES};
+use crate::diagnose::base::levels::{score, Law, LevelSystems, Score};
+use crate::diagnose::base::models::{fit_rbf, Stacked, RIDGES};
+use crate::diagnose::error::DiagnoseError;
+use crate::diagnose::validation::cv::{CvResult, Folds, Prepared};
+use crate::diagnose::validation::design::Design;
 use serde::Serialize;
 
 /// Highest polynomial degree in T tried.
@@ -55,20 +56,13 @@ pub struct BaseFit {
     pub width_factor: f64,
     pub ridge: f64,
     /// The RBF basis (None for polynomial and constant bases).
-    pub basis: Option<super::basis::RbfBasis>,
+    pub basis: Option<crate::diagnose::base::basis::RbfBasis>,
 }
 
 impl BaseFit {
-    /// The base's design columns before run offsets are removed.
-    pub fn raw_columns(&self, st: &Stacked) -> Vec<Vec<f64>> {
-        match &self.basis {
-            Some(b) => b.columns(&[st.temp_c.clone(), st.temp_rate_cps.clone()]),
-            None => poly_columns(
-                st,
-                self.spec.poly_degree_t.unwrap_or(0),
-                self.spec.uses_rate,
-            ),
-        }
+    /// The base's design (rows computed on demand) before run offsets are removed.
+    pub fn raw_design(&self) -> std::sync::Arc<dyn Design> {
+        self.prepared.design()
     }
 }
 
@@ -160,7 +154,7 @@ pub fn device_rate_half_s() -> f64 {
 /// `device` is the campaign stacked with the device's span (`device_rate_half_s`) and the
 /// base chosen on it with `folds` (already computed when the folds were laid out).
 pub fn choose_with_rate_window(
-    campaign: &super::input::Campaign,
+    campaign: &crate::diagnose::input::Campaign,
     folds: &Folds,
     (st, device): (Stacked, BaseChoice),
 ) -> Result<(Stacked, BaseChoice), DiagnoseError> {
@@ -173,8 +167,11 @@ pub fn choose_with_rate_window(
     let Ok(loo) = choose(folds, &st_loo) else {
         return Ok((st, device));
     };
-    let gains = super::screen::unit_gains(&device.chosen.cv, &loo.chosen.cv);
-    let p = super::signflip::paired_pvalue(&gains, super::screen::FLIP_SEED);
+    let gains = crate::diagnose::selection::screen::unit_gains(&device.chosen.cv, &loo.chosen.cv);
+    let p = crate::diagnose::validation::signflip::paired_pvalue(
+        &gains,
+        crate::diagnose::selection::screen::FLIP_SEED,
+    );
     if loo.chosen.cv.rms() < device.chosen.cv.rms() && p < RATE_WINDOW_ALPHA {
         Ok((st_loo, loo))
     } else {
@@ -328,11 +325,16 @@ fn unit_score(folds: &Folds, cv: &CvResult) -> Score {
 
 /// Both level treatments of one base, scored leaving one run out (run-grouped layouts).
 fn level_scores(folds: &Folds, st: &Stacked, f: &BaseFit) -> Vec<LevelScore> {
-    if folds.offsets != super::cv::Offsets::PerUnit {
+    if folds.offsets != crate::diagnose::validation::cv::Offsets::PerUnit {
         return vec![];
     }
-    let cols = f.raw_columns(st);
-    let lv = std::sync::Arc::new(LevelSystems::new(&folds.run_rows, &cols, &st.y, f.ridge));
+    let design = f.raw_design();
+    let lv = std::sync::Arc::new(LevelSystems::new(
+        &folds.run_rows,
+        design.as_ref(),
+        &st.y,
+        f.ridge,
+    ));
     let pts = lv.run_points();
     let all = vec![1.0; lv.runs()];
     let mut out = Vec::new();
@@ -343,7 +345,7 @@ fn level_scores(folds: &Folds, st: &Stacked, f: &BaseFit) -> Vec<LevelScore> {
         out.push(LevelScore {
             law: Law::Shared,
             score: score(&sse, &pts),
-            parameters: cols.len() + 1,
+            parameters: design.width() + 1,
             offsets_left: lv.offsets_left(&fit.w),
             sigma_u_dph: fit.sigma_u_dph,
             theta: fit.theta,
@@ -354,7 +356,7 @@ fn level_scores(folds: &Folds, st: &Stacked, f: &BaseFit) -> Vec<LevelScore> {
         out.push(LevelScore {
             law: Law::Free,
             score: score(&sse, &pts),
-            parameters: cols.len() + lv.runs(),
+            parameters: design.width() + lv.runs(),
             offsets_left: lv.offsets_left(&w),
             sigma_u_dph: f64::NAN,
             theta: 1.0,

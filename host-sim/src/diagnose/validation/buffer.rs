@@ -22,10 +22,10 @@
 //! (~70 candidates), and shifting a warm-up or cool-down record wraps its end onto its
 //! start, a jump no physical record has; the buffer keeps the sign-flip family test.
 
-use super::bases::{choose, BaseChoice};
-use super::cv::{Folds, Offsets};
-use super::error::DiagnoseError;
-use super::models::Stacked;
+use crate::diagnose::base::bases::{choose, BaseChoice};
+use crate::diagnose::base::models::Stacked;
+use crate::diagnose::error::DiagnoseError;
+use crate::diagnose::validation::cv::{Folds, Offsets};
 
 /// How the buffer between time blocks is set.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

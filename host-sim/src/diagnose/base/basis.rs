@@ -26,13 +26,13 @@ impl RbfBasis {
             mean[j] = m;
             scale[j] = if v.sqrt() > 1e-300 { v.sqrt() } else { 1.0 };
         }
-        let pts: Vec<Vec<f64>> = (0..n)
-            .map(|i| {
-                (0..d)
-                    .map(|j| (inputs[j][i] - mean[j]) / scale[j])
-                    .collect()
-            })
+        // One flat buffer and a slice per point (a Vec per point cost its header and a
+        // heap block each: ~3x the data at d = 2).
+        let flat: Vec<f64> = (0..n)
+            .flat_map(|i| (0..d).map(move |j| (i, j)))
+            .map(|(i, j)| (inputs[j][i] - mean[j]) / scale[j])
             .collect();
+        let pts: Vec<&[f64]> = flat.chunks_exact(d.max(1)).collect();
         let centres = kmeans(&pts, k.min(n).max(1));
         let spacing = mean_nearest_distance(&centres).max(1e-3);
         Self {
@@ -43,32 +43,72 @@ impl RbfBasis {
         }
     }
 
-    /// The design columns: one Gaussian per centre, then the normalised inputs.
-    // Row-wise walk over column-major inputs: the row index is the natural loop variable.
-    #[allow(clippy::needless_range_loop)]
-    pub fn columns(&self, inputs: &[Vec<f64>]) -> Vec<Vec<f64>> {
-        let d = inputs.len();
-        let n = inputs.first().map_or(0, Vec::len);
+    /// Number of design columns: one per centre, then the inputs.
+    pub fn width(&self) -> usize {
+        self.centres.len() + self.mean.len()
+    }
+
+    /// Row `i` of the design into `out` (`width()` long): one Gaussian per centre, then
+    /// the normalised inputs.
+    pub fn row_into(&self, inputs: &[Vec<f64>], i: usize, out: &mut [f64]) {
+        self.row_with(|j| inputs[j][i], out);
+    }
+
+    /// The design's row at the raw input values `raw(j)` (j over the inputs) into `out`.
+    pub fn row_with(&self, raw: impl Fn(usize) -> f64, out: &mut [f64]) {
+        let k = self.centres.len();
+        let d = self.mean.len();
         let inv = 1.0 / (2.0 * self.width * self.width);
-        let mut cols: Vec<Vec<f64>> = vec![Vec::with_capacity(n); self.centres.len() + d];
-        let mut x = vec![0.0; d];
+        for (j, xj) in out[k..k + d].iter_mut().enumerate() {
+            *xj = (raw(j) - self.mean[j]) / self.scale[j];
+        }
+        let (gauss, x) = out.split_at_mut(k);
+        let x = &x[..d];
+        for (c, g) in self.centres.iter().zip(gauss) {
+            let r2: f64 = c.iter().zip(x).map(|(a, b)| (a - b) * (a - b)).sum();
+            *g = (-r2 * inv).exp();
+        }
+    }
+
+    /// The design columns: one Gaussian per centre, then the normalised inputs (use
+    /// [`RbfDesign`] where the rows can be streamed: n x columns is the memory's largest
+    /// item).
+    pub fn columns(&self, inputs: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        let n = inputs.first().map_or(0, Vec::len);
+        let mut cols: Vec<Vec<f64>> = (0..self.width()).map(|_| Vec::with_capacity(n)).collect();
+        let mut row = vec![0.0; self.width()];
         for i in 0..n {
-            for (j, xj) in x.iter_mut().enumerate() {
-                *xj = (inputs[j][i] - self.mean[j]) / self.scale[j];
-            }
-            for (c, col) in self.centres.iter().zip(cols.iter_mut()) {
-                let r2: f64 = c.iter().zip(&x).map(|(a, b)| (a - b) * (a - b)).sum();
-                col.push((-r2 * inv).exp());
-            }
-            for (col, xj) in cols[self.centres.len()..].iter_mut().zip(&x) {
-                col.push(*xj);
-            }
+            self.row_into(inputs, i, &mut row);
+            cols.iter_mut().zip(&row).for_each(|(c, v)| c.push(*v));
         }
         cols
     }
 }
 
-fn dist2(a: &[f64], b: &[f64]) -> f64 {
+/// An RBF design given by its rows: the basis on `inputs`, then `linear` columns.
+#[derive(Clone, Debug)]
+pub struct RbfDesign {
+    pub basis: RbfBasis,
+    pub inputs: std::sync::Arc<Vec<Vec<f64>>>,
+    pub linear: std::sync::Arc<Vec<Vec<f64>>>,
+}
+
+impl crate::diagnose::validation::design::Design for RbfDesign {
+    fn width(&self) -> usize {
+        self.basis.width() + self.linear.len()
+    }
+
+    fn row(&self, i: usize, out: &mut [f64]) {
+        let b = self.basis.width();
+        self.basis.row_into(&self.inputs, i, &mut out[..b]);
+        for (o, c) in out[b..].iter_mut().zip(self.linear.iter()) {
+            *o = c[i];
+        }
+    }
+}
+
+fn dist2(a: impl AsRef<[f64]>, b: impl AsRef<[f64]>) -> f64 {
+    let (a, b) = (a.as_ref(), b.as_ref());
     a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
 }
 
@@ -101,12 +141,12 @@ fn mean_nearest_distance(c: &[Vec<f64>]) -> f64 {
 /// centre count x width of every RBF fit and candidate, picking centre count, width and
 /// ridge on held-out data anyway. linfa was deterministic (same seed twice, 1 vs 2
 /// threads), so that was not the reason.
-pub fn kmeans(pts: &[Vec<f64>], k: usize) -> Vec<Vec<f64>> {
+pub fn kmeans<P: AsRef<[f64]>>(pts: &[P], k: usize) -> Vec<Vec<f64>> {
     if pts.is_empty() {
         return vec![vec![]];
     }
-    let d = pts[0].len();
-    let mut centres = vec![pts[0].clone()];
+    let d = pts[0].as_ref().len();
+    let mut centres = vec![pts[0].as_ref().to_vec()];
     let mut near: Vec<f64> = pts.iter().map(|p| dist2(p, &pts[0])).collect();
     while centres.len() < k {
         let (far, &dmax) = near
@@ -117,7 +157,7 @@ pub fn kmeans(pts: &[Vec<f64>], k: usize) -> Vec<Vec<f64>> {
         if dmax <= 1e-18 {
             break;
         }
-        centres.push(pts[far].clone());
+        centres.push(pts[far].as_ref().to_vec());
         for (i, p) in pts.iter().enumerate() {
             near[i] = near[i].min(dist2(p, &pts[far]));
         }
@@ -135,6 +175,7 @@ pub fn kmeans(pts: &[Vec<f64>], k: usize) -> Vec<Vec<f64>> {
         let mut sum = vec![vec![0.0; d]; centres.len()];
         let mut cnt = vec![0usize; centres.len()];
         for (p, &a) in pts.iter().zip(&assign) {
+            let p = p.as_ref();
             cnt[a] += 1;
             for j in 0..d {
                 sum[a][j] += p[j];

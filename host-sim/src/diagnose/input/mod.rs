@@ -7,8 +7,10 @@
 //! Raw-rate records are averaged into 10 s windows (the paper's protocol); slower
 //! records (e.g. one mean per burst) are kept as they are.
 
-use super::derivatives::{self, WidthChoice};
+pub mod rawrows;
+
 use super::error::DiagnoseError;
+use crate::diagnose::library::derivatives::{self, WidthChoice};
 use crate::io::runs::Run;
 
 /// Window length the model works on, s.

@@ -1,13 +1,19 @@
 //! The diagnosis as data (JSON, the issue's schema and more) and as words (stdout).
 
-use super::azimuth::AzimuthEffect;
-use super::cause::Cause;
-use super::input::Exclusion;
-use super::residuals::Structure;
-use super::screen::Mode;
-use super::simfit::SimCalibration;
-use super::simterm::TermSummary;
-use super::transforms::Transform;
+pub mod azimuth;
+pub mod olscheck;
+pub mod outliers;
+pub mod plots;
+pub mod residuals;
+
+use crate::diagnose::input::Exclusion;
+use crate::diagnose::library::transforms::Transform;
+use crate::diagnose::report::azimuth::AzimuthEffect;
+use crate::diagnose::report::residuals::Structure;
+use crate::diagnose::selection::cause::Cause;
+use crate::diagnose::selection::screen::Mode;
+use crate::diagnose::simulator::simfit::SimCalibration;
+use crate::diagnose::simulator::simterm::TermSummary;
 use serde::Serialize;
 use std::fmt::Write as _;
 
@@ -28,12 +34,12 @@ pub struct ModelSummary {
     pub width_factor: f64,
     pub ridge: f64,
     /// Every base tried with its held-out rms (the lowest is chosen).
-    pub tried: Vec<super::bases::BaseScore>,
+    pub tried: Vec<crate::diagnose::base::bases::BaseScore>,
     /// Set when T, time and lags of T are nearly collinear.
     pub collinearity_warning: Option<String>,
     /// Which law holds across runs (shared with random turn-on offsets, or free offsets),
     /// chosen on held-out runs (None for time-block layouts).
-    pub levels: Option<super::bases::LevelChoice>,
+    pub levels: Option<crate::diagnose::base::bases::LevelChoice>,
 }
 
 /// One ranked candidate.
@@ -106,7 +112,7 @@ pub struct CampaignSummary {
     pub smallest_attainable_p: f64,
     /// When nothing is named: whether a planted 1-sigma effect would have been
     /// (`power`).
-    pub power_check: Option<super::power::PowerCheck>,
+    pub power_check: Option<crate::diagnose::selection::power::PowerCheck>,
 }
 
 /// The whole diagnosis.
@@ -115,11 +121,11 @@ pub struct Report {
     pub campaign: CampaignSummary,
     pub base: ModelSummary,
     pub residual_structure: Structure,
-    pub outliers: super::outliers::Outliers,
-    pub between_run: super::between::BetweenRun,
+    pub outliers: crate::diagnose::report::outliers::Outliers,
+    pub between_run: crate::diagnose::between::BetweenRun,
     /// Half-width of every `rate` / `accel` window, chosen per column by leave-one-out
     /// validation of the local polynomial on the column itself.
-    pub derivative_widths: Vec<super::derivatives::WidthChoice>,
+    pub derivative_widths: Vec<crate::diagnose::library::derivatives::WidthChoice>,
     pub candidates: Vec<CandidateRow>,
     pub named_cause: Option<Cause>,
     pub cause_in_words: String,
@@ -128,13 +134,13 @@ pub struct Report {
     pub extended: Extended,
     /// For a named `rate` / `accel` cause: the device's causal estimate, its delay and
     /// held-out gain next to the centred one.
-    pub causal_derivative: Option<super::causal::CausalCheck>,
+    pub causal_derivative: Option<crate::diagnose::library::causal::CausalCheck>,
     pub drift_std: DriftStd,
     pub azimuth: Option<Azimuth>,
     /// +/- (block bootstrap) on every fitted coefficient, ratios to the simulator.
-    pub uncertainty: super::uncertainty::Uncertainty,
+    pub uncertainty: crate::diagnose::uncertainty::Uncertainty,
     /// The raw rows before averaging (set by the command that streamed them).
-    pub raw_rows: Option<super::rawrows::RawRows>,
+    pub raw_rows: Option<crate::diagnose::input::rawrows::RawRows>,
     pub simulation: Simulation,
 }
 
@@ -142,13 +148,13 @@ pub struct Report {
 /// few validation units, or a planted 1-sigma effect that was not named either).
 pub fn nothing_named(
     smallest_attainable_p: f64,
-    power_check: Option<&super::power::PowerCheck>,
+    power_check: Option<&crate::diagnose::selection::power::PowerCheck>,
 ) -> String {
-    if smallest_attainable_p >= super::screen::ALPHA {
+    if smallest_attainable_p >= crate::diagnose::selection::screen::ALPHA {
         return format!(
             "cannot decide: no test power (smallest reachable p {smallest_attainable_p:.4} >= alpha {} with this \
              few validation units); absence of a named cause says nothing about the drift",
-            super::screen::ALPHA
+            crate::diagnose::selection::screen::ALPHA
         );
     }
     match power_check.map(|pc| (pc, pc.planted.as_deref())) {
@@ -157,13 +163,13 @@ pub fn nothing_named(
              candidate explains better than chance on held-out data (power not checked: each of \
              the {} best-ranked candidates is mostly predicted by the base itself, so an effect \
              of their shape could not be told from the base on this record)",
-            super::power::TRIED
+            crate::diagnose::selection::power::TRIED
         ),
         Some((pc, Some(planted))) if !pc.named => format!(
             "cannot decide: no test power at {} sigma (a copy of {} planted at the residual's own \
              size, {:.4} deg/h rms, was not named: gain {:+.1} %, p {:.4}); absence of a named \
              cause says nothing about effects of that size",
-            super::power::PLANTED_SIGMAS,
+            crate::diagnose::selection::power::PLANTED_SIGMAS,
             planted,
             pc.planted_rms_dph,
             pc.gain_pct,
@@ -174,7 +180,7 @@ pub fn nothing_named(
              candidate explains better than chance on held-out data (power check: a copy of {} \
              planted at {} sigma, {:.4} deg/h rms, is named, p {:.4})",
             planted,
-            super::power::PLANTED_SIGMAS,
+            crate::diagnose::selection::power::PLANTED_SIGMAS,
             pc.planted_rms_dph,
             pc.p_value
         ),
@@ -203,12 +209,12 @@ pub fn render_text(r: &Report) -> String {
 /// Header: campaign size, validation layout, test power, exclusions.
 fn write_campaign(s: &mut String, c: &CampaignSummary) {
     let _ = writeln!(s, "fogsim diagnose: {} runs, {} points (10 s means, or one row per slower sample); validation: {}", c.runs, c.points, c.validation);
-    if c.smallest_attainable_p >= super::screen::ALPHA {
+    if c.smallest_attainable_p >= crate::diagnose::selection::screen::ALPHA {
         let _ = writeln!(
             s,
             "  note: with this few validation units the smallest attainable p is {:.3} >= alpha {}: no cause can be named",
             c.smallest_attainable_p,
-            super::screen::ALPHA
+            crate::diagnose::selection::screen::ALPHA
         );
     }
     if let Some((pc, planted)) = c
@@ -220,7 +226,7 @@ fn write_campaign(s: &mut String, c: &CampaignSummary) {
             s,
             "  power check (nothing named): a copy of {} planted at {} sigma ({:.4} deg/h rms, orthogonal to the residual) is {}: gain {:+.1} %, p {:.4}",
             planted,
-            super::power::PLANTED_SIGMAS,
+            crate::diagnose::selection::power::PLANTED_SIGMAS,
             pc.planted_rms_dph,
             if pc.named { "named" } else { "NOT named (no test power at that size)" },
             pc.gain_pct,
@@ -303,8 +309,8 @@ fn write_levels(s: &mut String, r: &Report) {
                     "{}/{} {:.4} +/- {:.4}",
                     b.spec.name,
                     match v.law {
-                        super::levels::Law::Shared => "shared",
-                        super::levels::Law::Free => "free",
+                        crate::diagnose::base::levels::Law::Shared => "shared",
+                        crate::diagnose::base::levels::Law::Free => "free",
                     },
                     v.score.heldout_rms_dph,
                     v.score.standard_error_dph
@@ -322,7 +328,7 @@ fn write_levels(s: &mut String, r: &Report) {
         "  levels chosen: {} ({}), {:.4} +/- {:.4} deg/h: the simplest within one standard error of the best, {} {:.4} +/- {:.4}; \
          turn-on repeatability {:.4} deg/h",
         l.base,
-        super::bases::law_name(l.law),
+        crate::diagnose::base::bases::law_name(l.law),
         l.score.heldout_rms_dph,
         l.score.standard_error_dph,
         l.best,
@@ -379,7 +385,10 @@ fn write_residual(s: &mut String, r: &Report) {
 }
 
 /// The validated derivative windows, one line per column.
-fn write_derivative_widths(s: &mut String, widths: &[super::derivatives::WidthChoice]) {
+fn write_derivative_widths(
+    s: &mut String,
+    widths: &[crate::diagnose::library::derivatives::WidthChoice],
+) {
     let _ = writeln!(
         s,
         "  derivative windows (local polynomial, half-width by leave-one-out on the column itself):"
@@ -406,7 +415,7 @@ fn write_derivative_widths(s: &mut String, widths: &[super::derivatives::WidthCh
 }
 
 /// The named derivative as the device would compute it (causal), next to the centred one.
-fn write_causal(s: &mut String, c: &super::causal::CausalCheck) {
+fn write_causal(s: &mut String, c: &crate::diagnose::library::causal::CausalCheck) {
     let causal: Vec<String> = c
         .causal
         .iter()
@@ -555,7 +564,7 @@ fn write_simulator(s: &mut String, r: &Report) {
 }
 
 /// Section 6: every fitted coefficient with its bootstrap range, ratios to the simulator.
-fn write_uncertainty(s: &mut String, u: &super::uncertainty::Uncertainty) {
+fn write_uncertainty(s: &mut String, u: &crate::diagnose::uncertainty::Uncertainty) {
     let _ = writeln!(s, "\n6. Coefficients with +/- ({})", u.method);
     let groups = [
         ("base", &u.base),
@@ -587,7 +596,7 @@ fn write_uncertainty(s: &mut String, u: &super::uncertainty::Uncertainty) {
 }
 
 /// Section 7: Allan deviation, quantisation and steps of the raw rows.
-fn write_raw_rows(s: &mut String, raw: &super::rawrows::RawRows) {
+fn write_raw_rows(s: &mut String, raw: &crate::diagnose::input::rawrows::RawRows) {
     let _ = writeln!(
         s,
         "\n7. Raw rows ({} rows, period {:.4} s; drift = rate_dph - earth_dph, runs pooled, never across a gap)",

@@ -3,7 +3,7 @@
 //! (`simterm`) and the OLS cross-check (`olscheck`) share it without depending on each
 //! other.
 
-use super::transforms::{Candidate, Transform};
+use crate::diagnose::library::transforms::{Candidate, Transform};
 use serde::Serialize;
 
 /// The named cause.
@@ -80,7 +80,7 @@ impl Cause {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::diagnose::transforms::Source;
+    use crate::diagnose::library::transforms::Source;
 
     #[test]
     fn a_cause_is_labelled_like_the_candidate_it_comes_from() {

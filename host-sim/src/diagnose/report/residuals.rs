@@ -1,9 +1,9 @@
 //! Where the baseline's held-out residual has structure: by time since power-on, per
 //! ambient temperature, and against each signal (within-run correlation).
 
-use super::cv::Folds;
-use super::input::Campaign;
-use super::models::Stacked;
+use crate::diagnose::base::models::Stacked;
+use crate::diagnose::input::Campaign;
+use crate::diagnose::validation::cv::Folds;
 use serde::Serialize;
 
 /// Ambients closer than this belong to one group, degC.

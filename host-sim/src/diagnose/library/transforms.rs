@@ -6,8 +6,8 @@
 //! leave-one-out validation (`derivatives`): a diagnosis looks at the whole record, so it
 //! need not be causal. Lags are exact first-order low-passes started at the first value.
 
-use super::derivatives;
-use super::input::{Campaign, Series};
+use crate::diagnose::input::{Campaign, Series};
+use crate::diagnose::library::derivatives;
 use serde::Serialize;
 
 /// Time constants tried for `lag` and `decay`, s.
@@ -100,7 +100,9 @@ impl Candidate {
     pub fn compute(&self, s: &Series) -> Vec<Vec<f64>> {
         let x = self.source.of(s);
         let tau = self.tau_s.unwrap_or(0.0);
-        let half_s = self.half_s.unwrap_or(2.0 * super::input::WINDOW_S);
+        let half_s = self
+            .half_s
+            .unwrap_or(2.0 * crate::diagnose::input::WINDOW_S);
         match self.transform {
             Transform::Value => vec![x.to_vec()],
             Transform::Rate => vec![derivatives::centred(&s.t_s, x, 1, half_s)],

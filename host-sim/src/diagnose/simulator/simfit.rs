@@ -14,10 +14,10 @@
 //! this measures how well the simulator's physics can reproduce the record, not how well
 //! a black box fits it.
 
-use super::error::DiagnoseError;
-use super::input::Campaign;
-use super::levels::LevelSystems;
-use super::linalg::solve_spd;
+use crate::diagnose::base::levels::LevelSystems;
+use crate::diagnose::error::DiagnoseError;
+use crate::diagnose::input::Campaign;
+use crate::diagnose::linalg::solve_spd;
 use crate::stats::rms;
 use serde::Serialize;
 
@@ -39,7 +39,7 @@ pub const LAW_TERMS: [(&str, &str); 5] = [
 ];
 
 /// Fewest runs for the law shared across runs (else free run offsets).
-pub const MIN_RUNS_SHARED: usize = super::cv::MIN_RUNS_GROUPED;
+pub const MIN_RUNS_SHARED: usize = crate::diagnose::validation::cv::MIN_RUNS_GROUPED;
 
 /// Fitted simulator parameters and how well they reproduce the measurements.
 #[derive(Clone, Debug, Serialize)]
@@ -187,7 +187,7 @@ pub const TAU_SEARCH_ROWS: usize = 400;
 /// section in log tau), then the best fast tau between its grid neighbours the same way.
 /// (A 2-D grid then a local pattern search was tried: the valley is narrow and curved,
 /// and the search ended in the wrong basin on the simulator's own runs.)
-fn run_taus(s: &super::input::Series) -> (f64, f64) {
+fn run_taus(s: &crate::diagnose::input::Series) -> (f64, f64) {
     let step = s.t_s.len().div_ceil(TAU_SEARCH_ROWS).max(1);
     let t_s: Vec<f64> = s.t_s.iter().step_by(step).copied().collect();
     let temp: Vec<f64> = s.temp_c.iter().step_by(step).copied().collect();

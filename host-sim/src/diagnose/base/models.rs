@@ -3,11 +3,11 @@
 //! as a linear term or as a further RBF input. Width and ridge are chosen on held-out
 //! data from a small grid, the same way for every model, so comparisons are fair.
 
-use super::basis::RbfBasis;
-use super::cv::{CvResult, Folds, Prepared};
-use super::derivatives;
-use super::error::DiagnoseError;
-use super::input::Campaign;
+use crate::diagnose::base::basis::{RbfBasis, RbfDesign};
+use crate::diagnose::error::DiagnoseError;
+use crate::diagnose::input::Campaign;
+use crate::diagnose::library::derivatives;
+use crate::diagnose::validation::cv::{CvResult, Folds, Prepared};
 
 /// Width factors tried (x mean centre spacing).
 pub const WIDTH_FACTORS: [f64; 3] = [0.5, 1.0, 2.0];
@@ -32,7 +32,7 @@ impl Stacked {
     /// Stacks drift, time, temperature and dT/dt (a centred local polynomial over
     /// +/-`rate_half_s`, `derivatives`; the window is chosen with the base, `bases`).
     pub fn with_rate_half_width(c: &Campaign, rate_half_s: f64) -> Self {
-        let cat = |f: &dyn Fn(&super::input::Series) -> Vec<f64>| {
+        let cat = |f: &dyn Fn(&crate::diagnose::input::Series) -> Vec<f64>| {
             c.runs.iter().flat_map(f).collect::<Vec<f64>>()
         };
         Self {
@@ -70,14 +70,19 @@ pub fn fit_rbf(
     y: &[f64],
 ) -> Result<RbfFit, DiagnoseError> {
     let k_max = centre_count(y.len(), inputs.len());
-    // Only the best setting is remembered; its design is rebuilt once at the end, so at
-    // most one design (n x centres) is alive besides the one being scored (memory).
+    // Only the best setting is remembered and rebuilt at the end. Designs are rows
+    // computed on demand (`RbfDesign`): only the inputs are held, never n x centres.
     let mut best: Option<(usize, f64, f64, f64)> = None;
+    let shared_inputs = std::sync::Arc::new(inputs.to_vec());
+    let shared_linear = std::sync::Arc::new(linear.to_vec());
     let design = |k: usize, wf: f64| {
         let basis = RbfBasis::fit(inputs, k, wf);
-        let mut cols = basis.columns(inputs);
-        cols.extend(linear.iter().cloned());
-        let prepared = Prepared::from_owned(folds, cols, y, RIDGES[0]);
+        let rows = RbfDesign {
+            basis: basis.clone(),
+            inputs: shared_inputs.clone(),
+            linear: shared_linear.clone(),
+        };
+        let prepared = Prepared::from_design(folds, std::sync::Arc::new(rows), y, RIDGES[0]);
         (basis, prepared)
     };
     for frac in CENTRE_FRACTIONS {
@@ -114,7 +119,7 @@ pub fn fit_rbf(
 pub fn fit_rbf_input(
     folds: &Folds,
     st: &Stacked,
-    base: &super::bases::BaseSpec,
+    base: &crate::diagnose::base::bases::BaseSpec,
     cand: &[Vec<f64>],
 ) -> Result<RbfFit, DiagnoseError> {
     let mut inputs = Vec::new();

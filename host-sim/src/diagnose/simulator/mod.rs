@@ -1,0 +1,5 @@
+//! Stage 6, back to the simulator: its physics calibrated to the record and the named cause
+//! mapped onto its drift terms.
+
+pub mod simfit;
+pub mod simterm;

@@ -1,0 +1,120 @@
+//! `fogsim diagnose` keeps memory bounded per row (issue 18 item 8, issue 17 item 5:
+//! at most 300 B per 10 s row). Two campaigns of the same shape, one `SCALE` times the
+//! rows of the other, are diagnosed as child processes; each child's peak RSS comes from
+//! `wait4` (that child's own rusage, not the campaign generator's). The bytes per row are
+//! the slope between the two (the binary and the fixed tables cancel). Before the
+//! designs were streamed it was ~1,000 B/row; `DIAG_MEM_MINUTES` sets the record length
+//! (default 120 min, 11 ambients x 1 and x 3 runs: 7,920 and 23,760 rows).
+//!
+//! Ignored by default because the bound is not met yet (measured 1,450 B/row at the
+//! default sizes: the peak is the trainer cross-check `report::olscheck`, whose fold
+//! Grams grow with the trainer's candidate count until it saturates). Run it with
+//! `cargo test --release -p fog-sim --test diagnose_memory -- --ignored --nocapture`.
+
+use std::path::Path;
+use std::process::Command;
+
+/// The bound, bytes of peak RSS per 10 s row.
+const MAX_BYTES_PER_ROW: f64 = 300.0;
+/// Run-count ratio between the large and the small campaign.
+const SCALE: usize = 3;
+
+fn fogsim(args: &[&str]) {
+    let out = Command::new(env!("CARGO_BIN_EXE_fogsim"))
+        .args(args)
+        .output()
+        .expect("run fogsim");
+    assert!(
+        out.status.success(),
+        "fogsim {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// Peak RSS of one `fogsim diagnose` child, bytes.
+fn diagnose_peak_rss_bytes(camp: &Path, json: &Path) -> f64 {
+    let child = Command::new(env!("CARGO_BIN_EXE_fogsim"))
+        .args([
+            "diagnose",
+            camp.to_str().unwrap(),
+            "--json",
+            json.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .expect("spawn fogsim diagnose");
+    let pid = child.id() as libc::pid_t;
+    let mut status = 0;
+    // SAFETY: plain syscall on our own child; `usage` is a valid out-pointer.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    let r = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
+    assert_eq!(r, pid, "wait4 failed");
+    assert!(
+        libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0,
+        "fogsim diagnose failed on {}",
+        camp.display()
+    );
+    std::mem::forget(child); // already reaped by wait4
+    usage.ru_maxrss as f64 * 1024.0 // Linux: KiB
+}
+
+fn rows_of(camp: &Path) -> usize {
+    std::fs::read_dir(camp)
+        .unwrap()
+        .map(|e| {
+            let text = std::fs::read_to_string(e.unwrap().path()).unwrap();
+            text.lines()
+                .filter(|l| !l.starts_with('#') && !l.starts_with("t_s"))
+                .count()
+        })
+        .sum()
+}
+
+#[test]
+#[ignore = "not met yet: 1,450 B/row slope at 7,920 -> 23,760 rows, the OLS trainer cross-check's \
+            fold Grams (train/gram.rs) dominate; run with --ignored (docs/diagnose.md, Memory)"]
+fn diagnose_peak_memory_grows_at_most_300_bytes_per_row() {
+    let minutes = std::env::var("DIAG_MEM_MINUTES").unwrap_or_else(|_| "120".into());
+    let dir = tempfile_dir();
+    let mut points = Vec::new();
+    for runs in [1, SCALE] {
+        let camp = dir.join(format!("c{runs}"));
+        let runs_s = runs.to_string();
+        fogsim(&[
+            "campaign",
+            "--out",
+            camp.to_str().unwrap(),
+            "--runs",
+            &runs_s,
+            "--duration-min",
+            &minutes,
+            "--seed",
+            "3",
+        ]);
+        let rows = rows_of(&camp);
+        let rss = diagnose_peak_rss_bytes(&camp, &dir.join(format!("c{runs}.json")));
+        points.push((rows as f64, rss));
+    }
+    let (small, large) = (points[0], points[1]);
+    let per_row = (large.1 - small.1) / (large.0 - small.0);
+    eprintln!(
+        "peak RSS {:.1} MB at {} rows, {:.1} MB at {} rows: {per_row:.0} B per row",
+        small.1 / 1e6,
+        small.0,
+        large.1 / 1e6,
+        large.0
+    );
+    assert!(
+        per_row <= MAX_BYTES_PER_ROW,
+        "diagnose keeps {per_row:.0} B per 10 s row (bound {MAX_BYTES_PER_ROW})"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A fresh directory of this test's own (pid in the name: concurrent runs never mix).
+fn tempfile_dir() -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("fog_diag_mem_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
