@@ -29,6 +29,9 @@ pub const LINK_VERSION: u16 = 3;
 
 /// Most field records in one `FieldRecords` reply (one reply fits `MAX_LINK_FRAME_LEN`).
 pub const MAX_FIELD_RECORDS_PER_REPLY: usize = 4;
+/// Zero bytes a host sends before `GetFieldRecords`: they pay (reply budget) for the
+/// largest `FieldRecords` frame and the `Status` that follows every command.
+pub const FIELD_REQUEST_PADDING: usize = 2 * MAX_LINK_FRAME_LEN;
 
 /// Why the device last reset.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

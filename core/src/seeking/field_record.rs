@@ -244,16 +244,21 @@ impl SeekTempState {
     }
 }
 
-/// The residual bias of a completed two-position seek: the half-sum of its two positions'
-/// compensated rates, deg/h (`None` for any other position count: a four-position seek's
-/// bias is its own estimate, not recorded here).
+/// The residual bias of a completed two-position seek: the half-sum of its two main
+/// positions' compensated rates (headings 0 and 180 deg apart; the short ambiguity dwell
+/// at +90 deg is not used), deg/h. `None` for a four-position seek (its bias is its own
+/// estimate, not recorded here) or if the two main positions are not opposite.
 pub fn two_position_residual_dph(result: &crate::seeking::northfinder::SeekResult) -> Option<f64> {
-    if result.n_positions != 2 {
+    use crate::seeking::northfinder::SeekMode;
+    if result.mode != SeekMode::TwoPosition || result.n_positions < 2 {
         return None;
     }
-    let a = result.positions[0].mean_rate_dph;
-    let b = result.positions[1].mean_rate_dph;
-    let half_sum = 0.5 * (a + b);
+    let (a, b) = (&result.positions[0], &result.positions[1]);
+    let apart_deg = libm::fabsf(libm::remainderf(b.heading_deg - a.heading_deg, 360.0));
+    if libm::fabsf(apart_deg - 180.0) > 1.0 {
+        return None;
+    }
+    let half_sum = 0.5 * (a.mean_rate_dph + b.mean_rate_dph);
     half_sum.is_finite().then_some(half_sum)
 }
 

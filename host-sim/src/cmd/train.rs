@@ -95,6 +95,16 @@ pub struct Args {
     /// Write the training report as JSON here.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Field records (`fogsim field pull --out DIR`) measured under this chamber model:
+    /// each is one observation of the residual bias at its temperature state; a ridge
+    /// correction linear in the model's T / dT/dt / d2T/dt2 inputs is fitted to them and
+    /// folded into the model (`fog_sim::field::refine`).
+    #[arg(long)]
+    pub field: Option<PathBuf>,
+    /// Weight W of each field seek against the chamber model's prior (one row of weight 1
+    /// per correction coefficient). Default: chosen by leave-one-out over the field seeks.
+    #[arg(long, requires = "field")]
+    pub field_weight: Option<f64>,
 }
 
 fn parse_width_search(s: &str) -> Result<WidthSearch, String> {
@@ -191,7 +201,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     cfg.check(most_inputs).context("fogsim train")?;
     // Outputs next: a bad or input-destroying output is refused before any training,
     // and held until the command ends.
-    let guard = OutputGuard::new(&args.runs);
+    let mut inputs = args.runs.clone();
+    inputs.extend(
+        args.field
+            .iter()
+            .map(|d| crate::field::records_file::json_path(d)),
+    );
+    if args
+        .field_weight
+        .is_some_and(|w| !(w.is_finite() && w >= 0.0))
+    {
+        anyhow::bail!("--field-weight: must be a finite number >= 0");
+    }
+    let guard = OutputGuard::new(&inputs);
     check_outputs(&args, &guard)?;
     let outputs: Vec<&Path> = [
         Some(&args.out),
@@ -249,9 +271,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             anyhow::bail!("model does not clearly improve held-out drift");
         }
     }
+    let model = match &args.field {
+        Some(dir) => {
+            let refined = crate::field::refine_with_dir(&outcome.model, dir, args.field_weight)?;
+            print!("{}", refined.summary());
+            refined.model
+        }
+        None => outcome.model.clone(),
+    };
     let mut buf = [0u8; MAX_ENCODED_LEN];
-    let len = outcome
-        .model
+    let len = model
         .encode(&mut buf)
         .map_err(|e| anyhow::anyhow!("encoding the trained model: {e}"))?;
     stage(&mut staged, &args.out, &buf[..len])?;
