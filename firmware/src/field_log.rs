@@ -202,7 +202,7 @@ impl<F: NorFlash> FieldLog<F> {
     fn writable_slot(&mut self) -> Result<u32, FieldLogError> {
         for _ in 0..=self.slots() {
             let slot = self.cursor;
-            if slot % self.slots_per_sector == 0 {
+            if slot.is_multiple_of(self.slots_per_sector) {
                 let sector = slot / self.slots_per_sector;
                 if !self.sector_erased(sector)? {
                     self.erase_sector(sector)?;
@@ -248,7 +248,7 @@ impl<F: NorFlash> FieldLog<F> {
         if self.scan.oldest_sequence.is_none() {
             self.scan.oldest_sequence = Some(record.sequence);
         }
-        if slot % self.slots_per_sector == 0 {
+        if slot.is_multiple_of(self.slots_per_sector) {
             // A sector was (re)filled from empty: the oldest kept record may have moved.
             self.refresh_oldest()?;
         }

@@ -181,6 +181,37 @@ fn check_outputs(args: &Args, guard: &OutputGuard) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Every file the command reads (runs, field records), checked against the outputs;
+/// `--field-weight` is checked here too, before anything is read.
+fn inputs(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
+    if args
+        .field_weight
+        .is_some_and(|w| !(w.is_finite() && w >= 0.0))
+    {
+        anyhow::bail!("--field-weight: must be a finite number >= 0");
+    }
+    let mut inputs = args.runs.clone();
+    inputs.extend(
+        args.field
+            .iter()
+            .map(|d| crate::field::records_file::json_path(d)),
+    );
+    Ok(inputs)
+}
+
+/// The trained model, refined with `--field` records if given (`crate::field`).
+fn field_refined(
+    args: &Args,
+    model: &fog_core::model::format::RbfModel,
+) -> anyhow::Result<fog_core::model::format::RbfModel> {
+    let Some(dir) = &args.field else {
+        return Ok(model.clone());
+    };
+    let refined = crate::field::refine_with_dir(model, dir, args.field_weight)?;
+    print!("{}", refined.summary());
+    Ok(refined.model)
+}
+
 /// Stages one output (see [`StagedFiles`]), naming it on failure.
 fn stage(staged: &mut StagedFiles, path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     staged
@@ -201,19 +232,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     cfg.check(most_inputs).context("fogsim train")?;
     // Outputs next: a bad or input-destroying output is refused before any training,
     // and held until the command ends.
-    let mut inputs = args.runs.clone();
-    inputs.extend(
-        args.field
-            .iter()
-            .map(|d| crate::field::records_file::json_path(d)),
-    );
-    if args
-        .field_weight
-        .is_some_and(|w| !(w.is_finite() && w >= 0.0))
-    {
-        anyhow::bail!("--field-weight: must be a finite number >= 0");
-    }
-    let guard = OutputGuard::new(&inputs);
+    let guard = OutputGuard::new(&inputs(&args)?);
     check_outputs(&args, &guard)?;
     let outputs: Vec<&Path> = [
         Some(&args.out),
@@ -271,14 +290,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             anyhow::bail!("model does not clearly improve held-out drift");
         }
     }
-    let model = match &args.field {
-        Some(dir) => {
-            let refined = crate::field::refine_with_dir(&outcome.model, dir, args.field_weight)?;
-            print!("{}", refined.summary());
-            refined.model
-        }
-        None => outcome.model.clone(),
-    };
+    let model = field_refined(&args, &outcome.model)?;
     let mut buf = [0u8; MAX_ENCODED_LEN];
     let len = model
         .encode(&mut buf)

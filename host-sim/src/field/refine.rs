@@ -138,10 +138,10 @@ pub fn fit(obs: &[FieldObservation], terms: &[Term], w: f64) -> Correction {
     for o in obs {
         let mut z = vec![1.0];
         z.extend(terms.iter().map(|t| (o.input(t.kind) - t.mean) / t.std));
-        for i in 0..p {
-            b[i] += w * z[i] * o.residual_bias_dph;
-            for k in 0..p {
-                a[i][k] += w * z[i] * z[k];
+        for ((row, bi), &zi) in a.iter_mut().zip(b.iter_mut()).zip(&z) {
+            *bi += w * zi * o.residual_bias_dph;
+            for (x, &zk) in row.iter_mut().zip(&z) {
+                *x += w * zi * zk;
             }
         }
     }
@@ -159,13 +159,15 @@ pub fn fit(obs: &[FieldObservation], terms: &[Term], w: f64) -> Correction {
 fn solve_spd(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
     let p = b.len();
     for c in 0..p {
-        let piv = a[c][c];
-        for r in c + 1..p {
-            let f = a[r][c] / piv;
-            for k in c..p {
-                a[r][k] -= f * a[c][k];
+        let (top, rest) = a.split_at_mut(c + 1);
+        let pivot_row = &top[c];
+        let bc = b[c];
+        for (row, br) in rest.iter_mut().zip(b[c + 1..].iter_mut()) {
+            let f = row[c] / pivot_row[c];
+            for (x, &y) in row[c..].iter_mut().zip(&pivot_row[c..]) {
+                *x -= f * y;
             }
-            b[r] -= f * b[c];
+            *br -= f * bc;
         }
     }
     let mut x = vec![0.0; p];
