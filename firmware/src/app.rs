@@ -25,6 +25,7 @@ use fog_core::link::messages::{
     Command, DeviceMessage, FaultState, Refusal, ResetReason, SeekReport, Status, LINK_VERSION,
 };
 use fog_core::model::format::RbfModel;
+use fog_core::seeking::field_record::{two_position_residual_dph, FieldRecord, SeekTempState};
 use fog_core::seeking::heading_cal::HeadingHarmonic;
 use fog_core::seeking::northfinder::{NorthFinder, SeekConfig, SeekError, SeekMode, SeekResult};
 use fog_core::seeking::quality::{
@@ -184,6 +185,8 @@ pub struct App<T: Turntable, C: BorrowMut<Compensator> = Compensator> {
     /// (level until the first reading: a board without an inclinometer, the replay).
     tilt_window: TiltMean,
     tilt: Tilt,
+    /// Temperature state over the running seek's valid windows (the field record's).
+    seek_temp: SeekTempState,
 }
 
 impl<T: Turntable> App<T>
@@ -231,6 +234,7 @@ where
             bit: BitWord::PASS,
             tilt_window: TiltMean::default(),
             tilt: Tilt::LEVEL,
+            seek_temp: SeekTempState::new(),
         })
     }
 
@@ -312,6 +316,8 @@ where
         let refused = |r| Some(DeviceMessage::Refused(r));
         match cmd {
             Command::GetStatus => None,
+            // A board that keeps a field log answers this itself (`field_log`).
+            Command::GetFieldRecords { .. } => refused(Refusal::NoFieldLog),
             Command::Abort => {
                 if !self.supervisor.is_seeking() {
                     return refused(Refusal::NotSeeking);
@@ -393,7 +399,36 @@ where
         }
     }
 
+    /// The field record of a finished seek (sequence 0: the ring numbers it), or `None`
+    /// unless it was a valid two-position seek with a temperature state: the half-sum of
+    /// its two positions' compensated rates at the mean state of its windows.
+    /// `model_crc32`: the CRC-32 of the stored model in use (the board's store knows it);
+    /// recorded only while the compensator applies a model.
+    pub fn field_record(
+        &self,
+        r: &SeekResult,
+        validity: Validity,
+        model_crc32: Option<u32>,
+    ) -> Option<FieldRecord> {
+        if validity != Validity::Valid || r.mode != SeekMode::TwoPosition {
+            return None;
+        }
+        let residual_dph = two_position_residual_dph(r)?;
+        let state = self.seek_temp.state()?;
+        let record = FieldRecord {
+            sequence: 0,
+            temp_c: state.temp_c,
+            temp_rate_cps: state.temp_rate_cps,
+            temp_accel_cps2: state.temp_accel_cps2,
+            t_since_power_on_s: r.t_end_s as f32,
+            residual_bias_dph: residual_dph as f32,
+            model_crc32: self.compensator.borrow().model().and(model_crc32),
+        };
+        record.is_plausible().then_some(record)
+    }
+
     fn start_seek(&mut self, t_s: f64) -> Result<(), QualityError> {
+        self.seek_temp.reset();
         self.table.last_error = None;
         self.supervisor
             .start(&mut self.table, t_s, self.tilt, self.bit)?;
@@ -460,12 +495,18 @@ where
                 self.tilt = t;
             }
             self.tilt_window = TiltMean::default();
+            if self.supervisor.is_seeking() && w.status.is_valid() {
+                self.seek_temp.push(w.t_end_s, w.temp_c, w.temp_rate_cps);
+            }
             match self.supervisor.on_window(&w, self.tilt, &mut self.table) {
                 Ok(SupervisorEvent::Done(r, v)) => {
                     self.seeks_done = self.seeks_done.saturating_add(1);
                     step.seek = Some(SeekOutcome::Done(r, v));
                 }
-                Ok(SupervisorEvent::Restarted(why)) => step.restarted = Some(why),
+                Ok(SupervisorEvent::Restarted(why)) => {
+                    self.seek_temp.reset();
+                    step.restarted = Some(why);
+                }
                 Ok(SupervisorEvent::Running) => {}
                 Err(e) => step.seek = Some(self.fail(e, w.t_end_s)),
             }

@@ -7,8 +7,9 @@
 use crate::fault_record::BootFault;
 
 /// One line naming every argument, for the refusal message.
-pub const KNOWN: &str = "flash-file=PATH gyro-rate=HZ seek-dwell-s=S tilt-mdeg=PITCH:ROLL \
-inject=panic|hang|panic-after-commit|hardfault|boot-fault=NAME flash-cut-at=N";
+pub const KNOWN: &str = "flash-file=PATH field-file=PATH gyro-rate=HZ seek-dwell-s=S \
+tilt-mdeg=PITCH:ROLL inject=panic|hang|panic-after-commit|hardfault|boot-fault=NAME \
+flash-cut-at=N flash-tear-at=N";
 
 /// A fault the QEMU scenarios inject (first boot only, except where noted).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -41,6 +42,13 @@ pub struct BootArgs {
     /// `flash-cut-at=N`: stop before the N-th write to the flash image (1 = first
     /// since boot) and wait there to be killed: a power cut at a known point.
     pub flash_cut_at: Option<u32>,
+    /// `field-file=PATH` was given (the field-record ring's image, opened by the flash
+    /// driver itself).
+    pub field_file: bool,
+    /// `flash-tear-at=N`: the N-th write to a flash image (counted over all images since
+    /// boot) is made only in its first half, then the firmware waits to be killed: a
+    /// power cut in the middle of a flash write.
+    pub flash_tear_at: Option<u32>,
 }
 
 impl BootArgs {
@@ -51,6 +59,8 @@ impl BootArgs {
         tilt_mdeg: None,
         flash_file: false,
         flash_cut_at: None,
+        field_file: false,
+        flash_tear_at: None,
     };
 }
 
@@ -82,6 +92,15 @@ pub fn parse<'a>(args: impl IntoIterator<Item = &'a str>) -> Result<BootArgs, Ar
         match key {
             "flash-file" if !value.is_empty() => out.flash_file = true,
             "flash-file" => return Err(err("needs a file name")),
+            "field-file" if !value.is_empty() => out.field_file = true,
+            "field-file" => return Err(err("needs a file name")),
+            "flash-tear-at" => {
+                out.flash_tear_at = Some(
+                    number(value)
+                        .filter(|&n| n > 0)
+                        .ok_or(err("not a write number >= 1"))?,
+                )
+            }
             "gyro-rate" => {
                 out.gyro_rate_hz = Some(number(value).ok_or(err("not a whole number of Hz"))?)
             }

@@ -47,8 +47,9 @@ pub fn status(t_s: f64, model_crc32: Option<u32>, faults: FaultState) -> Status 
 pub fn answer(cmd: Command) -> Option<DeviceMessage> {
     match cmd {
         Command::GetStatus => None,
-        Command::StartSeek { .. } | Command::SetLatitude { .. } | Command::Abort => {
-            Some(DeviceMessage::Refused(Refusal::SafeMode))
-        }
+        Command::StartSeek { .. }
+        | Command::SetLatitude { .. }
+        | Command::Abort
+        | Command::GetFieldRecords { .. } => Some(DeviceMessage::Refused(Refusal::SafeMode)),
     }
 }

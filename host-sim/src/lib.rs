@@ -21,7 +21,8 @@
 //!   |         files, import, the one atomic writer, the output guard
 //!   |         upload, monitor: the host-link clients (model upload, status/results);
 //!   |         rig: the simulated gyro + turntable served on the device's links;
-//!   |         registry: the calibration registry (SQLite: counters, models, uploads, results)
+//!   |         registry: the calibration registry (SQLite: counters, models, uploads, results);
+//!   |         field: field records (pull client, record files, the field correction fit)
 //! stats/      statistics: std/rms, the one pooled within-run std, drift metrics, Allan,
 //!             windows in fog-core's convention; beside it seed (the one SplitMix64
 //!             seed mix) and fanout (the one thread fan-out, results in job order)
@@ -30,6 +31,7 @@
 pub mod cmd;
 pub mod diagnose;
 pub mod fanout;
+pub mod field;
 pub mod io;
 pub mod monitor;
 pub mod pipeline;

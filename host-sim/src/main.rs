@@ -44,6 +44,8 @@ enum Command {
     Registry(cmd::registry::Args),
     /// Serve a simulated gyro and turntable on the firmware's links (QEMU or a board).
     Rig(cmd::rig::Args),
+    /// Field records: pull what the device learnt from its seeks.
+    Field(cmd::field::Args),
 }
 
 fn main() {
@@ -62,6 +64,7 @@ fn main() {
         Command::Monitor(a) => cmd::monitor::run(a),
         Command::HeadingCal(a) => cmd::heading_cal::run(a),
         Command::Registry(a) => cmd::registry::run(a),
+        Command::Field(a) => cmd::field::run(a),
         Command::Rig(a) => cmd::rig::run(a),
     };
     if let Err(e) = result {

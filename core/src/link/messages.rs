@@ -16,14 +16,22 @@ use crate::link::bit::BitWord;
 use crate::link::upload::{
     decode_message, encode_frame, FrameError, Request, ResetCause, Response,
 };
+use crate::seeking::field_record::FieldRecord;
 use crate::seeking::quality::{MotionReason, QualityError, SeekState, Validity};
 use crate::seeking::tilt::Tilt;
 
 /// Version of these messages (in every `Status`). 2: `Status` gained `heading_cal` and
 /// `faults` (safe mode), `Refusal` gained `SafeMode`; a version-1 peer cannot decode a
 /// version-2 status (postcard has no optional trailing fields), so both ends move
-/// together (they build against this crate).
-pub const LINK_VERSION: u16 = 2;
+/// together (they build against this crate). 3: `Command::GetFieldRecords` and
+/// `DeviceMessage::FieldRecords` appended (the earlier variants keep their bytes).
+pub const LINK_VERSION: u16 = 3;
+
+/// Most field records in one `FieldRecords` reply (one reply fits `MAX_LINK_FRAME_LEN`).
+pub const MAX_FIELD_RECORDS_PER_REPLY: usize = 4;
+/// Zero bytes a host sends before `GetFieldRecords`: they pay (reply budget) for the
+/// largest `FieldRecords` frame and the `Status` that follows every command.
+pub const FIELD_REQUEST_PADDING: usize = 2 * MAX_LINK_FRAME_LEN;
 
 /// Why the device last reset.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -60,6 +68,10 @@ pub enum Command {
     Abort,
     /// Ask for one `Status` now.
     GetStatus,
+    /// Ask for the stored field records (one per completed two-position seek) with
+    /// sequence >= `from_sequence`, oldest first, at most `max_count` (clamped to
+    /// `MAX_FIELD_RECORDS_PER_REPLY`); answered with `FieldRecords`.
+    GetFieldRecords { from_sequence: u32, max_count: u8 },
 }
 
 /// Device -> PC.
@@ -71,6 +83,29 @@ pub enum DeviceMessage {
     Accepted,
     /// The last command was refused, and why.
     Refused(Refusal),
+    /// The answer to `GetFieldRecords`.
+    FieldRecords(FieldRecordBatch),
+}
+
+/// Up to `MAX_FIELD_RECORDS_PER_REPLY` field records (the first `count` of `records`),
+/// and the sequence range the device holds, so the host knows when it has them all.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FieldRecordBatch {
+    pub records: [FieldRecord; MAX_FIELD_RECORDS_PER_REPLY],
+    pub count: u8,
+    /// Oldest and newest sequence in the device's ring (`None`: the ring is empty).
+    pub oldest_sequence: Option<u32>,
+    pub newest_sequence: Option<u32>,
+    /// `false`: the ring could not be read (flash fault); `count` is then 0.
+    pub readable: bool,
+}
+
+impl FieldRecordBatch {
+    /// The records actually carried (a `count` beyond the array is clamped).
+    pub fn records(&self) -> &[FieldRecord] {
+        let n = usize::from(self.count).min(MAX_FIELD_RECORDS_PER_REPLY);
+        self.records.get(..n).unwrap_or(&[])
+    }
 }
 
 /// Why a command was refused.
@@ -86,6 +121,8 @@ pub enum Refusal {
     /// The device is in safe mode after a reset loop (`Status::faults`): no seeks until
     /// a good model upload (or a power cycle) clears it.
     SafeMode,
+    /// `GetFieldRecords` on a board that keeps no field log.
+    NoFieldLog,
 }
 
 /// Faults across resets (the firmware's no-init RAM record): resets by a fault in a row
@@ -175,7 +212,7 @@ pub enum DeviceFrame {
 }
 
 /// Largest frame of any link message on the wire, bytes (checked by a test).
-pub const MAX_LINK_FRAME_LEN: usize = 96;
+pub const MAX_LINK_FRAME_LEN: usize = 160;
 
 /// Encodes one message as a wire frame (upload framing) into `out`.
 pub fn encode<T: Serialize>(msg: &T, out: &mut [u8]) -> Result<usize, FrameError> {
@@ -254,7 +291,45 @@ mod tests {
             ))),
             DeviceMessage::Refused(Refusal::NotSeeking),
             DeviceMessage::Refused(Refusal::SafeMode),
+            DeviceMessage::FieldRecords(full_batch()),
+            DeviceMessage::FieldRecords(FieldRecordBatch {
+                records: [FieldRecord::ZERO; MAX_FIELD_RECORDS_PER_REPLY],
+                count: 0,
+                oldest_sequence: None,
+                newest_sequence: None,
+                readable: false,
+            }),
         ]
+    }
+
+    /// The largest batch: every record at its longest postcard encoding.
+    fn full_batch() -> FieldRecordBatch {
+        let worst = FieldRecord {
+            sequence: u32::MAX - 1,
+            temp_c: -40.5,
+            temp_rate_cps: 0.01,
+            temp_accel_cps2: -1e-5,
+            t_since_power_on_s: 86_400.0,
+            residual_bias_dph: 0.5,
+            model_crc32: Some(u32::MAX),
+        };
+        FieldRecordBatch {
+            records: [worst; MAX_FIELD_RECORDS_PER_REPLY],
+            count: MAX_FIELD_RECORDS_PER_REPLY as u8,
+            oldest_sequence: Some(u32::MAX - 1),
+            newest_sequence: Some(u32::MAX - 1),
+            readable: true,
+        }
+    }
+
+    #[test]
+    fn a_batch_shows_only_its_count_of_records() {
+        let mut b = full_batch();
+        assert_eq!(b.records().len(), MAX_FIELD_RECORDS_PER_REPLY);
+        b.count = 2;
+        assert_eq!(b.records().len(), 2);
+        b.count = u8::MAX;
+        assert_eq!(b.records().len(), MAX_FIELD_RECORDS_PER_REPLY);
     }
 
     #[test]
@@ -280,6 +355,10 @@ mod tests {
             },
             Command::Abort,
             Command::GetStatus,
+            Command::GetFieldRecords {
+                from_sequence: u32::MAX,
+                max_count: 4,
+            },
         ] {
             let n = encode(&HostFrame::Link(c), &mut wire).unwrap();
             let p = crate::link::upload::decode_frame(&mut wire[..n - 1]).unwrap();

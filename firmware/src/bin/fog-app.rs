@@ -19,7 +19,9 @@
 //! - SysTick: 1 kHz time base for turntable timeouts and the gyro's frame time base
 //!   (counter wraps during a stall are recovered from it);
 //! - the CMSDK watchdog (0x4000_8000): 500 ms, fed only while the gyro path is serviced;
-//! - the last 16 KiB of flash: the two model slots.
+//! - the last 16 KiB of flash: the two model slots; the 16 KiB below them: the
+//!   field-record ring (`fog_firmware::field_log`), one record per completed
+//!   two-position seek, sent on `GetFieldRecords`.
 //!
 //! Main loop, gyro path first: every gyro byte the RX interrupt put in its ring ->
 //! samples -> application (10 s windows, compensation, north seeks on the table);
@@ -64,9 +66,10 @@ use embedded_hal_nb::serial::{Read as _, Write as _};
 use fog_core::compensation::compensator::Compensator;
 use fog_core::hal::Gyro;
 use fog_core::link::bit::BitLimits;
-use fog_core::link::messages::{DeviceMessage, FaultState, ResetReason};
+use fog_core::link::messages::{Command, DeviceMessage, FaultState, Refusal, ResetReason};
 use fog_core::link::upload::ResetRecord;
 use fog_core::model::format::RbfModel;
+use fog_core::seeking::field_record::FieldRecord;
 use fog_core::seeking::tilt::Tilt;
 use fog_firmware::app::{App, AppConfig, BoardStatus, SeekOutcome};
 use fog_firmware::bit_monitor::{BitCounters, BitMonitor};
@@ -79,6 +82,7 @@ use fog_firmware::drivers::inclinometer::{
 use fog_firmware::drivers::serial_inclinometer::SerialInclinometer;
 use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig};
 use fog_firmware::fault_record::{CleanRun, FaultRecord};
+use fog_firmware::field_log::FieldLog;
 use fog_firmware::health::{GyroWatch, StuckEvent, DEFAULT_STUCK_RUN};
 use fog_firmware::link_out::{queue_whole, LinkFrame};
 use fog_firmware::upload::UploadServer;
@@ -137,13 +141,14 @@ fn main() -> ! {
     inject_fault_at_boot(options);
     let gyro_rate_hz = options.gyro_rate_hz;
     // SAFETY: each UART block and the model region are taken exactly once, here.
-    let (mut host, gyro_uart, table_uart, incl_uart, flash) = unsafe {
+    let (mut host, gyro_uart, table_uart, incl_uart, flash, field_flash) = unsafe {
         (
             uart::CmsdkUart::new(0, HOST_BAUD),
             uart::CmsdkUart::new(1, GYRO_BAUD),
             uart::CmsdkUart::new(2, TABLE_BAUD),
             uart::CmsdkUart::new(3, INCL_BAUD),
             flash::take_app_flash(),
+            flash::take_field_flash(),
         )
     };
 
@@ -180,6 +185,7 @@ fn main() -> ! {
         server.slots_refused_at_boot()
     );
     report_slots(server.boot_report());
+    let mut field_log = open_field_log(field_flash);
 
     let table = SerialTurntable::new(table_uart, millis::MillisClock, TurntableConfig::default());
     // Configured in place in `COMPENSATOR`; the `App` around it is a few hundred bytes.
@@ -284,6 +290,10 @@ fn main() -> ! {
                         }
                     }
                     if let Some(SeekOutcome::Done(r, v)) = &step.seek {
+                        let model_crc32 = server.active_info().map(|i| i.model_crc32);
+                        if let Some(record) = app.field_record(r, *v, model_crc32) {
+                            append_field_record(field_log.as_mut(), record);
+                        }
                         let report = app.report(r, *v);
                         send_link(tx_queue, DeviceMessage::Result(report));
                         seek_line(&report);
@@ -344,7 +354,19 @@ fn main() -> ! {
                 server.note_reply_dropped();
             }
             if let Some(cmd) = command {
-                let answer = app.command(cmd, watch.last_t_s());
+                let answer = match cmd {
+                    Command::GetFieldRecords {
+                        from_sequence,
+                        max_count,
+                    } => Some(
+                        field_log
+                            .as_mut()
+                            .map_or(DeviceMessage::Refused(Refusal::NoFieldLog), |log| {
+                                DeviceMessage::FieldRecords(log.answer(from_sequence, max_count))
+                            }),
+                    ),
+                    _ => app.command(cmd, watch.last_t_s()),
+                };
                 let board = board_status(&watch, &gyro, server, reset_reason, faults);
                 let status = DeviceMessage::Status(app.status(board));
                 for msg in answer.into_iter().chain(core::iter::once(status)) {
@@ -386,6 +408,56 @@ where
     defmt::info!("heading correction: {} headings (0: none)", n_headings);
     #[cfg(feature = "log-semihosting")]
     semihosting::eprintln!("FOG-HEADING-CAL n_headings={}", n_headings);
+}
+
+/// Opens the field-record ring on its region (`None`: the region is unusable; seeks
+/// run on, records are not kept, `GetFieldRecords` is refused). Under QEMU the boot scan
+/// is also a plain `FOG-FIELD-LOG` line.
+fn open_field_log(flash: flash::AppFlash) -> Option<FieldLog<flash::AppFlash>> {
+    let capacity = embedded_storage::nor_flash::ReadNorFlash::capacity(&flash) as u32;
+    match FieldLog::open(flash, 0, capacity) {
+        Ok(log) => {
+            let s = log.scan();
+            defmt::info!("field log: {}", s);
+            #[cfg(feature = "log-semihosting")]
+            semihosting::eprintln!(
+                "FOG-FIELD-LOG valid={} corrupt={} oldest={} newest={}",
+                s.valid,
+                s.corrupt,
+                s.oldest_sequence.unwrap_or(0),
+                s.newest_sequence.unwrap_or(0)
+            );
+            Some(log)
+        }
+        Err(e) => {
+            defmt::error!("field log unusable: {}", e);
+            #[cfg(feature = "log-semihosting")]
+            semihosting::eprintln!("FOG-FIELD-LOG unusable: {}", e);
+            None
+        }
+    }
+}
+
+/// Appends a finished seek's record (a failure is logged; the seek result stands).
+fn append_field_record(log: Option<&mut FieldLog<flash::AppFlash>>, record: FieldRecord) {
+    let Some(log) = log else { return };
+    match log.append(record) {
+        Ok(r) => {
+            defmt::info!("field record {}: {} deg/h", r.sequence, r.residual_bias_dph);
+            #[cfg(feature = "log-semihosting")]
+            semihosting::eprintln!(
+                "FOG-FIELD-RECORD sequence={} residual_udph={}",
+                r.sequence,
+                // Integer micro-deg/h: no float formatting code in the image.
+                (r.residual_bias_dph * 1.0e6) as i64
+            );
+        }
+        Err(e) => {
+            defmt::error!("field record not kept: {}", e);
+            #[cfg(feature = "log-semihosting")]
+            semihosting::eprintln!("FOG-FIELD-RECORD failed: {}", e);
+        }
+    }
 }
 
 /// The board's part of a status message: the gyro's time and temperature, the model
@@ -568,6 +640,10 @@ fn test_options(reset: &ResetRecord) -> TestOptions {
     #[cfg(feature = "log-semihosting")]
     if let Some(n) = args.flash_cut_at {
         flash_file::cut_at(n);
+    }
+    #[cfg(feature = "log-semihosting")]
+    if let Some(n) = args.flash_tear_at {
+        flash_file::tear_at(n);
     }
     if reset.boots != 1 {
         o.inject = Inject::None;

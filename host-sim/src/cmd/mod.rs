@@ -7,6 +7,7 @@ pub mod cli_error;
 pub mod compensate;
 pub mod demo;
 pub mod diagnose;
+pub mod field;
 pub mod heading_cal;
 pub mod import;
 pub mod monitor;

@@ -95,6 +95,16 @@ pub struct Args {
     /// Write the training report as JSON here.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Field records (`fogsim field pull --out DIR`) measured under this chamber model:
+    /// each is one observation of the residual bias at its temperature state; a ridge
+    /// correction linear in the model's T / dT/dt / d2T/dt2 inputs is fitted to them and
+    /// folded into the model (`fog_sim::field::refine`).
+    #[arg(long)]
+    pub field: Option<PathBuf>,
+    /// Weight W of each field seek against the chamber model's prior (one row of weight 1
+    /// per correction coefficient). Default: chosen by leave-one-out over the field seeks.
+    #[arg(long, requires = "field")]
+    pub field_weight: Option<f64>,
 }
 
 fn parse_width_search(s: &str) -> Result<WidthSearch, String> {
@@ -185,6 +195,37 @@ fn check_outputs(args: &Args, guard: &OutputGuard) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Every file the command reads (runs, field records), checked against the outputs;
+/// `--field-weight` is checked here too, before anything is read.
+fn inputs(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
+    if args
+        .field_weight
+        .is_some_and(|w| !(w.is_finite() && w >= 0.0))
+    {
+        anyhow::bail!("--field-weight: must be a finite number >= 0");
+    }
+    let mut inputs = args.runs.clone();
+    inputs.extend(
+        args.field
+            .iter()
+            .map(|d| crate::field::records_file::json_path(d)),
+    );
+    Ok(inputs)
+}
+
+/// The trained model, refined with `--field` records if given (`crate::field`).
+fn field_refined(
+    args: &Args,
+    model: &fog_core::model::format::RbfModel,
+) -> anyhow::Result<fog_core::model::format::RbfModel> {
+    let Some(dir) = &args.field else {
+        return Ok(model.clone());
+    };
+    let refined = crate::field::refine_with_dir(model, dir, args.field_weight)?;
+    print!("{}", refined.summary());
+    Ok(refined.model)
+}
+
 /// Stages one output (see [`StagedFiles`]), naming it on failure.
 fn stage(staged: &mut StagedFiles, path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     staged
@@ -205,7 +246,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     cfg.check(most_inputs).context("fogsim train")?;
     // Outputs next: a bad or input-destroying output is refused before any training,
     // and held until the command ends.
-    let guard = OutputGuard::new(&args.runs);
+    let guard = OutputGuard::new(&inputs(&args)?);
     check_outputs(&args, &guard)?;
     let outputs: Vec<&Path> = [
         Some(&args.out),
@@ -263,9 +304,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             anyhow::bail!("model does not clearly improve held-out drift");
         }
     }
+    let model = field_refined(&args, &outcome.model)?;
     let mut buf = [0u8; MAX_ENCODED_LEN];
-    let len = outcome
-        .model
+    let len = model
         .encode(&mut buf)
         .map_err(|e| anyhow::anyhow!("encoding the trained model: {e}"))?;
     stage(&mut staged, &args.out, &buf[..len])?;

@@ -158,6 +158,8 @@ fn handle(
         }
         DeviceMessage::Accepted => sum.accepted += 1,
         DeviceMessage::Refused(why) => sum.refusals.push(format!("{why:?}")),
+        // Answers to `fogsim field pull` only; the monitor never asks for records.
+        DeviceMessage::FieldRecords(_) => {}
     }
     Ok(())
 }

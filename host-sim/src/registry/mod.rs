@@ -12,6 +12,7 @@
 
 mod counters;
 mod export;
+mod field;
 mod records;
 pub mod utc;
 
@@ -82,6 +83,18 @@ CREATE TABLE IF NOT EXISTS seeks (
     roll_deg       REAL    NOT NULL,
     positions      INTEGER NOT NULL,
     duration_s     REAL    NOT NULL
+);
+CREATE TABLE IF NOT EXISTS field_records (
+    gyro_id            TEXT    NOT NULL,
+    sequence           INTEGER NOT NULL,
+    received_utc       TEXT    NOT NULL,
+    temp_c             REAL    NOT NULL,
+    temp_rate_cps      REAL    NOT NULL,
+    temp_accel_cps2    REAL    NOT NULL,
+    t_since_power_on_s REAL    NOT NULL,
+    residual_bias_dph  REAL    NOT NULL,
+    model_crc32        INTEGER,
+    PRIMARY KEY (gyro_id, sequence)
 );
 ";
 

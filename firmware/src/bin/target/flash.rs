@@ -1,9 +1,10 @@
-//! The model-slot flash region as an `embedded_storage` NOR flash. Under QEMU the
-//! region (linker symbols `_models_start`/`_models_end`, see memory.x) is plain memory,
+//! The model-slot flash region, and the field-record ring's, each as an `embedded_storage`
+//! NOR flash. Under QEMU a region (linker symbols `_models_start`/`_models_end`,
+//! `_field_start`/`_field_end`, see memory.x) is plain memory,
 //! so this driver enforces NOR semantics itself: erase sets 4 KiB sectors to 0xFF,
 //! a write can only clear bits. A real board replaces this file with its flash
 //! controller driver (same traits, same geometry or its own). Under QEMU `AppFlash`
-//! mirrors the region into a host file, so the store persists across QEMU restarts.
+//! mirrors each region into its own host file, so both persist across QEMU restarts.
 
 use core::ptr::{addr_of, read_volatile, write_volatile};
 
@@ -15,6 +16,8 @@ use embedded_storage::nor_flash::{
 extern "C" {
     static _models_start: u8;
     static _models_end: u8;
+    static _field_start: u8;
+    static _field_end: u8;
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -37,6 +40,19 @@ impl ModelFlash {
     pub unsafe fn take() -> Self {
         let base = addr_of!(_models_start) as usize;
         let end = addr_of!(_models_end) as usize;
+        Self {
+            base,
+            len: end - base,
+        }
+    }
+
+    /// The field-record ring's region (`fog_firmware::field_log`).
+    ///
+    /// # Safety
+    /// Only one may exist: it owns the region.
+    pub unsafe fn take_field() -> Self {
+        let base = addr_of!(_field_start) as usize;
+        let end = addr_of!(_field_end) as usize;
         Self {
             base,
             len: end - base,
@@ -116,7 +132,24 @@ pub unsafe fn take_app_flash() -> AppFlash {
     #[cfg(feature = "log-semihosting")]
     {
         let mut flash = flash;
-        let image = crate::flash_file::open_image(&mut flash);
+        let image = crate::flash_file::open_image(&mut flash, crate::flash_file::MODELS_ARG);
+        fog_firmware::store::mirrored::MirroredFlash::new(flash, image)
+    }
+    #[cfg(not(feature = "log-semihosting"))]
+    flash
+}
+
+/// Takes the field-record region (and, under QEMU, attaches the `field-file=` image).
+///
+/// # Safety
+/// As [`ModelFlash::take_field`]: called once.
+pub unsafe fn take_field_flash() -> AppFlash {
+    // SAFETY: forwarded to the caller.
+    let flash = unsafe { ModelFlash::take_field() };
+    #[cfg(feature = "log-semihosting")]
+    {
+        let mut flash = flash;
+        let image = crate::flash_file::open_image(&mut flash, crate::flash_file::FIELD_ARG);
         fog_firmware::store::mirrored::MirroredFlash::new(flash, image)
     }
     #[cfg(not(feature = "log-semihosting"))]

@@ -9,6 +9,7 @@
 //! - the file does not exist: it is created, fully erased (0xFF).
 //!
 //! Afterwards every erase and write is written through (`fog_firmware::store::mirrored`).
+//! The field-record ring's region is kept the same way in its own file (`field-file=PATH`).
 //! Each outcome is logged, also as a plain `FOG-FLASH` line on the semihosting console.
 
 use core::ffi::CStr;
@@ -22,8 +23,10 @@ use semihosting::io::{Read as _, Seek as _, SeekFrom, Write as _};
 use crate::flash::ModelFlash;
 use crate::semi::Args;
 
-/// The semihosting argument naming the flash image file.
-const ARG_PREFIX: &str = "flash-file=";
+/// The semihosting argument naming the model flash's image file.
+pub const MODELS_ARG: &str = "flash-file=";
+/// The semihosting argument naming the field-record ring's image file.
+pub const FIELD_ARG: &str = "field-file=";
 
 /// The flash image file, opened for reading and writing.
 pub struct HostImage(File);
@@ -32,6 +35,9 @@ pub struct HostImage(File);
 /// the firmware says so on the console and waits to be killed, so a test cuts the power
 /// at a known point of an upload (tests/tests/qemu_power_cut.rs).
 static CUT_AT: AtomicU32 = AtomicU32::new(0);
+/// `flash-tear-at=N` (0: none): the N-th write is made in its first half only (a write
+/// torn by the power cut), then the firmware waits to be killed.
+static TEAR_AT: AtomicU32 = AtomicU32::new(0);
 static WRITES: AtomicU32 = AtomicU32::new(0);
 
 /// Arms the power-cut point (`flash-cut-at=N`); call before the first write.
@@ -39,7 +45,12 @@ pub fn cut_at(n: u32) {
     CUT_AT.store(n, Ordering::Relaxed);
 }
 
-/// Writes made to the image since boot.
+/// Arms the torn-write point (`flash-tear-at=N`); call before the first write.
+pub fn tear_at(n: u32) {
+    TEAR_AT.store(n, Ordering::Relaxed);
+}
+
+/// Writes made to the images since boot.
 pub fn writes() -> u32 {
     WRITES.load(Ordering::Relaxed)
 }
@@ -54,26 +65,46 @@ impl Backing for HostImage {
                 crate::watchdog::feed();
             }
         }
+        let torn = n == TEAR_AT.load(Ordering::Relaxed);
+        // Torn: the first half of the bytes, in whole 4-byte flash words.
+        let bytes = if torn {
+            bytes.get(..bytes.len() / 8 * 4).unwrap_or(&[])
+        } else {
+            bytes
+        };
         self.0
             .seek(SeekFrom::Start(u64::from(offset)))
             .map_err(|_| BackingFailed)?;
-        self.0.write_all(bytes).map_err(|_| BackingFailed)
+        self.0.write_all(bytes).map_err(|_| BackingFailed)?;
+        if torn {
+            semihosting::eprintln!(
+                "FOG-FLASH-TEAR write={} offset={} bytes={}",
+                n,
+                offset,
+                bytes.len()
+            );
+            loop {
+                crate::watchdog::feed();
+            }
+        }
+        Ok(())
     }
 }
 
-/// Loads or creates the image named on the command line; `None`: no persistence.
-pub fn open_image(flash: &mut ModelFlash) -> Option<HostImage> {
+/// Loads or creates the image named on the command line by `arg` (`MODELS_ARG`,
+/// `FIELD_ARG`); `None`: no persistence.
+pub fn open_image(flash: &mut ModelFlash, arg: &str) -> Option<HostImage> {
     let args = Args::get().ok()?;
-    let path = (0..args.len()).find_map(|i| args.value_path(i, ARG_PREFIX))?;
+    let path = (0..args.len()).find_map(|i| args.value_path(i, arg))?;
     let name = path.to_str().unwrap_or("<not UTF-8>");
     match attach(flash, path) {
         Ok((image, what)) => {
-            defmt::info!("model flash: {} ({})", name, what);
+            defmt::info!("flash image: {} ({})", name, what);
             semihosting::eprintln!("FOG-FLASH file={} {}", name, what);
             Some(image)
         }
         Err(why) => {
-            defmt::error!("model flash {} refused: models are not kept", name);
+            defmt::error!("flash image {} refused: not kept across restarts", name);
             semihosting::eprintln!("FOG-FLASH file={} refused: {}", name, why);
             None
         }

@@ -1,0 +1,370 @@
+//! What one completed two-position seek teaches about the gyro in the field: the residual
+//! bias it measured (after the drift model) at the temperature state it ran in.
+//!
+//! A two-position seek differences headings 0 and 180 deg for the azimuth; the half-sum of
+//! the two positions' compensated rates is the bias the model left, at the seek's mean
+//! temperature, dT/dt, d2T/dt2 and time since power-on. The device keeps these records in
+//! a flash ring (`fog_firmware::field_log`), sends them on request (`link::messages`), and
+//! `fogsim train --field` refines the model with them. This module is the one definition
+//! both ends build against: the record, its fixed 36-byte flash encoding with its own
+//! CRC-32, and the temperature state averaged over a seek's windows.
+//!
+//! Flash encoding (little-endian):
+//!
+//! | offset | bytes | field |
+//! |---|---|---|
+//! | 0 | 2 | magic `"FR"` (0x5246) |
+//! | 2 | 1 | encoding version (1) |
+//! | 3 | 1 | flags: bit 0 = a model was active (`model_crc32` valid) |
+//! | 4 | 4 | sequence number (u32, never 0xFFFF_FFFF) |
+//! | 8 | 4 | temperature, degC (f32) |
+//! | 12 | 4 | dT/dt, degC/s (f32) |
+//! | 16 | 4 | d2T/dt2, degC/s^2 (f32) |
+//! | 20 | 4 | time since power-on at the seek's end, s (f32) |
+//! | 24 | 4 | residual bias, deg/h (f32) |
+//! | 28 | 4 | CRC-32 of the active model (0 without one) |
+//! | 32 | 4 | CRC-32 (ISO-HDLC, as the link) of bytes 0..32 |
+//!
+//! An erased slot reads all 0xFF and is `Empty`; anything else that fails the magic,
+//! version, CRC or range checks is `Corrupt` (a torn write), never a record.
+
+use serde::{Deserialize, Serialize};
+
+use crate::link::upload::CRC32;
+
+/// Bytes of one encoded record (a multiple of every supported flash word: 1, 2, 4 bytes).
+pub const FIELD_RECORD_LEN: usize = 36;
+/// Magic "FR".
+const RECORD_MAGIC: u16 = 0x5246;
+/// Encoding version.
+const RECORD_VERSION: u8 = 1;
+/// Flag: a model was active.
+const FLAG_MODEL: u8 = 1;
+/// Bytes covered by the record CRC.
+const CRC_SPAN: usize = 32;
+/// Largest |residual bias| a record may carry, deg/h (a navigation-grade FOG's residual
+/// is < 1 deg/h; beyond this the seek was not a measurement of bias).
+pub const MAX_ABS_RESIDUAL_DPH: f32 = 1000.0;
+/// Largest |temperature| a record may carry, degC.
+pub const MAX_ABS_TEMP_C: f32 = 200.0;
+
+/// One completed two-position seek's residual bias at its temperature state.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FieldRecord {
+    /// Ring sequence number (assigned at append; increases across power cycles).
+    pub sequence: u32,
+    /// Mean gyro temperature over the seek's windows, degC.
+    pub temp_c: f32,
+    /// Mean dT/dt over the seek's windows, degC/s.
+    pub temp_rate_cps: f32,
+    /// d2T/dt2 over the seek (least-squares slope of dT/dt in time), degC/s^2.
+    pub temp_accel_cps2: f32,
+    /// Seconds since power-on at the seek's end.
+    pub t_since_power_on_s: f32,
+    /// Half-sum of the two positions' compensated rates, deg/h.
+    pub residual_bias_dph: f32,
+    /// CRC-32 of the drift model that compensated the seek (`None`: uncompensated).
+    pub model_crc32: Option<u32>,
+}
+
+/// Why bytes are not a record.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum RecordDefect {
+    /// All 0xFF: an erased slot (not a fault).
+    Empty,
+    /// Wrong magic, version, CRC, or a value out of range: a torn or decayed write.
+    Corrupt,
+}
+
+impl FieldRecord {
+    /// An all-zero record (array filler of a reply; never sent as a record).
+    pub const ZERO: Self = Self {
+        sequence: 0,
+        temp_c: 0.0,
+        temp_rate_cps: 0.0,
+        temp_accel_cps2: 0.0,
+        t_since_power_on_s: 0.0,
+        residual_bias_dph: 0.0,
+        model_crc32: None,
+    };
+
+    /// `true` if every value is finite and in range and the sequence is not the erased
+    /// pattern (what `to_bytes` may write and `from_bytes` accepts).
+    pub fn is_plausible(&self) -> bool {
+        let finite = [
+            self.temp_c,
+            self.temp_rate_cps,
+            self.temp_accel_cps2,
+            self.t_since_power_on_s,
+            self.residual_bias_dph,
+        ]
+        .iter()
+        .all(|v| v.is_finite());
+        finite
+            && self.sequence != u32::MAX
+            && libm::fabsf(self.temp_c) <= MAX_ABS_TEMP_C
+            && libm::fabsf(self.residual_bias_dph) <= MAX_ABS_RESIDUAL_DPH
+            && self.t_since_power_on_s >= 0.0
+    }
+
+    /// The fixed flash encoding (table above).
+    pub fn to_bytes(&self) -> [u8; FIELD_RECORD_LEN] {
+        let mut b = [0u8; FIELD_RECORD_LEN];
+        b[0..2].copy_from_slice(&RECORD_MAGIC.to_le_bytes());
+        b[2] = RECORD_VERSION;
+        b[3] = if self.model_crc32.is_some() {
+            FLAG_MODEL
+        } else {
+            0
+        };
+        b[4..8].copy_from_slice(&self.sequence.to_le_bytes());
+        b[8..12].copy_from_slice(&self.temp_c.to_le_bytes());
+        b[12..16].copy_from_slice(&self.temp_rate_cps.to_le_bytes());
+        b[16..20].copy_from_slice(&self.temp_accel_cps2.to_le_bytes());
+        b[20..24].copy_from_slice(&self.t_since_power_on_s.to_le_bytes());
+        b[24..28].copy_from_slice(&self.residual_bias_dph.to_le_bytes());
+        b[28..32].copy_from_slice(&self.model_crc32.unwrap_or(0).to_le_bytes());
+        let crc = CRC32.checksum(&b[..CRC_SPAN]);
+        b[32..36].copy_from_slice(&crc.to_le_bytes());
+        b
+    }
+
+    /// Decodes and checks one slot's bytes.
+    pub fn from_bytes(b: &[u8; FIELD_RECORD_LEN]) -> Result<Self, RecordDefect> {
+        if b.iter().all(|&x| x == 0xFF) {
+            return Err(RecordDefect::Empty);
+        }
+        let word = |at: usize| u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]);
+        let float = |at: usize| f32::from_bits(word(at));
+        let header_ok = u16::from_le_bytes([b[0], b[1]]) == RECORD_MAGIC
+            && b[2] == RECORD_VERSION
+            && b[3] & !FLAG_MODEL == 0
+            && CRC32.checksum(&b[..CRC_SPAN]) == word(32);
+        if !header_ok {
+            return Err(RecordDefect::Corrupt);
+        }
+        let record = Self {
+            sequence: word(4),
+            temp_c: float(8),
+            temp_rate_cps: float(12),
+            temp_accel_cps2: float(16),
+            t_since_power_on_s: float(20),
+            residual_bias_dph: float(24),
+            model_crc32: (b[3] & FLAG_MODEL != 0).then(|| word(28)),
+        };
+        if record.is_plausible() {
+            Ok(record)
+        } else {
+            Err(RecordDefect::Corrupt)
+        }
+    }
+}
+
+/// The temperature state averaged over a seek's windows: mean T and dT/dt, and d2T/dt2 as
+/// the least-squares slope of dT/dt against time (the seek's bias is an average over the
+/// same windows, so its state is too). Reset at each seek start; no allocation.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SeekTempState {
+    n: u32,
+    t0_s: f64,
+    sum_t: f64,
+    sum_tt: f64,
+    sum_temp: f64,
+    sum_rate: f64,
+    sum_t_rate: f64,
+}
+
+/// The averaged state of a seek, what a record carries besides the bias.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TempState {
+    pub temp_c: f32,
+    pub temp_rate_cps: f32,
+    pub temp_accel_cps2: f32,
+}
+
+impl SeekTempState {
+    pub const fn new() -> Self {
+        Self {
+            n: 0,
+            t0_s: 0.0,
+            sum_t: 0.0,
+            sum_tt: 0.0,
+            sum_temp: 0.0,
+            sum_rate: 0.0,
+            sum_t_rate: 0.0,
+        }
+    }
+
+    /// Forgets everything (a seek starts).
+    pub fn reset(&mut self) {
+        *self = Self::new();
+    }
+
+    /// Adds one window (its end time, mean temperature, dT/dt); non-finite values are
+    /// skipped (a window without temperature does not move the state).
+    pub fn push(&mut self, t_end_s: f64, temp_c: f32, temp_rate_cps: f32) {
+        if !(t_end_s.is_finite() && temp_c.is_finite() && temp_rate_cps.is_finite()) {
+            return;
+        }
+        if self.n == 0 {
+            self.t0_s = t_end_s;
+        }
+        let t = t_end_s - self.t0_s;
+        let rate = f64::from(temp_rate_cps);
+        self.n += 1;
+        self.sum_t += t;
+        self.sum_tt += t * t;
+        self.sum_temp += f64::from(temp_c);
+        self.sum_rate += rate;
+        self.sum_t_rate += t * rate;
+    }
+
+    /// Windows averaged so far.
+    pub fn windows(&self) -> u32 {
+        self.n
+    }
+
+    /// The averaged state (`None` before the first window); d2T/dt2 is 0 with fewer than
+    /// two windows in distinct times.
+    pub fn state(&self) -> Option<TempState> {
+        if self.n == 0 {
+            return None;
+        }
+        let n = f64::from(self.n);
+        let sxx = self.sum_tt - self.sum_t * self.sum_t / n;
+        let sxy = self.sum_t_rate - self.sum_t * self.sum_rate / n;
+        let accel = if sxx > 1e-9 { sxy / sxx } else { 0.0 };
+        Some(TempState {
+            temp_c: (self.sum_temp / n) as f32,
+            temp_rate_cps: (self.sum_rate / n) as f32,
+            temp_accel_cps2: accel as f32,
+        })
+    }
+}
+
+/// The residual bias of a completed two-position seek: the half-sum of its two main
+/// positions' compensated rates (headings 0 and 180 deg apart; the short ambiguity dwell
+/// at +90 deg is not used), deg/h. `None` for a four-position seek (its bias is its own
+/// estimate, not recorded here) or if the two main positions are not opposite.
+pub fn two_position_residual_dph(result: &crate::seeking::northfinder::SeekResult) -> Option<f64> {
+    use crate::seeking::northfinder::SeekMode;
+    if result.mode != SeekMode::TwoPosition || result.n_positions < 2 {
+        return None;
+    }
+    let (a, b) = (&result.positions[0], &result.positions[1]);
+    let apart_deg = libm::fabsf(libm::remainderf(b.heading_deg - a.heading_deg, 360.0));
+    if libm::fabsf(apart_deg - 180.0) > 1.0 {
+        return None;
+    }
+    let half_sum = 0.5 * (a.mean_rate_dph + b.mean_rate_dph);
+    half_sum.is_finite().then_some(half_sum)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::synthetic::SplitMix64;
+
+    fn record(seq: u32) -> FieldRecord {
+        FieldRecord {
+            sequence: seq,
+            temp_c: 31.25,
+            temp_rate_cps: 0.004,
+            temp_accel_cps2: -1.5e-6,
+            t_since_power_on_s: 1234.5,
+            residual_bias_dph: -0.0123,
+            model_crc32: Some(0xDEAD_BEEF),
+        }
+    }
+
+    #[test]
+    fn records_roundtrip_through_the_flash_encoding() {
+        for r in [
+            record(1),
+            FieldRecord {
+                model_crc32: None,
+                ..record(u32::MAX - 1)
+            },
+        ] {
+            assert_eq!(FieldRecord::from_bytes(&r.to_bytes()), Ok(r));
+        }
+    }
+
+    #[test]
+    fn erased_is_empty_and_every_single_byte_change_is_corrupt() {
+        assert_eq!(
+            FieldRecord::from_bytes(&[0xFF; FIELD_RECORD_LEN]),
+            Err(RecordDefect::Empty)
+        );
+        let good = record(7).to_bytes();
+        let mut rng = SplitMix64::new(3);
+        for i in 0..FIELD_RECORD_LEN {
+            let mut b = good;
+            b[i] ^= 1 + (rng.next_u64() % 255) as u8;
+            assert_eq!(
+                FieldRecord::from_bytes(&b),
+                Err(RecordDefect::Corrupt),
+                "byte {i}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_torn_write_is_never_a_record() {
+        // NOR programming only clears bits: a write cut after k words leaves the rest 0xFF.
+        let good = record(9).to_bytes();
+        for words in 0..FIELD_RECORD_LEN / 4 {
+            let mut b = [0xFFu8; FIELD_RECORD_LEN];
+            b[..words * 4].copy_from_slice(&good[..words * 4]);
+            assert!(FieldRecord::from_bytes(&b).is_err(), "{words} words");
+        }
+    }
+
+    #[test]
+    fn implausible_values_are_refused() {
+        for bad in [
+            FieldRecord {
+                residual_bias_dph: f32::NAN,
+                ..record(1)
+            },
+            FieldRecord {
+                temp_c: 500.0,
+                ..record(1)
+            },
+            FieldRecord {
+                sequence: u32::MAX,
+                ..record(1)
+            },
+        ] {
+            assert!(!bad.is_plausible());
+            assert_eq!(
+                FieldRecord::from_bytes(&bad.to_bytes()),
+                Err(RecordDefect::Corrupt)
+            );
+        }
+    }
+
+    #[test]
+    fn the_seek_state_is_the_window_mean_and_the_slope_of_the_rate() {
+        let mut s = SeekTempState::new();
+        assert_eq!(s.state(), None);
+        // T = 20 + 0.01 t + 1e-5 t^2 / 2: dT/dt = 0.01 + 1e-5 t, d2T/dt2 = 1e-5.
+        let mut sum_temp = 0.0;
+        for k in 0..30 {
+            let t = 100.0 + 10.0 * f64::from(k);
+            let temp = 20.0 + 0.01 * t + 0.5e-5 * t * t;
+            sum_temp += temp;
+            s.push(t, temp as f32, (0.01 + 1e-5 * t) as f32);
+        }
+        s.push(f64::NAN, 1.0, 1.0);
+        let st = s.state().unwrap();
+        assert_eq!(s.windows(), 30);
+        assert!((f64::from(st.temp_c) - sum_temp / 30.0).abs() < 1e-4);
+        assert!((st.temp_accel_cps2 - 1e-5).abs() < 1e-8, "{st:?}");
+        assert!((st.temp_rate_cps - (0.01 + 1e-5 * 245.0) as f32).abs() < 1e-6);
+        s.reset();
+        assert_eq!(s.state(), None);
+    }
+}

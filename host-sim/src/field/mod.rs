@@ -1,0 +1,117 @@
+//! Field records on the host (issue 20 item 4): what the device learnt from its own seeks.
+//!
+//! - `pull`: the host-link client that asks the device for its field records
+//!   (`GetFieldRecords`, a bounded batch per reply) until it has them all;
+//! - `records_file`: the records as `field_records.csv` + `field_records.json` in a
+//!   directory (written atomically, read back size-bounded and checked whole);
+//! - `refine`: the field correction of a chamber model: a weighted ridge fit of the
+//!   residual biases on the temperature state, its weight chosen by held-out field seeks,
+//!   folded into the model's bias and linear terms.
+
+pub mod pull;
+pub mod records_file;
+pub mod refine;
+
+use std::path::Path;
+
+use anyhow::{bail, Result};
+use fog_core::link::upload::crc32;
+use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
+
+use refine::{FieldObservation, WeightChoice};
+
+/// What `train --field` did with the field records.
+pub struct FieldRefinement {
+    pub model: RbfModel,
+    pub used: usize,
+    /// Records measured under another model (their residual is not this model's).
+    pub other_model: usize,
+    pub choice: WeightChoice,
+    pub correction: refine::Correction,
+}
+
+/// CRC-32 of a model's encoding (what the device reports as its model's CRC).
+pub fn model_crc32(model: &RbfModel) -> Result<u32> {
+    let mut buf = [0u8; MAX_ENCODED_LEN];
+    let n = model
+        .encode(&mut buf)
+        .map_err(|e| anyhow::anyhow!("encoding the model: {e}"))?;
+    Ok(crc32(&buf[..n]))
+}
+
+/// Refines `model` with the records in `dir` measured under it (same model CRC-32).
+pub fn refine_with_dir(
+    model: &RbfModel,
+    dir: &Path,
+    weight: Option<f64>,
+) -> Result<FieldRefinement> {
+    let records = records_file::read_dir_records(dir)?;
+    if records.is_empty() {
+        bail!(
+            "--field {}: no {} there (run `fogsim field pull` first)",
+            dir.display(),
+            records_file::JSON_NAME
+        );
+    }
+    let crc = model_crc32(model)?;
+    let obs: Vec<FieldObservation> = records
+        .iter()
+        .filter(|r| r.model_crc32 == Some(crc))
+        .map(|r| FieldObservation {
+            temp_c: f64::from(r.temp_c),
+            temp_rate_cps: f64::from(r.temp_rate_cps),
+            temp_accel_cps2: f64::from(r.temp_accel_cps2),
+            residual_bias_dph: f64::from(r.residual_bias_dph),
+        })
+        .collect();
+    if obs.is_empty() {
+        bail!(
+            "--field {}: none of its {} records was measured under this chamber model (CRC-32 {crc:08x}); \
+             their residuals belong to another model",
+            dir.display(),
+            records.len()
+        );
+    }
+    let (model, correction, choice) = refine::refine(model, &obs, weight)?;
+    Ok(FieldRefinement {
+        model,
+        used: obs.len(),
+        other_model: records.len() - obs.len(),
+        choice,
+        correction,
+    })
+}
+
+impl FieldRefinement {
+    /// The lines `train` prints.
+    pub fn summary(&self) -> String {
+        let mut s = format!(
+            "field refinement: {} field seeks used ({} measured under another model, not used)\n",
+            self.used, self.other_model
+        );
+        if let Some(v) = self.choice.verdict {
+            s += &format!("field refinement: {v}\n");
+            return s;
+        }
+        s += "field weight W  leave-one-out rms of the residual bias, dph\n";
+        for &(w, rms) in &self.choice.loo_rms_dph {
+            let mark = if w == self.choice.weight {
+                " <- used"
+            } else {
+                ""
+            };
+            s += &format!("{w:>14}  {rms:>10.5}{mark}\n");
+        }
+        s += &format!(
+            "field correction: constant {:+.5} dph, terms {:?} coefficients {:?} dph per field std\n",
+            self.correction.coef_dph[0],
+            self.correction
+                .terms
+                .iter()
+                .map(|t| ["T", "dT/dt", "d2T/dt2"][t.kind])
+                .collect::<Vec<_>>(),
+            &self.correction.coef_dph[1..]
+        );
+        s
+    }
+}
