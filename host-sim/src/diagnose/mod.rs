@@ -146,6 +146,7 @@ pub fn diagnose_with(
             validation: folds.describe(),
             excluded_columns: campaign.exclusions.clone(),
             skipped_candidates: screening.skipped.iter().map(to_exclusion).collect(),
+            library_size: library.len(),
             smallest_attainable_p,
             power_check,
         },

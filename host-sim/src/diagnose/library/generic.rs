@@ -100,19 +100,46 @@ pub fn metadata(runs: &[Run]) -> Vec<MetaColumn> {
     out
 }
 
-/// Distinct values of `v` (sorted) when there are at most `MAX_LEVELS`, else `None`.
+/// Share of the rows the levels must cover (window means of a switching column fall
+/// between its levels where it switched within the window).
+pub const LEVEL_COVERAGE: f64 = 0.9;
+
+/// The column's levels (sorted) when at most `MAX_LEVELS` values, each on at least 1 %
+/// of the rows, cover `LEVEL_COVERAGE` of them; else `None`.
 pub fn few_levels(v: impl Iterator<Item = f64>) -> Option<Vec<f64>> {
-    let mut d: Vec<f64> = Vec::new();
-    for x in v {
-        if !d.contains(&x) {
-            if d.len() == MAX_LEVELS {
-                return None;
-            }
-            d.push(x);
+    let mut sorted: Vec<f64> = v.collect();
+    sorted.sort_by(f64::total_cmp);
+    let n = sorted.len();
+    let mut runs: Vec<(f64, usize)> = Vec::new();
+    for x in &sorted {
+        match runs.last_mut() {
+            Some((v, c)) if *v == *x => *c += 1,
+            _ => runs.push((*x, 1)),
         }
     }
-    d.sort_by(f64::total_cmp);
-    (d.len() >= 2).then_some(d)
+    let mut frequent: Vec<(f64, usize)> = runs.into_iter().filter(|(_, c)| *c * 100 >= n).collect();
+    frequent.sort_by(|a, b| b.1.cmp(&a.1));
+    frequent.truncate(MAX_LEVELS);
+    let covered: usize = frequent.iter().map(|(_, c)| c).sum();
+    let mut levels: Vec<f64> = frequent.into_iter().map(|(v, _)| v).collect();
+    levels.sort_by(f64::total_cmp);
+    (levels.len() >= 2 && covered as f64 >= LEVEL_COVERAGE * n as f64).then_some(levels)
+}
+
+/// Membership of `x` in `level` among the sorted `levels`: 1 on the level, falling
+/// linearly to 0 at the neighbouring levels (a window mean of a switch between adjacent
+/// levels is split in the right shares), 0 beyond.
+pub fn level_weight(x: f64, level: f64, levels: &[f64]) -> f64 {
+    let i = levels.iter().position(|l| *l == level).unwrap_or(0);
+    let below = i.checked_sub(1).map(|j| levels[j]);
+    let above = levels.get(i + 1).copied();
+    if x == level {
+        1.0
+    } else if x < level {
+        below.map_or(0.0, |b| ((x - b) / (level - b)).max(0.0))
+    } else {
+        above.map_or(0.0, |a| ((a - x) / (a - level)).max(0.0))
+    }
 }
 
 /// The levels to indicate: all but the most common one (the reference).
@@ -193,6 +220,7 @@ pub fn enumerate(
             _ => None,
         },
         knots: vec![],
+        levels: vec![],
         times: None,
         centres: (0.0, temp_mean),
         base_rate_half_s,
@@ -231,6 +259,7 @@ pub fn enumerate(
         let own = match &levels {
             Some(l) => Candidate {
                 knots: indicated_levels(l, pooled.iter().copied()),
+                levels: l.clone(),
                 ..blank(name, src, Transform::Levels)
             },
             None => Candidate {
@@ -274,6 +303,7 @@ pub fn enumerate(
         let own = match levels {
             Some(l) => Candidate {
                 knots: indicated_levels(&l, m.run_values.iter().copied()),
+                levels: l,
                 run_values: m.run_values.clone(),
                 ..blank(&m.key, Source::Meta, Transform::Levels)
             },
@@ -307,6 +337,14 @@ mod tests {
         assert_eq!(indicated_levels(&l, v.iter().copied()), vec![1.0, 3.0]);
         assert!(few_levels((0..10).map(f64::from)).is_none());
         assert!(few_levels([4.0, 4.0].into_iter()).is_none());
+        // a few window means between levels do not hide them
+        let mut m: Vec<f64> = (0..200).map(|i| f64::from(i % 2)).collect();
+        m.push(0.3);
+        assert_eq!(few_levels(m.into_iter()).unwrap(), vec![0.0, 1.0]);
+        let l = [0.0, 1.0, 2.0];
+        assert_eq!(level_weight(0.25, 0.0, &l), 0.75);
+        assert_eq!(level_weight(0.25, 1.0, &l), 0.25);
+        assert_eq!(level_weight(0.25, 2.0, &l), 0.0);
     }
 
     #[test]

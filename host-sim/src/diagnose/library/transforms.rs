@@ -103,6 +103,8 @@ pub struct Candidate {
     pub half_s: Option<f64>,
     /// Spline knots, or the levels indicated (all but the reference level).
     pub knots: Vec<f64>,
+    /// Every level of a `Levels` column, sorted (the reference included).
+    pub levels: Vec<f64>,
     /// The base input the feature is multiplied by, if any.
     pub times: Option<BaseInput>,
     /// Centre subtracted from the feature before a product (its campaign mean), and
@@ -197,7 +199,13 @@ impl Candidate {
             Transform::Levels => self
                 .knots
                 .iter()
-                .map(|l| x.iter().map(|v| f64::from(u8::from(v == l))).collect())
+                .map(|l| {
+                    x.iter()
+                        .map(|v| {
+                            crate::diagnose::library::generic::level_weight(*v, *l, &self.levels)
+                        })
+                        .collect()
+                })
                 .collect(),
             Transform::Spline => std::iter::once(x.to_vec())
                 .chain(natural_spline(x, &self.knots))

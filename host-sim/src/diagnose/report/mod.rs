@@ -133,6 +133,8 @@ pub struct CampaignSummary {
     pub validation: String,
     pub excluded_columns: Vec<Exclusion>,
     pub skipped_candidates: Vec<Exclusion>,
+    /// Candidates in the generic library (within runs; before the usability checks).
+    pub library_size: usize,
     /// Smallest p-value the sign-flip test can reach with this many validation units.
     pub smallest_attainable_p: f64,
     /// When nothing is named: whether a planted 1-sigma effect would have been

@@ -139,6 +139,7 @@ mod tests {
             tau_s: Some(240.0),
             half_s: None,
             knots: vec![],
+            levels: vec![],
             times: None,
             centres: (0.0, 0.0),
             base_rate_half_s: 20.0,

@@ -133,7 +133,7 @@ pub fn screen(
     for k in 1..=max_steps {
         let open: Vec<&Candidate> = cands
             .iter()
-            .filter(|c| !steps.iter().any(|s| s.scored.cand.label() == c.label()))
+            .filter(|c| !steps.iter().any(|s| same_form(&s.scored.cand, c)))
             .collect();
         let mut scored = Vec::with_capacity(open.len());
         let mut gains = Vec::with_capacity(open.len());
@@ -197,6 +197,12 @@ pub fn screen(
         skipped,
         steps,
     })
+}
+
+/// Same column, transform family and product: a second one adds nothing new (a spline
+/// of 4 knots after one of 6, a lag of another tau).
+fn same_form(a: &Candidate, b: &Candidate) -> bool {
+    a.column == b.column && a.transform == b.transform && a.times == b.times
 }
 
 /// Candidates whose columns are finite and, with run offsets free, vary within runs;
