@@ -79,7 +79,7 @@ pub struct NamedCause {
     pub conditional_gain_pct: f64,
     /// Drop in held-out squared error it brings, (deg/h)^2 x points (the ranking).
     pub heldout_sse_drop: f64,
-    /// Family-wise p (max-T over the library, x sequences x 2^step).
+    /// Family-wise p (max-T over the library, x sequences; steps gated).
     pub p_value: f64,
     /// Step at which it was named within its sequence (1 = first).
     pub step: usize,
@@ -475,7 +475,7 @@ fn write_causal(s: &mut String, c: &crate::diagnose::library::causal::CausalChec
 
 /// Section 3: ranked within-run candidates, then the between-run ones.
 fn write_candidates(s: &mut String, r: &Report) {
-    let _ = writeln!(s, "\n3. Candidate causes, first step (ranked by held-out rms; p = family-wise sign-flip max-T over the library and whole validation units, x sequences x 2)");
+    let _ = writeln!(s, "\n3. Candidate causes, first step (ranked by held-out rms; p = family-wise sign-flip max-T over the library and whole validation units, x sequences)");
     write_derivative_widths(s, &r.derivative_widths);
     for row in r.candidates.iter().take(8) {
         let _ = writeln!(
