@@ -76,24 +76,12 @@ pub fn diagnose_with(
     let (folds, st, choice) = layout_and_base(&campaign, rule)?;
     let base = &choice.chosen;
     let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
-    let latitude = campaign
-        .runs
-        .iter()
-        .find_map(|s| s.latitude_deg)
-        .unwrap_or(report::azimuth::DEFAULT_LATITUDE_DEG);
+    let latitude = latitude_of(&campaign);
     let meta = library::generic::metadata(runs);
-    let (library, left_out) = library::generic::enumerate(&campaign, &meta, st.temp_rate_half_s);
+    let (library, cap_note) = library_of(&campaign, &meta, st.temp_rate_half_s);
     let (mut screening, between_run, groups) =
         screen_both(&campaign, &meta, &folds, &st, &choice, &library, latitude)?;
-    if left_out > 0 {
-        screening.skipped.push((
-            format!("{left_out} candidates"),
-            format!(
-                "library capped at {} candidates",
-                library::generic::MAX_CANDIDATES
-            ),
-        ));
-    }
+    screening.skipped.extend(cap_note);
     let named = screening.steps.first();
     let cause = named.map(|s| Cause::from(&s.scored.cand));
     let sim = simulator::simfit::calibrate(
@@ -105,30 +93,21 @@ pub fn diagnose_with(
     let (extended, ext_resid) = extended_model(base, &screening);
     let causal_derivative = named
         .and_then(|s| library::causal::check(&campaign, &folds, base, &s.scored.cand, &s.cols));
-    let uncertainty = uncertainty::estimate(
-        &campaign,
-        &folds,
-        &st,
-        base,
-        named
-            .zip(cause.as_ref())
-            .map(|(s, c)| uncertainty::NamedFeature {
-                label: c.label(),
-                cols: &s.cols,
-            })
-            .as_ref(),
-    );
-    let has_heading = campaign.extra_names.iter().any(|n| n.contains("heading"));
-    let azimuth = has_heading.then(|| Azimuth {
-        baseline: report::azimuth::azimuth_effect(&folds, &st.t_s, &base.cv.residual, latitude),
-        extended: report::azimuth::azimuth_effect(&folds, &st.t_s, &ext_resid, latitude),
+    let named_feature = named.map(|s| uncertainty::NamedFeature {
+        label: s.scored.cand.label(),
+        cols: &s.cols,
     });
+    let uncertainty = uncertainty::estimate(&campaign, &folds, &st, base, named_feature.as_ref());
+    let azimuth = azimuth(&campaign, &folds, &st, base, &ext_resid, latitude);
     let named_causes = named_causes(&folds, &st, base, &screening, &between_run, latitude);
     let smallest_attainable_p = validation::signflip::smallest_p(folds.unit_rows.len());
     let silent = cause.is_none() && between_run.named.is_none();
-    let power_check = selection::power::check(
-        silent, &campaign, &folds, &st, base, &screening, &library, groups,
-    )?;
+    let rerun = selection::power::Rerun {
+        library: &library,
+        groups,
+    };
+    let power_check =
+        selection::power::check(silent, &campaign, &folds, &st, base, &screening, rerun)?;
     let words = cause_in_words(
         cause.as_ref(),
         &named_causes,
@@ -159,18 +138,7 @@ pub fn diagnose_with(
         named_causes,
         named_cause: cause,
         cause_in_words: words,
-        competing: screening
-            .steps
-            .iter()
-            .flat_map(|s| {
-                s.rivals.iter().map(|r| Competitor {
-                    candidate: r.label.clone(),
-                    named: s.scored.cand.label(),
-                    conditional_gain_pct: r.gain_pct,
-                    gap_se: r.gap_se,
-                })
-            })
-            .collect(),
+        competing: competing(&screening),
         parsimony_note: screening
             .steps
             .iter()
@@ -213,6 +181,70 @@ fn layout_and_base(
     let (st, choice) =
         base::bases::choose_with_rate_window(campaign, &folds, (device_rate, device_choice))?;
     Ok((folds, st, choice))
+}
+
+/// The campaign's latitude (the first run that states one), else the default.
+fn latitude_of(campaign: &input::Campaign) -> f64 {
+    campaign
+        .runs
+        .iter()
+        .find_map(|s| s.latitude_deg)
+        .unwrap_or(report::azimuth::DEFAULT_LATITUDE_DEG)
+}
+
+/// The azimuth effect of the base's and the extended model's residuals, when the
+/// campaign has a heading column.
+fn azimuth(
+    campaign: &input::Campaign,
+    folds: &Folds,
+    st: &Stacked,
+    base: &base::bases::BaseFit,
+    ext_resid: &[f64],
+    latitude: f64,
+) -> Option<Azimuth> {
+    let has_heading = campaign.extra_names.iter().any(|n| n.contains("heading"));
+    has_heading.then(|| Azimuth {
+        baseline: report::azimuth::azimuth_effect(folds, &st.t_s, &base.cv.residual, latitude),
+        extended: report::azimuth::azimuth_effect(folds, &st.t_s, ext_resid, latitude),
+    })
+}
+
+/// Every candidate within one standard error of a named cause, with the cause.
+fn competing(screening: &Screening) -> Vec<Competitor> {
+    screening
+        .steps
+        .iter()
+        .flat_map(|s| {
+            s.rivals.iter().map(|r| Competitor {
+                candidate: r.label.clone(),
+                named: s.scored.cand.label(),
+                conditional_gain_pct: r.gain_pct,
+                gap_se: r.gap_se,
+            })
+        })
+        .collect()
+}
+
+/// The generic library and, if the cap left candidates out, a note saying so.
+fn library_of(
+    campaign: &input::Campaign,
+    meta: &[library::generic::MetaColumn],
+    rate_half_s: f64,
+) -> (
+    Vec<library::transforms::Candidate>,
+    Option<selection::screen::Skipped>,
+) {
+    let (library, left_out) = library::generic::enumerate(campaign, meta, rate_half_s);
+    let note = (left_out > 0).then(|| {
+        (
+            format!("{left_out} candidates"),
+            format!(
+                "library capped at {} candidates",
+                library::generic::MAX_CANDIDATES
+            ),
+        )
+    });
+    (library, note)
 }
 
 /// Within-run and between-run selection, alpha shared between the two sequences

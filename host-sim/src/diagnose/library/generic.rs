@@ -118,7 +118,7 @@ pub fn few_levels(v: impl Iterator<Item = f64>) -> Option<Vec<f64>> {
         }
     }
     let mut frequent: Vec<(f64, usize)> = runs.into_iter().filter(|(_, c)| *c * 100 >= n).collect();
-    frequent.sort_by(|a, b| b.1.cmp(&a.1));
+    frequent.sort_by_key(|f| std::cmp::Reverse(f.1));
     frequent.truncate(MAX_LEVELS);
     let covered: usize = frequent.iter().map(|(_, c)| c).sum();
     let mut levels: Vec<f64> = frequent.into_iter().map(|(v, _)| v).collect();
@@ -242,58 +242,86 @@ pub fn enumerate(
         });
     }
     for (i, name) in c.extra_names.iter().enumerate() {
-        let src = Source::Extra(i);
-        let pooled: Vec<f64> = c
-            .runs
-            .iter()
-            .flat_map(|s| s.extras[i].iter().copied())
-            .collect();
-        let centre = mean(&pooled);
-        for tr in [Transform::Value, Transform::Rate, Transform::Accel] {
-            out.push(blank(name, src, tr));
-        }
-        if name.ends_with("_deg") {
-            out.push(blank(name, src, Transform::Harmonic));
-        }
-        let levels = few_levels(pooled.iter().copied());
-        let own = match &levels {
-            Some(l) => Candidate {
-                knots: indicated_levels(l, pooled.iter().copied()),
-                levels: l.clone(),
-                ..blank(name, src, Transform::Levels)
-            },
-            None => Candidate {
-                centres: (centre, temp_mean),
-                ..blank(name, src, Transform::Value)
-            },
-        };
-        if levels.is_some() {
-            out.push(own.clone());
-        } else {
-            let mut sorted = pooled.clone();
-            sorted.sort_by(f64::total_cmp);
-            for qs in SPLINE_KNOTS {
-                if let Some(knots) = knots_at(&sorted, qs) {
-                    out.push(Candidate {
-                        knots,
-                        ..blank(name, src, Transform::Spline)
-                    });
-                }
+        out.extend(column_candidates(c, i, name, &taus, &blank));
+    }
+    out.extend(metadata_products(meta, &blank));
+    let left_out = out.len().saturating_sub(MAX_CANDIDATES);
+    out.truncate(MAX_CANDIDATES);
+    (out, left_out)
+}
+
+/// Builds a candidate of `column` under `transform` with every other field at its default.
+type Blank<'a> = dyn Fn(&str, Source, Transform) -> Candidate + 'a;
+
+/// Every within-run candidate of extra column `i` (`name`).
+fn column_candidates(
+    c: &Campaign,
+    i: usize,
+    name: &str,
+    taus: &[f64],
+    blank: &Blank,
+) -> Vec<Candidate> {
+    let temp_mean = blank(name, Source::Temp, Transform::Value).centres.1;
+    let mut out = Vec::new();
+    let src = Source::Extra(i);
+    let pooled: Vec<f64> = c
+        .runs
+        .iter()
+        .flat_map(|s| s.extras[i].iter().copied())
+        .collect();
+    let centre = mean(&pooled);
+    for tr in [Transform::Value, Transform::Rate, Transform::Accel] {
+        out.push(blank(name, src, tr));
+    }
+    if name.ends_with("_deg") {
+        out.push(blank(name, src, Transform::Harmonic));
+    }
+    let levels = few_levels(pooled.iter().copied());
+    let own = match &levels {
+        Some(l) => Candidate {
+            knots: indicated_levels(l, pooled.iter().copied()),
+            levels: l.clone(),
+            ..blank(name, src, Transform::Levels)
+        },
+        None => Candidate {
+            centres: (centre, temp_mean),
+            ..blank(name, src, Transform::Value)
+        },
+    };
+    if levels.is_some() {
+        out.push(own.clone());
+    } else {
+        let mut sorted = pooled.clone();
+        sorted.sort_by(f64::total_cmp);
+        for qs in SPLINE_KNOTS {
+            if let Some(knots) = knots_at(&sorted, qs) {
+                out.push(Candidate {
+                    knots,
+                    ..blank(name, src, Transform::Spline)
+                });
             }
         }
-        for &tau in &taus {
-            out.push(Candidate {
-                tau_s: Some(tau),
-                ..blank(name, src, Transform::Lag)
-            });
-        }
-        for b in [BaseInput::Temp, BaseInput::TempRate] {
-            out.push(Candidate {
-                times: Some(b),
-                ..own.clone()
-            });
-        }
     }
+    for &tau in &taus {
+        out.push(Candidate {
+            tau_s: Some(tau),
+            ..blank(name, src, Transform::Lag)
+        });
+    }
+    for b in [BaseInput::Temp, BaseInput::TempRate] {
+        out.push(Candidate {
+            times: Some(b),
+            ..own.clone()
+        });
+    }
+    out
+}
+
+/// Products of every run-constant metadata column (its value, or its levels) with the
+/// base's inputs.
+fn metadata_products(meta: &[MetaColumn], blank: &Blank) -> Vec<Candidate> {
+    let temp_mean = blank("temp_c", Source::Temp, Transform::Value).centres.1;
+    let mut out = Vec::new();
     for m in meta {
         let levels = if m.categorical {
             few_levels(m.run_values.iter().copied())
@@ -320,9 +348,7 @@ pub fn enumerate(
             });
         }
     }
-    let left_out = out.len().saturating_sub(MAX_CANDIDATES);
-    out.truncate(MAX_CANDIDATES);
-    (out, left_out)
+    out
 }
 
 #[cfg(test)]

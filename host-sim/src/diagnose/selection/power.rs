@@ -58,6 +58,14 @@ pub struct PowerCheck {
     pub shapes: Vec<ShapeCheck>,
 }
 
+/// What the selection is re-run with on the record with a planted effect: the library
+/// and the number of sequences sharing alpha.
+#[derive(Clone, Copy)]
+pub struct Rerun<'a> {
+    pub library: &'a [Candidate],
+    pub groups: f64,
+}
+
 /// When nothing was named (`silent`) and the layout can reach p < alpha at all
 /// (otherwise the report already says "no test power"): plants one candidate of every
 /// shape of `screening` at 1 residual sigma into `st.y` and selects again. `None` when
@@ -69,8 +77,7 @@ pub fn check(
     st: &Stacked,
     base: &BaseFit,
     screening: &Screening,
-    library: &[Candidate],
-    groups: f64,
+    rerun: Rerun<'_>,
 ) -> Result<Option<PowerCheck>, DiagnoseError> {
     let reachable =
         crate::diagnose::validation::signflip::smallest_p(folds.unit_rows.len()) < screen::ALPHA;
@@ -87,7 +94,14 @@ pub fn check(
             .zip(&planted)
             .for_each(|(y, e)| *y += e);
         let base = bases::choose(folds, &with_effect)?.chosen;
-        let again = screen::screen(campaign, folds, &base, library.to_vec(), groups, 1)?;
+        let again = screen::screen(
+            campaign,
+            folds,
+            &base,
+            rerun.library.to_vec(),
+            rerun.groups,
+            1,
+        )?;
         let found = again.scored.iter().find(|s| s.cand.label() == cand.label());
         let named = again.steps.first().is_some_and(|s| {
             s.scored.cand.column == cand.column && s.scored.cand.times == cand.times
