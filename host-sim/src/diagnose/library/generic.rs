@@ -302,7 +302,7 @@ fn column_candidates(
             }
         }
     }
-    for &tau in &taus {
+    for &tau in taus {
         out.push(Candidate {
             tau_s: Some(tau),
             ..blank(name, src, Transform::Lag)
