@@ -6,15 +6,23 @@
 //! validated leaving one run out against the offsets' own mean (the turn-on
 //! repeatability), and its per-run held-out gains are scaled by the run's point count so
 //! they are drops in held-out squared error like the within-run gains. They then enter
-//! the same Westfall-Young sign-flip family as the within-run candidates (one
-//! family-wise decision); a run-level permutation test (features shuffled across runs)
-//! is reported next to it as a check.
+//! a Westfall-Young sign-flip max-T test over the run-level library, Bonferroni with the
+//! within-run sequence; the selection is stepwise like the within-run one (`selection::
+//! screen`: after a run-level cause is named, the rest are scored conditional on it,
+//! until nothing passes; the steps are gated, so no split over them). A run-level permutation test (features
+//! shuffled across runs) is reported next to each candidate as a check. The run-level
+//! library: the run mean (angles: circular-mean harmonic) of every extra column, the
+//! ambient, and every metadata key that varies between runs (numbers as values,
+//! categories as levels; `library::generic::metadata`).
 
 use crate::diagnose::base::bases::BaseFit;
 use crate::diagnose::base::models::Stacked;
 use crate::diagnose::input::Campaign;
+use crate::diagnose::library::generic::MetaColumn;
 use crate::diagnose::linalg::solve_spd;
+use crate::diagnose::selection::screen::{ALPHA, FLIP_SEED, MIN_GAIN_PCT};
 use crate::diagnose::validation::cv::Folds;
+use crate::diagnose::validation::signflip::max_t_pvalues;
 use fog_core::consts::EARTH_RATE_DPH;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
@@ -79,8 +87,10 @@ pub struct BetweenRun {
     /// What the offsets are left by: the chosen base and level treatment.
     pub offsets_from: String,
     pub rows: Vec<RunRow>,
-    /// Label of the named run-level effect, if any.
+    /// Label of the first named run-level effect, if any.
     pub named: Option<String>,
+    /// Every named run-level effect, in the order named, with its conditional gain.
+    pub named_steps: Vec<RunRow>,
     pub heading: Option<HeadingEffect>,
     /// Why the analysis was not run, if it was not.
     pub note: Option<String>,
@@ -117,8 +127,9 @@ pub fn run_offsets(folds: &Folds, st: &Stacked, base: &BaseFit) -> Vec<f64> {
 }
 
 /// Run-level candidates: the harmonic (cos, sin of the run's circular mean) of every
-/// `*_deg` column, the run mean of every other extra column, and the ambient.
-pub fn enumerate(c: &Campaign) -> Vec<RunCandidate> {
+/// `*_deg` column, the run mean of every other extra column, the ambient, and every
+/// metadata key (value, or indicators of all but its commonest level).
+pub fn enumerate(c: &Campaign, meta: &[MetaColumn]) -> Vec<RunCandidate> {
     let mut out = Vec::new();
     for (j, name) in c.extra_names.iter().enumerate() {
         if name.ends_with("_deg") {
@@ -169,6 +180,36 @@ pub fn enumerate(c: &Campaign) -> Vec<RunCandidate> {
                 .collect(),
         });
     }
+    for m in meta.iter().filter(|m| m.run_values.len() == c.runs.len()) {
+        let levels = m
+            .categorical
+            .then(|| crate::diagnose::library::generic::few_levels(m.run_values.iter().copied()))
+            .flatten();
+        let (label, features) = match levels {
+            Some(l) => {
+                let count = |v: f64| m.run_values.iter().filter(|x| **x == v).count();
+                let reference = l.iter().copied().max_by_key(|v| count(*v)).unwrap_or(0.0);
+                let shown: Vec<f64> = l.into_iter().filter(|v| *v != reference).collect();
+                (
+                    format!("# {}:levels", m.key),
+                    m.run_values
+                        .iter()
+                        .map(|x| shown.iter().map(|v| f64::from(u8::from(x == v))).collect())
+                        .collect(),
+                )
+            }
+            None => (
+                format!("# {}:run_value", m.key),
+                m.run_values.iter().map(|x| vec![*x]).collect(),
+            ),
+        };
+        out.push(RunCandidate {
+            label,
+            column: m.key.clone(),
+            harmonic: false,
+            features,
+        });
+    }
     out.retain(|c| varies(&c.features));
     out
 }
@@ -205,6 +246,18 @@ fn fit(o: &[f64], f: &[Vec<f64>], rows: &[usize]) -> Option<Vec<f64>> {
 
 fn predict(coef: &[f64], f: &[f64]) -> f64 {
     coef[0] + coef[1..].iter().zip(f).map(|(c, x)| c * x).sum::<f64>()
+}
+
+/// Leave-one-run-out errors of the offsets under o = a + b . f (f empty: the mean).
+fn loo_errors(o: &[f64], f: &[Vec<f64>]) -> Option<Vec<f64>> {
+    let n = o.len();
+    (0..n)
+        .map(|r| {
+            let rows: Vec<usize> = (0..n).filter(|&i| i != r).collect();
+            let coef = fit(o, f, &rows)?;
+            Some(o[r] - predict(&coef, &f[r]))
+        })
+        .collect()
 }
 
 /// Per-run held-out gains (run's points x drop in squared offset error, leave one run
@@ -269,21 +322,59 @@ pub fn heading_effect(column: &str, coef: &[f64], latitude_deg: f64) -> HeadingE
     }
 }
 
-/// Candidates with their per-run gains (for the shared family) and the scored rows
-/// (p-values filled in later by `finish`).
+/// The run levels the between-run stage explains: the offsets the chosen base leaves
+/// under free offsets, or the shared law's levels (refitted with the run features).
+pub enum LevelModel {
+    Free(Vec<f64>),
+    Shared(
+        std::sync::Arc<crate::diagnose::base::levels::LevelSystems>,
+        f64,
+    ),
+}
+
+impl LevelModel {
+    /// Leave-one-run-out level errors with run features `f` (per run; may be empty).
+    fn errors(&self, f: &[Vec<f64>]) -> Option<Vec<f64>> {
+        match self {
+            Self::Free(o) => loo_errors(o, f),
+            Self::Shared(lv, th) => lv.with_run_features(f).heldout_level_errors(*th),
+        }
+    }
+
+    /// Coefficients fitted on every run: intercept, then the last `k` features'.
+    fn coef(&self, f: &[Vec<f64>], k: usize) -> Vec<f64> {
+        let all = match self {
+            Self::Free(o) => fit(o, f, &(0..o.len()).collect::<Vec<_>>()),
+            Self::Shared(lv, th) => {
+                let with = lv.with_run_features(f);
+                with.solve_shared(&vec![1.0; lv.runs()], *th).map(|w| w.w)
+            }
+        };
+        let Some(w) = all else {
+            return vec![];
+        };
+        let mut coef = vec![w[0]];
+        coef.extend_from_slice(&w[w.len().saturating_sub(k)..]);
+        coef
+    }
+}
+
+/// Offsets, the level model, the run-level library and step 1's rows (p-values filled
+/// in by `finish`).
 pub struct Prepared {
     pub offsets: Vec<f64>,
     pub offsets_from: String,
     pub offsets_rms_dph: f64,
+    pub model: LevelModel,
+    pub lens: Vec<usize>,
     pub cands: Vec<RunCandidate>,
-    pub gains: Vec<Vec<f64>>,
-    pub rows: Vec<RunRow>,
     pub repeatability_dph: f64,
 }
 
-/// Offsets, candidates and gains; `None` (with the reason) when runs are too few.
+/// Offsets, level model and candidates; `Err` (with the reason) when runs are too few.
 pub fn prepare(
     c: &Campaign,
+    meta: &[MetaColumn],
     folds: &Folds,
     st: &Stacked,
     base: &BaseFit,
@@ -309,102 +400,120 @@ pub fn prepare(
     let lens: Vec<usize> = folds.run_rows.iter().map(|r| r.len()).collect();
     let offsets_rms_dph =
         loo_gains(&offsets, &lens, &vec![vec![]; offsets.len()]).map_or(f64::NAN, |(_, r0, _)| r0);
-    let mut out = Prepared {
-        repeatability_dph: levels.map_or(offsets_rms_dph, |l| l.repeatability_dph),
-        offsets_rms_dph,
-        offsets_from,
-        offsets,
-        cands: vec![],
-        gains: vec![],
-        rows: vec![],
-    };
     let shared = levels
         .filter(|l| l.law == crate::diagnose::base::levels::Law::Shared)
         .and_then(|l| Some((l.systems.clone()?, l.theta)));
-    let base_errors = shared
-        .as_ref()
-        .and_then(|(lv, th)| lv.heldout_level_errors(*th));
-    for cand in enumerate(c) {
-        if cand.features[0].len() + 2 >= out.offsets.len() {
-            continue;
+    let model = match shared {
+        Some((lv, th)) if lv.heldout_level_errors(th).is_some() => LevelModel::Shared(lv, th),
+        _ => LevelModel::Free(offsets.clone()),
+    };
+    Ok(Prepared {
+        repeatability_dph: levels.map_or(offsets_rms_dph, |l| l.repeatability_dph),
+        offsets_rms_dph,
+        offsets_from,
+        model,
+        cands: enumerate(c, meta),
+        lens,
+        offsets,
+    })
+}
+
+/// Per run, `given`'s features followed by `cand`'s.
+fn joined(given: &[Vec<f64>], cand: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    given
+        .iter()
+        .zip(cand)
+        .map(|(g, c)| g.iter().chain(c).copied().collect())
+        .collect()
+}
+
+fn rms(e: &[f64]) -> f64 {
+    (e.iter().map(|v| v * v).sum::<f64>() / e.len().max(1) as f64).sqrt()
+}
+
+/// Step-wise selection of run-level causes (see the module header); `groups` sequences
+/// share alpha (Bonferroni).
+pub fn finish(p: Prepared, groups: f64, latitude_deg: f64) -> BetweenRun {
+    let runs = p.offsets.len();
+    let mut given: Vec<Vec<f64>> = vec![vec![]; runs];
+    let mut named_steps: Vec<RunRow> = Vec::new();
+    let mut named_idx: Vec<usize> = Vec::new();
+    let mut first_rows = Vec::new();
+    let mut e0 = p.model.errors(&given);
+    for k in 1..=crate::diagnose::selection::screen::MAX_STEPS {
+        let Some(before) = e0.clone() else { break };
+        let mut rows = Vec::new();
+        let mut gains = Vec::new();
+        let mut idx = Vec::new();
+        for (i, cand) in p.cands.iter().enumerate() {
+            if named_idx.contains(&i) {
+                continue;
+            }
+            let f = joined(&given, &cand.features);
+            if f[0].len() + 2 >= runs {
+                continue;
+            }
+            let Some(after) = p.model.errors(&f) else {
+                continue;
+            };
+            gains.push(
+                p.lens
+                    .iter()
+                    .zip(before.iter().zip(&after))
+                    .map(|(&n, (a, b))| n as f64 * (a * a - b * b))
+                    .collect::<Vec<f64>>(),
+            );
+            rows.push(RunRow {
+                label: cand.label.clone(),
+                heldout_offset_rms_dph: rms(&after),
+                gain_pct: 100.0 * (1.0 - rms(&after) / rms(&before).max(1e-300)),
+                p_value: 1.0,
+                permutation_p: if k == 1 {
+                    permutation_p(&p.offsets, &p.lens, &cand.features)
+                } else {
+                    f64::NAN
+                },
+                significant: false,
+                coef: p.model.coef(&f, cand.features[0].len()),
+            });
+            idx.push(i);
         }
-        let all: Vec<usize> = (0..out.offsets.len()).collect();
-        let scored = match (&shared, &base_errors) {
-            (Some((lv, th)), Some(e0)) => inside_law(lv, *th, e0, &lens, &cand.features),
-            _ => loo_gains(&out.offsets, &lens, &cand.features).map(|(g, r0, r1)| {
-                let coef = fit(&out.offsets, &cand.features, &all).unwrap_or_default();
-                (g, r0, r1, coef)
-            }),
-        };
-        let Some((g, rms0, rms1, coef)) = scored else {
-            continue;
-        };
-        out.rows.push(RunRow {
-            label: cand.label.clone(),
-            heldout_offset_rms_dph: rms1,
-            gain_pct: 100.0 * (1.0 - rms1 / rms0.max(1e-300)),
-            p_value: 1.0,
-            permutation_p: permutation_p(&out.offsets, &lens, &cand.features),
-            significant: false,
-            coef,
-        });
-        out.gains.push(g);
-        out.cands.push(cand);
+        for (r, fp) in rows.iter_mut().zip(max_t_pvalues(&gains, FLIP_SEED)) {
+            r.p_value = (fp * groups).min(1.0);
+            r.significant = r.p_value < ALPHA && r.gain_pct > MIN_GAIN_PCT;
+        }
+        let best = rows
+            .iter()
+            .enumerate()
+            .filter(|(_, r)| r.significant)
+            .max_by(|a, b| a.1.gain_pct.total_cmp(&b.1.gain_pct))
+            .map(|(j, _)| j);
+        if let Some(j) = best {
+            named_steps.push(rows[j].clone());
+            named_idx.push(idx[j]);
+            given = joined(&given, &p.cands[idx[j]].features);
+            e0 = p.model.errors(&given);
+        }
+        if k == 1 {
+            first_rows = rows;
+        }
+        if best.is_none() {
+            break;
+        }
     }
-    Ok(out)
-}
-
-/// A run-level candidate refitted inside the shared law (`lv` at `theta`), leaving one
-/// run out: per-run gains (points x drop in squared level error), the level rms without
-/// and with it (`e0`: the law's own held-out level errors), and the coefficients fitted
-/// on every run (the law's intercept first, then the candidate's).
-fn inside_law(
-    lv: &crate::diagnose::base::levels::LevelSystems,
-    theta: f64,
-    e0: &[f64],
-    lens: &[usize],
-    features: &[Vec<f64>],
-) -> Option<(Vec<f64>, f64, f64, Vec<f64>)> {
-    let with = lv.with_run_features(features);
-    let e1 = with.heldout_level_errors(theta)?;
-    let gains = lens
+    let heading = named_idx
         .iter()
-        .zip(e0.iter().zip(&e1))
-        .map(|(&n, (a, b))| n as f64 * (a * a - b * b))
-        .collect();
-    let rms = |e: &[f64]| (e.iter().map(|v| v * v).sum::<f64>() / e.len().max(1) as f64).sqrt();
-    let w = with.solve_shared(&vec![1.0; lens.len()], theta)?.w;
-    let k = features.first().map_or(0, Vec::len);
-    let mut coef = vec![w[0]];
-    coef.extend_from_slice(&w[w.len() - k..]);
-    Some((gains, rms(e0), rms(&e1), coef))
-}
-
-/// Fills in the family-wise p-values and names the best significant run-level effect.
-pub fn finish(p: Prepared, family_p: &[f64], latitude_deg: f64) -> BetweenRun {
-    let mut rows = p.rows;
-    for (r, fp) in rows.iter_mut().zip(family_p) {
-        r.p_value = *fp;
-        r.significant = *fp < crate::diagnose::selection::screen::ALPHA
-            && r.gain_pct > crate::diagnose::selection::screen::MIN_GAIN_PCT;
-    }
-    let best = rows
-        .iter()
-        .enumerate()
-        .filter(|(_, r)| r.significant)
-        .max_by(|a, b| a.1.gain_pct.total_cmp(&b.1.gain_pct))
-        .map(|(i, _)| i);
-    let heading = best
-        .filter(|&i| p.cands[i].harmonic)
-        .map(|i| heading_effect(&p.cands[i].column, &rows[i].coef, latitude_deg));
-    let named = best.map(|i| rows[i].label.clone());
-    rows.sort_by(|a, b| b.gain_pct.total_cmp(&a.gain_pct));
+        .zip(&named_steps)
+        .find(|(i, _)| p.cands[**i].harmonic)
+        .map(|(i, r)| heading_effect(&p.cands[*i].column, &r.coef, latitude_deg));
+    first_rows.sort_by(|a, b| b.gain_pct.total_cmp(&a.gain_pct));
     BetweenRun {
         turn_on_repeatability_dph: p.repeatability_dph,
         offsets_heldout_rms_dph: p.offsets_rms_dph,
         offsets_from: p.offsets_from,
-        rows,
-        named,
+        rows: first_rows,
+        named: named_steps.first().map(|r| r.label.clone()),
+        named_steps,
         heading,
         note: None,
     }

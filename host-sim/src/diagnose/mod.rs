@@ -34,7 +34,7 @@ use base::models::Stacked;
 use input::Exclusion;
 use report::{
     Azimuth, CampaignSummary, CandidateRow, Competitor, DriftStd, Extended, ModelSummary,
-    Simulation,
+    NamedCause, Simulation,
 };
 use selection::screen::{Scored, Screening};
 use validation::cv::Folds;
@@ -76,46 +76,41 @@ pub fn diagnose_with(
     let (folds, st, choice) = layout_and_base(&campaign, rule)?;
     let base = &choice.chosen;
     let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
-    let latitude = campaign
-        .runs
-        .iter()
-        .find_map(|s| s.latitude_deg)
-        .unwrap_or(report::azimuth::DEFAULT_LATITUDE_DEG);
-    let (screening, between_run) = screen_both(&campaign, &folds, &st, &choice, latitude)?;
-    let named = screening.named.map(|i| &screening.scored[i]);
-    let cause = named.map(|s| Cause::from(&s.cand));
+    let latitude = latitude_of(&campaign);
+    let meta = library::generic::metadata(runs);
+    let (library, cap_note) = library_of(&campaign, &meta, st.temp_rate_half_s);
+    let (mut screening, between_run, groups) =
+        screen_both(&campaign, &meta, &folds, &st, &choice, &library, latitude)?;
+    screening.skipped.extend(cap_note);
+    let named = screening.steps.first();
+    let cause = named.map(|s| Cause::from(&s.scored.cand));
     let sim = simulator::simfit::calibrate(
         &campaign,
         &folds.run_rows,
         &st.y,
         named.map(|s| s.cols.as_slice()),
     )?;
-    let (extended, ext_resid) = extended_model(base, named, cause.as_ref());
-    let causal_derivative =
-        named.and_then(|s| library::causal::check(&campaign, &folds, base, &s.cand, &s.cols));
-    let uncertainty = uncertainty::estimate(
-        &campaign,
-        &folds,
-        &st,
-        base,
-        named
-            .zip(cause.as_ref())
-            .map(|(s, c)| uncertainty::NamedFeature {
-                label: c.label(),
-                cols: &s.cols,
-            })
-            .as_ref(),
-    );
-    let has_heading = campaign.extra_names.iter().any(|n| n.contains("heading"));
-    let azimuth = has_heading.then(|| Azimuth {
-        baseline: report::azimuth::azimuth_effect(&folds, &st.t_s, &base.cv.residual, latitude),
-        extended: report::azimuth::azimuth_effect(&folds, &st.t_s, &ext_resid, latitude),
+    let (extended, ext_resid) = extended_model(base, &screening);
+    let causal_derivative = named
+        .and_then(|s| library::causal::check(&campaign, &folds, base, &s.scored.cand, &s.cols));
+    let named_feature = named.map(|s| uncertainty::NamedFeature {
+        label: s.scored.cand.label(),
+        cols: &s.cols,
     });
+    let uncertainty = uncertainty::estimate(&campaign, &folds, &st, base, named_feature.as_ref());
+    let azimuth = azimuth(&campaign, &folds, &st, base, &ext_resid, latitude);
+    let named_causes = named_causes(&folds, &st, base, &screening, &between_run, latitude);
     let smallest_attainable_p = validation::signflip::smallest_p(folds.unit_rows.len());
     let silent = cause.is_none() && between_run.named.is_none();
-    let power_check = selection::power::check(silent, &campaign, &folds, &st, base, &screening)?;
+    let rerun = selection::power::Rerun {
+        library: &library,
+        groups,
+    };
+    let power_check =
+        selection::power::check(silent, &campaign, &folds, &st, base, &screening, rerun)?;
     let words = cause_in_words(
         cause.as_ref(),
+        &named_causes,
         &between_run,
         &sim.effect_coef,
         smallest_attainable_p,
@@ -130,6 +125,7 @@ pub fn diagnose_with(
             validation: folds.describe(),
             excluded_columns: campaign.exclusions.clone(),
             skipped_candidates: screening.skipped.iter().map(to_exclusion).collect(),
+            library_size: library.len(),
             smallest_attainable_p,
             power_check,
         },
@@ -139,17 +135,14 @@ pub fn diagnose_with(
         between_run,
         derivative_widths: campaign.derivative_widths.clone(),
         candidates: screening.scored.iter().map(candidate_row).collect(),
+        named_causes,
         named_cause: cause,
         cause_in_words: words,
-        competing: screening
-            .competing
+        competing: competing(&screening),
+        parsimony_note: screening
+            .steps
             .iter()
-            .map(|(c, g)| Competitor {
-                candidate: c.clone(),
-                conditional_gain_pct: *g,
-            })
-            .collect(),
-        parsimony_note: screening.parsimony_note.clone(),
+            .find_map(|s| s.parsimony_note.clone()),
         drift_std: drift_std(&folds, &st.y, &base.cv.residual, &ext_resid),
         extended,
         causal_derivative,
@@ -190,71 +183,179 @@ fn layout_and_base(
     Ok((folds, st, choice))
 }
 
-/// Within-run screening and the between-run analysis, decided as one family.
-fn screen_both(
+/// The campaign's latitude (the first run that states one), else the default.
+fn latitude_of(campaign: &input::Campaign) -> f64 {
+    campaign
+        .runs
+        .iter()
+        .find_map(|s| s.latitude_deg)
+        .unwrap_or(report::azimuth::DEFAULT_LATITUDE_DEG)
+}
+
+/// The azimuth effect of the base's and the extended model's residuals, when the
+/// campaign has a heading column.
+fn azimuth(
     campaign: &input::Campaign,
     folds: &Folds,
     st: &Stacked,
+    base: &base::bases::BaseFit,
+    ext_resid: &[f64],
+    latitude: f64,
+) -> Option<Azimuth> {
+    let has_heading = campaign.extra_names.iter().any(|n| n.contains("heading"));
+    has_heading.then(|| Azimuth {
+        baseline: report::azimuth::azimuth_effect(folds, &st.t_s, &base.cv.residual, latitude),
+        extended: report::azimuth::azimuth_effect(folds, &st.t_s, ext_resid, latitude),
+    })
+}
+
+/// Every candidate within one standard error of a named cause, with the cause.
+fn competing(screening: &Screening) -> Vec<Competitor> {
+    screening
+        .steps
+        .iter()
+        .flat_map(|s| {
+            s.rivals.iter().map(|r| Competitor {
+                candidate: r.label.clone(),
+                named: s.scored.cand.label(),
+                conditional_gain_pct: r.gain_pct,
+                gap_se: r.gap_se,
+            })
+        })
+        .collect()
+}
+
+/// The generic library and, if the cap left candidates out, a note saying so.
+fn library_of(
+    campaign: &input::Campaign,
+    meta: &[library::generic::MetaColumn],
+    rate_half_s: f64,
+) -> (
+    Vec<library::transforms::Candidate>,
+    Option<selection::screen::Skipped>,
+) {
+    let (library, left_out) = library::generic::enumerate(campaign, meta, rate_half_s);
+    let note = (left_out > 0).then(|| {
+        (
+            format!("{left_out} candidates"),
+            format!(
+                "library capped at {} candidates",
+                library::generic::MAX_CANDIDATES
+            ),
+        )
+    });
+    (library, note)
+}
+
+/// Within-run and between-run selection, alpha shared between the two sequences
+/// (Bonferroni; one sequence when runs are too few for the between-run one). Returns
+/// both and the number of sequences.
+fn screen_both(
+    campaign: &input::Campaign,
+    meta: &[library::generic::MetaColumn],
+    folds: &Folds,
+    st: &Stacked,
     choice: &base::bases::BaseChoice,
+    library: &[library::transforms::Candidate],
     latitude_deg: f64,
-) -> Result<(Screening, between::BetweenRun), DiagnoseError> {
+) -> Result<(Screening, between::BetweenRun, f64), DiagnoseError> {
     let base = &choice.chosen;
-    let run_level = between::prepare(campaign, folds, st, base, choice.levels.as_ref());
-    let no_gains = Vec::new();
+    let run_level = between::prepare(campaign, meta, folds, st, base, choice.levels.as_ref());
+    let groups = if run_level.is_ok() { 2.0 } else { 1.0 };
     let screening = selection::screen::screen(
         campaign,
         folds,
-        st,
         base,
-        library::transforms::enumerate(campaign),
-        run_level.as_ref().map_or(&no_gains, |p| &p.gains),
+        library.to_vec(),
+        groups,
+        selection::screen::MAX_STEPS,
     )?;
     let between_run = match run_level {
-        Ok(p) => between::finish(p, &screening.between_p, latitude_deg),
+        Ok(p) => between::finish(p, groups, latitude_deg),
         Err(note) => between::BetweenRun {
             turn_on_repeatability_dph: f64::NAN,
             offsets_heldout_rms_dph: f64::NAN,
             offsets_from: String::new(),
             rows: vec![],
             named: None,
+            named_steps: vec![],
             heading: None,
             note: Some(note),
         },
     };
-    Ok((screening, between_run))
+    Ok((screening, between_run, groups))
 }
 
-/// The base extended by the named cause (the base itself when nothing is named), and its
-/// held-out residual.
-fn extended_model(
-    base: &base::bases::BaseFit,
-    named: Option<&Scored>,
-    cause: Option<&Cause>,
-) -> (Extended, Vec<f64>) {
+/// The base extended by every named within-run cause (the base itself when nothing is
+/// named), and its held-out residual.
+fn extended_model(base: &base::bases::BaseFit, screening: &Screening) -> (Extended, Vec<f64>) {
     let mut inputs = base.spec.inputs();
-    match (named, cause) {
-        (Some(s), Some(c)) => {
-            inputs.push(c.label());
-            (
-                Extended {
-                    inputs,
-                    mode: Some(s.mode),
-                    heldout_rms_dph: s.heldout_rms_dph,
-                    gain_pct: s.gain_pct,
-                },
-                s.cv.residual.clone(),
-            )
-        }
-        _ => (
-            Extended {
-                inputs,
-                mode: None,
-                heldout_rms_dph: base.cv.rms(),
-                gain_pct: 0.0,
-            },
-            base.cv.residual.clone(),
-        ),
+    inputs.extend(screening.steps.iter().map(|s| s.scored.cand.label()));
+    let cv = screening.final_cv(base);
+    (
+        Extended {
+            inputs,
+            heldout_rms_dph: cv.rms(),
+            gain_pct: selection::screen::gain_pct(base.cv.rms(), cv.rms()),
+        },
+        cv.residual.clone(),
+    )
+}
+
+/// Every named cause, within and between runs, ranked by the drop in held-out squared
+/// error it brings (the two are in the same units: (deg/h)^2 x points).
+fn named_causes(
+    folds: &Folds,
+    st: &Stacked,
+    base: &base::bases::BaseFit,
+    screening: &Screening,
+    between_run: &between::BetweenRun,
+    latitude_deg: f64,
+) -> Vec<NamedCause> {
+    let sigma = |r: &[f64]| {
+        report::azimuth::azimuth_effect(folds, &st.t_s, r, latitude_deg).azimuth_sigma_deg
+    };
+    let mut out: Vec<NamedCause> = Vec::new();
+    let mut before = &base.cv;
+    for (k, s) in screening.steps.iter().enumerate() {
+        out.push(NamedCause {
+            label: s.scored.cand.label(),
+            level: "within runs",
+            conditional_gain_pct: s.scored.gain_pct,
+            heldout_sse_drop: before.unit_sse.iter().sum::<f64>()
+                - s.cv.unit_sse.iter().sum::<f64>(),
+            p_value: s.scored.p_value,
+            step: k + 1,
+            azimuth_sigma_deg_before: Some(sigma(&before.residual)),
+            azimuth_sigma_deg_after: Some(sigma(&s.cv.residual)),
+            azimuth_error_bound_deg: None,
+        });
+        before = &s.cv;
     }
+    let points: Vec<f64> = folds.run_rows.iter().map(|r| r.len() as f64).collect();
+    let total_points: f64 = points.iter().sum();
+    let mut level_rms = between_run.offsets_heldout_rms_dph;
+    for (k, r) in between_run.named_steps.iter().enumerate() {
+        let drop = total_points * (level_rms.powi(2) - r.heldout_offset_rms_dph.powi(2));
+        level_rms = r.heldout_offset_rms_dph;
+        let heading = between_run
+            .heading
+            .as_ref()
+            .filter(|h| r.label.starts_with(&h.column));
+        out.push(NamedCause {
+            label: r.label.clone(),
+            level: "between runs",
+            conditional_gain_pct: r.gain_pct,
+            heldout_sse_drop: drop,
+            p_value: r.p_value,
+            step: k + 1,
+            azimuth_sigma_deg_before: None,
+            azimuth_sigma_deg_after: None,
+            azimuth_error_bound_deg: heading.map(|h| h.azimuth_error_bound_deg),
+        });
+    }
+    out.sort_by(|a, b| b.heldout_sse_drop.total_cmp(&a.heldout_sse_drop));
+    out
 }
 
 /// The chosen base and every base tried, for the report.
@@ -291,10 +392,10 @@ fn base_summary(
 
 fn candidate_row(s: &Scored) -> CandidateRow {
     CandidateRow {
+        label: s.cand.label(),
         column: s.cand.column.clone(),
         transform: s.cand.transform,
         tau_s: s.cand.tau_s,
-        mode: s.mode,
         heldout_rms_dph: s.heldout_rms_dph,
         gain_pct: s.gain_pct,
         p_value: s.p_value,
@@ -321,16 +422,33 @@ fn to_exclusion((column, reason): &selection::screen::Skipped) -> Exclusion {
     }
 }
 
-/// The within-run cause in words, else the between-run one, else why nothing is named.
+/// The first within-run cause in words (and the others' labels), else the between-run
+/// one, else why nothing is named.
 fn cause_in_words(
     cause: Option<&Cause>,
+    all: &[NamedCause],
     between_run: &between::BetweenRun,
     coef: &[f64],
     smallest_attainable_p: f64,
     power_check: Option<&selection::power::PowerCheck>,
 ) -> String {
+    let others: Vec<String> = all
+        .iter()
+        .filter(|n| cause.is_none_or(|c| c.label() != n.label))
+        .map(|n| {
+            format!(
+                "{} ({}, {:+.1} %)",
+                n.label, n.level, n.conditional_gain_pct
+            )
+        })
+        .collect();
+    let also = if others.is_empty() {
+        String::new()
+    } else {
+        format!("; also named: {}", others.join(", "))
+    };
     match (cause, &between_run.named) {
-        (Some(c), _) => c.in_words(coef),
+        (Some(c), _) => format!("{}{also}", c.in_words(coef)),
         (None, Some(b)) => {
             format!("no within-run cause; between runs: {b} (see the heading / run-level lines)")
         }

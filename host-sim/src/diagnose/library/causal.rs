@@ -212,7 +212,7 @@ pub fn check(
             let per_run: Vec<Vec<Option<f64>>> = campaign
                 .runs
                 .iter()
-                .map(|s| e.run(&s.t_s, cand.source.of(s)))
+                .map(|s| e.run(&s.t_s, cand.source.of(s).unwrap_or_default()))
                 .collect();
             let warmup_rows = per_run
                 .iter()

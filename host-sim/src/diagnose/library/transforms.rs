@@ -1,17 +1,18 @@
-//! Candidate explanatory features: every usable column under `value`, `rate`, `accel`,
-//! `lag` (several tau), plus `t_s:decay` and `harmonic` for `*_deg` columns.
+//! One candidate explanatory feature: which column, under which transform, and how it
+//! is computed per run. The generic library (`generic`) decides which candidates exist;
+//! this module only says what each one is.
 //!
 //! Derivatives are local least-squares polynomial fits over a centred window (zero
 //! delay, edges use the samples available) whose half-width was chosen per column by
 //! leave-one-out validation (`derivatives`): a diagnosis looks at the whole record, so it
 //! need not be causal. Lags are exact first-order low-passes started at the first value.
+//! Splines are natural (restricted) cubic splines with knots at the column's campaign
+//! quantiles; levels are indicators of all but the most common value; a product
+//! multiplies the (centred) feature by one of the base's inputs (T - mean T, dT/dt).
 
-use crate::diagnose::input::{Campaign, Series};
+use crate::diagnose::input::Series;
 use crate::diagnose::library::derivatives;
 use serde::Serialize;
-
-/// Time constants tried for `lag` and `decay`, s.
-pub const TAUS_S: [f64; 7] = [30.0, 60.0, 120.0, 240.0, 480.0, 960.0, 1920.0];
 
 /// How a column is turned into a feature.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
@@ -21,8 +22,10 @@ pub enum Transform {
     Rate,
     Accel,
     Harmonic,
+    Levels,
     Decay,
     Lag,
+    Spline,
 }
 
 impl Transform {
@@ -33,12 +36,15 @@ impl Transform {
             Self::Rate => "rate",
             Self::Accel => "accel",
             Self::Harmonic => "harmonic",
+            Self::Levels => "levels",
             Self::Decay => "decay",
             Self::Lag => "lag",
+            Self::Spline => "spline",
         }
     }
 
-    /// Parsimony rank: fewer free choices first (lag and decay carry a fitted tau).
+    /// Parsimony rank: fewer free choices first (lag and decay carry a fitted tau, a
+    /// spline its knots).
     pub fn complexity(self) -> u8 {
         self as u8
     }
@@ -50,15 +56,38 @@ pub enum Source {
     Time,
     Temp,
     Extra(usize),
+    /// A run-level metadata value (`Candidate::run_values`), constant within each run.
+    Meta,
+}
+
+/// One of the base's inputs a feature can be multiplied by.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BaseInput {
+    /// T minus its campaign mean.
+    Temp,
+    /// dT/dt over the base's window.
+    TempRate,
+}
+
+impl BaseInput {
+    /// Report name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Temp => "temp_c",
+            Self::TempRate => "temp_c:rate",
+        }
+    }
 }
 
 impl Source {
-    /// This signal in one run.
-    pub fn of(self, s: &Series) -> &[f64] {
+    /// This signal in one run (`None` for metadata, which has no series).
+    pub fn of(self, s: &Series) -> Option<&[f64]> {
         match self {
-            Source::Time => &s.t_s,
-            Source::Temp => &s.temp_c,
-            Source::Extra(i) => &s.extras[i],
+            Source::Time => Some(&s.t_s),
+            Source::Temp => Some(&s.temp_c),
+            Source::Extra(i) => Some(&s.extras[i]),
+            Source::Meta => None,
         }
     }
 }
@@ -72,33 +101,87 @@ pub struct Candidate {
     pub tau_s: Option<f64>,
     /// Half-width of a `rate` or `accel` window, s (validated per column).
     pub half_s: Option<f64>,
+    /// Spline knots, or the levels indicated (all but the reference level).
+    pub knots: Vec<f64>,
+    /// Every level of a `Levels` column, sorted (the reference included).
+    pub levels: Vec<f64>,
+    /// The base input the feature is multiplied by, if any.
+    pub times: Option<BaseInput>,
+    /// Centre subtracted from the feature before a product (its campaign mean), and
+    /// the campaign mean of T for `BaseInput::Temp`.
+    pub centres: (f64, f64),
+    /// Half-width of the base's dT/dt window, s (products with `BaseInput::TempRate`).
+    pub base_rate_half_s: f64,
+    /// Per-run values of a `Source::Meta` column.
+    pub run_values: Vec<f64>,
 }
 
 impl Candidate {
     /// The report name, e.g. `temp_c:lag(tau_s=240)` (see `fog_core::compensation::label::feature_label`).
     pub fn label(&self) -> String {
-        fog_core::compensation::label::feature_label(
-            &self.column,
-            self.transform.name(),
-            self.tau_s,
-        )
-        .to_string()
+        let own = match self.transform {
+            Transform::Spline => format!("{}:spline(knots={})", self.column, self.knots.len()),
+            _ => fog_core::compensation::label::feature_label(
+                &self.column,
+                self.transform.name(),
+                self.tau_s,
+            )
+            .to_string(),
+        };
+        let own = if self.source == Source::Meta {
+            format!("# {own}")
+        } else {
+            own
+        };
+        match self.times {
+            Some(b) => format!("{own}*{}", b.name()),
+            None => own,
+        }
     }
 
     /// Parsimony rank within a column (see `Transform::complexity`), except that for an
     /// angle (`*_deg`) the harmonic is the natural form: its raw value wraps at 360 deg
     /// and is only equivalent when few headings occur (e.g. two, 180 deg apart).
     pub fn complexity(&self) -> u8 {
-        match self.transform {
+        let own = match self.transform {
             Transform::Harmonic if self.column.ends_with("_deg") => 0,
             Transform::Value if self.column.ends_with("_deg") => Transform::Harmonic.complexity(),
             t => t.complexity(),
-        }
+        };
+        own + if self.times.is_some() { 16 } else { 0 }
     }
 
-    /// The feature's columns for one run.
-    pub fn compute(&self, s: &Series) -> Vec<Vec<f64>> {
-        let x = self.source.of(s);
+    /// The feature's columns for run `run` (`s`, its series).
+    pub fn compute(&self, run: usize, s: &Series) -> Vec<Vec<f64>> {
+        let own = self.own_columns(run, s);
+        let Some(b) = self.times else {
+            return own;
+        };
+        let partner: Vec<f64> = match b {
+            BaseInput::Temp => s.temp_c.iter().map(|t| t - self.centres.1).collect(),
+            BaseInput::TempRate => {
+                derivatives::centred(&s.t_s, &s.temp_c, 1, self.base_rate_half_s)
+            }
+        };
+        let centre = if self.transform == Transform::Levels {
+            0.0
+        } else {
+            self.centres.0
+        };
+        own.into_iter()
+            .map(|c| {
+                c.iter()
+                    .zip(&partner)
+                    .map(|(x, p)| (x - centre) * p)
+                    .collect()
+            })
+            .collect()
+    }
+
+    fn own_columns(&self, run: usize, s: &Series) -> Vec<Vec<f64>> {
+        let n = s.t_s.len();
+        let meta = vec![self.run_values.get(run).copied().unwrap_or(0.0); n];
+        let x = self.source.of(s).unwrap_or(&meta);
         let tau = self.tau_s.unwrap_or(0.0);
         let half_s = self
             .half_s
@@ -113,44 +196,47 @@ impl Candidate {
                 x.iter().map(|d| d.to_radians().cos()).collect(),
                 x.iter().map(|d| d.to_radians().sin()).collect(),
             ],
+            Transform::Levels => self
+                .knots
+                .iter()
+                .map(|l| {
+                    x.iter()
+                        .map(|v| {
+                            crate::diagnose::library::generic::level_weight(*v, *l, &self.levels)
+                        })
+                        .collect()
+                })
+                .collect(),
+            Transform::Spline => std::iter::once(x.to_vec())
+                .chain(natural_spline(x, &self.knots))
+                .collect(),
         }
     }
 }
 
-/// Every candidate of the campaign, in a fixed order.
-pub fn enumerate(c: &Campaign) -> Vec<Candidate> {
-    let mut out = Vec::new();
-    let mk = |column: &str, source, transform, tau_s| Candidate {
-        column: column.to_owned(),
-        source,
-        transform,
-        tau_s,
-        half_s: match transform {
-            Transform::Rate => Some(c.half_width_s(column, 1)),
-            Transform::Accel => Some(c.half_width_s(column, 2)),
-            _ => None,
-        },
-    };
-    for tau in TAUS_S {
-        out.push(mk("t_s", Source::Time, Transform::Decay, Some(tau)));
+/// Restricted (natural) cubic spline basis without its linear term: for knots
+/// t_1 < ... < t_K, K - 2 columns, each cubic between knots and linear beyond the end
+/// knots (Harrell's form, scaled by (t_K - t_1)^2 so the columns are in the column's units).
+pub fn natural_spline(x: &[f64], knots: &[f64]) -> Vec<Vec<f64>> {
+    let k = knots.len();
+    if k < 3 {
+        return vec![];
     }
-    out.push(mk("temp_c", Source::Temp, Transform::Accel, None));
-    for tau in TAUS_S {
-        out.push(mk("temp_c", Source::Temp, Transform::Lag, Some(tau)));
-    }
-    for (i, name) in c.extra_names.iter().enumerate() {
-        let src = Source::Extra(i);
-        for tr in [Transform::Value, Transform::Rate, Transform::Accel] {
-            out.push(mk(name, src, tr, None));
-        }
-        if name.ends_with("_deg") {
-            out.push(mk(name, src, Transform::Harmonic, None));
-        }
-        for tau in TAUS_S {
-            out.push(mk(name, src, Transform::Lag, Some(tau)));
-        }
-    }
-    out
+    let (tk, tk1) = (knots[k - 1], knots[k - 2]);
+    let scale = (tk - knots[0]).powi(2).max(1e-300);
+    let cube = |v: f64| v.max(0.0).powi(3);
+    (0..k - 2)
+        .map(|j| {
+            let tj = knots[j];
+            x.iter()
+                .map(|&v| {
+                    (cube(v - tj) - cube(v - tk1) * (tk - tj) / (tk - tk1)
+                        + cube(v - tk) * (tk1 - tj) / (tk - tk1))
+                        / scale
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// First-order low-pass with time constant `tau_s`, exact for piecewise-constant input.
@@ -179,5 +265,24 @@ mod tests {
         let y = first_order_lag(&t, &x, 100.0);
         // the step is held from t[0] to t[1]; ten 10 s steps later it has risen 1 - e^-1
         assert!((y[10] - (1.0 - (-1.0f64).exp())).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_natural_spline_is_linear_beyond_its_end_knots() {
+        let knots = [0.0, 1.0, 2.0, 3.0];
+        let x: Vec<f64> = (0..100).map(|i| -5.0 + 0.2 * f64::from(i)).collect();
+        let cols = natural_spline(&x, &knots);
+        assert_eq!(cols.len(), 2);
+        for c in &cols {
+            // second differences vanish below t_1 and above t_K, not in between
+            let d2 = |i: usize| c[i + 1] - 2.0 * c[i] + c[i - 1];
+            assert!(
+                d2(5).abs() < 1e-12 && d2(90).abs() < 1e-9,
+                "{} {}",
+                d2(5),
+                d2(90)
+            );
+            assert!(d2(30).abs() > 1e-6);
+        }
     }
 }

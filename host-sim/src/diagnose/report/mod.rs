@@ -11,7 +11,6 @@ use crate::diagnose::library::transforms::Transform;
 use crate::diagnose::report::azimuth::AzimuthEffect;
 use crate::diagnose::report::residuals::Structure;
 use crate::diagnose::selection::cause::Cause;
-use crate::diagnose::selection::screen::Mode;
 use crate::diagnose::simulator::simfit::SimCalibration;
 use crate::diagnose::simulator::simterm::TermSummary;
 use serde::Serialize;
@@ -45,10 +44,10 @@ pub struct ModelSummary {
 /// One ranked candidate.
 #[derive(Clone, Debug, Serialize)]
 pub struct CandidateRow {
+    pub label: String,
     pub column: String,
     pub transform: Transform,
     pub tau_s: Option<f64>,
-    pub mode: Mode,
     pub heldout_rms_dph: f64,
     pub gain_pct: f64,
     pub p_value: f64,
@@ -56,19 +55,45 @@ pub struct CandidateRow {
     pub units_improved: f64,
 }
 
-/// A candidate that explains the same thing as the named cause.
+/// A candidate the held-out data cannot tell from a named cause (within one standard
+/// error of it): both are reported.
 #[derive(Clone, Debug, Serialize)]
 pub struct Competitor {
     pub candidate: String,
-    /// Its held-out gain once the named cause is in the model, %.
+    /// The named cause it competes with.
+    pub named: String,
+    /// Its held-out gain at the step the named cause was chosen, %.
     pub conditional_gain_pct: f64,
+    /// Its held-out squared-error excess over the named cause, standard errors (< 1).
+    pub gap_se: f64,
+}
+
+/// One named cause (issue 18 item 4), most important first.
+#[derive(Clone, Debug, Serialize)]
+pub struct NamedCause {
+    pub label: String,
+    /// `within runs` or `between runs`.
+    pub level: &'static str,
+    /// Its held-out gain given the base and the causes named before it, % (within runs:
+    /// of the drift residual's rms; between runs: of the run levels' rms).
+    pub conditional_gain_pct: f64,
+    /// Drop in held-out squared error it brings, (deg/h)^2 x points (the ranking).
+    pub heldout_sse_drop: f64,
+    /// Family-wise p (max-T over the library, x sequences; steps gated).
+    pub p_value: f64,
+    /// Step at which it was named within its sequence (1 = first).
+    pub step: usize,
+    /// Two-position seek azimuth 1 sigma before and after adding it, deg (within runs).
+    pub azimuth_sigma_deg_before: Option<f64>,
+    pub azimuth_sigma_deg_after: Option<f64>,
+    /// For a run-level heading harmonic: its azimuth error bound, deg.
+    pub azimuth_error_bound_deg: Option<f64>,
 }
 
 /// The extended model.
 #[derive(Clone, Debug, Serialize)]
 pub struct Extended {
     pub inputs: Vec<String>,
-    pub mode: Option<Mode>,
     pub heldout_rms_dph: f64,
     pub gain_pct: f64,
 }
@@ -108,6 +133,8 @@ pub struct CampaignSummary {
     pub validation: String,
     pub excluded_columns: Vec<Exclusion>,
     pub skipped_candidates: Vec<Exclusion>,
+    /// Candidates in the generic library (within runs; before the usability checks).
+    pub library_size: usize,
     /// Smallest p-value the sign-flip test can reach with this many validation units.
     pub smallest_attainable_p: f64,
     /// When nothing is named: whether a planted 1-sigma effect would have been
@@ -127,6 +154,9 @@ pub struct Report {
     /// validation of the local polynomial on the column itself.
     pub derivative_widths: Vec<crate::diagnose::library::derivatives::WidthChoice>,
     pub candidates: Vec<CandidateRow>,
+    /// Every named cause, within and between runs, most important first.
+    pub named_causes: Vec<NamedCause>,
+    /// The first named within-run cause (its column and transform).
     pub named_cause: Option<Cause>,
     pub cause_in_words: String,
     pub competing: Vec<Competitor>,
@@ -160,16 +190,18 @@ pub fn nothing_named(
     match power_check.map(|pc| (pc, pc.planted.as_deref())) {
         Some((_, None)) => format!(
             "no significant cause: the residual of the chosen base shows no structure that any \
-             candidate explains better than chance on held-out data (power not checked: each of \
-             the {} best-ranked candidates is mostly predicted by the base itself, so an effect \
-             of their shape could not be told from the base on this record)",
+             candidate explains better than chance on held-out data (power not checked: for every \
+             shape, each of its {} best-ranked candidates is mostly predicted by the base itself, \
+             so an effect of that shape could not be told from the base on this record)",
             crate::diagnose::selection::power::TRIED
         ),
         Some((pc, Some(planted))) if !pc.named => format!(
-            "cannot decide: no test power at {} sigma (a copy of {} planted at the residual's own \
-             size, {:.4} deg/h rms, was not named: gain {:+.1} %, p {:.4}); absence of a named \
-             cause says nothing about effects of that size",
+            "cannot decide: no test power at {} sigma for {} of {} planted shapes (e.g. a copy of {} \
+             planted at the residual's own size, {:.4} deg/h rms, was not named: gain {:+.1} %, p {:.4}); \
+             absence of a named cause says nothing about effects of that shape and size",
             crate::diagnose::selection::power::PLANTED_SIGMAS,
+            pc.shapes.iter().filter(|s| !s.named).count(),
+            pc.shapes.len(),
             planted,
             pc.planted_rms_dph,
             pc.gain_pct,
@@ -177,8 +209,9 @@ pub fn nothing_named(
         ),
         Some((pc, Some(planted))) => format!(
             "no significant cause: the residual of the chosen base shows no structure that any \
-             candidate explains better than chance on held-out data (power check: a copy of {} \
-             planted at {} sigma, {:.4} deg/h rms, is named, p {:.4})",
+             candidate explains better than chance on held-out data (power check: every one of {} \
+             shapes, e.g. {}, planted at {} sigma, {:.4} deg/h rms, is named, p {:.4})",
+            pc.shapes.len(),
             planted,
             crate::diagnose::selection::power::PLANTED_SIGMAS,
             pc.planted_rms_dph,
@@ -224,7 +257,9 @@ fn write_campaign(s: &mut String, c: &CampaignSummary) {
     {
         let _ = writeln!(
             s,
-            "  power check (nothing named): a copy of {} planted at {} sigma ({:.4} deg/h rms, orthogonal to the residual) is {}: gain {:+.1} %, p {:.4}",
+            "  power check (nothing named): {} of {} shapes named when planted; e.g. a copy of {} planted at {} sigma ({:.4} deg/h rms, orthogonal to the residual) is {}: gain {:+.1} %, p {:.4}",
+            pc.shapes.iter().filter(|s| s.named).count(),
+            pc.shapes.len(),
             planted,
             crate::diagnose::selection::power::PLANTED_SIGMAS,
             pc.planted_rms_dph,
@@ -440,20 +475,13 @@ fn write_causal(s: &mut String, c: &crate::diagnose::library::causal::CausalChec
 
 /// Section 3: ranked within-run candidates, then the between-run ones.
 fn write_candidates(s: &mut String, r: &Report) {
-    let _ = writeln!(s, "\n3. Candidate causes (ranked by held-out rms; p = family-wise sign-flip test over whole validation units)");
+    let _ = writeln!(s, "\n3. Candidate causes, first step (ranked by held-out rms; p = family-wise sign-flip max-T over the library and whole validation units, x sequences)");
     write_derivative_widths(s, &r.derivative_widths);
     for row in r.candidates.iter().take(8) {
-        let label = fog_core::compensation::label::feature_label(
-            &row.column,
-            row.transform.name(),
-            row.tau_s,
-        )
-        .to_string();
         let _ = writeln!(
             s,
-            "  {:<28} {:>9} rms {:.4}  gain {:+6.2}%  p {:.4}  units improved {:>3.0}%{}",
-            label,
-            format!("{:?}", row.mode),
+            "  {:<38} rms {:.4}  gain {:+6.2}%  p {:.4}  units improved {:>3.0}%{}",
+            row.label,
             row.heldout_rms_dph,
             row.gain_pct,
             row.p_value,
@@ -489,7 +517,27 @@ fn write_candidates(s: &mut String, r: &Report) {
 fn write_cause(s: &mut String, r: &Report) {
     let _ = writeln!(s, "\n4. Cause");
     let named = r.named_cause.as_ref().map_or("none".into(), Cause::label);
-    let _ = writeln!(s, "  named: {named}");
+    let _ = writeln!(s, "  named within runs first: {named}");
+    for c in &r.named_causes {
+        let _ = writeln!(
+            s,
+            "  named ({}, step {}): {}  conditional held-out gain {:+.2}%, p {:.4}{}",
+            c.level,
+            c.step,
+            c.label,
+            c.conditional_gain_pct,
+            c.p_value,
+            match (
+                c.azimuth_sigma_deg_before,
+                c.azimuth_sigma_deg_after,
+                c.azimuth_error_bound_deg
+            ) {
+                (Some(a), Some(b), _) => format!(", azimuth 1 sigma {a:.4} -> {b:.4} deg"),
+                (_, _, Some(e)) => format!(", azimuth error up to {e:.3} deg"),
+                _ => String::new(),
+            }
+        );
+    }
     let _ = writeln!(s, "  {}", r.cause_in_words);
     if let Some(n) = &r.parsimony_note {
         let _ = writeln!(s, "  {n}");
@@ -497,8 +545,8 @@ fn write_cause(s: &mut String, r: &Report) {
     for comp in &r.competing {
         let _ = writeln!(
             s,
-            "  competes: {} explains the same thing (its gain drops to {:+.2}% once the named cause is in)",
-            comp.candidate, comp.conditional_gain_pct
+            "  competes with {}: {} is within {:.2} standard errors on held-out data (gain {:+.2}%): the data cannot tell them apart",
+            comp.named, comp.candidate, comp.gap_se, comp.conditional_gain_pct
         );
     }
     if let Some(c) = &r.causal_derivative {

@@ -35,6 +35,9 @@ pub struct OlsCheck {
 fn cause_specs(c: &Cause) -> Option<(Vec<FeatureSpec>, Vec<String>)> {
     let spec = |kind, tau_s: f32| FeatureSpec { kind, tau_s };
     let tau = c.tau_s.unwrap_or(0.0) as f32;
+    if !c.is_plain() {
+        return None;
+    }
     match (c.column.as_str(), c.transform) {
         ("temp_c", Transform::Accel) => Some((vec![spec(FeatureKind::TempAccelCps2, 0.0)], vec![])),
         ("temp_c", Transform::Lag) => Some((vec![spec(FeatureKind::TempLagC, tau)], vec![])),

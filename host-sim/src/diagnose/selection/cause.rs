@@ -3,7 +3,7 @@
 //! (`simterm`) and the OLS cross-check (`olscheck`) share it without depending on each
 //! other.
 
-use crate::diagnose::library::transforms::{Candidate, Transform};
+use crate::diagnose::library::transforms::{BaseInput, Candidate, Source, Transform};
 use serde::Serialize;
 
 /// The named cause.
@@ -12,6 +12,17 @@ pub struct Cause {
     pub column: String,
     pub transform: Transform,
     pub tau_s: Option<f64>,
+    /// Spline knots or indicated levels (empty otherwise).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub knots: Vec<f64>,
+    /// The base input the feature is multiplied by, if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub times: Option<BaseInput>,
+    /// Whether the column is a metadata key (constant within each run).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub metadata: bool,
+    /// The report name (`Candidate::label`).
+    pub label: String,
 }
 
 impl From<&Candidate> for Cause {
@@ -20,25 +31,54 @@ impl From<&Candidate> for Cause {
             column: c.column.clone(),
             transform: c.transform,
             tau_s: c.tau_s,
+            knots: c.knots.clone(),
+            times: c.times,
+            metadata: c.source == Source::Meta,
+            label: c.label(),
         }
     }
 }
 
 impl Cause {
-    /// The report name, e.g. `temp_c:lag(tau_s=240)` (the one label format,
-    /// `fog_core::compensation::label::feature_label`, also used by `Candidate::label`).
+    /// A plain one-column cause (no product, spline, levels or metadata).
+    pub fn plain(column: &str, transform: Transform, tau_s: Option<f64>) -> Self {
+        Self {
+            column: column.into(),
+            transform,
+            tau_s,
+            knots: vec![],
+            times: None,
+            metadata: false,
+            label: fog_core::compensation::label::feature_label(column, transform.name(), tau_s)
+                .to_string(),
+        }
+    }
+
+    /// The report name, e.g. `temp_c:lag(tau_s=240)`, `supply_v*temp_c:rate`, `mode:levels`.
     pub fn label(&self) -> String {
-        fog_core::compensation::label::feature_label(
-            &self.column,
-            self.transform.name(),
-            self.tau_s,
-        )
-        .to_string()
+        self.label.clone()
+    }
+
+    /// Whether the cause is one transform of one recorded column (what the simulator
+    /// mapping, the device features and the OLS cross-check can express).
+    pub fn is_plain(&self) -> bool {
+        self.times.is_none()
+            && !self.metadata
+            && !matches!(self.transform, Transform::Spline | Transform::Levels)
     }
 
     /// The cause in words (physics reading of the column and transform); `coef` are the
     /// fitted coefficients of its term in the calibrated simulator.
     pub fn in_words(&self, coef: &[f64]) -> String {
+        if let Some(b) = self.times {
+            return format!(
+                "drift follows the product of `{}` and {} (the base's input): the {} sensitivity depends on `{}`",
+                self.label.split('*').next().unwrap_or(&self.column),
+                b.name(),
+                if b == BaseInput::Temp { "temperature" } else { "temperature-rate" },
+                self.column
+            );
+        }
         let tau = self.tau_s.unwrap_or(0.0);
         let k = coef.first().copied().unwrap_or(0.0);
         match (self.column.as_str(), self.transform) {
@@ -73,6 +113,14 @@ impl Cause {
             (col, Transform::Accel) => format!("drift follows the second derivative of `{col}` ({k:.4e} deg/h per unit/s^2)"),
             (col, Transform::Lag) => format!("drift follows `{col}` through a first-order lag of {tau:.0} s ({k:.4e} deg/h per unit)"),
             (col, Transform::Decay) => format!("drift decays as exp(-{col}/{tau:.0} s)"),
+            (col, Transform::Levels) => format!(
+                "the drift level depends on the value of `{col}` (a bias per level: {} levels apart from the commonest)",
+                self.knots.len()
+            ),
+            (col, Transform::Spline) => format!(
+                "drift follows a smooth nonlinear function of `{col}` (natural cubic spline, {} knots)",
+                self.knots.len()
+            ),
         }
     }
 }
@@ -90,10 +138,28 @@ mod tests {
             transform: Transform::Lag,
             tau_s: Some(240.0),
             half_s: None,
+            knots: vec![],
+            levels: vec![],
+            times: None,
+            centres: (0.0, 0.0),
+            base_rate_half_s: 20.0,
+            run_values: vec![],
         };
         let cause = Cause::from(&cand);
         assert_eq!(cause.label(), cand.label());
         assert_eq!(cause.label(), "temp_c:lag(tau_s=240)");
         assert!(cause.in_words(&[0.1]).contains("240 s lag"));
+        assert!(cause.is_plain());
+        let product = Candidate {
+            column: "supply_v".into(),
+            source: Source::Extra(0),
+            transform: Transform::Value,
+            tau_s: None,
+            times: Some(BaseInput::TempRate),
+            ..cand
+        };
+        let cause = Cause::from(&product);
+        assert_eq!(cause.label(), "supply_v:value*temp_c:rate");
+        assert!(!cause.is_plain());
     }
 }

@@ -5,21 +5,24 @@
 //! far from independent and an effect the size of the noise goes unseen although a small
 //! p is reachable (`tests/diagnose_single_record.rs`: named in 4 of 80 records).
 //!
-//! So an effect is planted and looked for: the part of the top-ranked candidate's feature
-//! that the chosen base cannot predict held out (the base fitted to the feature itself:
-//! a copy of T would be absorbed by a base in T, which is confounding, not lack of
-//! power), made orthogonal to the base's held-out residual within each run (so it adds a
-//! new structure rather than amplifying one the residual already has) and scaled to the
-//! residual's own within-run rms (1 noise sigma), is added to the drift; the base is
-//! chosen again on the same validation layout and the same family-wise screen is run.
-//! If the planted copy is not named, the report says "cannot decide: no test power at
-//! 1 sigma" instead of "no significant cause".
+//! So effects are planted and looked for, one of every shape the library can name (value,
+//! derivatives, memory, decay, sinusoid, levels, spline, products with the base's
+//! inputs): for each shape, the best-ranked candidate of that shape whose feature the
+//! chosen base cannot predict held out (the base fitted to the feature itself: a copy of
+//! T would be absorbed by a base in T, which is confounding, not lack of power). Its
+//! columns, each scaled to unit within-run rms and summed, minus what the base predicts,
+//! made orthogonal to the base's held-out residual within each run (so it adds a new
+//! structure rather than amplifying one the residual already has) and scaled to the
+//! residual's own within-run rms (1 noise sigma), are added to the drift; the base is
+//! chosen again on the same validation layout and the same family-wise selection (first
+//! step) is run. If any planted shape is not named, the report says "cannot decide: no
+//! test power at 1 sigma" for that shape instead of "no significant cause".
 
 use crate::diagnose::base::bases::{self, BaseFit};
 use crate::diagnose::base::models::Stacked;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
-use crate::diagnose::library::transforms;
+use crate::diagnose::library::transforms::Candidate;
 use crate::diagnose::report::residuals::demeaned_by_run;
 use crate::diagnose::selection::screen::{self, Screening};
 use crate::diagnose::validation::cv::Folds;
@@ -28,26 +31,45 @@ use serde::Serialize;
 /// Size of the planted effect, in within-run rms of the base's held-out residual.
 pub const PLANTED_SIGMAS: f64 = 1.0;
 
-/// The outcome of planting a known effect into the record.
+/// One planted shape.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct PowerCheck {
-    /// Label of the candidate whose (orthogonalised) feature was planted; `None` when
-    /// none of the `TRIED` best-ranked candidates could be (each mostly predicted by the
-    /// base: nothing else is counted then).
-    pub planted: Option<String>,
-    /// Its rms within runs, deg/h (`PLANTED_SIGMAS` x the residual's).
-    pub planted_rms_dph: f64,
-    /// Whether the family-wise screen named it.
+pub struct ShapeCheck {
+    pub planted: String,
+    /// Whether the selection's first step named it (its column, in the same product).
     pub named: bool,
-    /// Its held-out gain over the re-chosen base, %, and family-wise p.
     pub gain_pct: f64,
     pub p_value: f64,
 }
 
+/// The outcome of planting known effects into the record.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PowerCheck {
+    /// Label of the first planted shape that was not named (else of the first planted);
+    /// `None` when no candidate could be planted (each mostly predicted by the base).
+    pub planted: Option<String>,
+    /// Its rms within runs, deg/h (`PLANTED_SIGMAS` x the residual's).
+    pub planted_rms_dph: f64,
+    /// Whether every planted shape was named.
+    pub named: bool,
+    /// `planted`'s held-out gain over the re-chosen base, %, and family-wise p.
+    pub gain_pct: f64,
+    pub p_value: f64,
+    /// Every shape planted, in the order tried.
+    pub shapes: Vec<ShapeCheck>,
+}
+
+/// What the selection is re-run with on the record with a planted effect: the library
+/// and the number of sequences sharing alpha.
+#[derive(Clone, Copy)]
+pub struct Rerun<'a> {
+    pub library: &'a [Candidate],
+    pub groups: f64,
+}
+
 /// When nothing was named (`silent`) and the layout can reach p < alpha at all
-/// (otherwise the report already says "no test power"): plants the top-ranked plantable
-/// candidate of `screening` at 1 residual sigma into `st.y` and screens again. `None`
-/// when not silent, p < alpha is unreachable, or there is no candidate.
+/// (otherwise the report already says "no test power"): plants one candidate of every
+/// shape of `screening` at 1 residual sigma into `st.y` and selects again. `None` when
+/// not silent, p < alpha is unreachable, or there is no candidate.
 pub fn check(
     silent: bool,
     campaign: &Campaign,
@@ -55,87 +77,124 @@ pub fn check(
     st: &Stacked,
     base: &BaseFit,
     screening: &Screening,
+    rerun: Rerun<'_>,
 ) -> Result<Option<PowerCheck>, DiagnoseError> {
     let reachable =
         crate::diagnose::validation::signflip::smallest_p(folds.unit_rows.len()) < screen::ALPHA;
     if !silent || !reachable || screening.scored.is_empty() {
         return Ok(None);
     }
-    let Some((label, planted)) = plantable(campaign, folds, st, base, screening)? else {
-        return Ok(Some(PowerCheck {
-            planted: None,
-            planted_rms_dph: 0.0,
-            named: false,
-            gain_pct: 0.0,
-            p_value: 1.0,
-        }));
-    };
-    let mut with_effect = st.clone();
-    with_effect
-        .y
-        .iter_mut()
-        .zip(&planted)
-        .for_each(|(y, e)| *y += e);
-    let base = bases::choose(folds, &with_effect)?.chosen;
-    let again = screen::screen(
-        campaign,
-        folds,
-        &with_effect,
-        &base,
-        transforms::enumerate(campaign),
-        &[],
-    )?;
-    let found = again.scored.iter().position(|s| s.cand.label() == label);
-    let (gain_pct, p_value) = found.map_or((0.0, 1.0), |i| {
-        (again.scored[i].gain_pct, again.scored[i].p_value)
-    });
+    let mut shapes = Vec::new();
+    let mut planted_rms = 0.0;
+    for (cand, planted) in plantable(campaign, folds, st, base, screening)? {
+        let mut with_effect = st.clone();
+        with_effect
+            .y
+            .iter_mut()
+            .zip(&planted)
+            .for_each(|(y, e)| *y += e);
+        let base = bases::choose(folds, &with_effect)?.chosen;
+        let again = screen::screen(
+            campaign,
+            folds,
+            &base,
+            rerun.library.to_vec(),
+            rerun.groups,
+            1,
+        )?;
+        let found = again.scored.iter().find(|s| s.cand.label() == cand.label());
+        let named = again.steps.first().is_some_and(|s| {
+            s.scored.cand.column == cand.column && s.scored.cand.times == cand.times
+        });
+        planted_rms = within_rms(&folds.run_rows, &planted);
+        shapes.push(ShapeCheck {
+            planted: cand.label(),
+            named,
+            gain_pct: found.map_or(0.0, |s| s.gain_pct),
+            p_value: found.map_or(1.0, |s| s.p_value),
+        });
+    }
+    let headline = shapes.iter().find(|s| !s.named).or(shapes.first()).cloned();
     Ok(Some(PowerCheck {
-        planted: Some(label),
-        planted_rms_dph: within_rms(&folds.run_rows, &planted),
-        named: found.is_some() && again.named == found,
-        gain_pct,
-        p_value,
+        planted: headline.as_ref().map(|s| s.planted.clone()),
+        planted_rms_dph: planted_rms,
+        named: !shapes.is_empty() && shapes.iter().all(|s| s.named),
+        gain_pct: headline.as_ref().map_or(0.0, |s| s.gain_pct),
+        p_value: headline.as_ref().map_or(1.0, |s| s.p_value),
+        shapes,
     }))
 }
 
-/// Candidates tried in rank order for planting.
-pub const TRIED: usize = 20;
+/// Candidates tried per shape, in rank order, for planting.
+pub const TRIED: usize = 5;
 /// Least share of a feature's within-run variance the base must leave unexplained held
 /// out for the feature to be planted: a feature the base predicts (a copy of T under a
 /// base in T) cannot be told from the base on any record, which is confounding, not a
 /// lack of test power.
 const MIN_UNEXPLAINED: f64 = 0.5;
 
-/// The first of the `TRIED` best-ranked candidates whose feature the base leaves at
-/// least `MIN_UNEXPLAINED` unexplained, with the effect to plant.
+/// A candidate's shape: its transform and the base input it multiplies.
+fn shape_of(c: &Candidate) -> (&'static str, Option<&'static str>) {
+    (c.transform.name(), c.times.map(|b| b.name()))
+}
+
+/// For every shape among the ranked candidates, the first of its `TRIED` best whose
+/// feature the base leaves at least `MIN_UNEXPLAINED` unexplained, with the effect to
+/// plant.
 fn plantable(
     campaign: &Campaign,
     folds: &Folds,
     st: &Stacked,
     base: &BaseFit,
     screening: &Screening,
-) -> Result<Option<(String, Vec<f64>)>, DiagnoseError> {
+) -> Result<Vec<(Candidate, Vec<f64>)>, DiagnoseError> {
     let runs = &folds.run_rows;
-    for scored in screening.scored.iter().take(TRIED) {
-        let cols = scored.columns(campaign);
-        let Some(feature) = cols.first() else {
-            continue;
-        };
-        let mut feature_as_target = st.clone();
-        feature_as_target.y.clone_from(feature);
-        let Ok(fit) = bases::fit(folds, &feature_as_target, &base.spec) else {
-            continue;
-        };
-        let unexplained = fit.cv.residual;
-        let share = (within_rms(runs, &unexplained) / within_rms(runs, feature)).powi(2);
-        if share < MIN_UNEXPLAINED || !share.is_finite() {
-            continue;
-        }
-        if let Some(planted) = planted_effect(runs, &unexplained, &base.cv.residual) {
-            return Ok(Some((scored.cand.label(), planted)));
+    let mut shapes: Vec<(&'static str, Option<&'static str>)> = Vec::new();
+    for s in &screening.scored {
+        if !shapes.contains(&shape_of(&s.cand)) {
+            shapes.push(shape_of(&s.cand));
         }
     }
-    Ok(None)
+    let mut out = Vec::new();
+    for shape in shapes {
+        for scored in screening
+            .scored
+            .iter()
+            .filter(|s| shape_of(&s.cand) == shape)
+            .take(TRIED)
+        {
+            let cols = screen::stacked_columns(campaign, &scored.cand);
+            let feature = unit_sum(runs, &cols);
+            let mut feature_as_target = st.clone();
+            feature_as_target.y.clone_from(&feature);
+            let Ok(fit) = bases::fit(folds, &feature_as_target, &base.spec) else {
+                continue;
+            };
+            let unexplained = fit.cv.residual;
+            let share = (within_rms(runs, &unexplained) / within_rms(runs, &feature)).powi(2);
+            if share < MIN_UNEXPLAINED || !share.is_finite() {
+                continue;
+            }
+            if let Some(planted) = planted_effect(runs, &unexplained, &base.cv.residual) {
+                out.push((scored.cand.clone(), planted));
+                break;
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The columns, each scaled to unit within-run rms, summed.
+fn unit_sum(runs: &[std::ops::Range<usize>], cols: &[Vec<f64>]) -> Vec<f64> {
+    let n = cols.first().map_or(0, Vec::len);
+    let mut out = vec![0.0; n];
+    for c in cols {
+        let s = within_rms(runs, c);
+        if s > 0.0 && s.is_finite() {
+            out.iter_mut().zip(c).for_each(|(o, v)| *o += v / s);
+        }
+    }
+    out
 }
 
 /// `feature` minus its run means and its projection on the run-demeaned `residual`,

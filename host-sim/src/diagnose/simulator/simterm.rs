@@ -47,6 +47,7 @@ fn sim_transform(t: Transform, tau_s: Option<f64>) -> Option<AuxTransform> {
         Transform::Rate => Some(AuxTransform::Rate),
         Transform::Accel => Some(AuxTransform::Accel),
         Transform::Lag => tau_s.map(|tau_s| AuxTransform::Lag { tau_s }),
+        Transform::Levels | Transform::Spline => None,
     }
 }
 
@@ -74,6 +75,9 @@ pub fn terms_for_run(run: &Run, cause: &Cause, coef: &[f64]) -> Vec<DriftTerm> {
     let Some(transform) = sim_transform(cause.transform, cause.tau_s) else {
         return Vec::new();
     };
+    if !cause.is_plain() {
+        return Vec::new();
+    }
     let want = if cause.transform == Transform::Harmonic {
         2
     } else {
@@ -180,11 +184,7 @@ mod tests {
     }
 
     fn cause(column: &str, transform: Transform, tau_s: Option<f64>) -> Cause {
-        Cause {
-            column: column.into(),
-            transform,
-            tau_s,
-        }
+        Cause::plain(column, transform, tau_s)
     }
 
     #[test]
