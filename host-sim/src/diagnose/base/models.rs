@@ -113,22 +113,3 @@ pub fn fit_rbf(
         ridge,
     })
 }
-
-/// The candidate as a further RBF input next to the chosen base's inputs (T when the base
-/// uses it, dT/dt when it does; the candidate's columns also kept as linear terms).
-pub fn fit_rbf_input(
-    folds: &Folds,
-    st: &Stacked,
-    base: &crate::diagnose::base::bases::BaseSpec,
-    cand: &[Vec<f64>],
-) -> Result<RbfFit, DiagnoseError> {
-    let mut inputs = Vec::new();
-    if base.rbf || base.poly_degree_t.is_some() {
-        inputs.push(st.temp_c.clone());
-    }
-    if base.uses_rate {
-        inputs.push(st.temp_rate_cps.clone());
-    }
-    inputs.extend(cand.iter().cloned());
-    fit_rbf(folds, &inputs, &[], &st.y)
-}
