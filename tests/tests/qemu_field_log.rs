@@ -3,9 +3,11 @@
 //!
 //! The real `fog-app` keeps its models in `flash-file=models.img` and its field-record ring
 //! in `field-file=field.img` (both written through at every flash write, so they survive
-//! a QEMU restart). The world around it is the one of qemu_seek.rs: a simulated FOG on
-//! UART1 (Earth rate on the level input axis at the table heading + a constant bias
-//! `BIAS_DPH` + white noise, 25 degC), a turntable on UART2, the PC on UART0.
+//! a QEMU restart). The world around it is the bench simulator's (`fog_sim::rig`, as in
+//! qemu_seek.rs) with a gyro whose drift law is one constant: Earth rate on the level
+//! input axis at the table heading + `BIAS_DPH` + white noise, at 25 degC with no self
+//! heating, so the residual a record must carry is known exactly. Gyro on UART1,
+//! turntable on UART2, inclinometer on UART3, the PC on UART0.
 //!
 //! Run 1: upload a model, two two-position seeks; `fogsim field pull`'s client pulls two
 //! records (sequences 1, 2) whose residual bias is the generator's bias minus the model's
@@ -26,20 +28,21 @@ use std::net::TcpStream;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::Receiver;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Duration;
 
 use fog_core::link::messages::{Command, DeviceMessage};
 use fog_core::model::rbf::predict_f64;
 use fog_core::seeking::field_record::FieldRecord;
-use fog_core::seeking::tilt::{earth_rate_on_axis_dph, Tilt};
+use fog_core::seeking::tilt::Tilt;
 use fog_sim::field::pull::pull_records;
+use fog_sim::rig::{tcp_link, Rig, RigConfig};
+use fog_sim::sim::{GyroParams, StartState};
 use fog_sim::upload::UploadClient;
 use fog_tests::console::{start_with_console, wait_line, wait_line_where};
 use fog_tests::{firmware_elf, qemu_ready, scratch_dir, KillOnDrop, QemuOptions};
-use qemu_support::{link_command, polled, serve_table, stream_gyro_frames, Heading};
-use rand_distr::Distribution;
+use qemu_support::{link_command, polled};
 use upload_support::*;
 
 const RATE_HZ: u32 = 20;
@@ -49,7 +52,30 @@ const LATITUDE_DEG: f64 = 39.9;
 const TRUE_AZIMUTH_DEG: f64 = 61.0;
 const ARW_DPSH: f64 = 0.0011;
 const BIAS_DPH: f64 = 0.35;
+const AMBIENT_C: f64 = 25.0;
+const SEED: u64 = 20;
 const WAIT: Duration = Duration::from_secs(40);
+
+/// The rig's gyro: one constant bias, white noise, no temperature law, no heating.
+fn constant_bias_gyro() -> GyroParams {
+    let mut p = GyroParams::paper_default();
+    p.thermal.power_w = 0.0;
+    p.sensor.noise_c = 0.0;
+    p.drift.bias_dph = BIAS_DPH;
+    p.drift.bias_dph_per_c = 0.0;
+    p.drift.bias_dph_per_c2 = 0.0;
+    p.drift.shupe_dph_per_cps = 0.0;
+    p.drift.shupe_cold_gain_per_k = 0.0;
+    p.drift.gradient_dph_per_cps = 0.0;
+    p.drift.turn_on_bias_sigma_dph = 0.0;
+    p.noise.arw_dpsh = ARW_DPSH;
+    p.noise.bias_instability_dph = 0.0;
+    p.noise.rrw_dph_per_sqrt_h = 0.0;
+    p.noise.quantization_arcsec = 0.0;
+    p.variation.power_sigma_frac = 0.0;
+    p.variation.start_temp_sigma_c = 0.0;
+    p
+}
 
 /// One QEMU run on `dir`'s two flash images, with the simulated gyro and table.
 struct Run {
@@ -74,29 +100,31 @@ impl Run {
             cwd: Some(dir.to_path_buf()),
             ..QemuOptions::default()
         };
-        let (qemu, mut streams, console) = start_with_console(&firmware_elf("fog-app"), opts, 3);
+        let (qemu, mut streams, console) = start_with_console(&firmware_elf("fog-app"), opts, 4);
+        let incl_link = streams.pop().expect("inclinometer link");
         let table_link = streams.pop().expect("table link");
         let gyro_link = streams.pop().expect("gyro link");
         let host = polled(streams.pop().expect("host link"));
-        let heading: Heading = Arc::new(Mutex::new(0.0));
         let stop = Arc::new(AtomicBool::new(false));
-        let table = {
-            let (h, s) = (heading.clone(), stop.clone());
-            std::thread::spawn(move || serve_table(table_link, h, s))
-        };
-        let gyro = {
-            let (h, s) = (heading, stop.clone());
+        let rig = {
+            let s = stop.clone();
             std::thread::spawn(move || {
-                let period_s = 1.0 / f64::from(RATE_HZ);
-                let noise =
-                    rand_distr::Normal::new(0.0, ARW_DPSH * 60.0 / period_s.sqrt()).unwrap();
-                let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(20);
-                stream_gyro_frames(gyro_link, RATE_HZ, SPEED, &s, |_| {
-                    let h = *h.lock().unwrap();
-                    earth_rate_on_axis_dph(LATITUDE_DEG, TRUE_AZIMUTH_DEG, Tilt::LEVEL, h)
-                        + BIAS_DPH
-                        + noise.sample(&mut rng)
-                });
+                let mut rig = Rig::new(RigConfig {
+                    params: constant_bias_gyro(),
+                    seed: SEED,
+                    ambient_c: AMBIENT_C,
+                    latitude_deg: LATITUDE_DEG,
+                    azimuth_deg: TRUE_AZIMUTH_DEG,
+                    tilt: Tilt::LEVEL,
+                    start: StartState::Warm,
+                    rate_hz: f64::from(RATE_HZ),
+                    speed: SPEED,
+                    duration_s: None,
+                })
+                .expect("rig");
+                let [mut gyro, mut table, mut incl] =
+                    [gyro_link, table_link, incl_link].map(|l| tcp_link(l).expect("rig link"));
+                let _ = rig.serve(gyro.as_mut(), table.as_mut(), Some(incl.as_mut()), &s);
             })
         };
         Run {
@@ -104,7 +132,7 @@ impl Run {
             host,
             console,
             stop,
-            threads: vec![table, gyro],
+            threads: vec![rig],
         }
     }
 
