@@ -282,7 +282,7 @@ fn bad_input_is_rejected_with_a_clear_error() {
                 linear_only_inputs: 2,
                 ..TrainConfig::default()
             },
-            "linear-only inputs",
+            "linear-inputs",
         ),
     ] {
         match fit_width(&ds, &cfg, 0.5).unwrap_err() {

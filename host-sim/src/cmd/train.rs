@@ -103,7 +103,8 @@ pub struct Args {
     pub field: Option<PathBuf>,
     /// Weight W of each field seek against the chamber model's prior (one row of weight 1
     /// per correction coefficient). Default: chosen by leave-one-out over the field seeks.
-    #[arg(long, requires = "field")]
+    /// Given without `--field`, it is refused by name.
+    #[arg(long)]
     pub field_weight: Option<f64>,
 }
 
@@ -203,6 +204,9 @@ fn inputs(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
         .is_some_and(|w| !(w.is_finite() && w >= 0.0))
     {
         anyhow::bail!("--field-weight: must be a finite number >= 0");
+    }
+    if args.field_weight.is_some() && args.field.is_none() {
+        anyhow::bail!("--field-weight: needs --field DIR (the field records it weighs)");
     }
     let mut inputs = args.runs.clone();
     inputs.extend(
