@@ -52,6 +52,7 @@ const OUTPUT_FLAGS: &[&str] = &[
     "--plots",
     "--export-design",
     "--csv",
+    "--logger-csv",
 ];
 /// Flags with a free-text value: only a missing or non-UTF-8 value is bad for certain.
 const FREE_TEXT_FLAGS: &[&str] = &["--gyro-id", "--gyro"];
