@@ -237,14 +237,14 @@ impl<L: Read + Write> UploadClient<L> {
             if Instant::now() >= deadline {
                 return Err(ClientError::Timeout(self.timeout));
             }
-            match self.link.read(&mut byte) {
-                Ok(0) => {
+            match read_polled(&mut self.link, &mut byte) {
+                Ok(Some(0)) => {
                     return Err(ClientError::Io(std::io::Error::new(
                         ErrorKind::UnexpectedEof,
                         "link closed by the device",
                     )))
                 }
-                Ok(_) => {
+                Ok(Some(_)) => {
                     if let Some(frame) = self.rx.push(byte[0]) {
                         // The device's north-finder messages (periodic `Status`, seek
                         // results) share the port: not ours, skipped. So is a corrupt
@@ -258,8 +258,7 @@ impl<L: Read + Write> UploadClient<L> {
                         }
                     }
                 }
-                Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
-                Err(e) if e.kind() == ErrorKind::Interrupted => {}
+                Ok(None) => {}
                 Err(e) => return Err(e.into()),
             }
         }
@@ -376,4 +375,34 @@ pub fn describe_model(info: &ModelInfo) -> String {
         info.n_inputs,
         info.heldout_rms_dph
     )
+}
+
+/// One read of a polled link (a read timeout or non-blocking): `Ok(None)` when nothing
+/// arrived in time (timeout, would block, interrupted), `Ok(Some(0))` when the peer closed
+/// the link, `Ok(Some(n))` with `n` bytes. Every reader of the host and rig links uses it.
+pub fn read_polled(
+    link: &mut (impl Read + ?Sized),
+    buf: &mut [u8],
+) -> std::io::Result<Option<usize>> {
+    match link.read(buf) {
+        Ok(n) => Ok(Some(n)),
+        Err(e)
+            if matches!(
+                e.kind(),
+                ErrorKind::WouldBlock | ErrorKind::TimedOut | ErrorKind::Interrupted
+            ) =>
+        {
+            Ok(None)
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// The device's own gyro id (upload `Hello`), the key its records are filed under.
+pub fn device_gyro_id<L: Read + Write>(link: &mut L) -> anyhow::Result<String> {
+    Ok(UploadClient::new(link, Duration::from_secs(5))
+        .hello()
+        .context("asking the device for its gyro id (Hello)")?
+        .gyro_id
+        .to_string())
 }

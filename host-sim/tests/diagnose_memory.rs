@@ -11,6 +11,8 @@
 //! Grams grow with the trainer's candidate count until it saturates). Run it with
 //! `cargo test --release -p fog-sim --test diagnose_memory -- --ignored --nocapture`.
 
+mod app_support;
+
 use std::path::Path;
 use std::process::Command;
 
@@ -20,15 +22,7 @@ const MAX_BYTES_PER_ROW: f64 = 300.0;
 const SCALE: usize = 3;
 
 fn fogsim(args: &[&str]) {
-    let out = Command::new(env!("CARGO_BIN_EXE_fogsim"))
-        .args(args)
-        .output()
-        .expect("run fogsim");
-    assert!(
-        out.status.success(),
-        "fogsim {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    app_support::fogsim_ok(args);
 }
 
 /// Peak RSS of one `fogsim diagnose` child, bytes.

@@ -7,8 +7,9 @@
 //! The Shupe coefficient carries a known bias of 1.5-3 % on the full-size campaigns
 //! (`docs/diagnose.md`, "Self-consistency"): it is allowed 3 % on top of its 2 sigma.
 
+mod app_support;
+
 use std::path::Path;
-use std::process::Command;
 
 #[path = "common/seeds.rs"]
 mod seeds;
@@ -17,15 +18,7 @@ mod seeds;
 const SHUPE_BIAS_ALLOWED: f64 = 0.03;
 
 fn fogsim(args: &[&str]) {
-    let out = Command::new(env!("CARGO_BIN_EXE_fogsim"))
-        .args(args)
-        .output()
-        .expect("run fogsim");
-    assert!(
-        out.status.success(),
-        "fogsim {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    app_support::fogsim_ok(args);
 }
 
 /// One campaign and its verdict line; true when it passes.

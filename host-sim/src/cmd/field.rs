@@ -7,13 +7,13 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 
 use super::upload::LinkArgs;
 use crate::field::pull::{pull_records, MAX_PULLED_RECORDS};
 use crate::field::records_file::{merge_into_dir, StoredRecord, CSV_NAME, JSON_NAME};
 use crate::registry::{self, Registry};
-use crate::upload::UploadClient;
+use crate::upload::device_gyro_id;
 
 /// Options of `fogsim field`.
 #[derive(clap::Args, Debug)]
@@ -59,11 +59,7 @@ fn pull(a: PullArgs) -> Result<()> {
     }
     let reg_path = registry::resolve(a.registry.as_deref())?;
     let mut link = a.link.open()?;
-    let gyro_id = UploadClient::new(&mut link, Duration::from_secs(5))
-        .hello()
-        .context("asking the device for its gyro id (Hello)")?
-        .gyro_id
-        .to_string();
+    let gyro_id = device_gyro_id(&mut link)?;
     let records = pull_records(
         &mut link,
         a.from,

@@ -7,14 +7,14 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Duration;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use fog_core::link::messages::{Command, Status};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::upload::LinkArgs;
 use crate::monitor::{monitor, CsvAppend, MonitorOptions, ResultLog};
 use crate::registry::{self, utc::now_utc, Registry, SeekRecord};
-use crate::upload::UploadClient;
+use crate::upload::device_gyro_id;
 
 /// Options of `fogsim monitor`.
 #[derive(clap::Args, Debug)]
@@ -54,11 +54,7 @@ pub fn run(a: Args) -> Result<()> {
     let reg_path = reg.path().to_path_buf();
     let mut link = a.link.open()?;
     // The gyro id the results are filed under: the device's own (upload `Hello`).
-    let gyro_id = UploadClient::new(&mut link, Duration::from_secs(5))
-        .hello()
-        .context("asking the device for its gyro id (Hello)")?
-        .gyro_id
-        .to_string();
+    let gyro_id = device_gyro_id(&mut link)?;
     let mut log = ResultLog::new(reg, csv, &gyro_id);
     let opts = MonitorOptions {
         max_results: a.results,

@@ -17,6 +17,8 @@ use fog_core::link::messages::{
 use fog_core::link::upload::{FrameReceiver, MAX_WIRE_FRAME_LEN};
 use fog_core::seeking::field_record::FieldRecord;
 
+use crate::upload::read_polled;
+
 /// Most records one pull keeps (a 16 KiB ring holds ~450).
 pub const MAX_PULLED_RECORDS: usize = 100_000;
 
@@ -81,18 +83,10 @@ fn request<L: Read + Write>(
     let mut rx = FrameReceiver::new();
     let mut buf = [0u8; 256];
     while Instant::now() < deadline {
-        let got = match link.read(&mut buf) {
-            Ok(0) => bail!("the device closed the link"),
-            Ok(k) => k,
-            Err(e)
-                if matches!(
-                    e.kind(),
-                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
-                ) =>
-            {
-                continue
-            }
-            Err(e) => return Err(e.into()),
+        let got = match read_polled(link, &mut buf)? {
+            Some(0) => bail!("the device closed the link"),
+            Some(k) => k,
+            None => continue,
         };
         for &b in &buf[..got] {
             let Some(Ok(payload)) = rx.push(b) else {

@@ -25,6 +25,7 @@ use fog_core::link::upload::{FrameReceiver, MAX_WIRE_FRAME_LEN, STATUS_REQUEST_P
 use fog_core::seeking::quality::{QualityError, SeekState};
 
 use crate::registry::{SeekContext, SeekRecord};
+use crate::upload::read_polled;
 
 /// Limits and commands of one monitoring session.
 #[derive(Clone, Debug)]
@@ -74,18 +75,10 @@ pub fn monitor<L: Read + Write>(
     let deadline = Instant::now() + opts.max_duration;
     let mut buf = [0u8; 256];
     while sum.results < opts.max_results && Instant::now() < deadline {
-        let n = match link.read(&mut buf) {
-            Ok(0) => break, // the device closed the link
-            Ok(n) => n,
-            Err(e)
-                if matches!(
-                    e.kind(),
-                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
-                ) =>
-            {
-                continue
-            }
-            Err(e) => return Err(e).context("reading the link"),
+        let n = match read_polled(link, &mut buf).context("reading the link")? {
+            Some(0) => break, // the device closed the link
+            Some(n) => n,
+            None => continue,
         };
         for &b in &buf[..n] {
             let Some(frame) = rx.push(b) else { continue };

@@ -10,6 +10,7 @@ use std::io::ErrorKind;
 use fog_core::hal::{TableState, Turntable};
 
 use crate::sim::SimTurntable;
+use crate::upload::read_polled;
 
 /// Longest command line kept, bytes (`MOV 359.999` is 11).
 const MAX_LINE: usize = 32;
@@ -45,12 +46,10 @@ impl TableServer {
     /// complete line; returns the number of commands answered. Err: the link closed.
     pub fn serve(&mut self, link: &mut dyn super::Link) -> std::io::Result<u64> {
         let mut buf = [0u8; 64];
-        let n = match link.read(&mut buf) {
-            Ok(0) => return Err(ErrorKind::UnexpectedEof.into()),
-            Ok(n) => n,
-            Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => 0,
-            Err(e) if e.kind() == ErrorKind::Interrupted => 0,
-            Err(e) => return Err(e),
+        let n = match read_polled(link, &mut buf)? {
+            Some(0) => return Err(ErrorKind::UnexpectedEof.into()),
+            Some(n) => n,
+            None => 0,
         };
         let mut answered = 0;
         for &b in &buf[..n] {

@@ -19,6 +19,12 @@ pub fn fogsim(dir: &Path, args: &[&str]) -> Output {
         .expect("fogsim runs")
 }
 
+/// Runs `fogsim` with `args` (paths absolute) and asserts it succeeded, with its stderr.
+pub fn fogsim_ok(args: &[&str]) {
+    let out = fogsim(&std::env::temp_dir(), args);
+    assert!(out.status.success(), "fogsim {args:?}: {}", stderr(&out));
+}
+
 /// stderr as text.
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
