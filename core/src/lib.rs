@@ -16,6 +16,8 @@
 //!   seek `quality`);
 //! - [`link`]: the host port: model `upload` and frame format, north-finder `messages`, the
 //!   built-in-test word (`bit`);
+//! - [`sensor_link`]: the binary frames of the gyro and inclinometer links (`framing`,
+//!   `gyro_frame`, `tilt_frame`), encoded by the host's rig and decoded by the firmware;
 //! - [`hal`]: the hardware traits the simulator and the firmware drivers both implement.
 //!
 //! Two small files stay at the root because more than one concern uses them and none owns
@@ -32,3 +34,4 @@ pub mod link;
 pub mod model;
 pub mod numeric;
 pub mod seeking;
+pub mod sensor_link;

@@ -1,7 +1,7 @@
 //! The replay scenario, shared by the QEMU firmware binary (`src/bin/replay.rs`) and the
 //! host side of `tests/tests/qemu_replay.rs`, so both run literally the same code:
 //!
-//! - input 1: the gyro's serial byte stream (frames of `drivers::gyro_frame`), decoded
+//! - input 1: the gyro's serial byte stream (frames of `fog_core::sensor_link::gyro_frame`), decoded
 //!   by the real `FogSerialGyro` driver through a UART adapter over a byte reader;
 //! - input 2: the turntable log, recorded on the host while the simulated table was
 //!   driven in closed loop; `ReplayTurntable` answers the north finder's calls from it

@@ -6,10 +6,10 @@ use embedded_hal_mock::eh1::serial::{Mock, Transaction};
 use embedded_hal_nb::nb;
 use embedded_hal_nb::serial::ErrorKind;
 use fog_core::hal::{Gyro, GyroSample};
-use fog_firmware::drivers::fog_serial::{FogSerialGyro, UartError};
-use fog_firmware::drivers::gyro_frame::{
+use fog_core::sensor_link::gyro_frame::{
     FrameDecoder, GyroFrame, ANGLE_LSB_DEG, FRAME_LEN, STATUS_SOURCE_FAULT, STATUS_VALID,
 };
+use fog_firmware::drivers::fog_serial::{FogSerialGyro, UartError};
 use proptest::prelude::*;
 
 const RATE_HZ: u32 = 2000;

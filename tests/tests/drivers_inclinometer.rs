@@ -1,4 +1,4 @@
-//! Host tests of the inclinometer link (`fog_firmware::drivers::tilt_frame`,
+//! Host tests of the inclinometer link (`fog_core::sensor_link::tilt_frame`,
 //! `serial_inclinometer`) against embedded-hal-mock's UART: the frame round trip, the mean
 //! of the readings since the last read, invalid readings skipped, resynchronisation after
 //! garbage and a corrupted frame, a gyro stream on the wrong port decoding to nothing,
@@ -7,10 +7,10 @@
 use embedded_hal_mock::eh1::serial::{Mock, Transaction};
 use embedded_hal_nb::nb;
 use embedded_hal_nb::serial::ErrorKind;
-use fog_firmware::drivers::gyro_frame::GyroFrame;
+use fog_core::sensor_link::gyro_frame::GyroFrame;
+use fog_core::sensor_link::tilt_frame::{TiltFrame, TiltFrameDecoder, TILT_LSB_DEG};
 use fog_firmware::drivers::inclinometer::Inclinometer;
 use fog_firmware::drivers::serial_inclinometer::{SerialInclinometer, SerialInclinometerError};
-use fog_firmware::drivers::tilt_frame::{TiltFrame, TiltFrameDecoder, TILT_LSB_DEG};
 use fog_firmware::drivers::turntable::SerialFault;
 use proptest::prelude::*;
 

@@ -21,7 +21,7 @@ use fog_core::link::upload::{
     decode_frame, decode_message, encode_frame, FrameReceiver, Request, Response, UploadError,
     MAX_CHUNK_LEN, MAX_WIRE_FRAME_LEN,
 };
-use fog_firmware::drivers::gyro_frame::{FrameDecoder, GyroFrame, FRAME_LEN};
+use fog_core::sensor_link::gyro_frame::{FrameDecoder, GyroFrame, FRAME_LEN};
 use proptest::prelude::*;
 use proptest::test_runner::TestRunner;
 use upload_support::*;

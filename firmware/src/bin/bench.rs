@@ -31,9 +31,9 @@ use fog_core::model::fixed::FixedModel;
 use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
 use fog_core::model::rbf::predict_f32;
 use fog_core::model::synthetic::{warmup_inputs, warmup_model};
+use fog_core::sensor_link::gyro_frame::{GyroFrame, FRAME_LEN};
 use fog_firmware::app::{App, AppConfig};
 use fog_firmware::drivers::fog_serial::FogSerialGyro;
-use fog_firmware::drivers::gyro_frame::{GyroFrame, FRAME_LEN};
 use fog_firmware::signature::{verify_model, TEST_PUBLIC_KEY};
 
 const RATE_HZ: u32 = 2000;

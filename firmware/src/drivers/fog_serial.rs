@@ -20,8 +20,8 @@ use embedded_hal_nb::nb;
 use embedded_hal_nb::serial::{Error as _, ErrorKind, Read};
 use fog_core::hal::{Gyro, GyroSample, TempSample};
 
-use super::gyro_frame::{FrameDecoder, FrameStats, GyroFrame, ANGLE_LSB_DEG};
 use crate::clock::Clock;
+use fog_core::sensor_link::gyro_frame::{FrameDecoder, FrameStats, GyroFrame, ANGLE_LSB_DEG};
 
 /// Frames per wrap of the 8-bit frame counter.
 const COUNTER_WRAP: u64 = 256;

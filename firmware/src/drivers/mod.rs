@@ -3,11 +3,8 @@
 //! Each one implements the matching `fog_core::hal` trait.
 
 pub mod fog_serial;
-pub mod gyro_frame;
 pub mod inclinometer;
 pub mod scl3300;
 pub mod serial_inclinometer;
-pub mod sync_frame;
-pub mod tilt_frame;
 pub mod tmp117;
 pub mod turntable;

@@ -14,8 +14,8 @@ use embedded_hal_nb::serial::{Error as _, Read};
 use fog_core::seeking::tilt::Tilt;
 
 use super::inclinometer::Inclinometer;
-use super::tilt_frame::{FrameStats, TiltFrameDecoder};
 use super::turntable::SerialFault;
+use fog_core::sensor_link::tilt_frame::{FrameStats, TiltFrameDecoder};
 
 /// Why `read_tilt` has no tilt.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

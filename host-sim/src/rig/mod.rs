@@ -1,10 +1,10 @@
 //! `fogsim rig`: the bench around the device, simulated. The same `sim/` physics as the
 //! campaign (a `SimGyro` cold-started at the rig's power-on, on a `SimTurntable`, on a
 //! possibly tilted base) served on the firmware's own links: the FOG's 12-byte frames
-//! (`fog_firmware::drivers::gyro_frame`, the one encoder) on the gyro link, the ASCII
+//! (`fog_core::sensor_link::gyro_frame`, the one encoder) on the gyro link, the ASCII
 //! turntable protocol (`table`) on the table link, and the base inclinometer's readings
 //! of the same base (`sim::BaseMotion`, SCL3300-like noise) as 14-byte
-//! `fog_firmware::drivers::tilt_frame`s at 10 Hz of sample time on the inclinometer link.
+//! `fog_core::sensor_link::tilt_frame`s at 10 Hz of sample time on the inclinometer link.
 //! A link is a serial device (a board on the bench) or a TCP port the rig listens on
 //! (QEMU's `-serial tcp:...` client). The QEMU tests drive `fog-app` through this same
 //! server (`Rig::serve` on their sockets), so there is one simulated bench.
@@ -24,8 +24,8 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use fog_core::hal::Turntable;
 use fog_core::seeking::tilt::Tilt;
-use fog_firmware::drivers::gyro_frame::GyroFrame;
-use fog_firmware::drivers::tilt_frame::{TiltFrame, TILT_FRAME_RATE_HZ};
+use fog_core::sensor_link::gyro_frame::GyroFrame;
+use fog_core::sensor_link::tilt_frame::{TiltFrame, TILT_FRAME_RATE_HZ};
 
 use crate::sim::{rig, BaseMotion, GyroParams, RunSpec, SimGyro, StartState, TurntableParams};
 use crate::upload::Link;
@@ -283,7 +283,7 @@ pub fn tcp_link(stream: std::net::TcpStream) -> Result<Box<dyn Link>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use fog_firmware::drivers::gyro_frame::FrameDecoder;
+    use fog_core::sensor_link::gyro_frame::FrameDecoder;
 
     fn cfg(seed: u64) -> RigConfig {
         RigConfig {
@@ -326,7 +326,7 @@ mod tests {
 
     #[test]
     fn the_inclinometer_link_carries_the_base_tilt_at_10_hz_seeded() {
-        use fog_firmware::drivers::tilt_frame::TiltFrameDecoder;
+        use fog_core::sensor_link::tilt_frame::TiltFrameDecoder;
         let tilts = |seed: u64| -> Vec<u8> {
             let mut rig = Rig::new(cfg(seed)).unwrap();
             let mut temp = f64::NAN;

@@ -1,7 +1,7 @@
 //! The inclinometer link's frame: a two-axis inclinometer (an SCL3300 behind a small
 //! serial front end on a board; `fogsim rig --incl-port` under QEMU) streaming its base
 //! tilt at `TILT_FRAME_RATE_HZ` on a UART. Same framing as the FOG's frames
-//! (`sync_frame`: sync, body, CRC-16), its own sync marker, so a gyro stream on the
+//! (`framing`: sync, body, CRC-16), its own sync marker, so a gyro stream on the
 //! inclinometer's port (a swapped cable) decodes to nothing instead of to tilts.
 //!
 //! Frame, 14 bytes, little-endian fields:
@@ -17,10 +17,10 @@
 //!
 //! 140 B/s at 10 Hz: any baud rate carries it (115,200 Bd on the device).
 
-use fog_core::seeking::tilt::Tilt;
+use crate::seeking::tilt::Tilt;
 
-pub use super::sync_frame::FrameStats;
-use super::sync_frame::{round_sat_i32, seal, SyncDecoder};
+pub use super::framing::FrameStats;
+use super::framing::{round_sat_i32, seal, SyncDecoder};
 
 /// Frame start marker.
 pub const TILT_SYNC: [u8; 2] = [0xA5, 0xC3];

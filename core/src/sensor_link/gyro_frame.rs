@@ -15,8 +15,8 @@
 //!
 //! At 2 kHz this is 24,000 B/s, i.e. 240 kbaud with 8N1 framing (460,800 baud link).
 
-pub use super::sync_frame::FrameStats;
-use super::sync_frame::{round_sat_i32, seal, SyncDecoder};
+pub use super::framing::FrameStats;
+use super::framing::{round_sat_i32, seal, SyncDecoder};
 
 /// Frame start marker.
 pub const SYNC: [u8; 2] = [0xA5, 0x5A];
@@ -84,7 +84,7 @@ impl GyroFrame {
     }
 }
 
-/// Byte-at-a-time frame decoder with resynchronisation (`sync_frame`).
+/// Byte-at-a-time frame decoder with resynchronisation (`framing`).
 #[derive(Clone, Debug)]
 pub struct FrameDecoder(SyncDecoder<FRAME_LEN>);
 
