@@ -8,6 +8,7 @@ pub mod compensate;
 pub mod demo;
 pub mod diagnose;
 pub mod field;
+pub mod heap;
 pub mod heading_cal;
 pub mod import;
 pub mod monitor;
