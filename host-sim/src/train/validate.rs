@@ -166,8 +166,8 @@ fn search(ds: &Dataset, cfg: &TrainConfig, folds: usize, keep: KeepGrams) -> Res
             let scored = score_width(&ctx, cfg, width);
             let mut improved: Option<usize> = None;
             for (di, (score, _)) in scored.scores.iter().enumerate() {
-                let better = best
-                    .is_none_or(|b| criterion_key(cfg, score) < criterion_key(cfg, &scan[b]));
+                let better =
+                    best.is_none_or(|b| criterion_key(cfg, score) < criterion_key(cfg, &scan[b]));
                 scan.push(score.clone());
                 if better {
                     best = Some(scan.len() - 1);
