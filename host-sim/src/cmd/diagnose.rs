@@ -20,6 +20,7 @@ pub struct Args {
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    super::heap::return_large_blocks_to_the_system();
     let guard = OutputGuard::new(&args.runs);
     args.outputs.check(&guard)?;
     // Streamed into 10 s windows (memory grows with windows, not rows, at any row rate);

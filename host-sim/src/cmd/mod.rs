@@ -9,6 +9,7 @@ pub mod demo;
 pub mod diagnose;
 pub mod field;
 pub mod heading_cal;
+pub mod heap;
 pub mod import;
 pub mod monitor;
 pub mod north_seek;

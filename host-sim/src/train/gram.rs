@@ -65,27 +65,30 @@ pub fn gram_bytes(columns: usize) -> usize {
 
 impl FoldGrams {
     /// Accumulates G_f = A_f'A_f for every fold f (`fold[i]` < `folds` for every row i)
-    /// over `threads` threads (each accumulates its own share of a fold's rows).
+    /// over `threads` threads (each accumulates its own share of a fold's rows). Folds are
+    /// accumulated one after the other, so at most `threads` partial Grams exist beside
+    /// the fold Grams (memory: folds + 1 + threads Grams, not folds x threads), and only
+    /// the current fold's row list is held; every sum is the same, in the same order.
     pub fn build(layout: &Layout<'_>, fold: &[usize], folds: usize, threads: usize) -> Self {
         let p = layout.n_columns();
         let parts = threads.max(1);
-        let rows_of_fold: Vec<Vec<usize>> = (0..folds)
-            .map(|f| (0..fold.len()).filter(|&i| fold[i] == f).collect())
-            .collect();
-        let partial = map_in_order(folds * parts, parts, |job| {
-            let rows = &rows_of_fold[job / parts];
-            let share = rows.len().div_ceil(parts).max(1);
-            let start = (job % parts * share).min(rows.len());
-            let end = (start + share).min(rows.len());
-            accumulate(layout, &rows[start..end])
-        });
         let mut fold_grams: Vec<Vec<f64>> = Vec::with_capacity(folds);
-        for shares in partial.chunks(parts) {
+        let mut fold_rows = Vec::with_capacity(folds);
+        for f in 0..folds {
+            let rows: Vec<usize> = (0..fold.len()).filter(|&i| fold[i] == f).collect();
+            let share = rows.len().div_ceil(parts).max(1);
+            let shares = map_in_order(parts, parts, |part| {
+                let start = (part * share).min(rows.len());
+                let end = (start + share).min(rows.len());
+                accumulate(layout, &rows[start..end])
+            });
             let mut g = vec![0.0; p * p];
-            for s in shares {
+            for s in &shares {
                 g.iter_mut().zip(s).for_each(|(a, b)| *a += b);
             }
+            drop(shares);
             mirror_upper(&mut g, p);
+            fold_rows.push(rows.len());
             fold_grams.push(g);
         }
         let mut total = vec![0.0; p * p];
@@ -96,7 +99,7 @@ impl FoldGrams {
             p,
             n_forced: layout.forced.len(),
             folds: fold_grams,
-            fold_rows: rows_of_fold.iter().map(Vec::len).collect(),
+            fold_rows,
             total,
             n_rows: fold.len(),
         }

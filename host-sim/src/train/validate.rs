@@ -82,7 +82,7 @@ pub fn fold_of_rows(ds: &Dataset, folds: usize) -> Result<Vec<usize>> {
 /// grouped `folds`-fold cross-validation and returns the best (lowest pooled held-out
 /// rms; ties go to the first tried, i.e. the smaller model).
 pub fn cross_validate(ds: &Dataset, cfg: &TrainConfig, folds: usize) -> Result<CvReport> {
-    Ok(search(ds, cfg, folds)?.report)
+    Ok(search(ds, cfg, folds, KeepGrams::No)?.report)
 }
 
 /// Cross-validation (as `cross_validate`) followed by the selection path on all rows at
@@ -93,14 +93,15 @@ pub(super) fn cross_validate_and_fit(
     cfg: &TrainConfig,
     folds: usize,
 ) -> Result<(CvReport, PathFit)> {
-    let found = search(ds, cfg, folds)?;
+    let found = search(ds, cfg, folds, KeepGrams::Best)?;
     let best = &found.report.best;
     let shape = Shape {
         width: best.width,
         degree: best.degree,
         centers: best.centers,
     };
-    let (design, grams) = &found.best_gram;
+    let design = &found.best.design;
+    let grams = found.best.grams.as_ref().ok_or(TrainError::EmptyDataset)?;
     let path = path_on_gram(
         ds,
         cfg,
@@ -113,15 +114,33 @@ pub(super) fn cross_validate_and_fit(
 }
 
 /// A finished width search: the report, the normalisation it used and the best
-/// width's design with its per-fold Grams.
+/// width's design (with its per-fold Grams when they were kept).
 struct Search {
     report: CvReport,
     normalizer: Normalizer,
     points: Vec<f32>,
-    best_gram: (WidthDesign, FoldGrams),
+    best: BestWidth,
 }
 
-fn search(ds: &Dataset, cfg: &TrainConfig, folds: usize) -> Result<Search> {
+/// Whether the search keeps the best width's per-fold Grams (the final fit reuses
+/// them); without them at most one width's Grams exist at a time.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum KeepGrams {
+    No,
+    Best,
+}
+
+/// The width holding the best score so far: its design, the best degree's per-fold paths
+/// (the held-out residuals are recomputed from them once, at the end: bytes per row
+/// stay one residual vector per scoring thread, not one per degree and the best's), and
+/// its Grams if kept.
+struct BestWidth {
+    design: WidthDesign,
+    degree: DegreePaths,
+    grams: Option<FoldGrams>,
+}
+
+fn search(ds: &Dataset, cfg: &TrainConfig, folds: usize, keep: KeepGrams) -> Result<Search> {
     cfg.check(ds.n_inputs())?;
     if ds.is_empty() {
         return Err(TrainError::EmptyDataset);
@@ -134,10 +153,10 @@ fn search(ds: &Dataset, cfg: &TrainConfig, folds: usize) -> Result<Search> {
     let points = normalizer.normalized_rows(ds);
     let ctx = FoldContext::new(ds, &points, &fold, folds);
     let mut scan: Vec<WidthScore> = Vec::new();
-    let mut best: Option<(usize, Vec<f64>)> = None;
+    let mut best: Option<usize> = None;
     let mut tried: Vec<f64> = Vec::new();
     let mut widenings = 0;
-    let mut best_gram: Option<(WidthDesign, FoldGrams)> = None;
+    let mut best_width: Option<BestWidth> = None;
     let mut queue = match cfg.width_search {
         WidthSearch::Full => grid.clone(),
         WidthSearch::Climb => vec![grid[grid.len() / 2]],
@@ -145,27 +164,37 @@ fn search(ds: &Dataset, cfg: &TrainConfig, folds: usize) -> Result<Search> {
     while !queue.is_empty() {
         for &width in &queue {
             let scored = score_width(&ctx, cfg, width);
-            let mut improved = false;
-            for (score, residuals) in scored.scores {
-                let better = best.as_ref().is_none_or(|(b, _)| {
-                    criterion_key(cfg, &score) < criterion_key(cfg, &scan[*b])
-                });
-                scan.push(score);
+            let mut improved: Option<usize> = None;
+            for (di, (score, _)) in scored.scores.iter().enumerate() {
+                let better =
+                    best.is_none_or(|b| criterion_key(cfg, score) < criterion_key(cfg, &scan[b]));
+                scan.push(score.clone());
                 if better {
-                    best = Some((scan.len() - 1, residuals));
-                    improved = true;
+                    best = Some(scan.len() - 1);
+                    improved = Some(di);
                 }
             }
-            if improved {
-                best_gram = Some((scored.design, scored.grams));
+            if let Some(di) = improved {
+                let ScoredWidth {
+                    scores,
+                    design,
+                    grams,
+                } = scored;
+                let degree = scores.into_iter().nth(di).map(|(_, paths)| paths);
+                best_width = degree.map(|degree| BestWidth {
+                    design,
+                    degree,
+                    grams: (keep == KeepGrams::Best).then_some(grams),
+                });
             }
             tried.push(width);
         }
-        let Some((b, _)) = &best else { break };
-        queue = next_widths(&mut grid, &tried, scan[*b].width, &mut widenings);
+        let Some(b) = best else { break };
+        queue = next_widths(&mut grid, &tried, scan[b].width, &mut widenings);
     }
-    let (b, residuals_dph) = best.ok_or(TrainError::EmptyDataset)?;
-    let best_gram = best_gram.ok_or(TrainError::EmptyDataset)?;
+    let b = best.ok_or(TrainError::EmptyDataset)?;
+    let best_width = best_width.ok_or(TrainError::EmptyDataset)?;
+    let residuals_dph = best_width.degree.residuals(&ctx, &best_width.design);
     Ok(Search {
         report: CvReport {
             folds,
@@ -177,7 +206,7 @@ fn search(ds: &Dataset, cfg: &TrainConfig, folds: usize) -> Result<Search> {
         },
         normalizer,
         points,
-        best_gram,
+        best: best_width,
     })
 }
 
@@ -284,18 +313,37 @@ impl<'a> FoldContext<'a> {
     }
 }
 
-/// Scores every configured degree at one width: one Gram per fold, one selection path
-/// per (degree, fold) on the fold's training Gram, every prefix scored on the fold's
-/// held-out Gram; the best prefix's held-out residuals are then computed row by row.
-/// Degrees are scored in parallel (`fanout`), results in degree order.
-/// One width scored: every degree's score and held-out residuals, and the design and
+/// One width scored: every degree's score and per-fold paths, and the design and
 /// per-fold Grams they came from.
 struct ScoredWidth {
-    scores: Vec<(WidthScore, Vec<f64>)>,
+    scores: Vec<(WidthScore, DegreePaths)>,
     design: WidthDesign,
     grams: FoldGrams,
 }
 
+/// One degree's selection path on every fold and the prefix each fold's held-out rows
+/// are predicted with.
+struct DegreePaths {
+    paths: Vec<SelectedPath>,
+    picks: Vec<usize>,
+}
+
+impl DegreePaths {
+    /// Held-out residual (target - prediction) of every row, each row by its fold's path.
+    fn residuals(&self, ctx: &FoldContext<'_>, design: &WidthDesign) -> Vec<f64> {
+        let mut res = vec![0.0; ctx.ds.len()];
+        for (f, (path, &m)) in self.paths.iter().zip(&self.picks).enumerate() {
+            heldout_residuals(ctx, design, path, f, m, &mut res);
+        }
+        res
+    }
+}
+
+/// Scores every configured degree at one width: one Gram per fold, one selection path
+/// per (degree, fold) on the fold's training Gram, every prefix scored on the fold's
+/// held-out Gram; the best prefix's held-out residuals are then computed row by row,
+/// scored and dropped (`DegreePaths::residuals` recomputes the best one's).
+/// Degrees are scored in parallel (`fanout`), results in degree order.
 fn score_width(ctx: &FoldContext<'_>, cfg: &TrainConfig, width: f64) -> ScoredWidth {
     let (ds, folds) = (ctx.ds, ctx.folds);
     let max_degree = cfg.poly_degrees.iter().copied().max().unwrap_or(0);
@@ -344,12 +392,10 @@ fn score_width(ctx: &FoldContext<'_>, cfg: &TrainConfig, width: f64) -> ScoredWi
                 )
                 .0
         });
-        let mut res = vec![0.0; ds.len()];
-        let mut centers = 0usize;
-        for (f, path) in paths.iter().enumerate() {
-            centers += path.selected.len();
-            heldout_residuals(ctx, &design, path, f, pick(path, m_best), &mut res);
-        }
+        let centers: usize = paths.iter().map(|path| path.selected.len()).sum();
+        let picks = paths.iter().map(|path| pick(path, m_best)).collect();
+        let degree_paths = DegreePaths { paths, picks };
+        let res = degree_paths.residuals(ctx, &design);
         let score = WidthScore {
             width,
             degree,
@@ -360,7 +406,7 @@ fn score_width(ctx: &FoldContext<'_>, cfg: &TrainConfig, width: f64) -> ScoredWi
             mean_centers: m_best.map_or(centers as f64 / folds as f64, |m| m as f64),
             candidates: design.candidates.len(),
         };
-        (score, res)
+        (score, degree_paths)
     });
     if profiling() {
         eprintln!(
