@@ -138,7 +138,10 @@ pub fn diagnose_with(
         named_causes,
         named_cause: cause,
         cause_in_words: words,
-        competing: competing(&screening),
+        competing: competing(
+            &screening,
+            &report::competing::unit_names(&folds, &run_names),
+        ),
         parsimony_note: screening
             .steps
             .iter()
@@ -209,18 +212,17 @@ fn azimuth(
     })
 }
 
-/// Every candidate within one standard error of a named cause, with the cause.
-fn competing(screening: &Screening) -> Vec<Competitor> {
+/// Every candidate within one standard error of a named cause, with the cause and what
+/// the units where they differ said.
+fn competing(screening: &Screening, unit_names: &[String]) -> Vec<Competitor> {
     screening
         .steps
         .iter()
         .flat_map(|s| {
-            s.rivals.iter().map(|r| Competitor {
-                candidate: r.label.clone(),
-                named: s.scored.cand.label(),
-                conditional_gain_pct: r.gain_pct,
-                gap_se: r.gap_se,
-            })
+            let named = s.scored.cand.label();
+            s.rivals
+                .iter()
+                .map(move |r| report::competing::competitor(&named, r, unit_names))
         })
         .collect()
 }

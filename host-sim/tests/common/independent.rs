@@ -35,6 +35,38 @@ pub enum Hidden {
     /// Nothing planted, at the issue's noise level (the null twin of `HeadingNoiseSigmas`).
     #[allow(dead_code)] // only diagnose_between uses it
     NullIssueNoise,
+    /// A power-on transient in steady-chamber campaigns: `law` is planted with an rms
+    /// over the campaign of `sigmas` 10 s noise sigmas (0: the null twin, the same
+    /// campaigns). The electronics' decay k exp(-t / tau_d) (tau_d drawn per campaign in
+    /// the range of the thermal time constants) and the self-heating transient's d2T/dt2
+    /// both fall off after power-on; a warm restart starts part-way up the transient (T'
+    /// and T'' scaled by 1 - start) and still has the whole decay. `cold_only`: every
+    /// run a cold start (the same draws otherwise).
+    #[allow(dead_code)] // constructed by diagnose_competing only
+    PowerOn {
+        law: PowerOnLaw,
+        sigmas: f64,
+        cold_only: bool,
+    },
+}
+
+/// The law planted by [`Hidden::PowerOn`].
+#[allow(dead_code)] // constructed by diagnose_competing only
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PowerOnLaw {
+    /// k exp(-t / tau_d), t since power-on: the electronics settling.
+    Decay,
+    /// k d2T/dt2 of the self-heating transient (the twin: a thermal-gradient law).
+    Accel,
+}
+
+/// Time constant of the planted power-on decay for `seed`, s, in the range of the
+/// thermal time constants (its own stream: the campaign's draws stay those of the other
+/// variants). Measured: with one thermal tau for every run, a steady chamber puts
+/// d2T/dt2 in the base's span (tau^2 T'' = u - T - 2 tau T', u constant per run) and
+/// absorbs a decay near tau too (nothing to name); so tau varies between runs here.
+pub fn decay_tau_s(seed: u64) -> f64 {
+    ChaCha8Rng::seed_from_u64(seed ^ 0xDECA_7000).random_range(300.0..700.0)
 }
 
 /// Turn-on repeatability (sd of run offsets), deg/h.
@@ -59,7 +91,7 @@ pub fn campaign(hidden: Hidden, seed: u64) -> (Vec<Run>, Option<&'static str>) {
         ),
         Hidden::HeadingNoiseSigmas(s) => (s * ISSUE_NOISE_10S_DPH, ISSUE_NOISE_10S_DPH),
         Hidden::NullIssueNoise => (0.0, ISSUE_NOISE_10S_DPH),
-        Hidden::Null | Hidden::TempAccel(_) => (0.0, NOISE_10S_DPH),
+        Hidden::Null | Hidden::TempAccel(_) | Hidden::PowerOn { .. } => (0.0, NOISE_10S_DPH),
     };
     let (k1, k2) = (
         rng.random_range(-0.004..0.004),
@@ -69,16 +101,13 @@ pub fn campaign(hidden: Hidden, seed: u64) -> (Vec<Run>, Option<&'static str>) {
     let mut runs = Vec::new();
     let mut cabinet = 20.0;
     let mut accel_rows: Vec<Vec<f64>> = Vec::new();
+    let mut power_on_rows: Vec<Vec<f64>> = Vec::new();
     for (i, amb) in ambients.iter().flat_map(|a| [*a; 5]).enumerate() {
         let heading: f64 = rng.random_range(0.0..360.0);
         let warm = i % 3 == 2;
         let rise = rng.random_range(8.0..14.0);
         let tau = rng.random_range(300.0..700.0);
-        let start = if warm {
-            rng.random_range(0.4..0.8)
-        } else {
-            0.0
-        };
+        let start = start_of(hidden, warm, &mut rng);
         let offset = REPEATABILITY_DPH * g.sample(&mut rng);
         let mut supply = 24.0;
         let mut cols: Vec<Vec<f64>> = (0..6).map(|_| Vec::with_capacity(rows)).collect();
@@ -113,6 +142,10 @@ pub fn campaign(hidden: Hidden, seed: u64) -> (Vec<Run>, Option<&'static str>) {
             }
         }
         accel_rows.push(cycled.map(|c| c.accel).unwrap_or_default());
+        if let Hidden::PowerOn { law, .. } = hidden {
+            let transient = Transient { rise, tau, start };
+            power_on_rows.push(power_on_shape(law, decay_tau_s(seed), transient, &cols[0]));
+        }
         runs.push(Run {
             path: format!("ind{seed}_run{i:02}.csv").into(),
             meta: vec![
@@ -132,14 +165,52 @@ pub fn campaign(hidden: Hidden, seed: u64) -> (Vec<Run>, Option<&'static str>) {
             data: cols,
         });
     }
-    let expected = match hidden {
+    let expected = plant(hidden, &mut runs, &accel_rows, &power_on_rows, amp);
+    (runs, expected)
+}
+
+/// Where a run's self-heating transient starts: 0 for a cold start, part-way for a warm
+/// restart (drawn either way, so `cold_only` keeps the other draws).
+fn start_of(hidden: Hidden, warm: bool, rng: &mut ChaCha8Rng) -> f64 {
+    if !warm {
+        return 0.0;
+    }
+    let part_way = rng.random_range(0.4..0.8);
+    if matches!(
+        hidden,
+        Hidden::PowerOn {
+            cold_only: true,
+            ..
+        }
+    ) {
+        0.0
+    } else {
+        part_way
+    }
+}
+
+/// Adds the within-run laws to the runs; the label a right answer names.
+fn plant(
+    hidden: Hidden,
+    runs: &mut [Run],
+    accel_rows: &[Vec<f64>],
+    power_on_rows: &[Vec<f64>],
+    amp: f64,
+) -> Option<&'static str> {
+    match hidden {
         Hidden::TempAccel(s) if s > 0.0 => {
-            add_accel_effect(&mut runs, &accel_rows, s * NOISE_10S_DPH);
+            add_accel_effect(runs, accel_rows, s * NOISE_10S_DPH);
             Some("temp_c:accel")
         }
+        Hidden::PowerOn { law, sigmas, .. } if sigmas > 0.0 => {
+            add_scaled(runs, power_on_rows, sigmas * NOISE_10S_DPH);
+            Some(match law {
+                PowerOnLaw::Decay => "t_s:decay",
+                PowerOnLaw::Accel => "temp_c:accel",
+            })
+        }
         _ => (amp > 0.0).then_some("heading_deg:run_harmonic"),
-    };
-    (runs, expected)
+    }
 }
 
 /// The gyro's temperature under a cycling chamber: tau^2 T'' + 2 tau T' + T = u(t), u the
@@ -204,13 +275,41 @@ impl CycledChamber {
     }
 }
 
+/// One run's self-heating transient: rise, degC; time constant, s; where it started.
+#[derive(Clone, Copy)]
+struct Transient {
+    rise: f64,
+    tau: f64,
+    start: f64,
+}
+
+/// One run's planted power-on shape (before scaling) at the times `t_s`: the decay, or
+/// the steady chamber's true d2T/dt2 (critically damped, started part-way).
+fn power_on_shape(law: PowerOnLaw, decay_tau_s: f64, tr: Transient, t_s: &[f64]) -> Vec<f64> {
+    t_s.iter()
+        .map(|t| match law {
+            PowerOnLaw::Decay => (-t / decay_tau_s).exp(),
+            PowerOnLaw::Accel => {
+                let x = t / tr.tau;
+                (1.0 - tr.start) * tr.rise * (1.0 - x) * (-x).exp() / (tr.tau * tr.tau)
+            }
+        })
+        .collect()
+}
+
 /// Adds k d2T/dt2 to every run's `rate_dph` (column 1), k such that the effect's rms over
 /// the campaign is `rms_dph`.
 fn add_accel_effect(runs: &mut [Run], accel: &[Vec<f64>], rms_dph: f64) {
-    let all: Vec<f64> = accel.iter().flatten().copied().collect();
+    add_scaled(runs, accel, rms_dph);
+}
+
+/// Adds k x `shapes` (one per run) to every run's `rate_dph`, k such that the added
+/// effect's rms over the campaign is `rms_dph`.
+fn add_scaled(runs: &mut [Run], shapes: &[Vec<f64>], rms_dph: f64) {
+    let all: Vec<f64> = shapes.iter().flatten().copied().collect();
     let rms = (all.iter().map(|a| a * a).sum::<f64>() / all.len().max(1) as f64).sqrt();
     let k = if rms > 0.0 { rms_dph / rms } else { 0.0 };
-    for (run, a) in runs.iter_mut().zip(accel) {
+    for (run, a) in runs.iter_mut().zip(shapes) {
         for (r, a) in run.data[1].iter_mut().zip(a) {
             *r += k * a;
         }

@@ -1,6 +1,7 @@
 //! The diagnosis as data (JSON, the issue's schema and more) and as words (stdout).
 
 pub mod azimuth;
+pub mod competing;
 pub mod olscheck;
 pub mod outliers;
 pub mod plots;
@@ -55,18 +56,7 @@ pub struct CandidateRow {
     pub units_improved: f64,
 }
 
-/// A candidate the held-out data cannot tell from a named cause (within one standard
-/// error of it): both are reported.
-#[derive(Clone, Debug, Serialize)]
-pub struct Competitor {
-    pub candidate: String,
-    /// The named cause it competes with.
-    pub named: String,
-    /// Its held-out gain at the step the named cause was chosen, %.
-    pub conditional_gain_pct: f64,
-    /// Its held-out squared-error excess over the named cause, standard errors (< 1).
-    pub gap_se: f64,
-}
+pub use competing::Competitor;
 
 /// One named cause (issue 18 item 4), most important first.
 #[derive(Clone, Debug, Serialize)]
@@ -545,8 +535,8 @@ fn write_cause(s: &mut String, r: &Report) {
     for comp in &r.competing {
         let _ = writeln!(
             s,
-            "  competes with {}: {} is within {:.2} standard errors on held-out data (gain {:+.2}%): the data cannot tell them apart",
-            comp.named, comp.candidate, comp.gap_se, comp.conditional_gain_pct
+            "  competes with {}: {} is within {:.2} standard errors over all held-out data (gain {:+.2}%); {}",
+            comp.named, comp.candidate, comp.gap_se, comp.conditional_gain_pct, comp.in_words
         );
     }
     if let Some(c) = &r.causal_derivative {

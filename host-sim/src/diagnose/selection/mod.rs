@@ -1,6 +1,8 @@
 //! Stage 4, selection and tests: candidates ranked by held-out gain, the family-wise
-//! significance test, the power check when nothing is named, and the named cause.
+//! significance test, the power check when nothing is named, the named cause and the
+//! test that separates it from competing explanations.
 
 pub mod cause;
 pub mod power;
 pub mod screen;
+pub mod separate;

@@ -33,6 +33,8 @@ use crate::diagnose::library::transforms::Candidate;
 use crate::diagnose::validation::cv::{CvResult, Folds, Offsets};
 use crate::diagnose::validation::signflip::{max_t_pvalues, paired_pvalue};
 
+use super::separate::{find, refit_pair, separate, Pair, Separation, Verdict};
+
 /// Family-wise significance level.
 pub const ALPHA: f64 = 0.01;
 /// Smallest held-out gain worth naming, % of rms.
@@ -64,8 +66,11 @@ pub struct Rival {
     pub label: String,
     /// Its held-out gain at that step, %.
     pub gain_pct: f64,
-    /// Its held-out squared-error excess over the named cause, in standard errors.
+    /// Its held-out squared-error excess over the named cause, in standard errors
+    /// (negative for a former choice the separating units rejected).
     pub gap_se: f64,
+    /// What the units where the two disagree say (`separate`).
+    pub separation: Separation,
 }
 
 /// One named cause.
@@ -173,7 +178,19 @@ pub fn screen(
         }
         scored.sort_by(|a, b| a.heldout_rms_dph.total_cmp(&b.heldout_rms_dph));
         let (chosen, parsimony_note) = choose(&scored);
-        let rivals = chosen.map_or_else(Vec::new, |i| rivals_of(&scored, i));
+        let (chosen, rivals, parsimony_note) = match chosen {
+            Some(i) => {
+                let ctx = Context {
+                    campaign,
+                    folds,
+                    base,
+                    model_cols: &model_cols,
+                };
+                let (named, rivals) = settle(&ctx, &scored, i)?;
+                (Some(named), rivals, parsimony_note.filter(|_| named == i))
+            }
+            None => (None, vec![], None),
+        };
         let step = match chosen {
             Some(i) => {
                 let cols = stacked_columns(campaign, &scored[i].cand);
@@ -291,33 +308,105 @@ fn choose(scored: &[Scored]) -> (Option<usize>, Option<String>) {
 }
 
 /// Significant candidates of other columns whose held-out error is within one standard
-/// error of the chosen one's (per-unit differences, whole units).
-fn rivals_of(scored: &[Scored], chosen: usize) -> Vec<Rival> {
+/// error of the chosen one's (per-unit differences, whole units): (index, gap in SE).
+fn rivals_of(scored: &[Scored], chosen: usize) -> Vec<(usize, f64)> {
     let named = &scored[chosen];
     let mut seen = vec![named.cand.column.clone()];
     let mut out = Vec::new();
-    for s in scored.iter().filter(|s| s.significant) {
+    for (i, s) in scored.iter().enumerate().filter(|(_, s)| s.significant) {
         if seen.contains(&s.cand.column) {
             continue;
         }
-        let d = sse_drop(&named.unit_sse, &s.unit_sse);
-        let u = d.len() as f64;
-        if u < 2.0 {
-            continue;
-        }
-        let m = d.iter().sum::<f64>() / u;
-        let se = (u * d.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (u - 1.0)).sqrt();
-        let gap = -m * u / se.max(1e-300);
-        if gap < 1.0 {
+        if let Some(gap) = gap_se(named, s).filter(|g| *g < 1.0) {
             seen.push(s.cand.column.clone());
-            out.push(Rival {
-                label: s.cand.label(),
-                gain_pct: s.gain_pct,
-                gap_se: gap,
-            });
+            out.push((i, gap));
         }
     }
     out
+}
+
+/// `other`'s held-out squared-error excess over `named`, in standard errors of the sum
+/// of per-unit differences (None with fewer than 2 units).
+fn gap_se(named: &Scored, other: &Scored) -> Option<f64> {
+    let d = sse_drop(&named.unit_sse, &other.unit_sse);
+    let u = d.len() as f64;
+    if u < 2.0 {
+        return None;
+    }
+    let m = d.iter().sum::<f64>() / u;
+    let se = (u * d.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (u - 1.0)).sqrt();
+    Some(-m * u / se.max(1e-300))
+}
+
+/// What the separation tests need besides the scores.
+struct Context<'a> {
+    campaign: &'a Campaign,
+    folds: &'a Folds,
+    base: &'a BaseFit,
+    model_cols: &'a [Vec<f64>],
+}
+
+/// The chosen candidate's competitors, each tested on the units where the two disagree
+/// (`separate`); a competitor that wins there is named instead (the best-separated one
+/// when several do) and the step's competitors are tested again against it. Returns the
+/// named candidate's index and its competitors.
+fn settle(
+    ctx: &Context,
+    scored: &[Scored],
+    chosen: usize,
+) -> Result<(usize, Vec<Rival>), DiagnoseError> {
+    let rivals = rivals_of(scored, chosen);
+    let tested = test_rivals(ctx, scored, chosen, &rivals)?;
+    let winner = tested
+        .iter()
+        .filter(|r| r.separation.verdict == Verdict::Separated { rival_won: true })
+        .min_by(|a, b| a.separation.p_value.total_cmp(&b.separation.p_value))
+        .and_then(|r| find(scored, &r.label));
+    let Some(new) = winner else {
+        return Ok((chosen, tested));
+    };
+    let mut others: Vec<(usize, f64)> =
+        vec![(chosen, gap_se(&scored[new], &scored[chosen]).unwrap_or(0.0))];
+    others.extend(
+        rivals
+            .iter()
+            .filter(|(i, _)| *i != new)
+            .map(|(i, _)| (*i, gap_se(&scored[new], &scored[*i]).unwrap_or(0.0))),
+    );
+    Ok((new, test_rivals(ctx, scored, new, &others)?))
+}
+
+/// Each competitor's separation test against the named candidate.
+fn test_rivals(
+    ctx: &Context,
+    scored: &[Scored],
+    named: usize,
+    rivals: &[(usize, f64)],
+) -> Result<Vec<Rival>, DiagnoseError> {
+    let named_cols = stacked_columns(ctx.campaign, &scored[named].cand);
+    rivals
+        .iter()
+        .map(|&(i, gap)| {
+            let rival_cols = stacked_columns(ctx.campaign, &scored[i].cand);
+            let (a, b) = refit_pair(
+                ctx.folds,
+                ctx.base,
+                ctx.model_cols,
+                &named_cols,
+                &rival_cols,
+            )?;
+            let pair = Pair {
+                named: &a,
+                rival: &b,
+            };
+            Ok(Rival {
+                label: scored[i].cand.label(),
+                gain_pct: scored[i].gain_pct,
+                gap_se: gap,
+                separation: separate(ctx.folds, &pair, rivals.len()),
+            })
+        })
+        .collect()
 }
 
 /// Per-unit gains for the family-wise test, each bounded by +/- the unit's error before:
