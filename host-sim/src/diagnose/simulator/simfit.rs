@@ -40,6 +40,8 @@ pub struct SimCalibration {
     pub tau_slow_s: f64,
     /// The thermometer's first-order lag behind the coil, s (`thermal`; 0: none found).
     pub sensor_lag_s: f64,
+    /// Its standard error, s (NaN without a lag).
+    pub sensor_lag_se_s: f64,
     /// rms of measured minus fitted temperature, degC.
     pub temp_rms_c: f64,
     /// Bias temperature sensitivity at the campaign's mean temperature, deg/h per degC.
@@ -119,22 +121,37 @@ pub struct SimDesign {
     pub t_mean_c: f64,
     pub tau_s: (f64, f64),
     pub sensor_lag_s: f64,
+    /// The lag's standard error and the step of the shifted designs, s.
+    pub lag_se_s: f64,
+    pub lag_step_s: f64,
+    /// Standardised designs at the lag -/+ its step (empty without a lag).
+    pub shifted: Vec<Vec<Vec<f64>>>,
     pub temp_rms_c: f64,
+}
+
+/// The law's raw columns (see `SimDesign`) on coil curves, about `t_mean_c`.
+fn law_columns(c: &thermal::Curves, t_mean_c: f64) -> Vec<Vec<f64>> {
+    let dt: Vec<f64> = c.temp.iter().map(|t| t - t_mean_c).collect();
+    let squared = dt.iter().map(|d| d * d).collect();
+    let cold_gain = dt.iter().zip(&c.rate).map(|(d, r)| d * r).collect();
+    vec![dt, squared, c.rate.clone(), cold_gain, c.accel.clone()]
+}
+
+/// Divides every column by its `scale`.
+fn standardise(raw: Vec<Vec<f64>>, scale: &[f64]) -> Vec<Vec<f64>> {
+    raw.into_iter()
+        .zip(scale)
+        .map(|(c, k)| c.into_iter().map(|v| v / k).collect())
+        .collect()
 }
 
 impl SimDesign {
     /// Fits the thermal response (`thermal::fit`) and builds the design.
     pub fn new(c: &Campaign) -> Self {
         let th: ThermalFit = thermal::fit(c);
-        let t_mean_c = th.temp.iter().sum::<f64>() / th.temp.len().max(1) as f64;
-        let dt: Vec<f64> = th.temp.iter().map(|t| t - t_mean_c).collect();
-        let raw = vec![
-            dt.clone(),
-            dt.iter().map(|d| d * d).collect(),
-            th.rate.clone(),
-            dt.iter().zip(&th.rate).map(|(d, r)| d * r).collect(),
-            th.accel.clone(),
-        ];
+        let temp = &th.curves.temp;
+        let t_mean_c = temp.iter().sum::<f64>() / temp.len().max(1) as f64;
+        let raw = law_columns(&th.curves, t_mean_c);
         let scale: Vec<f64> = raw
             .iter()
             .map(|c| {
@@ -143,19 +160,48 @@ impl SimDesign {
                     .unwrap_or(1.0)
             })
             .collect();
-        let cols = raw
-            .into_iter()
-            .zip(&scale)
-            .map(|(c, k)| c.into_iter().map(|v| v / k).collect())
+        let shifted = th
+            .shifted
+            .iter()
+            .map(|cv| standardise(law_columns(cv, t_mean_c), &scale))
             .collect();
         Self {
-            cols,
+            cols: standardise(raw, &scale),
             scale,
             t_mean_c,
             tau_s: th.tau,
             sensor_lag_s: th.sensor_lag_s,
+            lag_se_s: th.lag_se_s,
+            lag_step_s: th.lag_step_s,
+            shifted,
             temp_rms_c: th.rms,
         }
+    }
+
+    /// One standard deviation of each coefficient (law, then the columns `extra`) from
+    /// the lag's own uncertainty: the central difference of the fits at the lag -/+ its
+    /// step, times the lag's standard error. None without a lag (or its error).
+    pub fn lag_spread(
+        &self,
+        run_rows: &[std::ops::Range<usize>],
+        y: &[f64],
+        extra: &[Vec<f64>],
+    ) -> Option<Vec<f64>> {
+        if self.shifted.len() != 2 || !(self.lag_se_s.is_finite() && self.lag_step_s > 0.0) {
+            return None;
+        }
+        let coef = |cols: &[Vec<f64>]| -> Option<Vec<f64>> {
+            let mut all = cols.to_vec();
+            all.extend(extra.iter().cloned());
+            fit_law(run_rows, &all, y).ok().map(|f| self.unscale(&f.0))
+        };
+        let (lo, hi) = (coef(&self.shifted[0])?, coef(&self.shifted[1])?);
+        Some(
+            lo.iter()
+                .zip(&hi)
+                .map(|(a, b)| ((b - a) / (2.0 * self.lag_step_s) * self.lag_se_s).abs())
+                .collect(),
+        )
     }
 
     /// Coefficients on the standardised columns (law first, any extra terms after) back
@@ -222,6 +268,7 @@ pub fn calibrate(
         tau_fast_s: design.tau_s.0,
         tau_slow_s: design.tau_s.1,
         sensor_lag_s: design.sensor_lag_s,
+        sensor_lag_se_s: design.lag_se_s,
         temp_rms_c: design.temp_rms_c,
         bias_dph_per_c: coef[0],
         bias_dph_per_c2: coef[1],

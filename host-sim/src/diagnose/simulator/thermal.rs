@@ -44,13 +44,25 @@ pub struct ThermalFit {
     pub sensor_lag_s: f64,
     /// Likelihood-ratio statistic of the lag against none (n ln(SSE_0 / SSE_L)).
     pub lag_chi2: f64,
+    /// Standard error of the lag from the curvature of the temperature fit's SSE in L
+    /// (var = 2 sigma^2 / SSE''), s; NaN without a lag.
+    pub lag_se_s: f64,
+    /// The coil curves at the lag -/+ `lag_step_s` (empty without a lag): how the law's
+    /// coefficients move with the lag, for their uncertainty (`uncertainty`).
+    pub shifted: Vec<Curves>,
+    pub lag_step_s: f64,
+    pub curves: Curves,
+    /// rms of measured minus fitted sensor temperature, degC.
+    pub rms: f64,
+}
+
+/// The fitted coil's curves, stacked over runs in campaign order.
+pub struct Curves {
     /// Coil temperature (row window means), degC.
     pub temp: Vec<f64>,
     /// Its first and second time derivatives, degC/s and degC/s^2.
     pub rate: Vec<f64>,
     pub accel: Vec<f64>,
-    /// rms of measured minus fitted sensor temperature, degC.
-    pub rms: f64,
 }
 
 /// Mean of e^(-s/tau) over the row window (t - dt, t] divided by e^(-t/tau).
@@ -227,9 +239,20 @@ fn total_sse_near(runs: &[&SearchRun], starts: &[(f64, f64)], lag_s: f64) -> f64
 /// Runs used to choose the lag (one sensor: a spread of at most this many is enough).
 const LAG_RUNS: usize = 12;
 
-/// The sensor lag (see the module header), its chi^2 against none, and every run's time
-/// constants at it.
-fn choose_lag(c: &Campaign) -> (f64, f64, Vec<(f64, f64)>) {
+/// The chosen lag with what `fit` needs besides the time constants.
+struct LagChoice {
+    lag_s: f64,
+    chi2: f64,
+    se_s: f64,
+    step_s: f64,
+    /// Every run's pair at the lag, and at the lag -/+ `step_s` (empty without a lag).
+    taus: Vec<(f64, f64)>,
+    shifted: Vec<Vec<(f64, f64)>>,
+}
+
+/// The sensor lag (see the module header), its chi^2 against none and standard error,
+/// and every run's time constants at it (and beside it).
+fn choose_lag(c: &Campaign) -> LagChoice {
     let runs: Vec<SearchRun> = c
         .runs
         .iter()
@@ -240,6 +263,14 @@ fn choose_lag(c: &Campaign) -> (f64, f64, Vec<(f64, f64)>) {
         .collect();
     let free: Vec<(f64, f64, f64)> = runs.iter().map(|r| run_taus(&rows_of(r), 0.0)).collect();
     let taus0: Vec<(f64, f64)> = free.iter().map(|f| (f.0, f.1)).collect();
+    let none = |chi2: f64, taus: Vec<(f64, f64)>| LagChoice {
+        lag_s: 0.0,
+        chi2,
+        se_s: f64::NAN,
+        step_s: 0.0,
+        taus,
+        shifted: vec![],
+    };
     let row_s = median(runs.iter().map(|r| r.2).collect());
     let step = runs.len().div_ceil(LAG_RUNS).max(1);
     let picked: Vec<usize> = (0..runs.len()).step_by(step).collect();
@@ -248,35 +279,46 @@ fn choose_lag(c: &Campaign) -> (f64, f64, Vec<(f64, f64)>) {
     let sse0: f64 = picked.iter().map(|&k| free[k].2).sum();
     let n: f64 = sub.iter().map(|r| r.0.len() as f64).sum();
     if !(row_s > 0.0) || !(sse0 > 0.0) {
-        return (0.0, 0.0, taus0);
+        return none(0.0, taus0);
     }
-    let (lag, sse_lag) = golden(
-        &|l| total_sse_near(&sub, &sub_starts, l),
-        row_s / 8.0,
-        4.0 * row_s,
-        10,
-    );
+    let sse_at = |l: f64| total_sse_near(&sub, &sub_starts, l);
+    let (lag, sse_lag) = golden(&sse_at, row_s / 8.0, 4.0 * row_s, 10);
     let chi2 = n * (sse0 / sse_lag).ln();
     if chi2 <= LAG_CHI2 {
-        return (0.0, chi2, taus0);
+        return none(chi2, taus0);
     }
-    let taus = runs
-        .iter()
-        .zip(&taus0)
-        .map(|(r, &st)| {
-            let (t1, t2, _) = run_taus_near(&rows_of(r), lag, st);
-            (t1, t2)
-        })
-        .collect();
-    (lag, chi2, taus)
+    let h = 0.1 * lag;
+    let curvature = (sse_at(lag - h) - 2.0 * sse_lag + sse_at(lag + h)) / (h * h);
+    let se_s = if curvature > 0.0 {
+        (2.0 * sse_lag / n / curvature).sqrt()
+    } else {
+        f64::NAN
+    };
+    let taus_at = |l: f64| -> Vec<(f64, f64)> {
+        runs.iter()
+            .zip(&taus0)
+            .map(|(r, &st)| {
+                let (t1, t2, _) = run_taus_near(&rows_of(r), l, st);
+                (t1, t2)
+            })
+            .collect()
+    };
+    LagChoice {
+        lag_s: lag,
+        chi2,
+        se_s,
+        step_s: h,
+        taus: taus_at(lag),
+        shifted: vec![taus_at(lag - h), taus_at(lag + h)],
+    }
 }
 
-/// Fits every run (see the module header); the reported pair is the median over runs.
-pub fn fit(c: &Campaign) -> ThermalFit {
-    let (lag_s, lag_chi2, taus) = choose_lag(c);
+/// The coil's curves of every run for its pair `taus` at lag `lag_s`, and the sensor
+/// fit's sum of squares.
+fn coil_curves(c: &Campaign, taus: &[(f64, f64)], lag_s: f64) -> (Curves, f64) {
     let (mut temp, mut rate, mut accel) = (Vec::new(), Vec::new(), Vec::new());
     let mut sse = 0.0;
-    for (s, &(t1, t2)) in c.runs.iter().zip(&taus) {
+    for (s, &(t1, t2)) in c.runs.iter().zip(taus) {
         let rows = RunRows {
             t_s: &s.t_s,
             temp_c: &s.temp_c,
@@ -294,16 +336,29 @@ pub fn fit(c: &Campaign) -> ThermalFit {
             accel.push(a1 / (t1 * t1) * e1 + a2 / (t2 * t2) * e2);
         }
     }
+    (Curves { temp, rate, accel }, sse)
+}
+
+/// Fits every run (see the module header); the reported pair is the median over runs.
+pub fn fit(c: &Campaign) -> ThermalFit {
+    let lag = choose_lag(c);
+    let (curves, sse) = coil_curves(c, &lag.taus, lag.lag_s);
+    let shifted = [-1.0, 1.0]
+        .iter()
+        .zip(&lag.shifted)
+        .map(|(sign, taus)| coil_curves(c, taus, lag.lag_s + sign * lag.step_s).0)
+        .collect();
     ThermalFit {
         tau: (
-            median(taus.iter().map(|t| t.0).collect()),
-            median(taus.iter().map(|t| t.1).collect()),
+            median(lag.taus.iter().map(|t| t.0).collect()),
+            median(lag.taus.iter().map(|t| t.1).collect()),
         ),
-        sensor_lag_s: lag_s,
-        lag_chi2,
-        rms: (sse / temp.len().max(1) as f64).sqrt(),
-        temp,
-        rate,
-        accel,
+        sensor_lag_s: lag.lag_s,
+        lag_chi2: lag.chi2,
+        lag_se_s: lag.se_s,
+        shifted,
+        lag_step_s: lag.step_s,
+        rms: (sse / curves.temp.len().max(1) as f64).sqrt(),
+        curves,
     }
 }

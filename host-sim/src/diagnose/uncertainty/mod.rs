@@ -2,10 +2,11 @@
 //! temperature sensitivity and rate coefficient (and, for a polynomial base, its
 //! coefficients in physical units), the named extension's coefficient(s), the calibrated
 //! simulator's bias slope, curvature, Shupe coefficient and noise, and the
-//! measured-vs-simulator ratios (temperature sensitivity, Shupe coefficient, ARW) against
+//! measured-vs-simulator ratios (temperature sensitivity, Shupe, gradient rate, ARW) against
 //! the project's simulator (`GyroParams::paper_default`). Ranges come from the block
 //! bootstrap of `bootstrap` (whole runs or time blocks resampled). The simulator stage is
-//! conditional on its fitted thermal response (the thermal time constants are not redrawn).
+//! conditional on each run's fitted thermal response (resampled with its run); the sensor
+//! lag shared by all runs adds its own error (delta method).
 
 pub mod bootstrap;
 
@@ -293,6 +294,11 @@ fn simulator_estimates(
             bootstrap(&sys, counts, &names, &summary)
         }
     };
+    // The thermal fit is not redrawn by the bootstrap; its sensor lag is shared by every
+    // run, so its error is added (`SimDesign::lag_spread`).
+    if let Some(spread) = sim.lag_spread(&folds.run_rows, &st.y, extra) {
+        out.iter_mut().zip(spread).for_each(|(e, sd)| e.widen(sd));
+    }
     if let Some(arw) = arw_estimate(folds, st, &prepared, &sys, counts) {
         out.push(arw);
     }
