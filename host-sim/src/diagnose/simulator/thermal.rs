@@ -278,7 +278,7 @@ fn choose_lag(c: &Campaign) -> LagChoice {
     let sub_starts: Vec<(f64, f64)> = picked.iter().map(|&k| taus0[k]).collect();
     let sse0: f64 = picked.iter().map(|&k| free[k].2).sum();
     let n: f64 = sub.iter().map(|r| r.0.len() as f64).sum();
-    if !(row_s > 0.0) || !(sse0 > 0.0) {
+    if row_s.is_nan() || row_s <= 0.0 || sse0.is_nan() || sse0 <= 0.0 {
         return none(0.0, taus0);
     }
     let sse_at = |l: f64| total_sse_near(&sub, &sub_starts, l);
