@@ -79,7 +79,7 @@ fn json_has_the_issue_schema_and_plots_are_written() {
         .iter()
         .map(|q| q["name"].as_str().unwrap())
         .collect();
-    assert_eq!(ratios.len(), 3, "{ratios:?}");
+    assert_eq!(ratios.len(), 4, "{ratios:?}");
     assert!(u["base"].is_array() && u["extension"].is_array());
     let raw = &v["raw_rows"];
     assert!(raw["rows"].as_u64().unwrap() > 0, "raw_rows: {raw}");

@@ -84,8 +84,9 @@ pub fn diagnose_with(
     screening.skipped.extend(cap_note);
     let named = screening.steps.first();
     let cause = named.map(|s| Cause::from(&s.scored.cand));
+    let sim_design = simulator::simfit::SimDesign::new(&campaign);
     let sim = simulator::simfit::calibrate(
-        &campaign,
+        &sim_design,
         &folds.run_rows,
         &st.y,
         named.map(|s| s.cols.as_slice()),
@@ -97,7 +98,7 @@ pub fn diagnose_with(
         label: s.scored.cand.label(),
         cols: &s.cols,
     });
-    let uncertainty = uncertainty::estimate(&campaign, &folds, &st, base, named_feature.as_ref());
+    let uncertainty = uncertainty::estimate(&sim_design, &folds, &st, base, named_feature.as_ref());
     let azimuth = azimuth(&campaign, &folds, &st, base, &ext_resid, latitude);
     let named_causes = named_causes(&folds, &st, base, &screening, &between_run, latitude);
     let smallest_attainable_p = validation::signflip::smallest_p(folds.unit_rows.len());

@@ -278,9 +278,9 @@ fn write_baseline(s: &mut String, r: &Report) {
     let _ = writeln!(s, "\n1. Baseline");
     let _ = writeln!(
         s,
-        "  simulator calibrated by least squares: thermal tau {:.0} s / {:.0} s (median over runs) (temp rms {:.3} degC), bias {:.4} deg/h/degC, \
+        "  simulator calibrated by least squares: thermal tau {:.0} s / {:.0} s (median over runs), sensor lag {:.1} s (temp rms {:.3} degC), bias {:.4} deg/h/degC, \
          Shupe {:.3} deg/h per degC/s, white noise {:.4} deg/h (10 s)",
-        sim.tau_fast_s, sim.tau_slow_s, sim.temp_rms_c, sim.bias_dph_per_c, sim.shupe_dph_per_cps, sim.noise_10s_dph
+        sim.tau_fast_s, sim.tau_slow_s, sim.sensor_lag_s, sim.temp_rms_c, sim.bias_dph_per_c, sim.shupe_dph_per_cps, sim.noise_10s_dph
     );
     let _ = writeln!(
         s,

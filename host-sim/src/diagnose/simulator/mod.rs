@@ -3,3 +3,4 @@
 
 pub mod simfit;
 pub mod simterm;
+pub mod thermal;

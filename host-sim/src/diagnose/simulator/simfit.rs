@@ -2,10 +2,9 @@
 //! the named effect as one more term with a fitted coefficient.
 //!
 //! The model class contains the simulator's own physics (`sim::gyro`, `sim::thermal`):
-//! a two-node lumped thermal response to power-on is a constant plus two exponentials,
-//! so each run's temperature is fitted with its own two time constants (the conductance
-//! to the ambient may change with it; found by a coarse grid then a log-space pattern
-//! search, not from a list that suits one device), amplitudes and start. The drift law on that fitted temperature:
+//! the coil's temperature after power-on as a two-node network's two modes, seen through
+//! a lagging thermometer (`thermal`: each run its own time constants, one sensor lag for
+//! the campaign, chosen by the data). The drift law on the fitted coil temperature:
 //! bias quadratic in T (one law across runs, `levels`: the runs' levels pin it down over
 //! the whole temperature range, a random turn-on offset per run), a Shupe term in dT/dt
 //! whose coefficient may change linearly with T, and the axial gradient rate: in a
@@ -18,16 +17,9 @@ use crate::diagnose::base::levels::LevelSystems;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
 use crate::diagnose::linalg::solve_spd;
+use crate::diagnose::simulator::thermal::{self, ThermalFit};
 use crate::stats::rms;
 use serde::Serialize;
-
-/// Coarse grid of fast thermal time constants: 10 s x 2^(k/2), up to 16,384 s (the slow
-/// one and then the fast one are found continuously, `run_taus`).
-pub fn thermal_taus_s() -> Vec<f64> {
-    (0..=21)
-        .map(|k| 10.0 * 2f64.powf(f64::from(k) / 2.0))
-        .collect()
-}
 
 /// The calibrated drift law's coefficients, in design order, with units.
 pub const LAW_TERMS: [(&str, &str); 5] = [
@@ -46,6 +38,10 @@ pub const MIN_RUNS_SHARED: usize = crate::diagnose::validation::cv::MIN_RUNS_GRO
 pub struct SimCalibration {
     pub tau_fast_s: f64,
     pub tau_slow_s: f64,
+    /// The thermometer's first-order lag behind the coil, s (`thermal`; 0: none found).
+    pub sensor_lag_s: f64,
+    /// Its standard error, s (NaN without a lag).
+    pub sensor_lag_se_s: f64,
     /// rms of measured minus fitted temperature, degC.
     pub temp_rms_c: f64,
     /// Bias temperature sensitivity at the campaign's mean temperature, deg/h per degC.
@@ -98,9 +94,10 @@ fn fit_with_offsets(
             a[i * p + j] = x[i].iter().zip(&x[j]).map(|(u, v)| u * v).sum();
         }
     }
-    let tr = (0..p).map(|i| a[i * p + i]).sum::<f64>() / p.max(1) as f64;
+    // A guard relative to each column's own scale (the columns differ by 10 orders of
+    // magnitude: a guard from the mean diagonal shrank the d2T/dt2 coefficient to ~0).
     for i in 0..p {
-        a[i * p + i] += 1e-12 * tr + 1e-300;
+        a[i * p + i] += 1e-12 * a[i * p + i] + 1e-300;
     }
     solve_spd(&mut a, &mut b, p).map_err(|_| DiagnoseError::Singular {
         what: "simulator calibration",
@@ -111,159 +108,110 @@ fn fit_with_offsets(
     Ok((b, resid))
 }
 
-/// Fitted temperature and its first two time derivatives per run for the best tau pair.
-struct Thermal {
-    tau: (f64, f64),
-    temp: Vec<f64>,
-    rate: Vec<f64>,
-    accel: Vec<f64>,
-    rms: f64,
+/// The calibration's drift design on the fitted thermal response, computed once per
+/// diagnosis: in `LAW_TERMS` order T - mean T, (T - mean T)^2, dT/dt, (T - mean T) dT/dt,
+/// d2T/dt2, stacked, each divided by its rms `scale` (the raw columns differ by ten orders
+/// of magnitude, and a solver's numerical guard relative to the mean diagonal shrank the
+/// d2T/dt2 coefficient to ~0: 31.5 where the simulator has 400).
+pub struct SimDesign {
+    /// Standardised columns (raw column / `scale`).
+    pub cols: Vec<Vec<f64>>,
+    pub scale: Vec<f64>,
+    /// Campaign mean of the fitted coil temperature, degC (where the coefficients apply).
+    pub t_mean_c: f64,
+    pub tau_s: (f64, f64),
+    pub sensor_lag_s: f64,
+    /// The lag's standard error and the step of the shifted designs, s.
+    pub lag_se_s: f64,
+    pub lag_step_s: f64,
+    /// Standardised designs at the lag -/+ its step (empty without a lag).
+    pub shifted: Vec<Vec<Vec<f64>>>,
+    pub temp_rms_c: f64,
 }
 
-/// Per-run least squares of T = b0 + b1 e^-t/t1 + b2 e^-t/t2 over the rows `pick` keeps
-/// (decaying columns: far better conditioned against the constant than 1 - e^-t/tau).
-fn exponentials(t_s: &[f64], temp_c: &[f64], t1: f64, t2: f64) -> [f64; 3] {
-    let mut a = [0.0; 9];
-    let mut b = [0.0; 3];
-    for (&t, &temp) in t_s.iter().zip(temp_c) {
-        let z = [1.0, (-t / t1).exp(), (-t / t2).exp()];
-        for r in 0..3 {
-            b[r] += z[r] * temp;
-            for q in 0..3 {
-                a[r * 3 + q] += z[r] * z[q];
-            }
+/// The law's raw columns (see `SimDesign`) on coil curves, about `t_mean_c`.
+fn law_columns(c: &thermal::Curves, t_mean_c: f64) -> Vec<Vec<f64>> {
+    let dt: Vec<f64> = c.temp.iter().map(|t| t - t_mean_c).collect();
+    let squared = dt.iter().map(|d| d * d).collect();
+    let cold_gain = dt.iter().zip(&c.rate).map(|(d, r)| d * r).collect();
+    vec![dt, squared, c.rate.clone(), cold_gain, c.accel.clone()]
+}
+
+/// Divides every column by its `scale`.
+fn standardise(raw: Vec<Vec<f64>>, scale: &[f64]) -> Vec<Vec<f64>> {
+    raw.into_iter()
+        .zip(scale)
+        .map(|(c, k)| c.into_iter().map(|v| v / k).collect())
+        .collect()
+}
+
+impl SimDesign {
+    /// Fits the thermal response (`thermal::fit`) and builds the design.
+    pub fn new(c: &Campaign) -> Self {
+        let th: ThermalFit = thermal::fit(c);
+        let temp = &th.curves.temp;
+        let t_mean_c = temp.iter().sum::<f64>() / temp.len().max(1) as f64;
+        let raw = law_columns(&th.curves, t_mean_c);
+        let scale: Vec<f64> = raw
+            .iter()
+            .map(|c| {
+                Some(rms(c))
+                    .filter(|v| *v > 0.0 && v.is_finite())
+                    .unwrap_or(1.0)
+            })
+            .collect();
+        let shifted = th
+            .shifted
+            .iter()
+            .map(|cv| standardise(law_columns(cv, t_mean_c), &scale))
+            .collect();
+        Self {
+            cols: standardise(raw, &scale),
+            scale,
+            t_mean_c,
+            tau_s: th.tau,
+            sensor_lag_s: th.sensor_lag_s,
+            lag_se_s: th.lag_se_s,
+            lag_step_s: th.lag_step_s,
+            shifted,
+            temp_rms_c: th.rms,
         }
     }
-    let tr = (a[0] + a[4] + a[8]) / 3.0;
-    for r in 0..3 {
-        a[r * 4] += 1e-9 * tr;
-    }
-    if solve_spd(&mut a, &mut b, 3).is_err() {
-        let n = temp_c.len().max(1) as f64;
-        return [temp_c.iter().sum::<f64>() / n, 0.0, 0.0];
-    }
-    b
-}
 
-/// Sum of squared temperature residuals for one tau pair.
-fn thermal_sse(t_s: &[f64], temp_c: &[f64], t1: f64, t2: f64) -> f64 {
-    let b = exponentials(t_s, temp_c, t1, t2);
-    t_s.iter()
-        .zip(temp_c)
-        .map(|(&t, &temp)| (temp - b[0] - b[1] * (-t / t1).exp() - b[2] * (-t / t2).exp()).powi(2))
-        .sum()
-}
-
-/// Golden-section minimum of `f` over log-tau in [lo, hi]: (tau, value).
-fn golden(f: &dyn Fn(f64) -> f64, lo: f64, hi: f64, iterations: usize) -> (f64, f64) {
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut a, mut b) = (lo.ln(), hi.ln());
-    let mut c = b - g * (b - a);
-    let mut d = a + g * (b - a);
-    let (mut fc, mut fd) = (f(c.exp()), f(d.exp()));
-    for _ in 0..iterations {
-        if fc < fd {
-            (b, d, fd) = (d, c, fc);
-            c = b - g * (b - a);
-            fc = f(c.exp());
-        } else {
-            (a, c, fc) = (c, d, fd);
-            d = a + g * (b - a);
-            fd = f(d.exp());
+    /// One standard deviation of each coefficient (law, then the columns `extra`) from
+    /// the lag's own uncertainty: the central difference of the fits at the lag -/+ its
+    /// step, times the lag's standard error. None without a lag (or its error).
+    pub fn lag_spread(
+        &self,
+        run_rows: &[std::ops::Range<usize>],
+        y: &[f64],
+        extra: &[Vec<f64>],
+    ) -> Option<Vec<f64>> {
+        if self.shifted.len() != 2 || !(self.lag_se_s.is_finite() && self.lag_step_s > 0.0) {
+            return None;
         }
+        let coef = |cols: &[Vec<f64>]| -> Option<Vec<f64>> {
+            let mut all = cols.to_vec();
+            all.extend(extra.iter().cloned());
+            fit_law(run_rows, &all, y).ok().map(|f| self.unscale(&f.0))
+        };
+        let (lo, hi) = (coef(&self.shifted[0])?, coef(&self.shifted[1])?);
+        Some(
+            lo.iter()
+                .zip(&hi)
+                .map(|(a, b)| ((b - a) / (2.0 * self.lag_step_s) * self.lag_se_s).abs())
+                .collect(),
+        )
     }
-    if fc < fd {
-        (c.exp(), fc)
-    } else {
-        (d.exp(), fd)
+
+    /// Coefficients on the standardised columns (law first, any extra terms after) back
+    /// in the units of `LAW_TERMS`.
+    pub fn unscale(&self, w: &[f64]) -> Vec<f64> {
+        w.iter()
+            .enumerate()
+            .map(|(k, v)| self.scale.get(k).map_or(*v, |s| v / s))
+            .collect()
     }
-}
-
-/// Rows used to search the time constants: at most this many per run, evenly spread
-/// (the amplitudes are then fitted on every row).
-pub const TAU_SEARCH_ROWS: usize = 400;
-
-/// One run's time constants: for every fast tau of the grid the best slow tau (golden
-/// section in log tau), then the best fast tau between its grid neighbours the same way.
-/// (A 2-D grid then a local pattern search was tried: the valley is narrow and curved,
-/// and the search ended in the wrong basin on the simulator's own runs.)
-fn run_taus(s: &crate::diagnose::input::Series) -> (f64, f64) {
-    let step = s.t_s.len().div_ceil(TAU_SEARCH_ROWS).max(1);
-    let t_s: Vec<f64> = s.t_s.iter().step_by(step).copied().collect();
-    let temp: Vec<f64> = s.temp_c.iter().step_by(step).copied().collect();
-    let taus = thermal_taus_s();
-    let top = *taus.last().unwrap_or(&16_384.0);
-    let profile = |t1: f64| golden(&|t2| thermal_sse(&t_s, &temp, t1, t2), t1 * 1.05, top, 30);
-    let mut best = (0usize, f64::INFINITY);
-    for (i, &t1) in taus[..taus.len() - 1].iter().enumerate() {
-        let (_, e) = profile(t1);
-        if e < best.1 {
-            best = (i, e);
-        }
-    }
-    let lo = taus[best.0.saturating_sub(1)];
-    let hi = taus[(best.0 + 1).min(taus.len() - 2)];
-    let (t1, _) = golden(&|t1| profile(t1).1, lo, hi.max(lo * 1.01), 20);
-    (t1, profile(t1).0)
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
-}
-
-/// Every run's own two time constants (the network's conductances may change with the
-/// ambient: one pair for all runs was tried and misfit the simulator's own campaigns),
-/// amplitudes and start; the reported pair is the median over runs.
-fn fit_thermal(c: &Campaign) -> Thermal {
-    let (mut temp, mut rate, mut accel) = (Vec::new(), Vec::new(), Vec::new());
-    let (mut fast, mut slow) = (Vec::new(), Vec::new());
-    let mut sse = 0.0;
-    for s in &c.runs {
-        let (t1, t2) = run_taus(s);
-        fast.push(t1);
-        slow.push(t2);
-        let b = exponentials(&s.t_s, &s.temp_c, t1, t2);
-        for (&t, &meas) in s.t_s.iter().zip(&s.temp_c) {
-            let (e1, e2) = ((-t / t1).exp(), (-t / t2).exp());
-            let m = b[0] + b[1] * e1 + b[2] * e2;
-            sse += (meas - m).powi(2);
-            temp.push(m);
-            rate.push(-b[1] / t1 * e1 - b[2] / t2 * e2);
-            accel.push(b[1] / (t1 * t1) * e1 + b[2] / (t2 * t2) * e2);
-        }
-    }
-    Thermal {
-        tau: (median(fast), median(slow)),
-        rms: (sse / temp.len().max(1) as f64).sqrt(),
-        temp,
-        rate,
-        accel,
-    }
-}
-
-/// The calibration's drift design from the fitted thermal response, in `LAW_TERMS`
-/// order: T - mean T, (T - mean T)^2, dT/dt, (T - mean T) dT/dt, d2T/dt2, stacked.
-fn design(c: &Campaign) -> (Thermal, Vec<Vec<f64>>) {
-    let th = fit_thermal(c);
-    let t_mean = th.temp.iter().sum::<f64>() / th.temp.len().max(1) as f64;
-    let dt: Vec<f64> = th.temp.iter().map(|t| t - t_mean).collect();
-    let cols = vec![
-        dt.clone(),
-        dt.iter().map(|d| d * d).collect(),
-        th.rate.clone(),
-        dt.iter().zip(&th.rate).map(|(d, r)| d * r).collect(),
-        th.accel.clone(),
-    ];
-    (th, cols)
-}
-
-/// The calibration's drift design columns (see `design`) and the mean fitted temperature,
-/// degC (where `bias_dph_per_c` applies).
-pub fn design_columns(c: &Campaign) -> (Vec<Vec<f64>>, f64) {
-    let (th, cols) = design(c);
-    let t_mean = th.temp.iter().sum::<f64>() / th.temp.len().max(1) as f64;
-    (cols, t_mean)
 }
 
 /// The law shared across runs (`levels`, quasi-demeaning chosen on held-out runs) on
@@ -306,26 +254,28 @@ fn fit_law(
     Ok((coef, resid, "free run offsets".into()))
 }
 
-/// Calibrates (see the module header); `effect` are the named cause's stacked columns.
+/// Calibrates (see the module header) on `design`; `effect` are the named cause's
+/// stacked columns.
 pub fn calibrate(
-    c: &Campaign,
+    design: &SimDesign,
     run_rows: &[std::ops::Range<usize>],
     y: &[f64],
     effect: Option<&[Vec<f64>]>,
 ) -> Result<SimCalibration, DiagnoseError> {
-    let (th, cols) = design(c);
-    let t_mean = th.temp.iter().sum::<f64>() / th.temp.len().max(1) as f64;
-    let (coef, resid, levels) = fit_law(run_rows, &cols, y)?;
+    let (coef, resid, levels) = fit_law(run_rows, &design.cols, y)?;
+    let coef = design.unscale(&coef);
     let mut out = SimCalibration {
-        tau_fast_s: th.tau.0,
-        tau_slow_s: th.tau.1,
-        temp_rms_c: th.rms,
+        tau_fast_s: design.tau_s.0,
+        tau_slow_s: design.tau_s.1,
+        sensor_lag_s: design.sensor_lag_s,
+        sensor_lag_se_s: design.lag_se_s,
+        temp_rms_c: design.temp_rms_c,
         bias_dph_per_c: coef[0],
         bias_dph_per_c2: coef[1],
         shupe_dph_per_cps: coef[2],
         shupe_dph_per_cps_per_c: coef[3],
         gradient_dph_per_cps2: coef[4],
-        t_mean_c: t_mean,
+        t_mean_c: design.t_mean_c,
         levels,
         noise_10s_dph: white_noise(run_rows, &resid),
         before_rms_dph: rms(&resid),
@@ -333,7 +283,7 @@ pub fn calibrate(
         effect_coef: vec![],
     };
     if let Some(e) = effect {
-        let mut all = cols;
+        let mut all = design.cols.clone();
         all.extend(e.iter().cloned());
         let (coef2, resid2, _) = fit_law(run_rows, &all, y)?;
         out.after_rms_dph = Some(rms(&resid2));

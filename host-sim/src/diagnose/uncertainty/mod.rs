@@ -2,16 +2,17 @@
 //! temperature sensitivity and rate coefficient (and, for a polynomial base, its
 //! coefficients in physical units), the named extension's coefficient(s), the calibrated
 //! simulator's bias slope, curvature, Shupe coefficient and noise, and the
-//! measured-vs-simulator ratios (temperature sensitivity, Shupe coefficient, ARW) against
+//! measured-vs-simulator ratios (temperature sensitivity, Shupe, gradient rate, ARW) against
 //! the project's simulator (`GyroParams::paper_default`). Ranges come from the block
 //! bootstrap of `bootstrap` (whole runs or time blocks resampled). The simulator stage is
-//! conditional on its fitted thermal response (the thermal time constants are not redrawn).
+//! conditional on each run's fitted thermal response (resampled with its run); the sensor
+//! lag shared by all runs adds its own error (delta method).
 
 pub mod bootstrap;
 
 use crate::diagnose::base::bases::{zscore_params, BaseFit};
 use crate::diagnose::base::models::Stacked;
-use crate::diagnose::input::Campaign;
+use crate::diagnose::simulator::simfit::SimDesign;
 use crate::diagnose::uncertainty::bootstrap::{draws, Estimate, REPLICATES};
 use crate::diagnose::validation::cv::{Folds, Offsets, Prepared, UnitSystems};
 use serde::Serialize;
@@ -47,7 +48,7 @@ pub struct NamedFeature<'a> {
 
 /// Computes every range (see the module header).
 pub fn estimate(
-    campaign: &Campaign,
+    sim: &SimDesign,
     folds: &Folds,
     st: &Stacked,
     base: &BaseFit,
@@ -58,7 +59,7 @@ pub fn estimate(
         Offsets::PerUnit => "whole runs",
         Offsets::RunDummies => "contiguous time blocks",
     };
-    let (simulator, ratios) = simulator_estimates(campaign, folds, st, named, &counts);
+    let (simulator, ratios) = simulator_estimates(sim, folds, st, named, &counts);
     Uncertainty {
         method: format!(
             "block bootstrap: {REPLICATES} replicates, {} {blocks} drawn with replacement; +/- is the bootstrap \
@@ -248,13 +249,13 @@ fn row_spacing_s(folds: &Folds, t_s: &[f64]) -> f64 {
 /// With runs held out whole the law shared across runs is bootstrapped (whole runs
 /// redrawn, `simfit::fit_shared`), else the free-offset fit over time blocks.
 fn simulator_estimates(
-    campaign: &Campaign,
+    sim: &SimDesign,
     folds: &Folds,
     st: &Stacked,
     named: Option<&NamedFeature<'_>>,
     counts: &[Vec<f64>],
 ) -> (Vec<Estimate>, Vec<Ratio>) {
-    let (mut cols, t_mean) = crate::diagnose::simulator::simfit::design_columns(campaign);
+    let (mut cols, t_mean) = (sim.cols.clone(), sim.t_mean_c);
     let n_law = crate::diagnose::simulator::simfit::LAW_TERMS.len();
     let prepared = Prepared::new(folds, &cols, &st.y, 0.0);
     let extra: &[Vec<f64>] = named.map_or(&[], |n| n.cols);
@@ -279,20 +280,25 @@ fn simulator_estimates(
         Some((coef, _, lv, theta)) => {
             let reps: Vec<Vec<f64>> = counts
                 .iter()
-                .filter_map(|c| lv.solve_shared(c, theta).map(|f| f.w[1..].to_vec()))
+                .filter_map(|c| lv.solve_shared(c, theta).map(|f| sim.unscale(&f.w[1..])))
                 .collect();
-            estimates(&names, &coef, &reps)
+            estimates(&names, &sim.unscale(&coef), &reps)
         }
         None => {
             let p = prepared.width();
             let summary = |w: &[f64]| -> Vec<f64> {
                 let mut v = w[..n_law].to_vec();
                 v.extend_from_slice(&w[p..]);
-                v
+                sim.unscale(&v)
             };
             bootstrap(&sys, counts, &names, &summary)
         }
     };
+    // The thermal fit is not redrawn by the bootstrap; its sensor lag is shared by every
+    // run, so its error is added (`SimDesign::lag_spread`).
+    if let Some(spread) = sim.lag_spread(&folds.run_rows, &st.y, extra) {
+        out.iter_mut().zip(spread).for_each(|(e, sd)| e.widen(sd));
+    }
     if let Some(arw) = arw_estimate(folds, st, &prepared, &sys, counts) {
         out.push(arw);
     }
@@ -346,7 +352,7 @@ fn arw_estimate(
 }
 
 /// Measured / simulator (`GyroParams::paper_default`) for the temperature sensitivity at
-/// the mean T (`t_mean_c`), the Shupe coefficient and the ARW (`est` as built above).
+/// the mean T (`t_mean_c`), the Shupe coefficient, the gradient-rate coefficient and the ARW (`est` as built above).
 fn ratios_to_simulator(est: &[Estimate], t_mean_c: f64) -> Vec<Ratio> {
     let sim = crate::sim::GyroParams::paper_default();
     let d = &sim.drift;
@@ -354,6 +360,10 @@ fn ratios_to_simulator(est: &[Estimate], t_mean_c: f64) -> Vec<Ratio> {
     // The simulator's Shupe coefficient at the same temperature (its cold gain included).
     let shupe =
         d.shupe_dph_per_cps * (1.0 - d.shupe_cold_gain_per_k * (t_mean_c - d.bias_ref_c)).max(0.0);
+    // Its axial gradient term k_G d(T_h - T_c)/dt on d2T_c/dt2: in the two-node network
+    // d(T_h - T_c)/dt = (C_coil / G_coil_housing) d2T_c/dt2.
+    let gradient = d.gradient_dph_per_cps * sim.thermal.coil_heat_capacity_j_per_k
+        / sim.thermal.coil_housing_w_per_k;
     let pairs = [
         (
             "bias_dph_per_c",
@@ -364,6 +374,11 @@ fn ratios_to_simulator(est: &[Estimate], t_mean_c: f64) -> Vec<Ratio> {
             "shupe_dph_per_cps",
             "Shupe coefficient at the mean T",
             shupe,
+        ),
+        (
+            "gradient_dph_per_cps2",
+            "gradient-rate (d2T/dt2) coefficient",
+            gradient,
         ),
         ("arw_from_row_noise", "ARW (row noise)", sim.noise.arw_dpsh),
     ];
