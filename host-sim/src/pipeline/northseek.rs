@@ -361,6 +361,43 @@ impl SeekLedger {
     }
 }
 
+/// What the device records per seek (`fog_firmware::app`): the temperature state of the
+/// seek's valid windows, reset at each start and motion restart, and the model's CRC-32.
+struct FieldRecorder {
+    seek_temp: SeekTempState,
+    model_crc32: Option<u32>,
+}
+
+impl FieldRecorder {
+    fn new(model: Option<&RbfModel>) -> Result<Self> {
+        Ok(Self {
+            seek_temp: SeekTempState::new(),
+            model_crc32: model.map(crate::field::model_crc32).transpose()?,
+        })
+    }
+
+    /// A window of a running seek (before the supervisor sees it, as on the device).
+    fn on_window(&mut self, w: &fog_core::compensation::compensator::WindowResult) {
+        if w.status.is_valid() {
+            self.seek_temp.push(w.t_end_s, w.temp_c, w.temp_rate_cps);
+        }
+    }
+
+    /// The record of a finished seek; a restart forgets the state.
+    fn on_event(&mut self, event: &Result<SupervisorEvent, QualityError>) -> Option<FieldRecord> {
+        match event {
+            Ok(SupervisorEvent::Done(r, validity)) => {
+                record_of_seek(r, *validity, self.seek_temp.state(), self.model_crc32)
+            }
+            Ok(SupervisorEvent::Restarted(_)) => {
+                self.seek_temp.reset();
+                None
+            }
+            _ => None,
+        }
+    }
+}
+
 /// Direction of the base tilt of a start, deg (pitch = tilt cos, roll = tilt sin).
 fn tilt_direction_deg(seed: u64) -> f64 {
     (seed % 3600) as f64 / 10.0
@@ -403,10 +440,7 @@ pub fn run_seeks(
         ..CompensatorConfig::default()
     };
     let mut comp = Compensator::new(comp_cfg, model.cloned()).map_err(|e| anyhow!("{e}"))?;
-    // What the device records per seek: the temperature state of the seek's valid windows
-    // (reset at each start and restart, as `fog_firmware::app` does) and the model's CRC.
-    let model_crc32 = model.map(crate::field::model_crc32).transpose()?;
-    let mut seek_temp = SeekTempState::new();
+    let mut recorder = FieldRecorder::new(model)?;
     let mut finder = NorthFinder::new(cfg.seek_config()).map_err(|e| anyhow!("{e}"))?;
     finder.set_heading_correction(arm.heading);
     // The motion threshold's floor from the simulated gyro's own ARW (its datasheet value).
@@ -462,7 +496,7 @@ pub fn run_seeks(
         if !sup.is_seeking() && !ledger.done() && s.t_s >= INIT_S {
             let tilt = window_tilt.unwrap_or_else(|| inclinometer.peek(arm.feed_tilt));
             let bit = simulated_bit(sensor_c, temp_rate_cps);
-            seek_temp.reset();
+            recorder.seek_temp.reset();
             if let Err(e) = sup.start(&mut table, s.t_s, tilt, bit) {
                 ledger.refuse(s.t_s, e);
             }
@@ -479,20 +513,9 @@ pub fn run_seeks(
         window_tilt = Some(tilt);
         temp_rate_cps = w.temp_rate_cps;
         if sup.is_seeking() {
-            if w.status.is_valid() {
-                seek_temp.push(w.t_end_s, w.temp_c, w.temp_rate_cps);
-            }
+            recorder.on_window(&w);
             let event = sup.on_window(&w, tilt, &mut table);
-            let field_record = match &event {
-                Ok(SupervisorEvent::Done(r, validity)) => {
-                    record_of_seek(r, *validity, seek_temp.state(), model_crc32)
-                }
-                Ok(SupervisorEvent::Restarted(_)) => {
-                    seek_temp.reset();
-                    None
-                }
-                _ => None,
-            };
+            let field_record = recorder.on_event(&event);
             ledger.record(event, w.t_end_s, sup.restarts().0, field_record);
         }
     }
