@@ -25,7 +25,7 @@ use fog_core::link::messages::{
     Command, DeviceMessage, FaultState, Refusal, ResetReason, SeekReport, Status, LINK_VERSION,
 };
 use fog_core::model::format::RbfModel;
-use fog_core::seeking::field_record::{two_position_residual_dph, FieldRecord, SeekTempState};
+use fog_core::seeking::field_record::{record_of_seek, FieldRecord, SeekTempState};
 use fog_core::seeking::heading_cal::HeadingHarmonic;
 use fog_core::seeking::northfinder::{NorthFinder, SeekConfig, SeekError, SeekMode, SeekResult};
 use fog_core::seeking::quality::{
@@ -410,21 +410,8 @@ where
         validity: Validity,
         model_crc32: Option<u32>,
     ) -> Option<FieldRecord> {
-        if validity != Validity::Valid || r.mode != SeekMode::TwoPosition {
-            return None;
-        }
-        let residual_dph = two_position_residual_dph(r)?;
-        let state = self.seek_temp.state()?;
-        let record = FieldRecord {
-            sequence: 0,
-            temp_c: state.temp_c,
-            temp_rate_cps: state.temp_rate_cps,
-            temp_accel_cps2: state.temp_accel_cps2,
-            t_since_power_on_s: r.t_end_s as f32,
-            residual_bias_dph: residual_dph as f32,
-            model_crc32: self.compensator.borrow().model().and(model_crc32),
-        };
-        record.is_plausible().then_some(record)
+        let model_crc32 = self.compensator.borrow().model().and(model_crc32);
+        record_of_seek(r, validity, self.seek_temp.state(), model_crc32)
     }
 
     fn start_seek(&mut self, t_s: f64) -> Result<(), QualityError> {

@@ -262,6 +262,37 @@ pub fn two_position_residual_dph(result: &crate::seeking::northfinder::SeekResul
     half_sum.is_finite().then_some(half_sum)
 }
 
+/// The record a finished seek leaves (sequence 0: the ring numbers it), or `None` unless it
+/// was a valid two-position seek with a temperature state: the half-sum of its two main
+/// positions' compensated rates at `state` (the `SeekTempState` of its valid windows), at
+/// its end time since power-on. `model_crc32`: the CRC-32 of the model that compensated it
+/// (`None` without a model). The device and the host's simulated field seeks both form
+/// their records here, so they are the same records.
+pub fn record_of_seek(
+    result: &crate::seeking::northfinder::SeekResult,
+    validity: crate::seeking::quality::Validity,
+    state: Option<TempState>,
+    model_crc32: Option<u32>,
+) -> Option<FieldRecord> {
+    use crate::seeking::northfinder::SeekMode;
+    use crate::seeking::quality::Validity;
+    if validity != Validity::Valid || result.mode != SeekMode::TwoPosition {
+        return None;
+    }
+    let residual_dph = two_position_residual_dph(result)?;
+    let state = state?;
+    let record = FieldRecord {
+        sequence: 0,
+        temp_c: state.temp_c,
+        temp_rate_cps: state.temp_rate_cps,
+        temp_accel_cps2: state.temp_accel_cps2,
+        t_since_power_on_s: result.t_end_s as f32,
+        residual_bias_dph: residual_dph as f32,
+        model_crc32,
+    };
+    record.is_plausible().then_some(record)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

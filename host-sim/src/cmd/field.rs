@@ -26,6 +26,8 @@ pub struct Args {
 pub enum Action {
     /// Pull the device's field records into DIR (and the registry, if it exists).
     Pull(PullArgs),
+    /// Measure what field refinement wins back on a simulated aged gyro (5/20/50 field seeks).
+    Aging(super::field_aging::AgingArgs),
 }
 
 #[derive(clap::Args, Debug)]
@@ -50,6 +52,7 @@ pub struct PullArgs {
 pub fn run(a: Args) -> Result<()> {
     match a.action {
         Action::Pull(p) => pull(p),
+        Action::Aging(a) => super::field_aging::run(a),
     }
 }
 

@@ -8,6 +8,7 @@ pub mod compensate;
 pub mod demo;
 pub mod diagnose;
 pub mod field;
+pub mod field_aging;
 pub mod heading_cal;
 pub mod heap;
 pub mod import;

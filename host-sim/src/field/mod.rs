@@ -18,6 +18,7 @@ use anyhow::{bail, Result};
 use fog_core::link::upload::crc32;
 use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
 
+use records_file::StoredRecord;
 use refine::{FieldObservation, WeightChoice};
 
 /// What `train --field` did with the field records.
@@ -53,6 +54,17 @@ pub fn refine_with_dir(
             records_file::JSON_NAME
         );
     }
+    refine_with_records(model, &records, weight)
+        .map_err(|e| anyhow::anyhow!("--field {}: {e}", dir.display()))
+}
+
+/// Refines `model` with those of `records` measured under it (same model CRC-32): what
+/// `train --field` does once the records are read (the aging measurement calls it directly).
+pub fn refine_with_records(
+    model: &RbfModel,
+    records: &[StoredRecord],
+    weight: Option<f64>,
+) -> Result<FieldRefinement> {
     let crc = model_crc32(model)?;
     let obs: Vec<FieldObservation> = records
         .iter()
@@ -66,9 +78,8 @@ pub fn refine_with_dir(
         .collect();
     if obs.is_empty() {
         bail!(
-            "--field {}: none of its {} records was measured under this chamber model (CRC-32 {crc:08x}); \
+            "none of its {} records was measured under this chamber model (CRC-32 {crc:08x}); \
              their residuals belong to another model",
-            dir.display(),
             records.len()
         );
     }
@@ -108,10 +119,13 @@ impl FieldRefinement {
             self.correction
                 .terms
                 .iter()
-                .map(|t| ["T", "dT/dt", "d2T/dt2"][t.kind])
+                .map(|t| refine::kind_name(t.kind))
                 .collect::<Vec<_>>(),
             &self.correction.coef_dph[1..]
         );
+        for note in &self.correction.not_fitted {
+            s += &format!("field correction: not fitted: {note}\n");
+        }
         s
     }
 }

@@ -18,7 +18,19 @@
 //! lowest held-out rms wins, W = 0 included, so a field that does not predict itself leaves
 //! the model unchanged. With fewer than `MIN_RECORDS` records there is no test power and
 //! no correction. A term whose field spread is below its floor is left out (not
-//! identifiable from the field).
+//! identifiable from the field), and so is a term whose field values correlate with an
+//! already kept term's beyond `MAX_TERM_CORRELATION` (T is tried first, then dT/dt): at one
+//! ambient every warm-up follows the same path, T and dT/dt of the field seeks correlate at
+//! r = -0.99 (`fogsim field aging`), and a fit of both makes large opposite coefficients
+//! that fit the seeks' half-sums but move the difference between a seek's two positions,
+//! which is its azimuth (measured: rms x1.14 on the null twin with T and dT/dt, x1.003
+//! with T alone).
+//!
+//! d2T/dt2 is not fitted: a record's d2T/dt2 is the least-squares slope of dT/dt over the
+//! seek, not the mean of the model's own per-window d2T/dt2 input, and early in a warm-up
+//! they differ by orders of magnitude (seek 1 of a 20 degC cold start: slope -1.5e-6
+//! degC/s^2, window inputs from +5e-4 down to -2e-5). A coefficient fitted on the one and
+//! applied to the other moved seek azimuths (rms x2.5 on the null twin).
 //!
 //! The correction is folded exactly into the model's bias and linear terms
 //! (x_j = offset_j + scale_j xn_j), so the device applies it with no new code.
@@ -32,8 +44,10 @@ pub const MIN_RECORDS: usize = 4;
 pub const WEIGHT_GRID: [f64; 12] = [
     0.0, 0.01, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0, 1000.0, 1.0e5,
 ];
-/// Spread below which a term is not fitted, per input kind (degC, degC/s, degC/s^2).
-const SPREAD_FLOOR: [f64; 3] = [0.05, 1.0e-5, 1.0e-8];
+/// Spread below which a term is not fitted, per input kind (degC, degC/s).
+const SPREAD_FLOOR: [f64; 2] = [0.05, 1.0e-5];
+/// |correlation| of a term's field values with a kept term's above which it is not fitted.
+pub const MAX_TERM_CORRELATION: f64 = 0.9;
 
 /// One field observation: the model's plain inputs at the seek and its residual bias.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -67,6 +81,8 @@ pub struct Correction {
     pub terms: Vec<Term>,
     /// b0 then one coefficient per term, deg/h.
     pub coef_dph: Vec<f64>,
+    /// Model inputs the field did not fit, and why.
+    pub not_fitted: Vec<String>,
 }
 
 impl Correction {
@@ -89,9 +105,14 @@ pub struct WeightChoice {
     pub verdict: Option<&'static str>,
 }
 
-/// The model inputs a correction can use: plain T, dT/dt, d2T/dt2.
+/// Name of a record value (0 T, 1 dT/dt).
+pub fn kind_name(kind: usize) -> &'static str {
+    ["T", "dT/dt"][kind]
+}
+
+/// The model inputs a correction can use: plain T and dT/dt (T first).
 fn candidate_terms(model: &RbfModel) -> Vec<(usize, usize)> {
-    model
+    let mut terms = model
         .inputs
         .iter()
         .enumerate()
@@ -99,35 +120,72 @@ fn candidate_terms(model: &RbfModel) -> Vec<(usize, usize)> {
             let kind = match s.kind {
                 FeatureKind::TempC => 0,
                 FeatureKind::TempRateCps if s.tau_s == 0.0 => 1,
-                FeatureKind::TempAccelCps2 if s.tau_s == 0.0 => 2,
                 _ => return None,
             };
             Some((j, kind))
         })
-        .collect()
+        .collect::<Vec<_>>();
+    terms.sort_by_key(|&(_, kind)| kind);
+    terms
 }
 
-/// The terms the field can identify (spread above the floor).
-pub fn terms_for(model: &RbfModel, obs: &[FieldObservation]) -> Vec<Term> {
+/// The terms the field can identify (spread above the floor, not collinear with a kept
+/// term), and a note for each model input left out.
+pub fn terms_for(model: &RbfModel, obs: &[FieldObservation]) -> (Vec<Term>, Vec<String>) {
     let n = obs.len().max(1) as f64;
-    candidate_terms(model)
-        .into_iter()
-        .filter_map(|(input, kind)| {
-            let mean = obs.iter().map(|o| o.input(kind)).sum::<f64>() / n;
-            let var = obs
-                .iter()
-                .map(|o| (o.input(kind) - mean).powi(2))
-                .sum::<f64>()
-                / n;
-            let std = var.sqrt();
-            (std > SPREAD_FLOOR[kind]).then_some(Term {
-                input,
-                kind,
-                mean,
-                std,
-            })
-        })
-        .collect()
+    let mut notes: Vec<String> = model
+        .inputs
+        .iter()
+        .filter(|s| s.kind == FeatureKind::TempAccelCps2)
+        .map(|_| "d2T/dt2 (a record's is the seek's slope, not the model's window input)".into())
+        .collect();
+    let mut terms: Vec<Term> = Vec::new();
+    for (input, kind) in candidate_terms(model) {
+        let mean = obs.iter().map(|o| o.input(kind)).sum::<f64>() / n;
+        let std = (obs
+            .iter()
+            .map(|o| (o.input(kind) - mean).powi(2))
+            .sum::<f64>()
+            / n)
+            .sqrt();
+        if std <= SPREAD_FLOOR[kind] {
+            notes.push(format!(
+                "{} (field spread {std:.2e} below {:.0e})",
+                kind_name(kind),
+                SPREAD_FLOOR[kind]
+            ));
+            continue;
+        }
+        let term = Term {
+            input,
+            kind,
+            mean,
+            std,
+        };
+        if let Some((kept, r)) = terms
+            .iter()
+            .map(|k| (k, correlation(obs, k, &term)))
+            .find(|(_, r)| r.abs() > MAX_TERM_CORRELATION)
+        {
+            notes.push(format!(
+                "{} (collinear with {} in the field, r = {r:+.3})",
+                kind_name(kind),
+                kind_name(kept.kind)
+            ));
+            continue;
+        }
+        terms.push(term);
+    }
+    (terms, notes)
+}
+
+/// Correlation of two terms' values over the field seeks.
+fn correlation(obs: &[FieldObservation], a: &Term, b: &Term) -> f64 {
+    let n = obs.len().max(1) as f64;
+    obs.iter()
+        .map(|o| (o.input(a.kind) - a.mean) * (o.input(b.kind) - b.mean))
+        .sum::<f64>()
+        / (n * a.std * b.std)
 }
 
 /// Fits the correction with weight `w` on `obs` (terms fixed by the caller).
@@ -152,6 +210,7 @@ pub fn fit(obs: &[FieldObservation], terms: &[Term], w: f64) -> Correction {
         weight: w,
         terms: terms.to_vec(),
         coef_dph: solve_spd(a, b),
+        not_fitted: Vec::new(),
     }
 }
 
@@ -242,9 +301,12 @@ pub fn refine(
     obs: &[FieldObservation],
     fixed: Option<f64>,
 ) -> Result<(RbfModel, Correction, WeightChoice)> {
-    let terms = terms_for(model, obs);
+    let (terms, not_fitted) = terms_for(model, obs);
     let choice = choose_weight(obs, &terms, fixed);
-    let c = fit(obs, &terms, choice.weight);
+    let c = Correction {
+        not_fitted,
+        ..fit(obs, &terms, choice.weight)
+    };
     Ok((apply(model, &c)?, c, choice))
 }
 
@@ -325,5 +387,32 @@ mod tests {
         let (same, _, choice) = refine(&m, &o[..3], None).unwrap();
         assert!(choice.verdict.is_some());
         assert_eq!(same, m);
+    }
+
+    #[test]
+    fn collinear_terms_are_not_fitted_and_say_why() {
+        // Warm-ups at one ambient: dT/dt falls as T rises (r = -1).
+        let o: Vec<FieldObservation> = (0..20)
+            .map(|i| FieldObservation {
+                temp_c: 20.0 + 0.2 * i as f64,
+                temp_rate_cps: 0.012 - 0.0005 * i as f64,
+                temp_accel_cps2: 0.0,
+                residual_bias_dph: 0.001 * i as f64,
+            })
+            .collect();
+        let (terms, notes) = terms_for(&model(), &o);
+        assert_eq!(terms.iter().map(|t| t.kind).collect::<Vec<_>>(), vec![0]);
+        assert!(notes[0].starts_with("dT/dt (collinear with T"), "{notes:?}");
+        // Twin: independent T and dT/dt are both fitted.
+        let spread: Vec<FieldObservation> = o
+            .iter()
+            .enumerate()
+            .map(|(i, x)| FieldObservation {
+                temp_rate_cps: 0.001 * ((i * 7) % 5) as f64,
+                ..*x
+            })
+            .collect();
+        let (terms, notes) = terms_for(&model(), &spread);
+        assert_eq!(terms.len(), 2, "{notes:?}");
     }
 }

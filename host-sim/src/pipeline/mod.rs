@@ -7,6 +7,7 @@ pub mod campaign;
 pub mod campaign_steps;
 pub mod compensate;
 pub mod compensation_replay;
+pub mod field_aging;
 pub mod heading_campaign;
 pub mod heading_fit;
 pub mod northseek;

@@ -24,6 +24,7 @@ use fog_core::consts::earth_rate_horizontal_dph;
 use fog_core::hal::{GyroSample, TempSample};
 use fog_core::link::bit::{evaluate, BitInputs, BitLimits, BitWord};
 use fog_core::model::format::RbfModel;
+use fog_core::seeking::field_record::{record_of_seek, FieldRecord, SeekTempState};
 use fog_core::seeking::heading_cal::{calibrate, HeadingDwell, HeadingHarmonic};
 use fog_core::seeking::northfinder::{NorthFinder, SeekConfig, SeekMode};
 use fog_core::seeking::quality::{
@@ -184,6 +185,10 @@ pub struct SeekOutcome {
     pub duration_s: f64,
     /// Dwell actually used per main position, s (windows x 10 s).
     pub main_dwell_s: f64,
+    /// The field record the device would keep for this seek (`record_of_seek`: residual
+    /// bias = half-sum of the two positions at the seek's temperature state; sequence 0,
+    /// model CRC-32 of the arm's model), `None` where the device keeps none.
+    pub field_record: Option<FieldRecord>,
 }
 
 /// A seek attempt that ended without a result (refused at its start or stopped by the
@@ -322,7 +327,13 @@ impl SeekLedger {
     }
 
     /// Records what the supervisor made of one window (`restarts` of the running seek).
-    fn record(&mut self, event: Result<SupervisorEvent, QualityError>, t_s: f64, restarts: u8) {
+    fn record(
+        &mut self,
+        event: Result<SupervisorEvent, QualityError>,
+        t_s: f64,
+        restarts: u8,
+        field_record: Option<FieldRecord>,
+    ) {
         match event {
             Ok(SupervisorEvent::Done(r, validity)) => {
                 let n_main = r.positions[0].n_windows as f64;
@@ -335,6 +346,7 @@ impl SeekLedger {
                     t_start_s: r.t_start_s,
                     duration_s: r.duration_s,
                     main_dwell_s: n_main * fog_core::consts::WINDOW_S as f64,
+                    field_record,
                 });
                 self.next();
             }
@@ -346,6 +358,43 @@ impl SeekLedger {
     fn next(&mut self) {
         self.index += 1;
         self.attempts = 0;
+    }
+}
+
+/// What the device records per seek (`fog_firmware::app`): the temperature state of the
+/// seek's valid windows, reset at each start and motion restart, and the model's CRC-32.
+struct FieldRecorder {
+    seek_temp: SeekTempState,
+    model_crc32: Option<u32>,
+}
+
+impl FieldRecorder {
+    fn new(model: Option<&RbfModel>) -> Result<Self> {
+        Ok(Self {
+            seek_temp: SeekTempState::new(),
+            model_crc32: model.map(crate::field::model_crc32).transpose()?,
+        })
+    }
+
+    /// A window of a running seek (before the supervisor sees it, as on the device).
+    fn on_window(&mut self, w: &fog_core::compensation::compensator::WindowResult) {
+        if w.status.is_valid() {
+            self.seek_temp.push(w.t_end_s, w.temp_c, w.temp_rate_cps);
+        }
+    }
+
+    /// The record of a finished seek; a restart forgets the state.
+    fn on_event(&mut self, event: &Result<SupervisorEvent, QualityError>) -> Option<FieldRecord> {
+        match event {
+            Ok(SupervisorEvent::Done(r, validity)) => {
+                record_of_seek(r, *validity, self.seek_temp.state(), self.model_crc32)
+            }
+            Ok(SupervisorEvent::Restarted(_)) => {
+                self.seek_temp.reset();
+                None
+            }
+            _ => None,
+        }
     }
 }
 
@@ -391,6 +440,7 @@ pub fn run_seeks(
         ..CompensatorConfig::default()
     };
     let mut comp = Compensator::new(comp_cfg, model.cloned()).map_err(|e| anyhow!("{e}"))?;
+    let mut recorder = FieldRecorder::new(model)?;
     let mut finder = NorthFinder::new(cfg.seek_config()).map_err(|e| anyhow!("{e}"))?;
     finder.set_heading_correction(arm.heading);
     // The motion threshold's floor from the simulated gyro's own ARW (its datasheet value).
@@ -446,6 +496,7 @@ pub fn run_seeks(
         if !sup.is_seeking() && !ledger.done() && s.t_s >= INIT_S {
             let tilt = window_tilt.unwrap_or_else(|| inclinometer.peek(arm.feed_tilt));
             let bit = simulated_bit(sensor_c, temp_rate_cps);
+            recorder.seek_temp.reset();
             if let Err(e) = sup.start(&mut table, s.t_s, tilt, bit) {
                 ledger.refuse(s.t_s, e);
             }
@@ -462,8 +513,10 @@ pub fn run_seeks(
         window_tilt = Some(tilt);
         temp_rate_cps = w.temp_rate_cps;
         if sup.is_seeking() {
+            recorder.on_window(&w);
             let event = sup.on_window(&w, tilt, &mut table);
-            ledger.record(event, w.t_end_s, sup.restarts().0);
+            let field_record = recorder.on_event(&event);
+            ledger.record(event, w.t_end_s, sup.restarts().0, field_record);
         }
     }
     Ok(ledger.out)
@@ -1086,6 +1139,7 @@ mod tests {
             t_start_s: 0.0,
             duration_s: 290.0,
             main_dwell_s: 120.0,
+            field_record: None,
         };
         let arm = |seeks: Vec<SeekOutcome>| ArmOutcome {
             seeks,

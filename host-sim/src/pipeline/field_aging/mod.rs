@@ -1,0 +1,420 @@
+//! The aging measurement (issue 20 item 4): does refining the chamber model with the
+//! device's own field records win back the seek accuracy a gyro loses as it ages?
+//!
+//! 1. Chamber: the gyro as delivered is characterised at the ambient and `north-seek`'s
+//!    own default model is trained on it (`own_model::train_own_model`).
+//! 2. Aging: the gyro's bias law moves by a stated amount (`laws`): turn-on bias and
+//!    temperature coefficient, its twin the Shupe coefficient, and the null twin (none).
+//! 3. Field: the aged gyro runs cold-start seeks with the chamber model through the
+//!    Monte Carlo's seek pipeline (`northseek::run_seeks`: fog-core's compensator, finder
+//!    and supervisor); each finished seek leaves the record the device keeps
+//!    (`fog_core::seeking::field_record::record_of_seek`), numbered as the ring numbers it.
+//! 4. Refinement: after the first N field seeks (5, 20, 50 by default) the chamber model is
+//!    refined exactly as `fogsim train --field` does (`field::refine_with_records`: the
+//!    records under the model's CRC-32, weight by leave-one-out).
+//! 5. Evaluation: an independent set of cold starts on the aged gyro, run once with the
+//!    chamber model and once with each refined model on the same seeds
+//!    (`paired::compare`): azimuth error std, mean and rms, with against without.
+//!
+//! Seeds: the chamber campaign uses the plan's seed as `north-seek` does; field and
+//! evaluation starts draw from their own streams of it (`derive_seed`), the same for every
+//! law, so laws differ by their aging only. Same seed, same report.
+
+pub mod laws;
+pub mod paired;
+
+use anyhow::{bail, Result};
+use fog_core::model::format::RbfModel;
+use serde::Serialize;
+
+use crate::field::records_file::StoredRecord;
+use crate::field::{model_crc32, refine_with_records};
+use crate::pipeline::northseek::{run_seeks, Arm, ArmOutcome, MonteCarloConfig};
+use crate::pipeline::own_model::{train_own_model, OwnModelPlan};
+use crate::report::Table;
+use crate::sim::GyroParams;
+use crate::train::seek_score::Criterion;
+
+pub use laws::AgingLaw;
+pub use paired::{Comparison, ErrorStats, Verdict};
+
+/// Stream of the field starts' seeds (`derive_seed(seed, FIELD_STREAM, 0)`), "FIELD".
+const FIELD_STREAM: u64 = 0x46_49_45_4C_44;
+/// Stream of the evaluation starts' seeds, "EVAL".
+const EVAL_STREAM: u64 = 0x45_56_41_4C;
+/// Gyro id the simulated field records carry.
+pub const SIM_GYRO_ID: &str = "sim-aged";
+
+/// What to measure.
+#[derive(Clone, Debug)]
+pub struct AgingPlan {
+    pub laws: Vec<AgingLaw>,
+    /// Field seeks after which the model is refined (ascending).
+    pub field_seek_counts: Vec<usize>,
+    /// Seeks per field power-on.
+    pub field_seeks_per_start: usize,
+    /// Evaluation cold starts and seeks per start.
+    pub eval_starts: usize,
+    pub eval_seeks_per_start: usize,
+    /// Ambient of the chamber campaign, the field and the evaluation, degC.
+    pub ambient_c: f64,
+    pub latitude_deg: f64,
+    pub seed: u64,
+    pub threads: usize,
+}
+
+impl AgingPlan {
+    /// The measurement in docs/field.md: three laws, 5 / 20 / 50 field seeks (6 per power-on),
+    /// 30 evaluation starts x 6 seeks, 20 degC.
+    pub fn standard(seed: u64) -> Self {
+        Self {
+            laws: AgingLaw::ALL.to_vec(),
+            field_seek_counts: vec![5, 20, 50],
+            field_seeks_per_start: 6,
+            eval_starts: 30,
+            eval_seeks_per_start: 6,
+            ambient_c: 20.0,
+            latitude_deg: crate::sim::DEFAULT_LATITUDE_DEG,
+            seed,
+            threads: crate::pipeline::northseek::default_threads(),
+        }
+    }
+
+    /// Checks the plan, naming the setting at fault.
+    pub fn validate(&self) -> Result<()> {
+        if self.laws.is_empty() {
+            bail!("laws: at least one aging law is needed");
+        }
+        if self.field_seek_counts.is_empty() || self.field_seek_counts.contains(&0) {
+            bail!("field seek counts: at least one, each at least 1");
+        }
+        if self.field_seek_counts.windows(2).any(|w| w[0] >= w[1]) {
+            bail!(
+                "field seek counts: must rise ({:?})",
+                self.field_seek_counts
+            );
+        }
+        if *self.field_seek_counts.last().unwrap_or(&0) > 10_000 {
+            bail!("field seek counts: at most 10000 field seeks");
+        }
+        if self.field_seeks_per_start == 0 || self.eval_seeks_per_start == 0 {
+            bail!("seeks per start: must be at least 1");
+        }
+        if self.eval_starts < 2 {
+            bail!("evaluation starts: at least 2 (the verdict needs a spread over starts)");
+        }
+        self.monte_carlo(EVAL_STREAM, 1, 1).validate()
+    }
+
+    /// The seek settings of the field or evaluation (`stream`) starts: `north-seek`'s.
+    fn monte_carlo(&self, stream: u64, starts: usize, seeks: usize) -> MonteCarloConfig {
+        let paper = MonteCarloConfig::paper(crate::seed::derive_seed(self.seed, stream, 0));
+        MonteCarloConfig {
+            starts,
+            seeks_per_start: seeks,
+            ambient_c: self.ambient_c,
+            latitude_deg: self.latitude_deg,
+            threads: self.threads,
+            ..paper
+        }
+    }
+}
+
+/// One row of the aging table: one law, one field seek count.
+#[derive(Clone, Debug, Serialize)]
+pub struct AgingRow {
+    pub law: AgingLaw,
+    pub field_seeks: usize,
+    /// Records `train --field` used (measured under the chamber model).
+    pub records_used: usize,
+    /// Field weight W chosen by leave-one-out (None: no test power, model unchanged).
+    pub field_weight: Option<f64>,
+    /// Terms of the correction (after the constant) and its coefficients (constant first),
+    /// deg/h per field std; the model inputs not fitted, and why.
+    pub correction_terms: Vec<String>,
+    pub correction_coef_dph: Vec<f64>,
+    pub not_fitted: Vec<String>,
+    pub comparison: Comparison,
+}
+
+/// One law's field: its amounts and the records its field seeks left.
+#[derive(Clone, Debug, Serialize)]
+pub struct LawField {
+    pub law: AgingLaw,
+    pub amounts: String,
+    /// Field power-ons run to collect the records.
+    pub field_starts: usize,
+    /// The records used, in ring order (the first `max(field_seek_counts)`).
+    pub records: Vec<StoredRecord>,
+}
+
+/// The whole measurement.
+#[derive(Clone, Debug, Serialize)]
+pub struct AgingReport {
+    pub seed: u64,
+    pub ambient_c: f64,
+    pub latitude_deg: f64,
+    pub chamber_runs: usize,
+    pub chamber_model_crc32: u32,
+    pub eval_starts: usize,
+    pub eval_seeks_per_start: usize,
+    pub field_seeks_per_start: usize,
+    pub laws: Vec<LawField>,
+    pub rows: Vec<AgingRow>,
+}
+
+/// Runs the measurement; `progress` gets one line per finished step.
+pub fn run_aging(plan: &AgingPlan, progress: &dyn Fn(&str)) -> Result<AgingReport> {
+    plan.validate()?;
+    let delivered = GyroParams::paper_default();
+    let eval_cfg = plan.monte_carlo(EVAL_STREAM, plan.eval_starts, plan.eval_seeks_per_start);
+    let own = train_own_model(
+        &delivered,
+        &OwnModelPlan {
+            ambient_c: plan.ambient_c,
+            latitude_deg: plan.latitude_deg,
+            dwell_s: eval_cfg.dwell_s as f64,
+            seed: plan.seed,
+            criterion: Criterion::parse(
+                crate::train::seek_score::DEFAULT_CRITERION_NAME,
+                eval_cfg.dwell_s as f64,
+                plan.latitude_deg,
+            )
+            .map_err(|e| anyhow::anyhow!("criterion: {e}"))?,
+        },
+    )?;
+    let chamber = own.trained.model;
+    progress(&format!(
+        "chamber model: {} runs at {} degC, {} centres",
+        own.runs, plan.ambient_c, own.trained.report.n_centers
+    ));
+    let mut report = AgingReport {
+        seed: plan.seed,
+        ambient_c: plan.ambient_c,
+        latitude_deg: plan.latitude_deg,
+        chamber_runs: own.runs,
+        chamber_model_crc32: model_crc32(&chamber)?,
+        eval_starts: plan.eval_starts,
+        eval_seeks_per_start: plan.eval_seeks_per_start,
+        field_seeks_per_start: plan.field_seeks_per_start,
+        laws: Vec::new(),
+        rows: Vec::new(),
+    };
+    for &law in &plan.laws {
+        let aged = law.age(&delivered);
+        let field = collect_field_records(plan, law, &aged, &chamber)?;
+        progress(&format!(
+            "{}: {} field records from {} power-ons",
+            law.name(),
+            field.records.len(),
+            field.field_starts
+        ));
+        let without = run_arm(&aged, &eval_cfg, &chamber)?;
+        for &n in &plan.field_seek_counts {
+            let refined = refine_with_records(&chamber, &field.records[..n], None)?;
+            let with = if refined.model == chamber {
+                without.clone()
+            } else {
+                run_arm(&aged, &eval_cfg, &refined.model)?
+            };
+            let comparison = paired::compare(&without, &with, eval_cfg.true_azimuth_deg);
+            progress(&format!(
+                "{} after {n} field seeks: rms {:.4} -> {:.4} deg ({})",
+                law.name(),
+                comparison.without.rms_deg,
+                comparison.with.rms_deg,
+                comparison.verdict.label()
+            ));
+            report.rows.push(AgingRow {
+                law,
+                field_seeks: n,
+                records_used: refined.used,
+                field_weight: refined
+                    .choice
+                    .verdict
+                    .is_none()
+                    .then_some(refined.choice.weight),
+                correction_terms: refined
+                    .correction
+                    .terms
+                    .iter()
+                    .map(|t| crate::field::refine::kind_name(t.kind).to_string())
+                    .collect(),
+                correction_coef_dph: refined.correction.coef_dph.clone(),
+                not_fitted: refined.correction.not_fitted.clone(),
+                comparison,
+            });
+        }
+        report.laws.push(field);
+    }
+    Ok(report)
+}
+
+/// Every evaluation start with `model` on the gyro `params`, in start order.
+fn run_arm(
+    params: &GyroParams,
+    cfg: &MonteCarloConfig,
+    model: &RbfModel,
+) -> Result<Vec<ArmOutcome>> {
+    let arm = Arm {
+        model: Some(model),
+        feed_tilt: true,
+        heading: None,
+    };
+    crate::fanout::try_map_in_order(cfg.starts, cfg.threads, |i| {
+        run_seeks(params, cfg, arm, cfg.start_seed(i))
+    })
+}
+
+/// Runs field power-ons on the aged gyro with the chamber model until the largest field
+/// seek count has records (a seek that leaves none, e.g. refused, is not a field seek).
+fn collect_field_records(
+    plan: &AgingPlan,
+    law: AgingLaw,
+    aged: &GyroParams,
+    chamber: &RbfModel,
+) -> Result<LawField> {
+    let wanted = *plan.field_seek_counts.last().unwrap_or(&0);
+    let per_start = plan.field_seeks_per_start;
+    // Four times the power-ons a clean field needs: more refusals than that is a broken
+    // field, not a slow one.
+    let most_starts = 4 * wanted.div_ceil(per_start);
+    let mut records: Vec<StoredRecord> = Vec::with_capacity(wanted);
+    let mut starts = 0;
+    while records.len() < wanted {
+        if starts >= most_starts {
+            bail!(
+                "{}: {starts} field power-ons left only {} of {wanted} field records",
+                law.name(),
+                records.len()
+            );
+        }
+        let batch = (wanted - records.len()).div_ceil(per_start);
+        let cfg = plan.monte_carlo(FIELD_STREAM, starts + batch, per_start);
+        let arm = Arm {
+            model: Some(chamber),
+            feed_tilt: true,
+            heading: None,
+        };
+        let outcomes = crate::fanout::try_map_in_order(batch, plan.threads, |k| {
+            run_seeks(aged, &cfg, arm, cfg.start_seed(starts + k))
+        })?;
+        starts += batch;
+        for seek in outcomes.iter().flat_map(|o| &o.seeks) {
+            if let Some(mut r) = seek.field_record {
+                if records.len() < wanted {
+                    r.sequence = records.len() as u32 + 1;
+                    records.push(StoredRecord::new(SIM_GYRO_ID, &r));
+                }
+            }
+        }
+    }
+    Ok(LawField {
+        law,
+        amounts: law.amounts(&GyroParams::paper_default()),
+        field_starts: starts,
+        records,
+    })
+}
+
+/// The aging table printed by `fogsim field aging` (and copied into docs/field.md).
+pub fn aging_table(r: &AgingReport) -> String {
+    let mut t = Table::new(&[
+        "law",
+        "field seeks",
+        "W",
+        "terms",
+        "std w/o (deg)",
+        "std with",
+        "mean w/o",
+        "mean with",
+        "rms w/o",
+        "rms with",
+        "ratio",
+        "verdict (2 SE)",
+    ]);
+    for row in &r.rows {
+        let c = &row.comparison;
+        t.row(&[
+            row.law.name().to_string(),
+            format!("{}", row.field_seeks),
+            row.field_weight
+                .map_or("none".to_string(), |w| format!("{w}")),
+            std::iter::once("1")
+                .chain(row.correction_terms.iter().map(String::as_str))
+                .collect::<Vec<_>>()
+                .join("+"),
+            format!("{:.4}", c.without.std_deg),
+            format!("{:.4}", c.with.std_deg),
+            format!("{:+.4}", c.without.mean_deg),
+            format!("{:+.4}", c.with.mean_deg),
+            format!("{:.4}", c.without.rms_deg),
+            format!("{:.4}", c.with.rms_deg),
+            format!("{:.3}", c.rms_ratio),
+            c.verdict.label().to_string(),
+        ]);
+    }
+    let mut s = format!(
+        "aging measurement: chamber model on {} runs at {} degC (CRC-32 {:08x}); evaluation {} cold starts x {} seeks on the aged gyro, same seeds with and without; field {} seeks per power-on; seed {}\n",
+        r.chamber_runs,
+        r.ambient_c,
+        r.chamber_model_crc32,
+        r.eval_starts,
+        r.eval_seeks_per_start,
+        r.field_seeks_per_start,
+        r.seed
+    );
+    for l in &r.laws {
+        s += &format!("  {}: {}\n", l.law.name(), l.amounts);
+    }
+    s + &t.render()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plan(laws: Vec<AgingLaw>, counts: Vec<usize>, eval_starts: usize) -> AgingPlan {
+        AgingPlan {
+            laws,
+            field_seek_counts: counts,
+            eval_starts,
+            threads: 2,
+            ..AgingPlan::standard(1)
+        }
+    }
+
+    #[test]
+    fn refinement_wins_back_shupe_aging_and_does_not_hurt_without_aging() {
+        // 50 field seeks, 30 evaluation starts x 6 seeks (seconds).
+        let r = run_aging(
+            &plan(vec![AgingLaw::Shupe, AgingLaw::None], vec![50], 30),
+            &|_| {},
+        )
+        .unwrap();
+        let row = |law| r.rows.iter().find(|x| x.law == law).unwrap();
+        let aged = &row(AgingLaw::Shupe).comparison;
+        assert_eq!(aged.verdict, Verdict::Helps, "{aged:?}");
+        assert!(aged.rms_ratio < 0.98, "{aged:?}");
+        let null = &row(AgingLaw::None).comparison;
+        assert_ne!(null.verdict, Verdict::Hurts, "{null:?}");
+        assert!(null.rms_ratio < 1.02, "{null:?}");
+        // The aging cost the seeks what refinement won back: aged without > null without.
+        assert!(
+            aged.without.rms_deg > null.without.rms_deg,
+            "{aged:?} {null:?}"
+        );
+        assert_eq!(row(AgingLaw::Shupe).records_used, 50);
+    }
+
+    #[test]
+    fn same_seed_same_report_and_bad_plans_are_named() {
+        let p = plan(vec![AgingLaw::None], vec![5], 2);
+        let json = |p: &AgingPlan| serde_json::to_string(&run_aging(p, &|_| {}).unwrap()).unwrap();
+        assert_eq!(json(&p), json(&p));
+        let err = |p: AgingPlan| p.validate().unwrap_err().to_string();
+        assert!(err(plan(vec![], vec![5], 2)).starts_with("laws"));
+        assert!(err(plan(vec![AgingLaw::None], vec![20, 5], 2)).contains("rise"));
+        assert!(err(plan(vec![AgingLaw::None], vec![5], 1)).starts_with("evaluation starts"));
+    }
+}
