@@ -362,3 +362,106 @@ pub fn fit(c: &Campaign) -> ThermalFit {
         curves,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Four runs of a coil at 28 degC + 1 e^(-t/65) - 8 e^(-t/385) read through a
+    /// first-order lag `lag_s` (0.1 s steps, the reading starting at the coil), 10 s
+    /// window means, plus +/-0.005 degC of deterministic pseudo-noise.
+    fn campaign(lag_s: f64) -> (Campaign, Vec<f64>) {
+        let mut state = 12345u64;
+        let mut noise = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 33) as f64 / (1u64 << 31) as f64 - 0.5) * 0.01
+        };
+        let coil = |t: f64| 28.0 + (-t / 65.0).exp() - 8.0 * (-t / 385.0).exp();
+        let coil_rate = |t: f64| -(-t / 65.0).exp() / 65.0 + 8.0 / 385.0 * (-t / 385.0).exp();
+        let mut runs = Vec::new();
+        let mut true_rate = Vec::new();
+        for k in 0..4 {
+            let (mut sensor, dt) = (coil(0.0), 0.1);
+            let (mut t_s, mut temp_c) = (Vec::new(), Vec::new());
+            let (mut sum, mut rate_sum, mut n) = (0.0, 0.0, 0);
+            for step in 1..=27_000 {
+                let t = f64::from(step) * dt;
+                if lag_s > 0.0 {
+                    sensor += (coil(t) - sensor) * (1.0 - (-dt / lag_s).exp());
+                } else {
+                    sensor = coil(t);
+                }
+                sum += sensor;
+                rate_sum += coil_rate(t);
+                n += 1;
+                if n == 100 {
+                    t_s.push(t);
+                    temp_c.push(sum / 100.0 + noise());
+                    true_rate.push(rate_sum / 100.0);
+                    (sum, rate_sum, n) = (0.0, 0.0, 0);
+                }
+            }
+            runs.push(Series {
+                name: format!("run{k}"),
+                ambient_c: None,
+                latitude_deg: None,
+                drift_dph: vec![0.0; t_s.len()],
+                t_s,
+                temp_c,
+                extras: vec![],
+            });
+        }
+        let c = Campaign {
+            runs,
+            extra_names: vec![],
+            exclusions: vec![],
+            derivative_widths: vec![],
+        };
+        (c, true_rate)
+    }
+
+    #[test]
+    fn a_lagging_thermometer_is_found_and_the_coil_rate_recovered() {
+        let (c, true_rate) = campaign(10.0);
+        let f = fit(&c);
+        assert!(
+            (f.sensor_lag_s - 10.0).abs() < 1.0,
+            "lag {}",
+            f.sensor_lag_s
+        );
+        assert!((f.tau.0 / 65.0 - 1.0).abs() < 0.03, "fast tau {}", f.tau.0);
+        assert!((f.tau.1 / 385.0 - 1.0).abs() < 0.03, "slow tau {}", f.tau.1);
+        assert!(
+            f.lag_se_s.is_finite() && f.lag_se_s < 2.0,
+            "se {}",
+            f.lag_se_s
+        );
+        // The fast mode dominates the early rate: 18 % too high if the lag were ignored.
+        let early: Vec<(f64, f64)> = f.curves.rate[..12]
+            .iter()
+            .copied()
+            .zip(true_rate[..12].iter().copied())
+            .collect();
+        for (fitted, truth) in early {
+            assert!(
+                (fitted / truth - 1.0).abs() < 0.03,
+                "rate {fitted} vs {truth}"
+            );
+        }
+    }
+
+    #[test]
+    fn no_lag_is_claimed_for_a_thermometer_without_one() {
+        let (c, _) = campaign(0.0);
+        let f = fit(&c);
+        assert!(
+            f.sensor_lag_s < 1.0,
+            "lag {} (chi2 {})",
+            f.sensor_lag_s,
+            f.lag_chi2
+        );
+        assert!((f.tau.0 / 65.0 - 1.0).abs() < 0.03, "fast tau {}", f.tau.0);
+    }
+}
