@@ -73,7 +73,7 @@ pub fn diagnose_with(
     rule: validation::buffer::BufferRule,
 ) -> Result<Diagnosis, DiagnoseError> {
     let campaign = input::prepare(runs)?;
-    let (folds, st, choice) = layout_and_base(&campaign, rule)?;
+    let (folds, mut st, choice) = layout_and_base(&campaign, rule)?;
     let base = &choice.chosen;
     let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
     let latitude = latitude_of(&campaign);
@@ -99,6 +99,9 @@ pub fn diagnose_with(
         cols: &s.cols,
     });
     let uncertainty = uncertainty::estimate(&sim_design, &folds, &st, base, named_feature.as_ref());
+    // The simulator's design (15 columns a row with the lag's shifted copies) is not
+    // needed past here: freed before the later stages' own per-row peaks (memory).
+    drop(sim_design);
     let azimuth = azimuth(&campaign, &folds, &st, base, &ext_resid, latitude);
     let named_causes = named_causes(&folds, &st, base, &screening, &between_run, latitude);
     let smallest_attainable_p = validation::signflip::smallest_p(folds.unit_rows.len());
@@ -108,7 +111,7 @@ pub fn diagnose_with(
         groups,
     };
     let power_check =
-        selection::power::check(silent, &campaign, &folds, &st, base, &screening, rerun)?;
+        selection::power::check(silent, &campaign, &folds, &mut st, base, &screening, rerun)?;
     let words = cause_in_words(
         cause.as_ref(),
         &named_causes,

@@ -204,14 +204,15 @@ fn poly_columns(st: &Stacked, degree: u8, uses_rate: bool) -> Vec<Vec<f64>> {
     cols
 }
 
-/// Fits a linear-in-parameters base choosing the ridge on held-out data.
+/// Fits a linear-in-parameters base choosing the ridge on held-out data. The columns are
+/// taken by value so they are held once (memory: up to four columns per row).
 fn fit_linear(
     folds: &Folds,
     spec: BaseSpec,
-    cols: &[Vec<f64>],
+    cols: Vec<Vec<f64>>,
     y: &[f64],
 ) -> Result<BaseFit, DiagnoseError> {
-    let mut prepared = Prepared::new(folds, cols, y, RIDGES[0]);
+    let mut prepared = Prepared::from_owned(folds, cols, y, RIDGES[0]);
     let mut best: Option<(f64, CvResult)> = None;
     for ridge in RIDGES {
         prepared.set_ridge(ridge);
@@ -267,8 +268,8 @@ pub fn fit(folds: &Folds, st: &Stacked, spec: &BaseSpec) -> Result<BaseFit, Diag
     if spec.rbf {
         let r = fit_rbf(
             folds,
-            &[st.temp_c.clone(), st.temp_rate_cps.clone()],
-            &[],
+            vec![st.temp_c.clone(), st.temp_rate_cps.clone()],
+            Vec::new(),
             &st.y,
         )?;
         return Ok(BaseFit {
@@ -282,7 +283,7 @@ pub fn fit(folds: &Folds, st: &Stacked, spec: &BaseSpec) -> Result<BaseFit, Diag
         });
     }
     let cols = poly_columns(st, spec.poly_degree_t.unwrap_or(0), spec.uses_rate);
-    fit_linear(folds, spec.clone(), &cols, &st.y)
+    fit_linear(folds, spec.clone(), cols, &st.y)
 }
 
 /// Fits every base and keeps the one with the lowest held-out rms. (Keeping a simpler

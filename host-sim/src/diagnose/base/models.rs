@@ -65,18 +65,19 @@ pub fn centre_count(n: usize, inputs: usize) -> usize {
 /// Fits an RBF on `inputs` (plus `linear` columns) choosing width and ridge on held-out data.
 pub fn fit_rbf(
     folds: &Folds,
-    inputs: &[Vec<f64>],
-    linear: &[Vec<f64>],
+    inputs: Vec<Vec<f64>>,
+    linear: Vec<Vec<f64>>,
     y: &[f64],
 ) -> Result<RbfFit, DiagnoseError> {
     let k_max = centre_count(y.len(), inputs.len());
     // Only the best setting is remembered and rebuilt at the end. Designs are rows
     // computed on demand (`RbfDesign`): only the inputs are held, never n x centres.
     let mut best: Option<(usize, f64, f64, f64)> = None;
-    let shared_inputs = std::sync::Arc::new(inputs.to_vec());
-    let shared_linear = std::sync::Arc::new(linear.to_vec());
+    // Taken by value: the inputs are held once (memory: two columns per row).
+    let shared_inputs = std::sync::Arc::new(inputs);
+    let shared_linear = std::sync::Arc::new(linear);
     let design = |k: usize, wf: f64| {
-        let basis = RbfBasis::fit(inputs, k, wf);
+        let basis = RbfBasis::fit(&shared_inputs, k, wf);
         let rows = RbfDesign {
             basis: basis.clone(),
             inputs: shared_inputs.clone(),

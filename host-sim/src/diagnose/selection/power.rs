@@ -74,7 +74,7 @@ pub fn check(
     silent: bool,
     campaign: &Campaign,
     folds: &Folds,
-    st: &Stacked,
+    st: &mut Stacked,
     base: &BaseFit,
     screening: &Screening,
     rerun: Rerun<'_>,
@@ -84,20 +84,23 @@ pub fn check(
     if !silent || !reachable || screening.scored.is_empty() {
         return Ok(None);
     }
-    let mut shapes = Vec::new();
+    let mut checked = Vec::new();
     let mut planted_rms = 0.0;
-    for (cand, planted) in plantable(campaign, folds, st, base, screening)? {
-        let mut with_effect = st.clone();
-        with_effect
-            .y
-            .iter_mut()
-            .zip(&planted)
-            .for_each(|(y, e)| *y += e);
-        let base = bases::choose(folds, &with_effect)?.chosen;
+    // One shape at a time, and only the drift is swapped in and out of `st` (memory: one
+    // planted effect and one drift column per row, never a copy of the stacked series).
+    for shape in shapes(screening) {
+        let Some((cand, planted)) = plantable(campaign, folds, st, base, screening, shape)? else {
+            continue;
+        };
+        let with_effect: Vec<f64> = st.y.iter().zip(&planted).map(|(y, e)| y + e).collect();
+        let drift = std::mem::replace(&mut st.y, with_effect);
+        let chosen = bases::choose(folds, st);
+        st.y = drift;
+        let replanted_base = chosen?.chosen;
         let again = screen::screen(
             campaign,
             folds,
-            &base,
+            &replanted_base,
             rerun.library.to_vec(),
             rerun.groups,
             1,
@@ -107,21 +110,25 @@ pub fn check(
             s.scored.cand.column == cand.column && s.scored.cand.times == cand.times
         });
         planted_rms = within_rms(&folds.run_rows, &planted);
-        shapes.push(ShapeCheck {
+        checked.push(ShapeCheck {
             planted: cand.label(),
             named,
             gain_pct: found.map_or(0.0, |s| s.gain_pct),
             p_value: found.map_or(1.0, |s| s.p_value),
         });
     }
-    let headline = shapes.iter().find(|s| !s.named).or(shapes.first()).cloned();
+    let headline = checked
+        .iter()
+        .find(|s| !s.named)
+        .or(checked.first())
+        .cloned();
     Ok(Some(PowerCheck {
         planted: headline.as_ref().map(|s| s.planted.clone()),
         planted_rms_dph: planted_rms,
-        named: !shapes.is_empty() && shapes.iter().all(|s| s.named),
+        named: !checked.is_empty() && checked.iter().all(|s| s.named),
         gain_pct: headline.as_ref().map_or(0.0, |s| s.gain_pct),
         p_value: headline.as_ref().map_or(1.0, |s| s.p_value),
-        shapes,
+        shapes: checked,
     }))
 }
 
@@ -134,54 +141,60 @@ pub const TRIED: usize = 5;
 const MIN_UNEXPLAINED: f64 = 0.5;
 
 /// A candidate's shape: its transform and the base input it multiplies.
-fn shape_of(c: &Candidate) -> (&'static str, Option<&'static str>) {
+fn shape_of(c: &Candidate) -> Shape {
     (c.transform.name(), c.times.map(|b| b.name()))
 }
 
-/// For every shape among the ranked candidates, the first of its `TRIED` best whose
-/// feature the base leaves at least `MIN_UNEXPLAINED` unexplained, with the effect to
-/// plant.
-fn plantable(
-    campaign: &Campaign,
-    folds: &Folds,
-    st: &Stacked,
-    base: &BaseFit,
-    screening: &Screening,
-) -> Result<Vec<(Candidate, Vec<f64>)>, DiagnoseError> {
-    let runs = &folds.run_rows;
-    let mut shapes: Vec<(&'static str, Option<&'static str>)> = Vec::new();
+/// A candidate's shape, as the power check plants it.
+type Shape = (&'static str, Option<&'static str>);
+
+/// The shapes among the ranked candidates, in rank order of their best candidate.
+fn shapes(screening: &Screening) -> Vec<Shape> {
+    let mut shapes: Vec<Shape> = Vec::new();
     for s in &screening.scored {
         if !shapes.contains(&shape_of(&s.cand)) {
             shapes.push(shape_of(&s.cand));
         }
     }
-    let mut out = Vec::new();
-    for shape in shapes {
-        for scored in screening
-            .scored
-            .iter()
-            .filter(|s| shape_of(&s.cand) == shape)
-            .take(TRIED)
-        {
-            let cols = screen::stacked_columns(campaign, &scored.cand);
-            let feature = unit_sum(runs, &cols);
-            let mut feature_as_target = st.clone();
-            feature_as_target.y.clone_from(&feature);
-            let Ok(fit) = bases::fit(folds, &feature_as_target, &base.spec) else {
-                continue;
-            };
-            let unexplained = fit.cv.residual;
-            let share = (within_rms(runs, &unexplained) / within_rms(runs, &feature)).powi(2);
-            if share < MIN_UNEXPLAINED || !share.is_finite() {
-                continue;
-            }
-            if let Some(planted) = planted_effect(runs, &unexplained, &base.cv.residual) {
-                out.push((scored.cand.clone(), planted));
-                break;
-            }
+    shapes
+}
+
+/// For one shape among the ranked candidates, the first of its `TRIED` best whose
+/// feature the base leaves at least `MIN_UNEXPLAINED` unexplained, with the effect to
+/// plant. The feature is fitted as the target in place of `st.y`, which is restored.
+fn plantable(
+    campaign: &Campaign,
+    folds: &Folds,
+    st: &mut Stacked,
+    base: &BaseFit,
+    screening: &Screening,
+    shape: Shape,
+) -> Result<Option<(Candidate, Vec<f64>)>, DiagnoseError> {
+    let runs = &folds.run_rows;
+    for scored in screening
+        .scored
+        .iter()
+        .filter(|s| shape_of(&s.cand) == shape)
+        .take(TRIED)
+    {
+        let cols = screen::stacked_columns(campaign, &scored.cand);
+        let drift = std::mem::replace(&mut st.y, unit_sum(runs, &cols));
+        drop(cols);
+        let fit = bases::fit(folds, st, &base.spec);
+        let feature = std::mem::replace(&mut st.y, drift);
+        let Ok(fit) = fit else {
+            continue;
+        };
+        let unexplained = fit.cv.residual;
+        let share = (within_rms(runs, &unexplained) / within_rms(runs, &feature)).powi(2);
+        if share < MIN_UNEXPLAINED || !share.is_finite() {
+            continue;
+        }
+        if let Some(planted) = planted_effect(runs, &unexplained, &base.cv.residual) {
+            return Ok(Some((scored.cand.clone(), planted)));
         }
     }
-    Ok(out)
+    Ok(None)
 }
 
 /// The columns, each scaled to unit within-run rms, summed.
