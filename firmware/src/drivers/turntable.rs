@@ -1,12 +1,8 @@
 //! Indexing turntable controller on a serial line as a `fog_core::hal::Turntable`.
 //!
-//! ASCII protocol, one command or reply per line, terminated by CR (LF tolerated),
-//! angles in degrees with three decimals:
-//!
-//! | host -> table | table -> host | meaning |
-//! |---|---|---|
-//! | `MOV 180.000` | `ACK` / `NAK` | start a move to an absolute heading (0..360) |
-//! | `POS?` | `POS 179.998 M` | position and state: `M` moving, `S` settled, `F<n>` fault n |
+//! The ASCII line protocol (`MOV 180.000` -> `ACK`/`NAK`, `POS?` -> `POS 179.998 M`/`S`/
+//! `F<n>`) is defined once, in `fog_core::sensor_link::table_line`, which the host's rig
+//! also speaks; this driver adds the timing.
 //!
 //! Everything is non-blocking: `command_heading` queues the command, `poll` pushes bytes
 //! out, reads replies, queries the position every `query_interval_s` while moving and
@@ -19,7 +15,7 @@
 use embedded_hal_nb::nb;
 use embedded_hal_nb::serial::{Error as _, ErrorKind, Read, Write};
 use fog_core::hal::{TableState, Turntable};
-use heapless::Vec;
+use fog_core::sensor_link::table_line::{TableCommand, TableLine, TableMotion, TableReply};
 
 use crate::clock::Clock;
 
@@ -134,8 +130,6 @@ enum Phase {
     Failed(TurntableError),
 }
 
-const LINE_MAX: usize = 32;
-
 /// Serial turntable controller driver.
 pub struct SerialTurntable<S, C> {
     uart: S,
@@ -144,9 +138,9 @@ pub struct SerialTurntable<S, C> {
     phase: Phase,
     target_deg: f32,
     move_deadline_s: f64,
-    tx: Vec<u8, LINE_MAX>,
+    tx: TableLine,
     tx_sent: usize,
-    rx: Vec<u8, LINE_MAX>,
+    rx: TableLine,
 }
 
 impl<S: Read<u8> + Write<u8>, C: Clock> SerialTurntable<S, C> {
@@ -158,9 +152,9 @@ impl<S: Read<u8> + Write<u8>, C: Clock> SerialTurntable<S, C> {
             phase: Phase::Idle,
             target_deg: 0.0,
             move_deadline_s: 0.0,
-            tx: Vec::new(),
+            tx: TableLine::new(),
             tx_sent: 0,
-            rx: Vec::new(),
+            rx: TableLine::new(),
         }
     }
 
@@ -172,7 +166,7 @@ impl<S: Read<u8> + Write<u8>, C: Clock> SerialTurntable<S, C> {
     fn queue_line(&mut self, line: &[u8]) {
         self.tx.clear();
         self.tx_sent = 0;
-        // LINE_MAX holds the longest command ("MOV 359.999\r" is 12 bytes).
+        // A `TableLine` holds the longest command ("MOV 359.999\r" is 12 bytes).
         let _ = self.tx.extend_from_slice(line);
         let _ = self.tx.push(b'\r');
     }
@@ -190,7 +184,7 @@ impl<S: Read<u8> + Write<u8>, C: Clock> SerialTurntable<S, C> {
     }
 
     /// Read bytes until a full line is available or the UART would block.
-    fn read_line(&mut self) -> Result<Option<Vec<u8, LINE_MAX>>, TurntableError> {
+    fn read_line(&mut self) -> Result<Option<TableLine>, TurntableError> {
         loop {
             match self.uart.read() {
                 Ok(b'\r' | b'\n') => {
@@ -232,7 +226,7 @@ impl<S: Read<u8> + Write<u8>, C: Clock> SerialTurntable<S, C> {
                 query_deadline_s: None,
                 next_query_s,
             } if now >= next_query_s => {
-                self.queue_line(b"POS?");
+                self.queue_line(&TableCommand::QueryPosition.encode());
                 self.flush_tx()?;
                 self.phase = Phase::Moving {
                     query_deadline_s: Some(now + self.config.reply_timeout_s),
@@ -245,27 +239,28 @@ impl<S: Read<u8> + Write<u8>, C: Clock> SerialTurntable<S, C> {
     }
 
     fn handle_line(&mut self, line: &[u8], now: f64) -> Result<(), TurntableError> {
-        match (self.phase, line) {
-            (Phase::AwaitAck { .. }, b"ACK") => {
+        let reply = TableReply::parse(line).ok_or(TurntableError::Garbled)?;
+        match (self.phase, reply) {
+            (Phase::AwaitAck { .. }, TableReply::Ack) => {
                 self.phase = Phase::Moving {
                     query_deadline_s: None,
                     next_query_s: now + self.config.query_interval_s,
                 };
                 Ok(())
             }
-            (Phase::AwaitAck { .. }, b"NAK") => Err(TurntableError::Rejected),
-            (Phase::Moving { .. }, reply) if reply.starts_with(b"POS ") => {
-                let (pos_deg, state) = parse_pos(&reply[4..]).ok_or(TurntableError::Garbled)?;
-                match state {
-                    [b'F', code @ ..] => Err(TurntableError::Fault(parse_code(code))),
-                    b"M" => {
+            (Phase::AwaitAck { .. }, TableReply::Nak) => Err(TurntableError::Rejected),
+            (Phase::Moving { .. }, TableReply::Position { angle_mdeg, motion }) => {
+                let pos_deg = angle_mdeg as f32 / 1000.0;
+                match motion {
+                    TableMotion::Fault(code) => Err(TurntableError::Fault(code)),
+                    TableMotion::Moving => {
                         self.phase = Phase::Moving {
                             query_deadline_s: None,
                             next_query_s: now + self.config.query_interval_s,
                         };
                         Ok(())
                     }
-                    b"S" => {
+                    TableMotion::Settled => {
                         if libm::fabsf(angle_diff_deg(pos_deg, self.target_deg))
                             > self.config.position_tolerance_deg
                         {
@@ -279,17 +274,11 @@ impl<S: Read<u8> + Write<u8>, C: Clock> SerialTurntable<S, C> {
                         };
                         Ok(())
                     }
-                    _ => Err(TurntableError::Garbled),
                 }
             }
-            (_, reply) if reply.starts_with(b"POS ") => {
-                // A late reply after settling or failing: nothing to learn from it.
-                let _ = parse_pos(&reply[4..]).ok_or(TurntableError::Garbled)?;
-                Ok(())
-            }
-            (_, reply) if reply.len() >= 2 && reply[0] == b'F' => {
-                Err(TurntableError::Fault(parse_code(&reply[1..])))
-            }
+            // A late reply after settling or failing: nothing to learn from it.
+            (_, TableReply::Position { .. }) => Ok(()),
+            (_, TableReply::Fault(code)) => Err(TurntableError::Fault(code)),
             _ => Err(TurntableError::Garbled),
         }
     }
@@ -304,7 +293,7 @@ impl<S: Read<u8> + Write<u8>, C: Clock> Turntable for SerialTurntable<S, C> {
         }
         let heading = wrap_360(heading_deg);
         let mdeg = ((heading * 1000.0 + 0.5) as u32) % 360_000;
-        self.queue_line(&move_command(mdeg));
+        self.queue_line(&TableCommand::Move { heading_mdeg: mdeg }.encode());
         self.rx.clear();
         let now = self.clock.now_s();
         self.target_deg = mdeg as f32 / 1000.0;
@@ -327,27 +316,6 @@ impl<S: Read<u8> + Write<u8>, C: Clock> Turntable for SerialTurntable<S, C> {
     }
 }
 
-/// `MOV d.ddd` for a heading in millidegrees (0..360,000), formatted by hand: exact
-/// digits and no `core::fmt` machinery in the firmware.
-fn move_command(mdeg: u32) -> Vec<u8, LINE_MAX> {
-    let mut line = Vec::new();
-    let _ = line.extend_from_slice(b"MOV ");
-    let deg = mdeg / 1000;
-    let mut started = false;
-    for div in [100, 10, 1] {
-        let d = (deg / div) % 10;
-        started |= d != 0 || div == 1;
-        if started {
-            let _ = line.push(b'0' + d as u8);
-        }
-    }
-    let _ = line.push(b'.');
-    for div in [100, 10, 1] {
-        let _ = line.push(b'0' + ((mdeg % 1000) / div % 10) as u8);
-    }
-    line
-}
-
 /// Signed shortest difference a - b on the circle, deg.
 fn angle_diff_deg(a: f32, b: f32) -> f32 {
     let d = wrap_360(a - b);
@@ -358,61 +326,9 @@ fn angle_diff_deg(a: f32, b: f32) -> f32 {
     }
 }
 
-/// Parse `"<deg> <state>"` with deg as `[-]d+[.d{1,3}]`; returns (deg, state field).
-fn parse_pos(s: &[u8]) -> Option<(f32, &[u8])> {
-    let space = s.iter().position(|&b| b == b' ')?;
-    let (num, state) = (&s[..space], &s[space + 1..]);
-    if state.is_empty() {
-        return None;
-    }
-    Some((parse_mdeg(num)? as f32 / 1000.0, state))
-}
-
-/// Controller fault code; 255 if the code itself is unreadable.
-fn parse_code(s: &[u8]) -> u8 {
-    parse_uint(s)
-        .and_then(|v| u8::try_from(v).ok())
-        .unwrap_or(u8::MAX)
-}
-
 /// x modulo 360 in [0, 360) (360 itself for tiny negative x, as f32 rounds it). Exact
 /// in f64 (`fog_core::numeric::wrap_360_deg`, |x| < 3e21) instead of f32 `%`, whose
 /// `fmodf` pulls 1.5 KB of 64-bit division into the firmware.
 fn wrap_360(x: f32) -> f32 {
     fog_core::numeric::wrap_360_deg(x as f64) as f32
-}
-
-/// `[-]d+[.d{1,3}]` as integer millidegrees.
-fn parse_mdeg(s: &[u8]) -> Option<i32> {
-    let (neg, s) = match s.split_first() {
-        Some((b'-', rest)) => (true, rest),
-        _ => (false, s),
-    };
-    let (int, frac) = match s.iter().position(|&b| b == b'.') {
-        Some(p) => (&s[..p], &s[p + 1..]),
-        None => (s, &s[..0]),
-    };
-    if int.is_empty() || int.len() > 4 || frac.len() > 3 {
-        return None;
-    }
-    let mut frac_m = if frac.is_empty() {
-        0
-    } else {
-        i32::from(parse_uint(frac)?)
-    };
-    for _ in frac.len()..3 {
-        frac_m *= 10;
-    }
-    let v = i32::from(parse_uint(int)?) * 1000 + frac_m;
-    Some(if neg { -v } else { v })
-}
-
-/// 1 to 4 decimal digits as a number; `None` if empty, longer or not all digits.
-fn parse_uint(s: &[u8]) -> Option<u16> {
-    if s.is_empty() || s.len() > 4 {
-        return None;
-    }
-    s.iter().try_fold(0u16, |acc, &b| {
-        b.is_ascii_digit().then(|| acc * 10 + u16::from(b - b'0'))
-    })
 }

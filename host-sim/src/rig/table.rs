@@ -1,5 +1,6 @@
-//! The turntable controller's side of `fog_firmware::drivers::turntable`'s ASCII protocol
-//! (one line per command, CR terminated, LF tolerated) on a `SimTurntable`:
+//! The turntable controller's side of the ASCII line protocol
+//! (`fog_core::sensor_link::table_line`, the one the firmware's driver speaks) on a
+//! `SimTurntable`:
 //! `MOV 180.000` -> `ACK` (move started) or `NAK` (not a heading), `POS?` ->
 //! `POS 179.998 M` while moving (the true angle), `POS 180.000 S` once settled (the
 //! encoder reads the commanded heading; the indexing error is what it cannot see).
@@ -8,12 +9,15 @@
 use std::io::ErrorKind;
 
 use fog_core::hal::{TableState, Turntable};
+use fog_core::sensor_link::table_line::{
+    deg_to_mdeg, CommandError, TableCommand, TableMotion, TableReply, TABLE_LINE_MAX,
+};
 
 use crate::sim::SimTurntable;
 use crate::upload::read_polled;
 
 /// Longest command line kept, bytes (`MOV 359.999` is 11).
-const MAX_LINE: usize = 32;
+const MAX_LINE: usize = TABLE_LINE_MAX;
 
 /// The table controller.
 pub struct TableServer {
@@ -73,26 +77,36 @@ impl TableServer {
 
     /// The reply to one command line (`None`: not a command, ignored).
     pub fn answer(&mut self, line: &[u8]) -> Option<String> {
-        let text = std::str::from_utf8(line).ok()?.trim();
-        if let Some(h) = text.strip_prefix("MOV ") {
-            let ok = h
-                .trim()
-                .parse::<f32>()
-                .ok()
-                .filter(|h| (0.0..360.0).contains(h))
-                .is_some_and(|h| self.table.command_heading(h).is_ok());
-            if ok {
-                self.moves += 1;
+        let reply = match TableCommand::parse(line) {
+            Err(CommandError::NotACommand) => return None,
+            Err(CommandError::NotAHeading) => TableReply::Nak,
+            Ok(TableCommand::Move { heading_mdeg }) => {
+                let ok = self
+                    .table
+                    .command_heading(heading_mdeg as f32 / 1000.0)
+                    .is_ok();
+                self.moves += u64::from(ok);
+                if ok {
+                    TableReply::Ack
+                } else {
+                    TableReply::Nak
+                }
             }
-            return Some(if ok { "ACK" } else { "NAK" }.to_string());
-        }
-        if text == "POS?" {
-            return Some(match self.table.poll() {
-                Ok(TableState::Settled { heading_deg }) => format!("POS {heading_deg:.3} S"),
-                Ok(TableState::Moving) => format!("POS {:.3} M", self.table.true_angle_deg()),
-                Err(_) => "POS 0.000 F1".to_string(),
-            });
-        }
-        None
+            Ok(TableCommand::QueryPosition) => match self.table.poll() {
+                Ok(TableState::Settled { heading_deg }) => TableReply::Position {
+                    angle_mdeg: deg_to_mdeg(f64::from(heading_deg)),
+                    motion: TableMotion::Settled,
+                },
+                Ok(TableState::Moving) => TableReply::Position {
+                    angle_mdeg: deg_to_mdeg(self.table.true_angle_deg()),
+                    motion: TableMotion::Moving,
+                },
+                Err(_) => TableReply::Position {
+                    angle_mdeg: 0,
+                    motion: TableMotion::Fault(1),
+                },
+            },
+        };
+        Some(String::from_utf8_lossy(&reply.encode()).into_owned())
     }
 }
