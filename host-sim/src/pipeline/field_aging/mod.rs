@@ -211,7 +211,7 @@ pub fn run_aging(plan: &AgingPlan, progress: &dyn Fn(&str)) -> Result<AgingRepor
         ));
         let without = run_arm(&aged, &eval_cfg, &chamber)?;
         for &n in &plan.field_seek_counts {
-            let refined = refine_with_records(&chamber, &field.records[..n], None)?;
+            let refined = refine_with_records(&chamber, &field.records[..n], &[], None)?;
             let with = if refined.model == chamber {
                 without.clone()
             } else {
