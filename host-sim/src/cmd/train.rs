@@ -97,7 +97,7 @@ pub struct Args {
     pub json: Option<PathBuf>,
     /// Field records (`fogsim field pull --out DIR`) measured under this chamber model:
     /// each is one observation of the residual bias at its temperature state; a ridge
-    /// correction linear in the model's T / dT/dt / d2T/dt2 inputs is fitted to them and
+    /// correction linear in the model's T and dT/dt inputs is fitted to them and
     /// folded into the model (`fog_sim::field::refine`).
     #[arg(long)]
     pub field: Option<PathBuf>,
