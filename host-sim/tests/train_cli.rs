@@ -232,26 +232,12 @@ fn train_refuses_a_model_that_does_not_help_and_compensate_warns_when_one_hurts(
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// `fogsim train`, its model with a heading calibration attached (`heading-cal`), the
-/// variant recorded in the calibration registry as `upload` records it, field records
-/// measured under the variant: `train --field --registry` retrains the same model and uses
-/// those records; records under a calibrated variant of another model stay "measured under
-/// another model". Without the registry (twin) no record matches and train refuses by name.
-#[test]
-fn train_field_counts_records_under_a_heading_calibrated_variant_the_registry_knows() {
-    use fog_sim::field::records_file::{merge_into_dir, StoredRecord};
+/// `model_path` with a heading calibration attached (`fogsim heading-cal`), and a calibrated
+/// variant of a different model (another bias), both recorded in a new registry at
+/// `registry` as `upload` records them; returns their CRC-32s (calibrated, other).
+fn register_calibrated_variants(model_path: &Path, registry: &Path) -> (u32, u32) {
     use fog_sim::registry::{ModelRecord, Registry};
-    let dir = std::env::temp_dir().join(format!("fogsim_train_field_{}", std::process::id()));
-    let runs = dir.join("runs");
-    std::fs::create_dir_all(&runs).unwrap();
-    for (a, amb) in [0.0, 20.0].iter().enumerate() {
-        for r in 0..3 {
-            write_run(&runs.join(format!("a{a}_run{r}.csv")), *amb, r);
-        }
-    }
-    let model_path = dir.join("model.bin");
-    let model = train_ok(&runs, &model_path, &["--gyro-id", "FIELD-1"]);
-    let cal_path = dir.join("model_cal.bin");
+    let cal_path = model_path.with_file_name("model_cal.bin");
     let cal = fogsim(&[
         "heading-cal",
         "--model",
@@ -275,51 +261,68 @@ fn train_field_counts_records_under_a_heading_calibrated_variant_the_registry_kn
     let cal_bytes = std::fs::read(&cal_path).unwrap();
     let cal_model = RbfModel::decode(&cal_bytes).unwrap();
     assert!(cal_model.heading.is_some());
-    // Another model (a different bias) with the same calibration: a different base.
     let other = RbfModel {
-        bias_dph: model.bias_dph + 0.01,
+        bias_dph: cal_model.bias_dph + 0.01,
         ..cal_model.clone()
     };
     let mut buf = [0u8; fog_core::model::format::MAX_ENCODED_LEN];
     let n = other.encode(&mut buf).unwrap();
-    let registry = dir.join("registry.sqlite");
-    let mut reg = Registry::open(&registry).unwrap();
+    let mut reg = Registry::open(registry).unwrap();
     let cal_record = ModelRecord::of(&cal_model, &cal_bytes);
     let other_record = ModelRecord::of(&other, &buf[..n]);
-    assert_eq!(
-        cal_record.base_crc32,
-        Some(fog_core::link::upload::crc32(
-            &std::fs::read(&model_path).unwrap()
-        ))
-    );
+    let trained_crc = fog_core::link::upload::crc32(&std::fs::read(model_path).unwrap());
+    assert_eq!(cal_record.base_crc32, Some(trained_crc));
+    assert_ne!(other_record.base_crc32, Some(trained_crc));
     reg.record_model(&cal_record).unwrap();
     reg.record_model(&other_record).unwrap();
-    drop(reg);
-    // Six seeks under the calibrated model (residual linear in T), three under the other.
-    let records: Vec<StoredRecord> = (0..9u32)
+    (cal_record.model_crc32, other_record.model_crc32)
+}
+
+/// Nine field records of gyro FIELD-1 (residual linear in T): six measured under `first`,
+/// three under `second`.
+fn field_records(first: u32, second: u32) -> Vec<fog_sim::field::records_file::StoredRecord> {
+    use fog_core::seeking::field_record::FieldRecord;
+    (0..9u32)
         .map(|i| {
             let temp_c = 15.0 + 2.0 * i as f32;
-            let crc = if i < 6 {
-                cal_record.model_crc32
-            } else {
-                other_record.model_crc32
-            };
-            StoredRecord::new(
+            fog_sim::field::records_file::StoredRecord::new(
                 "FIELD-1",
-                &fog_core::seeking::field_record::FieldRecord {
+                &FieldRecord {
                     sequence: i + 1,
                     temp_c,
                     temp_rate_cps: 0.001 * (i % 3) as f32,
                     t_since_power_on_s: 600.0,
                     residual_bias_dph: 0.002 * (temp_c - 20.0),
-                    model_crc32: Some(crc),
-                    ..fog_core::seeking::field_record::FieldRecord::ZERO
+                    model_crc32: Some(if i < 6 { first } else { second }),
+                    ..FieldRecord::ZERO
                 },
             )
         })
-        .collect();
+        .collect()
+}
+
+/// `fogsim train`, its model with a heading calibration attached (`heading-cal`), the
+/// variant recorded in the calibration registry as `upload` records it, field records
+/// measured under the variant: `train --field --registry` retrains the same model and uses
+/// those records; records under a calibrated variant of another model stay "measured under
+/// another model". Without the registry (twin) no record matches and train refuses by name.
+#[test]
+fn train_field_counts_records_under_a_heading_calibrated_variant_the_registry_knows() {
+    let dir = std::env::temp_dir().join(format!("fogsim_train_field_{}", std::process::id()));
+    let runs = dir.join("runs");
+    std::fs::create_dir_all(&runs).unwrap();
+    for (a, amb) in [0.0, 20.0].iter().enumerate() {
+        for r in 0..3 {
+            write_run(&runs.join(format!("a{a}_run{r}.csv")), *amb, r);
+        }
+    }
+    let model_path = dir.join("model.bin");
+    let model = train_ok(&runs, &model_path, &["--gyro-id", "FIELD-1"]);
+    let registry = dir.join("registry.sqlite");
+    let (cal_crc, other_crc) = register_calibrated_variants(&model_path, &registry);
     let field = dir.join("field");
-    merge_into_dir(&field, &records).unwrap();
+    fog_sim::field::records_file::merge_into_dir(&field, &field_records(cal_crc, other_crc))
+        .unwrap();
     let train_field = |out: &Path, registry: Option<&Path>| {
         let mut args = vec![
             "train".to_string(),
@@ -352,9 +355,8 @@ fn train_field_counts_records_under_a_heading_calibrated_variant_the_registry_kn
         String::from_utf8_lossy(&out.stderr)
     );
     let expected = format!(
-        "field refinement: 6 field seeks used (6 of them under heading-calibrated variants [{:08x}] \
-         (registry); 3 measured under another model, not used)",
-        cal_record.model_crc32
+        "field refinement: 6 field seeks used (6 of them under heading-calibrated variants \
+         [{cal_crc:08x}] (registry); 3 measured under another model, not used)"
     );
     assert!(stdout.contains(&expected), "{stdout}");
     assert!(stdout.contains("attach it again"), "{stdout}");
