@@ -477,13 +477,15 @@ where
                 step.seek = Some(self.fail(e, s.t_s));
             }
         }
-        if let Some(w) = self.compensator.borrow_mut().push_gyro(s) {
+        let window = self.compensator.borrow_mut().push_gyro(s);
+        if let Some(w) = window {
             if let Some(t) = self.tilt_window.mean() {
                 self.tilt = t;
             }
             self.tilt_window = TiltMean::default();
             if self.supervisor.is_seeking() && w.status.is_valid() {
-                self.seek_temp.push(w.t_end_s, w.temp_c, w.temp_rate_cps);
+                self.seek_temp
+                    .push_window(&w, self.compensator.borrow().model());
             }
             match self.supervisor.on_window(&w, self.tilt, &mut self.table) {
                 Ok(SupervisorEvent::Done(r, v)) => {

@@ -231,3 +231,147 @@ fn train_refuses_a_model_that_does_not_help_and_compensate_warns_when_one_hurts(
     assert_eq!(warned, 6, "{}", String::from_utf8_lossy(&other.stderr));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `model_path` with a heading calibration attached (`fogsim heading-cal`), and a calibrated
+/// variant of a different model (another bias), both recorded in a new registry at
+/// `registry` as `upload` records them; returns their CRC-32s (calibrated, other).
+fn register_calibrated_variants(model_path: &Path, registry: &Path) -> (u32, u32) {
+    use fog_sim::registry::{ModelRecord, Registry};
+    let cal_path = model_path.with_file_name("model_cal.bin");
+    let cal = fogsim(&[
+        "heading-cal",
+        "--model",
+        model_path.to_str().unwrap(),
+        "--out",
+        cal_path.to_str().unwrap(),
+        "--a-dph",
+        "0.004",
+        "--b-dph",
+        "-0.002",
+        "--sigma-dph",
+        "0.001",
+        "--n-headings",
+        "8",
+    ]);
+    assert!(
+        cal.status.success(),
+        "{}",
+        String::from_utf8_lossy(&cal.stderr)
+    );
+    let cal_bytes = std::fs::read(&cal_path).unwrap();
+    let cal_model = RbfModel::decode(&cal_bytes).unwrap();
+    assert!(cal_model.heading.is_some());
+    let other = RbfModel {
+        bias_dph: cal_model.bias_dph + 0.01,
+        ..cal_model.clone()
+    };
+    let mut buf = [0u8; fog_core::model::format::MAX_ENCODED_LEN];
+    let n = other.encode(&mut buf).unwrap();
+    let mut reg = Registry::open(registry).unwrap();
+    let cal_record = ModelRecord::of(&cal_model, &cal_bytes);
+    let other_record = ModelRecord::of(&other, &buf[..n]);
+    let trained_crc = fog_core::link::upload::crc32(&std::fs::read(model_path).unwrap());
+    assert_eq!(cal_record.base_crc32, Some(trained_crc));
+    assert_ne!(other_record.base_crc32, Some(trained_crc));
+    reg.record_model(&cal_record).unwrap();
+    reg.record_model(&other_record).unwrap();
+    (cal_record.model_crc32, other_record.model_crc32)
+}
+
+/// Nine field records of gyro FIELD-1 (residual linear in T): six measured under `first`,
+/// three under `second`.
+fn field_records(first: u32, second: u32) -> Vec<fog_sim::field::records_file::StoredRecord> {
+    use fog_core::seeking::field_record::FieldRecord;
+    (0..9u32)
+        .map(|i| {
+            let temp_c = 15.0 + 2.0 * i as f32;
+            fog_sim::field::records_file::StoredRecord::new(
+                "FIELD-1",
+                &FieldRecord {
+                    sequence: i + 1,
+                    temp_c,
+                    temp_rate_cps: 0.001 * (i % 3) as f32,
+                    t_since_power_on_s: 600.0,
+                    residual_bias_dph: 0.002 * (temp_c - 20.0),
+                    model_crc32: Some(if i < 6 { first } else { second }),
+                    ..FieldRecord::ZERO
+                },
+            )
+        })
+        .collect()
+}
+
+/// `fogsim train`, its model with a heading calibration attached (`heading-cal`), the
+/// variant recorded in the calibration registry as `upload` records it, field records
+/// measured under the variant: `train --field --registry` retrains the same model and uses
+/// those records; records under a calibrated variant of another model stay "measured under
+/// another model". Without the registry (twin) no record matches and train refuses by name.
+#[test]
+fn train_field_counts_records_under_a_heading_calibrated_variant_the_registry_knows() {
+    let dir = std::env::temp_dir().join(format!("fogsim_train_field_{}", std::process::id()));
+    let runs = dir.join("runs");
+    std::fs::create_dir_all(&runs).unwrap();
+    for (a, amb) in [0.0, 20.0].iter().enumerate() {
+        for r in 0..3 {
+            write_run(&runs.join(format!("a{a}_run{r}.csv")), *amb, r);
+        }
+    }
+    let model_path = dir.join("model.bin");
+    let model = train_ok(&runs, &model_path, &["--gyro-id", "FIELD-1"]);
+    let registry = dir.join("registry.sqlite");
+    let (cal_crc, other_crc) = register_calibrated_variants(&model_path, &registry);
+    let field = dir.join("field");
+    fog_sim::field::records_file::merge_into_dir(&field, &field_records(cal_crc, other_crc))
+        .unwrap();
+    let train_field = |out: &Path, registry: Option<&Path>| {
+        let mut args = vec![
+            "train".to_string(),
+            runs.display().to_string(),
+            "--out".into(),
+            out.display().to_string(),
+            "--widths".into(),
+            "0.5,1".into(),
+            "--gyro-id".into(),
+            "FIELD-1".into(),
+            "--field".into(),
+            field.display().to_string(),
+        ];
+        if let Some(r) = registry {
+            args.extend(["--registry".into(), r.display().to_string()]);
+        }
+        // No default registry: only the one given counts.
+        std::process::Command::new(env!("CARGO_BIN_EXE_fogsim"))
+            .env("XDG_DATA_HOME", dir.join("no-default"))
+            .args(&args)
+            .output()
+            .unwrap()
+    };
+    let refined_path = dir.join("refined.bin");
+    let out = train_field(&refined_path, Some(&registry));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let expected = format!(
+        "field refinement: 6 field seeks used (6 of them under heading-calibrated variants \
+         [{cal_crc:08x}] (registry); 3 measured under another model, not used)"
+    );
+    assert!(stdout.contains(&expected), "{stdout}");
+    assert!(stdout.contains("attach it again"), "{stdout}");
+    let refined = RbfModel::decode(&std::fs::read(&refined_path).unwrap()).unwrap();
+    assert_ne!(refined, model, "the field records moved the model");
+    assert!(refined.heading.is_none());
+    // Twin: the same records without the registry: none is this model's, refused by name.
+    let twin_path = dir.join("twin.bin");
+    let out = train_field(&twin_path, None);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("none of its 9 records was measured under this chamber model"),
+        "{stderr}"
+    );
+    assert!(!twin_path.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

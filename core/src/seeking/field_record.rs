@@ -3,7 +3,8 @@
 //!
 //! A two-position seek differences headings 0 and 180 deg for the azimuth; the half-sum of
 //! the two positions' compensated rates is the bias the model left, at the seek's mean
-//! temperature, dT/dt, d2T/dt2 and time since power-on. The device keeps these records in
+//! temperature, dT/dt, d2T/dt2 (the mean of the model's own window input) and time since
+//! power-on. The device keeps these records in
 //! a flash ring (`fog_firmware::field_log`), sends them on request (`link::messages`), and
 //! `fogsim train --field` refines the model with them. This module is the one definition
 //! both ends build against: the record, its fixed 36-byte flash encoding with its own
@@ -30,7 +31,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::compensation::compensator::WindowResult;
 use crate::link::upload::CRC32;
+use crate::model::format::{FeatureKind, RbfModel};
 
 /// Bytes of one encoded record (a multiple of every supported flash word: 1, 2, 4 bytes).
 pub const FIELD_RECORD_LEN: usize = 36;
@@ -58,7 +61,8 @@ pub struct FieldRecord {
     pub temp_c: f32,
     /// Mean dT/dt over the seek's windows, degC/s.
     pub temp_rate_cps: f32,
-    /// d2T/dt2 over the seek (least-squares slope of dT/dt in time), degC/s^2.
+    /// Mean over the seek's windows of the model's own d2T/dt2 input (its 10 s window
+    /// estimate), degC/s^2; 0 when the model has no plain d2T/dt2 input.
     pub temp_accel_cps2: f32,
     /// Seconds since power-on at the seek's end.
     pub t_since_power_on_s: f32,
@@ -162,18 +166,18 @@ impl FieldRecord {
     }
 }
 
-/// The temperature state averaged over a seek's windows: mean T and dT/dt, and d2T/dt2 as
-/// the least-squares slope of dT/dt against time (the seek's bias is an average over the
-/// same windows, so its state is too). Reset at each seek start; no allocation.
+/// The temperature state averaged over a seek's windows: mean T, mean dT/dt, and the mean
+/// of the model's own d2T/dt2 input (its 10 s window estimate, the value the model saw and
+/// a linear correction in it averages over; 0 when the model has none). The seek's bias is
+/// an average over the same windows, so its state is too. Reset at each seek start; no
+/// allocation.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SeekTempState {
     n: u32,
-    t0_s: f64,
-    sum_t: f64,
-    sum_tt: f64,
     sum_temp: f64,
     sum_rate: f64,
-    sum_t_rate: f64,
+    n_accel: u32,
+    sum_accel: f64,
 }
 
 /// The averaged state of a seek, what a record carries besides the bias.
@@ -184,16 +188,23 @@ pub struct TempState {
     pub temp_accel_cps2: f32,
 }
 
+/// Index of the model's plain d2T/dt2 input (`TempAccelCps2`, default span), if it has one:
+/// the input whose window values a record averages.
+pub fn accel_input_index(model: &RbfModel) -> Option<usize> {
+    model
+        .inputs
+        .iter()
+        .position(|s| s.kind == FeatureKind::TempAccelCps2 && s.tau_s == 0.0)
+}
+
 impl SeekTempState {
     pub const fn new() -> Self {
         Self {
             n: 0,
-            t0_s: 0.0,
-            sum_t: 0.0,
-            sum_tt: 0.0,
             sum_temp: 0.0,
             sum_rate: 0.0,
-            sum_t_rate: 0.0,
+            n_accel: 0,
+            sum_accel: 0.0,
         }
     }
 
@@ -202,23 +213,25 @@ impl SeekTempState {
         *self = Self::new();
     }
 
-    /// Adds one window (its end time, mean temperature, dT/dt); non-finite values are
-    /// skipped (a window without temperature does not move the state).
-    pub fn push(&mut self, t_end_s: f64, temp_c: f32, temp_rate_cps: f32) {
-        if !(t_end_s.is_finite() && temp_c.is_finite() && temp_rate_cps.is_finite()) {
+    /// Adds one window: its mean temperature, dT/dt and, when `model` (the model that
+    /// compensated it) has a plain d2T/dt2 input, that input's value in this window.
+    /// Non-finite values are skipped (a window without temperature does not move the state).
+    pub fn push_window(&mut self, w: &WindowResult, model: Option<&RbfModel>) {
+        if !(w.temp_c.is_finite() && w.temp_rate_cps.is_finite()) {
             return;
         }
-        if self.n == 0 {
-            self.t0_s = t_end_s;
-        }
-        let t = t_end_s - self.t0_s;
-        let rate = f64::from(temp_rate_cps);
         self.n += 1;
-        self.sum_t += t;
-        self.sum_tt += t * t;
-        self.sum_temp += f64::from(temp_c);
-        self.sum_rate += rate;
-        self.sum_t_rate += t * rate;
+        self.sum_temp += f64::from(w.temp_c);
+        self.sum_rate += f64::from(w.temp_rate_cps);
+        let accel = model
+            .and_then(accel_input_index)
+            .filter(|&j| j < usize::from(w.n_inputs))
+            .and_then(|j| w.inputs.get(j).copied())
+            .filter(|a| a.is_finite());
+        if let Some(a) = accel {
+            self.n_accel += 1;
+            self.sum_accel += f64::from(a);
+        }
     }
 
     /// Windows averaged so far.
@@ -226,16 +239,18 @@ impl SeekTempState {
         self.n
     }
 
-    /// The averaged state (`None` before the first window); d2T/dt2 is 0 with fewer than
-    /// two windows in distinct times.
+    /// The averaged state (`None` before the first window); d2T/dt2 is 0 if no window
+    /// carried the model's d2T/dt2 input.
     pub fn state(&self) -> Option<TempState> {
         if self.n == 0 {
             return None;
         }
         let n = f64::from(self.n);
-        let sxx = self.sum_tt - self.sum_t * self.sum_t / n;
-        let sxy = self.sum_t_rate - self.sum_t * self.sum_rate / n;
-        let accel = if sxx > 1e-9 { sxy / sxx } else { 0.0 };
+        let accel = if self.n_accel > 0 {
+            self.sum_accel / f64::from(self.n_accel)
+        } else {
+            0.0
+        };
         Some(TempState {
             temp_c: (self.sum_temp / n) as f32,
             temp_rate_cps: (self.sum_rate / n) as f32,
@@ -377,25 +392,76 @@ mod tests {
         }
     }
 
+    /// A window with `temp`, `rate` and model inputs `inputs`.
+    fn window(temp: f32, rate: f32, inputs: &[f32]) -> WindowResult {
+        let mut w = WindowResult {
+            t_start_s: 0.0,
+            t_end_s: 10.0,
+            mean_rate_dph: 0.0,
+            temp_c: temp,
+            temp_rate_cps: rate,
+            inputs: [0.0; crate::model::format::MAX_INPUTS],
+            n_inputs: inputs.len() as u8,
+            drift_dph: 0.0,
+            compensated_dph: 0.0,
+            n_samples: 100,
+            n_expected: 100,
+            n_gaps: 0,
+            model_applied: true,
+            status: crate::compensation::compensator::WindowStatus::Valid,
+        };
+        w.inputs[..inputs.len()].copy_from_slice(inputs);
+        w
+    }
+
+    fn model_with(kinds: &[FeatureKind]) -> RbfModel {
+        let mut m = RbfModel::empty();
+        for &k in kinds {
+            m.inputs
+                .push(crate::model::format::FeatureSpec::plain(k))
+                .unwrap();
+        }
+        m
+    }
+
     #[test]
-    fn the_seek_state_is_the_window_mean_and_the_slope_of_the_rate() {
+    fn the_seek_state_is_the_window_mean_and_the_model_own_accel_input() {
         let mut s = SeekTempState::new();
         assert_eq!(s.state(), None);
-        // T = 20 + 0.01 t + 1e-5 t^2 / 2: dT/dt = 0.01 + 1e-5 t, d2T/dt2 = 1e-5.
-        let mut sum_temp = 0.0;
-        for k in 0..30 {
-            let t = 100.0 + 10.0 * f64::from(k);
-            let temp = 20.0 + 0.01 * t + 0.5e-5 * t * t;
-            sum_temp += temp;
-            s.push(t, temp as f32, (0.01 + 1e-5 * t) as f32);
+        let m = model_with(&[
+            FeatureKind::TempC,
+            FeatureKind::TempRateCps,
+            FeatureKind::TempAccelCps2,
+        ]);
+        assert_eq!(accel_input_index(&m), Some(2));
+        // Early warm-up: the window estimates fall from +5e-4 to -2e-5 degC/s^2; the record
+        // carries their mean (what a linear correction in that input averages to).
+        let accels = [5e-4f32, 2e-4, 5e-5, -2e-5];
+        let (mut sum_temp, mut sum_rate) = (0.0, 0.0);
+        for (k, &a) in accels.iter().enumerate() {
+            let temp = 20.0 + k as f32;
+            let rate = 0.01 - 0.001 * k as f32;
+            sum_temp += f64::from(temp);
+            sum_rate += f64::from(rate);
+            s.push_window(&window(temp, rate, &[temp, rate, a]), Some(&m));
         }
-        s.push(f64::NAN, 1.0, 1.0);
+        s.push_window(&window(f32::NAN, 1.0, &[0.0, 0.0, 1.0]), Some(&m));
         let st = s.state().unwrap();
-        assert_eq!(s.windows(), 30);
-        assert!((f64::from(st.temp_c) - sum_temp / 30.0).abs() < 1e-4);
-        assert!((st.temp_accel_cps2 - 1e-5).abs() < 1e-8, "{st:?}");
-        assert!((st.temp_rate_cps - (0.01 + 1e-5 * 245.0) as f32).abs() < 1e-6);
+        assert_eq!(s.windows(), 4);
+        assert!((f64::from(st.temp_c) - sum_temp / 4.0).abs() < 1e-5);
+        assert!((f64::from(st.temp_rate_cps) - sum_rate / 4.0).abs() < 1e-8);
+        let mean_accel = accels.iter().map(|&a| f64::from(a)).sum::<f64>() / 4.0;
+        assert!(
+            (f64::from(st.temp_accel_cps2) - mean_accel).abs() < 1e-9,
+            "{st:?}"
+        );
         s.reset();
         assert_eq!(s.state(), None);
+        // A model without a d2T/dt2 input (or no model): the record carries 0.
+        let plain = model_with(&[FeatureKind::TempC, FeatureKind::TempRateCps]);
+        assert_eq!(accel_input_index(&plain), None);
+        s.push_window(&window(20.0, 0.01, &[20.0, 0.01]), Some(&plain));
+        s.push_window(&window(21.0, 0.01, &[]), None);
+        assert_eq!(s.state().unwrap().temp_accel_cps2, 0.0);
     }
 }

@@ -36,13 +36,16 @@ pub struct AgingArgs {
     /// Seeks per evaluation start.
     #[arg(long, default_value_t = 6)]
     pub seeks: usize,
-    /// Ambient of the chamber, the field and the evaluation, degC.
+    /// Ambients of the chamber, the field and the evaluation, degC: field and evaluation
+    /// power-on k runs at ambient k modulo their number (several: T and dT/dt of the field
+    /// seeks separate); the chamber covers them all.
     #[arg(
         long = "ambient-c",
-        default_value_t = 20.0,
+        value_delimiter = ',',
+        default_value = "20",
         allow_negative_numbers = true
     )]
-    pub ambient_c: f64,
+    pub ambient_c: Vec<f64>,
     /// Worker threads [default: available cores].
     #[arg(long)]
     pub threads: Option<usize>,
@@ -62,8 +65,10 @@ pub fn run(a: AgingArgs) -> Result<()> {
             })
         })
         .collect::<Result<Vec<_>>>()?;
-    if !(a.ambient_c.is_finite() && (-60.0..=100.0).contains(&a.ambient_c)) {
-        bail!("--ambient-c {}: must be within -60..=100 degC", a.ambient_c);
+    for &t in &a.ambient_c {
+        if !(t.is_finite() && (-60.0..=100.0).contains(&t)) {
+            bail!("--ambient-c {t}: must be within -60..=100 degC");
+        }
     }
     let plan = AgingPlan {
         laws,
@@ -71,7 +76,7 @@ pub fn run(a: AgingArgs) -> Result<()> {
         field_seeks_per_start: a.field_seeks_per_start,
         eval_starts: a.eval_starts,
         eval_seeks_per_start: a.seeks,
-        ambient_c: a.ambient_c,
+        ambients_c: a.ambient_c.clone(),
         threads: crate::fanout::thread_count(a.threads).min(8),
         ..AgingPlan::standard(a.seed)
     };

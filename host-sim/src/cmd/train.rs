@@ -97,7 +97,7 @@ pub struct Args {
     pub json: Option<PathBuf>,
     /// Field records (`fogsim field pull --out DIR`) measured under this chamber model:
     /// each is one observation of the residual bias at its temperature state; a ridge
-    /// correction linear in the model's T / dT/dt / d2T/dt2 inputs is fitted to them and
+    /// correction linear in the model's T and dT/dt inputs is fitted to them and
     /// folded into the model (`fog_sim::field::refine`).
     #[arg(long)]
     pub field: Option<PathBuf>,
@@ -106,6 +106,12 @@ pub struct Args {
     /// Given without `--field`, it is refused by name.
     #[arg(long)]
     pub field_weight: Option<f64>,
+    /// Calibration registry (SQLite) whose models tell which field records count: those
+    /// measured under this model or under a variant of it the registry recorded at upload
+    /// (the model with a heading calibration attached). Read only; used with `--field`.
+    /// Default: $XDG_DATA_HOME/fogsim/registry.sqlite, if it exists.
+    #[arg(long, requires = "field")]
+    pub registry: Option<PathBuf>,
 }
 
 fn parse_width_search(s: &str) -> Result<WidthSearch, String> {
@@ -214,6 +220,7 @@ fn inputs(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
             .iter()
             .map(|d| crate::field::records_file::json_path(d)),
     );
+    inputs.extend(args.registry.clone());
     Ok(inputs)
 }
 
@@ -225,7 +232,15 @@ fn field_refined(
     let Some(dir) = &args.field else {
         return Ok(model.clone());
     };
-    let refined = crate::field::refine_with_dir(model, dir, args.field_weight)?;
+    let variants = match (&args.registry, crate::registry::default_path()) {
+        (Some(path), _) if !path.is_file() => {
+            anyhow::bail!("--registry {}: no such registry file", path.display())
+        }
+        (Some(path), _) => crate::field::registry_variants(model, path)?,
+        (None, Ok(path)) if path.is_file() => crate::field::registry_variants(model, &path)?,
+        (None, _) => Vec::new(),
+    };
+    let refined = crate::field::refine_with_dir(model, dir, &variants, args.field_weight)?;
     print!("{}", refined.summary());
     Ok(refined.model)
 }

@@ -25,6 +25,10 @@ use refine::{FieldObservation, WeightChoice};
 pub struct FieldRefinement {
     pub model: RbfModel,
     pub used: usize,
+    /// Of `used`, records measured under a heading-calibrated variant of the model.
+    pub used_variant: usize,
+    /// The variants' CRC-32s that were accepted (from the registry).
+    pub variants: Vec<u32>,
     /// Records measured under another model (their residual is not this model's).
     pub other_model: usize,
     pub choice: WeightChoice,
@@ -40,10 +44,20 @@ pub fn model_crc32(model: &RbfModel) -> Result<u32> {
     Ok(crc32(&buf[..n]))
 }
 
-/// Refines `model` with the records in `dir` measured under it (same model CRC-32).
+/// The CRC-32s of the models the calibration registry at `registry` knows to derive from
+/// `model` (it with a heading calibration attached: `heading-cal`, then `upload`). Their
+/// records measured the same residual bias (`Registry::models_derived_from` says why).
+pub fn registry_variants(model: &RbfModel, registry: &Path) -> Result<Vec<u32>> {
+    let reg = crate::registry::Registry::open(registry)?;
+    reg.models_derived_from(model_crc32(model)?)
+}
+
+/// Refines `model` with the records in `dir` measured under it or under one of
+/// `variants` (heading-calibrated variants of it, `registry_variants`).
 pub fn refine_with_dir(
     model: &RbfModel,
     dir: &Path,
+    variants: &[u32],
     weight: Option<f64>,
 ) -> Result<FieldRefinement> {
     let records = records_file::read_dir_records(dir)?;
@@ -54,21 +68,25 @@ pub fn refine_with_dir(
             records_file::JSON_NAME
         );
     }
-    refine_with_records(model, &records, weight)
+    refine_with_records(model, &records, variants, weight)
         .map_err(|e| anyhow::anyhow!("--field {}: {e}", dir.display()))
 }
 
-/// Refines `model` with those of `records` measured under it (same model CRC-32): what
-/// `train --field` does once the records are read (the aging measurement calls it directly).
+/// Refines `model` with those of `records` measured under it (same model CRC-32) or under
+/// one of `variants`: what `train --field` does once the records are read (the aging
+/// measurement calls it directly).
 pub fn refine_with_records(
     model: &RbfModel,
     records: &[StoredRecord],
+    variants: &[u32],
     weight: Option<f64>,
 ) -> Result<FieldRefinement> {
     let crc = model_crc32(model)?;
+    let is_variant = |r: &&StoredRecord| r.model_crc32.is_some_and(|c| variants.contains(&c));
+    let used_variant = records.iter().filter(is_variant).count();
     let obs: Vec<FieldObservation> = records
         .iter()
-        .filter(|r| r.model_crc32 == Some(crc))
+        .filter(|r| r.model_crc32 == Some(crc) || is_variant(r))
         .map(|r| FieldObservation {
             temp_c: f64::from(r.temp_c),
             temp_rate_cps: f64::from(r.temp_rate_cps),
@@ -78,28 +96,55 @@ pub fn refine_with_records(
         .collect();
     if obs.is_empty() {
         bail!(
-            "none of its {} records was measured under this chamber model (CRC-32 {crc:08x}); \
-             their residuals belong to another model",
-            records.len()
+            "none of its {} records was measured under this chamber model (CRC-32 {crc:08x}) \
+             or a heading-calibrated variant the registry knows ({}); their residuals belong \
+             to another model",
+            records.len(),
+            crc_list(variants)
         );
     }
     let (model, correction, choice) = refine::refine(model, &obs, weight)?;
     Ok(FieldRefinement {
         model,
         used: obs.len(),
+        used_variant,
+        variants: variants.to_vec(),
         other_model: records.len() - obs.len(),
         choice,
         correction,
     })
 }
 
+/// `[0x0123abcd, ...]` (`none` if empty).
+fn crc_list(crcs: &[u32]) -> String {
+    if crcs.is_empty() {
+        return "none".into();
+    }
+    let list: Vec<String> = crcs.iter().map(|c| format!("{c:08x}")).collect();
+    format!("[{}]", list.join(", "))
+}
+
 impl FieldRefinement {
     /// The lines `train` prints.
     pub fn summary(&self) -> String {
+        let variants = if self.variants.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "{} of them under heading-calibrated variants {} (registry); ",
+                self.used_variant,
+                crc_list(&self.variants)
+            )
+        };
         let mut s = format!(
-            "field refinement: {} field seeks used ({} measured under another model, not used)\n",
+            "field refinement: {} field seeks used ({variants}{} measured under another model, \
+             not used)\n",
             self.used, self.other_model
         );
+        if self.used_variant > 0 {
+            s += "field refinement: the refined model carries no heading calibration: attach \
+                  it again (`fogsim heading-cal`) before uploading\n";
+        }
         if let Some(v) = self.choice.verdict {
             s += &format!("field refinement: {v}\n");
             return s;

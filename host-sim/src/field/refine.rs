@@ -2,7 +2,7 @@
 //!
 //! Each field record is one observation of the residual bias r (deg/h, measured after the
 //! chamber model) at a temperature state x. The correction is linear in the model's own
-//! plain inputs (T, dT/dt, d2T/dt2, whichever the model has) plus a constant:
+//! plain inputs (T and dT/dt, whichever the model has) plus a constant:
 //!
 //!   c(x) = b0 + sum_j b_j (x_j - m_j) / s_j     (m_j, s_j: mean and std of x_j in the field)
 //!
@@ -26,11 +26,14 @@
 //! which is its azimuth (measured: rms x1.14 on the null twin with T and dT/dt, x1.003
 //! with T alone).
 //!
-//! d2T/dt2 is not fitted: a record's d2T/dt2 is the least-squares slope of dT/dt over the
-//! seek, not the mean of the model's own per-window d2T/dt2 input, and early in a warm-up
-//! they differ by orders of magnitude (seek 1 of a 20 degC cold start: slope -1.5e-6
-//! degC/s^2, window inputs from +5e-4 down to -2e-5). A coefficient fitted on the one and
-//! applied to the other moved seek azimuths (rms x2.5 on the null twin).
+//! d2T/dt2 is not fitted. A record's d2T/dt2 was once the least-squares slope of dT/dt over
+//! the seek, which early in a warm-up differs from the model's own per-window input by
+//! orders of magnitude (seek 1 of a 20 degC cold start: slope -1.5e-6 degC/s^2, window
+//! inputs from +5e-4 down to -2e-5); a coefficient fitted on the one and applied to the
+//! other moved seek azimuths (rms x2.5 on the null twin). A record now carries the mean of
+//! the model's own window input (`SeekTempState`), what a linear correction in it averages
+//! to over the seek, but no measurement has checked such a correction yet: the aging
+//! measurement's chamber model (`north-seek`'s own) has no d2T/dt2 input.
 //!
 //! The correction is folded exactly into the model's bias and linear terms
 //! (x_j = offset_j + scale_j xn_j), so the device applies it with no new code.
@@ -137,7 +140,7 @@ pub fn terms_for(model: &RbfModel, obs: &[FieldObservation]) -> (Vec<Term>, Vec<
         .inputs
         .iter()
         .filter(|s| s.kind == FeatureKind::TempAccelCps2)
-        .map(|_| "d2T/dt2 (a record's is the seek's slope, not the model's window input)".into())
+        .map(|_| "d2T/dt2 (no measurement has checked a field correction in it yet)".into())
         .collect();
     let mut terms: Vec<Term> = Vec::new();
     for (input, kind) in candidate_terms(model) {

@@ -376,10 +376,15 @@ impl FieldRecorder {
         })
     }
 
-    /// A window of a running seek (before the supervisor sees it, as on the device).
-    fn on_window(&mut self, w: &fog_core::compensation::compensator::WindowResult) {
+    /// A window of a running seek (before the supervisor sees it, as on the device), with
+    /// the model that compensated it (its own d2T/dt2 input goes into the record).
+    fn on_window(
+        &mut self,
+        w: &fog_core::compensation::compensator::WindowResult,
+        model: Option<&RbfModel>,
+    ) {
         if w.status.is_valid() {
-            self.seek_temp.push(w.t_end_s, w.temp_c, w.temp_rate_cps);
+            self.seek_temp.push_window(w, model);
         }
     }
 
@@ -513,7 +518,7 @@ pub fn run_seeks(
         window_tilt = Some(tilt);
         temp_rate_cps = w.temp_rate_cps;
         if sup.is_seeking() {
-            recorder.on_window(&w);
+            recorder.on_window(&w, comp.model());
             let event = sup.on_window(&w, tilt, &mut table);
             let field_record = recorder.on_event(&event);
             ledger.record(event, w.t_end_s, sup.restarts().0, field_record);

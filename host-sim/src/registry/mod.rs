@@ -31,8 +31,9 @@ pub const BUSY_TIMEOUT: Duration = Duration::from_secs(30);
 
 /// `PRAGMA application_id` of a fogsim registry ("FOGR"): tells ours from any other database.
 const APPLICATION_ID: i64 = 0x464F_4752;
-/// Schema version (`PRAGMA user_version`).
-const SCHEMA_VERSION: i64 = 1;
+/// Schema version (`PRAGMA user_version`). 2: `models.base_crc32` (the model a heading
+/// calibration was attached to; `migrate` adds the column to a schema-1 registry).
+const SCHEMA_VERSION: i64 = 2;
 
 const SCHEMA: &str = "
 CREATE TABLE IF NOT EXISTS counters (
@@ -55,6 +56,7 @@ CREATE TABLE IF NOT EXISTS models (
     heading_sin_sigma_dph REAL,
     heading_n        INTEGER,
     first_seen_utc   TEXT    NOT NULL,
+    base_crc32       INTEGER,
     PRIMARY KEY (gyro_id, model_crc32)
 );
 CREATE TABLE IF NOT EXISTS uploads (
@@ -212,6 +214,7 @@ impl Registry {
             bail!("schema version {version} is newer than this fogsim's {SCHEMA_VERSION}");
         }
         tx.execute_batch(SCHEMA)?;
+        migrate(&tx)?;
         tx.execute_batch(&format!(
             "PRAGMA application_id = {APPLICATION_ID}; PRAGMA user_version = {SCHEMA_VERSION};"
         ))?;
@@ -231,6 +234,21 @@ fn check_identity(conn: &Connection) -> Result<()> {
     let objects: i64 = conn.query_row("SELECT count(*) FROM sqlite_master", [], |r| r.get(0))?;
     if app != APPLICATION_ID && (app != 0 || objects != 0) {
         bail!("another application's SQLite database (application_id {app:#x}, {objects} objects)");
+    }
+    Ok(())
+}
+
+/// Brings a schema-1 registry to schema 2 (inside the caller's transaction): adds
+/// `models.base_crc32`. Its existing rows keep NULL there (the bytes they were recorded
+/// from are not kept): such a model matches field records only by its own CRC.
+fn migrate(conn: &Connection) -> Result<()> {
+    let has_base: i64 = conn.query_row(
+        "SELECT count(*) FROM pragma_table_info('models') WHERE name = 'base_crc32'",
+        [],
+        |r| r.get(0),
+    )?;
+    if has_base == 0 {
+        conn.execute_batch("ALTER TABLE models ADD COLUMN base_crc32 INTEGER")?;
     }
     Ok(())
 }

@@ -21,6 +21,10 @@ pub struct ModelRecord {
     pub heldout_rms_dph: f64,
     /// a, b, sigma(a), sigma(b) in deg/h and the number of headings, if calibrated.
     pub heading: Option<([f64; 4], u32)>,
+    /// CRC-32 of the same model without its heading calibration: the model `train` made
+    /// (equal to `model_crc32` for a model without one; `None` for a model a registry of
+    /// schema 1 recorded, which did not keep it).
+    pub base_crc32: Option<u32>,
 }
 
 impl ModelRecord {
@@ -31,9 +35,10 @@ impl ModelRecord {
             .iter()
             .map(|i| format!("{:?}", i.kind))
             .collect();
+        let model_crc32 = fog_core::link::upload::crc32(bytes);
         Self {
             gyro_id: model.meta.gyro_id.to_string(),
-            model_crc32: fog_core::link::upload::crc32(bytes),
+            model_crc32,
             model_len: bytes.len() as u32,
             inputs: inputs.join(","),
             n_centers: model.centers.len() as u32,
@@ -44,6 +49,14 @@ impl ModelRecord {
                     u32::from(h.n_headings),
                 )
             }),
+            base_crc32: match model.heading {
+                None => Some(model_crc32),
+                Some(_) => crate::field::model_crc32(&RbfModel {
+                    heading: None,
+                    ..model.clone()
+                })
+                .ok(),
+            },
         }
     }
 }
@@ -156,8 +169,8 @@ impl Registry {
         self.conn.execute(
             "INSERT OR IGNORE INTO models (gyro_id, model_crc32, model_len, inputs, n_centers, \
              heldout_rms_dph, heading_cos_dph, heading_sin_dph, heading_cos_sigma_dph, \
-             heading_sin_sigma_dph, heading_n, first_seen_utc) \
-             VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12)",
+             heading_sin_sigma_dph, heading_n, first_seen_utc, base_crc32) \
+             VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13)",
             params![
                 m.gyro_id,
                 m.model_crc32,
@@ -170,7 +183,8 @@ impl Registry {
                 h.map(|(v, _)| v[2]),
                 h.map(|(v, _)| v[3]),
                 h.map(|(_, n)| n),
-                now_utc()
+                now_utc(),
+                m.base_crc32
             ],
         )?;
         Ok(())
@@ -258,8 +272,8 @@ impl Registry {
             .collect::<rusqlite::Result<_>>()?;
         let mut stmt = self.conn.prepare(
             "SELECT first_seen_utc, gyro_id, model_crc32, model_len, inputs, n_centers, heldout_rms_dph, \
-             heading_cos_dph, heading_sin_dph, heading_cos_sigma_dph, heading_sin_sigma_dph, heading_n \
-             FROM models WHERE gyro_id = ?1 ORDER BY first_seen_utc, model_crc32",
+             heading_cos_dph, heading_sin_dph, heading_cos_sigma_dph, heading_sin_sigma_dph, heading_n, \
+             base_crc32 FROM models WHERE gyro_id = ?1 ORDER BY first_seen_utc, model_crc32",
         )?;
         h.models = stmt
             .query_map([gyro_id], |r| {
@@ -277,6 +291,7 @@ impl Registry {
                         n_centers: r.get(5)?,
                         heldout_rms_dph: r.get(6)?,
                         heading,
+                        base_crc32: r.get(12)?,
                     },
                 ))
             })?

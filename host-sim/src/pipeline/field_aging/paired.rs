@@ -9,7 +9,7 @@
 
 use serde::Serialize;
 
-use crate::pipeline::northseek::{azimuth_error_deg, seek_stats, ArmOutcome};
+use crate::pipeline::northseek::{azimuth_error_deg, seek_stats, ArmOutcome, SeekOutcome};
 use crate::stats::std_dev;
 
 /// Azimuth error of one arm over the evaluation seeks.
@@ -77,9 +77,14 @@ pub fn error_stats(arms: &[ArmOutcome], true_azimuth_deg: f64) -> ErrorStats {
     }
 }
 
-/// Compares two arms run on the same starts (`without[i]` and `with[i]`: start i).
-pub fn compare(without: &[ArmOutcome], with: &[ArmOutcome], true_azimuth_deg: f64) -> Comparison {
-    let err = |a: f64| azimuth_error_deg(a, true_azimuth_deg);
+/// The paired change of a per-seek squared error between two arms run on the same starts:
+/// per start, the mean over the seeks both arms finished (and `sq` measured) of
+/// sq(with) - sq(without); its mean over starts, its standard error and the verdict.
+fn paired_change(
+    without: &[ArmOutcome],
+    with: &[ArmOutcome],
+    sq: impl Fn(&SeekOutcome) -> Option<f64>,
+) -> (f64, f64, Verdict) {
     let per_start: Vec<f64> = without
         .iter()
         .zip(with)
@@ -89,7 +94,7 @@ pub fn compare(without: &[ArmOutcome], with: &[ArmOutcome], true_azimuth_deg: f6
                 .iter()
                 .filter_map(|a| {
                     let b = w.seeks.iter().find(|b| b.index == a.index)?;
-                    Some(err(b.azimuth_deg).powi(2) - err(a.azimuth_deg).powi(2))
+                    Some(sq(b)? - sq(a)?)
                 })
                 .collect();
             (!d.is_empty()).then(|| d.iter().sum::<f64>() / d.len() as f64)
@@ -111,6 +116,14 @@ pub fn compare(without: &[ArmOutcome], with: &[ArmOutcome], true_azimuth_deg: f6
     } else {
         Verdict::NoDifferenceResolved
     };
+    (delta, se, verdict)
+}
+
+/// Compares two arms run on the same starts (`without[i]` and `with[i]`: start i).
+pub fn compare(without: &[ArmOutcome], with: &[ArmOutcome], true_azimuth_deg: f64) -> Comparison {
+    let (delta, se, verdict) = paired_change(without, with, |s| {
+        Some(azimuth_error_deg(s.azimuth_deg, true_azimuth_deg).powi(2))
+    });
     let without = error_stats(without, true_azimuth_deg);
     let with = error_stats(with, true_azimuth_deg);
     Comparison {
@@ -123,10 +136,53 @@ pub fn compare(without: &[ArmOutcome], with: &[ArmOutcome], true_azimuth_deg: f6
     }
 }
 
+/// The residual bias the evaluation seeks measured (their field records' half-sums, deg/h:
+/// the aged gyro's bias the model did not predict), with against without.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BiasComparison {
+    /// Seeks with a record in each arm.
+    pub seeks: usize,
+    pub rms_without_dph: f64,
+    pub rms_with_dph: f64,
+    pub mean_without_dph: f64,
+    pub mean_with_dph: f64,
+    /// Paired change of the mean squared residual bias, its standard error (deg/h)^2.
+    pub delta_ms_dph2: f64,
+    pub delta_ms_se_dph2: f64,
+    pub verdict: Verdict,
+}
+
+/// Residual bias of the evaluation seeks, with against without (same starts).
+pub fn compare_bias(without: &[ArmOutcome], with: &[ArmOutcome]) -> BiasComparison {
+    let bias = |s: &SeekOutcome| s.field_record.map(|r| f64::from(r.residual_bias_dph));
+    let (delta, se, verdict) = paired_change(without, with, |s| bias(s).map(|b| b * b));
+    let moments = |arms: &[ArmOutcome]| {
+        let v: Vec<f64> = arms
+            .iter()
+            .flat_map(|a| a.seeks.iter().filter_map(bias))
+            .collect();
+        let n = v.len().max(1) as f64;
+        let mean = v.iter().sum::<f64>() / n;
+        let rms = (v.iter().map(|b| b * b).sum::<f64>() / n).sqrt();
+        (v.len(), mean, rms)
+    };
+    let (n_without, mean_without_dph, rms_without_dph) = moments(without);
+    let (n_with, mean_with_dph, rms_with_dph) = moments(with);
+    BiasComparison {
+        seeks: n_without.min(n_with),
+        rms_without_dph,
+        rms_with_dph,
+        mean_without_dph,
+        mean_with_dph,
+        delta_ms_dph2: delta,
+        delta_ms_se_dph2: se,
+        verdict,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pipeline::northseek::SeekOutcome;
 
     fn arm(errors_deg: &[f64]) -> ArmOutcome {
         ArmOutcome {
