@@ -60,13 +60,7 @@ impl Estimate {
                 value + half95,
             )
         };
-        Self {
-            name: name.into(),
-            unit: unit.into(),
-            value,
-            plus_minus: sd,
-            ci95: [lo, hi],
-        }
+        Self::with_spread(name, unit, value, sd, [lo, hi])
     }
 }
 
