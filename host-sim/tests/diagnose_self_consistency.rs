@@ -4,7 +4,10 @@
 //! simulator's own physics (its two thermal modes seen through the thermometer's lag,
 //! Shupe with its cold gain, the gradient-rate term). Several seeds and two ambient sets;
 //! default seeds 7 and 8 at a small size (6 and 12 runs, 1 Hz raw rows), more via
-//! `DIAG_SEEDS=7,8,9,...`. No allowance beyond the stated 2 sigma.
+//! `DIAG_SEEDS=7,8,9,...`. No allowance beyond the stated 2 sigma (the jackknife over runs
+//! on the t scale, `diagnose/uncertainty/jackknife.rs`; its coverage over 20 seeds per
+//! ambient set is in docs/diagnose.md, "honest sigmas": about 1 ratio in 20 falls outside,
+//! so extra seeds will show an occasional FAIL line by design).
 
 mod app_support;
 

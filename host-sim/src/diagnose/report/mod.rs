@@ -292,15 +292,18 @@ fn write_baseline(s: &mut String, r: &Report) {
         .tried
         .iter()
         .map(|b| {
+            let p = b
+                .paired_p_vs_best
+                .map_or_else(|| " (lowest)".to_owned(), |p| format!(" (p {p:.3})"));
             format!(
-                "{} {:.4} +/- {:.4}",
+                "{} {:.4} +/- {:.4}{p}",
                 b.spec.name, b.heldout_rms_dph, b.heldout_se_dph
             )
         })
         .collect();
     let _ = writeln!(
         s,
-        "  bases tried (held-out rms +/- standard error, deg/h; run offsets free): {}",
+        "  bases tried (held-out rms +/- standard error, deg/h; run offsets free; paired p that the lowest beats it; the lowest is kept): {}",
         tried.join(", ")
     );
     write_levels(s, r);

@@ -45,12 +45,23 @@ impl Estimate {
             let sd = (r.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (n - 1) as f64).sqrt();
             (sd, quantile(&r, 0.025), quantile(&r, 0.975))
         };
+        Self::with_spread(name, unit, value, sd, [lo, hi])
+    }
+
+    /// An estimate from its parts (+/- and 95 % range already computed).
+    pub fn with_spread(
+        name: impl Into<String>,
+        unit: &str,
+        value: f64,
+        plus_minus: f64,
+        ci95: [f64; 2],
+    ) -> Self {
         Self {
             name: name.into(),
             unit: unit.into(),
             value,
-            plus_minus: sd,
-            ci95: [lo, hi],
+            plus_minus,
+            ci95,
         }
     }
 }

@@ -4,16 +4,20 @@
 //! simulator's bias slope, curvature, Shupe coefficient and noise, and the
 //! measured-vs-simulator ratios (temperature sensitivity, Shupe, gradient rate, ARW) against
 //! the project's simulator (`GyroParams::paper_default`). Ranges come from the block
-//! bootstrap of `bootstrap` (whole runs or time blocks resampled). The simulator stage is
-//! conditional on each run's fitted thermal response (resampled with its run); the sensor
-//! lag shared by all runs adds its own error (delta method).
+//! bootstrap of `bootstrap` (whole runs or time blocks resampled), except the simulator
+//! stage and its ratios: a delete-one-unit jackknife on the t scale (`jackknife`: the run
+//! bootstrap was badly calibrated on few runs). The simulator stage is conditional on each
+//! run's fitted thermal response (left out with its run); the sensor lag shared by all
+//! runs adds its own error (delta method).
 
 pub mod bootstrap;
+pub mod jackknife;
 
 use crate::diagnose::base::bases::{zscore_params, BaseFit};
 use crate::diagnose::base::models::Stacked;
 use crate::diagnose::simulator::simfit::SimDesign;
 use crate::diagnose::uncertainty::bootstrap::{draws, Estimate, REPLICATES};
+use crate::diagnose::uncertainty::jackknife::delete_one;
 use crate::diagnose::validation::cv::{Folds, Offsets, Prepared, UnitSystems};
 use serde::Serialize;
 
@@ -59,12 +63,16 @@ pub fn estimate(
         Offsets::PerUnit => "whole runs",
         Offsets::RunDummies => "contiguous time blocks",
     };
-    let (simulator, ratios) = simulator_estimates(sim, folds, st, named, &counts);
+    let (simulator, ratios) = simulator_estimates(sim, folds, st, named);
+    let units = folds.unit_rows.len();
     Uncertainty {
         method: format!(
-            "block bootstrap: {REPLICATES} replicates, {} {blocks} drawn with replacement; +/- is the bootstrap \
-             standard deviation (1 sigma), ci95 the 2.5-97.5 % percentiles",
-            folds.unit_rows.len()
+            "base and extension: block bootstrap, {REPLICATES} replicates, {units} {blocks} drawn with replacement; \
+             +/- is the bootstrap standard deviation (1 sigma), ci95 the 2.5-97.5 % percentiles. Simulator \
+             coefficients and ratios: jackknife leaving out one of the {units} {blocks} at a time, +/- its \
+             standard error x t_{}(97.7 %) / 2 (so 2 sigma is the 95.4 % t interval), ci95 the t interval, \
+             the sensor lag's error added",
+            units.saturating_sub(1)
         ),
         replicates: REPLICATES,
         base: base_estimates(folds, st, base, &counts),
@@ -74,12 +82,18 @@ pub fn estimate(
     }
 }
 
-/// Applies `summary` to the full fit and to every replicate: one Estimate per output.
-fn bootstrap(
+/// How an Estimate is made from its value and replicates (`Estimate::new` for bootstrap
+/// draws, `Estimate::jackknife` for delete-one fits).
+type Make = fn(String, &str, f64, &[f64]) -> Estimate;
+
+/// Applies `summary` to the full fit and to every replicate (unit weights `counts`): one
+/// Estimate per output, made by `make`.
+fn replicate(
     sys: &UnitSystems<'_>,
     counts: &[Vec<f64>],
     names: &[(String, &str)],
     summary: &dyn Fn(&[f64]) -> Vec<f64>,
+    make: Make,
 ) -> Vec<Estimate> {
     let ones = vec![1.0; counts.first().map_or(0, Vec::len)];
     let Ok(full) = sys.solve(&ones) else {
@@ -91,17 +105,34 @@ fn bootstrap(
         .filter_map(|c| sys.solve(c).ok())
         .map(|w| summary(&w))
         .collect();
-    estimates(names, &value, &reps)
+    estimates(names, &value, &reps, make)
+}
+
+/// Applies `summary` to the full fit and to every bootstrap replicate.
+fn bootstrap(
+    sys: &UnitSystems<'_>,
+    counts: &[Vec<f64>],
+    names: &[(String, &str)],
+    summary: &dyn Fn(&[f64]) -> Vec<f64>,
+) -> Vec<Estimate> {
+    replicate(sys, counts, names, summary, |n, u, v, r| {
+        Estimate::new(n, u, v, r)
+    })
 }
 
 /// One Estimate per name: `value[k]` with the spread of the replicates' k-th entries.
-fn estimates(names: &[(String, &str)], value: &[f64], reps: &[Vec<f64>]) -> Vec<Estimate> {
+fn estimates(
+    names: &[(String, &str)],
+    value: &[f64],
+    reps: &[Vec<f64>],
+    make: Make,
+) -> Vec<Estimate> {
     names
         .iter()
         .enumerate()
         .map(|(k, (name, unit))| {
             let r: Vec<f64> = reps.iter().map(|v| v[k]).collect();
-            Estimate::new(name.clone(), unit, value[k], &r)
+            make(name.clone(), unit, value[k], &r)
         })
         .collect()
 }
@@ -246,15 +277,16 @@ fn row_spacing_s(folds: &Folds, t_s: &[f64]) -> f64 {
 }
 
 /// The calibrated simulator's linear stage with ranges, and the ratios to the simulator.
-/// With runs held out whole the law shared across runs is bootstrapped (whole runs
-/// redrawn, `simfit::fit_shared`), else the free-offset fit over time blocks.
+/// With runs held out whole the law shared across runs is jackknifed (one run left out at
+/// a time, `simfit::fit_shared`), else the free-offset fit over time blocks.
 fn simulator_estimates(
     sim: &SimDesign,
     folds: &Folds,
     st: &Stacked,
     named: Option<&NamedFeature<'_>>,
-    counts: &[Vec<f64>],
 ) -> (Vec<Estimate>, Vec<Ratio>) {
+    let counts = &delete_one(folds.unit_rows.len());
+    let jackknife: Make = |n, u, v, r| Estimate::jackknife(n, u, v, r);
     let (mut cols, t_mean) = (sim.cols.clone(), sim.t_mean_c);
     let n_law = crate::diagnose::simulator::simfit::LAW_TERMS.len();
     let prepared = Prepared::new(folds, &cols, &st.y, 0.0);
@@ -282,7 +314,7 @@ fn simulator_estimates(
                 .iter()
                 .filter_map(|c| lv.solve_shared(c, theta).map(|f| sim.unscale(&f.w[1..])))
                 .collect();
-            estimates(&names, &sim.unscale(&coef), &reps)
+            estimates(&names, &sim.unscale(&coef), &reps, jackknife)
         }
         None => {
             let p = prepared.width();
@@ -291,7 +323,7 @@ fn simulator_estimates(
                 v.extend_from_slice(&w[p..]);
                 sim.unscale(&v)
             };
-            bootstrap(&sys, counts, &names, &summary)
+            replicate(&sys, counts, &names, &summary, jackknife)
         }
     };
     // The thermal fit is not redrawn by the bootstrap; its sensor lag is shared by every
@@ -307,7 +339,8 @@ fn simulator_estimates(
 }
 
 /// ARW from the noise of the rows: first differences of the full fit's residual, per
-/// unit, sigma of one row scaled by sqrt(row spacing / 1 h).
+/// unit, sigma of one row scaled by sqrt(row spacing / 1 h); jackknifed over the units
+/// (`counts`: the delete-one weights).
 fn arw_estimate(
     folds: &Folds,
     st: &Stacked,
@@ -343,7 +376,7 @@ fn arw_estimate(
         (d2 / n.max(1.0) / 2.0).sqrt() * to_arw
     };
     let reps: Vec<f64> = counts.iter().map(|c| arw(c)).collect();
-    Some(Estimate::new(
+    Some(Estimate::jackknife(
         "arw_from_row_noise",
         "deg/sqrt(h)",
         arw(&ones),
