@@ -136,7 +136,12 @@ pub fn terms_for(model: &RbfModel, obs: &[FieldObservation]) -> (Vec<Term>, Vec<
     let mut notes: Vec<String> = model
         .inputs
         .iter()
-        .filter(|s| s.kind == FeatureKind::TempAccelCps2)
+        .filter(|s| {
+            matches!(
+                s.kind,
+                FeatureKind::TempAccelCps2 | FeatureKind::TempAccelFlatStartCps2
+            )
+        })
         .map(|_| "d2T/dt2 (a record's is the seek's slope, not the model's window input)".into())
         .collect();
     let mut terms: Vec<Term> = Vec::new();
