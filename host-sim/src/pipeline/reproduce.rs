@@ -41,29 +41,34 @@ pub struct ReproduceOptions {
 /// The model inputs compared: the paper's (T, dT/dt), and the global model's, chosen from
 /// the training runs by `train`'s defaults (`choose_inputs_default` over every `InputSet`),
 /// with that choice.
-pub fn input_variants(
-    train_runs: &[&Run],
-) -> Result<Vec<(String, Vec<FeatureSpec>, Option<InputSelection>)>> {
+pub fn input_variants(train_runs: &[&Run]) -> Result<Vec<InputVariant>> {
     let owned: Vec<Run> = train_runs.iter().map(|r| (*r).clone()).collect();
     let cfg = TrainConfig::default();
     let (selection, _) = choose_inputs_default(&owned, &InputSet::ALL, &cfg)
         .map_err(|e| anyhow!("choosing the global model's inputs: {e}"))?;
     let chosen = selection.chosen;
     Ok(vec![
-        (
-            "paper inputs (T, dT/dt)".into(),
-            InputSet::TempRate.specs(),
-            None,
-        ),
-        (
-            format!(
+        InputVariant {
+            label: "paper inputs (T, dT/dt)".into(),
+            specs: InputSet::TempRate.specs(),
+            selection: None,
+        },
+        InputVariant {
+            label: format!(
                 "global model, inputs chosen by validation ({})",
                 chosen.name()
             ),
-            chosen.specs(),
-            Some(selection),
-        ),
+            specs: chosen.specs(),
+            selection: Some(selection),
+        },
     ])
+}
+
+/// One model `reproduce` trains: its label, inputs and how they were chosen (None: fixed).
+pub struct InputVariant {
+    pub label: String,
+    pub specs: Vec<FeatureSpec>,
+    pub selection: Option<InputSelection>,
 }
 
 /// File name of a variant's deployable model (written beside its plots).
@@ -170,7 +175,12 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
     let heldout_runs: Vec<Run> = heldout.iter().map(|c| c.run.clone()).collect();
     let variants = input_variants(&train_runs)?;
     let mut fitted = Vec::new();
-    for (label, specs, selection) in &variants {
+    for InputVariant {
+        label,
+        specs,
+        selection,
+    } in &variants
+    {
         let trained = train_default(&train_runs, specs, "sim")?;
         steps.inc(1);
         if let Some(dir) = &opts.plots {
