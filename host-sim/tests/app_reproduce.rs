@@ -29,7 +29,7 @@ fn small_reproduce_writes_report_and_plots() {
     let json: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("r.json")).unwrap()).unwrap();
     let models = json["models"].as_array().unwrap();
-    assert_eq!(models.len(), 2, "paper inputs and extended inputs");
+    assert_eq!(models.len(), 2, "paper inputs and the global model");
     for m in models {
         let amb = m["per_ambient"].as_array().unwrap();
         assert_eq!(amb.len(), 2);
@@ -45,11 +45,18 @@ fn small_reproduce_writes_report_and_plots() {
         assert!(m["targets"]["azimuth_std_over_floor"].as_f64().is_some());
     }
     assert!(json["paper_vs_us"].as_array().unwrap().len() >= 10);
-    // The deployable models beside the plots: the ones the report describes.
-    for (m, (file, inputs)) in models
-        .iter()
-        .zip([("model_t_rate.bin", 2), ("model_t_rate_accel.bin", 3)])
-    {
+    // The deployable models beside the plots: the ones the report describes (the paper's
+    // inputs, then the global model's, chosen by `train`'s defaults and reported).
+    assert_eq!(models[0]["model_file"], "model_t_rate.bin");
+    assert!(models[0]["input_selection"].is_null());
+    let chosen = models[1]["input_selection"]["chosen"].as_str().unwrap();
+    assert_eq!(
+        models[1]["model_file"].as_str().unwrap(),
+        format!("model_{}.bin", chosen.replace(',', "_"))
+    );
+    for m in models {
+        let file = m["model_file"].as_str().unwrap();
+        let inputs = m["training"]["inputs"].as_array().unwrap().len();
         let bytes = std::fs::read(dir.join("plots").join(file)).unwrap();
         let model = fog_core::model::format::RbfModel::decode(&bytes).unwrap();
         assert_eq!(model.n_inputs(), inputs, "{file}");

@@ -23,7 +23,7 @@ use std::cell::RefCell;
 use std::time::Duration;
 
 use fog_core::compensation::compensator::Evaluator;
-use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
+use fog_core::model::format::{FeatureKind, RbfModel, MAX_ENCODED_LEN};
 use fog_core::model::synthetic::warmup_model;
 use fog_core::sensor_link::gyro_frame::{FrameDecoder, GyroFrame, STATUS_TEMP_INVALID};
 use fog_firmware::app::{App, AppConfig};
@@ -171,14 +171,20 @@ fn seek_azimuths(out: &str) -> Vec<f64> {
         .collect()
 }
 
-/// `n_inputs`: the model's first inputs of (T, dT/dt, d2T/dt2, lagged T).
-fn scenario(evaluator: Evaluator, n_inputs: usize, tag: &str) {
+/// `n_inputs`: the model's first inputs of (T, dT/dt, d2T/dt2, lagged T), the d2T/dt2 of
+/// kind `accel` (the plain or the flat-start estimator).
+fn scenario(evaluator: Evaluator, n_inputs: usize, accel: FeatureKind, tag: &str) {
     if !qemu_ready("qemu_replay") {
         return;
     }
     // With a cubic polynomial base in T (model format version 2), evaluated by fog-core
     // on both sides.
     let mut model = warmup_model(35, n_inputs, 0.05, 35);
+    for spec in model.inputs.iter_mut() {
+        if spec.kind == FeatureKind::TempAccelCps2 {
+            spec.kind = accel;
+        }
+    }
     model
         .poly
         .extend_from_slice(&[0.03, -0.012, 0.004])
@@ -297,15 +303,27 @@ fn evaluator_arg(evaluator: Evaluator) -> &'static str {
 
 #[test]
 fn firmware_replay_matches_host_bit_for_bit_f32() {
-    scenario(Evaluator::F32, 2, "f32");
+    scenario(Evaluator::F32, 2, FeatureKind::TempAccelCps2, "f32");
 }
 
 #[test]
 fn firmware_replay_matches_host_bit_for_bit_fixed() {
-    scenario(Evaluator::Fixed, 2, "fixed");
+    scenario(Evaluator::Fixed, 2, FeatureKind::TempAccelCps2, "fixed");
 }
 
 #[test]
 fn firmware_replay_matches_host_bit_for_bit_three_inputs() {
-    scenario(Evaluator::F32, 3, "f32-accel");
+    scenario(Evaluator::F32, 3, FeatureKind::TempAccelCps2, "f32-accel");
+}
+
+/// The flat-start d2T/dt2 (`FeatureKind::TempAccelFlatStartCps2`): the device runs the
+/// estimator the model names, bit for bit as the host.
+#[test]
+fn firmware_replay_matches_host_bit_for_bit_flat_start_accel() {
+    scenario(
+        Evaluator::F32,
+        3,
+        FeatureKind::TempAccelFlatStartCps2,
+        "f32-accel-flat",
+    );
 }

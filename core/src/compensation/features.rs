@@ -9,7 +9,12 @@
 //!   exact; for a changing slope the estimate is the slope at the middle of the span, i.e.
 //!   it is causal with a delay of S/2 (30 s for the default 60 s span). A sensor quantised
 //!   in steps q moves the slope by at most 3 q / S (0.0031 degC/s for q = 0.0625 degC,
-//!   S = 60 s) instead of the q / dt spikes of a finite difference.
+//!   S = 60 s) instead of the q / dt spikes of a finite difference. The second derivative
+//!   comes in two kinds: `TempAccelCps2` fits the rows it has (a growing window after
+//!   power-on), `TempAccelFlatStartCps2` takes the series as flat before its first row
+//!   (`TempRateEstimator::new_flat_start`: a 3-row quadratic right after power-on is
+//!   noise, but the flat prior only holds for a soaked unit whose thermometer lags the
+//!   heat). Which one a model uses is chosen by the trainer from data.
 //! - `FirstOrderLag`, `power_on_decay`: the remaining `FeatureKind`s.
 //! - `FeatureExtractor` / `features_for_series`: a list of `FeatureSpec` -> input vectors.
 //!   The device feeds it its 10 s window means as they close; the trainer feeds it the
@@ -21,7 +26,8 @@ use heapless::{Deque, Vec};
 
 /// Default least-squares span of `TempRateCps` / `AuxRate` when `tau_s` is 0, s.
 pub const DEFAULT_RATE_SPAN_S: f64 = 60.0;
-/// Default least-squares span of `TempAccelCps2` when `tau_s` is 0, s.
+/// Default least-squares span of `TempAccelCps2` / `TempAccelFlatStartCps2` when `tau_s`
+/// is 0, s.
 pub const DEFAULT_ACCEL_SPAN_S: f64 = 180.0;
 /// Points kept by the estimators inside `FeatureExtractor` (10 s rows: spans up to 310 s).
 pub const EXTRACTOR_RATE_POINTS: usize = 32;
@@ -296,6 +302,11 @@ pub struct RateEstimate {
 pub struct TempRateEstimator<const N: usize = 128> {
     span_s: f64,
     points: Deque<(f64, f64), N>,
+    /// Extend the series back from its first point as flat (see `new_flat_start`).
+    flat_start: bool,
+    /// Time of the first point since `new`/`reset` and the spacing to the second, s.
+    first_t_s: Option<f64>,
+    first_step_s: Option<f64>,
 }
 
 impl<const N: usize> TempRateEstimator<N> {
@@ -307,7 +318,28 @@ impl<const N: usize> TempRateEstimator<N> {
         Ok(TempRateEstimator {
             span_s,
             points: Deque::new(),
+            flat_start: false,
+            first_t_s: None,
+            first_step_s: None,
         })
+    }
+
+    /// Estimator over the last `span_s` seconds whose series is taken as flat before its
+    /// first point: while the span reaches back past the first reading, the fit also sees
+    /// that reading repeated at the first two readings' spacing back to the span's start.
+    ///
+    /// Why: right after power-on a growing window holds 2..span/10 s rows, and an end-point
+    /// slope (or a 3-row quadratic) carries the sensor's noise and quantisation divided by
+    /// 10..20 s. A seek averages the model's drift over a dwell and differences dwells, so
+    /// what matters is the dwell-mean of the estimate: a fixed-span fit telescopes (its sum
+    /// over a dwell is a difference of two smoothed readings), a growing one stacks weight
+    /// on the first rows. A unit switched on after a soak is flat before power-on (and its
+    /// sensor lags), so the flat extension is the physical prior; the early estimates are
+    /// the delayed, diluted slope of that picture, the same on the device and in training.
+    pub fn new_flat_start(span_s: f64) -> Result<Self, FeatureError> {
+        let mut e = Self::new(span_s)?;
+        e.flat_start = true;
+        Ok(e)
     }
 
     /// Storage before `new` is assigned (span 0, all zero bytes, so a `static` holding
@@ -316,6 +348,9 @@ impl<const N: usize> TempRateEstimator<N> {
         TempRateEstimator {
             span_s: 0.0,
             points: Deque::new(),
+            flat_start: false,
+            first_t_s: None,
+            first_step_s: None,
         }
     }
 
@@ -327,6 +362,8 @@ impl<const N: usize> TempRateEstimator<N> {
     /// Forget all points.
     pub fn reset(&mut self) {
         self.points.clear();
+        self.first_t_s = None;
+        self.first_step_s = None;
     }
 
     /// Add a point; returns the estimate over the span ending at `t_s` (None with fewer than
@@ -342,6 +379,13 @@ impl<const N: usize> TempRateEstimator<N> {
         }
         if self.points.is_full() {
             self.points.pop_front();
+        }
+        match (self.first_t_s, self.points.back()) {
+            (None, _) => self.first_t_s = Some(t_s),
+            (Some(t0), Some(&(t_last, _))) if self.first_step_s.is_none() && t_last == t0 => {
+                self.first_step_s = Some(t_s - t0)
+            }
+            _ => {}
         }
         // Cannot fail: a slot was freed above.
         let _ = self.points.push_back((t_s, value));
@@ -364,15 +408,21 @@ impl<const N: usize> TempRateEstimator<N> {
         }
         let (t0, y0) = *self.points.front()?;
         let (t1, _) = *self.points.back()?;
-        let nf = n as f64;
+        let (n_pad, step) = self.flat_start_points(t0, t1).unwrap_or((0, 0.0));
+        let padded = || {
+            (1..=n_pad)
+                .map(move |i| (t0 - i as f64 * step, y0))
+                .chain(self.points.iter().copied())
+        };
+        let nf = (n + n_pad) as f64;
         let (mut st, mut sy) = (0.0, 0.0);
-        for &(t, y) in self.points.iter() {
+        for (t, y) in padded() {
             st += t - t0;
             sy += y - y0;
         }
         let (tm, ym) = (st / nf, sy / nf);
         let (mut s2, mut s3, mut s4, mut sty, mut st2y) = (0.0, 0.0, 0.0, 0.0, 0.0);
-        for &(t, y) in self.points.iter() {
+        for (t, y) in padded() {
             let tc = t - t0 - tm;
             let yc = y - y0 - ym;
             let tc2 = tc * tc;
@@ -407,6 +457,29 @@ impl<const N: usize> TempRateEstimator<N> {
             covered_s: covered,
             full: covered >= 0.9 * self.span_s,
         })
+    }
+
+    /// How many points the flat extension of `new_flat_start` adds for points spanning
+    /// `t0_s..=t1_s` (the first reading repeated back at the first spacing while inside the
+    /// span, at most `N` minus the points held), and that spacing, s. None once the first
+    /// reading has left the span, before a second reading, or without the flat start.
+    fn flat_start_points(&self, t0_s: f64, t1_s: f64) -> Option<(usize, f64)> {
+        let (first_t, step) = (self.first_t_s?, self.first_step_s?);
+        if !self.flat_start || t0_s != first_t || !step.is_finite() || step <= 0.0 {
+            return None;
+        }
+        let back_s = t0_s - (t1_s - self.span_s * (1.0 + 1e-9));
+        if !back_s.is_finite() || back_s < step {
+            return None;
+        }
+        let fit = libm::floor(back_s / step);
+        let room = N.saturating_sub(self.points.len());
+        let count = if fit >= room as f64 {
+            room
+        } else {
+            fit as usize
+        };
+        Some((count, step))
     }
 }
 
@@ -493,7 +566,7 @@ pub struct FeatureExtractor {
 /// Span used for a rate or accel spec (its `tau_s`, or the default when 0).
 pub fn span_for(spec: &FeatureSpec) -> f64 {
     let default = match spec.kind {
-        FeatureKind::TempAccelCps2 => DEFAULT_ACCEL_SPAN_S,
+        FeatureKind::TempAccelCps2 | FeatureKind::TempAccelFlatStartCps2 => DEFAULT_ACCEL_SPAN_S,
         _ => DEFAULT_RATE_SPAN_S,
     };
     if spec.tau_s > 0.0 {
@@ -506,6 +579,15 @@ pub fn span_for(spec: &FeatureSpec) -> f64 {
 /// The fresh state of one spec, or why the spec is invalid.
 fn fresh_state(spec: &FeatureSpec) -> Result<FeatureState, FeatureError> {
     let state = match spec.kind {
+        // Only the second derivative has a flat-start kind (the soaked unit at power-on,
+        // see `TempRateEstimator::new_flat_start`); the slope keeps its growing window: a
+        // flat-start slope is diluted in the first minute, which puts a cold-start row
+        // (T near ambient, small slope, large drift) where a later row of a colder run
+        // (same T, settled) sits, and a model over several ambients cannot tell them
+        // apart (measured: global model, seek 1 at -40 degC 0.0203 -> 0.0276 deg rms).
+        FeatureKind::TempAccelFlatStartCps2 => {
+            FeatureState::Rate(TempRateEstimator::new_flat_start(span_for(spec))?)
+        }
         FeatureKind::TempRateCps | FeatureKind::TempAccelCps2 | FeatureKind::AuxRate(_) => {
             FeatureState::Rate(TempRateEstimator::new(span_for(spec))?)
         }
@@ -619,9 +701,10 @@ impl FeatureExtractor {
                 (FeatureKind::TempRateCps, FeatureState::Rate(e)) => {
                     e.push(t_s, temp).map(|r| r.rate_per_s)
                 }
-                (FeatureKind::TempAccelCps2, FeatureState::Rate(e)) => {
-                    e.push(t_s, temp).and_then(|r| r.accel_per_s2)
-                }
+                (
+                    FeatureKind::TempAccelCps2 | FeatureKind::TempAccelFlatStartCps2,
+                    FeatureState::Rate(e),
+                ) => e.push(t_s, temp).and_then(|r| r.accel_per_s2),
                 (FeatureKind::TempLagC, FeatureState::Lag(l)) => Some(l.push(t_s, temp)),
                 (FeatureKind::PowerOnDecay, _) => Some(power_on_decay(t_s, spec.tau_s as f64)),
                 (FeatureKind::AuxValue(_), _) => aux_v,

@@ -81,6 +81,11 @@ pub enum FeatureKind {
     AuxCos(u8),
     /// sin of an angle channel n (deg).
     AuxSin(u8),
+    /// d2T/dt2, degC/s^2, with the temperature series taken as flat before its first
+    /// reading (a unit soaked before power-on whose thermometer lags the heat; see
+    /// `TempRateEstimator::new_flat_start`). Identical to `TempAccelCps2` once the first
+    /// reading has left the span. Appended last: existing model files keep their meaning.
+    TempAccelFlatStartCps2,
 }
 
 /// One model input: its kind and, for lags and decays, a time constant (s; 0 otherwise).

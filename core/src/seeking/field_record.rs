@@ -188,13 +188,16 @@ pub struct TempState {
     pub temp_accel_cps2: f32,
 }
 
-/// Index of the model's plain d2T/dt2 input (`TempAccelCps2`, default span), if it has one:
-/// the input whose window values a record averages.
+/// Index of the model's d2T/dt2 input (`TempAccelCps2` or its flat-start estimator
+/// `TempAccelFlatStartCps2`, default span), if it has one: the input whose window values
+/// a record averages.
 pub fn accel_input_index(model: &RbfModel) -> Option<usize> {
-    model
-        .inputs
-        .iter()
-        .position(|s| s.kind == FeatureKind::TempAccelCps2 && s.tau_s == 0.0)
+    model.inputs.iter().position(|s| {
+        matches!(
+            s.kind,
+            FeatureKind::TempAccelCps2 | FeatureKind::TempAccelFlatStartCps2
+        ) && s.tau_s == 0.0
+    })
 }
 
 impl SeekTempState {
@@ -434,6 +437,12 @@ mod tests {
             FeatureKind::TempAccelCps2,
         ]);
         assert_eq!(accel_input_index(&m), Some(2));
+        let flat = model_with(&[
+            FeatureKind::TempC,
+            FeatureKind::TempAccelFlatStartCps2,
+            FeatureKind::TempRateCps,
+        ]);
+        assert_eq!(accel_input_index(&flat), Some(1));
         // Early warm-up: the window estimates fall from +5e-4 to -2e-5 degC/s^2; the record
         // carries their mean (what a linear correction in that input averages to).
         let accels = [5e-4f32, 2e-4, 5e-5, -2e-5];

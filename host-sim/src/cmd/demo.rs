@@ -50,8 +50,14 @@ pub fn run(args: Args) -> Result<()> {
     let report = reproduce(&GyroParams::paper_default(), &opts).map_err(super::with_plan_flag)?;
     print!("{}", summary(&report));
     write_json(&args.out.join("report.json"), &report)?;
+    let files: Vec<&str> = report
+        .models
+        .iter()
+        .map(|m| m.model_file.as_str())
+        .collect();
     println!(
-        "\nplots, report.json and the models (model_t_rate.bin, model_t_rate_accel.bin) written to {} ({:.1} s)",
+        "\nplots, report.json and the models ({}) written to {} ({:.1} s)",
+        files.join(", "),
         args.out.display(),
         started.elapsed().as_secs_f64()
     );

@@ -10,7 +10,7 @@ use super::check_output_file;
 use crate::io::runs::run_files;
 use crate::io::{read_runs_binned, OutputGuard, OutputLock, StagedFiles};
 use crate::train::{
-    choose_inputs, train_model, GroupedCvRms, InputChoice, InputSelection, Method, TrainConfig,
+    choose_inputs_default, train_model, InputChoice, InputSelection, Method, TrainConfig,
     TrainOutcome, TrainReport, Verdict, WidthSearch, GUARD_RATIO,
 };
 use anyhow::Context;
@@ -75,8 +75,9 @@ pub struct Args {
     #[arg(long)]
     pub linear_inputs: bool,
     /// Model inputs: `t,rate` (T, dT/dt), `t,rate,accel` (and d2T/dt2, computed by
-    /// fog-core as on the device) or `auto` (each scored by grouped cross-validation over
-    /// whole runs on the same points; the lowest held-out rms wins).
+    /// fog-core as on the device), `t,rate,accel_flat` (d2T/dt2 with the series flat
+    /// before power-on) or `auto` (each scored by grouped cross-validation over whole runs
+    /// on the same points, by `--criterion`; a later set must win run by run).
     #[arg(long, default_value = "auto", value_parser = InputChoice::parse)]
     pub inputs: InputChoice,
     /// Gyro id stored in the model (at most 16 bytes).
@@ -287,7 +288,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         );
     }
     let runs = read_runs_binned(&args.runs)?;
-    let (selection, ds) = choose_inputs(&runs, &candidates, &cfg, &GroupedCvRms)?;
+    let (selection, ds) = choose_inputs_default(&runs, &candidates, &cfg)?;
     if args.inputs == InputChoice::Auto {
         print!("{}", selection.summary());
     }

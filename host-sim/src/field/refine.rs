@@ -139,7 +139,12 @@ pub fn terms_for(model: &RbfModel, obs: &[FieldObservation]) -> (Vec<Term>, Vec<
     let mut notes: Vec<String> = model
         .inputs
         .iter()
-        .filter(|s| s.kind == FeatureKind::TempAccelCps2)
+        .filter(|s| {
+            matches!(
+                s.kind,
+                FeatureKind::TempAccelCps2 | FeatureKind::TempAccelFlatStartCps2
+            )
+        })
         .map(|_| "d2T/dt2 (no measurement has checked a field correction in it yet)".into())
         .collect();
     let mut terms: Vec<Term> = Vec::new();

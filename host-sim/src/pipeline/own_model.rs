@@ -31,8 +31,8 @@ use crate::io::runs::Run;
 use crate::sim::GyroParams;
 use crate::train::seek_score::{seek_azimuth_rms_deg, Criterion};
 use crate::train::{
-    choose_inputs, dataset_from_runs, predict_batch, GroupedCvRms, InputSelection, InputSet,
-    TrainConfig, TrainOutcome,
+    choose_inputs_default, dataset_from_runs, predict_batch, InputSelection, InputSet, TrainConfig,
+    TrainOutcome,
 };
 
 /// Runs of the first step: two halves of 3, the fewest grouped 3-fold validation takes.
@@ -136,13 +136,14 @@ pub fn train_own_model(params: &GyroParams, plan: &OwnModelPlan) -> Result<OwnMo
             },
         )?;
         let runs: Vec<Run> = campaign.into_iter().map(|c: CampaignRun| c.run).collect();
-        let (selection, _) = choose_inputs(
-            &runs,
-            &InputSet::ALL,
-            &TrainConfig::default(),
-            &GroupedCvRms,
-        )
-        .map_err(|e| anyhow!("choosing the own model's inputs: {e}"))?;
+        // `train`'s defaults, with the plan's criterion choosing the d2T/dt2 estimator as
+        // well as the shape.
+        let cfg = TrainConfig {
+            criterion: plan.criterion,
+            ..TrainConfig::default()
+        };
+        let (selection, _) = choose_inputs_default(&runs, &InputSet::ALL, &cfg)
+            .map_err(|e| anyhow!("choosing the own model's inputs: {e}"))?;
         let specs = selection.chosen.specs();
         let learned = learned_seek_error_deg(&runs, &specs, plan)?;
         steps.push(RunCountStep {

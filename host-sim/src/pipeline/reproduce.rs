@@ -1,5 +1,6 @@
 //! The paper end to end, shared by `fogsim reproduce` (full size) and `fogsim demo` (short):
-//! simulate the campaign, train the paper's model (T, dT/dt; OLS) on runs 1-3 of every
+//! simulate the campaign, train the paper's model (T, dT/dt; OLS) and the global model (the
+//! inputs `train --inputs auto` chooses, `train`'s defaults) on runs 1-3 of every
 //! temperature, compensate the held-out runs, run the cold-start north-seek Monte Carlo,
 //! check the targets and print the paper-vs-us table; optionally write the plots.
 
@@ -24,7 +25,7 @@ use crate::report::{
 };
 use crate::sim::{GyroParams, RunSpec, SimGyro, StartState};
 use crate::stats::{allan, SPEC_DPH};
-use crate::train::{InputSet, TrainReport};
+use crate::train::{choose_inputs_default, InputSelection, InputSet, TrainConfig, TrainReport};
 use fog_core::model::format::FeatureSpec;
 
 /// Everything a reproduce run needs.
@@ -37,15 +38,37 @@ pub struct ReproduceOptions {
     pub plots: Option<PathBuf>,
 }
 
-/// The model inputs compared: the paper's (T, dT/dt) and this project's (T, dT/dt, d2T/dt2).
-pub fn input_variants() -> Vec<(&'static str, Vec<FeatureSpec>)> {
-    vec![
-        ("paper inputs (T, dT/dt)", InputSet::TempRate.specs()),
-        (
-            "extended inputs (T, dT/dt, d2T/dt2)",
-            InputSet::TempRateAccel.specs(),
-        ),
-    ]
+/// The model inputs compared: the paper's (T, dT/dt), and the global model's, chosen from
+/// the training runs by `train`'s defaults (`choose_inputs_default` over every `InputSet`),
+/// with that choice.
+pub fn input_variants(train_runs: &[&Run]) -> Result<Vec<InputVariant>> {
+    let owned: Vec<Run> = train_runs.iter().map(|r| (*r).clone()).collect();
+    let cfg = TrainConfig::default();
+    let (selection, _) = choose_inputs_default(&owned, &InputSet::ALL, &cfg)
+        .map_err(|e| anyhow!("choosing the global model's inputs: {e}"))?;
+    let chosen = selection.chosen;
+    Ok(vec![
+        InputVariant {
+            label: "paper inputs (T, dT/dt)".into(),
+            specs: InputSet::TempRate.specs(),
+            selection: None,
+        },
+        InputVariant {
+            label: format!(
+                "global model, inputs chosen by validation ({})",
+                chosen.name()
+            ),
+            specs: chosen.specs(),
+            selection: Some(selection),
+        },
+    ])
+}
+
+/// One model `reproduce` trains: its label, inputs and how they were chosen (None: fixed).
+pub struct InputVariant {
+    pub label: String,
+    pub specs: Vec<FeatureSpec>,
+    pub selection: Option<InputSelection>,
 }
 
 /// File name of a variant's deployable model (written beside its plots).
@@ -105,6 +128,10 @@ pub struct Targets {
 #[derive(Clone, Debug, Serialize)]
 pub struct ModelResult {
     pub label: String,
+    /// How the inputs were chosen (None: fixed, the paper's).
+    pub input_selection: Option<InputSelection>,
+    /// The deployable model's file name (written beside the plots with `--plots`).
+    pub model_file: String,
     pub training: TrainReport,
     pub per_ambient: Vec<AmbientResult>,
     pub validation: CompensateReport,
@@ -133,8 +160,7 @@ pub struct ReproduceReport {
 /// Runs the whole pipeline, printing progress to stderr.
 pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<ReproduceReport> {
     let plan = &opts.campaign;
-    let variants = input_variants();
-    let steps = progress_bar(1 + 2 * variants.len(), "campaign, training, validation");
+    let steps = progress_bar(5, "campaign, training, validation");
     let campaign = simulate_checked(params, plan)?;
     steps.inc(1);
     let (train, heldout) = split_train_validate(&campaign, opts.n_train);
@@ -147,8 +173,14 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
     }
     let train_runs: Vec<&Run> = train.iter().map(|c| &c.run).collect();
     let heldout_runs: Vec<Run> = heldout.iter().map(|c| c.run.clone()).collect();
+    let variants = input_variants(&train_runs)?;
     let mut fitted = Vec::new();
-    for (label, specs) in &variants {
+    for InputVariant {
+        label,
+        specs,
+        selection,
+    } in &variants
+    {
         let trained = train_default(&train_runs, specs, "sim")?;
         steps.inc(1);
         if let Some(dir) = &opts.plots {
@@ -157,12 +189,21 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
         }
         let (validation, series) = compensate_all(&heldout_runs, &trained.model)?;
         steps.inc(1);
-        fitted.push((label.to_string(), trained, validation, series));
+        fitted.push((
+            label.clone(),
+            selection.clone(),
+            model_file_name(specs),
+            trained,
+            validation,
+            series,
+        ));
     }
     steps.finish_and_clear();
 
     let mut models = Vec::new();
-    for (k, (label, trained, validation, series)) in fitted.into_iter().enumerate() {
+    for (k, (label, input_selection, model_file, trained, validation, series)) in
+        fitted.into_iter().enumerate()
+    {
         let per_ambient = per_ambient_results(&plan.ambients_c, &heldout, &series);
         let bar = progress_bar(
             opts.north_seek.starts,
@@ -192,6 +233,8 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
         let targets = measure_targets(&per_ambient, &north_seek);
         models.push(ModelResult {
             label,
+            input_selection,
+            model_file,
             training: trained.report,
             per_ambient,
             validation,

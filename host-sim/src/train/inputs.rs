@@ -1,10 +1,24 @@
-//! Which model inputs to train on: the paper's (T, dT/dt) or with d2T/dt2 added, chosen
-//! by a held-out criterion over whole runs, never by habit. Every candidate set is
-//! computed by fog-core's feature code (as the device computes it) and scored on the
-//! same rows: the 10 s points at which every candidate's inputs are ready, so a set
+//! Which model inputs to train on: the paper's (T, dT/dt), or with d2T/dt2 added (by the
+//! plain least-squares estimator, or by the one that takes the unit as flat before
+//! power-on), chosen by held-out criteria over whole runs, never by habit. Every candidate
+//! set is computed by fog-core's feature code (as the device computes it) and scored on
+//! the same rows: the 10 s points at which every candidate's inputs are ready, so a set
 //! whose estimator needs a longer warm-up (d2T/dt2) is not judged on fewer, easier
-//! points. The criterion is a trait so another one (e.g. scored by simulated seeks) can
-//! replace the default grouped cross-validation without touching the choice.
+//! points. A criterion is a trait: grouped cross-validation scored by the 10 s rms
+//! (`GroupedCvRms`) or by the azimuth error of seeks on the held-out runs
+//! (`GroupedCvSeek`).
+//!
+//! Two steps (`choose_inputs`): which inputs, by the 10 s rms (whether the drift follows
+//! d2T/dt2 is a property of the drift law over whole runs; measured on the independent
+//! generator, the seek score cannot make that choice: with d2T/dt2 planted it kept
+//! (T, dT/dt), and on its null twin it took d2T/dt2, 0.0050 against 0.0078 deg); then
+//! which d2T/dt2 estimator, by the training criterion (`criterion_for`: the seek score by
+//! default). Why a flat-start d2T/dt2 is a candidate: right after power-on the plain fit
+//! has 3..18 rows and its dwell means carry the thermometer noise divided by 10..20 s,
+//! which the first seek turns into azimuth scatter; the flat prior removes that noise but
+//! is wrong for a thermometer that follows a heated node at once (a kink at power-on).
+//! Which holds is a property of the unit, so its data decides, scored by what differs:
+//! the first seek, which the 10 s rms does not weigh (the first 190 s are 7 % of a run).
 
 use std::collections::HashSet;
 
@@ -13,6 +27,7 @@ use serde::Serialize;
 
 use super::error::{Result, TrainError};
 use super::features::{dataset_from_runs, default_specs};
+use super::seek_score::{seek_azimuth_per_run, Criterion};
 use super::validate::cross_validate;
 use super::{Dataset, TrainConfig};
 use crate::io::runs::Run;
@@ -26,30 +41,54 @@ pub enum InputSet {
     /// T, dT/dt, d2T/dt2.
     #[serde(rename = "t,rate,accel")]
     TempRateAccel,
+    /// T, dT/dt, d2T/dt2 with the series flat before power-on
+    /// (`FeatureKind::TempAccelFlatStartCps2`).
+    #[serde(rename = "t,rate,accel_flat")]
+    TempRateAccelFlat,
 }
 
 impl InputSet {
-    /// Every set, smallest first (ties in a choice go to the smaller).
-    pub const ALL: [InputSet; 2] = [InputSet::TempRate, InputSet::TempRateAccel];
+    /// Every set, smallest first, the plain estimator before the flat-start one (ties in a
+    /// choice go to the earlier).
+    pub const ALL: [InputSet; 3] = [
+        InputSet::TempRate,
+        InputSet::TempRateAccel,
+        InputSet::TempRateAccelFlat,
+    ];
 
     /// The command-line name.
     pub fn name(self) -> &'static str {
         match self {
             InputSet::TempRate => "t,rate",
             InputSet::TempRateAccel => "t,rate,accel",
+            InputSet::TempRateAccelFlat => "t,rate,accel_flat",
         }
     }
 
     /// fog-core's feature specs of the set (what the model file carries).
     pub fn specs(self) -> Vec<FeatureSpec> {
         let mut specs = default_specs();
-        if self == InputSet::TempRateAccel {
-            specs.push(FeatureSpec::plain(FeatureKind::TempAccelCps2));
+        match self {
+            InputSet::TempRate => {}
+            InputSet::TempRateAccel => specs.push(FeatureSpec::plain(FeatureKind::TempAccelCps2)),
+            InputSet::TempRateAccelFlat => {
+                specs.push(FeatureSpec::plain(FeatureKind::TempAccelFlatStartCps2))
+            }
         }
         specs
     }
 
-    /// Parses `t,rate` or `t,rate,accel` (spaces ignored).
+    /// Whether the set's d2T/dt2 is the flat-start estimator.
+    pub fn is_flat_start(self) -> bool {
+        self == InputSet::TempRateAccelFlat
+    }
+
+    /// The same inputs with the flat-start d2T/dt2 (None: the set has no plain d2T/dt2).
+    pub fn flat_start_variant(self) -> Option<InputSet> {
+        (self == InputSet::TempRateAccel).then_some(InputSet::TempRateAccelFlat)
+    }
+
+    /// Parses `t,rate`, `t,rate,accel` or `t,rate,accel_flat` (spaces ignored).
     pub fn parse(s: &str) -> Option<Self> {
         let s: String = s.chars().filter(|c| !c.is_whitespace()).collect();
         Self::ALL.into_iter().find(|set| set.name() == s)
@@ -64,14 +103,16 @@ pub enum InputChoice {
 }
 
 impl InputChoice {
-    /// Parses `auto`, `t,rate` or `t,rate,accel`.
+    /// Parses `auto` or a set's name.
     pub fn parse(s: &str) -> std::result::Result<Self, String> {
         if s.trim() == "auto" {
             return Ok(InputChoice::Auto);
         }
-        InputSet::parse(s)
-            .map(InputChoice::Fixed)
-            .ok_or_else(|| format!("`{s}` is not an input set (use auto, t,rate or t,rate,accel)"))
+        InputSet::parse(s).map(InputChoice::Fixed).ok_or_else(|| {
+            format!(
+                "`{s}` is not an input set (use auto, t,rate, t,rate,accel or t,rate,accel_flat)"
+            )
+        })
     }
 
     /// The candidate sets.
@@ -114,7 +155,7 @@ impl InputCriterion for GroupedCvRms {
         // Each set's shape is validated on the same metric this criterion scores (the
         // 10 s rms), whatever criterion later chooses the final model's shape.
         let cfg = &TrainConfig {
-            criterion: super::seek_score::Criterion::Rms10s,
+            criterion: Criterion::Rms10s,
             ..cfg.clone()
         };
         let cv = cross_validate(ds, cfg, cfg.folds)?;
@@ -137,9 +178,67 @@ impl InputCriterion for GroupedCvRms {
     }
 }
 
-/// Standard errors a larger set's mean per-unit gain must exceed to replace a smaller
-/// one: a gain the units' scatter cannot tell from zero does not earn an input the
-/// device must compute and the model must fit.
+/// Grouped cross-validation scored as seeks score it: each set's shape validated by the
+/// seek criterion (`cfg.criterion`'s dwell and latitude, or the defaults under the 10 s
+/// rms), the held-out residuals turned into back-to-back seek azimuth errors
+/// (`seek_score`); the figure is their rms, deg, and the units are the runs (mean square
+/// azimuth error of each run's seeks). The early minutes weigh as much as a seek gives
+/// them: one pair of a run's dozen, not the 4 % of its 10 s rows.
+pub struct GroupedCvSeek;
+
+impl InputCriterion for GroupedCvSeek {
+    fn describe(&self) -> &'static str {
+        "grouped cross-validation (whole runs held out), held-out seek azimuth error, deg"
+    }
+
+    fn score(&self, ds: &Dataset, cfg: &TrainConfig) -> Result<SetScore> {
+        let criterion = match cfg.criterion {
+            Criterion::Rms10s => Criterion::seek_default(),
+            c => c,
+        };
+        let Criterion::Seek {
+            dwell_s,
+            latitude_deg,
+        } = criterion
+        else {
+            return Err(TrainError::EmptyDataset);
+        };
+        let cfg = &TrainConfig {
+            criterion,
+            ..cfg.clone()
+        };
+        let cv = cross_validate(ds, cfg, cfg.folds)?;
+        let per_unit = seek_azimuth_per_run(
+            &cv.residuals_dph,
+            &ds.groups,
+            &ds.t_s,
+            dwell_s,
+            latitude_deg,
+        )
+        .iter()
+        .filter(|r| r.pairs > 0)
+        .map(|r| r.sum_sq_deg2 / r.pairs as f64)
+        .collect();
+        Ok(SetScore {
+            value: cv.best.heldout_seek_deg,
+            per_unit,
+        })
+    }
+}
+
+/// The input criterion scored like the training criterion `cfg.criterion` chooses the
+/// model's shape: the 10 s rms or the seek azimuth error.
+pub fn criterion_for(cfg: &TrainConfig) -> &'static dyn InputCriterion {
+    match cfg.criterion {
+        Criterion::Rms10s => &GroupedCvRms,
+        Criterion::Seek { .. } => &GroupedCvSeek,
+    }
+}
+
+/// Standard errors a later set's mean per-unit gain must exceed to replace the current
+/// choice: a gain the units' scatter cannot tell from zero does not earn an input the
+/// device must compute and the model must fit, nor a prior (the flat start) the data
+/// does not ask for.
 pub const SIGNIFICANT_GAIN_SE: f64 = 2.0;
 
 /// Whether `larger` beats `smaller` unit by unit: the mean of the paired differences
@@ -177,18 +276,28 @@ pub struct InputSetScore {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct InputSelection {
     pub chosen: InputSet,
+    /// The criterion that chose the inputs (`scores`).
     pub criterion: String,
-    /// Every candidate's figure, in the order tried (smallest set first).
+    /// Every plain-estimator candidate's figure, in the order tried (smallest set first).
+    pub scores: Vec<InputSetScore>,
+    /// The d2T/dt2 estimator's choice (plain, then flat start), when there was one.
+    pub estimator: Option<EstimatorChoice>,
+}
+
+/// The second step of `choose_inputs`: the plain against the flat-start d2T/dt2.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct EstimatorChoice {
+    pub criterion: String,
+    /// The plain set's figure, then the flat-start set's.
     pub scores: Vec<InputSetScore>,
 }
 
 impl InputSelection {
     /// One line per candidate, the chosen one marked.
     pub fn summary(&self) -> String {
-        let mut s = format!("inputs: {} (by {})\n", self.chosen.name(), self.criterion);
-        for c in &self.scores {
-            s += &format!(
-                "  {:<14} held-out {:.5} on {} points{}\n",
+        let line = |c: &InputSetScore| {
+            format!(
+                "  {:<18} held-out {:.5} on {} points{}\n",
                 c.set.name(),
                 c.score,
                 c.rows,
@@ -197,7 +306,13 @@ impl InputSelection {
                 } else {
                     ""
                 }
-            );
+            )
+        };
+        let mut s = format!("inputs: {} (by {})\n", self.chosen.name(), self.criterion);
+        s += &self.scores.iter().map(line).collect::<String>();
+        if let Some(e) = &self.estimator {
+            s += &format!("d2T/dt2 estimator (by {}):\n", e.criterion);
+            s += &e.scores.iter().map(line).collect::<String>();
         }
         s
     }
@@ -239,56 +354,115 @@ fn common_rows(sets: &[Dataset]) -> Vec<Dataset> {
         .collect()
 }
 
-/// Scores every candidate on the common rows; going from the smallest set up, a larger
-/// set replaces the current choice only when it is significantly better unit by unit
-/// ([`SIGNIFICANT_GAIN_SE`]). Returns the selection and the chosen set's full dataset
-/// (all its ready rows).
+/// Scores `sets` (indices into `candidates`/`data`) in order with `criterion`: a later set
+/// replaces the current choice only when it is significantly better unit by unit
+/// ([`SIGNIFICANT_GAIN_SE`]). Returns the chosen index and every set's score.
+fn choose_in_order(
+    sets: &[usize],
+    candidates: &[InputSet],
+    data: &[Dataset],
+    cfg: &TrainConfig,
+    criterion: &dyn InputCriterion,
+) -> Result<(usize, Vec<InputSetScore>)> {
+    let mut scores = Vec::new();
+    let mut best = sets.first().copied().ok_or(TrainError::EmptyDataset)?;
+    let mut kept: Option<SetScore> = None;
+    for &i in sets {
+        let ds = &data[i];
+        let score = criterion.score(ds, cfg)?;
+        let gain = match &kept {
+            None => true,
+            Some(k) => significantly_better(&score, k),
+        };
+        scores.push(InputSetScore {
+            set: candidates[i],
+            inputs: ds.input_names.clone(),
+            score: score.value,
+            rows: ds.len(),
+            significant_gain: gain && kept.is_some(),
+        });
+        if gain {
+            best = i;
+            kept = Some(score);
+        }
+    }
+    Ok((best, scores))
+}
+
+/// Chooses among `candidates` in two steps, all sets scored on the rows every candidate
+/// can use. First the inputs (the sets with the plain estimators, smallest first) by
+/// `inputs_criterion`: whether the drift needs d2T/dt2 at all is a question of the drift
+/// law, which the 10 s rms answers. Then, when the chosen set has a flat-start variant
+/// among the candidates, the d2T/dt2 estimator by `estimator_criterion`: the two differ
+/// only in the first 190 s after power-on, which the 10 s rms cannot see and the first
+/// seek does. In each step a later set replaces the choice only when it is significantly
+/// better unit by unit. Returns the selection and the chosen set's full dataset (all its
+/// ready rows).
 pub fn choose_inputs(
     runs: &[Run],
     candidates: &[InputSet],
     cfg: &TrainConfig,
-    criterion: &dyn InputCriterion,
+    inputs_criterion: &dyn InputCriterion,
+    estimator_criterion: &dyn InputCriterion,
 ) -> Result<(InputSelection, Dataset)> {
     let mut full = Vec::new();
     for set in candidates {
         full.push(dataset_from_runs(runs, &set.specs())?);
     }
-    let mut scores = Vec::new();
-    let mut best = 0;
-    if candidates.len() > 1 {
-        let mut kept: Option<SetScore> = None;
-        for (i, (set, ds)) in candidates.iter().zip(common_rows(&full)).enumerate() {
-            let score = criterion.score(&ds, cfg)?;
-            let gain = match &kept {
-                None => true,
-                Some(k) => significantly_better(&score, k),
-            };
-            scores.push(InputSetScore {
-                set: *set,
-                inputs: ds.input_names.clone(),
-                score: score.value,
-                rows: ds.len(),
-                significant_gain: gain && kept.is_some(),
-            });
-            if gain {
-                best = i;
-                kept = Some(score);
-            }
-        }
+    if candidates.len() < 2 {
+        let chosen = *candidates.first().ok_or(TrainError::EmptyDataset)?;
+        return Ok((
+            InputSelection {
+                chosen,
+                criterion: "given by --inputs".into(),
+                scores: Vec::new(),
+                estimator: None,
+            },
+            full.swap_remove(0),
+        ));
     }
-    let chosen = *candidates.get(best).ok_or(TrainError::EmptyDataset)?;
+    let common = common_rows(&full);
+    let plain: Vec<usize> = (0..candidates.len())
+        .filter(|&i| !candidates[i].is_flat_start())
+        .collect();
+    let (mut best, scores) = if plain.is_empty() {
+        (0, Vec::new())
+    } else {
+        choose_in_order(&plain, candidates, &common, cfg, inputs_criterion)?
+    };
+    let mut estimator = None;
+    if let Some(flat) = candidates[best]
+        .flat_start_variant()
+        .and_then(|v| candidates.iter().position(|&c| c == v))
+    {
+        let (b, pair) =
+            choose_in_order(&[best, flat], candidates, &common, cfg, estimator_criterion)?;
+        best = b;
+        estimator = Some(EstimatorChoice {
+            criterion: estimator_criterion.describe().into(),
+            scores: pair,
+        });
+    }
     Ok((
         InputSelection {
-            chosen,
-            criterion: if scores.is_empty() {
-                "given by --inputs".into()
-            } else {
-                criterion.describe().into()
-            },
+            chosen: candidates[best],
+            criterion: inputs_criterion.describe().into(),
             scores,
+            estimator,
         },
         full.swap_remove(best),
     ))
+}
+
+/// `train`'s defaults (and so `north-seek`'s own model's and `reproduce`'s global
+/// model's): inputs by the 10 s rms (`GroupedCvRms`), the d2T/dt2 estimator by the
+/// criterion `cfg.criterion` names (`criterion_for`: the seek score by default).
+pub fn choose_inputs_default(
+    runs: &[Run],
+    candidates: &[InputSet],
+    cfg: &TrainConfig,
+) -> Result<(InputSelection, Dataset)> {
+    choose_inputs(runs, candidates, cfg, &GroupedCvRms, criterion_for(cfg))
 }
 
 #[cfg(test)]
@@ -304,6 +478,14 @@ mod tests {
         );
         assert!(InputChoice::parse("t,accel").is_err());
         assert_eq!(InputSet::TempRateAccel.specs().len(), 3);
+        assert_eq!(
+            InputChoice::parse("t,rate,accel_flat"),
+            Ok(InputChoice::Fixed(InputSet::TempRateAccelFlat))
+        );
+        assert_eq!(
+            InputSet::TempRateAccelFlat.specs()[2].kind,
+            FeatureKind::TempAccelFlatStartCps2
+        );
         assert_eq!(InputSet::TempRate.specs(), default_specs());
     }
 

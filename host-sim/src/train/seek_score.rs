@@ -104,26 +104,59 @@ pub fn seek_azimuth_rms_deg(
     dwell_s: f64,
     latitude_deg: f64,
 ) -> f64 {
+    let per_run = seek_azimuth_per_run(res, groups, t_s, dwell_s, latitude_deg);
+    let (ss, n) = per_run.iter().fold((0.0, 0usize), |(ss, n), r| {
+        (ss + r.sum_sq_deg2, n + r.pairs)
+    });
+    if n == 0 {
+        0.0
+    } else {
+        (ss / n as f64).sqrt()
+    }
+}
+
+/// One run's seek pairs (`seek_azimuth_per_run`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RunSeekError {
+    /// The run id (`groups` value).
+    pub group: u32,
+    /// Sum of the squared azimuth errors of its pairs, deg^2.
+    pub sum_sq_deg2: f64,
+    /// Pairs scored.
+    pub pairs: usize,
+}
+
+/// As `seek_azimuth_rms_deg`, but one entry per run (consecutive rows of one group), in
+/// row order: what a criterion needs to compare two models run by run.
+pub fn seek_azimuth_per_run(
+    res: &[f64],
+    groups: &[u32],
+    t_s: &[f64],
+    dwell_s: f64,
+    latitude_deg: f64,
+) -> Vec<RunSeekError> {
     let omega_h = earth_rate_horizontal_dph(latitude_deg);
-    let (mut ss, mut n) = (0.0, 0usize);
+    let mut out = Vec::new();
     let mut i = 0;
     while i < res.len() {
         let g = groups[i];
         let end = (i..res.len())
             .find(|&k| groups[k] != g)
             .unwrap_or(res.len());
+        let mut run = RunSeekError {
+            group: g,
+            sum_sq_deg2: 0.0,
+            pairs: 0,
+        };
         for e in pair_errors_dph(&res[i..end], &t_s[i..end], dwell_s) {
             let az_rad = e / (2.0 * omega_h);
-            ss += az_rad.to_degrees().powi(2);
-            n += 1;
+            run.sum_sq_deg2 += az_rad.to_degrees().powi(2);
+            run.pairs += 1;
         }
+        out.push(run);
         i = end;
     }
-    if n == 0 {
-        0.0
-    } else {
-        (ss / n as f64).sqrt()
-    }
+    out
 }
 
 /// Differences of the block means (2k minus 2k+1) of one run, deg/h.
