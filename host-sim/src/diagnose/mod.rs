@@ -19,6 +19,7 @@ pub mod error;
 pub mod input;
 pub mod library;
 pub mod linalg;
+pub mod memprobe;
 pub mod report;
 pub mod selection;
 pub mod simulator;
@@ -62,6 +63,23 @@ pub struct Diagnosis {
     pub sim_terms: Vec<Vec<crate::sim::DriftTerm>>,
 }
 
+impl Diagnosis {
+    /// Frees the per-row series (only the plots read them; the report keeps everything
+    /// else): five or six values per row the later stages of the command need not hold.
+    pub fn drop_series(&mut self) {
+        for v in [
+            &mut self.t_s,
+            &mut self.temp_c,
+            &mut self.drift_dph,
+            &mut self.baseline_residual,
+            &mut self.extended_residual,
+        ] {
+            *v = Vec::new();
+        }
+        self.cause_feature = None;
+    }
+}
+
 /// Runs the whole diagnosis on a campaign.
 pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
     diagnose_with(runs, validation::buffer::BufferRule::default())
@@ -73,27 +91,34 @@ pub fn diagnose_with(
     rule: validation::buffer::BufferRule,
 ) -> Result<Diagnosis, DiagnoseError> {
     let campaign = input::prepare(runs)?;
+    memprobe::stage("input::prepare");
     let (folds, mut st, choice) = layout_and_base(&campaign, rule)?;
+    memprobe::stage("layout_and_base");
     let base = &choice.chosen;
     let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
     let latitude = latitude_of(&campaign);
     let meta = library::generic::metadata(runs);
     let (library, cap_note) = library_of(&campaign, &meta, st.temp_rate_half_s);
+    memprobe::stage("library");
     let (mut screening, between_run, groups) =
         screen_both(&campaign, &meta, &folds, &st, &choice, &library, latitude)?;
+    memprobe::stage("screen_both");
     screening.skipped.extend(cap_note);
     let named = screening.steps.first();
     let cause = named.map(|s| Cause::from(&s.scored.cand));
     let sim_design = simulator::simfit::SimDesign::new(&campaign);
+    memprobe::stage("SimDesign::new");
     let sim = simulator::simfit::calibrate(
         &sim_design,
         &folds.run_rows,
         &st.y,
         named.map(|s| s.cols.as_slice()),
     )?;
+    memprobe::stage("simulator::calibrate");
     let (extended, ext_resid) = extended_model(base, &screening);
     let causal_derivative = named
         .and_then(|s| library::causal::check(&campaign, &folds, base, &s.scored.cand, &s.cols));
+    memprobe::stage("extended_model + causal::check");
     let named_feature = named.map(|s| uncertainty::NamedFeature {
         label: s.scored.cand.label(),
         cols: &s.cols,
@@ -101,9 +126,11 @@ pub fn diagnose_with(
     let uncertainty = uncertainty::estimate(&sim_design, &folds, &st, base, named_feature.as_ref());
     // The simulator's design (15 columns a row with the lag's shifted copies) is not
     // needed past here: freed before the later stages' own per-row peaks (memory).
+    memprobe::stage("uncertainty::estimate");
     drop(sim_design);
     let azimuth = azimuth(&campaign, &folds, &st, base, &ext_resid, latitude);
     let named_causes = named_causes(&folds, &st, base, &screening, &between_run, latitude);
+    memprobe::stage("azimuth + named_causes");
     let smallest_attainable_p = validation::signflip::smallest_p(folds.unit_rows.len());
     let silent = cause.is_none() && between_run.named.is_none();
     let rerun = selection::power::Rerun {
@@ -112,6 +139,7 @@ pub fn diagnose_with(
     };
     let power_check =
         selection::power::check(silent, &campaign, &folds, &mut st, base, &screening, rerun)?;
+    memprobe::stage("power::check");
     let words = cause_in_words(
         cause.as_ref(),
         &named_causes,
@@ -158,6 +186,7 @@ pub fn diagnose_with(
         raw_rows: None,
         simulation: simulation_summary(sim, &sim_terms, cause_column.as_deref()),
     };
+    memprobe::stage("report");
     Ok(Diagnosis {
         report,
         run_names,
@@ -165,7 +194,7 @@ pub fn diagnose_with(
         unit_rows: folds.unit_rows.clone(),
         t_s: st.t_s.clone(),
         time_axis: time_axis(runs),
-        temp_c: st.temp_c.clone(),
+        temp_c: st.temp_c.to_vec(),
         drift_dph: base.prepared.target().to_vec(),
         baseline_residual: base.cv.residual.clone(),
         extended_residual: ext_resid,
@@ -185,6 +214,7 @@ fn layout_and_base(
     let run_lengths: Vec<usize> = campaign.runs.iter().map(|s| s.t_s.len()).collect();
     let (folds, device_choice) =
         validation::buffer::choose_buffered(Folds::new(&run_lengths)?, &device_rate, rule)?;
+    memprobe::stage("layout: device-rate stack + buffered folds");
     let (st, choice) =
         base::bases::choose_with_rate_window(campaign, &folds, (device_rate, device_choice))?;
     Ok((folds, st, choice))
