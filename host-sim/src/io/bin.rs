@@ -126,10 +126,6 @@ impl WindowBinner {
             self.settle_period();
         }
         self.close();
-        // Grown by doubling: the slack (up to half) would be held as long as the run.
-        for column in &mut self.out {
-            column.shrink_to_fit();
-        }
         self.out
     }
 }
