@@ -91,46 +91,32 @@ pub fn diagnose_with(
     rule: validation::buffer::BufferRule,
 ) -> Result<Diagnosis, DiagnoseError> {
     let campaign = input::prepare(runs)?;
-    memprobe::stage("input::prepare");
     let (folds, mut st, choice) = layout_and_base(&campaign, rule)?;
-    memprobe::stage("layout_and_base");
     let base = &choice.chosen;
     let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
     let latitude = latitude_of(&campaign);
     let meta = library::generic::metadata(runs);
     let (library, cap_note) = library_of(&campaign, &meta, st.temp_rate_half_s);
-    memprobe::stage("library");
     let (mut screening, between_run, groups) =
         screen_both(&campaign, &meta, &folds, &st, &choice, &library, latitude)?;
-    memprobe::stage("screen_both");
     screening.skipped.extend(cap_note);
     let named = screening.steps.first();
     let cause = named.map(|s| Cause::from(&s.scored.cand));
-    let sim_design = simulator::simfit::SimDesign::new(&campaign);
-    memprobe::stage("SimDesign::new");
-    let sim = simulator::simfit::calibrate(
-        &sim_design,
-        &folds.run_rows,
-        &st.y,
-        named.map(|s| s.cols.as_slice()),
-    )?;
-    memprobe::stage("simulator::calibrate");
-    let (extended, ext_resid) = extended_model(base, &screening);
+    let (sim_design, sim) = simulator_stage(&campaign, &folds, &st, named)?;
     let causal_derivative = named
         .and_then(|s| library::causal::check(&campaign, &folds, base, &s.scored.cand, &s.cols));
-    memprobe::stage("extended_model + causal::check");
+    let (extended, ext_resid) = extended_model(base, &screening);
     let named_feature = named.map(|s| uncertainty::NamedFeature {
         label: s.scored.cand.label(),
         cols: &s.cols,
     });
     let uncertainty = uncertainty::estimate(&sim_design, &folds, &st, base, named_feature.as_ref());
-    // The simulator's design (15 columns a row with the lag's shifted copies) is not
+    // The simulator's design (its rows' times; rows are computed on demand) is not
     // needed past here: freed before the later stages' own per-row peaks (memory).
     memprobe::stage("uncertainty::estimate");
     drop(sim_design);
     let azimuth = azimuth(&campaign, &folds, &st, base, &ext_resid, latitude);
     let named_causes = named_causes(&folds, &st, base, &screening, &between_run, latitude);
-    memprobe::stage("azimuth + named_causes");
     let smallest_attainable_p = validation::signflip::smallest_p(folds.unit_rows.len());
     let silent = cause.is_none() && between_run.named.is_none();
     let rerun = selection::power::Rerun {
@@ -186,7 +172,6 @@ pub fn diagnose_with(
         raw_rows: None,
         simulation: simulation_summary(sim, &sim_terms, cause_column.as_deref()),
     };
-    memprobe::stage("report");
     Ok(Diagnosis {
         report,
         run_names,
@@ -210,6 +195,7 @@ fn layout_and_base(
     campaign: &input::Campaign,
     rule: validation::buffer::BufferRule,
 ) -> Result<(Folds, Stacked, base::bases::BaseChoice), DiagnoseError> {
+    memprobe::stage("input::prepare");
     let device_rate = Stacked::with_rate_half_width(campaign, base::bases::device_rate_half_s());
     let run_lengths: Vec<usize> = campaign.runs.iter().map(|s| s.t_s.len()).collect();
     let (folds, device_choice) =
@@ -217,7 +203,34 @@ fn layout_and_base(
     memprobe::stage("layout: device-rate stack + buffered folds");
     let (st, choice) =
         base::bases::choose_with_rate_window(campaign, &folds, (device_rate, device_choice))?;
+    memprobe::stage("layout_and_base");
     Ok((folds, st, choice))
+}
+
+/// The simulator's physics calibrated to the campaign (`simulator`), with its design
+/// (the uncertainty stage refits on it).
+fn simulator_stage(
+    campaign: &input::Campaign,
+    folds: &Folds,
+    st: &Stacked,
+    named: Option<&selection::screen::Step>,
+) -> Result<
+    (
+        simulator::simfit::SimDesign,
+        simulator::simfit::SimCalibration,
+    ),
+    DiagnoseError,
+> {
+    let sim_design = simulator::simfit::SimDesign::new(campaign);
+    memprobe::stage("SimDesign::new");
+    let sim = simulator::simfit::calibrate(
+        &sim_design,
+        &folds.run_rows,
+        &st.y,
+        named.map(|s| s.cols.as_slice()),
+    )?;
+    memprobe::stage("simulator::calibrate");
+    Ok((sim_design, sim))
 }
 
 /// The campaign's latitude (the first run that states one), else the default.
@@ -271,6 +284,7 @@ fn library_of(
     Option<selection::screen::Skipped>,
 ) {
     let (library, left_out) = library::generic::enumerate(campaign, meta, rate_half_s);
+    memprobe::stage("library");
     let note = (left_out > 0).then(|| {
         (
             format!("{left_out} candidates"),
@@ -319,6 +333,7 @@ fn screen_both(
             note: Some(note),
         },
     };
+    memprobe::stage("screen_both");
     Ok((screening, between_run, groups))
 }
 
@@ -328,6 +343,7 @@ fn extended_model(base: &base::bases::BaseFit, screening: &Screening) -> (Extend
     let mut inputs = base.spec.inputs();
     inputs.extend(screening.steps.iter().map(|s| s.scored.cand.label()));
     let cv = screening.final_cv(base);
+    memprobe::stage("extended_model + causal::check");
     (
         Extended {
             inputs,
@@ -391,6 +407,7 @@ fn named_causes(
         });
     }
     out.sort_by(|a, b| b.heldout_sse_drop.total_cmp(&a.heldout_sse_drop));
+    memprobe::stage("azimuth + named_causes");
     out
 }
 

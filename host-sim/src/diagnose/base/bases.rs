@@ -201,25 +201,46 @@ fn zscore(v: &[f64]) -> Vec<f64> {
     v.iter().map(|x| (x - m) / sd).collect()
 }
 
-/// A polynomial base's design, rows on demand from the stacked columns (shared, never
-/// copied): z, z^2, .. z^degree of normalised T, then normalised dT/dt.
+/// A stacked column (shared, never copied) with the mean and standard deviation that
+/// normalise it (`zscore_params`).
+#[derive(Debug)]
+struct Normalised {
+    values: std::sync::Arc<Vec<f64>>,
+    mean: f64,
+    sd: f64,
+}
+
+impl Normalised {
+    fn new(values: &std::sync::Arc<Vec<f64>>) -> Self {
+        let (mean, sd) = zscore_params(values);
+        Self {
+            values: values.clone(),
+            mean,
+            sd,
+        }
+    }
+
+    fn at(&self, i: usize) -> f64 {
+        (self.values[i] - self.mean) / self.sd
+    }
+}
+
+/// A polynomial base's design, rows on demand from the stacked columns: z, z^2, ..
+/// z^degree of normalised T, then normalised dT/dt.
 #[derive(Debug)]
 struct PolyRows {
-    temp_c: std::sync::Arc<Vec<f64>>,
-    /// Mean and standard deviation normalising T (`zscore_params`).
-    temp_norm: (f64, f64),
+    temp: Normalised,
     degree: u8,
-    /// dT/dt and its normalisation, when the base uses it.
-    rate: Option<(std::sync::Arc<Vec<f64>>, (f64, f64))>,
+    /// dT/dt, when the base uses it.
+    rate: Option<Normalised>,
 }
 
 impl PolyRows {
     fn new(st: &Stacked, degree: u8, uses_rate: bool) -> Self {
         Self {
-            temp_c: st.temp_c.clone(),
-            temp_norm: zscore_params(&st.temp_c),
+            temp: Normalised::new(&st.temp_c),
             degree,
-            rate: uses_rate.then(|| (st.temp_rate_cps.clone(), zscore_params(&st.temp_rate_cps))),
+            rate: uses_rate.then(|| Normalised::new(&st.temp_rate_cps)),
         }
     }
 }
@@ -230,14 +251,13 @@ impl Design for PolyRows {
     }
 
     fn row(&self, i: usize, out: &mut [f64]) {
-        let (m, sd) = self.temp_norm;
-        let z = (self.temp_c[i] - m) / sd;
+        let z = self.temp.at(i);
         let d = usize::from(self.degree);
         for (k, o) in out[..d].iter_mut().enumerate() {
             *o = z.powi(k as i32 + 1);
         }
-        if let Some((rate, (m, sd))) = &self.rate {
-            out[d] = (rate[i] - m) / sd;
+        if let Some(rate) = &self.rate {
+            out[d] = rate.at(i);
         }
     }
 }
