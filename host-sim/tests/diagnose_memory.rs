@@ -12,7 +12,7 @@
 //! were built one fold at a time and the residuals of each degree dropped after
 //! scoring); 149-157 B/row since the simulator's design and the bases compute their rows
 //! on demand (154 before: at these sizes the peak is still the trainer cross-check's, the
-//! diagnosis' own gain shows on long campaigns). The bound is 200 B/row, a third above
+//! diagnosis' own gain shows on long campaigns). The bound is 200 B/row, 27-34 % above
 //! what is measured. Measured figures and the 316,800-row campaign (226 B/row whole,
 //! 167 B/row slope from 63,360 rows): docs/diagnose.md, "Memory".
 
