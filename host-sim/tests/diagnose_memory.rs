@@ -10,15 +10,20 @@
 //! cap of 500), so its Grams add to the slope: at 120 min the same measurement reads
 //! 464 B/row, at 240 min 171 B/row (1,513 and 507 B/row before the trainer's Grams
 //! were built one fold at a time and the residuals of each degree dropped after
-//! scoring). Measured figures and the 316,800-row campaign: docs/diagnose.md, "Memory".
+//! scoring); 149-157 B/row since the simulator's design and the bases compute their rows
+//! on demand (154 before: at these sizes the peak is still the trainer cross-check's, the
+//! diagnosis' own gain shows on long campaigns). The bound is 200 B/row, 27-34 % above
+//! what is measured. Measured figures and the 316,800-row campaign (226 B/row whole,
+//! 167 B/row slope from 63,360 rows): docs/diagnose.md, "Memory".
 
 mod app_support;
 
 use std::path::Path;
 use std::process::Command;
 
-/// The bound, bytes of peak RSS per 10 s row.
-const MAX_BYTES_PER_ROW: f64 = 300.0;
+/// The bound, bytes of peak RSS per 10 s row (the 300, tightened to what the
+/// diagnosis now needs plus a margin: 149-157 measured).
+const MAX_BYTES_PER_ROW: f64 = 200.0;
 /// Run-count ratio between the large and the small campaign.
 const SCALE: usize = 3;
 
@@ -66,7 +71,7 @@ fn rows_of(camp: &Path) -> usize {
 }
 
 #[test]
-fn diagnose_peak_memory_grows_at_most_300_bytes_per_row() {
+fn diagnose_peak_memory_grows_at_most_200_bytes_per_row() {
     let minutes = std::env::var("DIAG_MEM_MINUTES").unwrap_or_else(|_| "240".into());
     let dir = tempfile_dir();
     let mut points = Vec::new();

@@ -3,6 +3,7 @@
 
 use crate::diagnose::diagnose;
 use crate::diagnose::input::rawrows;
+use crate::diagnose::memprobe;
 use crate::diagnose::report::{self, olscheck, plots};
 use crate::io::{write_atomic, OutputGuard};
 use anyhow::Context;
@@ -26,9 +27,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     // Streamed into 10 s windows (memory grows with windows, not rows, at any row rate);
     // the raw rows are analysed on the way (Allan deviation, quantisation, steps).
     let (runs, raw) = rawrows::read_runs(&args.runs)?;
+    memprobe::stage("read_runs");
     let mut d = diagnose(&runs).context("diagnose")?;
     d.report.raw_rows = Some(raw);
     print!("{}", report::render_text(&d.report));
+    if args.outputs.plots.is_none() {
+        // Only the plots read the per-row series (memory: freed before the cross-check).
+        d.drop_series();
+    }
+    memprobe::stage("diagnose (after the report)");
     let check = if runs.len() >= 4 {
         match olscheck::ols_check(&runs, d.report.named_cause.as_ref()) {
             Ok(c) => {
@@ -51,6 +58,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     } else {
         None
     };
+    memprobe::stage("olscheck");
     if let Some(path) = &args.outputs.json {
         let mut value = serde_json::to_value(&d.report)?;
         value["ols_trainer_check"] = serde_json::to_value(&check)?;

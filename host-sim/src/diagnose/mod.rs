@@ -19,6 +19,7 @@ pub mod error;
 pub mod input;
 pub mod library;
 pub mod linalg;
+pub mod memprobe;
 pub mod report;
 pub mod selection;
 pub mod simulator;
@@ -62,6 +63,23 @@ pub struct Diagnosis {
     pub sim_terms: Vec<Vec<crate::sim::DriftTerm>>,
 }
 
+impl Diagnosis {
+    /// Frees the per-row series (only the plots read them; the report keeps everything
+    /// else): five or six values per row the later stages of the command need not hold.
+    pub fn drop_series(&mut self) {
+        for v in [
+            &mut self.t_s,
+            &mut self.temp_c,
+            &mut self.drift_dph,
+            &mut self.baseline_residual,
+            &mut self.extended_residual,
+        ] {
+            *v = Vec::new();
+        }
+        self.cause_feature = None;
+    }
+}
+
 /// Runs the whole diagnosis on a campaign.
 pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
     diagnose_with(runs, validation::buffer::BufferRule::default())
@@ -84,23 +102,18 @@ pub fn diagnose_with(
     screening.skipped.extend(cap_note);
     let named = screening.steps.first();
     let cause = named.map(|s| Cause::from(&s.scored.cand));
-    let sim_design = simulator::simfit::SimDesign::new(&campaign);
-    let sim = simulator::simfit::calibrate(
-        &sim_design,
-        &folds.run_rows,
-        &st.y,
-        named.map(|s| s.cols.as_slice()),
-    )?;
-    let (extended, ext_resid) = extended_model(base, &screening);
+    let (sim_design, sim) = simulator_stage(&campaign, &folds, &st, named)?;
     let causal_derivative = named
         .and_then(|s| library::causal::check(&campaign, &folds, base, &s.scored.cand, &s.cols));
+    let (extended, ext_resid) = extended_model(base, &screening);
     let named_feature = named.map(|s| uncertainty::NamedFeature {
         label: s.scored.cand.label(),
         cols: &s.cols,
     });
     let uncertainty = uncertainty::estimate(&sim_design, &folds, &st, base, named_feature.as_ref());
-    // The simulator's design (15 columns a row with the lag's shifted copies) is not
+    // The simulator's design (its rows' times; rows are computed on demand) is not
     // needed past here: freed before the later stages' own per-row peaks (memory).
+    memprobe::stage("uncertainty::estimate");
     drop(sim_design);
     let azimuth = azimuth(&campaign, &folds, &st, base, &ext_resid, latitude);
     let named_causes = named_causes(&folds, &st, base, &screening, &between_run, latitude);
@@ -112,6 +125,7 @@ pub fn diagnose_with(
     };
     let power_check =
         selection::power::check(silent, &campaign, &folds, &mut st, base, &screening, rerun)?;
+    memprobe::stage("power::check");
     let words = cause_in_words(
         cause.as_ref(),
         &named_causes,
@@ -165,7 +179,7 @@ pub fn diagnose_with(
         unit_rows: folds.unit_rows.clone(),
         t_s: st.t_s.clone(),
         time_axis: time_axis(runs),
-        temp_c: st.temp_c.clone(),
+        temp_c: st.temp_c.to_vec(),
         drift_dph: base.prepared.target().to_vec(),
         baseline_residual: base.cv.residual.clone(),
         extended_residual: ext_resid,
@@ -181,13 +195,42 @@ fn layout_and_base(
     campaign: &input::Campaign,
     rule: validation::buffer::BufferRule,
 ) -> Result<(Folds, Stacked, base::bases::BaseChoice), DiagnoseError> {
+    memprobe::stage("input::prepare");
     let device_rate = Stacked::with_rate_half_width(campaign, base::bases::device_rate_half_s());
     let run_lengths: Vec<usize> = campaign.runs.iter().map(|s| s.t_s.len()).collect();
     let (folds, device_choice) =
         validation::buffer::choose_buffered(Folds::new(&run_lengths)?, &device_rate, rule)?;
+    memprobe::stage("layout: device-rate stack + buffered folds");
     let (st, choice) =
         base::bases::choose_with_rate_window(campaign, &folds, (device_rate, device_choice))?;
+    memprobe::stage("layout_and_base");
     Ok((folds, st, choice))
+}
+
+/// The simulator's physics calibrated to the campaign (`simulator`), with its design
+/// (the uncertainty stage refits on it).
+fn simulator_stage(
+    campaign: &input::Campaign,
+    folds: &Folds,
+    st: &Stacked,
+    named: Option<&selection::screen::Step>,
+) -> Result<
+    (
+        simulator::simfit::SimDesign,
+        simulator::simfit::SimCalibration,
+    ),
+    DiagnoseError,
+> {
+    let sim_design = simulator::simfit::SimDesign::new(campaign);
+    memprobe::stage("SimDesign::new");
+    let sim = simulator::simfit::calibrate(
+        &sim_design,
+        &folds.run_rows,
+        &st.y,
+        named.map(|s| s.cols.as_slice()),
+    )?;
+    memprobe::stage("simulator::calibrate");
+    Ok((sim_design, sim))
 }
 
 /// The campaign's latitude (the first run that states one), else the default.
@@ -241,6 +284,7 @@ fn library_of(
     Option<selection::screen::Skipped>,
 ) {
     let (library, left_out) = library::generic::enumerate(campaign, meta, rate_half_s);
+    memprobe::stage("library");
     let note = (left_out > 0).then(|| {
         (
             format!("{left_out} candidates"),
@@ -289,6 +333,7 @@ fn screen_both(
             note: Some(note),
         },
     };
+    memprobe::stage("screen_both");
     Ok((screening, between_run, groups))
 }
 
@@ -298,6 +343,7 @@ fn extended_model(base: &base::bases::BaseFit, screening: &Screening) -> (Extend
     let mut inputs = base.spec.inputs();
     inputs.extend(screening.steps.iter().map(|s| s.scored.cand.label()));
     let cv = screening.final_cv(base);
+    memprobe::stage("extended_model + causal::check");
     (
         Extended {
             inputs,
@@ -361,6 +407,7 @@ fn named_causes(
         });
     }
     out.sort_by(|a, b| b.heldout_sse_drop.total_cmp(&a.heldout_sse_drop));
+    memprobe::stage("azimuth + named_causes");
     out
 }
 

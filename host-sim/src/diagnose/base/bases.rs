@@ -162,16 +162,25 @@ pub fn device_rate_half_s() -> f64 {
 pub fn choose_with_rate_window(
     campaign: &crate::diagnose::input::Campaign,
     folds: &Folds,
-    (st, device): (Stacked, BaseChoice),
+    (mut st, device): (Stacked, BaseChoice),
 ) -> Result<(Stacked, BaseChoice), DiagnoseError> {
     let device_half_s = st.temp_rate_half_s;
     let loo_half_s = campaign.half_width_s("temp_c", 1);
     if (loo_half_s - device_half_s).abs() < 1e-9 {
         return Ok((st, device));
     }
-    let st_loo = Stacked::with_rate_half_width(campaign, loo_half_s);
-    let Ok(loo) = choose(folds, &st_loo) else {
-        return Ok((st, device));
+    // Only dT/dt differs between the two stacks: it is swapped in, and back if the
+    // device's window stays (memory: never two stacked campaigns).
+    let loo_rate = std::sync::Arc::new(Stacked::rate_column(campaign, loo_half_s));
+    let device_rate = std::mem::replace(&mut st.temp_rate_cps, loo_rate);
+    st.temp_rate_half_s = loo_half_s;
+    let back_to_device = |mut st: Stacked| {
+        st.temp_rate_cps = device_rate;
+        st.temp_rate_half_s = device_half_s;
+        st
+    };
+    let Ok(loo) = choose(folds, &st) else {
+        return Ok((back_to_device(st), device));
     };
     let gains = crate::diagnose::selection::screen::unit_gains(&device.chosen.cv, &loo.chosen.cv);
     let p = crate::diagnose::validation::signflip::paired_pvalue(
@@ -179,9 +188,9 @@ pub fn choose_with_rate_window(
         crate::diagnose::selection::screen::FLIP_SEED,
     );
     if loo.chosen.cv.rms() < device.chosen.cv.rms() && p < RATE_WINDOW_ALPHA {
-        Ok((st_loo, loo))
+        Ok((st, loo))
     } else {
-        Ok((st, device))
+        Ok((back_to_device(st), device))
     }
 }
 
@@ -198,27 +207,76 @@ fn zscore(v: &[f64]) -> Vec<f64> {
     v.iter().map(|x| (x - m) / sd).collect()
 }
 
-/// Design columns of a polynomial base: z, z^2, .. z^degree of normalised T, then dT/dt.
-fn poly_columns(st: &Stacked, degree: u8, uses_rate: bool) -> Vec<Vec<f64>> {
-    let z = zscore(&st.temp_c);
-    let mut cols: Vec<Vec<f64>> = (1..=i32::from(degree))
-        .map(|k| z.iter().map(|x| x.powi(k)).collect())
-        .collect();
-    if uses_rate {
-        cols.push(zscore(&st.temp_rate_cps));
-    }
-    cols
+/// A stacked column (shared, never copied) with the mean and standard deviation that
+/// normalise it (`zscore_params`).
+#[derive(Debug)]
+struct Normalised {
+    values: std::sync::Arc<Vec<f64>>,
+    mean: f64,
+    sd: f64,
 }
 
-/// Fits a linear-in-parameters base choosing the ridge on held-out data. The columns are
-/// taken by value so they are held once (memory: up to four columns per row).
+impl Normalised {
+    fn new(values: &std::sync::Arc<Vec<f64>>) -> Self {
+        let (mean, sd) = zscore_params(values);
+        Self {
+            values: values.clone(),
+            mean,
+            sd,
+        }
+    }
+
+    fn at(&self, i: usize) -> f64 {
+        (self.values[i] - self.mean) / self.sd
+    }
+}
+
+/// A polynomial base's design, rows on demand from the stacked columns: z, z^2, ..
+/// z^degree of normalised T, then normalised dT/dt.
+#[derive(Debug)]
+struct PolyRows {
+    temp: Normalised,
+    degree: u8,
+    /// dT/dt, when the base uses it.
+    rate: Option<Normalised>,
+}
+
+impl PolyRows {
+    fn new(st: &Stacked, degree: u8, uses_rate: bool) -> Self {
+        Self {
+            temp: Normalised::new(&st.temp_c),
+            degree,
+            rate: uses_rate.then(|| Normalised::new(&st.temp_rate_cps)),
+        }
+    }
+}
+
+impl Design for PolyRows {
+    fn width(&self) -> usize {
+        usize::from(self.degree) + usize::from(self.rate.is_some())
+    }
+
+    fn row(&self, i: usize, out: &mut [f64]) {
+        let z = self.temp.at(i);
+        let d = usize::from(self.degree);
+        for (k, o) in out[..d].iter_mut().enumerate() {
+            *o = z.powi(k as i32 + 1);
+        }
+        if let Some(rate) = &self.rate {
+            out[d] = rate.at(i);
+        }
+    }
+}
+
+/// Fits a linear-in-parameters base choosing the ridge on held-out data. Its rows are
+/// computed on demand (memory: nothing per row is held but the fit's own target).
 fn fit_linear(
     folds: &Folds,
     spec: BaseSpec,
-    cols: Vec<Vec<f64>>,
+    design: std::sync::Arc<dyn Design>,
     y: &[f64],
 ) -> Result<BaseFit, DiagnoseError> {
-    let mut prepared = Prepared::from_owned(folds, cols, y, RIDGES[0]);
+    let mut prepared = Prepared::from_design(folds, design, y, RIDGES[0]);
     let mut best: Option<(f64, CvResult)> = None;
     for ridge in RIDGES {
         prepared.set_ridge(ridge);
@@ -288,8 +346,8 @@ pub fn fit(folds: &Folds, st: &Stacked, spec: &BaseSpec) -> Result<BaseFit, Diag
             basis: Some(r.basis),
         });
     }
-    let cols = poly_columns(st, spec.poly_degree_t.unwrap_or(0), spec.uses_rate);
-    fit_linear(folds, spec.clone(), cols, &st.y)
+    let design = PolyRows::new(st, spec.poly_degree_t.unwrap_or(0), spec.uses_rate);
+    fit_linear(folds, spec.clone(), std::sync::Arc::new(design), &st.y)
 }
 
 /// Within-run parameters of a base: polynomial degree + 1 for dT/dt (the constant 0);
@@ -515,11 +573,11 @@ mod tests {
         let white: Vec<f64> = (0..n).map(|_| rng.random::<f64>() - 0.5).collect();
         let noise = |i: usize| 0.01 * white[i];
         let mk = |y: Vec<f64>| Stacked {
-            temp_rate_cps: temp.iter().map(|t| t.sin()).collect(),
+            temp_rate_cps: std::sync::Arc::new(temp.iter().map(|t| t.sin()).collect()),
             temp_rate_half_s: 0.0,
             y,
             t_s: t_s.clone(),
-            temp_c: temp.clone(),
+            temp_c: std::sync::Arc::new(temp.clone()),
             run_lengths: lens.to_vec(),
         };
         let cubic = mk((0..n)

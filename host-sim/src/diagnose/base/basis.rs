@@ -15,9 +15,9 @@ impl RbfBasis {
     /// Builds the basis for `inputs` (one Vec per input, equal lengths): z-score
     /// normalisation, `k` k-means centres (deterministic farthest-point start), and
     /// width = `width_factor` x the mean distance from a centre to its nearest other centre.
-    pub fn fit(inputs: &[Vec<f64>], k: usize, width_factor: f64) -> Self {
+    pub fn fit(inputs: &[&[f64]], k: usize, width_factor: f64) -> Self {
         let d = inputs.len();
-        let n = inputs.first().map_or(0, Vec::len);
+        let n = inputs.first().map_or(0, |c| c.len());
         let mut mean = vec![0.0; d];
         let mut scale = vec![1.0; d];
         for j in 0..d {
@@ -32,8 +32,7 @@ impl RbfBasis {
             .flat_map(|i| (0..d).map(move |j| (i, j)))
             .map(|(i, j)| (inputs[j][i] - mean[j]) / scale[j])
             .collect();
-        let pts: Vec<&[f64]> = flat.chunks_exact(d.max(1)).collect();
-        let centres = kmeans(&pts, k.min(n).max(1));
+        let centres = kmeans_flat(&flat, d, k.min(n).max(1));
         let spacing = mean_nearest_distance(&centres).max(1e-3);
         Self {
             mean,
@@ -46,12 +45,6 @@ impl RbfBasis {
     /// Number of design columns: one per centre, then the inputs.
     pub fn width(&self) -> usize {
         self.centres.len() + self.mean.len()
-    }
-
-    /// Row `i` of the design into `out` (`width()` long): one Gaussian per centre, then
-    /// the normalised inputs.
-    pub fn row_into(&self, inputs: &[Vec<f64>], i: usize, out: &mut [f64]) {
-        self.row_with(|j| inputs[j][i], out);
     }
 
     /// The design's row at the raw input values `raw(j)` (j over the inputs) into `out`.
@@ -69,27 +62,13 @@ impl RbfBasis {
             *g = (-r2 * inv).exp();
         }
     }
-
-    /// The design columns: one Gaussian per centre, then the normalised inputs (use
-    /// [`RbfDesign`] where the rows can be streamed: n x columns is the memory's largest
-    /// item).
-    pub fn columns(&self, inputs: &[Vec<f64>]) -> Vec<Vec<f64>> {
-        let n = inputs.first().map_or(0, Vec::len);
-        let mut cols: Vec<Vec<f64>> = (0..self.width()).map(|_| Vec::with_capacity(n)).collect();
-        let mut row = vec![0.0; self.width()];
-        for i in 0..n {
-            self.row_into(inputs, i, &mut row);
-            cols.iter_mut().zip(&row).for_each(|(c, v)| c.push(*v));
-        }
-        cols
-    }
 }
 
 /// An RBF design given by its rows: the basis on `inputs`, then `linear` columns.
 #[derive(Clone, Debug)]
 pub struct RbfDesign {
     pub basis: RbfBasis,
-    pub inputs: std::sync::Arc<Vec<Vec<f64>>>,
+    pub inputs: std::sync::Arc<Vec<std::sync::Arc<Vec<f64>>>>,
     pub linear: std::sync::Arc<Vec<Vec<f64>>>,
 }
 
@@ -100,7 +79,7 @@ impl crate::diagnose::validation::design::Design for RbfDesign {
 
     fn row(&self, i: usize, out: &mut [f64]) {
         let b = self.basis.width();
-        self.basis.row_into(&self.inputs, i, &mut out[..b]);
+        self.basis.row_with(|j| self.inputs[j][i], &mut out[..b]);
         for (o, c) in out[b..].iter_mut().zip(self.linear.iter()) {
             *o = c[i];
         }
@@ -142,12 +121,24 @@ fn mean_nearest_distance(c: &[Vec<f64>]) -> f64 {
 /// ridge on held-out data anyway. linfa was deterministic (same seed twice, 1 vs 2
 /// threads), so that was not the reason.
 pub fn kmeans<P: AsRef<[f64]>>(pts: &[P], k: usize) -> Vec<Vec<f64>> {
-    if pts.is_empty() {
+    lloyd(pts.len(), |i| pts[i].as_ref(), k)
+}
+
+/// [`kmeans`] on `flat.len() / d` points of `d` values each, stored one after another
+/// (no slice per point: 16 B a point less, memory).
+pub fn kmeans_flat(flat: &[f64], d: usize, k: usize) -> Vec<Vec<f64>> {
+    let d = d.max(1);
+    lloyd(flat.len() / d, |i| &flat[i * d..(i + 1) * d], k)
+}
+
+/// Lloyd's iterations of [`kmeans`] on `n` points given by `point`.
+fn lloyd<'a>(n: usize, point: impl Fn(usize) -> &'a [f64], k: usize) -> Vec<Vec<f64>> {
+    if n == 0 {
         return vec![vec![]];
     }
-    let d = pts[0].as_ref().len();
-    let mut centres = vec![pts[0].as_ref().to_vec()];
-    let mut near: Vec<f64> = pts.iter().map(|p| dist2(p, &pts[0])).collect();
+    let d = point(0).len();
+    let mut centres = vec![point(0).to_vec()];
+    let mut near: Vec<f64> = (0..n).map(|i| dist2(point(i), point(0))).collect();
     while centres.len() < k {
         let (far, &dmax) = near
             .iter()
@@ -157,25 +148,27 @@ pub fn kmeans<P: AsRef<[f64]>>(pts: &[P], k: usize) -> Vec<Vec<f64>> {
         if dmax <= 1e-18 {
             break;
         }
-        centres.push(pts[far].as_ref().to_vec());
-        for (i, p) in pts.iter().enumerate() {
-            near[i] = near[i].min(dist2(p, &pts[far]));
+        centres.push(point(far).to_vec());
+        for (i, nearest) in near.iter_mut().enumerate() {
+            *nearest = nearest.min(dist2(point(i), point(far)));
         }
     }
-    let mut assign = vec![0usize; pts.len()];
+    // Centre indices (at most a few dozen centres): 4 B a point.
+    let mut assign = vec![0u32; n];
     for _ in 0..12 {
         let mut changed = false;
-        for (i, p) in pts.iter().enumerate() {
+        for (i, a) in assign.iter_mut().enumerate() {
+            let p = point(i);
             let best = (0..centres.len())
                 .min_by(|&a, &b| dist2(p, &centres[a]).total_cmp(&dist2(p, &centres[b])))
-                .unwrap_or(0);
-            changed |= best != assign[i];
-            assign[i] = best;
+                .unwrap_or(0) as u32;
+            changed |= best != *a;
+            *a = best;
         }
         let mut sum = vec![vec![0.0; d]; centres.len()];
         let mut cnt = vec![0usize; centres.len()];
-        for (p, &a) in pts.iter().zip(&assign) {
-            let p = p.as_ref();
+        for (i, &a) in assign.iter().enumerate() {
+            let (p, a) = (point(i), a as usize);
             cnt[a] += 1;
             for j in 0..d {
                 sum[a][j] += p[j];

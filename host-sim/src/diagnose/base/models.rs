@@ -8,6 +8,7 @@ use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
 use crate::diagnose::library::derivatives;
 use crate::diagnose::validation::cv::{CvResult, Folds, Prepared};
+use std::sync::Arc;
 
 /// Width factors tried (x mean centre spacing).
 pub const WIDTH_FACTORS: [f64; 3] = [0.5, 1.0, 2.0];
@@ -16,13 +17,15 @@ pub const RIDGES: [f64; 4] = [1e-6, 1e-4, 1e-2, 1e-1];
 /// Centre counts tried, as fractions of `centre_count`.
 pub const CENTRE_FRACTIONS: [f64; 2] = [0.5, 1.0];
 
-/// The campaign stacked run after run.
+/// The campaign stacked run after run. Temperature and dT/dt are shared (`Arc`) with the
+/// bases built on them (memory: an RBF's inputs and a polynomial's rows are read from
+/// these columns, never copied).
 #[derive(Clone, Debug)]
 pub struct Stacked {
     pub y: Vec<f64>,
     pub t_s: Vec<f64>,
-    pub temp_c: Vec<f64>,
-    pub temp_rate_cps: Vec<f64>,
+    pub temp_c: Arc<Vec<f64>>,
+    pub temp_rate_cps: Arc<Vec<f64>>,
     /// Half-width of the centred window `temp_rate_cps` was computed over, s.
     pub temp_rate_half_s: f64,
     pub run_lengths: Vec<usize>,
@@ -38,11 +41,19 @@ impl Stacked {
         Self {
             y: cat(&|s| s.drift_dph.clone()),
             t_s: cat(&|s| s.t_s.clone()),
-            temp_c: cat(&|s| s.temp_c.clone()),
-            temp_rate_cps: cat(&|s| derivatives::centred(&s.t_s, &s.temp_c, 1, rate_half_s)),
+            temp_c: Arc::new(cat(&|s| s.temp_c.clone())),
+            temp_rate_cps: Arc::new(Self::rate_column(c, rate_half_s)),
             temp_rate_half_s: rate_half_s,
             run_lengths: c.runs.iter().map(|s| s.t_s.len()).collect(),
         }
+    }
+
+    /// dT/dt of every run, stacked: a centred local polynomial over +/-`rate_half_s`.
+    pub fn rate_column(c: &Campaign, rate_half_s: f64) -> Vec<f64> {
+        c.runs
+            .iter()
+            .flat_map(|s| derivatives::centred(&s.t_s, &s.temp_c, 1, rate_half_s))
+            .collect()
     }
 }
 
@@ -65,7 +76,7 @@ pub fn centre_count(n: usize, inputs: usize) -> usize {
 /// Fits an RBF on `inputs` (plus `linear` columns) choosing width and ridge on held-out data.
 pub fn fit_rbf(
     folds: &Folds,
-    inputs: Vec<Vec<f64>>,
+    inputs: Vec<Arc<Vec<f64>>>,
     linear: Vec<Vec<f64>>,
     y: &[f64],
 ) -> Result<RbfFit, DiagnoseError> {
@@ -73,17 +84,18 @@ pub fn fit_rbf(
     // Only the best setting is remembered and rebuilt at the end. Designs are rows
     // computed on demand (`RbfDesign`): only the inputs are held, never n x centres.
     let mut best: Option<(usize, f64, f64, f64)> = None;
-    // Taken by value: the inputs are held once (memory: two columns per row).
-    let shared_inputs = std::sync::Arc::new(inputs);
-    let shared_linear = std::sync::Arc::new(linear);
+    // The inputs are shared, never copied (memory: the stacked columns serve every fit).
+    let shared_inputs = Arc::new(inputs);
+    let shared_linear = Arc::new(linear);
     let design = |k: usize, wf: f64| {
-        let basis = RbfBasis::fit(&shared_inputs, k, wf);
+        let views: Vec<&[f64]> = shared_inputs.iter().map(|c| c.as_slice()).collect();
+        let basis = RbfBasis::fit(&views, k, wf);
         let rows = RbfDesign {
             basis: basis.clone(),
             inputs: shared_inputs.clone(),
             linear: shared_linear.clone(),
         };
-        let prepared = Prepared::from_design(folds, std::sync::Arc::new(rows), y, RIDGES[0]);
+        let prepared = Prepared::from_design(folds, Arc::new(rows), y, RIDGES[0]);
         (basis, prepared)
     };
     for frac in CENTRE_FRACTIONS {

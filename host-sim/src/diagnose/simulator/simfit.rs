@@ -17,9 +17,11 @@ use crate::diagnose::base::levels::LevelSystems;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
 use crate::diagnose::linalg::solve_spd;
-use crate::diagnose::simulator::thermal::{self, ThermalFit};
+use crate::diagnose::simulator::thermal::{self, Curves, ThermalFit};
+use crate::diagnose::validation::design::{columns, Design, WithColumns};
 use crate::stats::rms;
 use serde::Serialize;
+use std::sync::Arc;
 
 /// The calibrated drift law's coefficients, in design order, with units.
 pub const LAW_TERMS: [(&str, &str); 5] = [
@@ -112,10 +114,13 @@ fn fit_with_offsets(
 /// diagnosis: in `LAW_TERMS` order T - mean T, (T - mean T)^2, dT/dt, (T - mean T) dT/dt,
 /// d2T/dt2, stacked, each divided by its rms `scale` (the raw columns differ by ten orders
 /// of magnitude, and a solver's numerical guard relative to the mean diagonal shrank the
-/// d2T/dt2 coefficient to ~0: 31.5 where the simulator has 400).
+/// d2T/dt2 coefficient to ~0: 31.5 where the simulator has 400). Its rows are computed on
+/// demand from each run's fitted coil (`LawRows`): the design and its two lag-shifted
+/// twins hold one time value per row between them, not 15 columns (memory, issue 18
+/// item 8).
 pub struct SimDesign {
-    /// Standardised columns (raw column / `scale`).
-    pub cols: Vec<Vec<f64>>,
+    /// The law's standardised rows on the fitted coil.
+    pub law: Arc<LawRows>,
     pub scale: Vec<f64>,
     /// Campaign mean of the fitted coil temperature, degC (where the coefficients apply).
     pub t_mean_c: f64,
@@ -125,48 +130,103 @@ pub struct SimDesign {
     pub lag_se_s: f64,
     pub lag_step_s: f64,
     /// Standardised designs at the lag -/+ its step (empty without a lag).
-    pub shifted: Vec<Vec<Vec<f64>>>,
+    pub shifted: Vec<LawRows>,
     pub temp_rms_c: f64,
 }
 
-/// The law's raw columns (see `SimDesign`) on coil curves, about `t_mean_c`.
-fn law_columns(c: &thermal::Curves, t_mean_c: f64) -> Vec<Vec<f64>> {
-    let dt: Vec<f64> = c.temp.iter().map(|t| t - t_mean_c).collect();
-    let squared = dt.iter().map(|d| d * d).collect();
-    let cold_gain = dt.iter().zip(&c.rate).map(|(d, r)| d * r).collect();
-    vec![dt, squared, c.rate.clone(), cold_gain, c.accel.clone()]
+/// The law's rows (see `SimDesign`) on one set of coil curves, about `t_mean_c`, each
+/// value divided by its column's `scale`: computed when asked.
+#[derive(Debug)]
+pub struct LawRows {
+    curves: Curves,
+    /// Time since power-on of every row, stacked (shared by the shifted twins).
+    t_s: Arc<Vec<f64>>,
+    /// End row (exclusive) of every run, stacked: the run of a row.
+    run_ends: Arc<Vec<usize>>,
+    t_mean_c: f64,
+    scale: Vec<f64>,
 }
 
-/// Divides every column by its `scale`.
-fn standardise(raw: Vec<Vec<f64>>, scale: &[f64]) -> Vec<Vec<f64>> {
-    raw.into_iter()
-        .zip(scale)
-        .map(|(c, k)| c.into_iter().map(|v| v / k).collect())
-        .collect()
+impl LawRows {
+    /// Row `i`'s raw values: T - mean T, its square, dT/dt, (T - mean T) dT/dt, d2T/dt2.
+    fn raw(&self, i: usize) -> [f64; 5] {
+        let run = self.run_ends.partition_point(|&end| end <= i);
+        let (temp, rate, accel) = self.curves.at(run, self.t_s[i]);
+        let d = temp - self.t_mean_c;
+        [d, d * d, rate, d * rate, accel]
+    }
+
+    /// Number of rows.
+    fn rows(&self) -> usize {
+        self.t_s.len()
+    }
+}
+
+impl Design for LawRows {
+    fn width(&self) -> usize {
+        LAW_TERMS.len()
+    }
+
+    fn row(&self, i: usize, out: &mut [f64]) {
+        for ((o, v), k) in out.iter_mut().zip(self.raw(i)).zip(&self.scale) {
+            *o = v / k;
+        }
+    }
 }
 
 impl SimDesign {
     /// Fits the thermal response (`thermal::fit`) and builds the design.
     pub fn new(c: &Campaign) -> Self {
         let th: ThermalFit = thermal::fit(c);
-        let temp = &th.curves.temp;
-        let t_mean_c = temp.iter().sum::<f64>() / temp.len().max(1) as f64;
-        let raw = law_columns(&th.curves, t_mean_c);
-        let scale: Vec<f64> = raw
-            .iter()
-            .map(|c| {
-                Some(rms(c))
+        let t_s: Arc<Vec<f64>> =
+            Arc::new(c.runs.iter().flat_map(|s| s.t_s.iter().copied()).collect());
+        let run_ends: Arc<Vec<usize>> = Arc::new(
+            c.runs
+                .iter()
+                .scan(0, |end, s| {
+                    *end += s.t_s.len();
+                    Some(*end)
+                })
+                .collect(),
+        );
+        let rows_on = |curves: Curves, t_mean_c: f64, scale: Vec<f64>| LawRows {
+            curves,
+            t_s: t_s.clone(),
+            run_ends: run_ends.clone(),
+            t_mean_c,
+            scale,
+        };
+        // Unscaled and about 0 first: the mean of T and each column's rms, summed in row
+        // order as over held columns.
+        let unscaled = rows_on(th.curves, 0.0, vec![1.0; LAW_TERMS.len()]);
+        let n = unscaled.rows();
+        let t_mean_c = (0..n).map(|i| unscaled.raw(i)[0]).sum::<f64>() / n.max(1) as f64;
+        let about_mean = LawRows {
+            t_mean_c,
+            ..unscaled
+        };
+        let scale: Vec<f64> = (0..LAW_TERMS.len())
+            .map(|k| {
+                let ms = (0..n)
+                    .map(|i| about_mean.raw(i)[k])
+                    .map(|v| v * v)
+                    .sum::<f64>()
+                    / n.max(1) as f64;
+                Some(ms.sqrt())
                     .filter(|v| *v > 0.0 && v.is_finite())
                     .unwrap_or(1.0)
             })
             .collect();
         let shifted = th
             .shifted
-            .iter()
-            .map(|cv| standardise(law_columns(cv, t_mean_c), &scale))
+            .into_iter()
+            .map(|curves| rows_on(curves, t_mean_c, scale.clone()))
             .collect();
         Self {
-            cols: standardise(raw, &scale),
+            law: Arc::new(LawRows {
+                scale: scale.clone(),
+                ..about_mean
+            }),
             scale,
             t_mean_c,
             tau_s: th.tau,
@@ -190,10 +250,11 @@ impl SimDesign {
         if self.shifted.len() != 2 || !(self.lag_se_s.is_finite() && self.lag_step_s > 0.0) {
             return None;
         }
-        let coef = |cols: &[Vec<f64>]| -> Option<Vec<f64>> {
-            let mut all = cols.to_vec();
-            all.extend(extra.iter().cloned());
-            fit_law(run_rows, &all, y).ok().map(|f| self.unscale(&f.0))
+        let coef = |law: &LawRows| -> Option<Vec<f64>> {
+            let design = WithColumns { design: law, extra };
+            fit_law(run_rows, &design, y)
+                .ok()
+                .map(|f| self.unscale(&f.0))
         };
         let (lo, hi) = (coef(&self.shifted[0])?, coef(&self.shifted[1])?);
         Some(
@@ -215,18 +276,22 @@ impl SimDesign {
 }
 
 /// The law shared across runs (`levels`, quasi-demeaning chosen on held-out runs) on
-/// the design `cols`: its coefficients (intercept dropped), the residual about each run's
-/// mean, and the per-run sums (for the bootstrap).
+/// the design `design` (rows on demand): its coefficients (intercept dropped), the
+/// residual about each run's mean, and the per-run sums (for the bootstrap).
 pub fn fit_shared(
     run_rows: &[std::ops::Range<usize>],
-    cols: &[Vec<f64>],
+    design: &dyn Design,
     y: &[f64],
 ) -> Option<(Vec<f64>, Vec<f64>, LevelSystems, f64)> {
-    let lv = LevelSystems::new(run_rows, cols, y, 0.0);
+    let lv = LevelSystems::new(run_rows, design, y, 0.0);
     let (_, theta) = lv.heldout_shared()?;
     let w = lv.solve_shared(&vec![1.0; lv.runs()], theta)?.w;
+    let mut z = vec![0.0; design.width()];
     let mut resid: Vec<f64> = (0..y.len())
-        .map(|r| y[r] - w[0] - cols.iter().zip(&w[1..]).map(|(c, b)| c[r] * b).sum::<f64>())
+        .map(|r| {
+            design.row(r, &mut z);
+            y[r] - w[0] - z.iter().zip(&w[1..]).map(|(c, b)| c * b).sum::<f64>()
+        })
         .collect();
     for rr in run_rows {
         let m = resid[rr.clone()].iter().sum::<f64>() / rr.len().max(1) as f64;
@@ -238,11 +303,11 @@ pub fn fit_shared(
 /// The drift law fitted with the level treatment the run count allows.
 fn fit_law(
     run_rows: &[std::ops::Range<usize>],
-    cols: &[Vec<f64>],
+    design: &dyn Design,
     y: &[f64],
 ) -> Result<(Vec<f64>, Vec<f64>, String), DiagnoseError> {
     if run_rows.len() >= MIN_RUNS_SHARED {
-        if let Some((coef, resid, _, theta)) = fit_shared(run_rows, cols, y) {
+        if let Some((coef, resid, _, theta)) = fit_shared(run_rows, design, y) {
             return Ok((
                 coef,
                 resid,
@@ -250,7 +315,8 @@ fn fit_law(
             ));
         }
     }
-    let (coef, resid) = fit_with_offsets(run_rows, cols, y)?;
+    // Free offsets need whole columns (fewer runs than `MIN_RUNS_SHARED`: small layouts).
+    let (coef, resid) = fit_with_offsets(run_rows, &columns(design, y.len()), y)?;
     Ok((coef, resid, "free run offsets".into()))
 }
 
@@ -262,7 +328,7 @@ pub fn calibrate(
     y: &[f64],
     effect: Option<&[Vec<f64>]>,
 ) -> Result<SimCalibration, DiagnoseError> {
-    let (coef, resid, levels) = fit_law(run_rows, &design.cols, y)?;
+    let (coef, resid, levels) = fit_law(run_rows, design.law.as_ref(), y)?;
     let coef = design.unscale(&coef);
     let mut out = SimCalibration {
         tau_fast_s: design.tau_s.0,
@@ -283,8 +349,10 @@ pub fn calibrate(
         effect_coef: vec![],
     };
     if let Some(e) = effect {
-        let mut all = design.cols.clone();
-        all.extend(e.iter().cloned());
+        let all = WithColumns {
+            design: design.law.as_ref(),
+            extra: e,
+        };
         let (coef2, resid2, _) = fit_law(run_rows, &all, y)?;
         out.after_rms_dph = Some(rms(&resid2));
         out.effect_coef = coef2[LAW_TERMS.len()..].to_vec();

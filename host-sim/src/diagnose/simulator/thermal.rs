@@ -56,13 +56,43 @@ pub struct ThermalFit {
     pub rms: f64,
 }
 
-/// The fitted coil's curves, stacked over runs in campaign order.
+/// One run's fitted coil: level + a_1 e^(-t/tau_1) + a_2 e^(-t/tau_2) (amplitudes as
+/// window means of the modes, see the module header).
+#[derive(Clone, Copy, Debug)]
+pub struct Coil {
+    pub level_c: f64,
+    pub amplitudes_c: (f64, f64),
+    pub tau_s: (f64, f64),
+}
+
+impl Coil {
+    /// The coil's temperature (degC), its rate (degC/s) and acceleration (degC/s^2) at
+    /// `t_s` after power-on.
+    pub fn at(&self, t_s: f64) -> (f64, f64, f64) {
+        let (a1, a2) = self.amplitudes_c;
+        let (t1, t2) = self.tau_s;
+        let (e1, e2) = ((-t_s / t1).exp(), (-t_s / t2).exp());
+        (
+            self.level_c + a1 * e1 + a2 * e2,
+            -a1 / t1 * e1 - a2 / t2 * e2,
+            a1 / (t1 * t1) * e1 + a2 / (t2 * t2) * e2,
+        )
+    }
+}
+
+/// The fitted coil's curves, one [`Coil`] per run in campaign order: evaluated at a row's
+/// time when asked, never held as columns (memory: three values per row per curve set,
+/// and the lag's uncertainty needs three sets).
+#[derive(Clone, Debug)]
 pub struct Curves {
-    /// Coil temperature (row window means), degC.
-    pub temp: Vec<f64>,
-    /// Its first and second time derivatives, degC/s and degC/s^2.
-    pub rate: Vec<f64>,
-    pub accel: Vec<f64>,
+    pub coils: Vec<Coil>,
+}
+
+impl Curves {
+    /// Temperature, rate and acceleration of run `run`'s coil at `t_s`.
+    pub fn at(&self, run: usize, t_s: f64) -> (f64, f64, f64) {
+        self.coils[run].at(t_s)
+    }
 }
 
 /// Mean of e^(-s/tau) over the row window (t - dt, t] divided by e^(-t/tau).
@@ -313,11 +343,12 @@ fn choose_lag(c: &Campaign) -> LagChoice {
     }
 }
 
-/// The coil's curves of every run for its pair `taus` at lag `lag_s`, and the sensor
-/// fit's sum of squares.
-fn coil_curves(c: &Campaign, taus: &[(f64, f64)], lag_s: f64) -> (Curves, f64) {
-    let (mut temp, mut rate, mut accel) = (Vec::new(), Vec::new(), Vec::new());
+/// The coil of every run for its pair `taus` at lag `lag_s`, and the sensor fit's sum
+/// of squares and row count.
+fn coil_curves(c: &Campaign, taus: &[(f64, f64)], lag_s: f64) -> (Curves, f64, usize) {
+    let mut coils = Vec::with_capacity(c.runs.len());
     let mut sse = 0.0;
+    let mut rows_total = 0;
     for (s, &(t1, t2)) in c.runs.iter().zip(taus) {
         let rows = RunRows {
             t_s: &s.t_s,
@@ -326,23 +357,23 @@ fn coil_curves(c: &Campaign, taus: &[(f64, f64)], lag_s: f64) -> (Curves, f64) {
         };
         let (b, e) = rows.fit(t1, t2, lag_s);
         sse += e;
+        rows_total += s.t_s.len();
         // The coil's amplitudes, as window means of its modes.
         let a1 = b[1] * (1.0 - lag_s / t1) * window_factor(t1, rows.row_s);
         let a2 = b[2] * (1.0 - lag_s / t2) * window_factor(t2, rows.row_s);
-        for &t in &s.t_s {
-            let (e1, e2) = ((-t / t1).exp(), (-t / t2).exp());
-            temp.push(b[0] + a1 * e1 + a2 * e2);
-            rate.push(-a1 / t1 * e1 - a2 / t2 * e2);
-            accel.push(a1 / (t1 * t1) * e1 + a2 / (t2 * t2) * e2);
-        }
+        coils.push(Coil {
+            level_c: b[0],
+            amplitudes_c: (a1, a2),
+            tau_s: (t1, t2),
+        });
     }
-    (Curves { temp, rate, accel }, sse)
+    (Curves { coils }, sse, rows_total)
 }
 
 /// Fits every run (see the module header); the reported pair is the median over runs.
 pub fn fit(c: &Campaign) -> ThermalFit {
     let lag = choose_lag(c);
-    let (curves, sse) = coil_curves(c, &lag.taus, lag.lag_s);
+    let (curves, sse, rows) = coil_curves(c, &lag.taus, lag.lag_s);
     let shifted = [-1.0, 1.0]
         .iter()
         .zip(&lag.shifted)
@@ -358,7 +389,7 @@ pub fn fit(c: &Campaign) -> ThermalFit {
         lag_se_s: lag.se_s,
         shifted,
         lag_step_s: lag.step_s,
-        rms: (sse / curves.temp.len().max(1) as f64).sqrt(),
+        rms: (sse / rows.max(1) as f64).sqrt(),
         curves,
     }
 }
@@ -439,9 +470,9 @@ mod tests {
             f.lag_se_s
         );
         // The fast mode dominates the early rate: 18 % too high if the lag were ignored.
-        let early: Vec<(f64, f64)> = f.curves.rate[..12]
+        let early: Vec<(f64, f64)> = c.runs[0].t_s[..12]
             .iter()
-            .copied()
+            .map(|&t| f.curves.at(0, t).1)
             .zip(true_rate[..12].iter().copied())
             .collect();
         for (fitted, truth) in early {

@@ -19,6 +19,7 @@ use crate::diagnose::simulator::simfit::SimDesign;
 use crate::diagnose::uncertainty::bootstrap::{draws, Estimate, REPLICATES};
 use crate::diagnose::uncertainty::jackknife::delete_one;
 use crate::diagnose::validation::cv::{Folds, Offsets, Prepared, UnitSystems};
+use crate::diagnose::validation::design::WithColumns;
 use serde::Serialize;
 
 /// A measured coefficient against the simulator's value.
@@ -287,9 +288,10 @@ fn simulator_estimates(
 ) -> (Vec<Estimate>, Vec<Ratio>) {
     let counts = &delete_one(folds.unit_rows.len());
     let jackknife: Make = |n, u, v, r| Estimate::jackknife(n, u, v, r);
-    let (mut cols, t_mean) = (sim.cols.clone(), sim.t_mean_c);
+    let t_mean = sim.t_mean_c;
     let n_law = crate::diagnose::simulator::simfit::LAW_TERMS.len();
-    let prepared = Prepared::new(folds, &cols, &st.y, 0.0);
+    // The law's rows on demand, shared with the design (never copied as columns).
+    let prepared = Prepared::from_design(folds, sim.law.clone(), &st.y, 0.0);
     let extra: &[Vec<f64>] = named.map_or(&[], |n| n.cols);
     let mut names: Vec<(String, &str)> = crate::diagnose::simulator::simfit::LAW_TERMS
         .iter()
@@ -304,8 +306,11 @@ fn simulator_estimates(
     let shared = (folds.offsets == Offsets::PerUnit
         && folds.run_rows.len() >= crate::diagnose::simulator::simfit::MIN_RUNS_SHARED)
         .then(|| {
-            cols.extend(extra.iter().cloned());
-            crate::diagnose::simulator::simfit::fit_shared(&folds.run_rows, &cols, &st.y)
+            let design = WithColumns {
+                design: sim.law.as_ref(),
+                extra,
+            };
+            crate::diagnose::simulator::simfit::fit_shared(&folds.run_rows, &design, &st.y)
         })
         .flatten();
     let mut out = match shared {

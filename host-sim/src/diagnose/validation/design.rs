@@ -36,3 +36,38 @@ impl Design for [Vec<f64>] {
         }
     }
 }
+
+/// A design followed by a few held columns (a law plus a named cause's feature), rows
+/// on demand: nothing of the design is copied.
+#[derive(Debug)]
+pub struct WithColumns<'a> {
+    pub design: &'a dyn Design,
+    pub extra: &'a [Vec<f64>],
+}
+
+impl Design for WithColumns<'_> {
+    fn width(&self) -> usize {
+        self.design.width() + self.extra.len()
+    }
+
+    fn row(&self, i: usize, out: &mut [f64]) {
+        let p = self.design.width();
+        self.design.row(i, &mut out[..p]);
+        for (o, c) in out[p..].iter_mut().zip(self.extra) {
+            *o = c[i];
+        }
+    }
+}
+
+/// Every column of a design, materialised (for the few fits that need columns: small
+/// layouts only).
+pub fn columns(design: &dyn Design, rows: usize) -> Vec<Vec<f64>> {
+    let p = design.width();
+    let mut cols: Vec<Vec<f64>> = (0..p).map(|_| Vec::with_capacity(rows)).collect();
+    let mut z = vec![0.0; p];
+    for i in 0..rows {
+        design.row(i, &mut z);
+        cols.iter_mut().zip(&z).for_each(|(c, v)| c.push(*v));
+    }
+    cols
+}
