@@ -84,14 +84,24 @@ pub fn refine_with_records(
     let crc = model_crc32(model)?;
     let is_variant = |r: &&StoredRecord| r.model_crc32.is_some_and(|c| variants.contains(&c));
     let used_variant = records.iter().filter(is_variant).count();
-    let obs: Vec<FieldObservation> = records
+    let mut used: Vec<&StoredRecord> = records
         .iter()
         .filter(|r| r.model_crc32 == Some(crc) || is_variant(r))
-        .map(|r| FieldObservation {
+        .collect();
+    used.sort_by(|a, b| (&a.gyro_id, a.sequence).cmp(&(&b.gyro_id, b.sequence)));
+    let clock: Vec<(&str, f64)> = used
+        .iter()
+        .map(|r| (r.gyro_id.as_str(), f64::from(r.t_since_power_on_s)))
+        .collect();
+    let obs: Vec<FieldObservation> = used
+        .iter()
+        .zip(refine::power_ons(&clock))
+        .map(|(r, power_on)| FieldObservation {
             temp_c: f64::from(r.temp_c),
             temp_rate_cps: f64::from(r.temp_rate_cps),
             temp_accel_cps2: f64::from(r.temp_accel_cps2),
             residual_bias_dph: f64::from(r.residual_bias_dph),
+            power_on,
         })
         .collect();
     if obs.is_empty() {
@@ -125,6 +135,15 @@ fn crc_list(crcs: &[u32]) -> String {
 }
 
 impl FieldRefinement {
+    /// Names of the first `k` identifiable terms (T, then dT/dt, as the model has them).
+    fn correction_term_names(&self, k: usize) -> impl Iterator<Item = &'static str> + '_ {
+        self.choice
+            .kinds
+            .iter()
+            .take(k)
+            .map(|&kind| refine::kind_name(kind))
+    }
+
     /// The lines `train` prints.
     pub fn summary(&self) -> String {
         let variants = if self.variants.is_empty() {
@@ -145,18 +164,35 @@ impl FieldRefinement {
             s += "field refinement: the refined model carries no heading calibration: attach \
                   it again (`fogsim heading-cal`) before uploading\n";
         }
-        if let Some(v) = self.choice.verdict {
+        for line in &self.correction.coverage {
+            s += &format!("field range: {line}\n");
+        }
+        if let Some(v) = &self.choice.verdict {
             s += &format!("field refinement: {v}\n");
             return s;
         }
-        s += "field weight W  leave-one-out rms of the residual bias, dph\n";
-        for &(w, rms) in &self.choice.loo_rms_dph {
-            let mark = if w == self.choice.weight {
+        s += &format!(
+            "terms  field weight W  leave-one-power-on-out rms of the residual bias, dph ({} power-ons)\n",
+            self.choice.power_ons
+        );
+        let names = |k: usize| {
+            std::iter::once("1")
+                .chain(self.correction_term_names(k))
+                .collect::<Vec<_>>()
+                .join("+")
+        };
+        for c in &self.choice.candidates {
+            let mark = if c.weight == self.choice.weight && c.terms == self.choice.terms_kept {
                 " <- used"
             } else {
                 ""
             };
-            s += &format!("{w:>14}  {rms:>10.5}{mark}\n");
+            s += &format!(
+                "{:<10} {:>14}  {:>10.5}{mark}\n",
+                names(c.terms),
+                c.weight,
+                c.rms_dph
+            );
         }
         s += &format!(
             "field correction: constant {:+.5} dph, terms {:?} coefficients {:?} dph per field std\n",

@@ -13,18 +13,37 @@
 //!
 //! W = 0 leaves the chamber model alone; W -> infinity trusts the field alone (plain
 //! least squares). With normalised regressors, the prior counts like 1/W field seeks per
-//! coefficient. The default W is chosen from the data: leave-one-out over the field seeks
-//! (each held out in turn, predicted by the fit on the others), the grid value with the
-//! lowest held-out rms wins, W = 0 included, so a field that does not predict itself leaves
-//! the model unchanged. With fewer than `MIN_RECORDS` records there is no test power and
-//! no correction. A term whose field spread is below its floor is left out (not
-//! identifiable from the field), and so is a term whose field values correlate with an
-//! already kept term's beyond `MAX_TERM_CORRELATION` (T is tried first, then dT/dt): at one
-//! ambient every warm-up follows the same path, T and dT/dt of the field seeks correlate at
-//! r = -0.99 (`fogsim field aging`), and a fit of both makes large opposite coefficients
-//! that fit the seeks' half-sums but move the difference between a seek's two positions,
-//! which is its azimuth (measured: rms x1.14 on the null twin with T and dT/dt, x1.003
-//! with T alone).
+//! coefficient.
+//!
+//! **Validated where it is used: on other power-ons.** The correction is used on the
+//! device's later power-ons, at whatever ambient and warm-up they have. So the weight W and
+//! the terms kept (the constant alone, + T, + T + dT/dt) are chosen together by
+//! leave-one-power-on-out (`power_ons`: a record whose time since power-on does not rise
+//! over the one before starts a new power-on): each power-on's seeks are held out in turn
+//! and predicted by the fit on the other power-ons. For each number of terms the W with
+//! the lowest held-out rms is taken (W = 0 included: the model unchanged), and of those the
+//! fewest terms whose held-out mean square is within one standard error (over power-ons)
+//! of the lowest (the one-standard-error rule): a term is kept only if it wins by more
+//! than the power-ons' scatter (without the rule the null twin kept a T term at W = 0.1
+//! that moved its azimuths by a resolved +0.4 % rms, `--ambient-c 10,20,30`, 20 seeks). A term fitted on power-ons at one ambient and held out
+//! at another is scored on exactly the extrapolation it will make in use. Leave-one-seek-out
+//! could not see that: the seeks of one power-on lie inside each other's range, and the
+//! first version of this refinement, validated that way, fitted a T term on the 5 seeks of
+//! one power-on at 10 degC that made the residual bias 4x worse at 20 and 30 degC
+//! (`fogsim field aging --ambient-c 10,20,30`, Shupe twin: 0.0105 -> 0.0409 deg/h). With
+//! field records from fewer than `MIN_POWER_ONS` power-ons (or fewer than `MIN_RECORDS`
+//! records) nothing can be scored on another power-on: no test power, no correction. The
+//! report states, per term refused, the held-out rms with and without it, and the field's
+//! range of each input against the model's trained range.
+//!
+//! A term whose field spread is below its floor is left out (not identifiable from the
+//! field), and so is a term whose field values correlate with an already kept term's beyond
+//! `MAX_TERM_CORRELATION` (T is tried first, then dT/dt): at one ambient every warm-up
+//! follows the same path, T and dT/dt of the field seeks correlate at r = -0.99
+//! (`fogsim field aging`), and a fit of both makes large opposite coefficients that fit
+//! the seeks' half-sums but move the difference between a seek's two positions, which is
+//! its azimuth (measured: rms x1.14 on the null twin with T and dT/dt, x1.003 with T
+//! alone); a held-out half-sum cannot see that either.
 //!
 //! d2T/dt2 is not fitted. A record's d2T/dt2 was once the least-squares slope of dT/dt over
 //! the seek, which early in a warm-up differs from the model's own per-window input by
@@ -43,7 +62,10 @@ use fog_core::model::format::{FeatureKind, RbfModel};
 
 /// Fewer field seeks than this: no test power, no correction.
 pub const MIN_RECORDS: usize = 4;
-/// Weights tried by leave-one-out (0: the chamber model unchanged).
+/// Fewer field power-ons than this: nothing can be scored on another power-on, no
+/// correction.
+pub const MIN_POWER_ONS: usize = 2;
+/// Weights tried by leave-one-power-on-out (0: the chamber model unchanged).
 pub const WEIGHT_GRID: [f64; 12] = [
     0.0, 0.01, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0, 1000.0, 1.0e5,
 ];
@@ -52,19 +74,44 @@ const SPREAD_FLOOR: [f64; 2] = [0.05, 1.0e-5];
 /// |correlation| of a term's field values with a kept term's above which it is not fitted.
 pub const MAX_TERM_CORRELATION: f64 = 0.9;
 
-/// One field observation: the model's plain inputs at the seek and its residual bias.
+/// One field observation: the model's plain inputs at the seek, its residual bias, and
+/// the power-on it came from (`power_ons`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FieldObservation {
     pub temp_c: f64,
     pub temp_rate_cps: f64,
     pub temp_accel_cps2: f64,
     pub residual_bias_dph: f64,
+    pub power_on: usize,
 }
 
 impl FieldObservation {
     fn input(&self, kind: usize) -> f64 {
         [self.temp_c, self.temp_rate_cps, self.temp_accel_cps2][kind]
     }
+}
+
+/// The power-on of each record, numbered from 0: records in ring order (one gyro), a
+/// record whose time since power-on does not rise over the previous one's starts a new
+/// power-on (the device's clock restarts at every power-on; within one, seeks follow each
+/// other).
+/// `records`: (gyro id, time since power-on, s) in ring order per gyro; a new gyro starts a
+/// new power-on too.
+pub fn power_ons(records: &[(&str, f64)]) -> Vec<usize> {
+    let mut k = 0;
+    records
+        .iter()
+        .enumerate()
+        .map(|(i, &(gyro, t))| {
+            if let Some(&(prev_gyro, prev_t)) = i.checked_sub(1).map(|p| &records[p]) {
+                if gyro != prev_gyro || t.partial_cmp(&prev_t) != Some(std::cmp::Ordering::Greater)
+                {
+                    k += 1;
+                }
+            }
+            k
+        })
+        .collect()
 }
 
 /// A linear term: which model input (index) carries it, which record value (0 T, 1 rate,
@@ -86,6 +133,8 @@ pub struct Correction {
     pub coef_dph: Vec<f64>,
     /// Model inputs the field did not fit, and why.
     pub not_fitted: Vec<String>,
+    /// Per candidate input: the field's range against the model's trained range.
+    pub coverage: Vec<String>,
 }
 
 impl Correction {
@@ -98,14 +147,32 @@ impl Correction {
     }
 }
 
-/// How the weight was chosen.
+/// One candidate scored by leave-one-power-on-out.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Candidate {
+    /// How many of the identifiable terms (in order: T, dT/dt) it keeps.
+    pub terms: usize,
+    pub weight: f64,
+    /// Held-out rms of the residual bias after the correction, deg/h.
+    pub rms_dph: f64,
+    /// Standard error of its mean square over the power-ons, (deg/h)^2.
+    pub ms_se_dph2: f64,
+}
+
+/// How the weight and the terms were chosen.
 #[derive(Clone, Debug, PartialEq)]
 pub struct WeightChoice {
-    /// (W, leave-one-out rms of the residual bias after the correction, deg/h).
-    pub loo_rms_dph: Vec<(f64, f64)>,
+    /// Power-ons the field records come from.
+    pub power_ons: usize,
+    /// Kinds of the identifiable terms (0 T, 1 dT/dt), in the order candidates add them.
+    pub kinds: Vec<usize>,
+    /// Every candidate, scored by leave-one-power-on-out (empty: no test power).
+    pub candidates: Vec<Candidate>,
     pub weight: f64,
-    /// `None`: too few records, nothing was chosen ("no test power").
-    pub verdict: Option<&'static str>,
+    /// Identifiable terms kept (the first this many).
+    pub terms_kept: usize,
+    /// `None`: too few records or power-ons, nothing was chosen ("no test power").
+    pub verdict: Option<String>,
 }
 
 /// Name of a record value (0 T, 1 dT/dt).
@@ -219,6 +286,7 @@ pub fn fit(obs: &[FieldObservation], terms: &[Term], w: f64) -> Correction {
         terms: terms.to_vec(),
         coef_dph: solve_spd(a, b),
         not_fitted: Vec::new(),
+        coverage: Vec::new(),
     }
 }
 
@@ -245,45 +313,161 @@ fn solve_spd(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
     x
 }
 
-/// Leave-one-out rms of the residual bias after the correction fitted with `w`.
-pub fn loo_rms_dph(obs: &[FieldObservation], terms: &[Term], w: f64) -> f64 {
+/// Leave-one-power-on-out rms of the residual bias after the correction fitted with `w`
+/// on `terms` (each power-on's records predicted by the fit on the other power-ons'), and
+/// the standard error of its mean square over the power-ons, (deg/h)^2.
+pub fn held_out_rms_dph(obs: &[FieldObservation], terms: &[Term], w: f64) -> (f64, f64) {
+    let groups = obs.iter().map(|o| o.power_on).max().map_or(0, |g| g + 1);
+    let mut per_group_ms = Vec::with_capacity(groups);
     let mut ss = 0.0;
-    for i in 0..obs.len() {
-        let rest: Vec<FieldObservation> = obs
-            .iter()
-            .enumerate()
-            .filter(|&(k, _)| k != i)
-            .map(|(_, o)| *o)
-            .collect();
+    for g in 0..groups {
+        let rest: Vec<FieldObservation> = obs.iter().filter(|o| o.power_on != g).copied().collect();
         let c = fit(&rest, terms, w);
-        ss += (obs[i].residual_bias_dph - c.predict_dph(&obs[i])).powi(2);
+        let held: Vec<f64> = obs
+            .iter()
+            .filter(|o| o.power_on == g)
+            .map(|o| (o.residual_bias_dph - c.predict_dph(o)).powi(2))
+            .collect();
+        ss += held.iter().sum::<f64>();
+        if !held.is_empty() {
+            per_group_ms.push(held.iter().sum::<f64>() / held.len() as f64);
+        }
     }
-    (ss / obs.len().max(1) as f64).sqrt()
+    let se = if per_group_ms.len() >= 2 {
+        crate::stats::std_dev(&per_group_ms) / (per_group_ms.len() as f64).sqrt()
+    } else {
+        f64::INFINITY
+    };
+    ((ss / obs.len().max(1) as f64).sqrt(), se)
 }
 
-/// Chooses W by leave-one-out over the field seeks (`fixed`: use it instead, still
-/// reporting the held-out rms of every grid value).
+/// Chooses W and the terms kept (the constant alone, then each of `terms` added in
+/// order) by leave-one-power-on-out (`fixed`: that W, the terms still chosen; every
+/// candidate's held-out rms is reported).
 pub fn choose_weight(obs: &[FieldObservation], terms: &[Term], fixed: Option<f64>) -> WeightChoice {
+    let mut distinct: Vec<usize> = obs.iter().map(|o| o.power_on).collect();
+    distinct.sort_unstable();
+    distinct.dedup();
+    let power_ons = distinct.len();
+    let kinds: Vec<usize> = terms.iter().map(|t| t.kind).collect();
+    let none = |verdict: String| WeightChoice {
+        power_ons,
+        kinds: kinds.clone(),
+        candidates: Vec::new(),
+        weight: 0.0,
+        terms_kept: 0,
+        verdict: Some(verdict),
+    };
     if obs.len() < MIN_RECORDS {
-        return WeightChoice {
-            loo_rms_dph: Vec::new(),
-            weight: 0.0,
-            verdict: Some("no test power: fewer field seeks than needed, model unchanged"),
-        };
+        return none(format!(
+            "no test power: {} field seeks, at least {MIN_RECORDS} needed; model unchanged",
+            obs.len()
+        ));
     }
-    let loo: Vec<(f64, f64)> = WEIGHT_GRID
+    if power_ons < MIN_POWER_ONS {
+        return none(format!(
+            "no test power: the {} field seeks come from {power_ons} power-on; the correction \
+             is used on other power-ons (other ambients and warm-ups) and leave-one-power-on-out \
+             needs at least {MIN_POWER_ONS} to score it there; model unchanged",
+            obs.len()
+        ));
+    }
+    // Power-ons renumbered 0.. so that every group is held out once.
+    let obs: Vec<FieldObservation> = obs
         .iter()
-        .map(|&w| (w, loo_rms_dph(obs, terms, w)))
+        .map(|o| FieldObservation {
+            power_on: distinct.binary_search(&o.power_on).unwrap_or(0),
+            ..*o
+        })
         .collect();
-    let best = loo
+    let weights: Vec<f64> = match fixed {
+        Some(w) => vec![w],
+        None => WEIGHT_GRID.to_vec(),
+    };
+    let mut candidates = Vec::new();
+    for k in 0..=terms.len() {
+        for &w in &weights {
+            let (rms_dph, ms_se_dph2) = held_out_rms_dph(&obs, &terms[..k], w);
+            candidates.push(Candidate {
+                terms: k,
+                weight: w,
+                rms_dph,
+                ms_se_dph2,
+            });
+        }
+    }
+    // The best W for each number of terms (the smaller W on a tie) ...
+    let best_of = |k: usize| {
+        candidates.iter().filter(|c| c.terms == k).copied().fold(
+            None::<Candidate>,
+            |b, c| match b {
+                Some(b) if b.rms_dph <= c.rms_dph => Some(b),
+                _ => Some(c),
+            },
+        )
+    };
+    let bests: Vec<Candidate> = (0..=terms.len()).filter_map(best_of).collect();
+    // ... and the fewest terms whose held-out mean square is within one standard error of
+    // the lowest (the one-standard-error rule): a term must win by more than the power-ons'
+    // scatter to be kept.
+    let lowest = bests
         .iter()
         .copied()
-        .fold((0.0, f64::INFINITY), |b, x| if x.1 < b.1 { x } else { b });
+        .fold(None::<Candidate>, |b, c| match b {
+            Some(b) if b.rms_dph <= c.rms_dph => Some(b),
+            _ => Some(c),
+        });
+    let chosen = lowest.and_then(|low| {
+        let bound = low.rms_dph.powi(2) + low.ms_se_dph2;
+        bests.iter().copied().find(|c| c.rms_dph.powi(2) <= bound)
+    });
+    let best = chosen.unwrap_or(Candidate {
+        terms: 0,
+        weight: 0.0,
+        rms_dph: f64::NAN,
+        ms_se_dph2: f64::NAN,
+    });
     WeightChoice {
-        loo_rms_dph: loo,
-        weight: fixed.unwrap_or(best.0),
+        power_ons,
+        kinds,
+        candidates,
+        weight: best.weight,
+        terms_kept: best.terms,
         verdict: None,
     }
+}
+
+/// The lowest held-out rms over the candidates that keep exactly `k` terms.
+fn best_rms_with(choice: &WeightChoice, k: usize) -> f64 {
+    choice
+        .candidates
+        .iter()
+        .filter(|c| c.terms == k)
+        .map(|c| c.rms_dph)
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Per candidate input: the field's range against the model's trained range.
+fn coverage(model: &RbfModel, obs: &[FieldObservation]) -> Vec<String> {
+    candidate_terms(model)
+        .into_iter()
+        .map(|(input, kind)| {
+            let (lo, hi) = obs.iter().map(|o| o.input(kind)).fold(
+                (f64::INFINITY, f64::NEG_INFINITY),
+                |(lo, hi), x| (lo.min(x), hi.max(x)),
+            );
+            let (tlo, thi) = (
+                f64::from(model.input_min[input]),
+                f64::from(model.input_max[input]),
+            );
+            let covered = (hi.min(thi) - lo.max(tlo)).max(0.0) / (thi - tlo);
+            format!(
+                "{}: field {lo:.4} .. {hi:.4}, trained {tlo:.4} .. {thi:.4} ({:.0} % of the trained range)",
+                kind_name(kind),
+                100.0 * covered
+            )
+        })
+        .collect()
 }
 
 /// The model with `c` folded into its bias and linear terms.
@@ -303,17 +487,31 @@ pub fn apply(model: &RbfModel, c: &Correction) -> Result<RbfModel> {
     Ok(out)
 }
 
-/// The whole refinement: terms, weight (chosen or `fixed`), fit, folded model.
+/// The whole refinement: terms, weight and terms kept (chosen, or at a `fixed` W), fit,
+/// folded model.
 pub fn refine(
     model: &RbfModel,
     obs: &[FieldObservation],
     fixed: Option<f64>,
 ) -> Result<(RbfModel, Correction, WeightChoice)> {
-    let (terms, not_fitted) = terms_for(model, obs);
+    let (terms, mut not_fitted) = terms_for(model, obs);
     let choice = choose_weight(obs, &terms, fixed);
+    if choice.verdict.is_none() {
+        let without = best_rms_with(&choice, choice.terms_kept);
+        for (k, t) in terms.iter().enumerate().skip(choice.terms_kept) {
+            not_fitted.push(format!(
+                "{} (leave-one-power-on-out over {} power-ons: held-out rms {:.5} dph with it, \
+                 {without:.5} without; kept only if better by more than one standard error)",
+                kind_name(t.kind),
+                choice.power_ons,
+                best_rms_with(&choice, k + 1)
+            ));
+        }
+    }
     let c = Correction {
         not_fitted,
-        ..fit(obs, &terms, choice.weight)
+        coverage: coverage(model, obs),
+        ..fit(obs, &terms[..choice.terms_kept], choice.weight)
     };
     Ok((apply(model, &c)?, c, choice))
 }
@@ -354,6 +552,7 @@ mod tests {
                     temp_rate_cps: 0.001 * (i % 3) as f64,
                     temp_accel_cps2: 0.0,
                     residual_bias_dph: 0.01 + k_dph_per_c * (t - 25.0) + noise * u,
+                    power_on: i % 8,
                 }
             })
             .collect()
@@ -406,6 +605,7 @@ mod tests {
                 temp_rate_cps: 0.012 - 0.0005 * i as f64,
                 temp_accel_cps2: 0.0,
                 residual_bias_dph: 0.001 * i as f64,
+                power_on: i / 5,
             })
             .collect();
         let (terms, notes) = terms_for(&model(), &o);
@@ -422,5 +622,81 @@ mod tests {
             .collect();
         let (terms, notes) = terms_for(&model(), &spread);
         assert_eq!(terms.len(), 2, "{notes:?}");
+    }
+
+    /// Warm-ups from `ambients_c` (one power-on each, 6 seeks): T rises from the ambient,
+    /// dT/dt falls; the residual is `law` of (T, dT/dt).
+    fn warm_ups(ambients_c: &[f64], law: impl Fn(f64, f64) -> f64) -> Vec<FieldObservation> {
+        let mut out = Vec::new();
+        for (p, &a) in ambients_c.iter().enumerate() {
+            for k in 0..6 {
+                let rate = 0.011 * (-(k as f64) / 1.5).exp();
+                let t = a + 6.0 * (1.0 - (-(k as f64) / 1.5).exp()) + 1.5;
+                out.push(FieldObservation {
+                    temp_c: t,
+                    temp_rate_cps: rate,
+                    temp_accel_cps2: 0.0,
+                    residual_bias_dph: law(t, rate),
+                    power_on: p,
+                });
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn a_term_is_scored_on_other_power_ons_and_one_power_on_has_no_test_power() {
+        // A T-only model; the gyro's aging is in dT/dt (Shupe), which within one warm-up
+        // looks like a T law (T and dT/dt correlate at r = -1 there).
+        let mut m = model();
+        m.inputs.pop();
+        m.input_offset.pop();
+        m.input_scale.pop();
+        m.input_min.pop();
+        m.input_max.pop();
+        m.linear.pop();
+        let shupe = |_t: f64, rate: f64| 1.4 * rate;
+        // One power-on at 10 degC: nothing can be scored at another ambient.
+        let one = warm_ups(&[10.0], shupe);
+        let (same, c, choice) = refine(&m, &one, None).unwrap();
+        assert!(
+            choice
+                .verdict
+                .as_deref()
+                .unwrap_or("")
+                .contains("1 power-on"),
+            "{choice:?}"
+        );
+        assert_eq!(same, m);
+        assert!(c.coverage[0].starts_with("T: field"), "{c:?}");
+        // Power-ons at 10, 20, 30 degC: a T slope fitted on two ambients mispredicts the
+        // third; the T term is refused and says why.
+        let three = warm_ups(&[10.0, 20.0, 30.0, 10.0], shupe);
+        let (_, c, choice) = refine(&m, &three, None).unwrap();
+        assert_eq!(choice.power_ons, 4);
+        assert_eq!(choice.terms_kept, 0, "{choice:?}");
+        assert!(
+            c.not_fitted
+                .iter()
+                .any(|n| n.starts_with("T (leave-one-power-on-out")),
+            "{c:?}"
+        );
+        // Twin: the aging is a T law; the same power-ons keep T and learn its slope.
+        let tempco = warm_ups(&[10.0, 20.0, 30.0, 10.0], |t, _| 0.001 * (t - 20.0));
+        let (_, c, choice) = refine(&m, &tempco, None).unwrap();
+        assert_eq!(choice.terms_kept, 1, "{choice:?}");
+        let slope = c.coef_dph[1] / c.terms[0].std;
+        assert!((slope - 0.001).abs() < 1e-4, "{slope}");
+        // Power-on numbering: the clock falls or a gyro changes.
+        assert_eq!(
+            power_ons(&[
+                ("a", 270.0),
+                ("a", 540.0),
+                ("a", 270.0),
+                ("b", 540.0),
+                ("b", 540.0)
+            ]),
+            vec![0, 0, 1, 2, 3]
+        );
     }
 }
