@@ -21,7 +21,7 @@
 use anyhow::{anyhow, bail, Context, Result};
 use fog_core::compensation::compensator::{Compensator, CompensatorConfig};
 use fog_core::consts::earth_rate_horizontal_dph;
-use fog_core::hal::{GyroSample, TempSample};
+use fog_core::hal::{Gyro, GyroSample, TempSample, TemperatureSensor, Turntable};
 use fog_core::link::bit::{evaluate, BitInputs, BitLimits, BitWord};
 use fog_core::model::format::RbfModel;
 use fog_core::seeking::field_record::{record_of_seek, FieldRecord, SeekTempState};
@@ -34,7 +34,9 @@ use fog_core::seeking::tilt::Tilt;
 use serde::Serialize;
 
 use crate::report::{NorthSeekReport, SeekReliability, SeekStats, Table};
-use crate::sim::{rig, BaseMotion, GyroParams, RunSpec, StartState, TurntableParams};
+use crate::sim::{
+    rig, BaseMotion, GyroParams, RunSpec, SeekInstrument, StartState, TurntableParams,
+};
 use crate::stats::{rms, std_dev};
 
 /// The paper's seek time, 4 min 56 s.
@@ -420,7 +422,6 @@ pub fn run_seeks(
     arm: Arm<'_>,
     seed: u64,
 ) -> Result<ArmOutcome> {
-    let model = arm.model;
     let spec = RunSpec {
         ambient_c: cfg.ambient_c,
         minutes: cfg.seeks_per_start as f64 * 10.0,
@@ -437,8 +438,24 @@ pub fn run_seeks(
         gyro.set_base(BaseMotion::tilted(cfg.tilt_deg, tilt_direction_deg(seed)))
             .map_err(|e| anyhow!("simulator: {e}"))?;
     }
+    run_seeks_on(&mut gyro, &mut table, cfg, arm)
+}
+
+/// `run_seeks` on any gyro and turntable behind fog-core's traits (the gyro powered on at
+/// t = 0, the table at its zero): the seeks of one power-on, as the device runs them.
+pub fn run_seeks_on<G, T>(
+    gyro: &mut G,
+    table: &mut T,
+    cfg: &MonteCarloConfig,
+    arm: Arm<'_>,
+) -> Result<ArmOutcome>
+where
+    G: Gyro + TemperatureSensor + SeekInstrument,
+    T: Turntable,
+{
+    let model = arm.model;
     let dt_s = gyro.sample_period_s();
-    let temp_period_s = params.sensor.sample_period_s;
+    let temp_period_s = gyro.temp_period_s();
     let comp_cfg = CompensatorConfig {
         gyro_rate_hz: cfg.raw_rate_hz as f32,
         temp_rate_hz: (1.0 / temp_period_s) as f32,
@@ -450,7 +467,7 @@ pub fn run_seeks(
     finder.set_heading_correction(arm.heading);
     // The motion threshold's floor from the simulated gyro's own ARW (its datasheet value).
     let quality = QualityConfig {
-        arw_dpsh: params.noise.arw_dpsh as f32,
+        arw_dpsh: gyro.arw_dpsh() as f32,
         ..QualityConfig::default()
     };
     let mut sup = SeekSupervisor::new(finder, quality);
@@ -473,7 +490,11 @@ pub fn run_seeks(
     let mut temp_rate_cps = 0.0f32;
     let mut window_tilt: Option<Tilt> = None;
     while !ledger.done() {
-        let s = gyro.next_sample();
+        let s = match gyro.read() {
+            Ok(Some(s)) => s,
+            Ok(None) => continue,
+            Err(e) => bail!("gyro: {e:?}"),
+        };
         step += 1;
         if s.t_s > t_limit_s {
             bail!(
@@ -482,7 +503,10 @@ pub fn run_seeks(
             );
         }
         if step.is_multiple_of(temp_every) {
-            sensor_c = gyro.read_sensor_c() as f32;
+            sensor_c = gyro
+                .read_temp()
+                .map_err(|e| anyhow!("temperature sensor: {e:?}"))?
+                .temp_c;
             comp.push_temp(TempSample {
                 t_s: s.t_s,
                 temp_c: sensor_c,
@@ -491,7 +515,7 @@ pub fn run_seeks(
         if step.is_multiple_of(poll_every) {
             inclinometer.add(gyro.read_inclinometer());
             if sup.is_seeking() {
-                if let Err(e) = sup.poll(&mut table, s.t_s) {
+                if let Err(e) = sup.poll(table, s.t_s) {
                     ledger.refuse(s.t_s, e);
                 }
             }
@@ -502,14 +526,14 @@ pub fn run_seeks(
             let tilt = window_tilt.unwrap_or_else(|| inclinometer.peek(arm.feed_tilt));
             let bit = simulated_bit(sensor_c, temp_rate_cps);
             recorder.seek_temp.reset();
-            if let Err(e) = sup.start(&mut table, s.t_s, tilt, bit) {
+            if let Err(e) = sup.start(table, s.t_s, tilt, bit) {
                 ledger.refuse(s.t_s, e);
             }
         }
         // A raw sample is the mean over (t - dt, t]: time-stamp it at the interval's middle.
         let sample = GyroSample {
             t_s: s.t_s - 0.5 * dt_s,
-            rate_dph: s.rate_dph as f32,
+            rate_dph: s.rate_dph,
         };
         let Some(w) = comp.push_gyro(sample) else {
             continue;
@@ -519,7 +543,7 @@ pub fn run_seeks(
         temp_rate_cps = w.temp_rate_cps;
         if sup.is_seeking() {
             recorder.on_window(&w, comp.model());
-            let event = sup.on_window(&w, tilt, &mut table);
+            let event = sup.on_window(&w, tilt, table);
             let field_record = recorder.on_event(&event);
             ledger.record(event, w.t_end_s, sup.restarts().0, field_record);
         }

@@ -167,6 +167,11 @@ impl SimGyro {
         }
     }
 
+    /// The gyro's parameters.
+    pub fn params(&self) -> &GyroParams {
+        &self.params
+    }
+
     /// Raw sample period, s.
     pub fn sample_period_s(&self) -> f64 {
         self.dt_s

@@ -7,6 +7,7 @@ pub mod base;
 mod checks;
 pub mod error;
 pub mod gyro;
+pub mod instrument;
 pub mod noise;
 pub mod params;
 pub mod run;
@@ -18,6 +19,7 @@ pub mod turntable;
 pub use base::{BaseMotion, Disturbance};
 pub use error::SimError;
 pub use gyro::{RawSample, SimGyro};
+pub use instrument::SeekInstrument;
 pub use params::{
     DriftParams, GyroParams, NoiseParams, RunVariation, SensorParams, SensorPlacement,
     ThermalParams,

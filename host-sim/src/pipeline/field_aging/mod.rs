@@ -5,7 +5,7 @@
 //!    `north-seek`'s own default model is trained on it (`own_model::train_own_model`).
 //!    With several ambients (`ambients_c`), the chamber covers all of them: the same inputs
 //!    and run count per ambient as the own model chose at the first, trained on the runs
-//!    of every ambient (`chamber_at_ambients`): a model trained at one ambient does not
+//!    of every ambient (`sim_subject`): a model trained at one ambient does not
 //!    cover another's temperatures (its windows there are out of the trained range).
 //! 2. Aging: the gyro's bias law moves by a stated amount (`laws`): turn-on bias and
 //!    temperature coefficient, its twin the Shupe coefficient, and the null twin (none).
@@ -17,12 +17,17 @@
 //!    (`fog_core::seeking::field_record::record_of_seek`), numbered as the ring numbers it.
 //! 4. Refinement: after the first N field seeks (5, 20, 50 by default) the chamber model is
 //!    refined exactly as `fogsim train --field` does (`field::refine_with_records`: the
-//!    records under the model's CRC-32, weight by leave-one-out).
+//!    records under the model's CRC-32, weight and terms by leave-one-power-on-out).
 //! 5. Evaluation: an independent set of cold starts on the aged gyro, run once with the
 //!    chamber model and once with each refined model on the same seeds
 //!    (`paired::compare`): azimuth error std, mean and rms, with against without; and the
 //!    residual bias the evaluation seeks measured (their records' half-sums,
 //!    `paired::compare_bias`): whether the refined model predicts the aged bias better.
+//!
+//! The gyro under test is an `AgingSubject`: the project's simulator (`SimAging`, what
+//! `fogsim field aging` measures) or any other gyro model the seek loop can drive
+//! (`northseek::run_seeks_on`); `host-sim/tests/field_aging_independent.rs` measures an
+//! independent one with other bias laws.
 //!
 //! Seeds: the chamber campaign uses the plan's seed as `north-seek` does; field and
 //! evaluation starts draw from their own streams of it (`derive_seed`), the same for every
@@ -30,6 +35,7 @@
 
 pub mod laws;
 pub mod paired;
+pub mod sim_subject;
 
 use anyhow::{bail, Result};
 use fog_core::model::format::RbfModel;
@@ -37,15 +43,11 @@ use serde::Serialize;
 
 use crate::field::records_file::StoredRecord;
 use crate::field::{model_crc32, refine_with_records};
-use crate::pipeline::campaign::CampaignSpec;
-use crate::pipeline::campaign_steps::{simulate_checked, train_with};
-use crate::pipeline::northseek::{run_seeks, Arm, ArmOutcome, MonteCarloConfig};
-use crate::pipeline::own_model::{train_own_model, OwnModelPlan};
+use crate::pipeline::northseek::{Arm, ArmOutcome, MonteCarloConfig};
 use crate::report::Table;
-use crate::sim::GyroParams;
-use crate::train::seek_score::Criterion;
 
 pub use laws::AgingLaw;
+pub use sim_subject::SimAging;
 pub use paired::{BiasComparison, Comparison, ErrorStats, Verdict};
 
 /// Stream of the field starts' seeds (`derive_seed(seed, FIELD_STREAM, 0)`), "FIELD".
@@ -148,7 +150,8 @@ impl AgingPlan {
 /// One row of the aging table: one law, one field seek count.
 #[derive(Clone, Debug, Serialize)]
 pub struct AgingRow {
-    pub law: AgingLaw,
+    /// The law's name (`AgingSubject::laws`).
+    pub law: String,
     pub field_seeks: usize,
     /// Records `train --field` used (measured under the chamber model).
     pub records_used: usize,
@@ -166,7 +169,8 @@ pub struct AgingRow {
 /// One law's field: its amounts and the records its field seeks left.
 #[derive(Clone, Debug, Serialize)]
 pub struct LawField {
-    pub law: AgingLaw,
+    /// The law's name (`AgingSubject::laws`).
+    pub law: String,
     pub amounts: String,
     /// Field power-ons run to collect the records.
     pub field_starts: usize,
@@ -189,40 +193,65 @@ pub struct AgingReport {
     pub rows: Vec<AgingRow>,
 }
 
-/// Runs the measurement; `progress` gets one line per finished step.
+/// The chamber model the field seeks run with.
+pub struct Chamber {
+    pub model: RbfModel,
+    /// Chamber runs it was trained on.
+    pub runs: usize,
+    pub centres: usize,
+}
+
+/// A gyro the aging measurement can age and drive through the seek loop: the project's
+/// simulator (`SimAging`), or any other gyro model behind the seek loop's traits
+/// (`northseek::run_seeks_on`; the field-aging test drives an independent one).
+pub trait AgingSubject: Sync {
+    /// The laws it plants, (name, amounts with units), in report order; a null law
+    /// (nothing moves) belongs among them.
+    fn laws(&self) -> Vec<(String, String)>;
+    /// The chamber model, trained on the delivered (not aged) gyro at `plan.ambients_c`.
+    fn chamber(&self, plan: &AgingPlan) -> Result<Chamber>;
+    /// One power-on of `cfg.seeks_per_start` cold-start seeks at `cfg.ambient_c` of the
+    /// gyro aged by law `law` (index into `laws`), with `arm`'s model.
+    fn power_on(
+        &self,
+        law: usize,
+        cfg: &MonteCarloConfig,
+        arm: Arm<'_>,
+        seed: u64,
+    ) -> Result<ArmOutcome>;
+}
+
+/// Runs the measurement on the simulator (`SimAging` with `plan.laws`); `progress` gets
+/// one line per finished step.
 pub fn run_aging(plan: &AgingPlan, progress: &dyn Fn(&str)) -> Result<AgingReport> {
     plan.validate()?;
-    let delivered = GyroParams::paper_default();
+    run_aging_on(plan, &SimAging::new(&plan.laws), progress)
+}
+
+/// Runs the measurement on `subject` (`plan.laws` is the simulator's and not used here).
+pub fn run_aging_on(
+    plan: &AgingPlan,
+    subject: &dyn AgingSubject,
+    progress: &dyn Fn(&str),
+) -> Result<AgingReport> {
+    plan.validate()?;
+    let laws = subject.laws();
+    if laws.is_empty() {
+        bail!("laws: the gyro under test plants none");
+    }
     let eval_cfgs: Vec<MonteCarloConfig> = plan
         .ambients_c
         .iter()
         .map(|&a| plan.monte_carlo(EVAL_STREAM, plan.eval_starts, plan.eval_seeks_per_start, a))
         .collect();
     let eval_cfg = &eval_cfgs[0];
-    let own_plan = OwnModelPlan {
-        ambient_c: plan.ambients_c[0],
-        latitude_deg: plan.latitude_deg,
-        dwell_s: eval_cfg.dwell_s as f64,
-        seed: plan.seed,
-        criterion: Criterion::parse(
-            crate::train::seek_score::DEFAULT_CRITERION_NAME,
-            eval_cfg.dwell_s as f64,
-            plan.latitude_deg,
-        )
-        .map_err(|e| anyhow::anyhow!("criterion: {e}"))?,
-    };
-    let own = train_own_model(&delivered, &own_plan)?;
-    let (chamber, chamber_runs, centres) = if plan.ambients_c.len() == 1 {
-        (own.trained.model, own.runs, own.trained.report.n_centers)
-    } else {
-        let trained = chamber_at_ambients(&delivered, plan, &own, &own_plan)?;
-        let centres = trained.report.n_centers;
-        (trained.model, own.runs * plan.ambients_c.len(), centres)
-    };
+    let chamber = subject.chamber(plan)?;
     progress(&format!(
-        "chamber model: {chamber_runs} runs at {:?} degC, {centres} centres",
-        plan.ambients_c
+        "chamber model: {} runs at {:?} degC, {} centres",
+        chamber.runs, plan.ambients_c, chamber.centres
     ));
+    let chamber_runs = chamber.runs;
+    let chamber = chamber.model;
     let mut report = AgingReport {
         seed: plan.seed,
         ambients_c: plan.ambients_c.clone(),
@@ -235,34 +264,31 @@ pub fn run_aging(plan: &AgingPlan, progress: &dyn Fn(&str)) -> Result<AgingRepor
         laws: Vec::new(),
         rows: Vec::new(),
     };
-    for &law in &plan.laws {
-        let aged = law.age(&delivered);
-        let field = collect_field_records(plan, law, &aged, &chamber)?;
+    for (law, (name, amounts)) in laws.into_iter().enumerate() {
+        let field = collect_field_records(plan, subject, law, &name, &amounts, &chamber)?;
         progress(&format!(
-            "{}: {} field records from {} power-ons",
-            law.name(),
+            "{name}: {} field records from {} power-ons",
             field.records.len(),
             field.field_starts
         ));
-        let without = run_arm(&aged, &eval_cfgs, &chamber)?;
+        let without = run_arm(subject, law, &eval_cfgs, &chamber)?;
         for &n in &plan.field_seek_counts {
             let refined = refine_with_records(&chamber, &field.records[..n], &[], None)?;
             let with = if refined.model == chamber {
                 without.clone()
             } else {
-                run_arm(&aged, &eval_cfgs, &refined.model)?
+                run_arm(subject, law, &eval_cfgs, &refined.model)?
             };
             let comparison = paired::compare(&without, &with, eval_cfg.true_azimuth_deg);
             let bias = paired::compare_bias(&without, &with);
             progress(&format!(
-                "{} after {n} field seeks: rms {:.4} -> {:.4} deg ({})",
-                law.name(),
+                "{name} after {n} field seeks: rms {:.4} -> {:.4} deg ({})",
                 comparison.without.rms_deg,
                 comparison.with.rms_deg,
                 comparison.verdict.label()
             ));
             report.rows.push(AgingRow {
-                law,
+                law: name.clone(),
                 field_seeks: n,
                 records_used: refined.used,
                 field_weight: refined
@@ -287,37 +313,11 @@ pub fn run_aging(plan: &AgingPlan, progress: &dyn Fn(&str)) -> Result<AgingRepor
     Ok(report)
 }
 
-/// The chamber model at several ambients: `own`'s inputs and run count per ambient, on
-/// runs of the delivered gyro at every ambient of the plan (the first ambient's runs are
-/// the own model's, the same seed).
-fn chamber_at_ambients(
-    delivered: &GyroParams,
-    plan: &AgingPlan,
-    own: &crate::pipeline::own_model::OwnModel,
-    own_plan: &OwnModelPlan,
-) -> Result<crate::train::TrainOutcome> {
-    let campaign = simulate_checked(
-        delivered,
-        &CampaignSpec {
-            ambients_c: plan.ambients_c.clone(),
-            runs_per_ambient: own.runs,
-            latitude_deg: plan.latitude_deg,
-            ..CampaignSpec::paper(plan.seed)
-        },
-    )?;
-    let runs: Vec<&crate::io::runs::Run> = campaign.iter().map(|c| &c.run).collect();
-    train_with(
-        &runs,
-        &own.selection.chosen.specs(),
-        "sim",
-        own_plan.criterion,
-    )
-}
-
-/// Every evaluation start with `model` on the gyro `params`, in start order; start i at
-/// the ambient of `cfgs[i % cfgs.len()]`.
+/// Every evaluation start with `model` on `subject`'s gyro aged by `law`, in start order;
+/// start i at the ambient of `cfgs[i % cfgs.len()]`.
 fn run_arm(
-    params: &GyroParams,
+    subject: &dyn AgingSubject,
+    law: usize,
     cfgs: &[MonteCarloConfig],
     model: &RbfModel,
 ) -> Result<Vec<ArmOutcome>> {
@@ -329,7 +329,7 @@ fn run_arm(
     let first = &cfgs[0];
     crate::fanout::try_map_in_order(first.starts, first.threads, |i| {
         let cfg = &cfgs[i % cfgs.len()];
-        run_seeks(params, cfg, arm, cfg.start_seed(i))
+        subject.power_on(law, cfg, arm, cfg.start_seed(i))
     })
 }
 
@@ -337,8 +337,10 @@ fn run_arm(
 /// seek count has records (a seek that leaves none, e.g. refused, is not a field seek).
 fn collect_field_records(
     plan: &AgingPlan,
-    law: AgingLaw,
-    aged: &GyroParams,
+    subject: &dyn AgingSubject,
+    law: usize,
+    name: &str,
+    amounts: &str,
     chamber: &RbfModel,
 ) -> Result<LawField> {
     let wanted = *plan.field_seek_counts.last().unwrap_or(&0);
@@ -351,8 +353,7 @@ fn collect_field_records(
     while records.len() < wanted {
         if starts >= most_starts {
             bail!(
-                "{}: {starts} field power-ons left only {} of {wanted} field records",
-                law.name(),
+                "{name}: {starts} field power-ons left only {} of {wanted} field records",
                 records.len()
             );
         }
@@ -369,7 +370,7 @@ fn collect_field_records(
         };
         let outcomes = crate::fanout::try_map_in_order(batch, plan.threads, |k| {
             let cfg = &cfgs[(starts + k) % cfgs.len()];
-            run_seeks(aged, cfg, arm, cfg.start_seed(starts + k))
+            subject.power_on(law, cfg, arm, cfg.start_seed(starts + k))
         })?;
         starts += batch;
         for seek in outcomes.iter().flat_map(|o| &o.seeks) {
@@ -382,8 +383,8 @@ fn collect_field_records(
         }
     }
     Ok(LawField {
-        law,
-        amounts: law.amounts(&GyroParams::paper_default()),
+        law: name.to_string(),
+        amounts: amounts.to_string(),
         field_starts: starts,
         records,
     })
@@ -411,7 +412,7 @@ pub fn aging_table(r: &AgingReport) -> String {
     for row in &r.rows {
         let c = &row.comparison;
         t.row(&[
-            row.law.name().to_string(),
+            row.law.clone(),
             format!("{}", row.field_seeks),
             row.field_weight
                 .map_or("none".to_string(), |w| format!("{w}")),
@@ -447,7 +448,7 @@ pub fn aging_table(r: &AgingReport) -> String {
         r.seed
     );
     for l in &r.laws {
-        s += &format!("  {}: {}\n", l.law.name(), l.amounts);
+        s += &format!("  {}: {}\n", l.law, l.amounts);
     }
     s + &t.render()
 }
@@ -474,7 +475,7 @@ mod tests {
             &|_| {},
         )
         .unwrap();
-        let row = |law| r.rows.iter().find(|x| x.law == law).unwrap();
+        let row = |law| r.rows.iter().find(|x| x.law == law.name()).unwrap();
         let aged = &row(AgingLaw::Shupe).comparison;
         assert_eq!(aged.verdict, Verdict::Helps, "{aged:?}");
         assert!(aged.rms_ratio < 0.98, "{aged:?}");
@@ -511,7 +512,7 @@ mod tests {
             let early = r
                 .rows
                 .iter()
-                .find(|x| x.law == law && x.field_seeks == 5)
+                .find(|x| x.law == law.name() && x.field_seeks == 5)
                 .unwrap();
             assert_eq!(early.field_weight, None, "{early:?}");
             assert_eq!(early.comparison.rms_ratio, 1.0);
@@ -519,10 +520,10 @@ mod tests {
         let row = |law| {
             r.rows
                 .iter()
-                .find(|x| x.law == law && x.field_seeks == 50)
+                .find(|x| x.law == law.name() && x.field_seeks == 50)
                 .unwrap()
         };
-        let field = |law| &r.laws.iter().find(|x| x.law == law).unwrap().records;
+        let field = |law| &r.laws.iter().find(|x| x.law == law.name()).unwrap().records;
         // T and dT/dt of the field seeks separate (at one ambient: r = -0.99).
         let recs = field(AgingLaw::TempcoTurnOn);
         let n = recs.len() as f64;
