@@ -47,8 +47,8 @@ use crate::pipeline::northseek::{Arm, ArmOutcome, MonteCarloConfig};
 use crate::report::Table;
 
 pub use laws::AgingLaw;
-pub use sim_subject::SimAging;
 pub use paired::{BiasComparison, Comparison, ErrorStats, Verdict};
+pub use sim_subject::SimAging;
 
 /// Stream of the field starts' seeds (`derive_seed(seed, FIELD_STREAM, 0)`), "FIELD".
 const FIELD_STREAM: u64 = 0x46_49_45_4C_44;
