@@ -360,6 +360,12 @@ fn train_field_counts_records_under_a_heading_calibrated_variant_the_registry_kn
     );
     assert!(stdout.contains(&expected), "{stdout}");
     assert!(stdout.contains("attach it again"), "{stdout}");
+    // Each record has its own power-on clock (600 s): 6 power-ons to hold out in turn.
+    assert!(stdout.contains("(6 power-ons;"), "{stdout}");
+    assert!(
+        stdout.contains("field range: T: field 15.0000 .. 25.0000"),
+        "{stdout}"
+    );
     let refined = RbfModel::decode(&std::fs::read(&refined_path).unwrap()).unwrap();
     assert_ne!(refined, model, "the field records moved the model");
     assert!(refined.heading.is_none());

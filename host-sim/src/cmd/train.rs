@@ -103,7 +103,7 @@ pub struct Args {
     #[arg(long)]
     pub field: Option<PathBuf>,
     /// Weight W of each field seek against the chamber model's prior (one row of weight 1
-    /// per correction coefficient). Default: chosen by leave-one-out over the field seeks.
+    /// per correction coefficient). Default: chosen, with the terms, by leave-one-power-on-out.
     /// Given without `--field`, it is refused by name.
     #[arg(long)]
     pub field_weight: Option<f64>,

@@ -172,7 +172,8 @@ impl FieldRefinement {
             return s;
         }
         s += &format!(
-            "terms  field weight W  leave-one-power-on-out rms of the residual bias, dph ({} power-ons)\n",
+            "terms  field weight W  leave-one-power-on-out rms of the residual bias, dph ({} power-ons; \
+             the best W per terms, then the fewest terms within one standard error)\n",
             self.choice.power_ons
         );
         let names = |k: usize| {

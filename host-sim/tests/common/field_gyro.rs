@@ -357,7 +357,7 @@ pub fn chamber_run(
     let (mut g, _table) = IndependentGyro::power_on(law, site, seed);
     let earth = g.earth_at_rest_dph();
     let rows = (minutes * 6.0) as usize;
-    let mut cols = vec![Vec::with_capacity(rows); 5];
+    let mut cols: Vec<Vec<f64>> = (0..5).map(|_| Vec::with_capacity(rows)).collect();
     for r in 0..rows {
         let (mut rate, mut temp) = (0.0, 0.0);
         for _ in 0..10 {

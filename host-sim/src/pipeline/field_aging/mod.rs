@@ -155,7 +155,8 @@ pub struct AgingRow {
     pub field_seeks: usize,
     /// Records `train --field` used (measured under the chamber model).
     pub records_used: usize,
-    /// Field weight W chosen by leave-one-out (None: no test power, model unchanged).
+    /// Field weight W chosen by leave-one-power-on-out (None: no test power, model
+    /// unchanged).
     pub field_weight: Option<f64>,
     /// Terms of the correction (after the constant) and its coefficients (constant first),
     /// deg/h per field std; the model inputs not fitted, and why.
@@ -164,6 +165,14 @@ pub struct AgingRow {
     pub not_fitted: Vec<String>,
     pub comparison: Comparison,
     pub bias: BiasComparison,
+}
+
+impl AgingRow {
+    /// Whether refinement made this row worse beyond noise: its azimuth or its residual
+    /// bias verdict is "HURTS".
+    pub fn hurts(&self) -> bool {
+        self.comparison.verdict == Verdict::Hurts || self.bias.verdict == Verdict::Hurts
+    }
 }
 
 /// One law's field: its amounts and the records its field seeks left.
@@ -475,7 +484,7 @@ mod tests {
             &|_| {},
         )
         .unwrap();
-        let row = |law| r.rows.iter().find(|x| x.law == law.name()).unwrap();
+        let row = |law: AgingLaw| r.rows.iter().find(|x| x.law == law.name()).unwrap();
         let aged = &row(AgingLaw::Shupe).comparison;
         assert_eq!(aged.verdict, Verdict::Helps, "{aged:?}");
         assert!(aged.rms_ratio < 0.98, "{aged:?}");
@@ -517,13 +526,13 @@ mod tests {
             assert_eq!(early.field_weight, None, "{early:?}");
             assert_eq!(early.comparison.rms_ratio, 1.0);
         }
-        let row = |law| {
+        let row = |law: AgingLaw| {
             r.rows
                 .iter()
                 .find(|x| x.law == law.name() && x.field_seeks == 50)
                 .unwrap()
         };
-        let field = |law| &r.laws.iter().find(|x| x.law == law.name()).unwrap().records;
+        let field = |law: AgingLaw| &r.laws.iter().find(|x| x.law == law.name()).unwrap().records;
         // T and dT/dt of the field seeks separate (at one ambient: r = -0.99).
         let recs = field(AgingLaw::TempcoTurnOn);
         let n = recs.len() as f64;
@@ -547,10 +556,11 @@ mod tests {
         // ... and the evaluation seeks' residual bias falls (the aging is recovered).
         assert_eq!(aged.bias.verdict, Verdict::Helps, "{:?}", aged.bias);
         assert!(aged.bias.rms_with_dph < 0.5 * aged.bias.rms_without_dph);
-        // Null twin: nothing to recover; its bias not made worse, its azimuth rms by < 1 %
-        // (measured: +0.4 %, resolved at these 10 starts, not at 30).
+        // Null twin: nothing to recover; neither its bias nor its azimuth made worse
+        // (measured: W = 0, the model unchanged; the leave-one-seek-out choice it replaced
+        // fitted T and cost +0.4 % azimuth rms, resolved at these 10 starts).
         let null = row(AgingLaw::None);
-        assert_ne!(null.bias.verdict, Verdict::Hurts, "{:?}", null.bias);
+        assert!(!null.hurts(), "{null:?}");
         assert!(null.comparison.rms_ratio < 1.01, "{:?}", null.comparison);
     }
 
