@@ -16,12 +16,13 @@ use crate::train::seek_score::Criterion;
 /// The project's simulator as the aging subject: `plan.laws` applied to
 /// `GyroParams::paper_default`.
 pub struct SimAging {
-    pub laws: Vec<AgingLaw>,
-    pub delivered: GyroParams,
+    laws: Vec<AgingLaw>,
+    delivered: GyroParams,
     aged: Vec<GyroParams>,
 }
 
 impl SimAging {
+    /// The delivered gyro and its aged variants, one per law.
     pub fn new(laws: &[AgingLaw]) -> Self {
         let delivered = GyroParams::paper_default();
         Self {
