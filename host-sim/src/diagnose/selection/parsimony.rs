@@ -1,6 +1,8 @@
 //! Parsimony (issue 18 item 6): the base is the simplest whose held-out score is within
-//! one standard error of the lowest one's, judged twice: as a base, and with the causes
-//! the selection names on it against the lowest base with the causes named on that one.
+//! one standard error of the lowest one's, judged twice: as a base (the standard error of
+//! the lowest score), and then with the causes the selection names on it against the
+//! lowest base with the causes named on that one (the standard error of the paired
+//! per-unit difference: the two are scored on the same validation units).
 //!
 //! Why twice: an effect that no base contains stays in every base's residual and spreads
 //! the per-unit scores, so at the base stage a base too simple for the drift (T without
@@ -8,17 +10,18 @@
 //! a residual that still holds the simpler base's misfit and loses its power. Measured
 //! (docs/diagnose.md, "Parsimony (item 6)"): a 1-sigma (supply_v - 24) x dT/dt product,
 //! +29.7 % and p 0.0005 on poly_t2_rate, fell to +19.1 % and p 0.024 on poly_t1_rate,
-//! whose base score was 0.00020 deg/h (0.8 of a standard error) above poly_t2_rate's but
-//! 0.0046 deg/h (4 standard errors) above it once the product was in.
+//! whose base score was 0.00020 deg/h (0.3 of a standard error) above poly_t2_rate's but
+//! 0.0046 deg/h (4 paired standard errors) above it once the product was in.
 //!
-//! Which standard error: that of the paired per-unit difference from the lowest (the form
-//! for models compared on the same validation units; delta method to the rms). The
-//! standard error of the lowest score alone was measured too: it let poly_t2_rate replace
-//! poly_t3_rate where T^3 was better in every run but by little, and the shared law's
-//! run levels then lost a 1-sigma `# mount` offset (p 0.0054 -> 0.020).
+//! Why the paired standard error for the second: where nothing is named within runs the
+//! two scores are the bases' own, and the lowest score's standard error let poly_t2_rate
+//! replace poly_t3_rate where T^3 was better in every run but by little; the shared law's
+//! run levels then lost a 1-sigma `# mount` offset (p 0.0054 -> 0.020) and a 1-sigma
+//! heading harmonic (`diagnose_between`, p 0.0001 -> 0.123). The paired form keeps a
+//! difference that holds in every unit, however small.
 //!
 //! Cost: one more selection for each simpler base within one standard error as a base,
-//! simplest first, until one is within it with its causes too (usually one more).
+//! simplest first, until one is within it with its causes too.
 
 use crate::diagnose::base::bases::{complexity, BaseChoice, BaseScore};
 use crate::diagnose::base::levels::score;
@@ -31,18 +34,19 @@ use crate::diagnose::validation::cv::Folds;
 use serde::Serialize;
 
 /// The rule, as the report states it.
-pub const RULE: &str = "simplest base within one standard error (of the paired per-unit difference) of the lowest held-out rms, alone and with the causes named on each";
+pub const RULE: &str = "simplest base within one standard error of the lowest held-out rms (that score's), and with the causes named on each within one standard error (of the paired difference) of the lowest with its causes";
 
 /// One simpler base weighed against the lowest: alone and with its named causes.
 #[derive(Clone, Debug, Serialize)]
 pub struct Weighed {
     pub base: String,
-    /// Its held-out rms minus the lowest's, and the standard error of that difference,
-    /// deg/h (bases alone).
+    /// Its held-out rms minus the lowest's, and the lowest score's standard error, deg/h
+    /// (bases alone).
     pub base_excess_dph: f64,
     pub base_excess_se_dph: f64,
-    /// The same with the causes named on each (None when the base alone is already
-    /// beyond one standard error and was not screened).
+    /// The same with the causes named on each, with the standard error of the paired
+    /// difference (None when the base alone is already beyond one standard error and was
+    /// not screened).
     pub whole_excess_dph: Option<f64>,
     pub whole_excess_se_dph: Option<f64>,
     /// Within-run causes named on this base.
@@ -122,6 +126,14 @@ pub fn choose_and_screen(
         weighed: Vec::new(),
         reason: String::new(),
     };
+    let Some((lowest_rms, lowest_se)) = choice
+        .scores
+        .iter()
+        .find(|s| s.spec.name == lowest)
+        .map(|s| (s.heldout_rms_dph, s.heldout_se_dph))
+    else {
+        return Ok((choice, lowest_screen, rule));
+    };
     let mut simpler: Vec<&BaseScore> = choice
         .scores
         .iter()
@@ -133,7 +145,8 @@ pub fn choose_and_screen(
             .then(a.heldout_rms_dph.total_cmp(&b.heldout_rms_dph))
     });
     for s in simpler {
-        let (base_excess, base_se) = excess(&s.unit_sse, &choice.chosen.cv.unit_sse, &points);
+        let base_excess = s.heldout_rms_dph - lowest_rms;
+        let base_se = lowest_se;
         let mut w = Weighed {
             base: s.spec.name.clone(),
             base_excess_dph: base_excess,
