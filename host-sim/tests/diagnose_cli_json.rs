@@ -52,7 +52,9 @@ fn json_has_the_issue_schema_and_plots_are_written() {
         b["heldout_rms_dph"].as_f64().unwrap()
     };
     let lowest = rms_of(&rule["lowest"]);
-    assert!(tried.iter().all(|b| b["heldout_rms_dph"].as_f64().unwrap() >= lowest));
+    assert!(tried
+        .iter()
+        .all(|b| b["heldout_rms_dph"].as_f64().unwrap() >= lowest));
     let weighed = rule["weighed"].as_array().unwrap();
     let within: Vec<&serde_json::Value> = weighed
         .iter()
