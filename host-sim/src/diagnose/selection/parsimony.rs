@@ -24,7 +24,7 @@
 //! simplest first, until one is within it with its causes too.
 
 use crate::diagnose::base::bases::{complexity, BaseChoice, BaseScore};
-use crate::diagnose::base::levels::score;
+use crate::diagnose::base::levels::{ratio_estimate, score};
 use crate::diagnose::base::models::Stacked;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
@@ -77,19 +77,7 @@ pub fn excess(a: &[f64], b: &[f64], points: &[f64]) -> (f64, f64) {
     let rms_a = score(a, points).heldout_rms_dph;
     let rms_b = score(b, points).heldout_rms_dph;
     let d: Vec<f64> = a.iter().zip(b).map(|(x, y)| x - y).collect();
-    let n: f64 = points.iter().sum();
-    let k = d.len() as f64;
-    let mean_sq = d.iter().sum::<f64>() / n.max(1e-300);
-    let var = if k > 1.0 {
-        k / (k - 1.0)
-            * d.iter()
-                .zip(points)
-                .map(|(x, m)| (x - mean_sq * m).powi(2))
-                .sum::<f64>()
-            / (n * n)
-    } else {
-        f64::NAN
-    };
+    let (_, var) = ratio_estimate(&d, points);
     (rms_a - rms_b, var.sqrt() / (2.0 * rms_b.max(1e-300)))
 }
 
