@@ -44,6 +44,7 @@ fn json_has_the_issue_schema_and_plots_are_written() {
     assert_eq!(tried.len(), 8, "constant, poly 1-3 with/without dT/dt, RBF");
     let same = tried.iter().find(|b| b["name"] == base["name"]).unwrap();
     assert_eq!(same["heldout_rms_dph"].as_f64().unwrap(), chosen);
+    base_rule_holds(base, tried);
     let c0 = &v["candidates"][0];
     for key in [
         "column",
@@ -95,4 +96,31 @@ fn json_has_the_issue_schema_and_plots_are_written() {
     );
     assert!(plots.join("residual_vs_time.svg").exists());
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The parsimony rule's bookkeeping (issue 18 item 6): the lowest is the reference; the
+/// chosen base is the lowest or the first simpler base weighed within one standard error.
+fn base_rule_holds(base: &serde_json::Value, tried: &[serde_json::Value]) {
+    let rule = &base["rule"];
+    let rms_of = |name: &serde_json::Value| {
+        let b = tried.iter().find(|b| b["name"] == *name).unwrap();
+        b["heldout_rms_dph"].as_f64().unwrap()
+    };
+    let lowest = rms_of(&rule["lowest"]);
+    assert!(tried
+        .iter()
+        .all(|b| b["heldout_rms_dph"].as_f64().unwrap() >= lowest));
+    let weighed = rule["weighed"].as_array().unwrap();
+    let within: Vec<&serde_json::Value> = weighed
+        .iter()
+        .filter(|w| w["within_one_se"] == true)
+        .collect();
+    if base["name"] == rule["lowest"] {
+        assert!(within.is_empty(), "{rule}");
+    } else {
+        assert_eq!(within.len(), 1, "{rule}");
+        assert_eq!(within[0]["base"], base["name"]);
+        assert_eq!(weighed.last(), Some(within[0]));
+    }
+    assert!(rule["reason"].as_str().is_some_and(|r| !r.is_empty()));
 }

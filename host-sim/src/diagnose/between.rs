@@ -371,6 +371,11 @@ pub struct Prepared {
     pub repeatability_dph: f64,
 }
 
+/// Whether the layout holds runs out whole (the between-run stage needs it).
+pub fn runs_held_out_whole(folds: &Folds) -> bool {
+    folds.offsets == crate::diagnose::validation::cv::Offsets::PerUnit
+}
+
 /// Offsets, level model and candidates; `Err` (with the reason) when runs are too few.
 pub fn prepare(
     c: &Campaign,
@@ -380,7 +385,7 @@ pub fn prepare(
     base: &BaseFit,
     levels: Option<&crate::diagnose::base::bases::LevelChoice>,
 ) -> Result<Prepared, String> {
-    if folds.offsets != crate::diagnose::validation::cv::Offsets::PerUnit {
+    if !runs_held_out_whole(folds) {
         return Err("between-run effects need >= 4 runs held out whole".into());
     }
     let (offsets, offsets_from) = match levels {

@@ -92,13 +92,13 @@ pub fn diagnose_with(
 ) -> Result<Diagnosis, DiagnoseError> {
     let campaign = input::prepare(runs)?;
     let (folds, mut st, choice) = layout_and_base(&campaign, rule)?;
-    let base = &choice.chosen;
     let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
     let latitude = latitude_of(&campaign);
     let meta = library::generic::metadata(runs);
     let (library, cap_note) = library_of(&campaign, &meta, st.temp_rate_half_s);
-    let (mut screening, between_run, groups) =
-        screen_both(&campaign, &meta, &folds, &st, &choice, &library, latitude)?;
+    let (choice, mut screening, base_rule, between_run, groups) =
+        screen_both(&campaign, &meta, &folds, &st, choice, &library, latitude)?;
+    let base = &choice.chosen;
     screening.skipped.extend(cap_note);
     let named = screening.steps.first();
     let cause = named.map(|s| Cause::from(&s.scored.cand));
@@ -147,7 +147,7 @@ pub fn diagnose_with(
             smallest_attainable_p,
             power_check,
         },
-        base: base_summary(&choice, &st, &campaign),
+        base: base_summary(&choice, base_rule, &st, &campaign),
         residual_structure: report::residuals::structure(&campaign, &folds, &st, &base.cv.residual),
         outliers: report::outliers::locate(&folds, &run_names, &st.t_s, &st.y, &base.cv.residual),
         between_run,
@@ -297,29 +297,50 @@ fn library_of(
     (library, note)
 }
 
-/// Within-run and between-run selection, alpha shared between the two sequences
-/// (Bonferroni; one sequence when runs are too few for the between-run one). Returns
-/// both and the number of sequences.
+/// The base by parsimony (`selection::parsimony`) with its within-run selection, then
+/// the between-run selection on it; alpha shared between the two sequences (Bonferroni;
+/// one sequence when runs are too few for the between-run one). Returns the base, both
+/// selections, how the base was chosen and the number of sequences.
 fn screen_both(
     campaign: &input::Campaign,
     meta: &[library::generic::MetaColumn],
     folds: &Folds,
     st: &Stacked,
-    choice: &base::bases::BaseChoice,
+    choice: base::bases::BaseChoice,
     library: &[library::transforms::Candidate],
     latitude_deg: f64,
-) -> Result<(Screening, between::BetweenRun, f64), DiagnoseError> {
-    let base = &choice.chosen;
-    let run_level = between::prepare(campaign, meta, folds, st, base, choice.levels.as_ref());
-    let groups = if run_level.is_ok() { 2.0 } else { 1.0 };
-    let screening = selection::screen::screen(
+) -> Result<
+    (
+        base::bases::BaseChoice,
+        Screening,
+        selection::parsimony::BaseRule,
+        between::BetweenRun,
+        f64,
+    ),
+    DiagnoseError,
+> {
+    let groups = if between::runs_held_out_whole(folds) {
+        2.0
+    } else {
+        1.0
+    };
+    let (choice, screening, base_rule) = selection::parsimony::choose_and_screen(
         campaign,
         folds,
-        base,
-        library.to_vec(),
+        st,
+        choice,
+        library,
         groups,
         selection::screen::MAX_STEPS,
     )?;
+    let run_level = between::prepare(
+        campaign,
+        meta,
+        folds,
+        st,
+        &choice.chosen,
+        choice.levels.as_ref(),
+    );
     let between_run = match run_level {
         Ok(p) => between::finish(p, groups, latitude_deg),
         Err(note) => between::BetweenRun {
@@ -334,7 +355,7 @@ fn screen_both(
         },
     };
     memprobe::stage("screen_both");
-    Ok((screening, between_run, groups))
+    Ok((choice, screening, base_rule, between_run, groups))
 }
 
 /// The base extended by every named within-run cause (the base itself when nothing is
@@ -414,6 +435,7 @@ fn named_causes(
 /// The chosen base and every base tried, for the report.
 fn base_summary(
     choice: &base::bases::BaseChoice,
+    rule: selection::parsimony::BaseRule,
     st: &Stacked,
     campaign: &input::Campaign,
 ) -> ModelSummary {
@@ -440,6 +462,7 @@ fn base_summary(
         tried: choice.scores.clone(),
         collinearity_warning: choice.collinearity_warning.clone(),
         levels: choice.levels.clone(),
+        rule,
     }
 }
 

@@ -395,15 +395,15 @@ pub struct Score {
     pub standard_error_dph: f64,
 }
 
-/// rms of per-run SSEs over `points`, and its standard error (ratio estimator over runs,
-/// delta method to the rms).
-pub fn score(sse: &[f64], points: &[f64]) -> Score {
-    let k = sse.len() as f64;
+/// Sum of per-unit values over the units' `points` (a mean square per point) and its
+/// variance (ratio estimator over units; NaN for one unit).
+pub fn ratio_estimate(per_unit: &[f64], points: &[f64]) -> (f64, f64) {
+    let k = per_unit.len() as f64;
     let n: f64 = points.iter().sum();
-    let ratio = sse.iter().sum::<f64>() / n.max(1e-300);
+    let ratio = per_unit.iter().sum::<f64>() / n.max(1e-300);
     let var = if k > 1.0 {
         k / (k - 1.0)
-            * sse
+            * per_unit
                 .iter()
                 .zip(points)
                 .map(|(s, m)| (s - ratio * m).powi(2))
@@ -412,6 +412,13 @@ pub fn score(sse: &[f64], points: &[f64]) -> Score {
     } else {
         f64::NAN
     };
+    (ratio, var)
+}
+
+/// rms of per-run SSEs over `points`, and its standard error (ratio estimator over runs,
+/// delta method to the rms).
+pub fn score(sse: &[f64], points: &[f64]) -> Score {
+    let (ratio, var) = ratio_estimate(sse, points);
     let rms = ratio.sqrt();
     Score {
         heldout_rms_dph: rms,

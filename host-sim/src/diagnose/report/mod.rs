@@ -33,13 +33,15 @@ pub struct ModelSummary {
     pub centres: usize,
     pub width_factor: f64,
     pub ridge: f64,
-    /// Every base tried with its held-out rms (the lowest is chosen).
+    /// Every base tried with its held-out rms (the reference of the parsimony rule, `rule`).
     pub tried: Vec<crate::diagnose::base::bases::BaseScore>,
     /// Set when T, time and lags of T are nearly collinear.
     pub collinearity_warning: Option<String>,
     /// Which law holds across runs (shared with random turn-on offsets, or free offsets),
     /// chosen on held-out runs (None for time-block layouts).
     pub levels: Option<crate::diagnose::base::bases::LevelChoice>,
+    /// How the base was chosen (issue 18 item 6: parsimony).
+    pub rule: crate::diagnose::selection::parsimony::BaseRule,
 }
 
 /// One ranked candidate.
@@ -303,8 +305,13 @@ fn write_baseline(s: &mut String, r: &Report) {
         .collect();
     let _ = writeln!(
         s,
-        "  bases tried (held-out rms +/- standard error, deg/h; run offsets free; paired p that the lowest beats it; the lowest is kept): {}",
+        "  bases tried (held-out rms +/- standard error, deg/h; run offsets free; paired p that the lowest beats it): {}",
         tried.join(", ")
+    );
+    let _ = writeln!(
+        s,
+        "  base rule: {}: {}",
+        r.base.rule.rule, r.base.rule.reason
     );
     write_levels(s, r);
     let _ = writeln!(

@@ -3,6 +3,7 @@
 //! test that separates it from competing explanations.
 
 pub mod cause;
+pub mod parsimony;
 pub mod power;
 pub mod screen;
 pub mod separate;
