@@ -128,7 +128,7 @@ impl InputChoice {
         }
         InputSet::parse(s).map(InputChoice::Fixed).ok_or_else(|| {
             format!(
-                "`{s}` is not an input set (use auto, t,rate, t,rate,accel or t,rate,accel_flat)"
+                "`{s}` is not an input set (use auto, t,rate, t,rate,accel, t,rate,accel_flat or t,rate,rise)"
             )
         })
     }
@@ -515,6 +515,19 @@ mod tests {
             FeatureKind::TempAccelFlatStartCps2
         );
         assert_eq!(InputSet::TempRate.specs(), default_specs());
+        assert_eq!(
+            InputChoice::parse("t,rate,rise"),
+            Ok(InputChoice::Fixed(InputSet::TempRateRise))
+        );
+        assert_eq!(
+            InputSet::TempRateRise.specs()[2].kind,
+            FeatureKind::TempRiseC
+        );
+        // Alternatives are tried only after the plain d2T/dt2 won the first step.
+        assert!(InputSet::ALL
+            .iter()
+            .all(|s| s.is_alternative() == InputSet::TempRateAccel.alternatives().contains(s)));
+        assert!(InputSet::TempRate.alternatives().is_empty());
     }
 
     #[test]
