@@ -17,7 +17,7 @@
 //! the seek score by default). Why the rise is a candidate: for a soaked unit the first
 //! reading is its ambient, so (T, dT/dt, T - T_first) tells the ambient a row warms up
 //! from as d2T/dt2 does, without a second derivative of the first few noisy rows (one
-//! global model, seek 1: the plain d2T/dt2's dwell means scatter 0.015 deg of azimuth
+//! global model, seek 1: the plain d2T/dt2's dwell means scatter 0.010-0.016 deg of azimuth
 //! from start to start, the rise's 0.002-0.006, docs/northfinder.md). Why a flat-start d2T/dt2 is a candidate: right after power-on the plain fit
 //! has 3..18 rows and its dwell means carry the thermometer noise divided by 10..20 s,
 //! which the first seek turns into azimuth scatter; the flat prior removes that noise but
