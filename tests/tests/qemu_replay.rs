@@ -192,8 +192,12 @@ fn scenario(evaluator: Evaluator, n_inputs: usize, accel: FeatureKind, tag: &str
     // The synthetic campaign's d2T/dt2 range is narrower than this soaked start's; a
     // range that covers it keeps the windows valid (the range guard is not under test).
     for j in 2..model.inputs.len() {
-        model.input_min[j] = -1.0;
-        model.input_max[j] = 1.0;
+        let (lo, hi) = match model.inputs[j].kind {
+            FeatureKind::TempRiseC => (-5.0, 100.0),
+            _ => (-1.0, 1.0),
+        };
+        model.input_min[j] = lo;
+        model.input_max[j] = hi;
     }
     let mut buf = [0u8; MAX_ENCODED_LEN];
     let n = model.encode(&mut buf).expect("model encodes");
@@ -326,4 +330,11 @@ fn firmware_replay_matches_host_bit_for_bit_flat_start_accel() {
         FeatureKind::TempAccelFlatStartCps2,
         "f32-accel-flat",
     );
+}
+
+/// The rise since power-on (`FeatureKind::TempRiseC`, the first reading kept by the
+/// extractor): the device computes it bit for bit as the host.
+#[test]
+fn firmware_replay_matches_host_bit_for_bit_rise() {
+    scenario(Evaluator::F32, 3, FeatureKind::TempRiseC, "f32-rise");
 }

@@ -15,7 +15,8 @@
 //!   (`TempRateEstimator::new_flat_start`: a 3-row quadratic right after power-on is
 //!   noise, but the flat prior only holds for a soaked unit whose thermometer lags the
 //!   heat). Which one a model uses is chosen by the trainer from data.
-//! - `FirstOrderLag`, `power_on_decay`: the remaining `FeatureKind`s.
+//! - `FirstOrderLag`, `power_on_decay`: the remaining `FeatureKind`s (and `TempRiseC`, the
+//!   temperature minus the first row's, kept in the extractor).
 //! - `FeatureExtractor` / `features_for_series`: a list of `FeatureSpec` -> input vectors.
 //!   The device feeds it its 10 s window means as they close; the trainer feeds it the
 //!   10 s rows of a fog-runs file. Same code, same inputs, so trained and deployed features
@@ -552,6 +553,8 @@ enum FeatureState {
     Plain,
     Rate(TempRateEstimator<EXTRACTOR_RATE_POINTS>),
     Lag(FirstOrderLag),
+    /// The first row's temperature (None before it), for `TempRiseC`.
+    First(Option<f64>),
 }
 
 /// Stateful computation of a list of `FeatureSpec`s, one row (window) at a time.
@@ -592,6 +595,7 @@ fn fresh_state(spec: &FeatureSpec) -> Result<FeatureState, FeatureError> {
             FeatureState::Rate(TempRateEstimator::new(span_for(spec))?)
         }
         FeatureKind::TempLagC => FeatureState::Lag(FirstOrderLag::new(spec.tau_s as f64)?),
+        FeatureKind::TempRiseC => FeatureState::First(None),
         FeatureKind::PowerOnDecay => {
             if !(spec.tau_s.is_finite() && spec.tau_s > 0.0) {
                 return Err(FeatureError::BadTimeConstant);
@@ -706,6 +710,9 @@ impl FeatureExtractor {
                     FeatureState::Rate(e),
                 ) => e.push(t_s, temp).and_then(|r| r.accel_per_s2),
                 (FeatureKind::TempLagC, FeatureState::Lag(l)) => Some(l.push(t_s, temp)),
+                (FeatureKind::TempRiseC, FeatureState::First(first)) => {
+                    Some(temp - *first.get_or_insert(temp))
+                }
                 (FeatureKind::PowerOnDecay, _) => Some(power_on_decay(t_s, spec.tau_s as f64)),
                 (FeatureKind::AuxValue(_), _) => aux_v,
                 (FeatureKind::AuxRate(_), FeatureState::Rate(e)) => {

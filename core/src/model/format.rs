@@ -86,6 +86,12 @@ pub enum FeatureKind {
     /// `TempRateEstimator::new_flat_start`). Identical to `TempAccelCps2` once the first
     /// reading has left the span. Appended last: existing model files keep their meaning.
     TempAccelFlatStartCps2,
+    /// Temperature rise since power-on, degC: the row's temperature minus the first row's
+    /// (the soaked unit's start temperature, i.e. about its ambient). With T and dT/dt it
+    /// tells a cold start at one ambient from a settled row of a colder one, which the
+    /// first minutes' d2T/dt2 can only tell through its noise. Appended last: existing
+    /// model files keep their meaning.
+    TempRiseC,
 }
 
 /// One model input: its kind and, for lags and decays, a time constant (s; 0 otherwise).

@@ -21,6 +21,7 @@ pub fn feature_name(spec: &FeatureSpec) -> String {
         FeatureKind::TempRateCps => "temp_c:rate".into(),
         FeatureKind::TempAccelCps2 => "temp_c:accel".into(),
         FeatureKind::TempAccelFlatStartCps2 => "temp_c:accel_flat_start".into(),
+        FeatureKind::TempRiseC => "temp_c:rise".into(),
         FeatureKind::TempLagC => {
             feature_label("temp_c", "lag", Some(f64::from(spec.tau_s))).to_string()
         }

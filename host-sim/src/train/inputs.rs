@@ -11,9 +11,14 @@
 //! Two steps (`choose_inputs`): which inputs, by the 10 s rms (whether the drift follows
 //! d2T/dt2 is a property of the drift law over whole runs; measured on the independent
 //! generator, the seek score cannot make that choice: with d2T/dt2 planted it kept
-//! (T, dT/dt), and on its null twin it took d2T/dt2, 0.0050 against 0.0078 deg); then
-//! which d2T/dt2 estimator, by the training criterion (`criterion_for`: the seek score by
-//! default). Why a flat-start d2T/dt2 is a candidate: right after power-on the plain fit
+//! (T, dT/dt), and on its null twin it took d2T/dt2, 0.0050 against 0.0078 deg); then,
+//! where d2T/dt2 was chosen, how its third state is read (plain or flat-start d2T/dt2,
+//! or the temperature rise since power-on), by the training criterion (`criterion_for`:
+//! the seek score by default). Why the rise is a candidate: for a soaked unit the first
+//! reading is its ambient, so (T, dT/dt, T - T_first) tells the ambient a row warms up
+//! from as d2T/dt2 does, without a second derivative of the first few noisy rows (one
+//! global model, seek 1: the plain d2T/dt2's dwell means scatter 0.010-0.016 deg of azimuth
+//! from start to start, the rise's 0.002-0.006, docs/northfinder.md). Why a flat-start d2T/dt2 is a candidate: right after power-on the plain fit
 //! has 3..18 rows and its dwell means carry the thermometer noise divided by 10..20 s,
 //! which the first seek turns into azimuth scatter; the flat prior removes that noise but
 //! is wrong for a thermometer that follows a heated node at once (a kink at power-on).
@@ -45,15 +50,21 @@ pub enum InputSet {
     /// (`FeatureKind::TempAccelFlatStartCps2`).
     #[serde(rename = "t,rate,accel_flat")]
     TempRateAccelFlat,
+    /// T, dT/dt and the temperature rise since power-on (`FeatureKind::TempRiseC`): the
+    /// third state d2T/dt2 stands for (which ambient a (T, dT/dt) row warms up from), read
+    /// from the first reading instead of a second derivative of the first few.
+    #[serde(rename = "t,rate,rise")]
+    TempRateRise,
 }
 
 impl InputSet {
-    /// Every set, smallest first, the plain estimator before the flat-start one (ties in a
+    /// Every set, smallest first, the plain d2T/dt2 before its alternatives (ties in a
     /// choice go to the earlier).
-    pub const ALL: [InputSet; 3] = [
+    pub const ALL: [InputSet; 4] = [
         InputSet::TempRate,
         InputSet::TempRateAccel,
         InputSet::TempRateAccelFlat,
+        InputSet::TempRateRise,
     ];
 
     /// The command-line name.
@@ -62,6 +73,7 @@ impl InputSet {
             InputSet::TempRate => "t,rate",
             InputSet::TempRateAccel => "t,rate,accel",
             InputSet::TempRateAccelFlat => "t,rate,accel_flat",
+            InputSet::TempRateRise => "t,rate,rise",
         }
     }
 
@@ -74,18 +86,24 @@ impl InputSet {
             InputSet::TempRateAccelFlat => {
                 specs.push(FeatureSpec::plain(FeatureKind::TempAccelFlatStartCps2))
             }
+            InputSet::TempRateRise => specs.push(FeatureSpec::plain(FeatureKind::TempRiseC)),
         }
         specs
     }
 
-    /// Whether the set's d2T/dt2 is the flat-start estimator.
-    pub fn is_flat_start(self) -> bool {
-        self == InputSet::TempRateAccelFlat
+    /// Whether the set is another reading of the plain d2T/dt2's third state (the
+    /// flat-start estimator, the rise since power-on): chosen in the second step only.
+    pub fn is_alternative(self) -> bool {
+        matches!(self, InputSet::TempRateAccelFlat | InputSet::TempRateRise)
     }
 
-    /// The same inputs with the flat-start d2T/dt2 (None: the set has no plain d2T/dt2).
-    pub fn flat_start_variant(self) -> Option<InputSet> {
-        (self == InputSet::TempRateAccel).then_some(InputSet::TempRateAccelFlat)
+    /// The other readings of this set's third input, in the order they are tried (empty:
+    /// the set has no plain d2T/dt2).
+    pub fn alternatives(self) -> &'static [InputSet] {
+        match self {
+            InputSet::TempRateAccel => &[InputSet::TempRateAccelFlat, InputSet::TempRateRise],
+            _ => &[],
+        }
     }
 
     /// Parses `t,rate`, `t,rate,accel` or `t,rate,accel_flat` (spaces ignored).
@@ -110,7 +128,7 @@ impl InputChoice {
         }
         InputSet::parse(s).map(InputChoice::Fixed).ok_or_else(|| {
             format!(
-                "`{s}` is not an input set (use auto, t,rate, t,rate,accel or t,rate,accel_flat)"
+                "`{s}` is not an input set (use auto, t,rate, t,rate,accel, t,rate,accel_flat or t,rate,rise)"
             )
         })
     }
@@ -280,15 +298,16 @@ pub struct InputSelection {
     pub criterion: String,
     /// Every plain-estimator candidate's figure, in the order tried (smallest set first).
     pub scores: Vec<InputSetScore>,
-    /// The d2T/dt2 estimator's choice (plain, then flat start), when there was one.
+    /// The third input's choice (plain d2T/dt2, then its alternatives), when there was one.
     pub estimator: Option<EstimatorChoice>,
 }
 
-/// The second step of `choose_inputs`: the plain against the flat-start d2T/dt2.
+/// The second step of `choose_inputs`: how the third state is read, the plain d2T/dt2
+/// against its alternatives (flat-start d2T/dt2, rise since power-on).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct EstimatorChoice {
     pub criterion: String,
-    /// The plain set's figure, then the flat-start set's.
+    /// The plain set's figure, then each alternative's, in the order tried.
     pub scores: Vec<InputSetScore>,
 }
 
@@ -311,7 +330,10 @@ impl InputSelection {
         let mut s = format!("inputs: {} (by {})\n", self.chosen.name(), self.criterion);
         s += &self.scores.iter().map(line).collect::<String>();
         if let Some(e) = &self.estimator {
-            s += &format!("d2T/dt2 estimator (by {}):\n", e.criterion);
+            s += &format!(
+                "third input: d2T/dt2 estimator or rise since power-on (by {}):\n",
+                e.criterion
+            );
             s += &e.scores.iter().map(line).collect::<String>();
         }
         s
@@ -391,11 +413,13 @@ fn choose_in_order(
 
 /// Chooses among `candidates` in two steps, all sets scored on the rows every candidate
 /// can use. First the inputs (the sets with the plain estimators, smallest first) by
-/// `inputs_criterion`: whether the drift needs d2T/dt2 at all is a question of the drift
-/// law, which the 10 s rms answers. Then, when the chosen set has a flat-start variant
-/// among the candidates, the d2T/dt2 estimator by `estimator_criterion`: the two differ
-/// only in the first 190 s after power-on, which the 10 s rms cannot see and the first
-/// seek does. In each step a later set replaces the choice only when it is significantly
+/// `inputs_criterion`: whether the drift needs a third input (d2T/dt2) at all is a
+/// question of the drift law, which the 10 s rms answers. Then, when the chosen set has
+/// alternatives among the candidates (`InputSet::alternatives`: the flat-start d2T/dt2,
+/// the rise since power-on), how that third state is read, by `estimator_criterion`:
+/// they carry the same information once the unit warms steadily and differ in the first
+/// minutes after power-on (estimator noise, the ambient a cold start warms from), which
+/// the 10 s rms cannot see and the first seeks do. In each step a later set replaces the choice only when it is significantly
 /// better unit by unit. Returns the selection and the chosen set's full dataset (all its
 /// ready rows).
 pub fn choose_inputs(
@@ -423,7 +447,7 @@ pub fn choose_inputs(
     }
     let common = common_rows(&full);
     let plain: Vec<usize> = (0..candidates.len())
-        .filter(|&i| !candidates[i].is_flat_start())
+        .filter(|&i| !candidates[i].is_alternative())
         .collect();
     let (mut best, scores) = if plain.is_empty() {
         (0, Vec::new())
@@ -431,16 +455,20 @@ pub fn choose_inputs(
         choose_in_order(&plain, candidates, &common, cfg, inputs_criterion)?
     };
     let mut estimator = None;
-    if let Some(flat) = candidates[best]
-        .flat_start_variant()
-        .and_then(|v| candidates.iter().position(|&c| c == v))
-    {
-        let (b, pair) =
-            choose_in_order(&[best, flat], candidates, &common, cfg, estimator_criterion)?;
+    let order: Vec<usize> = std::iter::once(best)
+        .chain(
+            candidates[best]
+                .alternatives()
+                .iter()
+                .filter_map(|v| candidates.iter().position(|c| c == v)),
+        )
+        .collect();
+    if order.len() > 1 {
+        let (b, tried) = choose_in_order(&order, candidates, &common, cfg, estimator_criterion)?;
         best = b;
         estimator = Some(EstimatorChoice {
             criterion: estimator_criterion.describe().into(),
-            scores: pair,
+            scores: tried,
         });
     }
     Ok((
@@ -487,6 +515,19 @@ mod tests {
             FeatureKind::TempAccelFlatStartCps2
         );
         assert_eq!(InputSet::TempRate.specs(), default_specs());
+        assert_eq!(
+            InputChoice::parse("t,rate,rise"),
+            Ok(InputChoice::Fixed(InputSet::TempRateRise))
+        );
+        assert_eq!(
+            InputSet::TempRateRise.specs()[2].kind,
+            FeatureKind::TempRiseC
+        );
+        // Alternatives are tried only after the plain d2T/dt2 won the first step.
+        assert!(InputSet::ALL
+            .iter()
+            .all(|s| s.is_alternative() == InputSet::TempRateAccel.alternatives().contains(s)));
+        assert!(InputSet::TempRate.alternatives().is_empty());
     }
 
     #[test]
