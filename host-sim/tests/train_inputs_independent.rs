@@ -111,19 +111,29 @@ fn estimator_scores(sel: &serde_json::Value) -> (f64, f64) {
     (score(0), score(1))
 }
 
+/// The third input chosen on top of T and dT/dt. Step 2 also weighs the rise since
+/// power-on as a reading of the third state; on these soaked starts (one warm-up shape per
+/// run) it wins by the seek score, so the tests below judge the d2T/dt2 estimators by their
+/// own scores and only require that some third input is chosen.
+fn has_third_input(sel: &serde_json::Value) -> bool {
+    let chosen = sel["chosen"].as_str().unwrap();
+    ["t,rate,accel", "t,rate,accel_flat", "t,rate,rise"].contains(&chosen)
+}
+
 #[test]
-fn a_lagged_soaked_thermometer_gets_a_d2t_dt2_and_the_flat_start_costs_nothing() {
+fn a_lagged_soaked_thermometer_gets_a_third_input_and_the_flat_start_costs_nothing() {
     let sel = soaked_choice(SoakedLaw::LaggedGradient(3.0), 1, "soaked-lagged");
     let (plain, flat) = estimator_scores(&sel);
-    assert!(sel["chosen"].as_str().unwrap().starts_with("t,rate,accel"));
+    assert!(has_third_input(&sel), "{}", sel["chosen"]);
     assert!(flat < 1.05 * plain, "flat {flat} vs plain {plain}");
 }
 
 #[test]
-fn a_thermometer_on_the_heated_node_keeps_the_plain_d2t_dt2() {
+fn a_thermometer_on_the_heated_node_never_gets_the_flat_start() {
     let sel = soaked_choice(SoakedLaw::UnlaggedTwoMode(3.0), 1, "soaked-unlagged");
     let (plain, flat) = estimator_scores(&sel);
-    assert_eq!(sel["chosen"], "t,rate,accel");
+    assert!(has_third_input(&sel), "{}", sel["chosen"]);
+    assert_ne!(sel["chosen"], "t,rate,accel_flat");
     assert!(flat > 1.05 * plain, "flat {flat} vs plain {plain}");
 }
 
