@@ -190,12 +190,15 @@ mod tests {
     }
 
     /// A fake device: waits for the commands, then sends `seeks` x (4 statuses, garbage,
-    /// one result) and closes. Bounded: it stops by itself.
+    /// one result) and closes. Bounded: it stops by itself. The wait for the commands is
+    /// generous (10 s): the monitor opens the shared registry before it sends them, and
+    /// with four monitors on one SQLite file under a loaded CI machine that once took
+    /// longer than the former 500 ms, so the device closed and the monitor's command met a
+    /// broken pipe.
     fn fake_device(listener: TcpListener, seeks: u32) -> std::thread::JoinHandle<Vec<Command>> {
         std::thread::spawn(move || {
             let (mut s, _) = listener.accept().unwrap();
-            s.set_read_timeout(Some(Duration::from_millis(500)))
-                .unwrap();
+            s.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
             let mut got = Vec::new();
             let mut rx = FrameReceiver::new();
             let mut b = [0u8; 1];
