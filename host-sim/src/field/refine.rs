@@ -360,7 +360,8 @@ pub fn choose_weight(obs: &[FieldObservation], terms: &[Term], fixed: Option<f64
     };
     if obs.len() < MIN_RECORDS {
         return none(format!(
-            "no test power: {} field seeks, at least {MIN_RECORDS} needed; model unchanged",
+            "no test power: {} field seeks, at least {MIN_RECORDS} needed; model unchanged \
+             (run more seeks, `fogsim field pull` them, then `train --field` again)",
             obs.len()
         ));
     }
@@ -368,7 +369,9 @@ pub fn choose_weight(obs: &[FieldObservation], terms: &[Term], fixed: Option<f64
         return none(format!(
             "no test power: the {} field seeks come from {power_ons} power-on; the correction \
              is used on other power-ons (other ambients and warm-ups) and leave-one-power-on-out \
-             needs at least {MIN_POWER_ONS} to score it there; model unchanged",
+             needs at least {MIN_POWER_ONS} to score it there; model unchanged (record seeks \
+             after another power-on, at another ambient if you can, `fogsim field pull` them, \
+             then `train --field` again)",
             obs.len()
         ));
     }
