@@ -18,7 +18,8 @@
 //! reading is its ambient, so (T, dT/dt, T - T_first) tells the ambient a row warms up
 //! from as d2T/dt2 does, without a second derivative of the first few noisy rows (one
 //! global model, seek 1: the plain d2T/dt2's dwell means scatter 0.010-0.016 deg of azimuth
-//! from start to start, the rise's 0.002-0.006, docs/northfinder.md). Why a flat-start d2T/dt2 is a candidate: right after power-on the plain fit
+//! from start to start, the rise's 0.002-0.006, docs/northfinder.md). Why a flat-start
+//! d2T/dt2 is a candidate: right after power-on the plain fit
 //! has 3..18 rows and its dwell means carry the thermometer noise divided by 10..20 s,
 //! which the first seek turns into azimuth scatter; the flat prior removes that noise but
 //! is wrong for a thermometer that follows a heated node at once (a kink at power-on).
@@ -106,7 +107,8 @@ impl InputSet {
         }
     }
 
-    /// Parses `t,rate`, `t,rate,accel` or `t,rate,accel_flat` (spaces ignored).
+    /// Parses `t,rate`, `t,rate,accel`, `t,rate,accel_flat` or `t,rate,rise` (spaces
+    /// ignored).
     pub fn parse(s: &str) -> Option<Self> {
         let s: String = s.chars().filter(|c| !c.is_whitespace()).collect();
         Self::ALL.into_iter().find(|set| set.name() == s)
@@ -419,7 +421,8 @@ fn choose_in_order(
 /// the rise since power-on), how that third state is read, by `estimator_criterion`:
 /// they carry the same information once the unit warms steadily and differ in the first
 /// minutes after power-on (estimator noise, the ambient a cold start warms from), which
-/// the 10 s rms cannot see and the first seeks do. In each step a later set replaces the choice only when it is significantly
+/// the 10 s rms cannot see and the first seeks do. In each step a later set replaces the
+/// choice only when it is significantly
 /// better unit by unit. Returns the selection and the chosen set's full dataset (all its
 /// ready rows).
 pub fn choose_inputs(
