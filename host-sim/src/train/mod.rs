@@ -82,7 +82,7 @@ pub struct TrainReport {
     /// uncompensated one, else `not_better` (the model does not clearly help).
     pub verdict: Verdict,
     pub stop: StopReason,
-    /// What chose the number of centres, in words, e.g. `cross-validation: 22 of 64 centres`
+    /// What chose the number of centres, in words, e.g. `cross-validation (held-out 10 s residual energy): 22 of 64 centres`
     /// (`stop` is where the final fit's selection path ended, which is not always it).
     pub size_chosen_by: String,
     /// Sum of the error-reduction ratios of the final fit (bias and linear terms included).
@@ -144,11 +144,15 @@ fn size_chosen_by(
         StopReason::NoCandidate => "no candidate left outside the span of the selection",
         StopReason::GcvMinimum => "generalised cross-validation (Orr)",
     };
+    // Whatever criterion chose the width and degree, each fold's number of centres is
+    // chosen by held-out residual energy (`validate`): choosing it by the held-out seek
+    // error picked 1 centre for `north-seek`'s own 20 degC model (docs/northfinder.md).
+    let cv = "cross-validation (held-out 10 s residual energy)";
     match cv_centers {
         Some(_) if stop == StopReason::MaxCenters && n == cfg.max_centers => {
-            format!("cross-validation: {of}, the --max-centers cap")
+            format!("{cv}: {of}, the --max-centers cap")
         }
-        Some(_) if stop == StopReason::MaxCenters => format!("cross-validation: {of}"),
+        Some(_) if stop == StopReason::MaxCenters => format!("{cv}: {of}"),
         _ => format!("{path_stop}: {of}"),
     }
 }
@@ -285,11 +289,14 @@ mod tests {
         let cv = |stop, n| size_chosen_by(&cfg, Some(22), stop, n);
         assert_eq!(
             cv(StopReason::MaxCenters, 22),
-            format!("cross-validation: 22 of {cap} centres")
+            format!("cross-validation (held-out 10 s residual energy): 22 of {cap} centres")
         );
         assert_eq!(
             size_chosen_by(&cfg, Some(cap), StopReason::MaxCenters, cap),
-            format!("cross-validation: {cap} of {cap} centres, the --max-centers cap")
+            format!(
+                "cross-validation (held-out 10 s residual energy): {cap} of {cap} centres, \
+                 the --max-centers cap"
+            )
         );
         // The path's own stop came before cross-validation's pick.
         assert!(cv(StopReason::Target, 5).starts_with("--target-dph stop"));
