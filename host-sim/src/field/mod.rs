@@ -167,6 +167,9 @@ impl FieldRefinement {
         for line in &self.correction.coverage {
             s += &format!("field range: {line}\n");
         }
+        for line in &self.correction.coverage_refused {
+            s += &format!("field coverage: {line}\n");
+        }
         if let Some(v) = &self.choice.verdict {
             s += &format!("field refinement: {v}\n");
             return s;

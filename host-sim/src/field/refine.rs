@@ -58,6 +58,7 @@
 //! (x_j = offset_j + scale_j xn_j), so the device applies it with no new code.
 
 use anyhow::{bail, Result};
+use fog_core::compensation::compensator::CompensatorConfig;
 use fog_core::model::format::{FeatureKind, RbfModel};
 
 /// Fewer field seeks than this: no test power, no correction.
@@ -69,6 +70,8 @@ pub const MIN_POWER_ONS: usize = 2;
 pub const WEIGHT_GRID: [f64; 12] = [
     0.0, 0.01, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0, 1000.0, 1.0e5,
 ];
+/// The grid's largest weight: the field alone (the prior rows negligible).
+const FIELD_ALONE_WEIGHT: f64 = WEIGHT_GRID[WEIGHT_GRID.len() - 1];
 /// Spread below which a term is not fitted, per input kind (degC, degC/s).
 const SPREAD_FLOOR: [f64; 2] = [0.05, 1.0e-5];
 /// |correlation| of a term's field values with a kept term's above which it is not fitted.
@@ -135,6 +138,9 @@ pub struct Correction {
     pub not_fitted: Vec<String>,
     /// Per candidate input: the field's range against the model's trained range.
     pub coverage: Vec<String>,
+    /// Terms refused because the device would apply them beyond what the records
+    /// support (`supported_terms`), one line each.
+    pub coverage_refused: Vec<String>,
 }
 
 impl Correction {
@@ -254,6 +260,110 @@ pub fn terms_for(model: &RbfModel, obs: &[FieldObservation]) -> (Vec<Term>, Vec<
     (terms, notes)
 }
 
+/// The field records' range of a record value (0 T, 1 dT/dt).
+fn field_range(obs: &[FieldObservation], kind: usize) -> (f64, f64) {
+    obs.iter()
+        .map(|o| o.input(kind))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+            (lo.min(x), hi.max(x))
+        })
+}
+
+/// Where the device applies a term in model input `input`: the compensator clamps every
+/// input to the trained range widened by its margin
+/// (`CompensatorConfig::range_margin_frac`), so a term folded into the model's linear
+/// coefficients acts as a straight line over all of that range.
+fn range_in_use(model: &RbfModel, input: usize) -> (f64, f64) {
+    let (lo, hi) = (
+        f64::from(model.input_min[input]),
+        f64::from(model.input_max[input]),
+    );
+    let margin = f64::from(CompensatorConfig::default().range_margin_frac) * (hi - lo);
+    (lo - margin, hi + margin)
+}
+
+/// The leave-one-power-on-out (jackknife) standard error, deg/h, of what the term `t`
+/// (fitted with the constant on the field alone) adds at input value `x`: each power-on
+/// left out in turn, the term's contribution at `x` refitted on the others.
+pub fn term_se_at_dph(obs: &[FieldObservation], t: &Term, x: f64) -> f64 {
+    let mut groups: Vec<usize> = obs.iter().map(|o| o.power_on).collect();
+    groups.sort_unstable();
+    groups.dedup();
+    if groups.len() < 2 {
+        return f64::INFINITY;
+    }
+    let at_x: Vec<f64> = groups
+        .iter()
+        .map(|&g| {
+            let rest: Vec<FieldObservation> =
+                obs.iter().filter(|o| o.power_on != g).copied().collect();
+            fit(&rest, std::slice::from_ref(t), FIELD_ALONE_WEIGHT).coef_dph[1] * (x - t.mean)
+                / t.std
+        })
+        .collect();
+    let g = at_x.len() as f64;
+    let mean = at_x.iter().sum::<f64>() / g;
+    ((g - 1.0) / g * at_x.iter().map(|d| (d - mean).powi(2)).sum::<f64>()).sqrt()
+}
+
+/// The terms the device may apply: a term is refused when, at the far end of where the
+/// device applies it (`range_in_use`), its own leave-one-power-on-out standard error
+/// (`term_se_at_dph`) exceeds the records' scatter (std of their residual biases): out
+/// there the term would add more uncertainty than the whole error the refinement works
+/// against. One line for each refused.
+///
+/// Why refuse and not clamp: the correction reaches the device folded into the model's
+/// bias and linear coefficients (`apply`), which the firmware evaluates as they are over
+/// the whole trained range (its compensator clamps inputs to that range only); the model
+/// format has no per-term bound, so a clamp to the records' range would be a new format
+/// and new firmware code, and the model the host scored would not be the one the device
+/// runs until both exist. The threshold is the data's own: the term's standard error
+/// against the records' scatter. Records from one ambient span a few degC of one warm-up
+/// path: a T slope from them, carried 20 degC further, is uncertain by more than the
+/// records scatter, and is refused however well it fits there; records from three
+/// ambients span the range and keep it.
+pub fn supported_terms(
+    model: &RbfModel,
+    obs: &[FieldObservation],
+    terms: &[Term],
+) -> (Vec<Term>, Vec<String>) {
+    let n = obs.len().max(1) as f64;
+    let mean_r = obs.iter().map(|o| o.residual_bias_dph).sum::<f64>() / n;
+    let scatter = (obs
+        .iter()
+        .map(|o| (o.residual_bias_dph - mean_r).powi(2))
+        .sum::<f64>()
+        / n)
+        .sqrt();
+    let mut refused = Vec::new();
+    let kept = terms
+        .iter()
+        .copied()
+        .filter(|t| {
+            let (lo, hi) = field_range(obs, t.kind);
+            let (ulo, uhi) = range_in_use(model, t.input);
+            let far = if (ulo - t.mean).abs() > (uhi - t.mean).abs() {
+                ulo
+            } else {
+                uhi
+            };
+            let se = term_se_at_dph(obs, t, far);
+            if se <= scatter {
+                return true;
+            }
+            refused.push(format!(
+                "{name} refused: the records span {lo:.4} .. {hi:.4}, the device applies the \
+                 model over {ulo:.4} .. {uhi:.4}; at {far:.4} the term's leave-one-power-on-out \
+                 standard error is {se:.5} dph, more than the records' scatter {scatter:.5} dph \
+                 (record seeks at other ambients to support it)",
+                name = kind_name(t.kind)
+            ));
+            false
+        })
+        .collect();
+    (kept, refused)
+}
+
 /// Correlation of two terms' values over the field seeks.
 fn correlation(obs: &[FieldObservation], a: &Term, b: &Term) -> f64 {
     let n = obs.len().max(1) as f64;
@@ -287,6 +397,7 @@ pub fn fit(obs: &[FieldObservation], terms: &[Term], w: f64) -> Correction {
         coef_dph: solve_spd(a, b),
         not_fitted: Vec::new(),
         coverage: Vec::new(),
+        coverage_refused: Vec::new(),
     }
 }
 
@@ -455,10 +566,7 @@ fn coverage(model: &RbfModel, obs: &[FieldObservation]) -> Vec<String> {
     candidate_terms(model)
         .into_iter()
         .map(|(input, kind)| {
-            let (lo, hi) = obs.iter().map(|o| o.input(kind)).fold(
-                (f64::INFINITY, f64::NEG_INFINITY),
-                |(lo, hi), x| (lo.min(x), hi.max(x)),
-            );
+            let (lo, hi) = field_range(obs, kind);
             let (tlo, thi) = (
                 f64::from(model.input_min[input]),
                 f64::from(model.input_max[input]),
@@ -497,7 +605,8 @@ pub fn refine(
     obs: &[FieldObservation],
     fixed: Option<f64>,
 ) -> Result<(RbfModel, Correction, WeightChoice)> {
-    let (terms, mut not_fitted) = terms_for(model, obs);
+    let (identifiable, mut not_fitted) = terms_for(model, obs);
+    let (terms, coverage_refused) = supported_terms(model, obs, &identifiable);
     let choice = choose_weight(obs, &terms, fixed);
     if choice.verdict.is_none() {
         let without = best_rms_with(&choice, choice.terms_kept);
@@ -514,6 +623,7 @@ pub fn refine(
     let c = Correction {
         not_fitted,
         coverage: coverage(model, obs),
+        coverage_refused,
         ..fit(obs, &terms[..choice.terms_kept], choice.weight)
     };
     Ok((apply(model, &c)?, c, choice))
@@ -527,17 +637,18 @@ mod tests {
     fn model() -> RbfModel {
         let mut m = RbfModel::empty();
         m.n_rbf_inputs = 0;
-        for (k, off, scale) in [
-            (FeatureKind::TempC, 25.0f32, 10.0f32),
-            (FeatureKind::TempRateCps, 0.0, 0.01),
+        // Trained ranges: T 10 .. 40 degC, dT/dt -0.003 .. 0.015 degC/s.
+        for (k, off, scale, lo, hi) in [
+            (FeatureKind::TempC, 25.0f32, 10.0f32, 10.0f32, 40.0f32),
+            (FeatureKind::TempRateCps, 0.0, 0.01, -0.003, 0.015),
         ] {
             m.inputs
                 .push(fog_core::model::format::FeatureSpec::plain(k))
                 .unwrap();
             m.input_offset.push(off).unwrap();
             m.input_scale.push(scale).unwrap();
-            m.input_min.push(-100.0).unwrap();
-            m.input_max.push(100.0).unwrap();
+            m.input_min.push(lo).unwrap();
+            m.input_max.push(hi).unwrap();
             m.linear.push(0.0).unwrap();
         }
         m.bias_dph = 0.5;
@@ -555,7 +666,8 @@ mod tests {
                     temp_rate_cps: 0.001 * (i % 3) as f64,
                     temp_accel_cps2: 0.0,
                     residual_bias_dph: 0.01 + k_dph_per_c * (t - 25.0) + noise * u,
-                    power_on: i % 8,
+                    // 8 power-ons, each over its own part of the T range.
+                    power_on: i * 8 / n,
                 }
             })
             .collect()
@@ -627,9 +739,65 @@ mod tests {
         assert_eq!(terms.len(), 2, "{notes:?}");
     }
 
+    /// `model()` without its dT/dt input.
+    fn t_only_model() -> RbfModel {
+        let mut m = model();
+        m.inputs.pop();
+        m.input_offset.pop();
+        m.input_scale.pop();
+        m.input_min.pop();
+        m.input_max.pop();
+        m.linear.pop();
+        m
+    }
+
+    #[test]
+    fn a_term_is_applied_only_as_far_as_the_records_support_it() {
+        // The gyro aged by a T law (+ record noise, +-0.004 deg/h); the model is used over
+        // T 8.5 .. 41.5 degC (trained 10 .. 40 plus the compensator's margin).
+        let m = t_only_model();
+        let noisy = |seed: u64, k_dph_per_c: f64| {
+            let mut rng = fog_core::model::synthetic::SplitMix64::new(seed);
+            move |t: f64, _| {
+                k_dph_per_c * (t - 20.0) + 0.008 * (rng.next_u64() as f64 / u64::MAX as f64 - 0.5)
+            }
+        };
+        let at = |model: &RbfModel, t: f64| predict_f64(model, &[t]).unwrap();
+        // Four power-ons near 10 degC (records 11.2 .. 17.7 degC): the T term fits there,
+        // but carried to 41.5 degC its own standard error exceeds the records' scatter:
+        // refused, one line says so, the model moves by its constant only (the same change
+        // at 12 and at 40 degC).
+        let one_ambient = warm_ups(&[10.0, 10.4, 9.7, 10.2], noisy(4, 0.001));
+        let (refined, c, choice) = refine(&m, &one_ambient, None).unwrap();
+        assert!(choice.verdict.is_none(), "{choice:?}");
+        assert!(choice.kinds.is_empty() && c.terms.is_empty(), "{c:?}");
+        assert_eq!(c.coverage_refused.len(), 1, "{c:?}");
+        assert!(
+            c.coverage_refused[0].starts_with("T refused: the records span 11.2"),
+            "{c:?}"
+        );
+        let moved_40 = at(&refined, 40.0) - at(&m, 40.0);
+        let moved_12 = at(&refined, 12.0) - at(&m, 12.0);
+        assert!((moved_40 - moved_12).abs() < 1e-6, "{moved_40} {moved_12}");
+        // Twin: power-ons at 10, 20, 30 and 10 degC (records 11.5 .. 37.3 degC): T kept,
+        // and the refined model follows the law at 40 degC.
+        let three = warm_ups(&[10.0, 20.0, 30.0, 10.0], noisy(4, 0.001));
+        let (refined, c, choice) = refine(&m, &three, None).unwrap();
+        assert!(c.coverage_refused.is_empty(), "{c:?}");
+        assert_eq!(choice.terms_kept, 1, "{choice:?}");
+        let moved_40 = at(&refined, 40.0) - at(&m, 40.0);
+        assert!((moved_40 - 0.02).abs() < 0.003, "{moved_40}");
+        // Null twin: the same power-ons, no aging (noise only): supported, but no term
+        // wins on the held-out power-ons.
+        let null = warm_ups(&[10.0, 20.0, 30.0, 10.0], noisy(5, 0.0));
+        let (_, c, choice) = refine(&m, &null, None).unwrap();
+        assert!(c.coverage_refused.is_empty(), "{c:?}");
+        assert_eq!(choice.terms_kept, 0, "{choice:?}");
+    }
+
     /// Warm-ups from `ambients_c` (one power-on each, 6 seeks): T rises from the ambient,
     /// dT/dt falls; the residual is `law` of (T, dT/dt).
-    fn warm_ups(ambients_c: &[f64], law: impl Fn(f64, f64) -> f64) -> Vec<FieldObservation> {
+    fn warm_ups(ambients_c: &[f64], mut law: impl FnMut(f64, f64) -> f64) -> Vec<FieldObservation> {
         let mut out = Vec::new();
         for (p, &a) in ambients_c.iter().enumerate() {
             for k in 0..6 {
@@ -651,13 +819,7 @@ mod tests {
     fn a_term_is_scored_on_other_power_ons_and_one_power_on_has_no_test_power() {
         // A T-only model; the gyro's aging is in dT/dt (Shupe), which within one warm-up
         // looks like a T law (T and dT/dt correlate at r = -1 there).
-        let mut m = model();
-        m.inputs.pop();
-        m.input_offset.pop();
-        m.input_scale.pop();
-        m.input_min.pop();
-        m.input_max.pop();
-        m.linear.pop();
+        let m = t_only_model();
         let shupe = |_t: f64, rate: f64| 1.4 * rate;
         // One power-on at 10 degC: nothing can be scored at another ambient.
         let one = warm_ups(&[10.0], shupe);
