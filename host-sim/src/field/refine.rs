@@ -605,21 +605,10 @@ pub fn choose_weight(obs: &[FieldObservation], terms: &[Term], fixed: Option<f64
         )
     };
     let bests: Vec<Candidate> = (0..=terms.len()).filter_map(best_of).collect();
-    // ... and the fewest terms whose held-out mean square is within one standard error of
-    // the lowest (the one-standard-error rule): a term must win by more than the power-ons'
-    // scatter to be kept. Once on the half-sums, once on the azimuth score.
-    let fewest_within_se = |score: &dyn Fn(&Candidate) -> (f64, f64)| {
-        let lowest = bests
-            .iter()
-            .map(|c| score(c))
-            .fold(None::<(f64, f64)>, |b, s| match b {
-                Some(b) if b.0 <= s.0 => Some(b),
-                _ => Some(s),
-            });
-        lowest.and_then(|(ms, se)| bests.iter().copied().find(|c| score(c).0 <= ms + se))
-    };
-    let by_half_sum = fewest_within_se(&|c| (c.rms_dph.powi(2), c.ms_se_dph2));
-    let by_azimuth = fewest_within_se(&|c| (c.az_rms_deg.powi(2), c.az_ms_se_deg2));
+    // ... and the fewest terms within one standard error of the lowest, once on the
+    // half-sums, once on the azimuth score.
+    let by_half_sum = fewest_within_se(&bests, |c| (c.rms_dph.powi(2), c.ms_se_dph2));
+    let by_azimuth = fewest_within_se(&bests, |c| (c.az_rms_deg.powi(2), c.az_ms_se_deg2));
     let chosen = match TERM_CRITERION {
         TermCriterion::HalfSum => by_half_sum,
         TermCriterion::Azimuth => by_azimuth,
@@ -643,6 +632,24 @@ pub fn choose_weight(obs: &[FieldObservation], terms: &[Term], fixed: Option<f64
         criterion: TERM_CRITERION,
         verdict: None,
     }
+}
+
+/// Of `bests` (one per number of terms, fewest first), the fewest terms whose held-out
+/// mean square (`score`: mean square, its standard error) is within one standard error of
+/// the lowest (the one-standard-error rule): a term must win by more than the power-ons'
+/// scatter to be kept.
+fn fewest_within_se(
+    bests: &[Candidate],
+    score: impl Fn(&Candidate) -> (f64, f64),
+) -> Option<Candidate> {
+    let lowest = bests
+        .iter()
+        .map(&score)
+        .fold(None::<(f64, f64)>, |b, s| match b {
+            Some(b) if b.0 <= s.0 => Some(b),
+            _ => Some(s),
+        });
+    lowest.and_then(|(ms, se)| bests.iter().copied().find(|c| score(c).0 <= ms + se))
 }
 
 /// The lowest held-out rms over the candidates that keep exactly `k` terms.
@@ -868,6 +875,7 @@ mod tests {
         assert!(choice.verdict.is_none(), "{choice:?}");
         assert!(choice.kinds.is_empty() && c.terms.is_empty(), "{c:?}");
         assert_eq!(c.coverage_refused.len(), 1, "{c:?}");
+        eprintln!("field coverage: {}", c.coverage_refused[0]);
         assert!(
             c.coverage_refused[0].starts_with("T refused: the records span 11.2"),
             "{c:?}"
