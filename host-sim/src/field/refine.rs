@@ -54,6 +54,15 @@
 //! to over the seek, but no measurement has checked such a correction yet: the aging
 //! measurement's chamber model (`north-seek`'s own) has no d2T/dt2 input.
 //!
+//! **Coverage** (`supported_terms`): the device applies a folded term over the model's
+//! whole range in use, so a term is refused where, at the far end of that range, its own
+//! leave-one-power-on-out standard error exceeds the records' scatter (refused, not
+//! clamped: the model format has no per-term bound).
+//!
+//! **Azimuth score** (`HeldOut::az_rms_deg`): beside the half-sum, every candidate is
+//! scored by what its held-out residual's drift between seeks does to a seek's azimuth;
+//! `TERM_CRITERION` says which score chooses the terms (measured: the half-sum).
+//!
 //! The correction is folded exactly into the model's bias and linear terms
 //! (x_j = offset_j + scale_j xn_j), so the device applies it with no new code.
 
