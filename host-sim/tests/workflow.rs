@@ -5,9 +5,10 @@
 //! free loopback ports; the default registry lives in a scratch `XDG_DATA_HOME`.
 //!
 //! Checked: every command succeeds, the path's steps all among them (import, train,
-//! compensate, heading-cal, upload, rig, monitor, registry); the seek's azimuth is within
-//! 3 of its reported sigma of the rig's truth and its tilt (measured over the
-//! inclinometer link, no `tilt-mdeg=`) within 0.01 deg of the rig's base (all read from
+//! compensate, heading-cal, upload, rig, monitor, field pull, train --field, registry); the
+//! seek's azimuth is within 3 of its reported sigma of the rig's truth and its tilt
+//! (measured over the inclinometer link, no `tilt-mdeg=`) within 0.01 deg of the rig's
+//! base; the seek's field record pulled and counted by `train --field` (all read from
 //! the commands' own output lines); the model carries the heading calibration; the
 //! registry shows the upload and the result. Prints the error, sigma and wall time.
 //!
@@ -136,6 +137,29 @@ fn field(line: &str, key: &str) -> f64 {
         .unwrap_or_else(|| panic!("no {key}= in {line:?}"))
 }
 
+/// The seek's field record: pulled, then counted by `train --field` as measured under the
+/// heading-calibrated variant of the retrained model (the registry knows it); one power-on
+/// has no test power, the model is left unchanged.
+fn check_field_step(walk: &Walk, dir: &Path) {
+    let pull = walk.output_of("fogsim field pull");
+    assert!(
+        pull.contains("pulled=1 ") && pull.contains("registry_added=1"),
+        "{pull}"
+    );
+    let refined = walk.output_of("fogsim train runs --out model-field.fogm");
+    assert!(
+        refined
+            .contains("field refinement: 1 field seeks used (1 of them under heading-calibrated")
+            && refined.contains("no test power"),
+        "{refined}"
+    );
+    assert_eq!(
+        std::fs::read(dir.join("model-field.fogm")).unwrap(),
+        std::fs::read(dir.join("model.fogm")).unwrap(),
+        "no test power: the model unchanged"
+    );
+}
+
 #[test]
 fn the_workflow_page_runs_as_written_and_finds_north() {
     if !qemu_ready("workflow") {
@@ -165,6 +189,8 @@ fn the_workflow_page_runs_as_written_and_finds_north() {
         "fogsim rig",
         "fogsim upload",
         "fogsim monitor",
+        "fogsim field pull",
+        "fogsim train runs --out model-field.fogm",
         "fogsim registry show",
     ] {
         assert!(
@@ -221,6 +247,7 @@ fn the_workflow_page_runs_as_written_and_finds_north() {
         "{}",
         walk.output_of("fogsim heading-cal")
     );
+    check_field_step(&walk, &dir);
     let show = walk.output_of("fogsim registry show");
     assert!(
         show.contains("committed") && show.contains("seek results: 1"),

@@ -102,6 +102,7 @@ pub fn refine_with_records(
             temp_accel_cps2: f64::from(r.temp_accel_cps2),
             residual_bias_dph: f64::from(r.residual_bias_dph),
             power_on,
+            t_since_power_on_s: f64::from(r.t_since_power_on_s),
         })
         .collect();
     if obs.is_empty() {
@@ -167,14 +168,19 @@ impl FieldRefinement {
         for line in &self.correction.coverage {
             s += &format!("field range: {line}\n");
         }
+        for line in &self.correction.coverage_refused {
+            s += &format!("field coverage: {line}\n");
+        }
         if let Some(v) = &self.choice.verdict {
             s += &format!("field refinement: {v}\n");
             return s;
         }
         s += &format!(
-            "terms  field weight W  leave-one-power-on-out rms of the residual bias, dph ({} power-ons; \
-             the best W per terms, then the fewest terms within one standard error)\n",
-            self.choice.power_ons
+            "terms  field weight W  leave-one-power-on-out: rms of the residual bias, dph; azimuth \
+             score, deg ({} power-ons; the best W per terms by the residual bias, then the \
+             fewest terms within one standard error by the {})\n",
+            self.choice.power_ons,
+            self.choice.criterion.name()
         );
         let names = |k: usize| {
             std::iter::once("1")
@@ -189,12 +195,19 @@ impl FieldRefinement {
                 ""
             };
             s += &format!(
-                "{:<10} {:>14}  {:>10.5}{mark}\n",
+                "{:<10} {:>14}  {:>10.5}  {:>8.5}{mark}\n",
                 names(c.terms),
                 c.weight,
-                c.rms_dph
+                c.rms_dph,
+                c.az_rms_deg
             );
         }
+        s += &format!(
+            "field terms: the residual bias chooses {}, the azimuth score {}; used: the {}\n",
+            names(self.choice.terms_by_half_sum),
+            names(self.choice.terms_by_azimuth),
+            self.choice.criterion.name()
+        );
         s += &format!(
             "field correction: constant {:+.5} dph, terms {:?} coefficients {:?} dph per field std\n",
             self.correction.coef_dph[0],

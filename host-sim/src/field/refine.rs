@@ -54,10 +54,23 @@
 //! to over the seek, but no measurement has checked such a correction yet: the aging
 //! measurement's chamber model (`north-seek`'s own) has no d2T/dt2 input.
 //!
+//! **Coverage** (`supported_terms`): the device applies a folded term over the model's
+//! whole range in use, so a term is refused where, at the far end of that range, its own
+//! leave-one-power-on-out standard error exceeds the records' scatter (refused, not
+//! clamped: the model format has no per-term bound).
+//!
+//! **Azimuth score** (`HeldOut::az_rms_deg`): beside the half-sum, every candidate is
+//! scored by what its held-out residual's drift between seeks does to a seek's azimuth;
+//! `TERM_CRITERION` says which score chooses the terms (measured: the half-sum).
+//!
 //! The correction is folded exactly into the model's bias and linear terms
 //! (x_j = offset_j + scale_j xn_j), so the device applies it with no new code.
 
 use anyhow::{bail, Result};
+
+use crate::train::seek_score::DEFAULT_SEEK_DWELL_S;
+use fog_core::compensation::compensator::CompensatorConfig;
+use fog_core::consts::earth_rate_horizontal_dph;
 use fog_core::model::format::{FeatureKind, RbfModel};
 
 /// Fewer field seeks than this: no test power, no correction.
@@ -69,6 +82,8 @@ pub const MIN_POWER_ONS: usize = 2;
 pub const WEIGHT_GRID: [f64; 12] = [
     0.0, 0.01, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0, 1000.0, 1.0e5,
 ];
+/// The grid's largest weight: the field alone (the prior rows negligible).
+const FIELD_ALONE_WEIGHT: f64 = WEIGHT_GRID[WEIGHT_GRID.len() - 1];
 /// Spread below which a term is not fitted, per input kind (degC, degC/s).
 const SPREAD_FLOOR: [f64; 2] = [0.05, 1.0e-5];
 /// |correlation| of a term's field values with a kept term's above which it is not fitted.
@@ -83,6 +98,8 @@ pub struct FieldObservation {
     pub temp_accel_cps2: f64,
     pub residual_bias_dph: f64,
     pub power_on: usize,
+    /// End of the seek, s since power-on (orders a power-on's seeks for the azimuth score).
+    pub t_since_power_on_s: f64,
 }
 
 impl FieldObservation {
@@ -135,6 +152,9 @@ pub struct Correction {
     pub not_fitted: Vec<String>,
     /// Per candidate input: the field's range against the model's trained range.
     pub coverage: Vec<String>,
+    /// Terms refused because the device would apply them beyond what the records
+    /// support (`supported_terms`), one line each.
+    pub coverage_refused: Vec<String>,
 }
 
 impl Correction {
@@ -157,6 +177,52 @@ pub struct Candidate {
     pub rms_dph: f64,
     /// Standard error of its mean square over the power-ons, (deg/h)^2.
     pub ms_se_dph2: f64,
+    /// Held-out azimuth score, deg (`HeldOut::az_rms_deg`), and the standard error of its
+    /// mean square over the power-ons, deg^2.
+    pub az_rms_deg: f64,
+    pub az_ms_se_deg2: f64,
+}
+
+/// Which held-out score chooses the number of terms (the weight of each is chosen by the
+/// half-sum either way: a constant cancels in a seek's azimuth, so the azimuth score
+/// cannot weigh it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TermCriterion {
+    /// Held-out rms of the residual bias (the seeks' half-sums), deg/h.
+    HalfSum,
+    /// Held-out azimuth score, deg.
+    Azimuth,
+}
+
+impl TermCriterion {
+    pub fn name(self) -> &'static str {
+        match self {
+            TermCriterion::HalfSum => "half-sum",
+            TermCriterion::Azimuth => "azimuth",
+        }
+    }
+}
+
+/// The criterion that chooses the terms. Measured with each (`fogsim field aging` seeds 1
+/// and 2, the independent gyro's full table seeds 1 and 2): the same choices everywhere
+/// except the independent gyro at seed 2, where the azimuth score drops T for the knee
+/// (azimuth rms ratio 0.975 / 0.972 after 20 / 50 seeks, resolved, becomes 1.000) and adds
+/// it for the gradient lag after 50 (1.000 becomes 0.984): the half-sum keeps more.
+pub const TERM_CRITERION: TermCriterion = TermCriterion::HalfSum;
+
+/// Leave-one-power-on-out scores of one candidate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HeldOut {
+    pub rms_dph: f64,
+    pub ms_se_dph2: f64,
+    /// The azimuth consequence of the held-out residual, as `train::seek_score` converts a
+    /// slow drift error: the held-out residual's change between a power-on's consecutive
+    /// seeks, scaled to one seek dwell (`DEFAULT_SEEK_DWELL_S`: what separates a seek's two
+    /// positions), over 2 Omega_H at the site latitude (|sin psi| = 1): the error a residual
+    /// that drifts along the warm-up puts into the difference of a seek's positions, which
+    /// the half-sum cannot see. rms over the pairs, deg (0 with no pair).
+    pub az_rms_deg: f64,
+    pub az_ms_se_deg2: f64,
 }
 
 /// How the weight and the terms were chosen.
@@ -171,6 +237,10 @@ pub struct WeightChoice {
     pub weight: f64,
     /// Identifiable terms kept (the first this many).
     pub terms_kept: usize,
+    /// The terms each criterion chose (`TERM_CRITERION` decides which is kept).
+    pub terms_by_half_sum: usize,
+    pub terms_by_azimuth: usize,
+    pub criterion: TermCriterion,
     /// `None`: too few records or power-ons, nothing was chosen ("no test power").
     pub verdict: Option<String>,
 }
@@ -254,6 +324,110 @@ pub fn terms_for(model: &RbfModel, obs: &[FieldObservation]) -> (Vec<Term>, Vec<
     (terms, notes)
 }
 
+/// The field records' range of a record value (0 T, 1 dT/dt).
+fn field_range(obs: &[FieldObservation], kind: usize) -> (f64, f64) {
+    obs.iter()
+        .map(|o| o.input(kind))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+            (lo.min(x), hi.max(x))
+        })
+}
+
+/// Where the device applies a term in model input `input`: the compensator clamps every
+/// input to the trained range widened by its margin
+/// (`CompensatorConfig::range_margin_frac`), so a term folded into the model's linear
+/// coefficients acts as a straight line over all of that range.
+fn range_in_use(model: &RbfModel, input: usize) -> (f64, f64) {
+    let (lo, hi) = (
+        f64::from(model.input_min[input]),
+        f64::from(model.input_max[input]),
+    );
+    let margin = f64::from(CompensatorConfig::default().range_margin_frac) * (hi - lo);
+    (lo - margin, hi + margin)
+}
+
+/// The leave-one-power-on-out (jackknife) standard error, deg/h, of what the term `t`
+/// (fitted with the constant on the field alone) adds at input value `x`: each power-on
+/// left out in turn, the term's contribution at `x` refitted on the others.
+pub fn term_se_at_dph(obs: &[FieldObservation], t: &Term, x: f64) -> f64 {
+    let mut groups: Vec<usize> = obs.iter().map(|o| o.power_on).collect();
+    groups.sort_unstable();
+    groups.dedup();
+    if groups.len() < 2 {
+        return f64::INFINITY;
+    }
+    let at_x: Vec<f64> = groups
+        .iter()
+        .map(|&g| {
+            let rest: Vec<FieldObservation> =
+                obs.iter().filter(|o| o.power_on != g).copied().collect();
+            fit(&rest, std::slice::from_ref(t), FIELD_ALONE_WEIGHT).coef_dph[1] * (x - t.mean)
+                / t.std
+        })
+        .collect();
+    let g = at_x.len() as f64;
+    let mean = at_x.iter().sum::<f64>() / g;
+    ((g - 1.0) / g * at_x.iter().map(|d| (d - mean).powi(2)).sum::<f64>()).sqrt()
+}
+
+/// The terms the device may apply: a term is refused when, at the far end of where the
+/// device applies it (`range_in_use`), its own leave-one-power-on-out standard error
+/// (`term_se_at_dph`) exceeds the records' scatter (std of their residual biases): out
+/// there the term would add more uncertainty than the whole error the refinement works
+/// against. One line for each refused.
+///
+/// Why refuse and not clamp: the correction reaches the device folded into the model's
+/// bias and linear coefficients (`apply`), which the firmware evaluates as they are over
+/// the whole trained range (its compensator clamps inputs to that range only); the model
+/// format has no per-term bound, so a clamp to the records' range would be a new format
+/// and new firmware code, and the model the host scored would not be the one the device
+/// runs until both exist. The threshold is the data's own: the term's standard error
+/// against the records' scatter. Records from one ambient span a few degC of one warm-up
+/// path: a T slope from them, carried 20 degC further, is uncertain by more than the
+/// records scatter, and is refused however well it fits there; records from three
+/// ambients span the range and keep it.
+pub fn supported_terms(
+    model: &RbfModel,
+    obs: &[FieldObservation],
+    terms: &[Term],
+) -> (Vec<Term>, Vec<String>) {
+    let n = obs.len().max(1) as f64;
+    let mean_r = obs.iter().map(|o| o.residual_bias_dph).sum::<f64>() / n;
+    let scatter = (obs
+        .iter()
+        .map(|o| (o.residual_bias_dph - mean_r).powi(2))
+        .sum::<f64>()
+        / n)
+        .sqrt();
+    let mut refused = Vec::new();
+    let kept = terms
+        .iter()
+        .copied()
+        .filter(|t| {
+            let (lo, hi) = field_range(obs, t.kind);
+            let (ulo, uhi) = range_in_use(model, t.input);
+            let far = if (ulo - t.mean).abs() > (uhi - t.mean).abs() {
+                ulo
+            } else {
+                uhi
+            };
+            let se = term_se_at_dph(obs, t, far);
+            if se <= scatter {
+                return true;
+            }
+            refused.push(format!(
+                "{name} refused: the records span {lo:.4} .. {hi:.4}, the device applies the \
+                 model over {ulo:.4} .. {uhi:.4}; at {far:.4} the term's leave-one-power-on-out \
+                 standard error is {se:.5} dph, more than the records' scatter {scatter:.5} dph \
+                 (record seeks at other ambients to support it)",
+                name = kind_name(t.kind)
+            ));
+            false
+        })
+        .collect();
+    (kept, refused)
+}
+
 /// Correlation of two terms' values over the field seeks.
 fn correlation(obs: &[FieldObservation], a: &Term, b: &Term) -> f64 {
     let n = obs.len().max(1) as f64;
@@ -287,6 +461,7 @@ pub fn fit(obs: &[FieldObservation], terms: &[Term], w: f64) -> Correction {
         coef_dph: solve_spd(a, b),
         not_fitted: Vec::new(),
         coverage: Vec::new(),
+        coverage_refused: Vec::new(),
     }
 }
 
@@ -313,32 +488,56 @@ fn solve_spd(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
     x
 }
 
-/// Leave-one-power-on-out rms of the residual bias after the correction fitted with `w`
-/// on `terms` (each power-on's records predicted by the fit on the other power-ons'), and
-/// the standard error of its mean square over the power-ons, (deg/h)^2.
-pub fn held_out_rms_dph(obs: &[FieldObservation], terms: &[Term], w: f64) -> (f64, f64) {
+/// Leave-one-power-on-out scores of the correction fitted with `w` on `terms` (each
+/// power-on's records predicted by the fit on the other power-ons'): rms of the residual
+/// bias and the azimuth score, each with the standard error of its mean square over the
+/// power-ons.
+pub fn held_out(obs: &[FieldObservation], terms: &[Term], w: f64) -> HeldOut {
+    let omega_h = earth_rate_horizontal_dph(crate::sim::DEFAULT_LATITUDE_DEG);
     let groups = obs.iter().map(|o| o.power_on).max().map_or(0, |g| g + 1);
-    let mut per_group_ms = Vec::with_capacity(groups);
-    let mut ss = 0.0;
+    let (mut per_group_ms, mut per_group_az) = (Vec::new(), Vec::new());
+    let (mut ss, mut az_ss, mut az_n) = (0.0, 0.0, 0usize);
     for g in 0..groups {
         let rest: Vec<FieldObservation> = obs.iter().filter(|o| o.power_on != g).copied().collect();
         let c = fit(&rest, terms, w);
-        let held: Vec<f64> = obs
+        let held: Vec<(f64, f64)> = obs
             .iter()
             .filter(|o| o.power_on == g)
-            .map(|o| (o.residual_bias_dph - c.predict_dph(o)).powi(2))
+            .map(|o| (o.t_since_power_on_s, o.residual_bias_dph - c.predict_dph(o)))
             .collect();
-        ss += held.iter().sum::<f64>();
-        if !held.is_empty() {
-            per_group_ms.push(held.iter().sum::<f64>() / held.len() as f64);
+        if held.is_empty() {
+            continue;
+        }
+        let sq: f64 = held.iter().map(|(_, e)| e * e).sum();
+        ss += sq;
+        per_group_ms.push(sq / held.len() as f64);
+        let az: Vec<f64> = held
+            .windows(2)
+            .filter(|p| p[1].0 > p[0].0)
+            .map(|p| {
+                let drift_dph = (p[1].1 - p[0].1) / (p[1].0 - p[0].0) * DEFAULT_SEEK_DWELL_S;
+                (drift_dph / (2.0 * omega_h)).to_degrees().powi(2)
+            })
+            .collect();
+        if !az.is_empty() {
+            az_ss += az.iter().sum::<f64>();
+            az_n += az.len();
+            per_group_az.push(az.iter().sum::<f64>() / az.len() as f64);
         }
     }
-    let se = if per_group_ms.len() >= 2 {
-        crate::stats::std_dev(&per_group_ms) / (per_group_ms.len() as f64).sqrt()
-    } else {
-        f64::INFINITY
+    let se = |v: &[f64]| {
+        if v.len() >= 2 {
+            crate::stats::std_dev(v) / (v.len() as f64).sqrt()
+        } else {
+            f64::INFINITY
+        }
     };
-    ((ss / obs.len().max(1) as f64).sqrt(), se)
+    HeldOut {
+        rms_dph: (ss / obs.len().max(1) as f64).sqrt(),
+        ms_se_dph2: se(&per_group_ms),
+        az_rms_deg: (az_ss / az_n.max(1) as f64).sqrt(),
+        az_ms_se_deg2: if az_n == 0 { 0.0 } else { se(&per_group_az) },
+    }
 }
 
 /// Chooses W and the terms kept (the constant alone, then each of `terms` added in
@@ -356,6 +555,9 @@ pub fn choose_weight(obs: &[FieldObservation], terms: &[Term], fixed: Option<f64
         candidates: Vec::new(),
         weight: 0.0,
         terms_kept: 0,
+        terms_by_half_sum: 0,
+        terms_by_azimuth: 0,
+        criterion: TERM_CRITERION,
         verdict: Some(verdict),
     };
     if obs.len() < MIN_RECORDS {
@@ -390,12 +592,14 @@ pub fn choose_weight(obs: &[FieldObservation], terms: &[Term], fixed: Option<f64
     let mut candidates = Vec::new();
     for k in 0..=terms.len() {
         for &w in &weights {
-            let (rms_dph, ms_se_dph2) = held_out_rms_dph(&obs, &terms[..k], w);
+            let h = held_out(&obs, &terms[..k], w);
             candidates.push(Candidate {
                 terms: k,
                 weight: w,
-                rms_dph,
-                ms_se_dph2,
+                rms_dph: h.rms_dph,
+                ms_se_dph2: h.ms_se_dph2,
+                az_rms_deg: h.az_rms_deg,
+                az_ms_se_deg2: h.az_ms_se_deg2,
             });
         }
     }
@@ -410,25 +614,21 @@ pub fn choose_weight(obs: &[FieldObservation], terms: &[Term], fixed: Option<f64
         )
     };
     let bests: Vec<Candidate> = (0..=terms.len()).filter_map(best_of).collect();
-    // ... and the fewest terms whose held-out mean square is within one standard error of
-    // the lowest (the one-standard-error rule): a term must win by more than the power-ons'
-    // scatter to be kept.
-    let lowest = bests
-        .iter()
-        .copied()
-        .fold(None::<Candidate>, |b, c| match b {
-            Some(b) if b.rms_dph <= c.rms_dph => Some(b),
-            _ => Some(c),
-        });
-    let chosen = lowest.and_then(|low| {
-        let bound = low.rms_dph.powi(2) + low.ms_se_dph2;
-        bests.iter().copied().find(|c| c.rms_dph.powi(2) <= bound)
-    });
+    // ... and the fewest terms within one standard error of the lowest, once on the
+    // half-sums, once on the azimuth score.
+    let by_half_sum = fewest_within_se(&bests, |c| (c.rms_dph.powi(2), c.ms_se_dph2));
+    let by_azimuth = fewest_within_se(&bests, |c| (c.az_rms_deg.powi(2), c.az_ms_se_deg2));
+    let chosen = match TERM_CRITERION {
+        TermCriterion::HalfSum => by_half_sum,
+        TermCriterion::Azimuth => by_azimuth,
+    };
     let best = chosen.unwrap_or(Candidate {
         terms: 0,
         weight: 0.0,
         rms_dph: f64::NAN,
         ms_se_dph2: f64::NAN,
+        az_rms_deg: f64::NAN,
+        az_ms_se_deg2: f64::NAN,
     });
     WeightChoice {
         power_ons,
@@ -436,8 +636,29 @@ pub fn choose_weight(obs: &[FieldObservation], terms: &[Term], fixed: Option<f64
         candidates,
         weight: best.weight,
         terms_kept: best.terms,
+        terms_by_half_sum: by_half_sum.map_or(0, |c| c.terms),
+        terms_by_azimuth: by_azimuth.map_or(0, |c| c.terms),
+        criterion: TERM_CRITERION,
         verdict: None,
     }
+}
+
+/// Of `bests` (one per number of terms, fewest first), the fewest terms whose held-out
+/// mean square (`score`: mean square, its standard error) is within one standard error of
+/// the lowest (the one-standard-error rule): a term must win by more than the power-ons'
+/// scatter to be kept.
+fn fewest_within_se(
+    bests: &[Candidate],
+    score: impl Fn(&Candidate) -> (f64, f64),
+) -> Option<Candidate> {
+    let lowest = bests
+        .iter()
+        .map(&score)
+        .fold(None::<(f64, f64)>, |b, s| match b {
+            Some(b) if b.0 <= s.0 => Some(b),
+            _ => Some(s),
+        });
+    lowest.and_then(|(ms, se)| bests.iter().copied().find(|c| score(c).0 <= ms + se))
 }
 
 /// The lowest held-out rms over the candidates that keep exactly `k` terms.
@@ -455,10 +676,7 @@ fn coverage(model: &RbfModel, obs: &[FieldObservation]) -> Vec<String> {
     candidate_terms(model)
         .into_iter()
         .map(|(input, kind)| {
-            let (lo, hi) = obs.iter().map(|o| o.input(kind)).fold(
-                (f64::INFINITY, f64::NEG_INFINITY),
-                |(lo, hi), x| (lo.min(x), hi.max(x)),
-            );
+            let (lo, hi) = field_range(obs, kind);
             let (tlo, thi) = (
                 f64::from(model.input_min[input]),
                 f64::from(model.input_max[input]),
@@ -497,7 +715,8 @@ pub fn refine(
     obs: &[FieldObservation],
     fixed: Option<f64>,
 ) -> Result<(RbfModel, Correction, WeightChoice)> {
-    let (terms, mut not_fitted) = terms_for(model, obs);
+    let (identifiable, mut not_fitted) = terms_for(model, obs);
+    let (terms, coverage_refused) = supported_terms(model, obs, &identifiable);
     let choice = choose_weight(obs, &terms, fixed);
     if choice.verdict.is_none() {
         let without = best_rms_with(&choice, choice.terms_kept);
@@ -514,6 +733,7 @@ pub fn refine(
     let c = Correction {
         not_fitted,
         coverage: coverage(model, obs),
+        coverage_refused,
         ..fit(obs, &terms[..choice.terms_kept], choice.weight)
     };
     Ok((apply(model, &c)?, c, choice))
@@ -527,17 +747,18 @@ mod tests {
     fn model() -> RbfModel {
         let mut m = RbfModel::empty();
         m.n_rbf_inputs = 0;
-        for (k, off, scale) in [
-            (FeatureKind::TempC, 25.0f32, 10.0f32),
-            (FeatureKind::TempRateCps, 0.0, 0.01),
+        // Trained ranges: T 10 .. 40 degC, dT/dt -0.003 .. 0.015 degC/s.
+        for (k, off, scale, lo, hi) in [
+            (FeatureKind::TempC, 25.0f32, 10.0f32, 10.0f32, 40.0f32),
+            (FeatureKind::TempRateCps, 0.0, 0.01, -0.003, 0.015),
         ] {
             m.inputs
                 .push(fog_core::model::format::FeatureSpec::plain(k))
                 .unwrap();
             m.input_offset.push(off).unwrap();
             m.input_scale.push(scale).unwrap();
-            m.input_min.push(-100.0).unwrap();
-            m.input_max.push(100.0).unwrap();
+            m.input_min.push(lo).unwrap();
+            m.input_max.push(hi).unwrap();
             m.linear.push(0.0).unwrap();
         }
         m.bias_dph = 0.5;
@@ -555,7 +776,9 @@ mod tests {
                     temp_rate_cps: 0.001 * (i % 3) as f64,
                     temp_accel_cps2: 0.0,
                     residual_bias_dph: 0.01 + k_dph_per_c * (t - 25.0) + noise * u,
-                    power_on: i % 8,
+                    // 8 power-ons, each over its own part of the T range.
+                    power_on: i * 8 / n,
+                    t_since_power_on_s: 300.0 * (1 + i % (n / 8).max(1)) as f64,
                 }
             })
             .collect()
@@ -609,6 +832,7 @@ mod tests {
                 temp_accel_cps2: 0.0,
                 residual_bias_dph: 0.001 * i as f64,
                 power_on: i / 5,
+                t_since_power_on_s: 300.0 * (1 + i % 5) as f64,
             })
             .collect();
         let (terms, notes) = terms_for(&model(), &o);
@@ -627,9 +851,66 @@ mod tests {
         assert_eq!(terms.len(), 2, "{notes:?}");
     }
 
+    /// `model()` without its dT/dt input.
+    fn t_only_model() -> RbfModel {
+        let mut m = model();
+        m.inputs.pop();
+        m.input_offset.pop();
+        m.input_scale.pop();
+        m.input_min.pop();
+        m.input_max.pop();
+        m.linear.pop();
+        m
+    }
+
+    #[test]
+    fn a_term_is_applied_only_as_far_as_the_records_support_it() {
+        // The gyro aged by a T law (+ record noise, +-0.004 deg/h); the model is used over
+        // T 8.5 .. 41.5 degC (trained 10 .. 40 plus the compensator's margin).
+        let m = t_only_model();
+        let noisy = |seed: u64, k_dph_per_c: f64| {
+            let mut rng = fog_core::model::synthetic::SplitMix64::new(seed);
+            move |t: f64, _| {
+                k_dph_per_c * (t - 20.0) + 0.008 * (rng.next_u64() as f64 / u64::MAX as f64 - 0.5)
+            }
+        };
+        let at = |model: &RbfModel, t: f64| predict_f64(model, &[t]).unwrap();
+        // Four power-ons near 10 degC (records 11.2 .. 17.7 degC): the T term fits there,
+        // but carried to 41.5 degC its own standard error exceeds the records' scatter:
+        // refused, one line says so, the model moves by its constant only (the same change
+        // at 12 and at 40 degC).
+        let one_ambient = warm_ups(&[10.0, 10.4, 9.7, 10.2], noisy(4, 0.001));
+        let (refined, c, choice) = refine(&m, &one_ambient, None).unwrap();
+        assert!(choice.verdict.is_none(), "{choice:?}");
+        assert!(choice.kinds.is_empty() && c.terms.is_empty(), "{c:?}");
+        assert_eq!(c.coverage_refused.len(), 1, "{c:?}");
+        eprintln!("field coverage: {}", c.coverage_refused[0]);
+        assert!(
+            c.coverage_refused[0].starts_with("T refused: the records span 11.2"),
+            "{c:?}"
+        );
+        let moved_40 = at(&refined, 40.0) - at(&m, 40.0);
+        let moved_12 = at(&refined, 12.0) - at(&m, 12.0);
+        assert!((moved_40 - moved_12).abs() < 1e-6, "{moved_40} {moved_12}");
+        // Twin: power-ons at 10, 20, 30 and 10 degC (records 11.5 .. 37.3 degC): T kept,
+        // and the refined model follows the law at 40 degC.
+        let three = warm_ups(&[10.0, 20.0, 30.0, 10.0], noisy(4, 0.001));
+        let (refined, c, choice) = refine(&m, &three, None).unwrap();
+        assert!(c.coverage_refused.is_empty(), "{c:?}");
+        assert_eq!(choice.terms_kept, 1, "{choice:?}");
+        let moved_40 = at(&refined, 40.0) - at(&m, 40.0);
+        assert!((moved_40 - 0.02).abs() < 0.003, "{moved_40}");
+        // Null twin: the same power-ons, no aging (noise only): supported, but no term
+        // wins on the held-out power-ons.
+        let null = warm_ups(&[10.0, 20.0, 30.0, 10.0], noisy(5, 0.0));
+        let (_, c, choice) = refine(&m, &null, None).unwrap();
+        assert!(c.coverage_refused.is_empty(), "{c:?}");
+        assert_eq!(choice.terms_kept, 0, "{choice:?}");
+    }
+
     /// Warm-ups from `ambients_c` (one power-on each, 6 seeks): T rises from the ambient,
     /// dT/dt falls; the residual is `law` of (T, dT/dt).
-    fn warm_ups(ambients_c: &[f64], law: impl Fn(f64, f64) -> f64) -> Vec<FieldObservation> {
+    fn warm_ups(ambients_c: &[f64], mut law: impl FnMut(f64, f64) -> f64) -> Vec<FieldObservation> {
         let mut out = Vec::new();
         for (p, &a) in ambients_c.iter().enumerate() {
             for k in 0..6 {
@@ -641,6 +922,7 @@ mod tests {
                     temp_accel_cps2: 0.0,
                     residual_bias_dph: law(t, rate),
                     power_on: p,
+                    t_since_power_on_s: 300.0 * (k + 1) as f64,
                 });
             }
         }
@@ -651,13 +933,7 @@ mod tests {
     fn a_term_is_scored_on_other_power_ons_and_one_power_on_has_no_test_power() {
         // A T-only model; the gyro's aging is in dT/dt (Shupe), which within one warm-up
         // looks like a T law (T and dT/dt correlate at r = -1 there).
-        let mut m = model();
-        m.inputs.pop();
-        m.input_offset.pop();
-        m.input_scale.pop();
-        m.input_min.pop();
-        m.input_max.pop();
-        m.linear.pop();
+        let m = t_only_model();
         let shupe = |_t: f64, rate: f64| 1.4 * rate;
         // One power-on at 10 degC: nothing can be scored at another ambient.
         let one = warm_ups(&[10.0], shupe);

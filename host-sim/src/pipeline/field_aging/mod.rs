@@ -159,7 +159,8 @@ pub struct AgingRow {
     /// unchanged).
     pub field_weight: Option<f64>,
     /// Terms of the correction (after the constant) and its coefficients (constant first),
-    /// deg/h per field std; the model inputs not fitted, and why.
+    /// deg/h per field std; the model inputs not fitted, and why (coverage refusals
+    /// included: `refine::supported_terms`).
     pub correction_terms: Vec<String>,
     pub correction_coef_dph: Vec<f64>,
     pub not_fitted: Vec<String>,
@@ -312,7 +313,13 @@ pub fn run_aging_on(
                     .map(|t| crate::field::refine::kind_name(t.kind).to_string())
                     .collect(),
                 correction_coef_dph: refined.correction.coef_dph.clone(),
-                not_fitted: refined.correction.not_fitted.clone(),
+                not_fitted: refined
+                    .correction
+                    .not_fitted
+                    .iter()
+                    .chain(&refined.correction.coverage_refused)
+                    .cloned()
+                    .collect(),
                 comparison,
                 bias,
             });
