@@ -247,3 +247,137 @@ proptest! {
         }
     }
 }
+
+/// Rows of a warm-up with a kink from `t0_s` (10 s apart), one aux channel.
+fn warmup_rows(t0_s: f64, n: usize) -> Vec<(f64, f32, f32)> {
+    (0..n)
+        .map(|k| {
+            let t = t0_s + 10.0 * k as f64;
+            let kink = if k > n / 2 { 0.004 * (t - t0_s) } else { 0.0 };
+            let temp = 20.0 + 5.0 * (1.0 - (-t / 400.0).exp()) + kink;
+            (t, temp as f32, (t / 7.0 % 360.0) as f32)
+        })
+        .collect()
+}
+
+fn run_rows(fx: &mut FeatureExtractor, rows: &[(f64, f32, f32)]) -> Vec<FeatureVector> {
+    rows.iter()
+        .map(|&(t, temp, aux)| fx.push(t, temp, &[aux]).unwrap())
+        .collect()
+}
+
+/// `reset_to` restarts every state where it lives (the firmware's boot path builds no
+/// estimator by value): after any earlier specs and history it gives exactly what `new`
+/// gives, for every kind, including a slot that held a flat-start estimator with points
+/// (its first reading and spacing must be forgotten, or the padding would differ).
+#[test]
+fn reset_to_in_place_equals_new_for_every_kind() {
+    let tau = |kind, tau_s| FeatureSpec { kind, tau_s };
+    let lists: [&[FeatureSpec]; 4] = [
+        &[
+            FeatureSpec::plain(FeatureKind::TempC),
+            FeatureSpec::plain(FeatureKind::TempRateCps),
+            FeatureSpec::plain(FeatureKind::TempAccelFlatStartCps2),
+            FeatureSpec::plain(FeatureKind::TempRiseC),
+        ],
+        &[
+            tau(FeatureKind::TempLagC, 300.0),
+            tau(FeatureKind::TempAccelCps2, 120.0),
+            FeatureSpec::plain(FeatureKind::AuxRate(0)),
+            tau(FeatureKind::PowerOnDecay, 600.0),
+        ],
+        &[
+            tau(FeatureKind::TempAccelFlatStartCps2, 90.0),
+            tau(FeatureKind::TempRateCps, 30.0),
+            FeatureSpec::plain(FeatureKind::AuxValue(0)),
+            FeatureSpec::plain(FeatureKind::TempRiseC),
+        ],
+        &[],
+    ];
+    let before = warmup_rows(0.0, 40);
+    let after = warmup_rows(1000.0, 40);
+    for first in lists {
+        for second in lists {
+            let mut reused = FeatureExtractor::new(first).unwrap();
+            run_rows(&mut reused, &before);
+            reused.reset_to(second).unwrap();
+            let mut fresh = FeatureExtractor::new(second).unwrap();
+            assert_eq!(reused.specs(), fresh.specs());
+            // FeatureVector's PartialEq on f32: equal values; the Debug text pins the bits.
+            let (a, b) = (run_rows(&mut reused, &after), run_rows(&mut fresh, &after));
+            assert_eq!(
+                format!("{a:?}"),
+                format!("{b:?}"),
+                "{first:?} -> {second:?}"
+            );
+            assert!(a.iter().any(|v| v.ready) || second.is_empty());
+        }
+    }
+}
+
+/// Invalid specs give the same errors as before the in-place rewrite (span or time
+/// constant first, then the aux channel), and a refused `reset_to` leaves the extractor's
+/// specs and history untouched.
+#[test]
+fn invalid_specs_refused_before_anything_is_written() {
+    use fog_core::compensation::features::FeatureError;
+    let bad = |kind, tau_s| [FeatureSpec { kind, tau_s }];
+    let cases = [
+        (
+            bad(FeatureKind::TempRateCps, f32::INFINITY),
+            FeatureError::BadTimeConstant,
+        ),
+        (
+            bad(FeatureKind::TempAccelFlatStartCps2, f32::INFINITY),
+            FeatureError::BadTimeConstant,
+        ),
+        (
+            bad(FeatureKind::TempLagC, 0.0),
+            FeatureError::BadTimeConstant,
+        ),
+        (
+            bad(FeatureKind::TempLagC, f32::NAN),
+            FeatureError::BadTimeConstant,
+        ),
+        (
+            bad(FeatureKind::PowerOnDecay, -1.0),
+            FeatureError::BadTimeConstant,
+        ),
+        (
+            bad(FeatureKind::AuxRate(4), f32::INFINITY),
+            FeatureError::BadTimeConstant,
+        ),
+        (
+            bad(FeatureKind::AuxRate(4), 0.0),
+            FeatureError::MissingAux { channel: 4 },
+        ),
+        (
+            bad(FeatureKind::AuxValue(9), 0.0),
+            FeatureError::MissingAux { channel: 9 },
+        ),
+    ];
+    let good = [
+        FeatureSpec::plain(FeatureKind::TempAccelFlatStartCps2),
+        FeatureSpec::plain(FeatureKind::AuxRate(0)),
+    ];
+    let rows = warmup_rows(0.0, 30);
+    let mut untouched = FeatureExtractor::new(&good).unwrap();
+    let head = run_rows(&mut untouched, &rows[..15]);
+    for (specs, want) in cases {
+        assert_eq!(
+            FeatureExtractor::check_specs(&specs),
+            Err(want),
+            "{specs:?}"
+        );
+        assert_eq!(FeatureExtractor::new(&specs).err(), Some(want), "{specs:?}");
+        let mut fx = FeatureExtractor::new(&good).unwrap();
+        assert_eq!(run_rows(&mut fx, &rows[..15]), head);
+        assert_eq!(fx.reset_to(&specs), Err(want));
+        assert_eq!(fx.specs(), &good);
+        let (a, b) = (
+            run_rows(&mut fx, &rows[15..]),
+            run_rows(&mut untouched.clone(), &rows[15..]),
+        );
+        assert_eq!(format!("{a:?}"), format!("{b:?}"));
+    }
+}

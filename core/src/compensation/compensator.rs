@@ -263,7 +263,10 @@ impl Compensator {
         for aux in self.aux.iter_mut() {
             aux.clone_from(&self.temp);
         }
-        self.rate_report = TempRateEstimator::new(DEFAULT_RATE_SPAN_S).map_err(bad)?;
+        // Restarted in place (not `TempRateEstimator::new` moved in: ~540 B of stack).
+        self.rate_report
+            .restart(DEFAULT_RATE_SPAN_S, false)
+            .map_err(bad)?;
         self.temp_pending = None;
         self.aux_pending = [None; MAX_AUX];
         self.fault_windows = None;

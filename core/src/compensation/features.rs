@@ -281,6 +281,15 @@ impl WindowAverager {
     }
 }
 
+/// `BadTimeConstant` unless `s` (a span or time constant, s) is positive and finite.
+fn positive_time_constant(s: f64) -> Result<(), FeatureError> {
+    if s.is_finite() && s > 0.0 {
+        Ok(())
+    } else {
+        Err(FeatureError::BadTimeConstant)
+    }
+}
+
 /// Result of a least-squares fit over the sliding span.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -313,16 +322,9 @@ pub struct TempRateEstimator<const N: usize = 128> {
 impl<const N: usize> TempRateEstimator<N> {
     /// Estimator over the last `span_s` seconds (> 0).
     pub fn new(span_s: f64) -> Result<Self, FeatureError> {
-        if !(span_s.is_finite() && span_s > 0.0) {
-            return Err(FeatureError::BadTimeConstant);
-        }
-        Ok(TempRateEstimator {
-            span_s,
-            points: Deque::new(),
-            flat_start: false,
-            first_t_s: None,
-            first_step_s: None,
-        })
+        let mut e = Self::placeholder();
+        e.restart(span_s, false)?;
+        Ok(e)
     }
 
     /// Estimator over the last `span_s` seconds whose series is taken as flat before its
@@ -338,9 +340,20 @@ impl<const N: usize> TempRateEstimator<N> {
     /// sensor lags), so the flat extension is the physical prior; the early estimates are
     /// the delayed, diluted slope of that picture, the same on the device and in training.
     pub fn new_flat_start(span_s: f64) -> Result<Self, FeatureError> {
-        let mut e = Self::new(span_s)?;
-        e.flat_start = true;
+        let mut e = Self::placeholder();
+        e.restart(span_s, true)?;
         Ok(e)
+    }
+
+    /// Become `new(span_s)` (or `new_flat_start(span_s)`) where it lives: the ~540 B of
+    /// points are cleared in place, never built as a temporary and moved (the firmware's
+    /// boot stack). On error (span not a positive finite number) `self` is unchanged.
+    pub(crate) fn restart(&mut self, span_s: f64, flat_start: bool) -> Result<(), FeatureError> {
+        positive_time_constant(span_s)?;
+        self.reset();
+        self.span_s = span_s;
+        self.flat_start = flat_start;
+        Ok(())
     }
 
     /// Storage before `new` is assigned (span 0, all zero bytes, so a `static` holding
@@ -495,9 +508,7 @@ pub struct FirstOrderLag {
 impl FirstOrderLag {
     /// Lag with time constant `tau_s` (> 0).
     pub fn new(tau_s: f64) -> Result<Self, FeatureError> {
-        if !(tau_s.is_finite() && tau_s > 0.0) {
-            return Err(FeatureError::BadTimeConstant);
-        }
+        positive_time_constant(tau_s)?;
         Ok(FirstOrderLag { tau_s, state: None })
     }
 
@@ -579,37 +590,57 @@ pub fn span_for(spec: &FeatureSpec) -> f64 {
     }
 }
 
-/// The fresh state of one spec, or why the spec is invalid.
-fn fresh_state(spec: &FeatureSpec) -> Result<FeatureState, FeatureError> {
-    let state = match spec.kind {
+/// Why `spec` is invalid, if it is (checked before any state is written).
+fn check_spec(spec: &FeatureSpec) -> Result<(), FeatureError> {
+    match spec.kind {
+        FeatureKind::TempRateCps
+        | FeatureKind::TempAccelCps2
+        | FeatureKind::TempAccelFlatStartCps2
+        | FeatureKind::AuxRate(_) => positive_time_constant(span_for(spec))?,
+        FeatureKind::TempLagC | FeatureKind::PowerOnDecay => {
+            positive_time_constant(spec.tau_s as f64)?
+        }
+        _ => {}
+    }
+    if let Some(ch) = spec.kind.aux_channel() {
+        if ch as usize >= MAX_AUX {
+            return Err(FeatureError::MissingAux { channel: ch });
+        }
+    }
+    Ok(())
+}
+
+/// A rate state with its estimator in the all-zero placeholder (`reset_state` restarts it).
+const RATE_PLACEHOLDER: FeatureState = FeatureState::Rate(TempRateEstimator::placeholder());
+
+/// Set `state` to the fresh state of `spec` (passed by `check_spec`) in place. The rate
+/// estimator (~540 B) is restarted where it lives: building it by value and moving it in
+/// put three copies on the firmware's boot stack (issue: boot peak 7,764 -> 9,180 B).
+fn reset_state(state: &mut FeatureState, spec: &FeatureSpec) -> Result<(), FeatureError> {
+    match spec.kind {
         // Only the second derivative has a flat-start kind (the soaked unit at power-on,
         // see `TempRateEstimator::new_flat_start`); the slope keeps its growing window: a
         // flat-start slope is diluted in the first minute, which puts a cold-start row
         // (T near ambient, small slope, large drift) where a later row of a colder run
         // (same T, settled) sits, and a model over several ambients cannot tell them
         // apart (measured: global model, seek 1 at -40 degC 0.0203 -> 0.0276 deg rms).
-        FeatureKind::TempAccelFlatStartCps2 => {
-            FeatureState::Rate(TempRateEstimator::new_flat_start(span_for(spec))?)
-        }
-        FeatureKind::TempRateCps | FeatureKind::TempAccelCps2 | FeatureKind::AuxRate(_) => {
-            FeatureState::Rate(TempRateEstimator::new(span_for(spec))?)
-        }
-        FeatureKind::TempLagC => FeatureState::Lag(FirstOrderLag::new(spec.tau_s as f64)?),
-        FeatureKind::TempRiseC => FeatureState::First(None),
-        FeatureKind::PowerOnDecay => {
-            if !(spec.tau_s.is_finite() && spec.tau_s > 0.0) {
-                return Err(FeatureError::BadTimeConstant);
+        FeatureKind::TempRateCps
+        | FeatureKind::TempAccelCps2
+        | FeatureKind::TempAccelFlatStartCps2
+        | FeatureKind::AuxRate(_) => {
+            if !matches!(state, FeatureState::Rate(_)) {
+                *state = RATE_PLACEHOLDER;
             }
-            FeatureState::Plain
+            if let FeatureState::Rate(e) = state {
+                let flat_start = spec.kind == FeatureKind::TempAccelFlatStartCps2;
+                e.restart(span_for(spec), flat_start)?;
+            }
         }
-        _ => FeatureState::Plain,
-    };
-    if let Some(ch) = spec.kind.aux_channel() {
-        if ch as usize >= MAX_AUX {
-            return Err(FeatureError::MissingAux { channel: ch });
-        }
+        FeatureKind::TempLagC => *state = FeatureState::Lag(FirstOrderLag::new(spec.tau_s as f64)?),
+        FeatureKind::TempRiseC => *state = FeatureState::First(None),
+        _ => *state = FeatureState::Plain,
     }
-    Ok(state)
+    Ok(())
 }
 
 impl FeatureExtractor {
@@ -634,7 +665,7 @@ impl FeatureExtractor {
     /// The error `new(specs)` would return, if any, without building an extractor.
     pub fn check_specs(specs: &[FeatureSpec]) -> Result<(), FeatureError> {
         for (i, spec) in specs.iter().enumerate() {
-            fresh_state(spec)?;
+            check_spec(spec)?;
             if i >= MAX_INPUTS {
                 return Err(FeatureError::TooManyFeatures);
             }
@@ -651,14 +682,16 @@ impl FeatureExtractor {
         self.last_t_s = None;
         self.row = 0;
         for spec in specs {
-            // Checked above: neither the state nor the pushes can fail.
-            let state = fresh_state(spec)?;
+            // Checked above: neither the pushes nor the state can fail.
             self.specs
                 .push(*spec)
                 .map_err(|_| FeatureError::TooManyFeatures)?;
             self.states
-                .push(state)
+                .push(FeatureState::Plain)
                 .map_err(|_| FeatureError::TooManyFeatures)?;
+            if let Some(state) = self.states.last_mut() {
+                reset_state(state, spec)?;
+            }
         }
         Ok(())
     }
@@ -778,4 +811,47 @@ pub fn features_for_series(
         out[k] = fx.push(t_s[k], temp_c[k], &row_aux[..aux.len()])?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `restart` in place equals a new estimator, whatever the old one held: a flat-start
+    /// estimator with points must forget its first reading and spacing (else the flat
+    /// padding of the next series would start from the old series' first reading).
+    #[test]
+    fn restart_equals_new_after_any_history() {
+        let series = |t0_s: f64, step_s: f64| {
+            (0..25).map(move |k| {
+                let t = t0_s + step_s * k as f64;
+                (t, 20.0 + 3.0 * libm::sin(t / 300.0))
+            })
+        };
+        for (old_flat, new_flat) in [(true, true), (false, true), (true, false)] {
+            let mut reused = TempRateEstimator::<EXTRACTOR_RATE_POINTS>::placeholder();
+            reused.restart(120.0, old_flat).unwrap();
+            for (t, y) in series(5.0, 7.0) {
+                reused.push(t, y);
+            }
+            reused.restart(180.0, new_flat).unwrap();
+            let mut fresh = if new_flat {
+                TempRateEstimator::<EXTRACTOR_RATE_POINTS>::new_flat_start(180.0).unwrap()
+            } else {
+                TempRateEstimator::<EXTRACTOR_RATE_POINTS>::new(180.0).unwrap()
+            };
+            for (t, y) in series(1000.0, 10.0) {
+                assert_eq!(
+                    reused.push(t, y),
+                    fresh.push(t, y),
+                    "{old_flat} -> {new_flat}"
+                );
+            }
+            assert_eq!(
+                reused.restart(f64::NAN, true),
+                Err(FeatureError::BadTimeConstant)
+            );
+            assert_eq!(reused.span_s(), 180.0, "a refused restart changes nothing");
+        }
+    }
 }
