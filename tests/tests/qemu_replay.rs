@@ -23,7 +23,7 @@ use std::cell::RefCell;
 use std::time::Duration;
 
 use fog_core::compensation::compensator::Evaluator;
-use fog_core::model::format::{FeatureKind, RbfModel, MAX_ENCODED_LEN};
+use fog_core::model::format::{FeatureKind, FeatureSpec, RbfModel, MAX_ENCODED_LEN};
 use fog_core::model::synthetic::warmup_model;
 use fog_core::sensor_link::gyro_frame::{FrameDecoder, GyroFrame, STATUS_TEMP_INVALID};
 use fog_firmware::app::{App, AppConfig};
@@ -174,6 +174,17 @@ fn seek_azimuths(out: &str) -> Vec<f64> {
 /// `n_inputs`: the model's first inputs of (T, dT/dt, d2T/dt2, lagged T), the d2T/dt2 of
 /// kind `accel` (the plain or the flat-start estimator).
 fn scenario(evaluator: Evaluator, n_inputs: usize, accel: FeatureKind, tag: &str) {
+    scenario_with(evaluator, n_inputs, accel, None, tag)
+}
+
+/// `scenario` with the lagged T (the fourth input) replaced by `fourth`.
+fn scenario_with(
+    evaluator: Evaluator,
+    n_inputs: usize,
+    accel: FeatureKind,
+    fourth: Option<FeatureSpec>,
+    tag: &str,
+) {
     if !qemu_ready("qemu_replay") {
         return;
     }
@@ -183,6 +194,9 @@ fn scenario(evaluator: Evaluator, n_inputs: usize, accel: FeatureKind, tag: &str
     for spec in model.inputs.iter_mut() {
         if spec.kind == FeatureKind::TempAccelCps2 {
             spec.kind = accel;
+        }
+        if let (FeatureKind::TempLagC, Some(f)) = (spec.kind, fourth) {
+            *spec = f;
         }
     }
     model
@@ -194,10 +208,16 @@ fn scenario(evaluator: Evaluator, n_inputs: usize, accel: FeatureKind, tag: &str
     for j in 2..model.inputs.len() {
         let (lo, hi) = match model.inputs[j].kind {
             FeatureKind::TempRiseC => (-5.0, 100.0),
+            FeatureKind::PowerOnDecay => (0.0, 1.0),
             _ => (-1.0, 1.0),
         };
         model.input_min[j] = lo;
         model.input_max[j] = hi;
+        if model.inputs[j].kind == FeatureKind::PowerOnDecay {
+            // Normalised over its own range (the synthetic model's is the lagged T's).
+            model.input_offset[j] = 0.5;
+            model.input_scale[j] = 0.5;
+        }
     }
     let mut buf = [0u8; MAX_ENCODED_LEN];
     let n = model.encode(&mut buf).expect("model encodes");
@@ -366,4 +386,20 @@ fn firmware_replay_matches_host_bit_for_bit_flat_start_accel() {
 #[test]
 fn firmware_replay_matches_host_bit_for_bit_rise() {
     scenario(Evaluator::F32, 3, FeatureKind::TempRiseC, "f32-rise");
+}
+
+/// The time since power-on (`FeatureKind::PowerOnDecay`, exp(-t / tau), the clock input of
+/// `north-seek`'s own model): the device computes it bit for bit as the host.
+#[test]
+fn firmware_replay_matches_host_bit_for_bit_clock() {
+    scenario_with(
+        Evaluator::F32,
+        4,
+        FeatureKind::TempAccelFlatStartCps2,
+        Some(FeatureSpec {
+            kind: FeatureKind::PowerOnDecay,
+            tau_s: 510.0,
+        }),
+        "f32-clock",
+    );
 }

@@ -106,10 +106,5 @@ fn chamber_at_ambients(
         },
     )?;
     let runs: Vec<&crate::io::runs::Run> = campaign.iter().map(|c| &c.run).collect();
-    train_with(
-        &runs,
-        &own.selection.chosen.specs(),
-        "sim",
-        own_plan.criterion,
-    )
+    train_with(&runs, &own.specs, "sim", own_plan.criterion)
 }
