@@ -218,7 +218,8 @@ pub struct HeldOut {
     /// The azimuth consequence of the held-out residual, as `train::seek_score` converts a
     /// slow drift error: the held-out residual's change between a power-on's consecutive
     /// seeks, scaled to one seek dwell (`DEFAULT_SEEK_DWELL_S`: what separates a seek's two
-    /// positions), over 2 Omega_H at the site latitude (|sin psi| = 1): the error a residual
+    /// positions), over 2 Omega_H at the simulator's default latitude (`DEFAULT_LATITUDE_DEG`,
+    /// 39.9 deg, not yet `train --seek-latitude-deg`; |sin psi| = 1): the error a residual
     /// that drifts along the warm-up puts into the difference of a seek's positions, which
     /// the half-sum cannot see. rms over the pairs, deg (0 with no pair).
     pub az_rms_deg: f64,
