@@ -31,6 +31,9 @@ use upload_support::*;
 /// The model region of the QEMU build: the last 16 KiB of flash (memory.x).
 const IMAGE_LEN: usize = 16 * 1024;
 const WAIT: Duration = Duration::from_secs(30);
+/// Bound on fog-app's painted boot stack peak with a model in use: measured 29,660 B
+/// (the upload server and a model built by value at boot), +10 %.
+const BOOT_STACK_BOUND_B: usize = 32 * 1024;
 
 /// One QEMU process on `file` (relative to `dir`): QEMU, the host link, the console.
 fn boot(dir: &Path, file: &str) -> (KillOnDrop, UploadClient<TcpStream>, Receiver<String>) {
@@ -62,6 +65,25 @@ fn first_boot_status(client: &mut UploadClient<TcpStream>) -> DeviceStatus {
         "booted once, no reset"
     );
     status
+}
+
+/// The painted stack peak of a boot that verified and decoded a stored model
+/// (`FOG-STACK boot_peak_bytes=N of=M`, fog-app's console), bounded: docs/stack.md.
+fn check_boot_stack(console: &Receiver<String>) {
+    let line = wait_line(console, "FOG-STACK boot_peak_bytes=", WAIT);
+    let field = |key: &str| -> usize {
+        line.split_whitespace()
+            .find_map(|w| w.strip_prefix(key))
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("stack line lacks `{key}N`: {line}"))
+    };
+    let (peak, stack) = (field("boot_peak_bytes="), field("of="));
+    eprintln!("qemu_persist: fog-app boot stack peak {peak} B of {stack} B (model in use)");
+    assert!(
+        peak > 256 && peak < BOOT_STACK_BOUND_B,
+        "fog-app boot stack peak {peak} bytes is implausible or over {BOOT_STACK_BOUND_B} B \
+         (a model or the upload server built by value on the stack? docs/stack.md)"
+    );
 }
 
 #[test]
@@ -97,6 +119,7 @@ fn qemu_model_survives_restart_and_a_flipped_byte_is_refused_with_its_reason() {
         wait_line(&console, "FOG-FLASH file=models.img loaded", WAIT);
         wait_line(&console, "FOG-SLOT A standby", WAIT);
         wait_line(&console, "FOG-SLOT B in use", WAIT);
+        check_boot_stack(&console);
         assert_eq!(first_boot_status(&mut client).active, Some(info2.clone()));
     }
 

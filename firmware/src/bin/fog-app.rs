@@ -49,6 +49,9 @@ mod safe_loop;
 #[cfg(feature = "log-semihosting")]
 #[path = "target/semi.rs"]
 mod semi;
+#[cfg(feature = "log-semihosting")]
+#[path = "target/stack.rs"]
+mod stack;
 #[path = "target/uart.rs"]
 mod uart;
 #[path = "target/upload_boot.rs"]
@@ -127,6 +130,9 @@ fn main() -> ! {
     static mut MODEL: RbfModel = RbfModel::empty();
     static mut TX_QUEUE: TxQueue = heapless::Deque::new();
     let (compensator, model, tx_queue) = (COMPENSATOR, MODEL, TX_QUEUE);
+    // Under QEMU the boot's stack peak is measured: painted here, read before the loop.
+    #[cfg(feature = "log-semihosting")]
+    stack::paint();
     let record = resets::boot_record();
     let reset = record.reset;
     announce_boot(&record);
@@ -227,6 +233,7 @@ fn main() -> ! {
     let mut next_status_s = 0.0;
     let reset_reason = ResetReason::from(reset.cause);
     let mut clean_run = CleanRun::new(&record);
+    report_boot_stack();
 
     loop {
         let now_s = millis::MillisClock.now_s();
@@ -579,6 +586,18 @@ fn report_slots(report: [fog_firmware::upload::SlotVerdict; 2]) {
         #[cfg(feature = "log-semihosting")]
         semihosting::eprintln!("FOG-SLOT {} {}", name, verdict);
     }
+}
+
+/// The boot's painted stack peak (store scan, signature re-check, model decode,
+/// configuration), under QEMU as a plain `FOG-STACK` line that `qemu_persist.rs` bounds
+/// (docs/stack.md). Hardware builds do not paint.
+fn report_boot_stack() {
+    #[cfg(feature = "log-semihosting")]
+    semihosting::eprintln!(
+        "FOG-STACK boot_peak_bytes={} of={}",
+        stack::high_water_bytes(),
+        stack::size_bytes()
+    );
 }
 
 /// A closed window as one plain-text line on the semihosting console (QEMU tests).
