@@ -45,14 +45,13 @@ use cortex_m_rt::entry;
 use embedded_hal_nb::serial::{Read as _, Write as _};
 use fog_core::compensation::compensator::Compensator;
 use fog_core::hal::{Gyro, TemperatureSensor};
-use fog_core::model::format::RbfModel;
 use fog_firmware::app::{App, AppConfig};
 use fog_firmware::clock::Clock;
 use fog_firmware::drivers::fog_serial::FogSerialGyro;
 use fog_firmware::drivers::tmp117::Tmp117;
 use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig};
 use fog_firmware::health::{GyroWatch, StuckEvent, DEFAULT_STUCK_RUN};
-use fog_firmware::upload::UploadServer;
+use fog_firmware::upload::UploadBuffers;
 use resets::BootFault;
 use stm32f4xx_hal::i2c::I2c;
 use stm32f4xx_hal::pac::{self, interrupt, Interrupt};
@@ -83,14 +82,14 @@ static HOST_RING: Ring = Ring::new();
 static GYRO_RING: Ring = Ring::new();
 static TABLE_RING: Ring = Ring::new();
 
-type Server = UploadServer<SectorFlash>;
+type Server = upload_boot::StaticServer<SectorFlash>;
 
 #[entry]
 fn main() -> ! {
     static mut COMPENSATOR: Compensator = Compensator::unconfigured();
-    static mut MODEL: RbfModel = RbfModel::empty();
+    static mut UPLOAD_BUFFERS: UploadBuffers = UploadBuffers::new();
     static mut TX_QUEUE: heapless::Deque<u8, TX_QUEUE_LEN> = heapless::Deque::new();
-    let (compensator, model, tx_queue) = (COMPENSATOR, MODEL, TX_QUEUE);
+    let (compensator, upload_buffers, tx_queue) = (COMPENSATOR, UPLOAD_BUFFERS, TX_QUEUE);
     let record = resets::boot_record();
     let reset = record.reset;
     defmt::info!(
@@ -173,7 +172,10 @@ fn main() -> ! {
         // A reset loop (fault_record.rs): host link and upload server only, until a good
         // upload; the TMP117, the gyro path and the turntable are not started.
         let mut server = model_flash
-            .and_then(|f| upload_boot::try_new_upload_server(f, VERIFY_KEY, GYRO_ID, reset).ok())
+            .and_then(|f| {
+                upload_boot::try_new_upload_server(f, VERIFY_KEY, GYRO_ID, reset, upload_buffers)
+                    .ok()
+            })
             .map(keep_server);
         let faults = record.state(true);
         let feed = || watchdog.feed();
@@ -189,6 +191,7 @@ fn main() -> ! {
             VERIFY_KEY,
             GYRO_ID,
             reset,
+            upload_buffers,
         ))
     };
 
@@ -201,17 +204,19 @@ fn main() -> ! {
         }
     };
 
-    let stored = server.load_active_model_into(model).unwrap_or_else(|e| {
+    let slot_report = server.boot_report();
+    // Decoded in place into the server's model buffer (the compensator keeps its own copy).
+    let model = server.load_active_model_in_place().unwrap_or_else(|e| {
         defmt::warn!("stored model not loaded ({}): running uncompensated", e);
-        false
+        None
     });
-    for (name, verdict) in ["A", "B"].into_iter().zip(server.boot_report()) {
+    for (name, verdict) in ["A", "B"].into_iter().zip(slot_report) {
         defmt::info!("model slot {}: {}", name, verdict);
     }
 
     let table = SerialTurntable::new(table_port, millis::MillisClock, TurntableConfig::default());
     let cfg = AppConfig::for_rate(GYRO_RATE_HZ as f32);
-    let mut app = match App::with_compensator(cfg, stored.then_some(&*model), table, compensator) {
+    let mut app = match App::with_compensator(cfg, model, table, compensator) {
         Ok(a) => a,
         Err(e) => {
             defmt::error!("configuration rejected: {}", e);
@@ -294,8 +299,8 @@ fn main() -> ! {
             if changed {
                 // A good upload clears the faults in a row (fault_record.rs).
                 resets::clear_faults();
-                let loaded = server.load_active_model_into(model);
-                match loaded.map(|stored| app.set_model_from(stored.then_some(&*model))) {
+                let loaded = server.load_active_model_in_place();
+                match loaded.map(|model| app.set_model_from(model)) {
                     Ok(Ok(())) => defmt::info!("new model in use"),
                     Ok(Err(e)) => defmt::error!("new model refused: {}", e),
                     Err(e) => defmt::error!("new model not loaded: {}", e),

@@ -22,6 +22,14 @@
 //!
 //! At boot (`new`) the active slot's signature is checked again; a slot that fails
 //! (another key, tampered flash) is not used and the other slot is tried.
+//!
+//! The server's large state (receive and reply frames, the signed-model buffer and the
+//! model it is decoded into, ~5 KB: [`UploadBuffers`]) can live elsewhere, e.g. in a
+//! zero-initialised `static` ([`UploadServer::with_buffers`]): the firmware then builds
+//! and moves only the small rest, and no model is ever decoded onto the stack
+//! (docs/stack.md).
+
+use core::borrow::BorrowMut;
 
 use embedded_storage::nor_flash::NorFlash;
 use fog_core::link::messages::{Command, DeviceFrame, HostFrame};
@@ -125,15 +133,42 @@ enum Session {
     },
 }
 
-/// Upload protocol server holding the model store.
-pub struct UploadServer<F> {
-    store: ModelStore<F>,
-    public_key: [u8; 32],
-    gyro_id: String<GYRO_ID_LEN>,
+/// The upload server's large state, kept apart so it can live in a `static`
+/// ([`UploadServer::with_buffers`]); [`UploadBuffers::new`] is all zero bytes (`.bss`).
+pub struct UploadBuffers {
     rx: FrameReceiver,
     tx: [u8; MAX_WIRE_FRAME_LEN],
     /// `signed_prefix` followed by the model bytes: the message the signature covers.
     buf: [u8; SIGNED_PREFIX_LEN + MAX_ENCODED_LEN],
+    /// Where a stored or uploaded model is decoded (in place) to check it and read its
+    /// identity, and what [`UploadServer::load_active_model_in_place`] hands out.
+    model: RbfModel,
+}
+
+impl UploadBuffers {
+    pub const fn new() -> Self {
+        Self {
+            rx: FrameReceiver::new(),
+            tx: [0; MAX_WIRE_FRAME_LEN],
+            buf: [0; SIGNED_PREFIX_LEN + MAX_ENCODED_LEN],
+            model: RbfModel::empty(),
+        }
+    }
+}
+
+impl Default for UploadBuffers {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Upload protocol server holding the model store. `B` holds its large state: owned
+/// (the default, `new`) or borrowed from a `static` (`with_buffers`).
+pub struct UploadServer<F, B = UploadBuffers> {
+    store: ModelStore<F>,
+    public_key: [u8; 32],
+    gyro_id: String<GYRO_ID_LEN>,
+    bufs: B,
     session: Session,
     next_session_id: u32,
     now_s: f64,
@@ -163,6 +198,20 @@ impl<F: NorFlash> UploadServer<F> {
         public_key: [u8; 32],
         gyro_id: String<GYRO_ID_LEN>,
     ) -> Result<Self, StoreError> {
+        Self::with_buffers(flash, base, public_key, gyro_id, UploadBuffers::new())
+    }
+}
+
+impl<F: NorFlash, B: BorrowMut<UploadBuffers>> UploadServer<F, B> {
+    /// `new` with the large state in `bufs` (e.g. a `&'static mut` to a `static`): the
+    /// boot check decodes the stored models there, in place.
+    pub fn with_buffers(
+        flash: F,
+        base: u32,
+        public_key: [u8; 32],
+        gyro_id: String<GYRO_ID_LEN>,
+        bufs: B,
+    ) -> Result<Self, StoreError> {
         let mut server = Self {
             store: ModelStore::open(flash, base)?,
             public_key,
@@ -175,9 +224,7 @@ impl<F: NorFlash> UploadServer<F> {
                 public_key[3],
             ]) | 1,
             gyro_id,
-            rx: FrameReceiver::new(),
-            tx: [0; MAX_WIRE_FRAME_LEN],
-            buf: [0; SIGNED_PREFIX_LEN + MAX_ENCODED_LEN],
+            bufs,
             session: Session::Idle,
             now_s: 0.0,
             active_info: None,
@@ -206,13 +253,12 @@ impl<F: NorFlash> UploadServer<F> {
         let second = self.store.inactive();
         for candidate in [first, second].into_iter().flatten() {
             self.store.select(Some(candidate));
-            let mut model = RbfModel::empty();
-            let verdict = self.verify_active_into(&mut model);
+            let verdict = self.verify_active();
             if let Some(entry) = self.boot_report.get_mut(usize::from(candidate.slot)) {
                 *entry = verdict;
             }
             if verdict == SlotVerdict::InUse {
-                self.active_info = Some(model_info(&candidate, &model));
+                self.active_info = Some(model_info(&candidate, &self.bufs.borrow().model));
                 return;
             }
             self.slots_refused_at_boot += 1;
@@ -221,24 +267,26 @@ impl<F: NorFlash> UploadServer<F> {
         self.active_info = None;
     }
 
-    /// Reads the active slot, checks its signature for this gyro and decodes it.
-    fn verify_active_into(&mut self, model: &mut RbfModel) -> SlotVerdict {
+    /// Reads the active slot, checks its signature for this gyro and decodes it into
+    /// the buffers' model (in place).
+    fn verify_active(&mut self) -> SlotVerdict {
         let Some(slot) = self.store.active().copied() else {
             return SlotVerdict::Defect(SlotDefect::Empty);
         };
         let Some(prefix) = signed_prefix(slot.header.security_counter, &self.gyro_id) else {
             return SlotVerdict::ModelRefused;
         };
-        let (head, body) = self.buf.split_at_mut(SIGNED_PREFIX_LEN);
+        let UploadBuffers { buf, model, .. } = self.bufs.borrow_mut();
+        let (head, body) = buf.split_at_mut(SIGNED_PREFIX_LEN);
         head.copy_from_slice(&prefix);
         let Ok(Some(bytes)) = self.store.read_active(body) else {
             return SlotVerdict::Defect(SlotDefect::Unreadable);
         };
         let len = SIGNED_PREFIX_LEN + bytes.len();
-        if verify_model(&self.public_key, &self.buf[..len], &slot.header.signature).is_err() {
+        if verify_model(&self.public_key, &buf[..len], &slot.header.signature).is_err() {
             return SlotVerdict::SignatureInvalid;
         }
-        let decoded = model.decode_into(&self.buf[SIGNED_PREFIX_LEN..len]).is_ok();
+        let decoded = model.decode_into(&buf[SIGNED_PREFIX_LEN..len]).is_ok();
         if decoded && model.meta.gyro_id == self.gyro_id {
             SlotVerdict::InUse
         } else {
@@ -280,7 +328,8 @@ impl<F: NorFlash> UploadServer<F> {
         if byte == 0 {
             self.frame_bytes = 0;
         }
-        let outcome = match self.rx.push(byte)? {
+        let UploadBuffers { rx, tx, buf, model } = self.bufs.borrow_mut();
+        let outcome = match rx.push(byte)? {
             Err(e) => Err(e.as_upload_error()),
             Ok(payload) => match decode_message::<HostFrame<'_>>(payload) {
                 Err(e) => Err(e.as_upload_error()),
@@ -308,7 +357,8 @@ impl<F: NorFlash> UploadServer<F> {
                         store: &mut self.store,
                         public_key: &self.public_key,
                         gyro_id: &self.gyro_id,
-                        buf: &mut self.buf,
+                        buf,
+                        model,
                         session: &mut self.session,
                         next_session_id: &mut self.next_session_id,
                         now_s: self.now_s,
@@ -322,9 +372,9 @@ impl<F: NorFlash> UploadServer<F> {
         // Every response fits MAX_WIRE_FRAME_LEN (`largest_response_fits_a_frame` in
         // fog-core), so the empty fallback is unreachable.
         let frame_level = outcome_is_frame_level(&response, model_changed);
-        let len = encode_frame(&DeviceFrame::Upload(response), &mut self.tx).unwrap_or(0);
+        let len = encode_frame(&DeviceFrame::Upload(response), tx).unwrap_or(0);
         if len > self.reply_credit || (frame_level && len > frame_len) {
-            self.note_reply_dropped();
+            self.counters.replies_suppressed = self.counters.replies_suppressed.saturating_add(1);
             return model_changed.then_some(Reply {
                 frame: &[],
                 model_changed,
@@ -333,7 +383,7 @@ impl<F: NorFlash> UploadServer<F> {
         }
         self.reply_credit -= len;
         Some(Reply {
-            frame: &self.tx[..len],
+            frame: &tx[..len],
             model_changed,
             command: None,
         })
@@ -362,19 +412,28 @@ impl<F: NorFlash> UploadServer<F> {
     /// model is never on the stack): `Ok(true)` if a model was stored and `dst` now holds
     /// it, `Ok(false)` if none is stored. On error `dst` must not be used.
     pub fn load_active_model_into(&mut self, dst: &mut RbfModel) -> Result<bool, LoadError> {
-        if matches!(self.session, Session::Receiving { .. }) {
-            return Err(LoadError::UploadInProgress);
-        }
-        match self
-            .store
-            .read_active(&mut self.buf[SIGNED_PREFIX_LEN..])
-            .map_err(LoadError::Store)?
-        {
+        let buf = &mut self.bufs.borrow_mut().buf;
+        match read_active_bytes(&mut self.store, &self.session, buf)? {
             None => Ok(false),
             Some(bytes) => dst
                 .decode_into(bytes)
                 .map(|()| true)
                 .map_err(LoadError::Model),
+        }
+    }
+
+    /// `load_active_model` decoded in place into the server's own model buffer (part of
+    /// [`UploadBuffers`], e.g. a `static`): `Ok(Some(model))` if a model is stored,
+    /// `Ok(None)` if none is. The buffer is scratch: the next boot check, commit or load
+    /// overwrites it (the compensator keeps its own copy).
+    pub fn load_active_model_in_place(&mut self) -> Result<Option<&RbfModel>, LoadError> {
+        let UploadBuffers { buf, model, .. } = self.bufs.borrow_mut();
+        match read_active_bytes(&mut self.store, &self.session, buf)? {
+            None => Ok(None),
+            Some(bytes) => {
+                model.decode_into(bytes).map_err(LoadError::Model)?;
+                Ok(Some(model))
+            }
         }
     }
 
@@ -400,6 +459,21 @@ impl<F: NorFlash> UploadServer<F> {
     }
 }
 
+/// The active model's bytes, read into the model part of `buf` (`None`: none stored);
+/// refused while an upload is using that buffer.
+fn read_active_bytes<'b, F: NorFlash>(
+    store: &mut ModelStore<F>,
+    session: &Session,
+    buf: &'b mut [u8; SIGNED_PREFIX_LEN + MAX_ENCODED_LEN],
+) -> Result<Option<&'b [u8]>, LoadError> {
+    if matches!(session, Session::Receiving { .. }) {
+        return Err(LoadError::UploadInProgress);
+    }
+    store
+        .read_active(&mut buf[SIGNED_PREFIX_LEN..])
+        .map_err(LoadError::Store)
+}
+
 /// A frame-level rejection (the frame itself was bad), which is never worth more
 /// bytes than the bad frame.
 fn outcome_is_frame_level(response: &Response, model_changed: bool) -> bool {
@@ -421,6 +495,8 @@ struct Fields<'s, F> {
     public_key: &'s [u8; 32],
     gyro_id: &'s String<GYRO_ID_LEN>,
     buf: &'s mut [u8; SIGNED_PREFIX_LEN + MAX_ENCODED_LEN],
+    /// Where a committed model is decoded (in place) to check it.
+    model: &'s mut RbfModel,
     session: &'s mut Session,
     next_session_id: &'s mut u32,
     now_s: f64,
@@ -614,9 +690,10 @@ fn commit<F: NorFlash>(
     verify_model(s.public_key, &s.buf[..end], signature)
         .map_err(|_| UploadError::SignatureInvalid)?;
     let bytes = &s.buf[SIGNED_PREFIX_LEN..end];
-    let model =
-        RbfModel::decode(bytes).map_err(|e| UploadError::ModelInvalid(ModelRejection::from(e)))?;
-    if model.meta.gyro_id != *s.gyro_id {
+    s.model
+        .decode_into(bytes)
+        .map_err(|e| UploadError::ModelInvalid(ModelRejection::from(e)))?;
+    if s.model.meta.gyro_id != *s.gyro_id {
         return Err(UploadError::WrongGyro);
     }
     let slot = s
@@ -626,7 +703,7 @@ fn commit<F: NorFlash>(
             StoreError::SequenceExhausted => UploadError::SequenceExhausted,
             _ => UploadError::FlashFailure,
         })?;
-    let info = model_info(&slot, &model);
+    let info = model_info(&slot, s.model);
     *s.active_info = Some(info.clone());
     Ok((info, true))
 }

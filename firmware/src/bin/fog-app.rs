@@ -71,7 +71,6 @@ use fog_core::hal::Gyro;
 use fog_core::link::bit::BitLimits;
 use fog_core::link::messages::{Command, DeviceMessage, FaultState, Refusal, ResetReason};
 use fog_core::link::upload::ResetRecord;
-use fog_core::model::format::RbfModel;
 use fog_core::seeking::field_record::FieldRecord;
 use fog_core::seeking::tilt::Tilt;
 use fog_firmware::app::{App, AppConfig, BoardStatus, SeekOutcome};
@@ -88,7 +87,7 @@ use fog_firmware::fault_record::{CleanRun, FaultRecord};
 use fog_firmware::field_log::FieldLog;
 use fog_firmware::health::{GyroWatch, StuckEvent, DEFAULT_STUCK_RUN};
 use fog_firmware::link_out::{queue_whole, LinkFrame};
-use fog_firmware::upload::UploadServer;
+use fog_firmware::upload::UploadBuffers;
 use resets::BootFault;
 
 #[cfg(not(any(feature = "log-semihosting", feature = "log-rtt")))]
@@ -122,14 +121,15 @@ const GYRO_ID: &str = include_str!(concat!(env!("OUT_DIR"), "/gyro_id.txt"));
 
 #[entry]
 fn main() -> ! {
-    // The application's big state (the compensator, ~8 KB) and the model buffer live in
-    // statics, set up there in place and never built on the stack. Their `const` values
-    // are all zero bytes, so they go to `.bss` (no flash); cortex-m-rt hands them out
-    // as `&'static mut` exactly once (no unsafe here).
+    // The application's big state (the compensator, ~8 KB) and the upload server's
+    // (frames, model bytes and the model decoded from them, ~5 KB) live in statics, set
+    // up there in place and never built on the stack. Their `const` values are all zero
+    // bytes, so they go to `.bss` (no flash); cortex-m-rt hands them out as
+    // `&'static mut` exactly once (no unsafe here).
     static mut COMPENSATOR: Compensator = Compensator::unconfigured();
-    static mut MODEL: RbfModel = RbfModel::empty();
+    static mut UPLOAD_BUFFERS: UploadBuffers = UploadBuffers::new();
     static mut TX_QUEUE: TxQueue = heapless::Deque::new();
-    let (compensator, model, tx_queue) = (COMPENSATOR, MODEL, TX_QUEUE);
+    let (compensator, upload_buffers, tx_queue) = (COMPENSATOR, UPLOAD_BUFFERS, TX_QUEUE);
     // Under QEMU the boot's stack peak is measured: painted here, read before the loop.
     #[cfg(feature = "log-semihosting")]
     stack::paint();
@@ -163,9 +163,10 @@ fn main() -> ! {
     let mut faults = record.state(false);
     let server = if record.safe_mode() {
         // A reset loop: host link and upload server only, until a good upload.
-        let server = upload_boot::try_new_upload_server(flash, VERIFY_KEY, GYRO_ID, reset)
-            .ok()
-            .map(|s| keep_server(s, options));
+        let server =
+            upload_boot::try_new_upload_server(flash, VERIFY_KEY, GYRO_ID, reset, upload_buffers)
+                .ok()
+                .map(|s| keep_server(s, options));
         let mut server = server;
         safe_loop::run(
             &mut host,
@@ -178,19 +179,20 @@ fn main() -> ! {
         // `run` returns only after a good upload, which needs the store.
         server.unwrap_or_else(|| resets::fatal_boot(BootFault::StoreGeometry))
     } else {
-        start_upload_server(flash, reset, options)
+        start_upload_server(flash, reset, options, upload_buffers)
     };
-    // Decoded in place into `MODEL` (the compensator keeps its own copy).
-    let stored = server.load_active_model_into(model).unwrap_or_else(|e| {
+    let (slots_refused, slot_report) = (server.slots_refused_at_boot(), server.boot_report());
+    // Decoded in place into the server's model buffer (the compensator keeps its own copy).
+    let model = server.load_active_model_in_place().unwrap_or_else(|e| {
         defmt::warn!("stored model not loaded ({}): running uncompensated", e);
-        false
+        None
     });
     defmt::info!(
         "model active: {} (slots refused at boot: {})",
-        stored,
-        server.slots_refused_at_boot()
+        model.is_some(),
+        slots_refused
     );
-    report_slots(server.boot_report());
+    report_slots(slot_report);
     let mut field_log = open_field_log(field_flash);
 
     let table = SerialTurntable::new(table_uart, millis::MillisClock, TurntableConfig::default());
@@ -206,7 +208,7 @@ fn main() -> ! {
         cfg.seek.dwell_s = d as f32;
         cfg.seek.ambiguity_dwell_s = (d as f32 / 6.0).max(10.0);
     }
-    let mut app = match App::with_compensator(cfg, stored.then_some(&*model), table, compensator) {
+    let mut app = match App::with_compensator(cfg, model, table, compensator) {
         Ok(a) => a,
         Err(e) => {
             defmt::error!("configuration rejected: {}", e);
@@ -384,7 +386,7 @@ fn main() -> ! {
                 #[cfg(feature = "log-semihosting")]
                 semihosting::eprintln!("FOG-COMMITTED flash_writes={}", flash_file::writes());
                 clear_faults(&mut faults, "good upload");
-                swap_model(server, model, &mut app);
+                swap_model(server, &mut app);
                 // The BIT's model item and the status follow at once.
                 next_status_s = now_s;
                 if options.inject == Inject::PanicAfterCommit {
@@ -535,14 +537,14 @@ fn seek_line(r: &fog_core::link::messages::SeekReport) {
 type TxQueue = heapless::Deque<u8, TX_QUEUE_LEN>;
 
 /// A committed model: load it and hand it to the compensator.
-fn swap_model<T, C>(server: &mut Server, model: &mut RbfModel, app: &mut App<T, C>)
+fn swap_model<T, C>(server: &mut Server, app: &mut App<T, C>)
 where
     T: fog_core::hal::Turntable,
     T::Error: Copy,
     C: core::borrow::BorrowMut<Compensator>,
 {
-    match server.load_active_model_into(model) {
-        Ok(stored) => match app.set_model_from(stored.then_some(&*model)) {
+    match server.load_active_model_in_place() {
+        Ok(model) => match app.set_model_from(model) {
             Ok(()) => {
                 defmt::info!("new model in use");
                 announce_heading_correction(app);
@@ -740,19 +742,20 @@ fn report<E: defmt::Format>(step: fog_firmware::app::Step<E>) {
     }
 }
 
-type Server = UploadServer<flash::AppFlash>;
+type Server = upload_boot::StaticServer<flash::AppFlash>;
 
 /// The upload server, in a static (`upload_boot.rs` builds it).
 fn start_upload_server(
     flash: flash::AppFlash,
     reset: ResetRecord,
     options: TestOptions,
+    bufs: &'static mut UploadBuffers,
 ) -> &'static mut Server {
     if options.injects(BootFault::StoreGeometry) {
         // Where the store's open fails (`upload_boot.rs`).
         resets::fatal_boot(BootFault::StoreGeometry)
     }
-    let server = upload_boot::new_upload_server(flash, VERIFY_KEY, GYRO_ID, reset);
+    let server = upload_boot::new_upload_server(flash, VERIFY_KEY, GYRO_ID, reset, bufs);
     keep_server(server, options)
 }
 

@@ -11,10 +11,10 @@ use fog_core::link::messages::{DeviceMessage, FaultState};
 use fog_firmware::clock::Clock as _;
 use fog_firmware::link_out::{queue_whole, LinkFrame};
 use fog_firmware::safe_mode;
-use fog_firmware::upload::UploadServer;
 
 use crate::millis::MillisClock;
 use crate::resets;
+use crate::upload_boot::StaticServer;
 
 /// Status period in safe mode, s.
 const STATUS_PERIOD_S: f64 = 1.0;
@@ -23,7 +23,7 @@ const HOST_BYTES_PER_PASS: usize = 64;
 
 pub fn run<H, F, const N: usize>(
     host: &mut H,
-    mut server: Option<&mut UploadServer<F>>,
+    mut server: Option<&mut StaticServer<F>>,
     tx: &mut heapless::Deque<u8, N>,
     faults: FaultState,
     mut feed_watchdog: impl FnMut(),
