@@ -8,11 +8,14 @@ out="$PWD/docs/budgets.md"
 table="$(mktemp)"
 stack="$(mktemp)"
 board="$(mktemp)"
-trap 'rm -f "$table" "$stack" "$board"' EXIT
+appstack="$(mktemp)"
+trap 'rm -f "$table" "$stack" "$board" "$appstack"' EXIT
 FOG_REQUIRE_QEMU=1 FOG_BUDGETS_OUT="$table" \
     cargo test -p fog-tests --test fw_budgets -- --nocapture
 FOG_REQUIRE_QEMU=1 FOG_BUDGETS_STACK_OUT="$stack" \
     cargo test -p fog-tests --test qemu_replay -- --nocapture
+FOG_REQUIRE_QEMU=1 FOG_BUDGETS_BOOT_STACK_OUT="$appstack" \
+    cargo test -p fog-tests --test qemu_persist -- --nocapture
 FOG_REQUIRE_QEMU=1 FOG_BUDGETS_BOARD_OUT="$board" \
     cargo test -p fog-tests --test board_budgets -- --nocapture
 # Hand-written notes below the table (from the marker on) are kept.
@@ -21,10 +24,10 @@ notes="$(sed -n '/<!-- notes:begin -->/,$p' "$out" 2>/dev/null || true)"
     echo "# Firmware budgets"
     echo
     echo "Measured by \`scripts/budgets.sh\` on $(date -u +%Y-%m-%d) with $(rustc --version | cut -d' ' -f1-2)"
-    echo "(\`cargo test -p fog-tests --test fw_budgets\` and \`--test qemu_replay\`; firmware profile \`fw\`, QEMU"
+    echo "(\`cargo test -p fog-tests --test fw_budgets\`, \`--test qemu_replay\` and \`--test qemu_persist\`; firmware profile \`fw\`, QEMU"
     echo "\`mps2-an386\` with \`-icount shift=0\`: instruction counts, not cycles)."
     echo
-    cat "$table" "$stack" "$board"
+    cat "$table" "$stack" "$appstack" "$board"
     if [ -n "$notes" ]; then
         echo
         echo "$notes"
@@ -35,7 +38,7 @@ echo "wrote $out"
 # The README carries the same table between its budget markers.
 readme="$PWD/README.md"
 if grep -q '<!-- budgets:begin -->' "$readme"; then
-    python3 - "$readme" "$table" "$stack" "$board" <<'PY'
+    python3 - "$readme" "$table" "$stack" "$appstack" "$board" <<'PY'
 import sys
 readme, parts = sys.argv[1], sys.argv[2:]
 text = open(readme).read()

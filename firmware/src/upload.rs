@@ -24,7 +24,7 @@
 //! (another key, tampered flash) is not used and the other slot is tried.
 //!
 //! The server's large state (receive and reply frames, the signed-model buffer and the
-//! model it is decoded into, ~5 KB: [`UploadBuffers`]) can live elsewhere, e.g. in a
+//! model it is decoded into, 4,500 B: [`UploadBuffers`]) can live elsewhere, e.g. in a
 //! zero-initialised `static` ([`UploadServer::with_buffers`]): the firmware then builds
 //! and moves only the small rest, and no model is ever decoded onto the stack
 //! (docs/stack.md).

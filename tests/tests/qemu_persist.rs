@@ -10,6 +10,10 @@
 //! answering; with both slots damaged it runs without a model. A file that is not a
 //! flash image is refused whole and left as it was.
 //!
+//! The boot with a stored model in use also bounds fog-app's painted boot stack peak
+//! (`FOG-STACK`); with `FOG_BUDGETS_BOOT_STACK_OUT=<file>` its budget-table row is
+//! written there (scripts/budgets.sh).
+//!
 //! Skips loudly without QEMU / the target unless FOG_REQUIRE_QEMU=1. Every wait is
 //! bounded; QEMU is killed when each run ends.
 
@@ -86,6 +90,13 @@ fn check_boot_stack(console: &Receiver<String>) {
         "fog-app boot stack peak {peak} bytes is implausible or over {BOOT_STACK_BOUND_B} B \
          (a model or the upload server built by value on the stack? docs/stack.md)"
     );
+    if let Ok(path) = std::env::var("FOG_BUDGETS_BOOT_STACK_OUT") {
+        let row = format!(
+            "| stack peak at boot, `fog-app` (store scan, signature re-check, model decode; painted) \
+             | {peak} B | CI bound {BOOT_STACK_BOUND_B} B |\n"
+        );
+        std::fs::write(path, row).expect("write the boot stack row");
+    }
 }
 
 #[test]

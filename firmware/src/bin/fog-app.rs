@@ -122,7 +122,7 @@ const GYRO_ID: &str = include_str!(concat!(env!("OUT_DIR"), "/gyro_id.txt"));
 #[entry]
 fn main() -> ! {
     // The application's big state (the compensator, ~8 KB) and the upload server's
-    // (frames, model bytes and the model decoded from them, ~5 KB) live in statics, set
+    // (frames, model bytes and the model decoded from them, 4.5 KB) live in statics, set
     // up there in place and never built on the stack. Their `const` values are all zero
     // bytes, so they go to `.bss` (no flash); cortex-m-rt hands them out as
     // `&'static mut` exactly once (no unsafe here).
