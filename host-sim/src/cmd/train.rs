@@ -89,10 +89,12 @@ pub struct Args {
     /// of `--seek-dwell-s` at `--seek-latitude-deg`) or `rms10s` (10 s residual rms).
     #[arg(long, default_value = crate::train::seek_score::DEFAULT_CRITERION_NAME)]
     pub criterion: String,
-    /// Dwell per position of the seeks the `seek` criterion scores, s.
+    /// Dwell per position of the seeks the `seek` criterion scores (and `--field`'s
+    /// azimuth score), s.
     #[arg(long = "seek-dwell-s", default_value_t = crate::train::seek_score::DEFAULT_SEEK_DWELL_S)]
     pub seek_dwell: f64,
-    /// Site latitude of the seeks the `seek` criterion scores, deg.
+    /// Site latitude of the seeks the `seek` criterion scores (and `--field`'s azimuth
+    /// score), deg.
     #[arg(long = "seek-latitude-deg", default_value_t = crate::sim::DEFAULT_LATITUDE_DEG, allow_negative_numbers = true)]
     pub seek_latitude: f64,
     /// Write the training report as JSON here.
@@ -243,7 +245,12 @@ fn field_refined(
         (None, Ok(path)) if path.is_file() => crate::field::registry_variants(model, &path)?,
         (None, _) => Vec::new(),
     };
-    let refined = crate::field::refine_with_dir(model, dir, &variants, args.field_weight)?;
+    // The azimuth score's seeks are the ones the trainer's seek criterion scores.
+    let seek = crate::train::seek_score::SeekGeometry {
+        dwell_s: args.seek_dwell,
+        latitude_deg: args.seek_latitude,
+    };
+    let refined = crate::field::refine_with_dir(model, dir, &variants, args.field_weight, seek)?;
     print!("{}", refined.summary());
     Ok(refined.model)
 }

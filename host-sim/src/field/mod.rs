@@ -18,6 +18,7 @@ use anyhow::{bail, Result};
 use fog_core::link::upload::crc32;
 use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
 
+use crate::train::seek_score::SeekGeometry;
 use records_file::StoredRecord;
 use refine::{FieldObservation, WeightChoice};
 
@@ -59,6 +60,7 @@ pub fn refine_with_dir(
     dir: &Path,
     variants: &[u32],
     weight: Option<f64>,
+    seek: SeekGeometry,
 ) -> Result<FieldRefinement> {
     let records = records_file::read_dir_records(dir)?;
     if records.is_empty() {
@@ -68,7 +70,7 @@ pub fn refine_with_dir(
             records_file::JSON_NAME
         );
     }
-    refine_with_records(model, &records, variants, weight)
+    refine_with_records(model, &records, variants, weight, seek)
         .map_err(|e| anyhow::anyhow!("--field {}: {e}", dir.display()))
 }
 
@@ -80,6 +82,7 @@ pub fn refine_with_records(
     records: &[StoredRecord],
     variants: &[u32],
     weight: Option<f64>,
+    seek: SeekGeometry,
 ) -> Result<FieldRefinement> {
     let crc = model_crc32(model)?;
     let is_variant = |r: &&StoredRecord| r.model_crc32.is_some_and(|c| variants.contains(&c));
@@ -114,7 +117,7 @@ pub fn refine_with_records(
             crc_list(variants)
         );
     }
-    let (model, correction, choice) = refine::refine(model, &obs, weight)?;
+    let (model, correction, choice) = refine::refine(model, &obs, weight, seek)?;
     Ok(FieldRefinement {
         model,
         used: obs.len(),

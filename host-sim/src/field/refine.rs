@@ -68,9 +68,8 @@
 
 use anyhow::{bail, Result};
 
-use crate::train::seek_score::DEFAULT_SEEK_DWELL_S;
+use crate::train::seek_score::SeekGeometry;
 use fog_core::compensation::compensator::CompensatorConfig;
-use fog_core::consts::earth_rate_horizontal_dph;
 use fog_core::model::format::{FeatureKind, RbfModel};
 
 /// Fewer field seeks than this: no test power, no correction.
@@ -217,9 +216,9 @@ pub struct HeldOut {
     pub ms_se_dph2: f64,
     /// The azimuth consequence of the held-out residual, as `train::seek_score` converts a
     /// slow drift error: the held-out residual's change between a power-on's consecutive
-    /// seeks, scaled to one seek dwell (`DEFAULT_SEEK_DWELL_S`: what separates a seek's two
-    /// positions), over 2 Omega_H at the simulator's default latitude (`DEFAULT_LATITUDE_DEG`,
-    /// 39.9 deg, not yet `train --seek-latitude-deg`; |sin psi| = 1): the error a residual
+    /// seeks, scaled to one seek dwell (what separates a seek's two positions), over
+    /// 2 Omega_H at the site latitude (`SeekGeometry`: `train`'s `--seek-dwell-s` and
+    /// `--seek-latitude-deg`; |sin psi| = 1): the error a residual
     /// that drifts along the warm-up puts into the difference of a seek's positions, which
     /// the half-sum cannot see. rms over the pairs, deg (0 with no pair).
     pub az_rms_deg: f64,
@@ -493,8 +492,7 @@ fn solve_spd(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
 /// power-on's records predicted by the fit on the other power-ons'): rms of the residual
 /// bias and the azimuth score, each with the standard error of its mean square over the
 /// power-ons.
-pub fn held_out(obs: &[FieldObservation], terms: &[Term], w: f64) -> HeldOut {
-    let omega_h = earth_rate_horizontal_dph(crate::sim::DEFAULT_LATITUDE_DEG);
+pub fn held_out(obs: &[FieldObservation], terms: &[Term], w: f64, seek: SeekGeometry) -> HeldOut {
     let groups = obs.iter().map(|o| o.power_on).max().map_or(0, |g| g + 1);
     let (mut per_group_ms, mut per_group_az) = (Vec::new(), Vec::new());
     let (mut ss, mut az_ss, mut az_n) = (0.0, 0.0, 0usize);
@@ -516,8 +514,8 @@ pub fn held_out(obs: &[FieldObservation], terms: &[Term], w: f64) -> HeldOut {
             .windows(2)
             .filter(|p| p[1].0 > p[0].0)
             .map(|p| {
-                let drift_dph = (p[1].1 - p[0].1) / (p[1].0 - p[0].0) * DEFAULT_SEEK_DWELL_S;
-                (drift_dph / (2.0 * omega_h)).to_degrees().powi(2)
+                let drift_dph = (p[1].1 - p[0].1) / (p[1].0 - p[0].0) * seek.dwell_s;
+                seek.azimuth_deg(drift_dph).powi(2)
             })
             .collect();
         if !az.is_empty() {
@@ -544,7 +542,12 @@ pub fn held_out(obs: &[FieldObservation], terms: &[Term], w: f64) -> HeldOut {
 /// Chooses W and the terms kept (the constant alone, then each of `terms` added in
 /// order) by leave-one-power-on-out (`fixed`: that W, the terms still chosen; every
 /// candidate's held-out rms is reported).
-pub fn choose_weight(obs: &[FieldObservation], terms: &[Term], fixed: Option<f64>) -> WeightChoice {
+pub fn choose_weight(
+    obs: &[FieldObservation],
+    terms: &[Term],
+    fixed: Option<f64>,
+    seek: SeekGeometry,
+) -> WeightChoice {
     let mut distinct: Vec<usize> = obs.iter().map(|o| o.power_on).collect();
     distinct.sort_unstable();
     distinct.dedup();
@@ -593,7 +596,7 @@ pub fn choose_weight(obs: &[FieldObservation], terms: &[Term], fixed: Option<f64
     let mut candidates = Vec::new();
     for k in 0..=terms.len() {
         for &w in &weights {
-            let h = held_out(&obs, &terms[..k], w);
+            let h = held_out(&obs, &terms[..k], w, seek);
             candidates.push(Candidate {
                 terms: k,
                 weight: w,
@@ -715,10 +718,11 @@ pub fn refine(
     model: &RbfModel,
     obs: &[FieldObservation],
     fixed: Option<f64>,
+    seek: SeekGeometry,
 ) -> Result<(RbfModel, Correction, WeightChoice)> {
     let (identifiable, mut not_fitted) = terms_for(model, obs);
     let (terms, coverage_refused) = supported_terms(model, obs, &identifiable);
-    let choice = choose_weight(obs, &terms, fixed);
+    let choice = choose_weight(obs, &terms, fixed, seek);
     if choice.verdict.is_none() {
         let without = best_rms_with(&choice, choice.terms_kept);
         for (k, t) in terms.iter().enumerate().skip(choice.terms_kept) {
@@ -789,7 +793,7 @@ mod tests {
     fn a_clean_aging_law_is_learnt_and_folded_exactly() {
         let m = model();
         let o = obs(40, 0.0005, 0.0, 1);
-        let (refined, c, choice) = refine(&m, &o, None).unwrap();
+        let (refined, c, choice) = refine(&m, &o, None, SeekGeometry::default_site()).unwrap();
         assert!(choice.weight >= 10.0, "{choice:?}");
         for x in &o {
             let before = predict_f64(&m, &[x.temp_c, x.temp_rate_cps]).unwrap();
@@ -803,6 +807,26 @@ mod tests {
     }
 
     #[test]
+    fn the_azimuth_score_is_taken_at_the_seeks_of_the_site() {
+        let o = obs(40, 0.0005, 0.02, 3);
+        let here = SeekGeometry::default_site();
+        let north = SeekGeometry {
+            dwell_s: 2.0 * here.dwell_s,
+            latitude_deg: 60.0,
+        };
+        let (a, b) = (held_out(&o, &[], 0.0, here), held_out(&o, &[], 0.0, north));
+        assert!(a.az_rms_deg > 0.0, "{a:?}");
+        assert_eq!(a.rms_dph, b.rms_dph, "the half-sum does not depend on it");
+        // Twice the dwell doubles the drift between positions; Omega_H scales by cos(lat).
+        let expect = 2.0 * here.latitude_deg.to_radians().cos() / 60f64.to_radians().cos();
+        assert!(
+            (b.az_rms_deg / a.az_rms_deg - expect).abs() < 1e-9,
+            "{} vs {expect}",
+            b.az_rms_deg / a.az_rms_deg
+        );
+    }
+
+    #[test]
     fn pure_noise_keeps_the_model_nearly_unchanged_and_few_records_have_no_power() {
         let m = model();
         let o = obs(40, 0.0, 0.02, 2)
@@ -812,13 +836,13 @@ mod tests {
                 ..x
             })
             .collect::<Vec<_>>();
-        let (_, c, choice) = refine(&m, &o, None).unwrap();
+        let (_, c, choice) = refine(&m, &o, None, SeekGeometry::default_site()).unwrap();
         let worst = o.iter().map(|x| c.predict_dph(x).abs()).fold(0.0, f64::max);
         assert!(
             worst < 0.006,
             "noise (+-0.01) mostly not learnt: {worst} {choice:?}"
         );
-        let (same, _, choice) = refine(&m, &o[..3], None).unwrap();
+        let (same, _, choice) = refine(&m, &o[..3], None, SeekGeometry::default_site()).unwrap();
         assert!(choice.verdict.is_some());
         assert_eq!(same, m);
     }
@@ -881,7 +905,8 @@ mod tests {
         // refused, one line says so, the model moves by its constant only (the same change
         // at 12 and at 40 degC).
         let one_ambient = warm_ups(&[10.0, 10.4, 9.7, 10.2], noisy(4, 0.001));
-        let (refined, c, choice) = refine(&m, &one_ambient, None).unwrap();
+        let (refined, c, choice) =
+            refine(&m, &one_ambient, None, SeekGeometry::default_site()).unwrap();
         assert!(choice.verdict.is_none(), "{choice:?}");
         assert!(choice.kinds.is_empty() && c.terms.is_empty(), "{c:?}");
         assert_eq!(c.coverage_refused.len(), 1, "{c:?}");
@@ -896,7 +921,7 @@ mod tests {
         // Twin: power-ons at 10, 20, 30 and 10 degC (records 11.5 .. 37.3 degC): T kept,
         // and the refined model follows the law at 40 degC.
         let three = warm_ups(&[10.0, 20.0, 30.0, 10.0], noisy(4, 0.001));
-        let (refined, c, choice) = refine(&m, &three, None).unwrap();
+        let (refined, c, choice) = refine(&m, &three, None, SeekGeometry::default_site()).unwrap();
         assert!(c.coverage_refused.is_empty(), "{c:?}");
         assert_eq!(choice.terms_kept, 1, "{choice:?}");
         let moved_40 = at(&refined, 40.0) - at(&m, 40.0);
@@ -904,7 +929,7 @@ mod tests {
         // Null twin: the same power-ons, no aging (noise only): supported, but no term
         // wins on the held-out power-ons.
         let null = warm_ups(&[10.0, 20.0, 30.0, 10.0], noisy(5, 0.0));
-        let (_, c, choice) = refine(&m, &null, None).unwrap();
+        let (_, c, choice) = refine(&m, &null, None, SeekGeometry::default_site()).unwrap();
         assert!(c.coverage_refused.is_empty(), "{c:?}");
         assert_eq!(choice.terms_kept, 0, "{choice:?}");
     }
@@ -938,7 +963,7 @@ mod tests {
         let shupe = |_t: f64, rate: f64| 1.4 * rate;
         // One power-on at 10 degC: nothing can be scored at another ambient.
         let one = warm_ups(&[10.0], shupe);
-        let (same, c, choice) = refine(&m, &one, None).unwrap();
+        let (same, c, choice) = refine(&m, &one, None, SeekGeometry::default_site()).unwrap();
         assert!(
             choice
                 .verdict
@@ -952,7 +977,7 @@ mod tests {
         // Power-ons at 10, 20, 30 degC: a T slope fitted on two ambients mispredicts the
         // third; the T term is refused and says why.
         let three = warm_ups(&[10.0, 20.0, 30.0, 10.0], shupe);
-        let (_, c, choice) = refine(&m, &three, None).unwrap();
+        let (_, c, choice) = refine(&m, &three, None, SeekGeometry::default_site()).unwrap();
         assert_eq!(choice.power_ons, 4);
         assert_eq!(choice.terms_kept, 0, "{choice:?}");
         assert!(
@@ -963,7 +988,7 @@ mod tests {
         );
         // Twin: the aging is a T law; the same power-ons keep T and learn its slope.
         let tempco = warm_ups(&[10.0, 20.0, 30.0, 10.0], |t, _| 0.001 * (t - 20.0));
-        let (_, c, choice) = refine(&m, &tempco, None).unwrap();
+        let (_, c, choice) = refine(&m, &tempco, None, SeekGeometry::default_site()).unwrap();
         assert_eq!(choice.terms_kept, 1, "{choice:?}");
         let slope = c.coef_dph[1] / c.terms[0].std;
         assert!((slope - 0.001).abs() < 1e-4, "{slope}");

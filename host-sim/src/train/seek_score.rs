@@ -26,6 +26,31 @@ pub const DEFAULT_SEEK_DWELL_S: f64 = 110.0;
 /// 0.0095 vs 0.0097 deg over 4 campaigns).
 pub const DEFAULT_CRITERION_NAME: &str = "seek";
 
+/// The seeks a residual is scored for: dwell per position and site latitude. What turns
+/// a change of the drift error between a seek's two positions into azimuth error, for the
+/// trainer's seek criterion and for the field refinement's azimuth score alike.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct SeekGeometry {
+    pub dwell_s: f64,
+    pub latitude_deg: f64,
+}
+
+impl SeekGeometry {
+    /// `north-seek`'s dwell at the simulator's site latitude.
+    pub fn default_site() -> Self {
+        SeekGeometry {
+            dwell_s: DEFAULT_SEEK_DWELL_S,
+            latitude_deg: crate::sim::DEFAULT_LATITUDE_DEG,
+        }
+    }
+
+    /// Azimuth error, deg, of a two-position seek whose drift error differs by
+    /// `difference_dph` between its positions: difference / (2 Omega_H), |sin psi| = 1.
+    pub fn azimuth_deg(&self, difference_dph: f64) -> f64 {
+        (difference_dph / (2.0 * earth_rate_horizontal_dph(self.latitude_deg))).to_degrees()
+    }
+}
+
 /// Which held-out score chooses the model.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -135,7 +160,10 @@ pub fn seek_azimuth_per_run(
     dwell_s: f64,
     latitude_deg: f64,
 ) -> Vec<RunSeekError> {
-    let omega_h = earth_rate_horizontal_dph(latitude_deg);
+    let geometry = SeekGeometry {
+        dwell_s,
+        latitude_deg,
+    };
     let mut out = Vec::new();
     let mut i = 0;
     while i < res.len() {
@@ -149,8 +177,7 @@ pub fn seek_azimuth_per_run(
             pairs: 0,
         };
         for e in pair_errors_dph(&res[i..end], &t_s[i..end], dwell_s) {
-            let az_rad = e / (2.0 * omega_h);
-            run.sum_sq_deg2 += az_rad.to_degrees().powi(2);
+            run.sum_sq_deg2 += geometry.azimuth_deg(e).powi(2);
             run.pairs += 1;
         }
         out.push(run);

@@ -255,6 +255,11 @@ pub fn run_aging_on(
         .map(|&a| plan.monte_carlo(EVAL_STREAM, plan.eval_starts, plan.eval_seeks_per_start, a))
         .collect();
     let eval_cfg = &eval_cfgs[0];
+    // The refinement's azimuth score scores the seeks this measurement runs.
+    let seek = crate::train::seek_score::SeekGeometry {
+        dwell_s: f64::from(eval_cfg.dwell_s),
+        latitude_deg: plan.latitude_deg,
+    };
     let chamber = subject.chamber(plan)?;
     progress(&format!(
         "chamber model: {} runs at {:?} degC, {} centres",
@@ -283,7 +288,7 @@ pub fn run_aging_on(
         ));
         let without = run_arm(subject, law, &eval_cfgs, &chamber)?;
         for &n in &plan.field_seek_counts {
-            let refined = refine_with_records(&chamber, &field.records[..n], &[], None)?;
+            let refined = refine_with_records(&chamber, &field.records[..n], &[], None, seek)?;
             let with = if refined.model == chamber {
                 without.clone()
             } else {
