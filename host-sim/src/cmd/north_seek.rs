@@ -129,8 +129,8 @@ pub fn run(args: Args) -> Result<()> {
         None => {
             // The same defaults as `fogsim train` (inputs chosen by grouped validation
             // over whole runs, d2T/dt2 kept where it wins) plus the time since power-on
-            // of these cold starts (`own_model`), on as many runs at the ambient as the
-            // half-split learned seek error needs.
+            // of these cold starts (`own_model`), on the chamber campaign at the
+            // ambient (`own_model::CAMPAIGN_RUNS` runs).
             let plan = OwnModelPlan {
                 ambient_c: cfg.ambient_c,
                 latitude_deg: cfg.latitude_deg,
