@@ -121,14 +121,23 @@ pub fn train_with(
     gyro_id: &str,
     criterion: crate::train::seek_score::Criterion,
 ) -> Result<TrainOutcome> {
-    let owned: Vec<Run> = runs.iter().map(|r| (*r).clone()).collect();
-    let ds = dataset_from_runs(&owned, specs).map_err(|e| anyhow!("training: {e}"))?;
     let cfg = TrainConfig {
         gyro_id: gyro_id.chars().take(16).collect(),
         criterion,
         ..TrainConfig::default()
     };
-    train_model(&ds, &cfg)
+    train_with_config(runs, specs, &cfg)
+}
+
+/// Trains a model on `specs` with the trainer configuration `cfg`.
+pub fn train_with_config(
+    runs: &[&Run],
+    specs: &[FeatureSpec],
+    cfg: &TrainConfig,
+) -> Result<TrainOutcome> {
+    let owned: Vec<Run> = runs.iter().map(|r| (*r).clone()).collect();
+    let ds = dataset_from_runs(&owned, specs).map_err(|e| anyhow!("training: {e}"))?;
+    train_model(&ds, cfg)
         .map_err(|e| anyhow!("training: {e}"))
         .context("training the default model")
 }

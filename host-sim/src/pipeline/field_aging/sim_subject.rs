@@ -7,7 +7,7 @@ use anyhow::Result;
 
 use super::{AgingLaw, AgingPlan, AgingSubject, Chamber};
 use crate::pipeline::campaign::CampaignSpec;
-use crate::pipeline::campaign_steps::{simulate_checked, train_with};
+use crate::pipeline::campaign_steps::{simulate_checked, train_with_config};
 use crate::pipeline::northseek::{run_seeks, Arm, ArmOutcome, MonteCarloConfig};
 use crate::pipeline::own_model::{train_own_model, OwnModelPlan};
 use crate::sim::GyroParams;
@@ -106,5 +106,9 @@ fn chamber_at_ambients(
         },
     )?;
     let runs: Vec<&crate::io::runs::Run> = campaign.iter().map(|c| &c.run).collect();
-    train_with(&runs, &own.specs, "sim", own_plan.criterion)
+    train_with_config(
+        &runs,
+        &own.specs,
+        &crate::pipeline::own_model::train_config(own_plan, own.linear_inputs),
+    )
 }
