@@ -33,9 +33,9 @@
 //! simulator), a thin tube; Gaussians fitted to the tube get the drift's change across it
 //! (the Shupe and gradient terms are linear in the rates) only as well as the tube's few
 //! runs at its edge allow, while a linear term extends it. Measured over six campaigns per
-//! ambient (docs/northfinder.md): linear terms on every model met the targets in 16 of 18
-//! cells against 14 of 18 without (-40 degC 5 of 6 against 2 of 6), with 0-26 centres
-//! instead of 5-62.
+//! ambient (docs/northfinder.md): chosen this way the targets are met in 17 of 18 cells
+//! (-40 degC 5 of 6), against 14 of 18 without linear terms (-40 degC 2 of 6) and 16 of 18
+//! with them forced on every model.
 //!
 //! The clock input: every run of the campaign is a cold start from a soak at one ambient,
 //! so the time since power-on is a state of the warm-up, and with T it tells a run that
