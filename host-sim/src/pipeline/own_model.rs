@@ -167,11 +167,7 @@ pub fn train_own_model(params: &GyroParams, plan: &OwnModelPlan) -> Result<OwnMo
     let runs: Vec<Run> = campaign.into_iter().map(|c: CampaignRun| c.run).collect();
     // `train`'s defaults, with the plan's criterion choosing the d2T/dt2 estimator as well
     // as the shape.
-    let cfg = TrainConfig {
-        criterion: plan.criterion,
-        ..TrainConfig::default()
-    };
-    let (selection, _) = choose_inputs_default(&runs, &InputSet::ALL, &cfg)
+    let (selection, _) = choose_inputs_default(&runs, &InputSet::ALL, &train_config(plan, false))
         .map_err(|e| anyhow!("choosing the own model's inputs: {e}"))?;
     let clock_tau_s = warmup_time_constant_s(&runs)?;
     let mut specs = selection.chosen.specs();
@@ -187,10 +183,8 @@ pub fn train_own_model(params: &GyroParams, plan: &OwnModelPlan) -> Result<OwnMo
     let refs: Vec<&Run> = runs.iter().collect();
     let plain = train_with_config(&refs, &specs, &train_config(plan, false))?;
     let linear = train_with_config(&refs, &specs, &train_config(plan, true))?;
-    let (score_plain, score_linear) = (
-        criterion_score(plan, &plain),
-        criterion_score(plan, &linear),
-    );
+    let score = |t: &TrainOutcome| t.report.cross_validation.best.score_for(plan.criterion);
+    let (score_plain, score_linear) = (score(&plain), score(&linear));
     let linear_inputs = score_linear < score_plain;
     let trained = if linear_inputs { linear } else { plain };
     let learned_seek_deg = learned_seek_error_deg(&runs, &specs, plan, linear_inputs)?;
@@ -216,15 +210,6 @@ pub fn train_config(plan: &OwnModelPlan, linear_inputs: bool) -> TrainConfig {
         criterion: plan.criterion,
         linear_on_rbf_inputs: linear_inputs,
         ..TrainConfig::default()
-    }
-}
-
-/// The held-out score the plan's criterion minimises, of a trained model's chosen shape.
-fn criterion_score(plan: &OwnModelPlan, t: &TrainOutcome) -> f64 {
-    let best = &t.report.cross_validation.best;
-    match plan.criterion {
-        Criterion::Rms10s => best.heldout_rms_dph,
-        Criterion::Seek { .. } => best.heldout_seek_deg,
     }
 }
 

@@ -248,9 +248,17 @@ fn next_widths(grid: &mut Vec<f64>, tried: &[f64], w: f64, widenings: &mut usize
 
 /// The score `cfg.criterion` minimises.
 fn criterion_key(cfg: &TrainConfig, s: &WidthScore) -> f64 {
-    match cfg.criterion {
-        Criterion::Rms10s => s.heldout_rms_dph,
-        Criterion::Seek { .. } => s.heldout_seek_deg,
+    s.score_for(cfg.criterion)
+}
+
+impl WidthScore {
+    /// The held-out score `criterion` minimises: the 10 s rms (deg/h) or the seek score
+    /// (deg).
+    pub fn score_for(&self, criterion: Criterion) -> f64 {
+        match criterion {
+            Criterion::Rms10s => self.heldout_rms_dph,
+            Criterion::Seek { .. } => self.heldout_seek_deg,
+        }
     }
 }
 
