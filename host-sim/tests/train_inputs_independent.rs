@@ -22,6 +22,7 @@ mod app_support;
 #[path = "common/independent.rs"]
 #[allow(dead_code)] // the heading variants are used by diagnose_between
 mod independent;
+#[allow(dead_code)] // the test files share the generator, each uses some of its laws
 #[path = "common/soaked.rs"]
 mod soaked;
 

@@ -177,28 +177,49 @@ pub fn train_own_model(params: &GyroParams, plan: &OwnModelPlan) -> Result<OwnMo
             tau_s: tau as f32,
         });
     }
-    // Linear terms in the RBF inputs under the Gaussians, or not: a shape choice, made as
-    // the trainer makes its width and degree, by the lower held-out score of the plan's
-    // criterion (a tie keeps the paper's pure RBF).
-    let refs: Vec<&Run> = runs.iter().collect();
-    let plain = train_with_config(&refs, &specs, &train_config(plan, false))?;
-    let linear = train_with_config(&refs, &specs, &train_config(plan, true))?;
-    let score = |t: &TrainOutcome| t.report.cross_validation.best.score_for(plan.criterion);
-    let (score_plain, score_linear) = (score(&plain), score(&linear));
-    let linear_inputs = score_linear < score_plain;
-    let trained = if linear_inputs { linear } else { plain };
-    let learned_seek_deg = learned_seek_error_deg(&runs, &specs, plan, linear_inputs)?;
+    let shape = choose_linear_terms(&runs, &specs, plan)?;
+    let learned_seek_deg = learned_seek_error_deg(&runs, &specs, plan, shape.linear_inputs)?;
     Ok(OwnModel {
-        trained,
+        trained: shape.trained,
         selection,
         clock_tau_s,
         specs,
-        linear_inputs,
-        linear_scores: [score_plain, score_linear],
+        linear_inputs: shape.linear_inputs,
+        linear_scores: shape.scores,
         runs: runs.len(),
         learned_seek_deg,
         budget_deg,
         budget_met: learned_seek_deg <= budget_deg,
+    })
+}
+
+/// The model of `choose_linear_terms`: trained with or without linear terms in its RBF
+/// inputs, and the held-out scores that chose.
+pub struct LinearTermsChoice {
+    pub trained: TrainOutcome,
+    pub linear_inputs: bool,
+    /// The held-out scores (the plan's criterion) without and with the linear terms.
+    pub scores: [f64; 2],
+}
+
+/// Linear terms in the RBF inputs under the Gaussians, or not: a shape choice, made as the
+/// trainer makes its width and degree, by the lower held-out score of the plan's criterion
+/// over whole runs; a tie keeps the paper's pure RBF.
+pub fn choose_linear_terms(
+    runs: &[Run],
+    specs: &[FeatureSpec],
+    plan: &OwnModelPlan,
+) -> Result<LinearTermsChoice> {
+    let refs: Vec<&Run> = runs.iter().collect();
+    let plain = train_with_config(&refs, specs, &train_config(plan, false))?;
+    let linear = train_with_config(&refs, specs, &train_config(plan, true))?;
+    let score = |t: &TrainOutcome| t.report.cross_validation.best.score_for(plan.criterion);
+    let scores = [score(&plain), score(&linear)];
+    let linear_inputs = scores[1] < scores[0];
+    Ok(LinearTermsChoice {
+        trained: if linear_inputs { linear } else { plain },
+        linear_inputs,
+        scores,
     })
 }
 

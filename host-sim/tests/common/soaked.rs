@@ -22,6 +22,10 @@
 //! - the null twin: the lagged thermometer with nothing in d2T/dt2 (the drift follows
 //!   the measured T and dT/dt only).
 //!
+//! For the choice of linear terms in the RBF inputs, two more laws on the lagged
+//! thermometer: a bump in the coil temperature (nothing linear in T or dT/dt) and the
+//! turn-on offset alone (nothing follows the temperature).
+//!
 //! The planted d2T/dt2 effect is sized on the settled part of the warm-up (rows from
 //! [`SIZED_FROM_S`] on, where the 10 s rms sees it): its rms there is `sigmas` 10 s noise
 //! sigmas.
@@ -54,6 +58,14 @@ pub enum SoakedLaw {
     UnlaggedTwoMode(f64),
     /// The lagged thermometer, nothing in d2T/dt2 (the null twin).
     LaggedNull,
+    /// The lagged thermometer; the drift is a bump in the coil temperature of this many
+    /// 10 s noise sigmas (a resonance of the coil's mount, 1 degC wide, 3 degC above the
+    /// ambient, which every run passes in its first half hour) instead of the temperature coefficient and the
+    /// Shupe term: nothing in it is linear in T or dT/dt.
+    LaggedTemperatureBump(f64),
+    /// The lagged thermometer; the drift is the turn-on offset alone (nothing follows the
+    /// temperature).
+    LaggedOffsetOnly,
 }
 
 /// One run's warm-up: the measured temperature rise above the ambient, its rate and the
@@ -120,8 +132,33 @@ fn unlagged_warmup(rise_c: f64, fast_share: f64, tau_fast_s: f64, tau_slow_s: f6
     w
 }
 
+/// How much the runs' warm-ups differ.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Tube {
+    /// Rise 8-14 degC, housing time constant 1,000-2,000 s, run to run.
+    Wide,
+    /// The same draws pulled to 1/20 of their spread about the middle (rise 10.85-11.15
+    /// degC, 1,475-1,525 s): a unit whose only run-to-run difference is a 1-2 %
+    /// dissipation spread, as in the project's simulator.
+    Thin,
+}
+
+impl Tube {
+    fn spread(self, low: f64, high: f64, draw: f64) -> f64 {
+        match self {
+            Tube::Wide => draw,
+            Tube::Thin => 0.5 * (low + high) + (draw - 0.5 * (low + high)) / 20.0,
+        }
+    }
+}
+
 /// The campaign: [`RUNS`] soaked cold starts at [`AMBIENT_C`], [`RUN_S`] s each.
 pub fn soaked_campaign(law: SoakedLaw, seed: u64) -> Vec<Run> {
+    soaked_campaign_in(law, Tube::Wide, seed)
+}
+
+/// [`soaked_campaign`] with the runs' warm-ups as wide apart as `tube` says.
+pub fn soaked_campaign_in(law: SoakedLaw, tube: Tube, seed: u64) -> Vec<Run> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0x50A7);
     let g = Normal::new(0.0, 1.0).unwrap();
     let (k1, shupe) = (rng.random_range(-0.004..0.004), rng.random_range(2.0..6.0));
@@ -133,9 +170,10 @@ pub fn soaked_campaign(law: SoakedLaw, seed: u64) -> Vec<Run> {
     let mut accel_term = Vec::new();
     let amb = AMBIENT_C;
     for i in 0..RUNS {
-        let rise = rng.random_range(8.0..14.0);
+        let rise = tube.spread(8.0, 14.0, rng.random_range(8.0..14.0));
         let w = if lagged {
-            lagged_warmup(rise, rng.random_range(1000.0..2000.0), lag_s)
+            let tau_s = tube.spread(1000.0, 2000.0, rng.random_range(1000.0..2000.0));
+            lagged_warmup(rise, tau_s, lag_s)
         } else {
             let share = rng.random_range(0.3..0.7);
             let fast = rng.random_range(150.0..300.0);
@@ -145,7 +183,14 @@ pub fn soaked_campaign(law: SoakedLaw, seed: u64) -> Vec<Run> {
         let (mut t, mut rate, mut temp) = (vec![], vec![], vec![]);
         for (k, (dt_c, rate_cps)) in w.rise_c.iter().zip(&w.rate_cps).enumerate() {
             let d = amb + dt_c - 25.0;
-            let drift = offset + k1 * d + shupe * rate_cps;
+            let drift = offset
+                + match law {
+                    SoakedLaw::LaggedTemperatureBump(sigmas) => {
+                        sigmas * NOISE_10S_DPH * (-0.5 * ((dt_c - 3.0) / 1.0).powi(2)).exp()
+                    }
+                    SoakedLaw::LaggedOffsetOnly => 0.0,
+                    _ => k1 * d + shupe * rate_cps,
+                };
             t.push((k + 1) as f64);
             rate.push(drift + NOISE_10S_DPH * 10f64.sqrt() * g.sample(&mut rng));
             temp.push(((amb + dt_c + 0.02 * g.sample(&mut rng)) / 0.0625).round() * 0.0625);
@@ -163,7 +208,9 @@ pub fn soaked_campaign(law: SoakedLaw, seed: u64) -> Vec<Run> {
     }
     let sigmas = match law {
         SoakedLaw::LaggedGradient(s) | SoakedLaw::UnlaggedTwoMode(s) => s,
-        SoakedLaw::LaggedNull => 0.0,
+        SoakedLaw::LaggedNull
+        | SoakedLaw::LaggedTemperatureBump(_)
+        | SoakedLaw::LaggedOffsetOnly => 0.0,
     };
     plant(&mut runs, &accel_term, sigmas * NOISE_10S_DPH);
     runs
