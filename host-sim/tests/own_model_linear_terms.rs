@@ -16,7 +16,7 @@ mod soaked;
 use fog_core::model::format::{FeatureKind, FeatureSpec, RbfModel};
 use fog_sim::io::runs::Run;
 use fog_sim::pipeline::own_model::{choose_linear_terms, warmup_time_constant_s, OwnModelPlan};
-use fog_sim::train::seek_score::{seek_azimuth_rms_deg, Criterion};
+use fog_sim::train::seek_score::{seek_azimuth_rms_deg, Criterion, SeekGeometry};
 use fog_sim::train::{dataset_from_runs, predict_batch, InputSet};
 use soaked::{soaked_campaign_in, SoakedLaw, Tube, AMBIENT_C};
 
@@ -29,10 +29,10 @@ fn plan() -> OwnModelPlan {
         latitude_deg: LATITUDE_DEG,
         dwell_s: DWELL_S,
         seed: 1,
-        criterion: Criterion::Seek {
+        criterion: Criterion::Seek(SeekGeometry {
             dwell_s: DWELL_S,
             latitude_deg: LATITUDE_DEG,
-        },
+        }),
     }
 }
 

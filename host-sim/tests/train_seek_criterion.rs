@@ -56,16 +56,10 @@ fn heldout_scores(hidden: Hidden, seed: u64, criterion: Criterion) -> (f64, f64)
         .zip(&pred)
         .map(|(y, p)| y - p)
         .collect();
-    let Criterion::Seek {
-        dwell_s,
-        latitude_deg,
-    } = Criterion::seek_default()
-    else {
-        unreachable!()
-    };
+    let seek = Criterion::seek_default().seek_geometry();
     (
         rms(&res),
-        seek_azimuth_rms_deg(&res, &hd.groups, &hd.t_s, dwell_s, latitude_deg),
+        seek_azimuth_rms_deg(&res, &hd.groups, &hd.t_s, seek.dwell_s, seek.latitude_deg),
     )
 }
 

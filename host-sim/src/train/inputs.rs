@@ -212,19 +212,9 @@ impl InputCriterion for GroupedCvSeek {
     }
 
     fn score(&self, ds: &Dataset, cfg: &TrainConfig) -> Result<SetScore> {
-        let criterion = match cfg.criterion {
-            Criterion::Rms10s => Criterion::seek_default(),
-            c => c,
-        };
-        let Criterion::Seek {
-            dwell_s,
-            latitude_deg,
-        } = criterion
-        else {
-            return Err(TrainError::EmptyDataset);
-        };
+        let seek = cfg.criterion.seek_geometry();
         let cfg = &TrainConfig {
-            criterion,
+            criterion: Criterion::Seek(seek),
             ..cfg.clone()
         };
         let cv = cross_validate(ds, cfg, cfg.folds)?;
@@ -232,8 +222,8 @@ impl InputCriterion for GroupedCvSeek {
             &cv.residuals_dph,
             &ds.groups,
             &ds.t_s,
-            dwell_s,
-            latitude_deg,
+            seek.dwell_s,
+            seek.latitude_deg,
         )
         .iter()
         .filter(|r| r.pairs > 0)
@@ -251,7 +241,7 @@ impl InputCriterion for GroupedCvSeek {
 pub fn criterion_for(cfg: &TrainConfig) -> &'static dyn InputCriterion {
     match cfg.criterion {
         Criterion::Rms10s => &GroupedCvRms,
-        Criterion::Seek { .. } => &GroupedCvSeek,
+        Criterion::Seek(_) => &GroupedCvSeek,
     }
 }
 

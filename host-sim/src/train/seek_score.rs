@@ -57,16 +57,23 @@ impl SeekGeometry {
 pub enum Criterion {
     /// Pooled rms of the held-out 10 s residuals, deg/h.
     Rms10s,
-    /// rms of the azimuth error of seeks with dwells of `dwell_s` at `latitude_deg`, deg.
-    Seek { dwell_s: f64, latitude_deg: f64 },
+    /// rms of the azimuth error of seeks of this geometry (dwell per position, site
+    /// latitude), deg.
+    Seek(SeekGeometry),
 }
 
 impl Criterion {
     /// The seek criterion with `north-seek`'s dwell at the simulator's site latitude.
     pub fn seek_default() -> Self {
-        Criterion::Seek {
-            dwell_s: DEFAULT_SEEK_DWELL_S,
-            latitude_deg: crate::sim::DEFAULT_LATITUDE_DEG,
+        Criterion::Seek(SeekGeometry::default_site())
+    }
+
+    /// The seeks a held-out residual is scored for: the criterion's, or `north-seek`'s
+    /// default site under the 10 s rms (whose reports still show a seek score).
+    pub fn seek_geometry(&self) -> SeekGeometry {
+        match *self {
+            Criterion::Rms10s => SeekGeometry::default_site(),
+            Criterion::Seek(geometry) => geometry,
         }
     }
 
@@ -84,7 +91,7 @@ impl Criterion {
     pub fn name(&self) -> &'static str {
         match self {
             Criterion::Rms10s => "10 s rms",
-            Criterion::Seek { .. } => "seek azimuth error",
+            Criterion::Seek(_) => "seek azimuth error",
         }
     }
 
@@ -92,10 +99,10 @@ impl Criterion {
     pub fn parse(name: &str, dwell_s: f64, latitude_deg: f64) -> Result<Self, String> {
         let c = match name {
             "rms10s" => Criterion::Rms10s,
-            "seek" => Criterion::Seek {
+            "seek" => Criterion::Seek(SeekGeometry {
                 dwell_s,
                 latitude_deg,
-            },
+            }),
             _ => return Err(format!("`{name}`: use `seek` or `rms10s`")),
         };
         if !c.is_valid() {
@@ -110,10 +117,10 @@ impl Criterion {
     pub fn is_valid(&self) -> bool {
         match *self {
             Criterion::Rms10s => true,
-            Criterion::Seek {
+            Criterion::Seek(SeekGeometry {
                 dwell_s,
                 latitude_deg,
-            } => dwell_s.is_finite() && dwell_s > 0.0 && latitude_deg.abs() < 85.0,
+            }) => dwell_s.is_finite() && dwell_s > 0.0 && latitude_deg.abs() < 85.0,
         }
     }
 }

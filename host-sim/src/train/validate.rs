@@ -257,24 +257,15 @@ impl WidthScore {
     pub fn score_for(&self, criterion: Criterion) -> f64 {
         match criterion {
             Criterion::Rms10s => self.heldout_rms_dph,
-            Criterion::Seek { .. } => self.heldout_seek_deg,
+            Criterion::Seek(_) => self.heldout_seek_deg,
         }
     }
 }
 
 /// Held-out seek score at the criterion's dwell and latitude (the defaults under `Rms10s`).
 fn seek_score_of(cfg: &TrainConfig, res: &[f64], ds: &Dataset) -> f64 {
-    let Criterion::Seek {
-        dwell_s,
-        latitude_deg,
-    } = (match cfg.criterion {
-        Criterion::Rms10s => Criterion::seek_default(),
-        c => c,
-    })
-    else {
-        return f64::NAN;
-    };
-    seek_azimuth_rms_deg(res, &ds.groups, &ds.t_s, dwell_s, latitude_deg)
+    let seek = cfg.criterion.seek_geometry();
+    seek_azimuth_rms_deg(res, &ds.groups, &ds.t_s, seek.dwell_s, seek.latitude_deg)
 }
 
 /// Std around the overall mean.
