@@ -113,6 +113,8 @@ fn every_json_report_is_byte_identical_for_the_same_seed() {
             "30",
             "--starts",
             "2",
+            "--qualification-runs",
+            "6",
             "--seed",
             "7",
         ],

@@ -1,5 +1,6 @@
-//! A small `fogsim reproduce` (two temperatures, four runs each, two cold starts): the report
-//! holds every section, per-ambient held-out figures, the paper-vs-us table and the plots.
+//! A small `fogsim reproduce` (two temperatures, four runs each, two cold starts, a
+//! qualification campaign of six runs per temperature): the report holds every section
+//! for the three models, per-ambient held-out figures, the paper-vs-us table and the plots.
 
 mod app_support;
 
@@ -17,6 +18,8 @@ fn small_reproduce_writes_report_and_plots() {
         "4",
         "--starts",
         "2",
+        "--qualification-runs",
+        "6",
         "--json",
         "r.json",
         "--plots",
@@ -29,7 +32,11 @@ fn small_reproduce_writes_report_and_plots() {
     let json: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("r.json")).unwrap()).unwrap();
     let models = json["models"].as_array().unwrap();
-    assert_eq!(models.len(), 2, "paper inputs and the global model");
+    assert_eq!(
+        models.len(),
+        3,
+        "paper inputs, the global model and the qualification model"
+    );
     for m in models {
         let amb = m["per_ambient"].as_array().unwrap();
         assert_eq!(amb.len(), 2);
@@ -66,9 +73,27 @@ fn small_reproduce_writes_report_and_plots() {
             "{file}"
         );
     }
+    // The qualification model: `north-seek`'s recipe (the chosen inputs, then the warm-up
+    // clock when the runs have one) on its own campaign.
+    assert_eq!(models[2]["model_file"], "model_qualification.bin");
+    let chosen = models[2]["input_selection"]["chosen"].as_str().unwrap();
+    let label = models[2]["label"].as_str().unwrap();
+    assert!(label.contains(chosen), "{label}");
+    let inputs = models[2]["training"]["inputs"].as_array().unwrap().len();
+    assert!(inputs >= chosen.split(',').count(), "{inputs} inputs");
+    assert_eq!(
+        models[2]["north_seek_other_ambients"]
+            .as_array()
+            .unwrap()
+            .len(),
+        2,
+        "-40 and +60 degC"
+    );
     for f in [
         "model_extended/startup_after.svg",
         "model_extended/azimuth_scatter.svg",
+        "model_qualification/startup_after.svg",
+        "model_qualification/azimuth_scatter.svg",
     ] {
         assert!(dir.join("plots").join(f).exists(), "{f}");
     }

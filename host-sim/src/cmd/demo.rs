@@ -44,6 +44,8 @@ pub fn run(args: Args) -> Result<()> {
         args.starts,
         None,
         Some(args.out.clone()),
+        // The demo stays short: `reproduce` adds the qualification model.
+        0,
     )?;
     prepare_output_dir(&OutputGuard::default(), Some(&args.out), "--out")?;
     let started = std::time::Instant::now();

@@ -1,6 +1,8 @@
 //! `fogsim reproduce`: the whole paper end to end (campaign -40..+60 degC, train on runs 1-3
 //! of each temperature, validate on runs 4-5, cold-start north-seek Monte Carlo at 20 degC)
-//! and a side-by-side table: paper vs this project.
+//! and a side-by-side table: paper vs this project; then one global model by `north-seek`'s
+//! own-model recipe on a qualification campaign (`--qualification-runs` per ambient),
+//! validated on the same held-out runs and seeking at the same ambients.
 
 use std::path::PathBuf;
 
@@ -45,6 +47,11 @@ pub struct Args {
     /// Worker threads [default: available cores].
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Cold starts per ambient of the qualification campaign the third model trains on
+    /// (one global model by `north-seek`'s own-model recipe: inputs by validation, the
+    /// warm-up clock, linear terms where they score better); 0: no third model.
+    #[arg(long = "qualification-runs", default_value_t = crate::pipeline::own_model::CAMPAIGN_RUNS)]
+    pub qualification_runs: usize,
 }
 
 /// Checks the options and builds the pipeline's settings.
@@ -53,6 +60,7 @@ pub fn options(
     starts: usize,
     threads: Option<usize>,
     plots: Option<PathBuf>,
+    qualification_runs: usize,
 ) -> Result<ReproduceOptions> {
     validate_plan(&campaign).map_err(|e| super::with_plan_flag(e.into()))?;
     if campaign.runs_per_ambient <= TRAIN_RUNS {
@@ -86,6 +94,7 @@ pub fn options(
         n_train: TRAIN_RUNS,
         north_seek,
         plots,
+        qualification_runs,
     })
 }
 
@@ -104,6 +113,7 @@ pub fn run(args: Args) -> Result<()> {
         args.starts,
         args.threads,
         args.outputs.plots.clone(),
+        args.qualification_runs,
     )?;
     let report = reproduce(&GyroParams::paper_default(), &opts).map_err(super::with_plan_flag)?;
     print!("{}\n{}", validation_tables(&report), summary(&report));

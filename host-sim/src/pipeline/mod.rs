@@ -13,3 +13,4 @@ pub mod heading_fit;
 pub mod northseek;
 pub mod own_model;
 pub mod reproduce;
+pub mod seek_targets;

@@ -968,12 +968,13 @@ pub fn seek_table(r: &NorthSeekReport) -> String {
     ]);
     format!(
         "{}noise floor (ARW {:.4} deg/sqrt(h), {:.0} s per position): {:.4} deg; compensated/floor = {:.2}\n\
-         seek duration: mean {:.0} s, max {:.0} s (paper: {:.0} s)\n{}{}",
+         {}seek duration: mean {:.0} s, max {:.0} s (paper: {:.0} s)\n{}{}",
         t.render(),
         r.arw_dpsh,
         r.main_dwell_s,
         r.noise_floor_deg,
         r.compensated.std_deg / r.noise_floor_deg,
+        super::seek_targets::seek_targets_line(r),
         r.seek_duration_s,
         r.max_seek_duration_s,
         r.paper_seek_duration_s,

@@ -129,7 +129,7 @@ impl OwnModel {
             self.linear_scores[0]
         );
         s += &format!(
-            "runs at the ambient: {} (the chamber campaign); training-set error (half-split, mean of {SPLITS} splits) {:.4} deg, budget {:.4} deg ({} x the white-noise floor): {}\n",
+            "training runs: {} (the chamber campaign); training-set error (half-split, mean of {SPLITS} splits) {:.4} deg, budget {:.4} deg ({} x the white-noise floor): {}\n",
             self.runs,
             self.learned_seek_deg,
             self.budget_deg,
@@ -147,14 +147,6 @@ impl OwnModel {
 /// Simulates the chamber campaign at the plan's ambient and trains the own model on it,
 /// with the training-set error checked against the budget (see the module notes).
 pub fn train_own_model(params: &GyroParams, plan: &OwnModelPlan) -> Result<OwnModel> {
-    let floor_deg = noise_floor_deg(
-        params.noise.arw_dpsh,
-        SeekMode::TwoPosition,
-        plan.latitude_deg,
-        90.0,
-        plan.dwell_s,
-    );
-    let budget_deg = LEARNED_SHARE_OF_FLOOR * floor_deg;
     let campaign = simulate_checked(
         params,
         &CampaignSpec {
@@ -165,8 +157,30 @@ pub fn train_own_model(params: &GyroParams, plan: &OwnModelPlan) -> Result<OwnMo
         },
     )?;
     let runs: Vec<Run> = campaign.into_iter().map(|c: CampaignRun| c.run).collect();
+    own_model_from_runs(params, runs, plan)
+}
+
+/// The own model's recipe on any campaign of cold starts (one ambient for `north-seek`,
+/// every ambient for `reproduce`'s qualification model): `train`'s input choice, the clock
+/// of the runs' warm-up when they have one, linear terms in the RBF inputs when the
+/// held-out score wants them, and the half-split training-set error against its budget
+/// (`LEARNED_SHARE_OF_FLOOR` of the seek's white-noise floor for `params`' gyro).
+pub fn own_model_from_runs(
+    params: &GyroParams,
+    runs: Vec<Run>,
+    plan: &OwnModelPlan,
+) -> Result<OwnModel> {
+    let floor_deg = noise_floor_deg(
+        params.noise.arw_dpsh,
+        SeekMode::TwoPosition,
+        plan.latitude_deg,
+        90.0,
+        plan.dwell_s,
+    );
+    let budget_deg = LEARNED_SHARE_OF_FLOOR * floor_deg;
     // `train`'s defaults, with the plan's criterion choosing the d2T/dt2 estimator as well
-    // as the shape.
+    // as the shape. (Scoring each set with the clock beside it was tried and not kept:
+    // docs/northfinder.md, "The one global model over training campaigns".)
     let (selection, _) = choose_inputs_default(&runs, &InputSet::ALL, &train_config(plan, false))
         .map_err(|e| anyhow!("choosing the own model's inputs: {e}"))?;
     let clock_tau_s = warmup_time_constant_s(&runs)?;

@@ -186,6 +186,17 @@ fn band_outline(chart: &Chart, b: &super::chart::Band) -> Vec<(f64, f64)> {
         .collect()
 }
 
+/// The title's font and size: `style::TITLE_FONT_PX`, smaller for a title that would not fit
+/// the plot area's width (`style::TITLE_CHAR_EM` of the size per character), never below
+/// `style::MIN_TITLE_FONT_PX`. Long model labels made titles run off both edges.
+fn title_font(chart: &Chart, root: &DrawingArea<SVGBackend<'_>, Shift>) -> (&'static str, u32) {
+    let chars = chart.title.chars().count().max(1) as f64;
+    let width_px = f64::from(root.dim_in_pixel().0);
+    let fit = (width_px - 2.0 * f64::from(style::MARGIN_PX)) / (style::TITLE_CHAR_EM * chars);
+    let px = (fit.floor() as u32).clamp(style::MIN_TITLE_FONT_PX, style::TITLE_FONT_PX);
+    (style::FONT, px)
+}
+
 fn draw_on<XR, YR>(
     root: &DrawingArea<SVGBackend<'_>, Shift>,
     chart: &Chart,
@@ -199,8 +210,8 @@ where
     YR::CoordDescType: ValueFormatter<f64>,
 {
     let mut ctx = ChartBuilder::on(root)
-        .caption(&chart.title, (style::FONT, style::TITLE_FONT_PX))
-        .margin(16)
+        .caption(&chart.title, title_font(chart, root))
+        .margin(style::MARGIN_PX)
         .x_label_area_size(50)
         .y_label_area_size(84)
         .build_cartesian_2d(x_range, y_range)

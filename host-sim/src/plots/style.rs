@@ -10,6 +10,12 @@ pub const CHART_SIZE_PX: (u32, u32) = (1000, 600);
 pub const LEGEND_WIDTH_PX: u32 = 250;
 pub const FONT: &str = "sans-serif";
 pub const TITLE_FONT_PX: u32 = 22;
+/// Smallest title font, px (a longer title is drawn at this size and may still clip).
+pub const MIN_TITLE_FONT_PX: u32 = 12;
+/// Width of an average sans-serif character, in font sizes (em), for fitting titles.
+pub const TITLE_CHAR_EM: f64 = 0.5;
+/// Margin around the plot area, px.
+pub const MARGIN_PX: u32 = 16;
 pub const LABEL_FONT_PX: u32 = 16;
 pub const LEGEND_FONT_PX: u32 = 14;
 pub const LINE_WIDTH_PX: u32 = 2;

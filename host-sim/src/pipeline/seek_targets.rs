@@ -1,0 +1,154 @@
+//! The cold-start seek targets, checked on a Monte Carlo report: a north finder started
+//! cold must seek as well as a warm one. Over all seeks the compensated azimuth std is at
+//! most 1.1x the white-noise floor; each of the first three seeks (the ones the warm-up
+//! drift hits) has an rms error about the true azimuth of at most 1.15x the floor; and no
+//! seek carries a common bias: each seek's |mean error| is at most 0.3 of its std over the
+//! starts (std = sqrt(rms^2 - mean^2)). Printed under every seek table, so a user reads
+//! the verdict where the numbers are.
+
+use serde::Serialize;
+
+use crate::report::NorthSeekReport;
+
+/// Compensated std over all seeks, x the floor.
+pub const ALL_SEEKS_OVER_FLOOR: f64 = 1.1;
+/// rms error of each of the first `FIRST_SEEKS` seeks, x the floor.
+pub const FIRST_SEEKS_OVER_FLOOR: f64 = 1.15;
+/// How many seeks after power-on `FIRST_SEEKS_OVER_FLOOR` applies to.
+pub const FIRST_SEEKS: usize = 3;
+/// Largest |mean error| / std of any seek.
+pub const MEAN_OVER_STD: f64 = 0.3;
+
+/// The measured figures and whether each target is met.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct SeekTargets {
+    pub all_over_floor: f64,
+    /// Worst rms of the first seeks, x the floor, and which seek (1-based).
+    pub worst_first_over_floor: f64,
+    pub worst_first_seek: usize,
+    /// Worst |mean| / std over every seek, and which seek (1-based).
+    pub worst_mean_over_std: f64,
+    pub worst_mean_seek: usize,
+    pub met: bool,
+}
+
+/// The targets on the compensated arm of `r` (None: no compensated seeks).
+pub fn seek_targets(r: &NorthSeekReport) -> Option<SeekTargets> {
+    let c = &r.compensated;
+    targets_of(
+        c.std_deg,
+        &c.per_seek_std_deg,
+        &c.per_seek_mean_error_deg,
+        r.noise_floor_deg,
+    )
+}
+
+/// The targets from the std over all seeks, each seek's rms error and mean error, deg,
+/// and the white-noise floor, deg (None: no seeks or no floor).
+pub fn targets_of(
+    all_std_deg: f64,
+    per_seek_rms_deg: &[f64],
+    per_seek_mean_deg: &[f64],
+    floor_deg: f64,
+) -> Option<SeekTargets> {
+    if per_seek_rms_deg.is_empty() || floor_deg.is_nan() || floor_deg <= 0.0 {
+        return None;
+    }
+    let worst = |v: &mut dyn Iterator<Item = (usize, f64)>| {
+        v.fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a })
+    };
+    let (first, first_rms) = worst(
+        &mut per_seek_rms_deg
+            .iter()
+            .take(FIRST_SEEKS)
+            .map(|&x| x / floor_deg)
+            .enumerate(),
+    );
+    let (mean_seek, mean_ratio) = worst(
+        &mut per_seek_rms_deg
+            .iter()
+            .zip(per_seek_mean_deg)
+            .map(|(&rms, &mean)| {
+                let std = (rms * rms - mean * mean).max(0.0).sqrt();
+                if std > 0.0 {
+                    mean.abs() / std
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .enumerate(),
+    );
+    let all = all_std_deg / floor_deg;
+    Some(SeekTargets {
+        all_over_floor: all,
+        worst_first_over_floor: first_rms,
+        worst_first_seek: first + 1,
+        worst_mean_over_std: mean_ratio,
+        worst_mean_seek: mean_seek + 1,
+        met: all <= ALL_SEEKS_OVER_FLOOR
+            && first_rms <= FIRST_SEEKS_OVER_FLOOR
+            && mean_ratio <= MEAN_OVER_STD,
+    })
+}
+
+/// One line for the seek table: each figure against its target, and the verdict.
+pub fn seek_targets_line(r: &NorthSeekReport) -> String {
+    let Some(t) = seek_targets(r) else {
+        return String::new();
+    };
+    let ok = |b: bool| if b { "met" } else { "MISSED" };
+    format!(
+        "cold-start targets: all seeks {:.3}x floor (<= {ALL_SEEKS_OVER_FLOOR}) {}; worst of seeks 1-{FIRST_SEEKS} {:.3}x (seek {}, <= {FIRST_SEEKS_OVER_FLOOR}) {}; worst |mean|/std {:.2} (seek {}, <= {MEAN_OVER_STD}) {} -> {}\n",
+        t.all_over_floor,
+        ok(t.all_over_floor <= ALL_SEEKS_OVER_FLOOR),
+        t.worst_first_over_floor,
+        t.worst_first_seek,
+        ok(t.worst_first_over_floor <= FIRST_SEEKS_OVER_FLOOR),
+        t.worst_mean_over_std,
+        t.worst_mean_seek,
+        ok(t.worst_mean_over_std <= MEAN_OVER_STD),
+        if t.met { "MET" } else { "MISSED" }
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const FLOOR: f64 = 0.0148;
+
+    #[test]
+    fn seeks_at_the_floor_meet_every_target() {
+        let t = targets_of(FLOOR, &[FLOOR; 6], &[0.0; 6], FLOOR).unwrap();
+        assert!(t.met, "{t:?}");
+        assert_eq!((t.all_over_floor, t.worst_mean_over_std), (1.0, 0.0));
+    }
+
+    #[test]
+    fn each_target_misses_on_its_own() {
+        // All seeks 1.12x the floor.
+        let all = targets_of(1.12 * FLOOR, &[FLOOR; 6], &[0.0; 6], FLOOR).unwrap();
+        assert!(!all.met && all.worst_first_over_floor <= FIRST_SEEKS_OVER_FLOOR);
+        // Seek 2 at 1.2x the floor; seek 4 at 1.3x does not count (after the first three).
+        let mut rms = [FLOOR; 6];
+        rms[1] = 1.2 * FLOOR;
+        let first = targets_of(FLOOR, &rms, &[0.0; 6], FLOOR).unwrap();
+        assert_eq!((first.met, first.worst_first_seek), (false, 2));
+        rms[1] = FLOOR;
+        rms[3] = 1.3 * FLOOR;
+        assert!(targets_of(FLOOR, &rms, &[0.0; 6], FLOOR).unwrap().met);
+        // Seek 5 biased by 0.35 of its std: rms^2 = std^2 (1 + 0.35^2).
+        let mut mean = [0.0; 6];
+        mean[4] = 0.35 * FLOOR / (1.0 + 0.35f64.powi(2)).sqrt();
+        let bias = targets_of(FLOOR, &[FLOOR; 6], &mean, FLOOR).unwrap();
+        assert_eq!(bias.worst_mean_seek, 5);
+        assert!((bias.worst_mean_over_std - 0.35).abs() < 1e-12 && !bias.met);
+    }
+
+    #[test]
+    fn no_seeks_or_no_floor_gives_no_verdict() {
+        assert!(targets_of(FLOOR, &[], &[], FLOOR).is_none());
+        assert!(targets_of(FLOOR, &[FLOOR], &[0.0], 0.0).is_none());
+        assert!(targets_of(FLOOR, &[FLOOR], &[0.0], f64::NAN).is_none());
+    }
+}
