@@ -1,5 +1,7 @@
 //! `north-seek`'s own default model: trained on chamber runs at the seek's ambient, with as
 //! many runs as it takes for the model not to carry its training runs' noise into the seeks.
+//! The same recipe (`own_model_from_runs`) trains `reproduce`'s qualification model, one
+//! global model on as many runs at every ambient of the campaign.
 //!
 //! Why: at one ambient every cold start follows nearly the same warm-up trajectory in
 //! (T, dT/dt), so whatever the fitted model owes to its particular training runs (their

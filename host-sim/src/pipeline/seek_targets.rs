@@ -91,20 +91,30 @@ pub fn targets_of(
     })
 }
 
-/// One line for the seek table: each figure against its target, and the verdict.
+/// One line for the seek table: each figure (+- its standard error over `r.starts` cold
+/// starts: a std or rms of n values has about x / sqrt(2n), a mean over its std
+/// 1 / sqrt(n)) against its target, and the verdict on the point values. The errors say
+/// how far to trust it: at the default 30 starts |mean| / std carries +-0.18, so a 0.3
+/// target is not decided by one run.
 pub fn seek_targets_line(r: &NorthSeekReport) -> String {
     let Some(t) = seek_targets(r) else {
         return String::new();
     };
+    let n = r.starts.max(1) as f64;
+    let all_n = n * r.seeks_per_start.max(1) as f64;
     let ok = |b: bool| if b { "met" } else { "MISSED" };
     format!(
-        "cold-start targets: all seeks {:.3}x floor (<= {ALL_SEEKS_OVER_FLOOR}) {}; worst of seeks 1-{FIRST_SEEKS} {:.3}x (seek {}, <= {FIRST_SEEKS_OVER_FLOOR}) {}; worst |mean|/std {:.2} (seek {}, <= {MEAN_OVER_STD}) {} -> {}\n",
+        "cold-start targets ({} starts): all seeks {:.3} +- {:.3}x floor (<= {ALL_SEEKS_OVER_FLOOR}) {}; worst of seeks 1-{FIRST_SEEKS} {:.3} +- {:.3}x (seek {}, <= {FIRST_SEEKS_OVER_FLOOR}) {}; worst |mean|/std {:.2} +- {:.2} (seek {}, <= {MEAN_OVER_STD}) {} -> {}\n",
+        r.starts,
         t.all_over_floor,
+        t.all_over_floor / (2.0 * all_n).sqrt(),
         ok(t.all_over_floor <= ALL_SEEKS_OVER_FLOOR),
         t.worst_first_over_floor,
+        t.worst_first_over_floor / (2.0 * n).sqrt(),
         t.worst_first_seek,
         ok(t.worst_first_over_floor <= FIRST_SEEKS_OVER_FLOOR),
         t.worst_mean_over_std,
+        1.0 / n.sqrt(),
         t.worst_mean_seek,
         ok(t.worst_mean_over_std <= MEAN_OVER_STD),
         if t.met { "MET" } else { "MISSED" }
