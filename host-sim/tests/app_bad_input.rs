@@ -98,6 +98,11 @@ fn malformed_files_and_impossible_options_are_rejected() {
         &[&["reproduce", "--ambient", "-40,500"][..], &json].concat(),
         &["--ambient"],
     );
+    rejects(
+        &dir,
+        &[&["reproduce", "--qualification-runs", "100000"][..], &json].concat(),
+        &["--qualification-runs"],
+    );
     // An output path in a missing directory is refused before any work.
     rejects(
         &dir,

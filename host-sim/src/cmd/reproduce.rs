@@ -18,6 +18,12 @@ use crate::sim::GyroParams;
 /// Training runs per temperature (the paper's protocol).
 pub const TRAIN_RUNS: usize = 3;
 
+/// Most cold starts per ambient `--qualification-runs` takes: twice the own model's
+/// chamber campaign (`own_model::CAMPAIGN_RUNS`); every run is held in memory (peak RSS
+/// of `reproduce --starts 2`: 34 MB without it, 89 MB with the default 48 runs x 11
+/// ambients x 45 min at 1 Hz).
+pub const MAX_QUALIFICATION_RUNS: usize = 2 * crate::pipeline::own_model::CAMPAIGN_RUNS;
+
 /// Options of `fogsim reproduce`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -68,6 +74,11 @@ pub fn options(
             "--runs {}: runs 1-{TRAIN_RUNS} of each temperature train, so at least {} are needed to hold some out",
             campaign.runs_per_ambient,
             TRAIN_RUNS + 1
+        );
+    }
+    if qualification_runs > MAX_QUALIFICATION_RUNS {
+        bail!(
+            "--qualification-runs {qualification_runs}: at most {MAX_QUALIFICATION_RUNS} per ambient (the qualification campaign is held in memory to train on)"
         );
     }
     if campaign.minutes < 30.0 {
