@@ -103,6 +103,22 @@ fn malformed_files_and_impossible_options_are_rejected() {
         &[&["reproduce", "--qualification-runs", "100000"][..], &json].concat(),
         &["--qualification-runs"],
     );
+    // A campaign too large to hold in memory is refused before anything is simulated.
+    rejects(
+        &dir,
+        &[&["reproduce", "--runs", "100000"][..], &json].concat(),
+        &["--runs"],
+    );
+    rejects(
+        &dir,
+        &["campaign", "--out", "big", "--runs", "1000000"],
+        &["--runs"],
+    );
+    rejects(
+        &dir,
+        &["campaign", "--out", "long", "--duration-min", "1e9"],
+        &["--duration-min"],
+    );
     // An output path in a missing directory is refused before any work.
     rejects(
         &dir,

@@ -17,6 +17,12 @@ pub const PAPER_RUNS: usize = 5;
 /// Record length in the paper, min.
 pub const PAPER_MINUTES: f64 = 45.0;
 
+/// Most record time a campaign may hold, s of 1 Hz rows over all its runs: every run is
+/// simulated into memory before it is written or trained on. 3e6 s is 1,111 runs of 45
+/// min (11 ambients x 96 runs + 5, `reproduce`'s largest qualification campaign with the
+/// paper's); `reproduce --starts 2` peaked at 89 MB with 583 such runs.
+pub const MAX_CAMPAIGN_RECORD_S: f64 = 3.0e6;
+
 /// What to simulate.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CampaignSpec {
@@ -116,6 +122,16 @@ pub fn simulate_campaign(
         .collect();
     // Fail fast on a bad spec before spawning anything.
     spec.run_spec(0, 0).validate().map_err(CampaignError::Sim)?;
+    let record_s =
+        spec.ambients_c.len() as f64 * spec.runs_per_ambient as f64 * spec.minutes * 60.0;
+    if record_s > MAX_CAMPAIGN_RECORD_S {
+        return Err(CampaignError::Spec(format!(
+            "{} ambients x {} runs x {} min = {record_s:.3e} s of 1 Hz records, more than the {MAX_CAMPAIGN_RECORD_S:.0} s a campaign holds in memory (lower --runs, --duration-min or the number of ambients)",
+            spec.ambients_c.len(),
+            spec.runs_per_ambient,
+            spec.minutes
+        )));
+    }
     let results = crate::fanout::map_in_order(jobs.len(), crate::fanout::thread_count(None), |j| {
         let (a, r) = jobs[j];
         simulate_run(params, &spec.run_spec(a, r))
