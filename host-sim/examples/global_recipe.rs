@@ -13,10 +13,10 @@
 //! (docs/northfinder.md, "The one global model over training campaigns").
 
 use anyhow::{anyhow, bail, Context, Result};
-use fog_core::model::format::{FeatureKind, FeatureSpec, MAX_ENCODED_LEN};
+use fog_core::model::format::{FeatureSpec, MAX_ENCODED_LEN};
 use fog_sim::io::runs::{list_run_files, read_runs};
 use fog_sim::pipeline::campaign_steps::train_with_config;
-use fog_sim::pipeline::own_model::warmup_time_constant_s;
+use fog_sim::pipeline::own_model::{clock_spec, warmup_time_constant_s};
 use fog_sim::train::{choose_inputs_default, InputChoice, InputSet, TrainConfig};
 
 fn main() -> Result<()> {
@@ -36,11 +36,11 @@ fn main() -> Result<()> {
         InputChoice::Auto => choose_inputs_default(&runs, &InputSet::ALL, &cfg)?.0.chosen,
     };
     let tau_s = warmup_time_constant_s(&runs)?;
-    let clock = tau_s.map(|tau_s| FeatureSpec {
-        kind: FeatureKind::PowerOnDecay,
-        tau_s: tau_s as f32,
-    });
-    let specs: Vec<FeatureSpec> = set.specs().into_iter().chain(clock).collect();
+    let specs: Vec<FeatureSpec> = set
+        .specs()
+        .into_iter()
+        .chain(tau_s.map(clock_spec))
+        .collect();
     println!(
         "{} runs; inputs {}{}",
         runs.len(),

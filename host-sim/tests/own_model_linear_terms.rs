@@ -13,9 +13,11 @@
 #[path = "common/soaked.rs"]
 mod soaked;
 
-use fog_core::model::format::{FeatureKind, FeatureSpec, RbfModel};
+use fog_core::model::format::{FeatureSpec, RbfModel};
 use fog_sim::io::runs::Run;
-use fog_sim::pipeline::own_model::{choose_linear_terms, warmup_time_constant_s, OwnModelPlan};
+use fog_sim::pipeline::own_model::{
+    choose_linear_terms, clock_spec, warmup_time_constant_s, OwnModelPlan,
+};
 use fog_sim::train::seek_score::{seek_azimuth_rms_deg, Criterion, SeekGeometry};
 use fog_sim::train::{dataset_from_runs, predict_batch, InputSet};
 use soaked::{soaked_campaign_in, SoakedLaw, Tube, AMBIENT_C};
@@ -42,10 +44,7 @@ fn specs(runs: &[Run]) -> Vec<FeatureSpec> {
     let tau_s = warmup_time_constant_s(runs)
         .unwrap()
         .expect("soaked cold starts have a warm-up");
-    specs.push(FeatureSpec {
-        kind: FeatureKind::PowerOnDecay,
-        tau_s: tau_s as f32,
-    });
+    specs.push(clock_spec(tau_s));
     specs
 }
 

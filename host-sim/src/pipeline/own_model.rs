@@ -186,13 +186,12 @@ pub fn own_model_from_runs(
     let (selection, _) = choose_inputs_default(&runs, &InputSet::ALL, &train_config(plan, false))
         .map_err(|e| anyhow!("choosing the own model's inputs: {e}"))?;
     let clock_tau_s = warmup_time_constant_s(&runs)?;
-    let mut specs = selection.chosen.specs();
-    if let Some(tau) = clock_tau_s {
-        specs.push(FeatureSpec {
-            kind: FeatureKind::PowerOnDecay,
-            tau_s: tau as f32,
-        });
-    }
+    let specs: Vec<FeatureSpec> = selection
+        .chosen
+        .specs()
+        .into_iter()
+        .chain(clock_tau_s.map(clock_spec))
+        .collect();
     let shape = choose_linear_terms(&runs, &specs, plan)?;
     let learned_seek_deg = learned_seek_error_deg(&runs, &specs, plan, shape.linear_inputs)?;
     Ok(OwnModel {
@@ -247,6 +246,15 @@ pub fn train_config(plan: &OwnModelPlan, linear_inputs: bool) -> TrainConfig {
         criterion: plan.criterion,
         linear_on_rbf_inputs: linear_inputs,
         ..TrainConfig::default()
+    }
+}
+
+/// The clock input of a campaign whose warm-up time is `tau_s` (`warmup_time_constant_s`):
+/// fog-core's `PowerOnDecay`, exp(-t / tau).
+pub fn clock_spec(tau_s: f64) -> FeatureSpec {
+    FeatureSpec {
+        kind: FeatureKind::PowerOnDecay,
+        tau_s: tau_s as f32,
     }
 }
 

@@ -201,6 +201,7 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
             recipe,
             model_file,
             source,
+            plot_tag,
             trained,
             validation,
             series,
@@ -216,7 +217,6 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
         let north_seek_other_ambients =
             seek_other_ambients(params, &opts.north_seek, &trained.model, &source)?;
         if let Some(dir) = &opts.plots {
-            let tag = ["", "_extended", "_qualification"][k.min(2)];
             write_model_plots(
                 dir,
                 &heldout,
@@ -224,7 +224,7 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
                 &north_seek,
                 opts.north_seek.ambient_c,
                 &label,
-                tag,
+                plot_tag,
             )?;
         }
         let targets = measure_targets(&per_ambient, &north_seek);
@@ -320,6 +320,8 @@ struct Fitted {
     model_file: String,
     /// What its north-seek report says it was trained on.
     source: String,
+    /// Suffix of its plot folder beside `--plots` (empty: the plots at the top).
+    plot_tag: &'static str,
     trained: crate::train::TrainOutcome,
     validation: CompensateReport,
     series: Vec<CompensatedSeries>,
@@ -334,12 +336,12 @@ fn fit_paper_campaign_models(
     steps: &indicatif::ProgressBar,
 ) -> Result<Vec<Fitted>> {
     let mut fitted = Vec::new();
-    for InputVariant {
-        label,
-        specs,
-        selection,
-    } in &input_variants(train_runs)?
-    {
+    for (k, variant) in input_variants(train_runs)?.iter().enumerate() {
+        let InputVariant {
+            label,
+            specs,
+            selection,
+        } = variant;
         let trained = train_default(train_runs, specs, "sim")?;
         steps.inc(1);
         if let Some(dir) = &opts.plots {
@@ -357,6 +359,7 @@ fn fit_paper_campaign_models(
                 "{label}, trained on runs 1-{} of every campaign temperature",
                 opts.n_train
             ),
+            plot_tag: if k == 0 { "" } else { "_extended" },
             trained,
             validation,
             series,
@@ -392,6 +395,7 @@ fn fit_qualification_model(
         input_selection: Some(own.selection),
         recipe: Some(recipe),
         model_file: QUALIFICATION_MODEL_FILE.into(),
+        plot_tag: "_qualification",
         trained: own.trained,
         validation,
         series,
