@@ -119,6 +119,42 @@ fn malformed_files_and_impossible_options_are_rejected() {
         &["campaign", "--out", "long", "--duration-min", "1e9"],
         &["--duration-min"],
     );
+    // Each flag within its own range, their product not: 1,000 runs x 11 ambients x 24 h.
+    rejects(
+        &dir,
+        &[
+            "campaign",
+            "--out",
+            "product",
+            "--runs",
+            "1000",
+            "--duration-min",
+            "1440",
+        ],
+        &["--runs", "--duration-min", "in memory"],
+    );
+    // The same at several headings: 8 x 11 ambients x 200 runs x 45 min.
+    rejects(
+        &dir,
+        &[
+            "campaign",
+            "--out",
+            "headings",
+            "--runs",
+            "200",
+            "--headings-deg",
+            "0,45,90,135,180,225,270,315",
+        ],
+        &["8 headings", "--headings-deg", "in memory"],
+    );
+    assert!(
+        !dir.join("headings").exists(),
+        "a refused campaign left its output directory behind"
+    );
+    assert!(
+        !dir.join("product").exists(),
+        "a refused campaign left its output directory behind"
+    );
     // An output path in a missing directory is refused before any work.
     rejects(
         &dir,

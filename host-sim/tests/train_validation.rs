@@ -157,3 +157,39 @@ fn the_width_climb_finds_the_full_searchs_best_scoring_fewer_widths() {
         );
     }
 }
+
+#[test]
+fn a_seek_criterion_whose_seek_fits_in_no_run_is_refused_not_scored_as_zero() {
+    use fog_sim::train::seek_score::{Criterion, SeekGeometry};
+    use fog_sim::train::TrainError;
+    let ds = campaign(&AMBIENTS, 3, 0.01, 13, shupe_like);
+    let run_s = ds.t_s[ds.indices_where(|g| g == 0).last().copied().unwrap()] - ds.t_s[0];
+    let seek = |dwell_s: f64| TrainConfig {
+        criterion: Criterion::Seek(SeekGeometry {
+            dwell_s,
+            latitude_deg: 34.0,
+        }),
+        ..TrainConfig::default()
+    };
+    // Two positions of a third of the run each fit; two of the whole run do not.
+    assert!(cross_validate(&ds, &seek(run_s / 3.0), 3).is_ok());
+    match cross_validate(&ds, &seek(run_s), 3) {
+        Err(TrainError::NoSeekPairs {
+            dwell_s,
+            longest_run_s,
+        }) => {
+            assert_eq!(dwell_s, run_s);
+            assert!(
+                (longest_run_s - run_s).abs() < 1e-9,
+                "{longest_run_s} vs {run_s}"
+            );
+        }
+        other => panic!("expected NoSeekPairs, got {:?}", other.map(|r| r.best)),
+    }
+    // The 10 s rms does not need seeks.
+    let rms = TrainConfig {
+        criterion: Criterion::Rms10s,
+        ..TrainConfig::default()
+    };
+    assert!(cross_validate(&ds, &rms, 3).is_ok());
+}

@@ -60,6 +60,32 @@ impl CampaignSpec {
         }
     }
 
+    /// Refuses, in one line naming the flags to lower, a campaign whose 1 Hz records
+    /// (`power_ons_per_run` of them per ambient and run: the headings of a heading
+    /// campaign, else 1) exceed `MAX_CAMPAIGN_RECORD_S`. Called before anything is simulated.
+    pub fn check_record_size(&self, power_ons_per_run: usize) -> Result<(), CampaignError> {
+        let record_s = self.ambients_c.len() as f64
+            * self.runs_per_ambient as f64
+            * power_ons_per_run as f64
+            * self.minutes
+            * 60.0;
+        if record_s > MAX_CAMPAIGN_RECORD_S {
+            let headings = if power_ons_per_run > 1 {
+                format!(" x {power_ons_per_run} headings")
+            } else {
+                String::new()
+            };
+            return Err(CampaignError::Spec(format!(
+                "{} ambients x {} runs{headings} x {} min = {record_s:.3e} s of 1 Hz records, more than the {MAX_CAMPAIGN_RECORD_S:.0} s a campaign holds in memory (lower --runs, --duration-min{}, or the number of ambients)",
+                self.ambients_c.len(),
+                self.runs_per_ambient,
+                self.minutes,
+                if power_ons_per_run > 1 { ", --headings-deg" } else { "" },
+            )));
+        }
+        Ok(())
+    }
+
     /// File name of a run; sorts by ambient (in list order), then by run number.
     pub fn file_name(&self, amb: usize, run: usize) -> String {
         let a = self.ambients_c[amb];
@@ -122,16 +148,7 @@ pub fn simulate_campaign(
         .collect();
     // Fail fast on a bad spec before spawning anything.
     spec.run_spec(0, 0).validate().map_err(CampaignError::Sim)?;
-    let record_s =
-        spec.ambients_c.len() as f64 * spec.runs_per_ambient as f64 * spec.minutes * 60.0;
-    if record_s > MAX_CAMPAIGN_RECORD_S {
-        return Err(CampaignError::Spec(format!(
-            "{} ambients x {} runs x {} min = {record_s:.3e} s of 1 Hz records, more than the {MAX_CAMPAIGN_RECORD_S:.0} s a campaign holds in memory (lower --runs, --duration-min or the number of ambients)",
-            spec.ambients_c.len(),
-            spec.runs_per_ambient,
-            spec.minutes
-        )));
-    }
+    spec.check_record_size(1)?;
     let results = crate::fanout::map_in_order(jobs.len(), crate::fanout::thread_count(None), |j| {
         let (a, r) = jobs[j];
         simulate_run(params, &spec.run_spec(a, r))

@@ -50,6 +50,7 @@ pub fn simulate_heading_campaign(
             "campaign: needs ambients and runs".into(),
         ));
     }
+    spec.check_record_size(headings_deg.len())?;
     let jobs: Vec<(usize, usize, usize)> = (0..spec.ambients_c.len())
         .flat_map(|a| {
             (0..headings_deg.len())

@@ -42,6 +42,9 @@ pub enum TrainError {
     Model { why: String },
     /// fog-core's RBF evaluation rejected an input row.
     Predict { row: usize, why: String },
+    /// The seek criterion's dwell is too long for the runs: no run holds one seek (two
+    /// dwells), so there is nothing to score.
+    NoSeekPairs { dwell_s: f64, longest_run_s: f64 },
     /// The training set would need working memory above the limit.
     TooLarge {
         rows: usize,
@@ -96,6 +99,15 @@ impl fmt::Display for TrainError {
             }
             Self::Model { why } => write!(f, "trained model rejected by fog-core: {why}"),
             Self::Predict { row, why } => write!(f, "RBF evaluation failed at row {row}: {why}"),
+            Self::NoSeekPairs {
+                dwell_s,
+                longest_run_s,
+            } => write!(
+                f,
+                "seek criterion: a seek of two {dwell_s} s positions fits in no run (the longest \
+                 is {longest_run_s:.0} s), so no model can be scored by it: give a shorter \
+                 seek dwell or the 10 s rms criterion (rms10s)"
+            ),
             Self::TooLarge { rows, bytes, limit } => write!(
                 f,
                 "{rows} training points need {} MiB of working memory (Gram matrices and \

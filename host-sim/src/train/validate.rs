@@ -16,7 +16,7 @@ use super::error::{Result, TrainError};
 use super::fit::{path_on_gram, select_path, PathFit, SelectedPath, Shape, WidthDesign};
 use super::gram::FoldGrams;
 use super::normalize::Normalizer;
-use super::seek_score::{seek_azimuth_rms_deg, Criterion};
+use super::seek_score::{seek_azimuth_per_run, seek_azimuth_rms_deg, Criterion, SeekGeometry};
 use crate::fanout::{map_in_order, thread_count};
 pub use crate::stats::rms;
 use fog_core::model::format::WIDTH_RANGE;
@@ -145,6 +145,9 @@ fn search(ds: &Dataset, cfg: &TrainConfig, folds: usize, keep: KeepGrams) -> Res
     if ds.is_empty() {
         return Err(TrainError::EmptyDataset);
     }
+    if let Criterion::Seek(seek) = cfg.criterion {
+        check_seek_fits(ds, seek)?;
+    }
     let fold = fold_of_rows(ds, folds)?;
     let mut grid: Vec<f64> = cfg.width_candidates.clone();
     grid.sort_by(f64::total_cmp);
@@ -260,6 +263,32 @@ impl WidthScore {
             Criterion::Seek(_) => self.heldout_seek_deg,
         }
     }
+}
+
+/// Refuses a seek criterion none of whose seeks fits in a run (`TrainError::NoSeekPairs`):
+/// every model would score 0 and the choice would be arbitrary.
+fn check_seek_fits(ds: &Dataset, seek: SeekGeometry) -> Result<()> {
+    let zeros = vec![0.0; ds.len()];
+    let pairs: usize =
+        seek_azimuth_per_run(&zeros, &ds.groups, &ds.t_s, seek.dwell_s, seek.latitude_deg)
+            .iter()
+            .map(|r| r.pairs)
+            .sum();
+    if pairs > 0 {
+        return Ok(());
+    }
+    let mut longest_run_s: f64 = 0.0;
+    let mut start = 0;
+    for i in 1..=ds.len() {
+        if i == ds.len() || ds.groups[i] != ds.groups[start] {
+            longest_run_s = longest_run_s.max(ds.t_s[i - 1] - ds.t_s[start]);
+            start = i;
+        }
+    }
+    Err(TrainError::NoSeekPairs {
+        dwell_s: seek.dwell_s,
+        longest_run_s,
+    })
 }
 
 /// Held-out seek score at the criterion's dwell and latitude (the defaults under `Rms10s`).
