@@ -103,7 +103,21 @@ fn malformed_files_and_impossible_options_are_rejected() {
         &[&["reproduce", "--qualification-runs", "100000"][..], &json].concat(),
         &["--qualification-runs"],
     );
-    // A campaign too large to hold in memory is refused before anything is simulated.
+    // An output path in a missing directory is refused before any work.
+    rejects(
+        &dir,
+        &["north-seek", "--json", "no/such/dir/report.json"],
+        &["--json"],
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A campaign too large to hold in memory is refused before anything is simulated,
+/// whichever flags make it so, and leaves no output behind.
+#[test]
+fn campaigns_too_large_for_memory_are_refused_before_anything_is_simulated() {
+    let dir = scratch_dir("too-large");
+    let json = ["--json", "report.json"];
     rejects(
         &dir,
         &[&["reproduce", "--runs", "100000"][..], &json].concat(),
@@ -154,12 +168,6 @@ fn malformed_files_and_impossible_options_are_rejected() {
     assert!(
         !dir.join("product").exists(),
         "a refused campaign left its output directory behind"
-    );
-    // An output path in a missing directory is refused before any work.
-    rejects(
-        &dir,
-        &["north-seek", "--json", "no/such/dir/report.json"],
-        &["--json"],
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
