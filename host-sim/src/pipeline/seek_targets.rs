@@ -91,32 +91,72 @@ pub fn targets_of(
     })
 }
 
+/// Standard errors a figure must lie from its target for the Monte Carlo to have decided
+/// it: the project's two-standard-error rule (as for an input's gain in `train::inputs`).
+pub const DECIDED_SE: f64 = 2.0;
+
+/// Whether the Monte Carlo decided the verdict: `Some(met)` when every figure is below its
+/// target by `DECIDED_SE` standard errors (met) or one is above its target by as much
+/// (missed); None when a figure within that band leaves it open. `figures` are (value,
+/// standard error, target).
+pub fn decided_verdict(figures: &[(f64, f64, f64)]) -> Option<bool> {
+    if figures
+        .iter()
+        .any(|&(v, se, limit)| v > limit + DECIDED_SE * se)
+    {
+        Some(false)
+    } else if figures
+        .iter()
+        .all(|&(v, se, limit)| v < limit - DECIDED_SE * se)
+    {
+        Some(true)
+    } else {
+        None
+    }
+}
+
 /// One line for the seek table: each figure (+- its standard error over `r.starts` cold
 /// starts: a std or rms of n values has about x / sqrt(2n), a mean over its std
-/// 1 / sqrt(n)) against its target, and the verdict on the point values. The errors say
-/// how far to trust it: at the default 30 starts |mean| / std carries +-0.18, so a 0.3
-/// target is not decided by one run.
+/// 1 / sqrt(n)) against its target, the verdict on the point values, and whether the
+/// Monte Carlo decided it (`decided_verdict`). The errors say how far to trust it: at the
+/// default 30 starts |mean| / std carries +-0.18, so a 0.3 target is not decided by one
+/// run; at 300 starts a seek 1.12x the floor is within 2 standard errors of 1.15x.
 pub fn seek_targets_line(r: &NorthSeekReport) -> String {
     let Some(t) = seek_targets(r) else {
         return String::new();
     };
     let n = r.starts.max(1) as f64;
     let all_n = n * r.seeks_per_start.max(1) as f64;
+    let figures = [
+        (
+            t.all_over_floor,
+            t.all_over_floor / (2.0 * all_n).sqrt(),
+            ALL_SEEKS_OVER_FLOOR,
+        ),
+        (
+            t.worst_first_over_floor,
+            t.worst_first_over_floor / (2.0 * n).sqrt(),
+            FIRST_SEEKS_OVER_FLOOR,
+        ),
+        (t.worst_mean_over_std, 1.0 / n.sqrt(), MEAN_OVER_STD),
+    ];
     let ok = |b: bool| if b { "met" } else { "MISSED" };
+    let decided = match decided_verdict(&figures) {
+        Some(_) => format!("decided at {DECIDED_SE} standard errors"),
+        None => format!(
+            "not decided by {} starts: a figure within {DECIDED_SE} standard errors of its target",
+            r.starts
+        ),
+    };
+    let [(all, all_se, _), (first, first_se, _), (mean, mean_se, _)] = figures;
     format!(
-        "cold-start targets ({} starts): all seeks {:.3} +- {:.3}x floor (<= {ALL_SEEKS_OVER_FLOOR}) {}; worst of seeks 1-{FIRST_SEEKS} {:.3} +- {:.3}x (seek {}, <= {FIRST_SEEKS_OVER_FLOOR}) {}; worst |mean|/std {:.2} +- {:.2} (seek {}, <= {MEAN_OVER_STD}) {} -> {}\n",
+        "cold-start targets ({} starts): all seeks {all:.3} +- {all_se:.3}x floor (<= {ALL_SEEKS_OVER_FLOOR}) {}; worst of seeks 1-{FIRST_SEEKS} {first:.3} +- {first_se:.3}x (seek {}, <= {FIRST_SEEKS_OVER_FLOOR}) {}; worst |mean|/std {mean:.2} +- {mean_se:.2} (seek {}, <= {MEAN_OVER_STD}) {} -> {} ({decided})\n",
         r.starts,
-        t.all_over_floor,
-        t.all_over_floor / (2.0 * all_n).sqrt(),
-        ok(t.all_over_floor <= ALL_SEEKS_OVER_FLOOR),
-        t.worst_first_over_floor,
-        t.worst_first_over_floor / (2.0 * n).sqrt(),
+        ok(all <= ALL_SEEKS_OVER_FLOOR),
         t.worst_first_seek,
-        ok(t.worst_first_over_floor <= FIRST_SEEKS_OVER_FLOOR),
-        t.worst_mean_over_std,
-        1.0 / n.sqrt(),
+        ok(first <= FIRST_SEEKS_OVER_FLOOR),
         t.worst_mean_seek,
-        ok(t.worst_mean_over_std <= MEAN_OVER_STD),
+        ok(mean <= MEAN_OVER_STD),
         if t.met { "MET" } else { "MISSED" }
     )
 }
@@ -153,6 +193,27 @@ mod tests {
         let bias = targets_of(FLOOR, &[FLOOR; 6], &mean, FLOOR).unwrap();
         assert_eq!(bias.worst_mean_seek, 5);
         assert!((bias.worst_mean_over_std - 0.35).abs() < 1e-12 && !bias.met);
+    }
+
+    #[test]
+    fn a_verdict_is_decided_only_two_standard_errors_from_every_target() {
+        // Every figure well below its target: decided, met.
+        assert_eq!(
+            decided_verdict(&[(1.0, 0.01, 1.1), (0.1, 0.05, 0.3)]),
+            Some(true)
+        );
+        // One figure well above: decided, missed, whatever the others.
+        assert_eq!(
+            decided_verdict(&[(1.3, 0.05, 1.15), (1.14, 0.05, 1.15)]),
+            Some(false)
+        );
+        // 1.12 +- 0.047 against 1.15 (300 starts): open, on either side of the line.
+        assert_eq!(decided_verdict(&[(1.12, 0.047, 1.15)]), None);
+        assert_eq!(decided_verdict(&[(1.16, 0.047, 1.15)]), None);
+        // The same figure with four times the starts (half the error) is still open at
+        // 1.12; at 1.05 it is decided.
+        assert_eq!(decided_verdict(&[(1.12, 0.0235, 1.15)]), None);
+        assert_eq!(decided_verdict(&[(1.05, 0.0235, 1.15)]), Some(true));
     }
 
     #[test]
