@@ -156,6 +156,8 @@ pub struct RunSeekError {
     pub sum_sq_deg2: f64,
     /// Pairs scored.
     pub pairs: usize,
+    /// Time from the run's first row to its last, s.
+    pub span_s: f64,
 }
 
 /// As `seek_azimuth_rms_deg`, but one entry per run (consecutive rows of one group), in
@@ -182,6 +184,7 @@ pub fn seek_azimuth_per_run(
             group: g,
             sum_sq_deg2: 0.0,
             pairs: 0,
+            span_s: t_s[end - 1] - t_s[i],
         };
         for e in pair_errors_dph(&res[i..end], &t_s[i..end], dwell_s) {
             run.sum_sq_deg2 += geometry.azimuth_deg(e).powi(2);

@@ -269,25 +269,13 @@ impl WidthScore {
 /// every model would score 0 and the choice would be arbitrary.
 fn check_seek_fits(ds: &Dataset, seek: SeekGeometry) -> Result<()> {
     let zeros = vec![0.0; ds.len()];
-    let pairs: usize =
-        seek_azimuth_per_run(&zeros, &ds.groups, &ds.t_s, seek.dwell_s, seek.latitude_deg)
-            .iter()
-            .map(|r| r.pairs)
-            .sum();
-    if pairs > 0 {
+    let runs = seek_azimuth_per_run(&zeros, &ds.groups, &ds.t_s, seek.dwell_s, seek.latitude_deg);
+    if runs.iter().any(|r| r.pairs > 0) {
         return Ok(());
-    }
-    let mut longest_run_s: f64 = 0.0;
-    let mut start = 0;
-    for i in 1..=ds.len() {
-        if i == ds.len() || ds.groups[i] != ds.groups[start] {
-            longest_run_s = longest_run_s.max(ds.t_s[i - 1] - ds.t_s[start]);
-            start = i;
-        }
     }
     Err(TrainError::NoSeekPairs {
         dwell_s: seek.dwell_s,
-        longest_run_s,
+        longest_run_s: runs.iter().map(|r| r.span_s).fold(0.0, f64::max),
     })
 }
 
