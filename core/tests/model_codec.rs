@@ -33,6 +33,7 @@ struct LooseModel {
     meta: fog_core::model::format::TrainingMeta,
     poly: Vec<f32>,
     heading: Option<HeadingHarmonic>,
+    linear_by_t: Vec<f32>,
 }
 
 impl From<&RbfModel> for LooseModel {
@@ -52,6 +53,7 @@ impl From<&RbfModel> for LooseModel {
             meta: m.meta.clone(),
             poly: m.poly.to_vec(),
             heading: m.heading,
+            linear_by_t: m.linear_by_t.to_vec(),
         }
     }
 }
@@ -351,6 +353,21 @@ fn encode_v2(m: &RbfModel) -> Vec<u8> {
     wrap(&body, 2)
 }
 
+/// Format version 3 (before the temperature-coupled linear terms): the body ends after
+/// `heading`.
+fn encode_v3(m: &RbfModel) -> Vec<u8> {
+    let loose = LooseModel::from(m);
+    let body = postcard::to_allocvec(&(
+        m.inputs.len() as u16,
+        m.centers.len() as u16,
+        v1_fields(&loose),
+        &loose.poly,
+        &loose.heading,
+    ))
+    .unwrap();
+    wrap(&body, 3)
+}
+
 fn wrap(body: &[u8], version: u16) -> Vec<u8> {
     postcard::to_allocvec(&Wire {
         magic: MODEL_MAGIC,
@@ -572,4 +589,64 @@ fn implausible_heading_harmonics_get_their_typed_error() {
         ..harmonic()
     });
     assert_eq!(RbfModel::decode(&encode(&m)), Ok(m));
+}
+
+#[test]
+fn temperature_coupled_linear_terms_round_trip_and_old_versions_decode_without_them() {
+    let mut m = warmup_model(35, 2, 2.0, 5);
+    m.poly.extend_from_slice(&[0.1, -0.02]).unwrap();
+    m.heading = Some(harmonic());
+    let plain = m.clone();
+    m.linear_by_t.extend_from_slice(&[0.0, -0.031]).unwrap();
+    assert_eq!(RbfModel::decode(&encode(&m)), Ok(m.clone()));
+    // Version 3 bytes (no linear_by_t field) decode with none.
+    assert_eq!(RbfModel::decode(&encode_v3(&m)), Ok(plain.clone()));
+    // A version-4 body announced as version 3 has trailing bytes (the new field).
+    assert!(matches!(
+        RbfModel::decode(&encode_loose(&LooseModel::from(&m), 3)),
+        Err(ModelError::TrailingBytes { .. })
+    ));
+    // One length byte and one f32 per input over "none" (the length byte alone).
+    assert_eq!(encode(&m).len(), encode(&plain).len() + 2 * 4);
+    // Neither empty nor one per input: refused, naming the field.
+    let mut short = m.clone();
+    short.linear_by_t.truncate(1);
+    assert_eq!(
+        short.validate(),
+        Err(ModelError::LengthMismatch {
+            field: ModelField::LinearByT,
+            expected: 2,
+            found: 1
+        })
+    );
+    let mut nan = m.clone();
+    nan.linear_by_t[1] = f32::NAN;
+    assert!(matches!(
+        RbfModel::decode(&encode_loose(&LooseModel::from(&nan), MODEL_VERSION)),
+        Err(ModelError::NonFinite {
+            field: ModelField::LinearByT,
+            index: 1
+        })
+    ));
+}
+
+#[test]
+fn full_model_with_every_field_fits_the_limit() {
+    let mut m = warmup_model(MAX_CENTERS, 4, 2.0, 11);
+    m.meta.gyro_id.clear();
+    m.meta.gyro_id.push_str("0123456789ABCDEF").unwrap();
+    m.poly.extend_from_slice(&[0.3, -0.05, 0.01]).unwrap();
+    m.heading = Some(HeadingHarmonic {
+        n_headings: u16::MAX,
+        ..harmonic()
+    });
+    m.linear_by_t
+        .extend_from_slice(&[0.0, 0.02, -0.01, 0.005])
+        .unwrap();
+    let bytes = encode(&m);
+    println!(
+        "64 centres x 4 inputs + poly + heading + linear_by_t: {} bytes",
+        bytes.len()
+    );
+    assert!(bytes.len() <= MAX_ENCODED_LEN, "{} bytes", bytes.len());
 }

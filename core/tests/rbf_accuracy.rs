@@ -316,3 +316,57 @@ fn polynomial_base_agrees_across_paths() {
     };
     assert!((below - edge - rbf_only).abs() < 1e-4);
 }
+
+/// Temperature-coupled linear terms (coefficient of input 1 changing with t): f32 and
+/// fixed point against the f64 reference, inside and outside input 0's trained range,
+/// and against the term written out by hand (t held to the range, not extrapolated).
+#[test]
+fn temperature_coupled_linear_terms_agree_across_paths() {
+    let mut m = warmup_model(35, 2, 1.0, 9);
+    m.linear[1] = 0.7;
+    m.linear_by_t.extend_from_slice(&[0.0, -0.25]).unwrap();
+    m.validate().unwrap();
+    let fm = FixedModel::from_model(&m).unwrap();
+    let mut worst_fixed = 0.0f64;
+    for k in 0..=200 {
+        let t = m.input_min[0] - 10.0 + k as f32 * (m.input_max[0] - m.input_min[0] + 20.0) / 200.0;
+        for r in [
+            m.input_min[1],
+            0.5 * (m.input_min[1] + m.input_max[1]),
+            m.input_max[1],
+        ] {
+            let x = [t, r];
+            let want = predict_f64(&m, &[f64::from(x[0]), f64::from(x[1])]).unwrap();
+            let f = f64::from(predict_f32(&m, &x).unwrap());
+            let q = f64::from(fm.predict(&x).unwrap());
+            assert!(
+                (f - want).abs() < 1e-4,
+                "f32 {f} vs {want} at T={t}, rate={r}"
+            );
+            worst_fixed = worst_fixed.max((q - want).abs());
+        }
+    }
+    assert!(worst_fixed < 1e-3, "fixed worst {worst_fixed}");
+    // The term by hand: with and without it, at a row inside and one below the range.
+    let without = {
+        let mut r = m.clone();
+        r.linear_by_t.clear();
+        r
+    };
+    let norm = |j: usize, v: f32| f64::from((v - m.input_offset[j]) / m.input_scale[j]);
+    let (lo, _) = m.poly_domain();
+    for (t_raw, t_held) in [
+        (0.5 * (m.input_min[0] + m.input_max[0]), None),
+        (m.input_min[0] - 30.0, Some(f64::from(lo))),
+    ] {
+        let x = [t_raw, m.input_max[1]];
+        let t = t_held.unwrap_or_else(|| norm(0, t_raw));
+        let term = -0.25 * t * norm(1, x[1]);
+        let xf = [f64::from(x[0]), f64::from(x[1])];
+        let got = predict_f64(&m, &xf).unwrap() - predict_f64(&without, &xf).unwrap();
+        assert!(
+            (got - term).abs() < 1e-6,
+            "term {got} vs {term} at T={t_raw}"
+        );
+    }
+}

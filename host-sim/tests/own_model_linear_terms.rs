@@ -16,7 +16,7 @@ mod soaked;
 use fog_core::model::format::{FeatureSpec, RbfModel};
 use fog_sim::io::runs::Run;
 use fog_sim::pipeline::own_model::{
-    choose_linear_terms, clock_spec, warmup_time_constant_s, OwnModelPlan,
+    choose_linear_terms, clock_spec, warmup_time_constant_s, LinearShape, OwnModelPlan,
 };
 use fog_sim::train::seek_score::{seek_azimuth_rms_deg, Criterion, SeekGeometry};
 use fog_sim::train::{dataset_from_runs, predict_batch, InputSet};
@@ -74,20 +74,17 @@ fn outcome(law: SoakedLaw, tube: Tube, seed: u64) -> Outcome {
     let specs = specs(&runs);
     let plan = plan();
     let choice = choose_linear_terms(&runs, &specs, &plan).unwrap();
-    let other = fog_sim::pipeline::campaign_steps::train_with_config(
-        &runs.iter().collect::<Vec<_>>(),
-        &specs,
-        &fog_sim::pipeline::own_model::train_config(&plan, !choice.linear_inputs),
-    )
-    .unwrap();
-    let (pure, linear) = if choice.linear_inputs {
-        (&other.model, &choice.trained.model)
+    let linear_chosen = choice.shape != LinearShape::Pure;
+    let pure = &choice.trained[LinearShape::Pure as usize].model;
+    let linear = &choice.chosen().model;
+    let linear = if linear_chosen {
+        linear
     } else {
-        (&choice.trained.model, &other.model)
+        &choice.trained[LinearShape::Linear as usize].model
     };
     let o = Outcome {
-        linear_chosen: choice.linear_inputs,
-        heldout: choice.scores,
+        linear_chosen,
+        heldout: [choice.scores[0], choice.scores[1]],
         fresh: [
             seek_rms_deg(pure, &fresh, &specs),
             seek_rms_deg(linear, &fresh, &specs),

@@ -75,6 +75,34 @@ fn train_writes_a_valid_model_and_rejects_bad_input_without_output() {
     );
     assert_eq!(lin.linear.len(), 2, "one linear weight per RBF input");
     assert!(lin.linear.iter().any(|w| *w != 0.0));
+    assert!(
+        lin.linear_by_t.is_empty(),
+        "no T-coupled terms unless asked"
+    );
+    // --linear-by-t: beside each of them a coefficient of T x input (the dT/dt one here;
+    // T x T is the polynomial's), written in format version 4.
+    let coupled_path = dir.join("model_lin_t.bin");
+    let coupled = train_ok(
+        &runs,
+        &coupled_path,
+        &["--linear-inputs", "--linear-by-t", "--inputs", "t,rate"],
+    );
+    assert_eq!(coupled.linear_by_t.len(), 2);
+    assert!(coupled.linear_by_t[1] != 0.0);
+    let bytes = std::fs::read(&coupled_path).unwrap();
+    assert_eq!(bytes[5], 4, "format version byte: {:?}", &bytes[..8]);
+    // Without linear terms there is nothing to couple: refused by name, nothing written.
+    let refused = dir.join("model_refused.bin");
+    let out = fogsim(&[
+        "train",
+        runs.to_str().unwrap(),
+        "--out",
+        refused.to_str().unwrap(),
+        "--linear-by-t",
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("linear-by-t"));
+    assert!(!refused.exists());
 
     // A malformed cell: error names the file and line, exit != 0, no model written.
     let bad_dir = dir.join("bad");

@@ -15,7 +15,8 @@
 //!   32-entry Q.30 table and a 4th-order polynomial (truncation error < 5e-11); Q.30 result;
 //! - weights, bias, linear and polynomial terms: Q.`w_frac`, scaled per model so the
 //!   largest fits in 31 bits; the weighted sum accumulates in i64;
-//! - polynomial base: Horner in i128 on t = xn_0 (Q.28) held to input 0's trained range.
+//! - polynomial base: Horner in i128 on t = xn_0 (Q.28) held to input 0's trained range;
+//!   temperature-coupled linear terms: (t xn_j >> 28) times their Q.`w_frac` coefficient.
 //!
 //! Worst error against the f64 reference: see `docs/core.md` (measured by the
 //! `fixed_worst_error_*` tests: `cargo test -p fog-core --test rbf_accuracy fixed_worst -- --nocapture`).
@@ -110,6 +111,8 @@ pub struct FixedModel {
     gain_q: [i32; MAX_CENTERS],
     weights_q: [i32; MAX_CENTERS],
     linear_q: [i32; MAX_INPUTS],
+    /// Temperature-coupled linear terms (Q.w_frac) of t * xn_j.
+    linear_by_t_q: [i32; MAX_INPUTS],
     bias_q: i64,
     w_frac: u8,
     /// Polynomial coefficients (Q.w_frac) of t^1..t^n_poly.
@@ -150,6 +153,7 @@ impl FixedModel {
             gain_q: [0; MAX_CENTERS],
             weights_q: [0; MAX_CENTERS],
             linear_q: [0; MAX_INPUTS],
+            linear_by_t_q: [0; MAX_INPUTS],
             bias_q: 0,
             w_frac: 0,
             poly_q: [0; MAX_POLY_DEGREE],
@@ -183,6 +187,7 @@ impl FixedModel {
         fm.gain_q = [0; MAX_CENTERS];
         fm.weights_q = [0; MAX_CENTERS];
         fm.linear_q = [0; MAX_INPUTS];
+        fm.linear_by_t_q = [0; MAX_INPUTS];
         fm.bias_q = 0;
         fm.w_frac = 0;
         fm.poly_q = [0; MAX_POLY_DEGREE];
@@ -226,6 +231,7 @@ impl FixedModel {
             .weights
             .iter()
             .chain(model.linear.iter())
+            .chain(model.linear_by_t.iter())
             .chain(model.poly.iter())
             .chain(core::iter::once(&model.bias_dph))
             .fold(0.0f64, |m, &w| m.max((w as f64).abs()));
@@ -242,6 +248,9 @@ impl FixedModel {
             *q = to_q(w as f64, w_frac) as i32;
         }
         for (q, &w) in fm.linear_q.iter_mut().zip(model.linear.iter()) {
+            *q = to_q(w as f64, w_frac) as i32;
+        }
+        for (q, &w) in fm.linear_by_t_q.iter_mut().zip(model.linear_by_t.iter()) {
             *q = to_q(w as f64, w_frac) as i32;
         }
         for (q, &p) in fm.poly_q.iter_mut().zip(model.poly.iter()) {
@@ -291,6 +300,11 @@ impl FixedModel {
         for (&l, &x) in self.linear_q.iter().zip(xn.iter()).take(n) {
             // |l| < 2^31 and |x| < 2^35: exact in i128 (only n_inputs products).
             acc += ((l as i128 * x as i128) >> XN_FRAC) as i64;
+        }
+        let t = xn[0].max(self.poly_lo_q).min(self.poly_hi_q) as i128;
+        for (&l, &x) in self.linear_by_t_q.iter().zip(xn.iter()).take(n) {
+            // |t|, |x| < 2^35: t x < 2^70, >> 28 < 2^42, times |l| < 2^31: exact in i128.
+            acc += ((l as i128 * ((t * x as i128) >> XN_FRAC)) >> XN_FRAC) as i64;
         }
         let z_limit: i64 = 5 << XN_FRAC; // z^2 >= 25 > EXP_CUTOFF
         let u_limit: i64 = (EXP_CUTOFF as i64) << (2 * XN_FRAC);

@@ -5,7 +5,7 @@
 //! (magic, version, body, CRC-32 of the body bytes); decoding validates sizes,
 //! finiteness, positive widths and ranges and returns a `ModelError`.
 //!
-//! drift_dph = bias_dph + sum_j linear[j] * xn_j + sum_k poly[k-1] * t^k
+//! drift_dph = bias_dph + sum_j (linear[j] + linear_by_t[j] * t) * xn_j + sum_k poly[k-1] * t^k
 //!             + sum_i weights[i] * exp(-||xn - c_i||^2 / (2 widths[i]^2))
 //! with xn_j = (x_j - input_offset[j]) / input_scale[j] (normalised inputs, each held to
 //! +-`XN_CLAMP`) and t = xn_0 held to the trained range of input 0 (a polynomial is not
@@ -15,7 +15,9 @@
 //! Format versions: 1 has no `poly` (decoded with an empty one), 2 appends `poly` after
 //! `meta`, 3 appends `heading` after `poly`: the optional heading harmonic of the bias
 //! (`heading_cal`), stored inside the model bytes so that the model's CRC and the upload
-//! signature cover it (v1 and v2 decode with none). Validation bounds every parameter's magnitude so that any model that decodes
+//! signature cover it (v1 and v2 decode with none), 4 appends `linear_by_t` after
+//! `heading`: linear terms whose coefficients change with temperature (a Shupe coefficient
+//! k_S(T) = k_0 + k_1 T makes the drift k_0 dT/dt + k_1 T dT/dt; v1-v3 decode with none). Validation bounds every parameter's magnitude so that any model that decodes
 //! gives a finite drift below `MAX_OUTPUT_DPH` at any finite input.
 
 use heapless::{String, Vec};
@@ -30,8 +32,8 @@ pub const MAX_CENTERS: usize = 64;
 pub const MAX_INPUTS: usize = 4;
 /// Magic at the start of every encoded model: "FOGM".
 pub const MODEL_MAGIC: u32 = 0x4D47_4F46;
-/// Current format version (3: optional heading harmonic after the polynomial base).
-pub const MODEL_VERSION: u16 = 3;
+/// Current format version (4: temperature-coupled linear terms after the heading harmonic).
+pub const MODEL_VERSION: u16 = 4;
 /// Oldest format version still decoded (1: no polynomial base).
 pub const MODEL_VERSION_OLDEST: u16 = 1;
 /// Highest power of the polynomial base in the first input.
@@ -152,6 +154,11 @@ pub struct RbfModel {
     /// Heading harmonic of the bias (format version 3), applied by the north finder while
     /// this model is active; `None`: no heading calibration (also for v1/v2 models).
     pub heading: Option<HeadingHarmonic>,
+    /// Temperature-coupled linear terms (format version 4): coefficient j multiplies
+    /// t * xn_j, deg/h per unit^2, t as for `poly` (normalised input 0 held to its trained
+    /// range), so input j's linear coefficient is linear[j] + linear_by_t[j] t. Empty
+    /// (none, also for v1-v3 models) or one per input.
+    pub linear_by_t: Vec<f32, MAX_INPUTS>,
 }
 
 /// Most auxiliary (extra sensor) channels a model may refer to.
@@ -179,6 +186,8 @@ pub enum ModelField {
     /// The heading harmonic; index 0 a, 1 b, 2 sigma a, 3 sigma b, 4 correlation,
     /// 5 n_headings.
     Heading,
+    /// The temperature-coupled linear terms.
+    LinearByT,
 }
 
 impl ModelField {
@@ -199,6 +208,7 @@ impl ModelField {
             ModelField::TimeConstant => "inputs[].tau_s",
             ModelField::Poly => "poly",
             ModelField::Heading => "heading",
+            ModelField::LinearByT => "linear_by_t",
         }
     }
 }
@@ -416,6 +426,7 @@ impl RbfModel {
             },
             poly: Vec::new(),
             heading: None,
+            linear_by_t: Vec::new(),
         }
     }
 
@@ -438,6 +449,7 @@ impl RbfModel {
         copy(&mut self.widths, &src.widths);
         copy(&mut self.weights, &src.weights);
         copy(&mut self.poly, &src.poly);
+        copy(&mut self.linear_by_t, &src.linear_by_t);
         self.heading = src.heading;
         self.bias_dph = src.bias_dph;
         self.meta.gyro_id.clear();
@@ -501,6 +513,10 @@ impl RbfModel {
         check_finite(ModelField::InputMin, &self.input_min)?;
         check_finite(ModelField::InputMax, &self.input_max)?;
         check_finite(ModelField::Linear, &self.linear)?;
+        if !self.linear_by_t.is_empty() {
+            check_len(ModelField::LinearByT, n, self.linear_by_t.len())?;
+        }
+        check_finite(ModelField::LinearByT, &self.linear_by_t)?;
         if let Some(i) = self.input_scale.iter().position(|&s| s <= 0.0) {
             return Err(ModelError::NonPositiveScale { input: i as u8 });
         }
@@ -650,7 +666,8 @@ impl RbfModel {
         let (lo, hi) = self.poly_domain();
         let t = libm::fmax(libm::fabs(lo as f64), libm::fabs(hi as f64));
         let abs = |v: &f32| libm::fabs(*v as f64);
-        let linear: f64 = self.linear.iter().map(abs).sum::<f64>() * XN_CLAMP as f64;
+        let linear: f64 = self.linear.iter().map(abs).sum::<f64>() * XN_CLAMP as f64
+            + self.linear_by_t.iter().map(abs).sum::<f64>() * XN_CLAMP as f64 * t;
         let mut power = 1.0;
         let mut poly = 0.0;
         for p in &self.poly {

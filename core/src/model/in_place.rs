@@ -31,10 +31,12 @@ const FIELDS: &[&str] = &[
     "meta",
     "poly",
     "heading",
+    "linear_by_t",
 ];
 
 /// Seed that fills `model` with the model being deserialised in format `version`: 1 has
-/// no `poly` (left empty), 1 and 2 no `heading` (left `None`).
+/// no `poly` (left empty), 1 and 2 no `heading` (left `None`), 1-3 no `linear_by_t` (left
+/// empty).
 pub(crate) struct ModelInPlace<'a> {
     pub(crate) model: &'a mut RbfModel,
     pub(crate) version: u16,
@@ -48,14 +50,20 @@ impl ModelInPlace<'_> {
     fn has_heading(&self) -> bool {
         self.version >= 3
     }
+
+    fn has_linear_by_t(&self) -> bool {
+        self.version >= 4
+    }
 }
 
 impl<'de> DeserializeSeed<'de> for ModelInPlace<'_> {
     type Value = ();
 
     fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<(), D::Error> {
-        let n_fields =
-            FIELDS.len() - usize::from(!self.has_poly()) - usize::from(!self.has_heading());
+        let n_fields = FIELDS.len()
+            - usize::from(!self.has_poly())
+            - usize::from(!self.has_heading())
+            - usize::from(!self.has_linear_by_t());
         let fields = &FIELDS[..n_fields];
         d.deserialize_struct("RbfModel", fields, self)
     }
@@ -88,7 +96,8 @@ impl<'de> Visitor<'de> for ModelInPlace<'_> {
     }
 
     fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<(), A::Error> {
-        let (has_poly, has_heading) = (self.has_poly(), self.has_heading());
+        let (has_poly, has_heading, has_linear_by_t) =
+            (self.has_poly(), self.has_heading(), self.has_linear_by_t());
         let m = self.model;
         m.n_rbf_inputs = next(&mut seq, 0)?;
         next_vec(&mut seq, 1, &mut m.inputs)?;
@@ -112,6 +121,11 @@ impl<'de> Visitor<'de> for ModelInPlace<'_> {
         } else {
             None
         };
+        if has_linear_by_t {
+            next_vec(&mut seq, 14, &mut m.linear_by_t)?;
+        } else {
+            m.linear_by_t.clear();
+        }
         Ok(())
     }
 }

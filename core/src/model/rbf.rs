@@ -2,7 +2,7 @@
 //! exponential made for the Cortex-M4F's instruction count), plus the f64 reference
 //! (`libm::exp`) the other evaluation paths are measured against.
 //!
-//! drift_dph = bias + sum_j linear[j] * xn_j + sum_k poly[k-1] t^k
+//! drift_dph = bias + sum_j (linear[j] + linear_by_t[j] t) * xn_j + sum_k poly[k-1] t^k
 //!             + sum_i w_i * exp(-||xn - c_i||^2 / (2 s_i^2)),
 //! xn_j = (x_j - input_offset[j]) / input_scale[j] held to +-`XN_CLAMP`, t = xn_0 held
 //! to the trained range of input 0; only the first `n_rbf_inputs` normalised inputs enter
@@ -93,22 +93,38 @@ pub fn normalise_f32(model: &RbfModel, x_raw: &[f32]) -> Result<[f32; MAX_INPUTS
     }))
 }
 
-/// The polynomial base sum_k poly[k-1] t^k, t = xn0 held to the trained range of input 0
-/// (Horner); 0 without a polynomial, which skips computing the range.
-fn poly_f32(model: &RbfModel, xn0: f32) -> f32 {
-    if model.poly.is_empty() {
+/// t = xn0 held to the trained range of input 0 (`RbfModel::poly_domain`), compared and
+/// selected as `f32::max` then `f32::min` would (a NaN bound is ignored, a reversed pair
+/// gives `hi`), without their libm calls on the M4F.
+fn held_t_f32(model: &RbfModel, xn0: f32) -> f32 {
+    let (lo, hi) = model.poly_domain();
+    let t = if xn0 < lo { lo } else { xn0 };
+    if t > hi {
+        hi
+    } else {
+        t
+    }
+}
+
+/// The terms in t: the polynomial base sum_k poly[k-1] t^k (Horner) and the
+/// temperature-coupled linear terms t sum_j linear_by_t[j] xn_j; 0 without either, which
+/// skips computing the range.
+fn t_terms_f32(model: &RbfModel, xn: &[f32; MAX_INPUTS]) -> f32 {
+    if model.poly.is_empty() && model.linear_by_t.is_empty() {
         return 0.0;
     }
-    let (lo, hi) = model.poly_domain();
-    // Compare and select as `f32::max` then `f32::min` would (a NaN bound is ignored, a
-    // reversed pair gives `hi`), without their libm calls on the M4F.
-    let t = if xn0 < lo { lo } else { xn0 };
-    let t = if t > hi { hi } else { t };
-    model
+    let t = held_t_f32(model, xn[0]);
+    let poly = model
         .poly
         .iter()
         .rev()
-        .fold(0.0f32, |acc, &p| (acc + p) * t)
+        .fold(0.0f32, |acc, &p| (acc + p) * t);
+    let coupled = model
+        .linear_by_t
+        .iter()
+        .zip(xn.iter())
+        .fold(0.0f32, |acc, (&l, &x)| acc + l * x);
+    poly + coupled * t
 }
 
 /// The square of `d`.
@@ -144,7 +160,7 @@ fn add_gaussians(model: &RbfModel, acc: f32, d2: impl Fn(&[f32; MAX_INPUTS]) -> 
 pub fn predict_f32(model: &RbfModel, x_raw: &[f32]) -> Result<f32, RbfError> {
     let xn = normalise_f32(model, x_raw)?;
     let n = model.inputs.len();
-    let mut acc = model.bias_dph + poly_f32(model, xn[0]);
+    let mut acc = model.bias_dph + t_terms_f32(model, &xn);
     for (&l, &x) in model.linear.iter().zip(xn.iter()).take(n) {
         acc += l * x;
     }
@@ -184,6 +200,9 @@ pub fn predict_f64(model: &RbfModel, x_raw: &[f64]) -> Result<f64, RbfError> {
             .fold(0.0f64, |acc, &p| (acc + p as f64) * t);
     for (&l, &x) in model.linear.iter().zip(xn.iter()).take(n) {
         acc += l as f64 * x;
+    }
+    for (&l, &x) in model.linear_by_t.iter().zip(xn.iter()).take(n) {
+        acc += l as f64 * t * x;
     }
     for ((c, &s), &w) in model
         .centers

@@ -74,6 +74,11 @@ pub struct Args {
     /// the Gaussians, jointly with the centres.
     #[arg(long)]
     pub linear_inputs: bool,
+    /// Let those linear terms' coefficients change with temperature: a term in T x input
+    /// beside each (e.g. a Shupe coefficient k_0 + k_1 T); needs `--linear-inputs`. The
+    /// model is then written in format version 4.
+    #[arg(long)]
+    pub linear_by_t: bool,
     /// Model inputs: `t,rate` (T, dT/dt), `t,rate,accel` (and d2T/dt2, computed by
     /// fog-core as on the device), `t,rate,accel_flat` (d2T/dt2 with the series flat
     /// before power-on), `t,rate,rise` (the temperature rise since power-on instead of
@@ -173,6 +178,7 @@ impl Args {
             folds: self.folds,
             collinearity_tol: self.collinearity_tol,
             linear_on_rbf_inputs: self.linear_inputs,
+            linear_by_t: self.linear_by_t,
             gyro_id: self.gyro_id.clone(),
             ..TrainConfig::default()
         })

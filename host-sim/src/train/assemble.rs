@@ -16,6 +16,8 @@ pub enum ForcedTerm {
     Linear(usize),
     /// Normalised input 0 to the power k (1..=3): the model's `poly[k-1]`.
     Poly(usize),
+    /// t times input j's normalised value: the model's `linear_by_t[j]`.
+    LinearByT(usize),
 }
 
 /// The parts of a trained model in plain f64 form.
@@ -84,6 +86,15 @@ pub fn assemble(parts: &ModelParts<'_>) -> Result<RbfModel> {
         match *term {
             ForcedTerm::Bias => model.bias_dph = coef as f32,
             ForcedTerm::Linear(j) => model.linear[j] = coef as f32,
+            ForcedTerm::LinearByT(j) => {
+                while model.linear_by_t.len() < d {
+                    model
+                        .linear_by_t
+                        .push(0.0)
+                        .map_err(|_| capacity("inputs"))?;
+                }
+                model.linear_by_t[j] = coef as f32;
+            }
             ForcedTerm::Poly(k) => {
                 while model.poly.len() < k {
                     model

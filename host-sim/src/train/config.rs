@@ -56,6 +56,10 @@ pub struct TrainConfig {
     pub linear_only_inputs: usize,
     /// Also fit linear terms on the RBF inputs (jointly with the centres).
     pub linear_on_rbf_inputs: bool,
+    /// Let every linear term's coefficient change with temperature: a term in
+    /// t * xn_j beside each linear term in xn_j (fog-core's `linear_by_t`; t = normalised
+    /// input 0), e.g. a Shupe coefficient k_0 + k_1 T.
+    pub linear_by_t: bool,
     /// A candidate is dropped once less than this fraction of its energy is new
     /// (orthogonal to the selection): guards the triangular solve's conditioning.
     pub collinearity_tol: f64,
@@ -82,6 +86,7 @@ impl Default for TrainConfig {
             folds: 3,
             linear_only_inputs: 0,
             linear_on_rbf_inputs: false,
+            linear_by_t: false,
             collinearity_tol: 1e-4,
             gyro_id: String::from("sim"),
             threads: None,
@@ -150,6 +155,13 @@ impl TrainConfig {
                     "{} of {n_inputs} inputs: at least one RBF input is needed",
                     self.linear_only_inputs
                 ),
+            );
+        }
+        if self.linear_by_t && !self.linear_on_rbf_inputs && self.linear_only_inputs == 0 {
+            return bad(
+                "linear-by-t",
+                "no linear terms whose coefficients could change with T (add --linear-inputs)"
+                    .into(),
             );
         }
         if !(self.collinearity_tol > 0.0 && self.collinearity_tol < 1.0) {

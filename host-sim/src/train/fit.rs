@@ -145,6 +145,9 @@ impl WidthDesign {
         let mut columns = vec![ForcedColumn::Bias];
         columns.extend((1..=powers).map(ForcedColumn::Power));
         columns.extend((first_linear.max(1)..d).map(ForcedColumn::Input));
+        if cfg.linear_by_t {
+            columns.extend((first_linear.max(1)..d).map(ForcedColumn::InputByT));
+        }
         Self {
             width,
             candidates,
@@ -180,7 +183,8 @@ impl WidthDesign {
     }
 
     /// The forced terms of a model of polynomial `degree`, each with its Gram column:
-    /// bias, T^1..T^degree, then the linear inputs (input 0's linear term is T^1).
+    /// bias, T^1..T^degree, then the linear inputs (input 0's linear term is T^1), then
+    /// their temperature-coupled twins (t x input j) when the design has them.
     pub fn forced_terms(&self, degree: usize, n_inputs: usize) -> Vec<(ForcedTerm, usize)> {
         let col = |c: ForcedColumn| self.columns.iter().position(|&x| x == c);
         let mut terms = vec![(ForcedTerm::Bias, 0)];
@@ -197,6 +201,9 @@ impl WidthDesign {
                 ForcedColumn::Input(j)
             };
             terms.extend(col(c).map(|c| (ForcedTerm::Linear(j), c)));
+        }
+        for j in 1..n_inputs {
+            terms.extend(col(ForcedColumn::InputByT(j)).map(|c| (ForcedTerm::LinearByT(j), c)));
         }
         terms
     }

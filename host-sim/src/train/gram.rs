@@ -21,6 +21,8 @@ pub enum ForcedColumn {
     Power(usize),
     /// Normalised input j.
     Input(usize),
+    /// Normalised input 0 times normalised input j (a temperature-coupled linear term).
+    InputByT(usize),
 }
 
 /// What the extended design is made of.
@@ -266,6 +268,7 @@ impl<'a> GaussianRow<'a> {
                 ForcedColumn::Bias => 1.0,
                 ForcedColumn::Power(k) => f64::from(x[0]).powi(k as i32),
                 ForcedColumn::Input(j) => f64::from(x[j]),
+                ForcedColumn::InputByT(j) => f64::from(x[0]) * f64::from(x[j]),
             };
         }
         d2.fill(0.0);

@@ -480,6 +480,7 @@ fn heldout_residuals(
                     ForcedTerm::Bias => 1.0,
                     ForcedTerm::Poly(k) => t.powi(k as i32),
                     ForcedTerm::Linear(j) => f64::from(x[j]),
+                    ForcedTerm::LinearByT(j) => t * f64::from(x[j]),
                 }
             })
             .sum();

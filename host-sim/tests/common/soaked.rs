@@ -66,6 +66,15 @@ pub enum SoakedLaw {
     /// The lagged thermometer; the drift is the turn-on offset alone (nothing follows the
     /// temperature).
     LaggedOffsetOnly,
+    /// The lagged thermometer; the temperature coefficient and a Shupe coefficient that
+    /// changes linearly with the coil temperature, by this fraction per degC about 25 degC
+    /// (k_S(T) = k_S (1 + f (T - 25))): the law a global model over many ambients needs
+    /// linear terms with T-dependent coefficients for.
+    LaggedShupeLinearInT(f64),
+    /// Its twin with a different law: the Shupe coefficient steps by this fraction across
+    /// a 6 degC wide transition at 0 degC (a fibre coating's glass transition: tanh in T,
+    /// flat on either side), which no linear change with T follows.
+    LaggedShupeStepInT(f64),
 }
 
 /// One run's warm-up: the measured temperature rise above the ambient, its rate and the
@@ -159,6 +168,28 @@ pub fn soaked_campaign(law: SoakedLaw, seed: u64) -> Vec<Run> {
 
 /// [`soaked_campaign`] with the runs' warm-ups as wide apart as `tube` says.
 pub fn soaked_campaign_in(law: SoakedLaw, tube: Tube, seed: u64) -> Vec<Run> {
+    soaked_campaign_over(law, tube, seed, &[AMBIENT_C], RUNS)
+}
+
+/// The Shupe coefficient's factor at coil temperature `coil_c` under `law` (1 for the laws
+/// with a constant coefficient).
+fn shupe_factor(law: SoakedLaw, coil_c: f64) -> f64 {
+    match law {
+        SoakedLaw::LaggedShupeLinearInT(f) => 1.0 + f * (coil_c - 25.0),
+        SoakedLaw::LaggedShupeStepInT(f) => 1.0 + 0.5 * f * (1.0 + (coil_c / 3.0).tanh()),
+        _ => 1.0,
+    }
+}
+
+/// `runs_per_ambient` soaked cold starts of one unit at each of `ambients_c`, the
+/// warm-ups as wide apart as `tube` says.
+pub fn soaked_campaign_over(
+    law: SoakedLaw,
+    tube: Tube,
+    seed: u64,
+    ambients_c: &[f64],
+    runs_per_ambient: usize,
+) -> Vec<Run> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0x50A7);
     let g = Normal::new(0.0, 1.0).unwrap();
     let (k1, shupe) = (rng.random_range(-0.004..0.004), rng.random_range(2.0..6.0));
@@ -168,8 +199,10 @@ pub fn soaked_campaign_in(law: SoakedLaw, tube: Tube, seed: u64) -> Vec<Run> {
     let lagged = !matches!(law, SoakedLaw::UnlaggedTwoMode(_));
     let mut runs = Vec::new();
     let mut accel_term = Vec::new();
-    let amb = AMBIENT_C;
-    for i in 0..RUNS {
+    let layout = ambients_c
+        .iter()
+        .flat_map(|&a| std::iter::repeat_n(a, runs_per_ambient));
+    for (i, amb) in layout.enumerate() {
         let rise = tube.spread(8.0, 14.0, rng.random_range(8.0..14.0));
         let w = if lagged {
             let tau_s = tube.spread(1000.0, 2000.0, rng.random_range(1000.0..2000.0));
@@ -189,7 +222,7 @@ pub fn soaked_campaign_in(law: SoakedLaw, tube: Tube, seed: u64) -> Vec<Run> {
                         sigmas * NOISE_10S_DPH * (-0.5 * ((dt_c - 3.0) / 1.0).powi(2)).exp()
                     }
                     SoakedLaw::LaggedOffsetOnly => 0.0,
-                    _ => k1 * d + shupe * rate_cps,
+                    _ => k1 * d + shupe * shupe_factor(law, amb + dt_c) * rate_cps,
                 };
             t.push((k + 1) as f64);
             rate.push(drift + NOISE_10S_DPH * 10f64.sqrt() * g.sample(&mut rng));
@@ -210,7 +243,9 @@ pub fn soaked_campaign_in(law: SoakedLaw, tube: Tube, seed: u64) -> Vec<Run> {
         SoakedLaw::LaggedGradient(s) | SoakedLaw::UnlaggedTwoMode(s) => s,
         SoakedLaw::LaggedNull
         | SoakedLaw::LaggedTemperatureBump(_)
-        | SoakedLaw::LaggedOffsetOnly => 0.0,
+        | SoakedLaw::LaggedOffsetOnly
+        | SoakedLaw::LaggedShupeLinearInT(_)
+        | SoakedLaw::LaggedShupeStepInT(_) => 0.0,
     };
     plant(&mut runs, &accel_term, sigmas * NOISE_10S_DPH);
     runs
