@@ -15,12 +15,10 @@ mod soaked;
 
 use fog_core::model::format::{FeatureSpec, RbfModel};
 use fog_sim::io::runs::Run;
-use fog_sim::pipeline::own_model::{
-    choose_linear_terms, clock_spec, warmup_time_constant_s, LinearShape, OwnModelPlan,
-};
+use fog_sim::pipeline::own_model::{choose_linear_terms, OwnModelPlan};
 use fog_sim::train::seek_score::{seek_azimuth_rms_deg, Criterion, SeekGeometry};
-use fog_sim::train::{dataset_from_runs, predict_batch, InputSet};
-use soaked::{soaked_campaign_in, SoakedLaw, Tube, AMBIENT_C};
+use fog_sim::train::{dataset_from_runs, predict_batch};
+use soaked::{clocked_specs, soaked_campaign_in, SoakedLaw, Tube, AMBIENT_C};
 
 const LATITUDE_DEG: f64 = 40.0;
 const DWELL_S: f64 = 110.0;
@@ -36,16 +34,6 @@ fn plan() -> OwnModelPlan {
             latitude_deg: LATITUDE_DEG,
         }),
     }
-}
-
-/// The own model's inputs on these runs: T, dT/dt and the clock of their warm-up.
-fn specs(runs: &[Run]) -> Vec<FeatureSpec> {
-    let mut specs = InputSet::TempRate.specs();
-    let tau_s = warmup_time_constant_s(runs)
-        .unwrap()
-        .expect("soaked cold starts have a warm-up");
-    specs.push(clock_spec(tau_s));
-    specs
 }
 
 /// Seek azimuth rms, deg, of `model`'s residuals on `runs`.
@@ -71,20 +59,23 @@ struct Outcome {
 fn outcome(law: SoakedLaw, tube: Tube, seed: u64) -> Outcome {
     let runs = soaked_campaign_in(law, tube, seed);
     let fresh = soaked_campaign_in(law, tube, seed + 1000);
-    let specs = specs(&runs);
+    let specs = clocked_specs(&runs);
     let plan = plan();
     let choice = choose_linear_terms(&runs, &specs, &plan).unwrap();
-    let linear_chosen = choice.shape != LinearShape::Pure;
-    let pure = &choice.trained[LinearShape::Pure as usize].model;
-    let linear = &choice.chosen().model;
-    let linear = if linear_chosen {
-        linear
+    let other = fog_sim::pipeline::campaign_steps::train_with_config(
+        &runs.iter().collect::<Vec<_>>(),
+        &specs,
+        &fog_sim::pipeline::own_model::train_config(&plan, !choice.linear_inputs),
+    )
+    .unwrap();
+    let (pure, linear) = if choice.linear_inputs {
+        (&other.model, &choice.trained.model)
     } else {
-        &choice.trained[LinearShape::Linear as usize].model
+        (&choice.trained.model, &other.model)
     };
     let o = Outcome {
-        linear_chosen,
-        heldout: [choice.scores[0], choice.scores[1]],
+        linear_chosen: choice.linear_inputs,
+        heldout: choice.scores,
         fresh: [
             seek_rms_deg(pure, &fresh, &specs),
             seek_rms_deg(linear, &fresh, &specs),

@@ -45,6 +45,21 @@ fn train_ok(runs: &Path, model: &Path, extra: &[&str]) -> RbfModel {
     RbfModel::decode(&std::fs::read(model).unwrap()).unwrap()
 }
 
+/// `fogsim train RUNS --out MODEL EXTRA...` must fail and write no model; its stderr.
+fn train_refused(runs: &Path, model: &Path, extra: &[&str]) -> String {
+    let mut args = vec![
+        "train",
+        runs.to_str().unwrap(),
+        "--out",
+        model.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let out = fogsim(&args);
+    assert!(!out.status.success());
+    assert!(!model.exists());
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
 #[test]
 fn train_writes_a_valid_model_and_rejects_bad_input_without_output() {
     let dir = std::env::temp_dir().join(format!("fogsim_train_cli_{}", std::process::id()));
@@ -92,17 +107,9 @@ fn train_writes_a_valid_model_and_rejects_bad_input_without_output() {
     let bytes = std::fs::read(&coupled_path).unwrap();
     assert_eq!(bytes[5], 4, "format version byte: {:?}", &bytes[..8]);
     // Without linear terms there is nothing to couple: refused by name, nothing written.
-    let refused = dir.join("model_refused.bin");
-    let out = fogsim(&[
-        "train",
-        runs.to_str().unwrap(),
-        "--out",
-        refused.to_str().unwrap(),
-        "--linear-by-t",
-    ]);
-    assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("linear-by-t"));
-    assert!(!refused.exists());
+    let bad_model = dir.join("bad_model.bin");
+    let err = train_refused(&runs, &bad_model, &["--linear-by-t"]);
+    assert!(err.contains("linear-by-t"), "{err}");
 
     // A malformed cell: error names the file and line, exit != 0, no model written.
     let bad_dir = dir.join("bad");
@@ -115,33 +122,15 @@ fn train_writes_a_valid_model_and_rejects_bad_input_without_output() {
         .unwrap()
         .replacen("9.7\n", "oops\n", 1);
     std::fs::write(&bad_file, text).unwrap();
-    let bad_model = dir.join("bad_model.bin");
-    let out = fogsim(&[
-        "train",
-        bad_dir.to_str().unwrap(),
-        "--out",
-        bad_model.to_str().unwrap(),
-    ]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success());
+    let err = train_refused(&bad_dir, &bad_model, &[]);
     assert!(
         err.contains("run1.csv") && err.trim().lines().count() == 1,
         "{err}"
     );
-    assert!(!bad_model.exists());
 
     // Impossible option: named, no output.
-    let out = fogsim(&[
-        "train",
-        runs.to_str().unwrap(),
-        "--out",
-        bad_model.to_str().unwrap(),
-        "--rho",
-        "2",
-    ]);
-    assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("rho"));
-    assert!(!bad_model.exists());
+    let err = train_refused(&runs, &bad_model, &["--rho", "2"]);
+    assert!(err.contains("rho"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

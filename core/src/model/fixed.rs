@@ -111,8 +111,10 @@ pub struct FixedModel {
     gain_q: [i32; MAX_CENTERS],
     weights_q: [i32; MAX_CENTERS],
     linear_q: [i32; MAX_INPUTS],
-    /// Temperature-coupled linear terms (Q.w_frac) of t * xn_j.
+    /// Temperature-coupled linear terms (Q.w_frac) of t * xn_j; `n_linear_by_t` of them
+    /// (0: none, and no cost).
     linear_by_t_q: [i32; MAX_INPUTS],
+    n_linear_by_t: u8,
     bias_q: i64,
     w_frac: u8,
     /// Polynomial coefficients (Q.w_frac) of t^1..t^n_poly.
@@ -154,6 +156,7 @@ impl FixedModel {
             weights_q: [0; MAX_CENTERS],
             linear_q: [0; MAX_INPUTS],
             linear_by_t_q: [0; MAX_INPUTS],
+            n_linear_by_t: 0,
             bias_q: 0,
             w_frac: 0,
             poly_q: [0; MAX_POLY_DEGREE],
@@ -188,6 +191,7 @@ impl FixedModel {
         fm.weights_q = [0; MAX_CENTERS];
         fm.linear_q = [0; MAX_INPUTS];
         fm.linear_by_t_q = [0; MAX_INPUTS];
+        fm.n_linear_by_t = model.linear_by_t.len() as u8;
         fm.bias_q = 0;
         fm.w_frac = 0;
         fm.poly_q = [0; MAX_POLY_DEGREE];
@@ -302,7 +306,8 @@ impl FixedModel {
             acc += ((l as i128 * x as i128) >> XN_FRAC) as i64;
         }
         let t = xn[0].max(self.poly_lo_q).min(self.poly_hi_q) as i128;
-        for (&l, &x) in self.linear_by_t_q.iter().zip(xn.iter()).take(n) {
+        let n_coupled = (self.n_linear_by_t as usize).min(n);
+        for (&l, &x) in self.linear_by_t_q.iter().zip(xn.iter()).take(n_coupled) {
             // |t|, |x| < 2^35: t x < 2^70, >> 28 < 2^42, times |l| < 2^31: exact in i128.
             acc += ((l as i128 * ((t * x as i128) >> XN_FRAC)) >> XN_FRAC) as i64;
         }

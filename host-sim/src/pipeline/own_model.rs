@@ -101,10 +101,10 @@ pub struct OwnModel {
     pub clock_tau_s: Option<f64>,
     /// The model's inputs: the selection's, then the clock input when there is one.
     pub specs: Vec<FeatureSpec>,
-    /// Which linear terms the model has (chosen by the held-out score).
-    pub linear_shape: LinearShape,
-    /// The held-out scores (the plan's criterion) of every `LinearShape`, in its order.
-    pub linear_scores: [f64; 3],
+    /// Whether the model has linear terms in its RBF inputs (chosen by the held-out score).
+    pub linear_inputs: bool,
+    /// The held-out scores (the plan's criterion) without and with those linear terms.
+    pub linear_scores: [f64; 2],
     pub runs: usize,
     /// Estimated per-seek azimuth bias the model owes to its training set, deg (half-split
     /// rms / 2, at |sin psi| = 1; `learned_seek_error_deg`).
@@ -125,11 +125,10 @@ impl OwnModel {
             None => "clock input: none (the runs show no warm-up)\n".into(),
         };
         s += &format!(
-            "linear terms in the RBF inputs: {} (held-out: none {:.5}, linear {:.5}, changing with T {:.5})\n",
-            self.linear_shape.describe(),
-            self.linear_scores[0],
+            "linear terms in the RBF inputs: {} (held-out {:.5} with, {:.5} without)\n",
+            if self.linear_inputs { "yes" } else { "no" },
             self.linear_scores[1],
-            self.linear_scores[2]
+            self.linear_scores[0]
         );
         s += &format!(
             "training runs: {} (the chamber campaign); training-set error (half-split, mean of {SPLITS} splits) {:.4} deg, budget {:.4} deg ({} x the white-noise floor): {}\n",
@@ -184,12 +183,8 @@ pub fn own_model_from_runs(
     // `train`'s defaults, with the plan's criterion choosing the d2T/dt2 estimator as well
     // as the shape. (Scoring each set with the clock beside it was tried and not kept:
     // docs/northfinder.md, "The one global model over training campaigns".)
-    let (selection, _) = choose_inputs_default(
-        &runs,
-        &InputSet::ALL,
-        &train_config(plan, LinearShape::Pure),
-    )
-    .map_err(|e| anyhow!("choosing the own model's inputs: {e}"))?;
+    let (selection, _) = choose_inputs_default(&runs, &InputSet::ALL, &train_config(plan, false))
+        .map_err(|e| anyhow!("choosing the own model's inputs: {e}"))?;
     let clock_tau_s = warmup_time_constant_s(&runs)?;
     let specs: Vec<FeatureSpec> = selection
         .chosen
@@ -197,16 +192,15 @@ pub fn own_model_from_runs(
         .into_iter()
         .chain(clock_tau_s.map(clock_spec))
         .collect();
-    let choice = choose_linear_terms(&runs, &specs, plan)?;
-    let (linear_shape, linear_scores) = (choice.shape, choice.scores);
-    let learned_seek_deg = learned_seek_error_deg(&runs, &specs, plan, linear_shape)?;
+    let shape = choose_linear_terms(&runs, &specs, plan)?;
+    let learned_seek_deg = learned_seek_error_deg(&runs, &specs, plan, shape.linear_inputs)?;
     Ok(OwnModel {
-        trained: choice.into_chosen(),
+        trained: shape.trained,
         selection,
         clock_tau_s,
         specs,
-        linear_shape,
-        linear_scores,
+        linear_inputs: shape.linear_inputs,
+        linear_scores: shape.scores,
         runs: runs.len(),
         learned_seek_deg,
         budget_deg,
@@ -214,97 +208,43 @@ pub fn own_model_from_runs(
     })
 }
 
-/// Which linear terms a model has beside its Gaussians.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LinearShape {
-    /// The paper's pure RBF (linear terms on linear-only inputs only).
-    Pure,
-    /// Linear terms in the RBF inputs too (`train --linear-inputs`).
-    Linear,
-    /// Those linear terms with coefficients that change with temperature
-    /// (`train --linear-inputs --linear-by-t`).
-    LinearByT,
-}
-
-impl LinearShape {
-    /// Every shape, simplest first (a tie keeps the simpler).
-    pub const ALL: [LinearShape; 3] = [
-        LinearShape::Pure,
-        LinearShape::Linear,
-        LinearShape::LinearByT,
-    ];
-
-    /// For reports.
-    pub fn describe(self) -> &'static str {
-        match self {
-            LinearShape::Pure => "no",
-            LinearShape::Linear => "yes",
-            LinearShape::LinearByT => "yes, with coefficients changing with T",
-        }
-    }
-}
-
-/// The models of `choose_linear_terms`: one per `LinearShape`, the chosen one, and the
-/// held-out scores that chose.
+/// The model of `choose_linear_terms`: trained with or without linear terms in its RBF
+/// inputs, and the held-out scores that chose.
 pub struct LinearTermsChoice {
-    /// One trained model per shape, in `LinearShape::ALL`'s order.
-    pub trained: Vec<TrainOutcome>,
-    pub shape: LinearShape,
-    /// The held-out scores (the plan's criterion) of every `LinearShape`, in its order.
-    pub scores: [f64; 3],
+    pub trained: TrainOutcome,
+    pub linear_inputs: bool,
+    /// The held-out scores (the plan's criterion) without and with the linear terms.
+    pub scores: [f64; 2],
 }
 
-impl LinearTermsChoice {
-    /// The chosen shape's model.
-    pub fn chosen(&self) -> &TrainOutcome {
-        &self.trained[self.shape as usize]
-    }
-
-    /// The chosen shape's model, by value.
-    pub fn into_chosen(mut self) -> TrainOutcome {
-        self.trained.swap_remove(self.shape as usize)
-    }
-}
-
-/// Linear terms in the RBF inputs under the Gaussians, and whether their coefficients
-/// change with temperature, or neither: a shape choice, made as the trainer makes its width
-/// and degree, by the lowest held-out score of the plan's criterion over whole runs; a tie
-/// keeps the simpler shape (the paper's pure RBF first). Why coefficients that change with
-/// T: a Shupe coefficient that changes with temperature (k_0 + k_1 T) makes the drift
-/// k_0 dT/dt + k_1 T dT/dt, which one global model over -40..+60 degC otherwise gets only
-/// from Gaussians of one width, worst at the range's ends.
+/// Linear terms in the RBF inputs under the Gaussians, or not: a shape choice, made as the
+/// trainer makes its width and degree, by the lower held-out score of the plan's criterion
+/// over whole runs; a tie keeps the paper's pure RBF.
 pub fn choose_linear_terms(
     runs: &[Run],
     specs: &[FeatureSpec],
     plan: &OwnModelPlan,
 ) -> Result<LinearTermsChoice> {
     let refs: Vec<&Run> = runs.iter().collect();
-    let mut trained = Vec::new();
-    let mut scores = [f64::INFINITY; 3];
-    let mut shape = LinearShape::Pure;
-    for (i, s) in LinearShape::ALL.into_iter().enumerate() {
-        let t = train_with_config(&refs, specs, &train_config(plan, s))?;
-        scores[i] = t.report.cross_validation.best.score_for(plan.criterion);
-        if scores[i] < scores[shape as usize] {
-            shape = s;
-        }
-        trained.push(t);
-    }
+    let plain = train_with_config(&refs, specs, &train_config(plan, false))?;
+    let linear = train_with_config(&refs, specs, &train_config(plan, true))?;
+    let score = |t: &TrainOutcome| t.report.cross_validation.best.score_for(plan.criterion);
+    let scores = [score(&plain), score(&linear)];
+    let linear_inputs = scores[1] < scores[0];
     Ok(LinearTermsChoice {
-        trained,
-        shape,
+        trained: if linear_inputs { linear } else { plain },
+        linear_inputs,
         scores,
     })
 }
 
 /// The own model's trainer configuration: `train`'s defaults with the plan's criterion,
-/// and the linear terms of `shape`.
-pub fn train_config(plan: &OwnModelPlan, shape: LinearShape) -> TrainConfig {
+/// and linear terms in the RBF inputs when `linear_inputs`.
+pub fn train_config(plan: &OwnModelPlan, linear_inputs: bool) -> TrainConfig {
     TrainConfig {
         gyro_id: "sim".into(),
         criterion: plan.criterion,
-        linear_on_rbf_inputs: shape != LinearShape::Pure,
-        linear_by_t: shape == LinearShape::LinearByT,
+        linear_on_rbf_inputs: linear_inputs,
         ..TrainConfig::default()
     }
 }
@@ -368,9 +308,9 @@ pub fn learned_seek_error_deg(
     runs: &[Run],
     specs: &[FeatureSpec],
     plan: &OwnModelPlan,
-    shape: LinearShape,
+    linear_inputs: bool,
 ) -> Result<f64> {
-    let cfg = train_config(plan, shape);
+    let cfg = train_config(plan, linear_inputs);
     let n = runs.len();
     let side = |split: usize, i: usize| match split {
         0 => i % 2,
@@ -444,7 +384,7 @@ mod tests {
                 &runs(&with_noise_scaled(&paper, k), 6),
                 &specs,
                 &plan(),
-                LinearShape::Pure,
+                false,
             )
             .unwrap()
         };
@@ -458,8 +398,7 @@ mod tests {
         same.sensor.noise_c = 0.0;
         same.variation.power_sigma_frac = 0.0;
         same.variation.start_temp_sigma_c = 0.0;
-        let null =
-            learned_seek_error_deg(&runs(&same, 6), &specs, &plan(), LinearShape::Pure).unwrap();
+        let null = learned_seek_error_deg(&runs(&same, 6), &specs, &plan(), false).unwrap();
         assert!(
             null < 0.05 * base,
             "identical runs {null:.6} deg vs {base:.5} deg"

@@ -44,6 +44,21 @@ fn capacity(what: &str) -> TrainError {
     }
 }
 
+/// Sets `v[index] = value`, first growing `v` with zeros to at least `len` entries.
+fn set_grown<const N: usize>(
+    v: &mut heapless::Vec<f32, N>,
+    len: usize,
+    index: usize,
+    value: f64,
+    what: &str,
+) -> Result<()> {
+    while v.len() < len.max(index + 1) {
+        v.push(0.0).map_err(|_| capacity(what))?;
+    }
+    v[index] = value as f32;
+    Ok(())
+}
+
 /// Builds and validates the model.
 pub fn assemble(parts: &ModelParts<'_>) -> Result<RbfModel> {
     let d = parts.specs.len();
@@ -87,22 +102,10 @@ pub fn assemble(parts: &ModelParts<'_>) -> Result<RbfModel> {
             ForcedTerm::Bias => model.bias_dph = coef as f32,
             ForcedTerm::Linear(j) => model.linear[j] = coef as f32,
             ForcedTerm::LinearByT(j) => {
-                while model.linear_by_t.len() < d {
-                    model
-                        .linear_by_t
-                        .push(0.0)
-                        .map_err(|_| capacity("inputs"))?;
-                }
-                model.linear_by_t[j] = coef as f32;
+                set_grown(&mut model.linear_by_t, d, j, coef, "inputs")?;
             }
             ForcedTerm::Poly(k) => {
-                while model.poly.len() < k {
-                    model
-                        .poly
-                        .push(0.0)
-                        .map_err(|_| capacity("polynomial terms"))?;
-                }
-                model.poly[k - 1] = coef as f32;
+                set_grown(&mut model.poly, k, k - 1, coef, "polynomial terms")?;
             }
         }
     }

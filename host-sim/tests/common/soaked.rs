@@ -24,13 +24,19 @@
 //!
 //! For the choice of linear terms in the RBF inputs, two more laws on the lagged
 //! thermometer: a bump in the coil temperature (nothing linear in T or dT/dt) and the
-//! turn-on offset alone (nothing follows the temperature).
+//! turn-on offset alone (nothing follows the temperature). For linear terms whose
+//! coefficients change with T, campaigns over several ambients
+//! ([`soaked_campaign_over`]) and two more laws: a Shupe coefficient linear in T and one
+//! that steps across 0 degC.
 //!
 //! The planted d2T/dt2 effect is sized on the settled part of the warm-up (rows from
 //! [`SIZED_FROM_S`] on, where the 10 s rms sees it): its rms there is `sigmas` 10 s noise
 //! sigmas.
 
+use fog_core::model::format::FeatureSpec;
 use fog_sim::io::runs::Run;
+use fog_sim::pipeline::own_model::{clock_spec, warmup_time_constant_s};
+use fog_sim::train::InputSet;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
@@ -266,4 +272,14 @@ fn plant(runs: &mut [Run], terms: &[Vec<f64>], rms_dph: f64) {
             *r += k * a;
         }
     }
+}
+
+/// The own model's inputs on soaked runs: T, dT/dt and the clock of their warm-up.
+pub fn clocked_specs(runs: &[Run]) -> Vec<FeatureSpec> {
+    let mut specs = InputSet::TempRate.specs();
+    let tau_s = warmup_time_constant_s(runs)
+        .unwrap()
+        .expect("soaked cold starts have a warm-up");
+    specs.push(clock_spec(tau_s));
+    specs
 }

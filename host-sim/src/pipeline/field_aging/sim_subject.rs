@@ -109,6 +109,6 @@ fn chamber_at_ambients(
     train_with_config(
         &runs,
         &own.specs,
-        &crate::pipeline::own_model::train_config(own_plan, own.linear_shape),
+        &crate::pipeline::own_model::train_config(own_plan, own.linear_inputs),
     )
 }
