@@ -328,44 +328,24 @@ fn random_bytes_never_panic() {
     }
 }
 
-/// Format version 1 (before the polynomial base): the body ends after `meta`.
-fn encode_v1(m: &RbfModel) -> Vec<u8> {
+/// An older format version's bytes: version 1 ends the body after `meta`, 2 after `poly`,
+/// 3 after `heading` (postcard writes a struct as its fields back to back, so the body is
+/// the older fields' bytes in order).
+fn encode_version(m: &RbfModel, version: u16) -> Vec<u8> {
     let loose = LooseModel::from(m);
-    let body = postcard::to_allocvec(&(
+    let mut body = postcard::to_allocvec(&(
         m.inputs.len() as u16,
         m.centers.len() as u16,
         v1_fields(&loose),
     ))
     .unwrap();
-    wrap(&body, 1)
-}
-
-/// Format version 2 (before the heading harmonic): the body ends after `poly`.
-fn encode_v2(m: &RbfModel) -> Vec<u8> {
-    let loose = LooseModel::from(m);
-    let body = postcard::to_allocvec(&(
-        m.inputs.len() as u16,
-        m.centers.len() as u16,
-        v1_fields(&loose),
-        &loose.poly,
-    ))
-    .unwrap();
-    wrap(&body, 2)
-}
-
-/// Format version 3 (before the temperature-coupled linear terms): the body ends after
-/// `heading`.
-fn encode_v3(m: &RbfModel) -> Vec<u8> {
-    let loose = LooseModel::from(m);
-    let body = postcard::to_allocvec(&(
-        m.inputs.len() as u16,
-        m.centers.len() as u16,
-        v1_fields(&loose),
-        &loose.poly,
-        &loose.heading,
-    ))
-    .unwrap();
-    wrap(&body, 3)
+    if version >= 2 {
+        body.extend(postcard::to_allocvec(&loose.poly).unwrap());
+    }
+    if version >= 3 {
+        body.extend(postcard::to_allocvec(&loose.heading).unwrap());
+    }
+    wrap(&body, version)
 }
 
 fn wrap(body: &[u8], version: u16) -> Vec<u8> {
@@ -417,7 +397,7 @@ fn v1_fields(
 fn version_1_models_still_decode_without_a_polynomial() {
     let mut m = warmup_model(35, 2, 2.0, 5);
     m.poly.clear();
-    assert_eq!(RbfModel::decode(&encode_v1(&m)), Ok(m.clone()));
+    assert_eq!(RbfModel::decode(&encode_version(&m, 1)), Ok(m.clone()));
     // A version-2 body announced as version 1 has trailing bytes (the poly field).
     let mut with_poly = m.clone();
     with_poly.poly.extend_from_slice(&[0.1, -0.02]).unwrap();
@@ -491,7 +471,7 @@ fn heading_harmonic_round_trips_and_old_versions_decode_without_it() {
     m.heading = Some(harmonic());
     assert_eq!(RbfModel::decode(&encode(&m)), Ok(m.clone()));
     // Version 2 bytes (no heading field) decode with none.
-    assert_eq!(RbfModel::decode(&encode_v2(&m)), Ok(plain.clone()));
+    assert_eq!(RbfModel::decode(&encode_version(&m, 2)), Ok(plain.clone()));
     // A version-3 body announced as version 2 has trailing bytes (the heading field).
     assert!(matches!(
         RbfModel::decode(&encode_loose(&LooseModel::from(&m), 2)),
@@ -603,7 +583,7 @@ fn temperature_coupled_linear_terms_round_trip_and_old_versions_decode_without_t
     m.linear_by_t.extend_from_slice(&[0.0, -0.031]).unwrap();
     assert_eq!(RbfModel::decode(&encode(&m)), Ok(m.clone()));
     // Version 3 bytes (no linear_by_t field) decode with none.
-    assert_eq!(RbfModel::decode(&encode_v3(&m)), Ok(plain.clone()));
+    assert_eq!(RbfModel::decode(&encode_version(&m, 3)), Ok(plain.clone()));
     // A version-4 body announced as version 3 has trailing bytes (the new field).
     assert!(matches!(
         RbfModel::decode(&encode_loose(&LooseModel::from(&m), 3)),

@@ -25,18 +25,21 @@ fn fogsim(args: &[&str]) -> std::process::Output {
     app_support::fogsim(&std::env::temp_dir(), args)
 }
 
-/// `fogsim train RUNS --out MODEL --widths 0.5,1 EXTRA...` must succeed; the model it wrote.
-fn train_ok(runs: &Path, model: &Path, extra: &[&str]) -> RbfModel {
+/// `fogsim train RUNS --out MODEL EXTRA...`.
+fn train(runs: &Path, model: &Path, extra: &[&str]) -> std::process::Output {
     let mut args = vec![
         "train",
         runs.to_str().unwrap(),
         "--out",
         model.to_str().unwrap(),
-        "--widths",
-        "0.5,1",
     ];
     args.extend_from_slice(extra);
-    let out = fogsim(&args);
+    fogsim(&args)
+}
+
+/// `fogsim train RUNS --out MODEL --widths 0.5,1 EXTRA...` must succeed; the model it wrote.
+fn train_ok(runs: &Path, model: &Path, extra: &[&str]) -> RbfModel {
+    let out = train(runs, model, &[&["--widths", "0.5,1"], extra].concat());
     assert!(
         out.status.success(),
         "{}",
@@ -47,14 +50,7 @@ fn train_ok(runs: &Path, model: &Path, extra: &[&str]) -> RbfModel {
 
 /// `fogsim train RUNS --out MODEL EXTRA...` must fail and write no model; its stderr.
 fn train_refused(runs: &Path, model: &Path, extra: &[&str]) -> String {
-    let mut args = vec![
-        "train",
-        runs.to_str().unwrap(),
-        "--out",
-        model.to_str().unwrap(),
-    ];
-    args.extend_from_slice(extra);
-    let out = fogsim(&args);
+    let out = train(runs, model, extra);
     assert!(!out.status.success());
     assert!(!model.exists());
     String::from_utf8_lossy(&out.stderr).into_owned()
