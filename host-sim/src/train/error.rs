@@ -56,7 +56,10 @@ pub enum TrainError {
 impl fmt::Display for TrainError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Self::EmptyDataset => write!(f, "training data is empty (no usable 10 s points)"),
+            Self::EmptyDataset => write!(
+                f,
+                "training data is empty (no usable 10 s points: a row is usable once its inputs are ready, e.g. dT/dt after 60 s of readings; for sparse or burst-sampled records use `fogsim diagnose`)"
+            ),
             Self::InputCount {
                 expected,
                 found,
