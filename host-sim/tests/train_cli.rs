@@ -39,13 +39,29 @@ fn train(runs: &Path, model: &Path, extra: &[&str]) -> std::process::Output {
 
 /// `fogsim train RUNS --out MODEL --widths 0.5,1 EXTRA...` must succeed; the model it wrote.
 fn train_ok(runs: &Path, model: &Path, extra: &[&str]) -> RbfModel {
+    train_ok_printed(runs, model, extra).0
+}
+
+/// `train_ok`, with the report it printed.
+fn train_ok_printed(runs: &Path, model: &Path, extra: &[&str]) -> (RbfModel, String) {
     let out = train(runs, model, &[&["--widths", "0.5,1"], extra].concat());
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    RbfModel::decode(&std::fs::read(model).unwrap()).unwrap()
+    (
+        RbfModel::decode(&std::fs::read(model).unwrap()).unwrap(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+    )
+}
+
+/// The report's `linear terms:` line.
+fn linear_terms_line(report: &str) -> &str {
+    report
+        .lines()
+        .find(|l| l.starts_with("linear terms:"))
+        .unwrap_or_else(|| panic!("no `linear terms:` line in\n{report}"))
 }
 
 /// `fogsim train RUNS --out MODEL EXTRA...` must fail and write no model; its stderr.
@@ -68,22 +84,25 @@ fn train_writes_a_valid_model_and_rejects_bad_input_without_output() {
     }
     let model = dir.join("model.bin");
     let json = dir.join("report.json");
-    let m = train_ok(
+    let (m, printed) = train_ok_printed(
         &runs,
         &model,
         &["--json", json.to_str().unwrap(), "--max-centers", "10"],
     );
+    assert_eq!(linear_terms_line(&printed), "linear terms: none (pure RBF)");
     assert!(!m.centers.is_empty() && m.centers.len() <= 10);
     let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
     assert_eq!(report["n_runs"], 6);
     assert!(report["heldout_rms_dph"].as_f64().unwrap() < 0.01);
 
     // --linear-inputs: linear terms in T and dT/dt under the Gaussians, in the model.
-    let lin = train_ok(
+    let (lin, printed) = train_ok_printed(
         &runs,
         &dir.join("model_lin.bin"),
         &["--linear-inputs", "--inputs", "t,rate"],
     );
+    // T's own linear term is the polynomial's (degree >= 1), so the line names dT/dt's.
+    assert_eq!(linear_terms_line(&printed), "linear terms: temp_c:rate");
     assert_eq!(lin.linear.len(), 2, "one linear weight per RBF input");
     assert!(lin.linear.iter().any(|w| *w != 0.0));
     assert!(
@@ -93,10 +112,14 @@ fn train_writes_a_valid_model_and_rejects_bad_input_without_output() {
     // --linear-by-t: beside each of them a coefficient of T x input (the dT/dt one here;
     // T x T is the polynomial's), written in format version 4.
     let coupled_path = dir.join("model_lin_t.bin");
-    let coupled = train_ok(
+    let (coupled, printed) = train_ok_printed(
         &runs,
         &coupled_path,
         &["--linear-inputs", "--linear-by-t", "--inputs", "t,rate"],
+    );
+    assert!(
+        linear_terms_line(&printed).ends_with("coefficients changing with T (t x input terms)"),
+        "{printed}"
     );
     assert_eq!(coupled.linear_by_t.len(), 2);
     assert!(coupled.linear_by_t[1] != 0.0);

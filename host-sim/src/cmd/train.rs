@@ -14,7 +14,7 @@ use crate::train::{
     TrainOutcome, TrainReport, Verdict, WidthSearch, GUARD_RATIO,
 };
 use anyhow::Context;
-use fog_core::model::format::MAX_ENCODED_LEN;
+use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
 use serde::Serialize;
 use std::path::Path;
 use std::path::PathBuf;
@@ -388,6 +388,28 @@ fn design_export(
     }))
 }
 
+/// Which inputs carry linear terms beside the Gaussians (`--linear-inputs`, forced
+/// linear-only inputs), and whether their coefficients change with T (`--linear-by-t`):
+/// the model's shape, which the scan table above does not show.
+fn linear_terms_line(model: &RbfModel, inputs: &[String]) -> String {
+    let with: Vec<&str> = model
+        .linear
+        .iter()
+        .zip(inputs)
+        .filter(|(c, _)| **c != 0.0)
+        .map(|(_, name)| name.as_str())
+        .collect();
+    if with.is_empty() {
+        return "linear terms: none (pure RBF)\n".into();
+    }
+    let by_t = if model.linear_by_t.iter().any(|c| *c != 0.0) {
+        ", coefficients changing with T (t x input terms)"
+    } else {
+        ""
+    };
+    format!("linear terms: {}{by_t}\n", with.join(", "))
+}
+
 /// The human-readable summary printed after training.
 pub fn summary(outcome: &TrainOutcome, n_runs: usize, model_bytes: usize) -> String {
     let r = &outcome.report;
@@ -424,6 +446,7 @@ pub fn summary(outcome: &TrainOutcome, n_runs: usize, model_bytes: usize) -> Str
         "final: {} centres ({}), sum(err) = {:.4}, training rms {:.4} dph, held-out rms {:.4} dph\n",
         r.n_centers, r.size_chosen_by, r.err_sum, r.train_rms_dph, r.heldout_rms_dph
     );
+    s += &linear_terms_line(&outcome.model, &r.inputs);
     s += &format!(
         "time: width selection {:.2} s, final fit {:.2} s; model {} bytes\n",
         r.timings.validation_s, r.timings.final_fit_s, model_bytes

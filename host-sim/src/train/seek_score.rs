@@ -169,6 +169,19 @@ pub fn seek_azimuth_per_run(
     dwell_s: f64,
     latitude_deg: f64,
 ) -> Vec<RunSeekError> {
+    seek_azimuth_first_pairs_per_run(res, groups, t_s, dwell_s, latitude_deg, usize::MAX)
+}
+
+/// As `seek_azimuth_per_run`, but each run's first `max_pairs` pairs from power-on only
+/// (the first seeks after a cold start, which the seek targets judge one by one).
+pub fn seek_azimuth_first_pairs_per_run(
+    res: &[f64],
+    groups: &[u32],
+    t_s: &[f64],
+    dwell_s: f64,
+    latitude_deg: f64,
+    max_pairs: usize,
+) -> Vec<RunSeekError> {
     let geometry = SeekGeometry {
         dwell_s,
         latitude_deg,
@@ -186,7 +199,10 @@ pub fn seek_azimuth_per_run(
             pairs: 0,
             span_s: t_s[end - 1] - t_s[i],
         };
-        for e in pair_errors_dph(&res[i..end], &t_s[i..end], dwell_s) {
+        for e in pair_errors_dph(&res[i..end], &t_s[i..end], dwell_s)
+            .into_iter()
+            .take(max_pairs)
+        {
             run.sum_sq_deg2 += geometry.azimuth_deg(e).powi(2);
             run.pairs += 1;
         }
@@ -263,5 +279,23 @@ mod tests {
         let rms_fast = 0.05;
         let rms_slow = slope * 44.0 * 60.0 / 12f64.sqrt();
         assert!(rms_fast > 3.0 * rms_slow);
+    }
+
+    #[test]
+    fn the_first_pairs_score_sees_an_early_step_that_pooling_dilutes() {
+        let lat = 39.9;
+        // A step of 0.01 deg/h at 60 s: only the first pair (blocks 0-110, 110-220 s)
+        // differs; the 11 later pairs are clean.
+        let (r, g, t) = run(|x| if x < 60.0 { 0.01 } else { 0.0 }, 44.0);
+        let all = seek_azimuth_per_run(&r, &g, &t, 110.0, lat);
+        let first = seek_azimuth_first_pairs_per_run(&r, &g, &t, 110.0, lat, 3);
+        assert_eq!((all[0].pairs, first[0].pairs), (12, 3));
+        assert_eq!(all[0].sum_sq_deg2, first[0].sum_sq_deg2);
+        let ms = |e: &RunSeekError| e.sum_sq_deg2 / e.pairs as f64;
+        assert!((ms(&first[0]) / ms(&all[0]) - 4.0).abs() < 1e-9);
+        // A run shorter than the limit keeps all its pairs.
+        let (r, g, t) = run(|x| 1e-4 * x, 8.0);
+        let short = seek_azimuth_first_pairs_per_run(&r, &g, &t, 110.0, lat, 3);
+        assert_eq!(short[0].pairs, 2);
     }
 }
