@@ -22,7 +22,7 @@ use anyhow::{anyhow, Result};
 use fog_sim::io::runs::Run;
 use fog_sim::pipeline::campaign::CampaignSpec;
 use fog_sim::pipeline::campaign_steps::simulate_checked;
-use fog_sim::pipeline::reproduce::QUALIFICATION_STREAM;
+use fog_sim::pipeline::reproduce::qualification_campaign_spec;
 use fog_sim::train::seek_score::{seek_azimuth_first_pairs_per_run, Criterion};
 use fog_sim::train::{cross_validate, dataset_from_runs, InputSet, TrainConfig};
 
@@ -30,11 +30,7 @@ fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let seed: u64 = args.first().map_or(Ok(5), |s| s.parse())?;
     let runs_per_ambient: usize = args.get(1).map_or(Ok(48), |s| s.parse())?;
-    let plan = CampaignSpec {
-        runs_per_ambient,
-        seed: fog_sim::seed::derive_seed(seed, QUALIFICATION_STREAM, 0),
-        ..CampaignSpec::paper(seed)
-    };
+    let plan = qualification_campaign_spec(&CampaignSpec::paper(seed), runs_per_ambient);
     let params = fog_sim::sim::GyroParams::paper_default();
     let campaign = simulate_checked(&params, &plan)?;
     let ambient_of: Vec<f64> = campaign.iter().map(|c| c.ambient_c).collect();

@@ -270,11 +270,7 @@ fn qualification_model(params: &GyroParams, opts: &ReproduceOptions) -> Result<O
     let plan = &opts.campaign;
     let campaign = simulate_checked(
         params,
-        &CampaignSpec {
-            runs_per_ambient: opts.qualification_runs,
-            seed: crate::seed::derive_seed(plan.seed, QUALIFICATION_STREAM, 0),
-            ..plan.clone()
-        },
+        &qualification_campaign_spec(plan, opts.qualification_runs),
     )?;
     let own_plan = OwnModelPlan {
         ambient_c: opts.north_seek.ambient_c,
@@ -288,6 +284,17 @@ fn qualification_model(params: &GyroParams, opts: &ReproduceOptions) -> Result<O
         campaign.into_iter().map(|c| c.run).collect(),
         &own_plan,
     )
+}
+
+/// The qualification campaign of a paper campaign `plan`: `runs_per_ambient` cold starts at
+/// each of its ambients, from the qualification seed stream (`QUALIFICATION_STREAM`), so
+/// that no run is shared with `plan`'s and its held-out runs stay held out.
+pub fn qualification_campaign_spec(plan: &CampaignSpec, runs_per_ambient: usize) -> CampaignSpec {
+    CampaignSpec {
+        runs_per_ambient,
+        seed: crate::seed::derive_seed(plan.seed, QUALIFICATION_STREAM, 0),
+        ..plan.clone()
+    }
 }
 
 /// The north-seek Monte Carlo of `cfg` at the other `SEEK_AMBIENTS_C`.
