@@ -42,10 +42,17 @@ fn compensated_cold_start_seeks_beat_uncompensated_ones() {
     for arm in ["uncompensated", "compensated"] {
         assert!(f(&json, &[arm, "std_deg"]) > 0.0);
         assert!(f(&json, &[arm, "max_dev_deg"]) > 0.0);
+        assert_eq!(
+            json[arm]["per_seek_rms_error_deg"]
+                .as_array()
+                .unwrap()
+                .len(),
+            3
+        );
         assert_eq!(json[arm]["per_seek_std_deg"].as_array().unwrap().len(), 3);
         assert_eq!(json[arm]["azimuths_deg"].as_array().unwrap().len(), 6);
     }
-    let first = |arm: &str| json[arm]["per_seek_std_deg"][0].as_f64().unwrap();
+    let first = |arm: &str| json[arm]["per_seek_rms_error_deg"][0].as_f64().unwrap();
     assert!(
         first("compensated") < 0.6 * first("uncompensated"),
         "first seek: compensated {} vs uncompensated {}",

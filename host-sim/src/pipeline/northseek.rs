@@ -760,7 +760,8 @@ pub fn seek_stats(arms: &[ArmOutcome], true_azimuth_deg: f64) -> SeekStats {
         max_dev_deg: all.iter().fold(0.0f64, |m, e| m.max(e.abs())),
         mean_error_deg: mean(&all),
         rms_error_deg: rms(&all),
-        per_seek_std_deg: (0..n_seek).map(|k| rms(&column(k))).collect(),
+        per_seek_rms_error_deg: (0..n_seek).map(|k| rms(&column(k))).collect(),
+        per_seek_std_deg: (0..n_seek).map(|k| std_dev(&column(k))).collect(),
         per_seek_mean_error_deg: (0..n_seek).map(|k| mean(&column(k))).collect(),
         mean_range_deg: per_start(range),
         mean_within_start_std_deg: per_start(std_dev),
@@ -927,45 +928,48 @@ pub fn build_product_report(
     }
 }
 
-/// The per-seek table printed by `north-seek`, `reproduce` and `demo`.
+/// The per-seek table printed by `north-seek`, `reproduce` and `demo`: for each arm the rms
+/// error about the true azimuth, the mean error and the 1 sigma about that mean (rms^2 =
+/// mean^2 + sigma^2), per seek index over the starts and over all seeks.
 pub fn seek_table(r: &NorthSeekReport) -> String {
     let mut t = Table::new(&[
         "seek",
-        "uncomp. 1 sigma (deg)",
+        "uncomp. rms err (deg)",
         "uncomp. mean err (deg)",
-        "comp. 1 sigma (deg)",
+        "uncomp. 1 sigma (deg)",
+        "comp. rms err (deg)",
         "comp. mean err (deg)",
+        "comp. 1 sigma (deg)",
     ]);
-    for k in 0..r.uncompensated.per_seek_std_deg.len() {
-        t.row(&[
-            format!("{}", k + 1),
-            format!("{:.4}", r.uncompensated.per_seek_std_deg[k]),
-            format!("{:+.4}", r.uncompensated.per_seek_mean_error_deg[k]),
-            format!(
-                "{:.4}",
-                r.compensated
-                    .per_seek_std_deg
-                    .get(k)
-                    .copied()
-                    .unwrap_or(f64::NAN)
+    let cells = |s: &SeekStats, k: Option<usize>| -> [String; 3] {
+        let (rms, mean, std) = match k {
+            Some(k) => (
+                s.per_seek_rms_error_deg.get(k),
+                s.per_seek_mean_error_deg.get(k),
+                s.per_seek_std_deg.get(k),
             ),
-            format!(
-                "{:+.4}",
-                r.compensated
-                    .per_seek_mean_error_deg
-                    .get(k)
-                    .copied()
-                    .unwrap_or(f64::NAN)
+            None => (
+                Some(&s.rms_error_deg),
+                Some(&s.mean_error_deg),
+                Some(&s.std_deg),
             ),
-        ]);
+        };
+        let v = |x: Option<&f64>| x.copied().unwrap_or(f64::NAN);
+        [
+            format!("{:.4}", v(rms)),
+            format!("{:+.4}", v(mean)),
+            format!("{:.4}", v(std)),
+        ]
+    };
+    let rows = (0..r.uncompensated.per_seek_rms_error_deg.len())
+        .map(|k| (format!("{}", k + 1), Some(k)))
+        .chain(std::iter::once(("all".to_string(), None)));
+    for (label, k) in rows {
+        let mut row = vec![label];
+        row.extend(cells(&r.uncompensated, k));
+        row.extend(cells(&r.compensated, k));
+        t.row(&row);
     }
-    t.row(&[
-        "all".to_string(),
-        format!("{:.4}", r.uncompensated.std_deg),
-        format!("{:+.4}", r.uncompensated.mean_error_deg),
-        format!("{:.4}", r.compensated.std_deg),
-        format!("{:+.4}", r.compensated.mean_error_deg),
-    ]);
     format!(
         "{}noise floor (ARW {:.4} deg/sqrt(h), {:.0} s per position): {:.4} deg; compensated/floor = {:.2}\n\
          {}seek duration: mean {:.0} s, max {:.0} s (paper: {:.0} s)\n{}{}",
@@ -1182,7 +1186,10 @@ mod tests {
         let st = seek_stats(&seeks, 108.4);
         assert!((st.mean_error_deg).abs() < 1e-9);
         assert!((st.max_dev_deg - 0.1).abs() < 1e-9);
-        assert!((st.per_seek_std_deg[0] - 0.1).abs() < 1e-9);
+        // Seek 1 errs +0.1 and -0.1: rms 0.1 about the truth, 1 sigma (n - 1) sqrt(2) x 0.1.
+        assert!((st.per_seek_rms_error_deg[0] - 0.1).abs() < 1e-9);
+        assert!((st.per_seek_std_deg[0] - 0.1 * 2f64.sqrt()).abs() < 1e-9);
+        assert!(st.per_seek_rms_error_deg[1].abs() < 1e-9);
         assert!(st.per_seek_std_deg[1].abs() < 1e-9);
         assert!((st.mean_range_deg - 0.1).abs() < 1e-9);
     }

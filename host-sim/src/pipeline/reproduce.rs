@@ -129,7 +129,7 @@ pub struct Targets {
     /// Compensated azimuth std / white-noise floor, and whether it is <= 1.2.
     pub azimuth_std_over_floor: f64,
     pub azimuth_within_1_2x_floor: bool,
-    /// Uncompensated / compensated per-seek std of seeks 1 and 2.
+    /// Uncompensated / compensated rms error (about the true azimuth) of seeks 1 and 2.
     pub first_seeks_uncomp_over_comp: Vec<f64>,
     pub seek_time_within_paper: bool,
 }
@@ -457,8 +457,11 @@ fn measure_targets(per_ambient: &[AmbientResult], ns: &NorthSeekReport) -> Targe
         worst_time_to_spec_after_s: worst_time(|a| a.after.time_to_spec_s),
         azimuth_std_over_floor: ratio,
         azimuth_within_1_2x_floor: ratio <= 1.2,
-        first_seeks_uncomp_over_comp: (0..2.min(ns.compensated.per_seek_std_deg.len()))
-            .map(|k| ns.uncompensated.per_seek_std_deg[k] / ns.compensated.per_seek_std_deg[k])
+        first_seeks_uncomp_over_comp: (0..2.min(ns.compensated.per_seek_rms_error_deg.len()))
+            .map(|k| {
+                ns.uncompensated.per_seek_rms_error_deg[k]
+                    / ns.compensated.per_seek_rms_error_deg[k]
+            })
             .collect(),
         seek_time_within_paper: ns.max_seek_duration_s <= PAPER_SEEK_DURATION_S,
     }
@@ -586,7 +589,7 @@ fn model_summary(m: &ModelResult) -> String {
          - held-out compensated std <= {SPEC_DPH} deg/h at every ambient: worst {:.4} -> {}\n\
          - time to spec: worst before {}, worst after {}\n\
          - compensated azimuth std within 1.2x the noise floor: {:.2}x -> {}\n\
-         - uncompensated / compensated std of seeks 1, 2: {}\n\
+         - uncompensated / compensated rms error of seeks 1, 2: {}\n\
          - seek time <= 296 s: {}\n\n",
         m.label,
         m.training.n_centers,

@@ -37,7 +37,7 @@ pub fn seek_targets(r: &NorthSeekReport) -> Option<SeekTargets> {
     let c = &r.compensated;
     targets_of(
         c.std_deg,
-        &c.per_seek_std_deg,
+        &c.per_seek_rms_error_deg,
         &c.per_seek_mean_error_deg,
         r.noise_floor_deg,
     )

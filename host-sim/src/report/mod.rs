@@ -72,7 +72,9 @@ pub struct SeekStats {
     pub mean_error_deg: f64,
     /// Root mean square azimuth error against the truth, deg.
     pub rms_error_deg: f64,
-    /// 1 sigma (about the true azimuth, i.e. rms error) of each seek index over the starts, deg.
+    /// Rms error (about the true azimuth) of each seek index over the starts, deg.
+    pub per_seek_rms_error_deg: Vec<f64>,
+    /// 1 sigma (about that seek's mean error) of each seek index over the starts, deg.
     pub per_seek_std_deg: Vec<f64>,
     /// Mean error of each seek index over the starts, deg.
     pub per_seek_mean_error_deg: Vec<f64>,

@@ -71,7 +71,7 @@ pub fn error_stats(arms: &[ArmOutcome], true_azimuth_deg: f64) -> ErrorStats {
         std_deg: s.std_deg,
         mean_deg: s.mean_error_deg,
         rms_deg: s.rms_error_deg,
-        per_seek_rms_deg: s.per_seek_std_deg,
+        per_seek_rms_deg: s.per_seek_rms_error_deg,
         refused: s.reliability.refused,
         failed_seeks: s.reliability.failed_seeks,
     }
