@@ -4,12 +4,13 @@
 //!
 //! Builds `reproduce`'s qualification campaign for a seed (48 cold starts at each of the
 //! paper's 11 ambients, `QUALIFICATION_STREAM`), computes the three readings of the third
-//! state (plain d2T/dt2, flat-start d2T/dt2, rise since power-on) on the rows every one
-//! can use, cross-validates each over whole runs as the trainer's estimator step does
+//! state (plain d2T/dt2, flat-start d2T/dt2, rise since power-on) and a rate-free set (T
+//! and the rise, no dT/dt: the inputs whose first-minute noise is one 10 s mean's) on the
+//! rows every one can use, cross-validates each over whole runs as the trainer's estimator step does
 //! (shape chosen by the seek criterion), and turns each held-out run's residuals into its
 //! first back-to-back seek (blocks of 110 s from the first common row, |sin psi| = 1).
 //! Prints, per ambient, the rms of that first seek for each reading, and the mean paired
-//! difference of the squared errors (reading minus plain d2T/dt2) over the ambient's 48
+//! difference of the squared errors (each set minus plain d2T/dt2) over the ambient's 48
 //! runs with its standard error: what a per-ambient criterion could resolve.
 //!
 //! With `ESTIMATOR_POWER_DEPLOYED=1` each reading is scored in the form the qualification
@@ -19,6 +20,7 @@
 //! `target/release/examples/estimator_power SEED [RUNS_PER_AMBIENT]` (defaults 5, 48).
 
 use anyhow::{anyhow, Result};
+use fog_core::model::format::FeatureSpec;
 use fog_sim::io::runs::Run;
 use fog_sim::pipeline::campaign::CampaignSpec;
 use fog_sim::pipeline::campaign_steps::simulate_checked;
@@ -50,16 +52,20 @@ fn main() -> Result<()> {
         ..TrainConfig::default()
     };
     let seek = cfg.criterion.seek_geometry();
-    let sets = [
+    let sets: Vec<(&str, Vec<FeatureSpec>)> = [
         InputSet::TempRateAccel,
         InputSet::TempRateAccelFlat,
         InputSet::TempRateRise,
-    ];
+        InputSet::TempRise,
+    ]
+    .into_iter()
+    .map(|set| (set.name(), set.specs()))
+    .collect();
     // First seek of every run (squared azimuth error, deg^2), per set; rows from the
     // plain d2T/dt2's first ready row (30 s), the rows every reading can use.
     let mut first_sq: Vec<Vec<f64>> = Vec::new();
-    for set in sets {
-        let specs: Vec<_> = set.specs().into_iter().chain(clock).collect();
+    for (name, set_specs) in &sets {
+        let specs: Vec<_> = set_specs.iter().copied().chain(clock).collect();
         let full = dataset_from_runs(&runs, &specs).map_err(|e| anyhow!("{e}"))?;
         let keep: Vec<usize> = (0..full.len()).filter(|&i| full.t_s[i] >= 29.5).collect();
         let ds = full.subset(&keep);
@@ -73,20 +79,31 @@ fn main() -> Result<()> {
             1,
         );
         eprintln!(
-            "{}: width {:.2}, degree {}, held-out seek {:.5} deg",
-            set.name(),
-            cv.best.width,
-            cv.best.degree,
-            cv.best.heldout_seek_deg
+            "{name}: width {:.2}, degree {}, held-out seek {:.5} deg",
+            cv.best.width, cv.best.degree, cv.best.heldout_seek_deg
         );
         first_sq.push(per_run.iter().map(|r| r.sum_sq_deg2).collect());
     }
-    let mut ambients: Vec<f64> = ambient_of.clone();
+    let names: Vec<&str> = sets.iter().map(|(n, _)| *n).collect();
+    print_first_seeks(&names, &ambient_of, &first_sq);
+    Ok(())
+}
+
+/// Per ambient, each set's held-out first-seek rms and its paired difference from the
+/// first set (squared errors, with the standard error over the ambient's runs); then pooled.
+fn print_first_seeks(names: &[&str], ambient_of: &[f64], first_sq: &[Vec<f64>]) {
+    let mut ambients: Vec<f64> = ambient_of.to_vec();
     ambients.dedup();
-    println!("ambient  first seek rms accel / accel_flat / rise (deg)  flat - accel (deg^2, +-SE)  rise - accel");
-    let mut all = vec![Vec::new(); sets.len()];
+    println!(
+        "ambient  first seek rms {} (deg)  each minus {} (deg^2, +-SE)",
+        names.join(" / "),
+        names[0]
+    );
+    let mut all = vec![Vec::new(); names.len()];
     for a in ambients {
-        let idx: Vec<usize> = (0..runs.len()).filter(|&i| ambient_of[i] == a).collect();
+        let idx: Vec<usize> = (0..ambient_of.len())
+            .filter(|&i| ambient_of[i] == a)
+            .collect();
         let rms =
             |s: usize| (idx.iter().map(|&i| first_sq[s][i]).sum::<f64>() / idx.len() as f64).sqrt();
         let diff = |s: usize| {
@@ -102,21 +119,22 @@ fn main() -> Result<()> {
         for (s, col) in all.iter_mut().enumerate() {
             col.extend(idx.iter().map(|&i| first_sq[s][i]));
         }
-        let (f, fse) = diff(1);
-        let (r, rse) = diff(2);
+        let rms_cells: Vec<String> = (0..names.len()).map(|s| format!("{:.4}", rms(s))).collect();
+        let diff_cells: Vec<String> = (1..names.len())
+            .map(|s| {
+                let (m, se) = diff(s);
+                format!("{m:+.2e} +- {se:.1e}")
+            })
+            .collect();
         println!(
-            "{a:+5.0}    {:.4} / {:.4} / {:.4}    {f:+.2e} +- {fse:.1e}    {r:+.2e} +- {rse:.1e}",
-            rms(0),
-            rms(1),
-            rms(2)
+            "{a:+5.0}    {}    {}",
+            rms_cells.join(" / "),
+            diff_cells.join("    ")
         );
     }
-    let pooled = |s: usize| (all[s].iter().sum::<f64>() / all[s].len() as f64).sqrt();
-    println!(
-        "pooled   {:.4} / {:.4} / {:.4}",
-        pooled(0),
-        pooled(1),
-        pooled(2)
-    );
-    Ok(())
+    let pooled: Vec<String> = all
+        .iter()
+        .map(|col| format!("{:.4}", (col.iter().sum::<f64>() / col.len() as f64).sqrt()))
+        .collect();
+    println!("pooled   {}", pooled.join(" / "));
 }

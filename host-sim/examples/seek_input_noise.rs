@@ -103,6 +103,7 @@ fn model_under_test(
             dwell_s: 110.0,
             seed: 1,
             criterion: Criterion::seek_default(),
+            inputs: fog_sim::train::InputChoice::Auto,
         },
     )?;
     let mut specs = own.selection.chosen.specs();

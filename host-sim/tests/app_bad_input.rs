@@ -83,6 +83,27 @@ fn malformed_files_and_impossible_options_are_rejected() {
         &[&["north-seek", "--model", "garbage.bin"][..], &json].concat(),
         &["--model"],
     );
+    // `--inputs` chooses the trained default model's inputs: with `--model` it would be
+    // ignored, so it is refused by name; an unknown set is refused with the sets listed.
+    rejects(
+        &dir,
+        &[
+            &["north-seek", "--model", "garbage.bin", "--inputs", "t,rise"][..],
+            &json,
+        ]
+        .concat(),
+        &["--inputs", "--model garbage.bin"],
+    );
+    rejects(
+        &dir,
+        &[&["north-seek", "--inputs", "t,accel"][..], &json].concat(),
+        &["--inputs", "t,rise"],
+    );
+    rejects(
+        &dir,
+        &[&["reproduce", "--qualification-inputs", "rise"][..], &json].concat(),
+        &["--qualification-inputs", "t,rate,rise"],
+    );
     rejects(
         &dir,
         &[&["reproduce", "--minutes", "-5"][..], &json].concat(),

@@ -33,6 +33,7 @@ fn plan() -> OwnModelPlan {
             dwell_s: DWELL_S,
             latitude_deg: LATITUDE_DEG,
         }),
+        inputs: fog_sim::train::InputChoice::Auto,
     }
 }
 

@@ -68,6 +68,7 @@ const NAME_FLAGS: &[&str] = &[
     "--method",
     "--criterion",
     "--inputs",
+    "--qualification-inputs",
     "--preset",
     "--axis",
     "--time",

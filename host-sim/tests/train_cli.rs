@@ -3,7 +3,7 @@
 
 mod app_support;
 
-use fog_core::model::format::RbfModel;
+use fog_core::model::format::{FeatureKind, RbfModel};
 use std::path::Path;
 
 /// Writes one fog-runs v1 file of a warm-up whose drift follows dT/dt.
@@ -109,6 +109,11 @@ fn train_writes_a_valid_model_and_rejects_bad_input_without_output() {
         lin.linear_by_t.is_empty(),
         "no T-coupled terms unless asked"
     );
+    // --inputs t,rise: T and the rise since power-on, no dT/dt, as given.
+    let (rate_free, _) =
+        train_ok_printed(&runs, &dir.join("model_rise.bin"), &["--inputs", "t,rise"]);
+    let kinds: Vec<FeatureKind> = rate_free.inputs.iter().map(|s| s.kind).collect();
+    assert_eq!(kinds, [FeatureKind::TempC, FeatureKind::TempRiseC]);
     // --linear-by-t: beside each of them a coefficient of T x input (the dT/dt one here;
     // T x T is the polynomial's), written in format version 4.
     let coupled_path = dir.join("model_lin_t.bin");

@@ -46,6 +46,7 @@ pub fn run(args: Args) -> Result<()> {
         Some(args.out.clone()),
         // The demo stays short: `reproduce` adds the qualification model.
         0,
+        crate::train::InputChoice::Auto,
     )?;
     prepare_output_dir(&OutputGuard::default(), Some(&args.out), "--out")?;
     let started = std::time::Instant::now();

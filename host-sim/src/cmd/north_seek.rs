@@ -72,6 +72,11 @@ pub struct Args {
     /// dwell and latitude are this Monte Carlo's).
     #[arg(long, default_value = crate::train::seek_score::DEFAULT_CRITERION_NAME)]
     pub criterion: String,
+    /// The default model's inputs (as `train --inputs`): `auto` (chosen by validation) or
+    /// a set, e.g. `t,rise`; the warm-up clock and linear terms are still the recipe's.
+    /// Refused with `--model`, which brings its own inputs.
+    #[arg(long, value_parser = crate::train::InputChoice::parse)]
+    pub inputs: Option<crate::train::InputChoice>,
 }
 
 /// Turns the options into a Monte Carlo configuration, rejecting impossible values.
@@ -115,6 +120,12 @@ pub fn run(args: Args) -> Result<()> {
         cfg.latitude_deg,
     )
     .map_err(|e| anyhow::anyhow!("--criterion {e}"))?;
+    if let (Some(_), Some(m)) = (args.inputs, &args.model) {
+        bail!(
+            "--inputs chooses the inputs of the model north-seek trains; --model {} brings its own",
+            m.display()
+        );
+    }
     let guard = match &args.model {
         Some(m) => OutputGuard::new(&[m]),
         None => OutputGuard::default(),
@@ -137,6 +148,7 @@ pub fn run(args: Args) -> Result<()> {
                 dwell_s: cfg.dwell_s as f64,
                 seed: cfg.seed,
                 criterion,
+                inputs: args.inputs.unwrap_or(crate::train::InputChoice::Auto),
             };
             let own = train_own_model(&params, &plan)?;
             eprint!("{}", own.selection.summary());

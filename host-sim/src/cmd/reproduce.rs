@@ -14,6 +14,7 @@ use crate::pipeline::northseek::{default_threads, MonteCarloConfig};
 use crate::pipeline::reproduce::{reproduce, summary, validation_tables, ReproduceOptions};
 use crate::report::write_json;
 use crate::sim::GyroParams;
+use crate::train::InputChoice;
 
 /// Training runs per temperature (the paper's protocol).
 pub const TRAIN_RUNS: usize = 3;
@@ -58,6 +59,11 @@ pub struct Args {
     /// warm-up clock, linear terms where they score better); 0: no third model.
     #[arg(long = "qualification-runs", default_value_t = crate::pipeline::own_model::CAMPAIGN_RUNS)]
     pub qualification_runs: usize,
+    /// The qualification model's inputs, as `train --inputs` takes them: `auto` (chosen by
+    /// validation) or a set, e.g. `t,rise` (T and the rise since power-on, no dT/dt); the
+    /// warm-up clock and the linear terms are still the recipe's.
+    #[arg(long = "qualification-inputs", default_value = "auto", value_parser = InputChoice::parse)]
+    pub qualification_inputs: InputChoice,
 }
 
 /// Checks the options and builds the pipeline's settings.
@@ -67,6 +73,7 @@ pub fn options(
     threads: Option<usize>,
     plots: Option<PathBuf>,
     qualification_runs: usize,
+    qualification_inputs: InputChoice,
 ) -> Result<ReproduceOptions> {
     validate_plan(&campaign).map_err(|e| super::with_plan_flag(e.into()))?;
     if campaign.runs_per_ambient <= TRAIN_RUNS {
@@ -106,6 +113,7 @@ pub fn options(
         north_seek,
         plots,
         qualification_runs,
+        qualification_inputs,
     })
 }
 
@@ -125,6 +133,7 @@ pub fn run(args: Args) -> Result<()> {
         args.threads,
         args.outputs.plots.clone(),
         args.qualification_runs,
+        args.qualification_inputs,
     )?;
     let report = reproduce(&GyroParams::paper_default(), &opts).map_err(super::with_plan_flag)?;
     print!("{}\n{}", validation_tables(&report), summary(&report));

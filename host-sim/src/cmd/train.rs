@@ -82,7 +82,7 @@ pub struct Args {
     /// Model inputs: `t,rate` (T, dT/dt), `t,rate,accel` (and d2T/dt2, computed by
     /// fog-core as on the device), `t,rate,accel_flat` (d2T/dt2 with the series flat
     /// before power-on), `t,rate,rise` (the temperature rise since power-on instead of
-    /// d2T/dt2) or `auto` (each scored by grouped cross-validation over whole runs on the
+    /// d2T/dt2), `t,rise` (T and the rise, no dT/dt; only on request) or `auto` (each scored by grouped cross-validation over whole runs on the
     /// same points: the inputs by the 10 s rms, how d2T/dt2's third state is read by
     /// `--criterion`; a later set must win run by run).
     #[arg(long, default_value = "auto", value_parser = InputChoice::parse)]

@@ -61,8 +61,8 @@ use crate::io::runs::Run;
 use crate::sim::GyroParams;
 use crate::train::seek_score::{seek_azimuth_rms_deg, Criterion};
 use crate::train::{
-    choose_inputs_default, dataset_from_runs, predict_batch, InputSelection, InputSet, TrainConfig,
-    TrainOutcome,
+    choose_inputs_default, dataset_from_runs, predict_batch, InputChoice, InputSelection,
+    TrainConfig, TrainOutcome,
 };
 
 /// Runs of the own model's chamber campaign at its ambient (45 min each: 36 h of chamber
@@ -91,6 +91,9 @@ pub struct OwnModelPlan {
     pub dwell_s: f64,
     pub seed: u64,
     pub criterion: Criterion,
+    /// The input sets the recipe's input step chooses from (`auto`: `train`'s defaults;
+    /// a fixed set is taken as given, the clock and linear terms still by the recipe).
+    pub inputs: InputChoice,
 }
 
 /// The trained own model and how its run count was chosen.
@@ -183,7 +186,8 @@ pub fn own_model_from_runs(
     // `train`'s defaults, with the plan's criterion choosing the d2T/dt2 estimator as well
     // as the shape. (Scoring each set with the clock beside it was tried and not kept:
     // docs/northfinder.md, "The one global model over training campaigns".)
-    let (selection, _) = choose_inputs_default(&runs, &InputSet::ALL, &train_config(plan, false))
+    let candidates = plan.inputs.candidates();
+    let (selection, _) = choose_inputs_default(&runs, &candidates, &train_config(plan, false))
         .map_err(|e| anyhow!("choosing the own model's inputs: {e}"))?;
     let clock_tau_s = warmup_time_constant_s(&runs)?;
     let specs: Vec<FeatureSpec> = selection
@@ -349,6 +353,7 @@ mod tests {
             dwell_s: 110.0,
             seed: 1,
             criterion: Criterion::seek_default(),
+            inputs: InputChoice::Auto,
         }
     }
 
@@ -403,6 +408,37 @@ mod tests {
             null < 0.05 * base,
             "identical runs {null:.6} deg vs {base:.5} deg"
         );
+    }
+
+    #[test]
+    fn a_fixed_input_set_reaches_the_model_with_the_clock_beside_it() {
+        let fixed = OwnModelPlan {
+            inputs: InputChoice::Fixed(crate::train::InputSet::TempRise),
+            ..plan()
+        };
+        let own = own_model_from_runs(
+            &GyroParams::paper_default(),
+            runs(&GyroParams::paper_default(), 6),
+            &fixed,
+        )
+        .unwrap();
+        let kinds: Vec<FeatureKind> = own.trained.model.inputs.iter().map(|s| s.kind).collect();
+        assert_eq!(
+            kinds,
+            [
+                FeatureKind::TempC,
+                FeatureKind::TempRiseC,
+                FeatureKind::PowerOnDecay
+            ]
+        );
+        // The default still chooses by validation, and never the rate-free set.
+        let auto = own_model_from_runs(
+            &GyroParams::paper_default(),
+            runs(&GyroParams::paper_default(), 6),
+            &plan(),
+        )
+        .unwrap();
+        assert_eq!(auto.trained.model.inputs[1].kind, FeatureKind::TempRateCps);
     }
 
     #[test]

@@ -28,7 +28,9 @@ use crate::report::{
 };
 use crate::sim::{GyroParams, RunSpec, SimGyro, StartState};
 use crate::stats::{allan, SPEC_DPH};
-use crate::train::{choose_inputs_default, InputSelection, InputSet, TrainConfig, TrainReport};
+use crate::train::{
+    choose_inputs_default, InputChoice, InputSelection, InputSet, TrainConfig, TrainReport,
+};
 use fog_core::model::format::FeatureSpec;
 
 /// Everything a reproduce run needs.
@@ -42,6 +44,8 @@ pub struct ReproduceOptions {
     /// Cold starts per ambient of the qualification campaign the third model (one global
     /// model by `north-seek`'s own-model recipe) is trained on; 0: no third model.
     pub qualification_runs: usize,
+    /// The qualification model's input sets (`auto`: the recipe's validated choice).
+    pub qualification_inputs: InputChoice,
 }
 
 /// Seed stream of the qualification campaign (`derive_seed(seed, this, 0)`): its runs
@@ -83,7 +87,7 @@ pub struct InputVariant {
 
 /// File name of a variant's deployable model (written beside its plots).
 pub fn model_file_name(specs: &[FeatureSpec]) -> String {
-    let set = InputSet::ALL
+    let set = InputSet::NAMED
         .into_iter()
         .find(|s| s.specs() == specs)
         .map_or("custom", InputSet::name);
@@ -278,6 +282,7 @@ fn qualification_model(params: &GyroParams, opts: &ReproduceOptions) -> Result<O
         dwell_s: f64::from(opts.north_seek.dwell_s),
         seed: plan.seed,
         criterion: TrainConfig::default().criterion,
+        inputs: opts.qualification_inputs,
     };
     own_model_from_runs(
         params,

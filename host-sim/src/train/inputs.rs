@@ -56,6 +56,14 @@ pub enum InputSet {
     /// from the first reading instead of a second derivative of the first few.
     #[serde(rename = "t,rate,rise")]
     TempRateRise,
+    /// T and the temperature rise since power-on, no dT/dt: for soaked cold starts with
+    /// the warm-up clock beside it (`own_model::clock_spec`) the same warm-up state, read
+    /// without a derivative, so the first minutes carry one 10 s mean's noise instead of a
+    /// few-row slope's (docs/northfinder.md, "Without dT/dt"). Only on request (`--inputs
+    /// t,rise`): `auto` does not offer it, since without the clock it does not follow a
+    /// warm-up, and the held-out scores cannot yet tell when it wins.
+    #[serde(rename = "t,rise")]
+    TempRise,
 }
 
 impl InputSet {
@@ -68,6 +76,15 @@ impl InputSet {
         InputSet::TempRateRise,
     ];
 
+    /// Every set `--inputs` can name: `ALL`, then the sets offered only on request.
+    pub const NAMED: [InputSet; 5] = [
+        InputSet::TempRate,
+        InputSet::TempRateAccel,
+        InputSet::TempRateAccelFlat,
+        InputSet::TempRateRise,
+        InputSet::TempRise,
+    ];
+
     /// The command-line name.
     pub fn name(self) -> &'static str {
         match self {
@@ -75,6 +92,7 @@ impl InputSet {
             InputSet::TempRateAccel => "t,rate,accel",
             InputSet::TempRateAccelFlat => "t,rate,accel_flat",
             InputSet::TempRateRise => "t,rate,rise",
+            InputSet::TempRise => "t,rise",
         }
     }
 
@@ -88,6 +106,12 @@ impl InputSet {
                 specs.push(FeatureSpec::plain(FeatureKind::TempAccelFlatStartCps2))
             }
             InputSet::TempRateRise => specs.push(FeatureSpec::plain(FeatureKind::TempRiseC)),
+            InputSet::TempRise => {
+                specs = vec![
+                    FeatureSpec::plain(FeatureKind::TempC),
+                    FeatureSpec::plain(FeatureKind::TempRiseC),
+                ]
+            }
         }
         specs
     }
@@ -107,11 +131,11 @@ impl InputSet {
         }
     }
 
-    /// Parses `t,rate`, `t,rate,accel`, `t,rate,accel_flat` or `t,rate,rise` (spaces
-    /// ignored).
+    /// Parses `t,rate`, `t,rate,accel`, `t,rate,accel_flat`, `t,rate,rise` or `t,rise`
+    /// (spaces ignored).
     pub fn parse(s: &str) -> Option<Self> {
         let s: String = s.chars().filter(|c| !c.is_whitespace()).collect();
-        Self::ALL.into_iter().find(|set| set.name() == s)
+        Self::NAMED.into_iter().find(|set| set.name() == s)
     }
 }
 
@@ -130,7 +154,7 @@ impl InputChoice {
         }
         InputSet::parse(s).map(InputChoice::Fixed).ok_or_else(|| {
             format!(
-                "`{s}` is not an input set (use auto, t,rate, t,rate,accel, t,rate,accel_flat or t,rate,rise)"
+                "`{s}` is not an input set (use auto, t,rate, t,rate,accel, t,rate,accel_flat, t,rate,rise or t,rise)"
             )
         })
     }
@@ -431,7 +455,7 @@ pub fn choose_inputs(
         return Ok((
             InputSelection {
                 chosen,
-                criterion: "given by --inputs".into(),
+                criterion: "request: one set given, none chosen".into(),
                 scores: Vec::new(),
                 estimator: None,
             },
@@ -516,6 +540,17 @@ mod tests {
             InputSet::TempRateRise.specs()[2].kind,
             FeatureKind::TempRiseC
         );
+        // The rate-free set: T and the rise, named only on request, never offered by auto.
+        assert_eq!(
+            InputChoice::parse("t,rise"),
+            Ok(InputChoice::Fixed(InputSet::TempRise))
+        );
+        let kinds: Vec<FeatureKind> = InputSet::TempRise.specs().iter().map(|s| s.kind).collect();
+        assert_eq!(kinds, [FeatureKind::TempC, FeatureKind::TempRiseC]);
+        assert!(!InputChoice::Auto.candidates().contains(&InputSet::TempRise));
+        assert!(InputSet::NAMED
+            .iter()
+            .all(|s| InputSet::parse(s.name()) == Some(*s)));
         // Alternatives are tried only after the plain d2T/dt2 won the first step.
         assert!(InputSet::ALL
             .iter()

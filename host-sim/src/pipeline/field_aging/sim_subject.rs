@@ -84,6 +84,7 @@ fn own_model_plan(plan: &AgingPlan) -> Result<OwnModelPlan> {
             plan.latitude_deg,
         )
         .map_err(|e| anyhow::anyhow!("criterion: {e}"))?,
+        inputs: crate::train::InputChoice::Auto,
     })
 }
 
