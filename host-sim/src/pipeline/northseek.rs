@@ -929,8 +929,9 @@ pub fn build_product_report(
 }
 
 /// The per-seek table printed by `north-seek`, `reproduce` and `demo`: for each arm the rms
-/// error about the true azimuth, the mean error and the 1 sigma about that mean (rms^2 =
-/// mean^2 + sigma^2), per seek index over the starts and over all seeks.
+/// error about the true azimuth, the mean error and the 1 sigma about that mean (sample
+/// std, n - 1: rms^2 = mean^2 + sigma^2 (n - 1) / n), per seek index over the starts and
+/// over all seeks.
 pub fn seek_table(r: &NorthSeekReport) -> String {
     let mut t = Table::new(&[
         "seek",
