@@ -1,0 +1,95 @@
+//! Does the final qualification model carry a warm-up misfit at one ambient that its
+//! seeks turn into a bias? The held-out scores that choose the model are the fold models',
+//! which pick their own centres and so do not share the final fit's particular misfit
+//! (docs/northfinder.md, "Without dT/dt"). This scores the final model itself: its
+//! residuals on its own training runs, each run's first three seeks in the Monte Carlo's
+//! timing (position 0 on the 10 s means ending in (270k + 13, 270k + 113] s, position 180 in
+//! (270k + 169, 270k + 269] s, azimuth error -(e0 - e180) / (2 Omega_H sin psi), psi 108.4
+//! deg), averaged over the runs of one ambient with its standard error.
+//!
+//! Builds `reproduce`'s qualification campaign for a seed (48 cold starts at each of the
+//! paper's 11 ambients) and trains the qualification model by the own-model recipe, with
+//! `t,rise` or `auto` inputs as `reproduce --qualification-inputs` would.
+//!
+//! `target/release/examples/end_misfit SEED [auto|t,rise]` (defaults 5, auto).
+
+use anyhow::{anyhow, Result};
+use fog_core::consts::earth_rate_horizontal_dph;
+use fog_sim::io::runs::Run;
+use fog_sim::pipeline::campaign::CampaignSpec;
+use fog_sim::pipeline::campaign_steps::simulate_checked;
+use fog_sim::pipeline::own_model::{own_model_from_runs, OwnModelPlan};
+use fog_sim::pipeline::reproduce::qualification_campaign_spec;
+use fog_sim::train::{dataset_from_runs, predict_batch, InputChoice, TrainConfig};
+
+const TRUE_AZIMUTH_DEG: f64 = 108.4;
+const SEEKS: usize = 3;
+
+fn main() -> Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let seed: u64 = args.first().map_or(Ok(5), |s| s.parse())?;
+    let inputs = InputChoice::parse(args.get(1).map_or("auto", String::as_str))
+        .map_err(|e| anyhow!("{e}"))?;
+    let paper = CampaignSpec::paper(seed);
+    let params = fog_sim::sim::GyroParams::paper_default();
+    let campaign = simulate_checked(&params, &qualification_campaign_spec(&paper, 48))?;
+    let ambient_of: Vec<f64> = campaign.iter().map(|c| c.ambient_c).collect();
+    let runs: Vec<Run> = campaign.into_iter().map(|c| c.run).collect();
+    let plan = OwnModelPlan {
+        ambient_c: 20.0,
+        latitude_deg: paper.latitude_deg,
+        dwell_s: 110.0,
+        seed,
+        criterion: TrainConfig::default().criterion,
+        inputs,
+    };
+    let own = own_model_from_runs(&params, runs.clone(), &plan)?;
+    eprint!("{}{}", own.selection.summary(), own.summary());
+    let ds = dataset_from_runs(&runs, &own.specs).map_err(|e| anyhow!("{e}"))?;
+    let predicted = predict_batch(&own.trained.model, ds.rows()).map_err(|e| anyhow!("{e}"))?;
+    let scale = 2.0
+        * earth_rate_horizontal_dph(paper.latitude_deg)
+        * TRUE_AZIMUTH_DEG.to_radians().sin().abs();
+    // Each run's seek errors from its residuals, deg.
+    let mut per_run: Vec<[f64; SEEKS]> = vec![[f64::NAN; SEEKS]; runs.len()];
+    let mut start = 0;
+    while start < ds.len() {
+        let g = ds.groups[start];
+        let end = (start..ds.len())
+            .find(|&i| ds.groups[i] != g)
+            .unwrap_or(ds.len());
+        let block_mean = |lo: f64, hi: f64| {
+            let v: Vec<f64> = (start..end)
+                .filter(|&i| ds.t_s[i] > lo && ds.t_s[i] <= hi)
+                .map(|i| ds.targets_dph[i] - predicted[i])
+                .collect();
+            v.iter().sum::<f64>() / v.len() as f64
+        };
+        for (k, slot) in per_run[g as usize].iter_mut().enumerate() {
+            let t0 = 270.0 * k as f64;
+            let e0 = block_mean(t0 + 13.0, t0 + 113.0);
+            let e180 = block_mean(t0 + 169.0, t0 + 269.0);
+            *slot = (-(e0 - e180) / scale).to_degrees();
+        }
+        start = end;
+    }
+    let mut ambients = ambient_of.clone();
+    ambients.dedup();
+    println!("ambient  seek 1 / 2 / 3 bias of the final model on its training runs, deg (+- SE)");
+    for a in ambients {
+        let cells: Vec<String> = (0..SEEKS)
+            .map(|k| {
+                let v: Vec<f64> = (0..runs.len())
+                    .filter(|&r| ambient_of[r] == a)
+                    .map(|r| per_run[r][k])
+                    .collect();
+                let n = v.len() as f64;
+                let m = v.iter().sum::<f64>() / n;
+                let sd = (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+                format!("{m:+.4} +- {:.4}", sd / n.sqrt())
+            })
+            .collect();
+        println!("{a:+5.0}    {}", cells.join("   "));
+    }
+    Ok(())
+}
