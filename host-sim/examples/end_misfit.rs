@@ -18,9 +18,10 @@ use fog_core::consts::earth_rate_horizontal_dph;
 use fog_sim::io::runs::Run;
 use fog_sim::pipeline::campaign::CampaignSpec;
 use fog_sim::pipeline::campaign_steps::simulate_checked;
-use fog_sim::pipeline::own_model::{own_model_from_runs, OwnModelPlan};
-use fog_sim::pipeline::reproduce::qualification_campaign_spec;
-use fog_sim::train::{dataset_from_runs, predict_batch, InputChoice, TrainConfig};
+use fog_sim::pipeline::northseek::MonteCarloConfig;
+use fog_sim::pipeline::own_model::own_model_from_runs;
+use fog_sim::pipeline::reproduce::{qualification_campaign_spec, qualification_plan};
+use fog_sim::train::{dataset_from_runs, predict_batch, InputChoice};
 
 const TRUE_AZIMUTH_DEG: f64 = 108.4;
 const SEEKS: usize = 3;
@@ -35,14 +36,12 @@ fn main() -> Result<()> {
     let campaign = simulate_checked(&params, &qualification_campaign_spec(&paper, 48))?;
     let ambient_of: Vec<f64> = campaign.iter().map(|c| c.ambient_c).collect();
     let runs: Vec<Run> = campaign.into_iter().map(|c| c.run).collect();
-    let plan = OwnModelPlan {
+    // `reproduce`'s plan: its Monte Carlo seeks at 20 degC first (the paper's room).
+    let north_seek = MonteCarloConfig {
         ambient_c: 20.0,
-        latitude_deg: paper.latitude_deg,
-        dwell_s: 110.0,
-        seed,
-        criterion: TrainConfig::default().criterion,
-        inputs,
+        ..MonteCarloConfig::paper(seed)
     };
+    let plan = qualification_plan(&paper, &north_seek, inputs);
     let own = own_model_from_runs(&params, runs.clone(), &plan)?;
     eprint!("{}{}", own.selection.summary(), own.summary());
     let ds = dataset_from_runs(&runs, &own.specs).map_err(|e| anyhow!("{e}"))?;

@@ -276,19 +276,29 @@ fn qualification_model(params: &GyroParams, opts: &ReproduceOptions) -> Result<O
         params,
         &qualification_campaign_spec(plan, opts.qualification_runs),
     )?;
-    let own_plan = OwnModelPlan {
-        ambient_c: opts.north_seek.ambient_c,
-        latitude_deg: plan.latitude_deg,
-        dwell_s: f64::from(opts.north_seek.dwell_s),
-        seed: plan.seed,
-        criterion: TrainConfig::default().criterion,
-        inputs: opts.qualification_inputs,
-    };
     own_model_from_runs(
         params,
         campaign.into_iter().map(|c| c.run).collect(),
-        &own_plan,
+        &qualification_plan(plan, &opts.north_seek, opts.qualification_inputs),
     )
+}
+
+/// The own-model recipe's plan for the qualification model of campaign `plan`: the seek
+/// criterion at the Monte Carlo's `north_seek` dwell and the site's latitude, inputs from
+/// `inputs`.
+pub fn qualification_plan(
+    plan: &CampaignSpec,
+    north_seek: &MonteCarloConfig,
+    inputs: InputChoice,
+) -> OwnModelPlan {
+    OwnModelPlan {
+        ambient_c: north_seek.ambient_c,
+        latitude_deg: plan.latitude_deg,
+        dwell_s: f64::from(north_seek.dwell_s),
+        seed: plan.seed,
+        criterion: TrainConfig::default().criterion,
+        inputs,
+    }
 }
 
 /// The qualification campaign of a paper campaign `plan`: `runs_per_ambient` cold starts at
