@@ -3,8 +3,11 @@
 
 Input: the CSV of `target/release/examples/misfit_rows MODEL RUNS...` (measured drift and
 the model's prediction per 10 s window). For each ambient and each of seeks 1-3 (the
-Monte Carlo's timing: position 0 rows ending in (270k+13, 270k+113] s, position 180 in
-(270k+169, 270k+269] s; psi 108.4 deg, latitude 39.9 deg) it prints, over the runs:
+Monte Carlo's timing as `pipeline::seek_schedule` measures it: position 0 on the windows
+(270k+10, 270k+120] s, position 180 on (270k+140, 270k+250] s, i.e. rows ending in
+(270k+19, 270k+120] and (270k+149, 270k+250]; psi 108.4 deg, latitude 39.9 deg; until
+2026-11-26 this used (270k+13, 270k+113] and (270k+169, 270k+269], a guess 20-30 s off at
+position 180) it prints, over the runs:
 bias (mean azimuth error: the model's drift misfit averaged over the dwells, systematic
 across starts), std (scatter: gyro noise plus the model's) and the scatter of the model's
 own predicted seek difference (the inputs' noise through the model), deg; then the mean
@@ -29,8 +32,8 @@ for amb in sorted({a for a,_ in runs}):
         s=k*270.0
         errs=[];preds=[]
         for rows in rs:
-            w0=[(b-p,p) for t,b,p in rows if s+13<t<=s+113]
-            w1=[(b-p,p) for t,b,p in rows if s+169<t<=s+269]
+            w0=[(b-p,p) for t,b,p in rows if s+19<t<=s+120]
+            w1=[(b-p,p) for t,b,p in rows if s+149<t<=s+250]
             if len(w0)<5 or len(w1)<5: continue
             errs.append(az(mean([x for x,_ in w0]),mean([x for x,_ in w1])))
             preds.append(az(mean([p for _,p in w0]),mean([p for _,p in w1])))

@@ -3,15 +3,16 @@
 //! which pick their own centres and so do not share the final fit's particular misfit
 //! (docs/northfinder.md, "Without dT/dt"). This scores the final model itself: its
 //! residuals on its own training runs, each run's first three seeks in the Monte Carlo's
-//! timing (position 0 on the 10 s means ending in (270k + 13, 270k + 113] s, position 180 in
-//! (270k + 169, 270k + 269] s, azimuth error -(e0 - e180) / (2 Omega_H sin psi), psi 108.4
-//! deg), averaged over the runs of one ambient with its standard error.
+//! timing (the measured `pipeline::seek_schedule`: the rows whose 10 s interval lies in
+//! each main position's accepted windows; azimuth error -(e0 - e180) / (2 Omega_H sin
+//! psi), psi 108.4 deg), averaged over the runs of one ambient with its standard error.
 //!
 //! Builds `reproduce`'s qualification campaign for a seed (48 cold starts at each of the
 //! paper's 11 ambients) and trains the qualification model by the own-model recipe, with
-//! `t,rise` or `auto` inputs as `reproduce --qualification-inputs` would.
+//! `t,rise` or `auto` inputs as `reproduce --qualification-inputs` would; `norefit`
+//! leaves out the recipe's seek refit (`train::seek_refit`) to show what it removed.
 //!
-//! `target/release/examples/end_misfit SEED [auto|t,rise]` (defaults 5, auto).
+//! `target/release/examples/end_misfit SEED [auto|t,rise] [norefit]` (defaults 5, auto).
 
 use anyhow::{anyhow, Result};
 use fog_core::consts::earth_rate_horizontal_dph;
@@ -41,7 +42,14 @@ fn main() -> Result<()> {
         ambient_c: 20.0,
         ..MonteCarloConfig::paper(seed)
     };
-    let plan = qualification_plan(&paper, &north_seek, inputs);
+    let mut plan = qualification_plan(&params, &paper, &north_seek, inputs)?;
+    let schedule = plan
+        .seek_schedule
+        .clone()
+        .ok_or_else(|| anyhow!("no seek schedule"))?;
+    if args.get(2).is_some_and(|a| a == "norefit") {
+        plan.seek_schedule = None;
+    }
     let own = own_model_from_runs(&params, runs.clone(), &plan)?;
     eprint!("{}{}", own.selection.summary(), own.summary());
     let ds = dataset_from_runs(&runs, &own.specs).map_err(|e| anyhow!("{e}"))?;
@@ -64,10 +72,13 @@ fn main() -> Result<()> {
                 .collect();
             v.iter().sum::<f64>() / v.len() as f64
         };
-        for (k, slot) in per_run[g as usize].iter_mut().enumerate() {
-            let t0 = 270.0 * k as f64;
-            let e0 = block_mean(t0 + 13.0, t0 + 113.0);
-            let e180 = block_mean(t0 + 169.0, t0 + 269.0);
+        for (slot, pair) in per_run[g as usize]
+            .iter_mut()
+            .zip(&schedule.pairs_until(ds.t_s[end - 1]))
+        {
+            // A 10 s row ending at t covers (t - 10, t]: inside when both ends are.
+            let e0 = block_mean(pair.first_s.0 + 9.5, pair.first_s.1);
+            let e180 = block_mean(pair.second_s.0 + 9.5, pair.second_s.1);
             *slot = (-(e0 - e180) / scale).to_degrees();
         }
         start = end;

@@ -422,3 +422,55 @@ fn train_field_counts_records_under_a_heading_calibrated_variant_the_registry_kn
     assert!(!twin_path.exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn train_seek_refit_reports_its_weight_and_refuses_runs_without_a_whole_seek() {
+    let dir = std::env::temp_dir().join(format!("fogsim_train_refit_{}", std::process::id()));
+    let long = dir.join("long");
+    let short = dir.join("short");
+    std::fs::create_dir_all(&long).unwrap();
+    std::fs::create_dir_all(&short).unwrap();
+    for (a, amb) in [0.0, 20.0].iter().enumerate() {
+        for r in 0..3 {
+            write_run(&long.join(format!("a{a}_run{r}.csv")), *amb, r);
+            // The same warm-up cut at 200 s: no seek's two positions (to 250 s) are in it.
+            let text = std::fs::read_to_string(long.join(format!("a{a}_run{r}.csv"))).unwrap();
+            let cut: Vec<&str> = text.lines().take(3 + 20).collect();
+            std::fs::write(
+                short.join(format!("a{a}_run{r}.csv")),
+                cut.join("\n") + "\n",
+            )
+            .unwrap();
+        }
+    }
+    let model = dir.join("m.bin");
+    let json = dir.join("m.json");
+    let (_, printed) = train_ok_printed(
+        &long,
+        &model,
+        &["--seek-refit", "--json", json.to_str().unwrap()],
+    );
+    let line = printed
+        .lines()
+        .find(|l| l.starts_with("seek refit: pair weight"))
+        .unwrap_or_else(|| panic!("no seek refit line in\n{printed}"));
+    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let refit = &report["seek_refit"];
+    // 6 runs of 1,200 s: 4 seeks each (the device's 270 s seek).
+    assert_eq!(refit["pair_rows"], 24, "{refit}");
+    assert_eq!(
+        refit["bias_rms_deg"].as_array().unwrap().len(),
+        9,
+        "{refit}"
+    );
+    let w = refit["weight"].as_f64().unwrap();
+    assert!(line.contains(&format!("pair weight {w} ")), "{line}");
+    let short_model = dir.join("short.bin");
+    let err = train_refused(&short, &short_model, &["--widths", "0.5,1", "--seek-refit"]);
+    assert!(
+        err.contains("--seek-refit") && err.contains("no run has rows over both positions"),
+        "{err}"
+    );
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

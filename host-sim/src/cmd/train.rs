@@ -9,6 +9,7 @@
 use super::check_output_file;
 use crate::io::runs::run_files;
 use crate::io::{read_runs_binned, OutputGuard, OutputLock, StagedFiles};
+use crate::train::seek_refit::{refit_for_seeks, SeekRefit};
 use crate::train::{
     choose_inputs_default, train_model, InputChoice, InputSelection, Method, TrainConfig,
     TrainOutcome, TrainReport, Verdict, WidthSearch, GUARD_RATIO,
@@ -102,6 +103,14 @@ pub struct Args {
     /// score), deg.
     #[arg(long = "seek-latitude-deg", default_value_t = crate::sim::DEFAULT_LATITUDE_DEG, allow_negative_numbers = true)]
     pub seek_latitude: f64,
+    /// Refit the final model's output layer to the seeks of the north finder's own
+    /// sequence at `--seek-dwell-s` and `--seek-latitude-deg` (the simulated device's
+    /// timing, measured), with the weight of a seek pair chosen over folds of runs
+    /// (`fog_sim::train::seek_refit`). The runs must be cold starts timed from power-on:
+    /// the seeks are counted from t = 0. `north-seek` and `reproduce` do this for the
+    /// models they train.
+    #[arg(long)]
+    pub seek_refit: bool,
     /// Write the training report as JSON here.
     #[arg(long)]
     pub json: Option<PathBuf>,
@@ -192,6 +201,8 @@ pub struct TrainCommandReport<'a> {
     pub training: &'a TrainReport,
     pub input_selection: &'a InputSelection,
     pub gyro_id: &'a str,
+    /// `--seek-refit`: how the output layer was refitted (None without it).
+    pub seek_refit: Option<&'a SeekRefit>,
 }
 
 /// Checks the outputs before anything is read: creatable, not inputs, distinct.
@@ -307,11 +318,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if args.inputs == InputChoice::Auto {
         print!("{}", selection.summary());
     }
-    let outcome = train_model(&ds, &cfg)?;
+    let mut outcome = train_model(&ds, &cfg)?;
+    let refit = match args.seek_refit {
+        true => Some(refit_to_device_seeks(&args, &runs, &ds, &outcome.model)?),
+        false => None,
+    };
+    if let Some(r) = &refit {
+        outcome.model = r.model.clone();
+    }
     let report = TrainCommandReport {
         training: &outcome.report,
         input_selection: &selection,
         gyro_id: &cfg.gyro_id,
+        seek_refit: refit.as_ref(),
     };
     let json = match &args.json {
         Some(_) => Some(serde_json::to_vec_pretty(&report)?),
@@ -357,7 +376,39 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     staged.commit().context("committing the outputs")?;
     print!("{}", summary(&outcome, runs.len(), len));
+    if let Some(r) = &refit {
+        println!("{}", r.summary());
+    }
     Ok(())
+}
+
+/// `--seek-refit`: the device's seek timing at the command's seek dwell and latitude
+/// (measured on the simulated device), the runs grouped by their first temperature.
+fn refit_to_device_seeks(
+    args: &Args,
+    runs: &[crate::io::runs::Run],
+    ds: &crate::train::Dataset,
+    model: &RbfModel,
+) -> anyhow::Result<SeekRefit> {
+    let seek = crate::pipeline::northseek::MonteCarloConfig {
+        dwell_s: args.seek_dwell as f32,
+        latitude_deg: args.seek_latitude,
+        ..crate::pipeline::northseek::MonteCarloConfig::paper(1)
+    };
+    seek.validate().context("--seek-refit")?;
+    let schedule = crate::pipeline::seek_schedule::seek_schedule(
+        &crate::sim::GyroParams::paper_default(),
+        &seek,
+    )?;
+    let start_c: Vec<f64> = runs
+        .iter()
+        .map(|r| r.temp_c().first().copied().unwrap_or(f64::NAN))
+        .collect();
+    let geometry = crate::train::seek_score::SeekGeometry {
+        dwell_s: args.seek_dwell,
+        latitude_deg: args.seek_latitude,
+    };
+    refit_for_seeks(model, ds, &start_c, &schedule, geometry).context("--seek-refit")
 }
 
 /// `--export-design`: the normalised training points, targets, width and candidates.

@@ -13,4 +13,5 @@ pub mod heading_fit;
 pub mod northseek;
 pub mod own_model;
 pub mod reproduce;
+pub mod seek_schedule;
 pub mod seek_targets;

@@ -26,7 +26,9 @@ use fog_core::link::bit::{evaluate, BitInputs, BitLimits, BitWord};
 use fog_core::model::format::RbfModel;
 use fog_core::seeking::field_record::{record_of_seek, FieldRecord, SeekTempState};
 use fog_core::seeking::heading_cal::{calibrate, HeadingDwell, HeadingHarmonic};
-use fog_core::seeking::northfinder::{NorthFinder, SeekConfig, SeekMode};
+use fog_core::seeking::northfinder::{
+    NorthFinder, SeekConfig, SeekMode, SeekStatus, MAX_POSITIONS,
+};
 use fog_core::seeking::quality::{
     QualityConfig, QualityError, SeekSupervisor, SupervisorEvent, Validity,
 };
@@ -191,6 +193,54 @@ pub struct SeekOutcome {
     /// bias = half-sum of the two positions at the seek's temperature state; sequence 0,
     /// model CRC-32 of the arm's model), `None` where the device keeps none.
     pub field_record: Option<FieldRecord>,
+    /// When each position's accepted windows lie (`PositionSpans`).
+    pub position_spans_s: PositionSpans,
+}
+
+/// Where each position's accepted 10 s windows lie, s since power-on: the first window's
+/// start and the last one's end, by position index (None for a position not dwelt at).
+/// What the trainer's seek refit reads the device's seek timing from (`seek_schedule`).
+pub type PositionSpans = [Option<(f64, f64)>; MAX_POSITIONS];
+
+/// No position dwelt at yet.
+pub const NO_SPANS: PositionSpans = [None; MAX_POSITIONS];
+
+/// The running seek's `PositionSpans`: a window counts for the position the finder was
+/// dwelling at when it arrived if, after it, that position has one window more, the
+/// table moves on, or the seek is done (an invalid or too early window changes none).
+struct SpanTracker {
+    spans: PositionSpans,
+}
+
+impl SpanTracker {
+    fn reset(&mut self) {
+        self.spans = NO_SPANS;
+    }
+
+    fn on_window(
+        &mut self,
+        w: &fog_core::compensation::compensator::WindowResult,
+        before: SeekStatus,
+        event: &Result<SupervisorEvent, QualityError>,
+        after: SeekStatus,
+    ) {
+        let SeekStatus::Dwelling { position, windows } = before else {
+            return;
+        };
+        let counted = matches!(event, Ok(SupervisorEvent::Done(..)))
+            || match after {
+                SeekStatus::Dwelling {
+                    position: p,
+                    windows: n,
+                } => p != position || n > windows,
+                SeekStatus::Moving { .. } => true,
+                _ => false,
+            };
+        if let (true, Some(span)) = (counted, self.spans.get_mut(position as usize)) {
+            let start_s = span.map_or(w.t_start_s, |(start_s, _)| start_s);
+            *span = Some((start_s, w.t_end_s));
+        }
+    }
 }
 
 /// A seek attempt that ended without a result (refused at its start or stopped by the
@@ -335,6 +385,7 @@ impl SeekLedger {
         t_s: f64,
         restarts: u8,
         field_record: Option<FieldRecord>,
+        position_spans_s: PositionSpans,
     ) {
         match event {
             Ok(SupervisorEvent::Done(r, validity)) => {
@@ -349,6 +400,7 @@ impl SeekLedger {
                     duration_s: r.duration_s,
                     main_dwell_s: n_main * fog_core::consts::WINDOW_S as f64,
                     field_record,
+                    position_spans_s,
                 });
                 self.next();
             }
@@ -489,6 +541,7 @@ where
     let mut sensor_c = f32::NAN;
     let mut temp_rate_cps = 0.0f32;
     let mut window_tilt: Option<Tilt> = None;
+    let mut spans = SpanTracker { spans: NO_SPANS };
     while !ledger.done() {
         let s = match gyro.read() {
             Ok(Some(s)) => s,
@@ -526,6 +579,7 @@ where
             let tilt = window_tilt.unwrap_or_else(|| inclinometer.peek(arm.feed_tilt));
             let bit = simulated_bit(sensor_c, temp_rate_cps);
             recorder.seek_temp.reset();
+            spans.reset();
             if let Err(e) = sup.start(table, s.t_s, tilt, bit) {
                 ledger.refuse(s.t_s, e);
             }
@@ -543,9 +597,21 @@ where
         temp_rate_cps = w.temp_rate_cps;
         if sup.is_seeking() {
             recorder.on_window(&w, comp.model());
+            let before = sup.finder().status();
             let event = sup.on_window(&w, tilt, table);
+            if matches!(event, Ok(SupervisorEvent::Restarted(_))) {
+                spans.reset();
+            } else {
+                spans.on_window(&w, before, &event, sup.finder().status());
+            }
             let field_record = recorder.on_event(&event);
-            ledger.record(event, w.t_end_s, sup.restarts().0, field_record);
+            ledger.record(
+                event,
+                w.t_end_s,
+                sup.restarts().0,
+                field_record,
+                spans.spans,
+            );
         }
     }
     Ok(ledger.out)
@@ -1175,6 +1241,7 @@ mod tests {
             duration_s: 290.0,
             main_dwell_s: 120.0,
             field_record: None,
+            position_spans_s: NO_SPANS,
         };
         let arm = |seeks: Vec<SeekOutcome>| ArmOutcome {
             seeks,

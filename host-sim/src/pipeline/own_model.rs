@@ -59,7 +59,8 @@ use super::campaign_steps::{simulate_checked, train_with_config};
 use super::northseek::noise_floor_deg;
 use crate::io::runs::Run;
 use crate::sim::GyroParams;
-use crate::train::seek_score::{seek_azimuth_rms_deg, Criterion};
+use crate::train::seek_refit::{refit_for_seeks, SeekRefit, SeekSchedule};
+use crate::train::seek_score::{seek_azimuth_rms_deg, Criterion, SeekGeometry};
 use crate::train::{
     choose_inputs_default, dataset_from_runs, predict_batch, InputChoice, InputSelection,
     TrainConfig, TrainOutcome,
@@ -94,6 +95,9 @@ pub struct OwnModelPlan {
     /// The input sets the recipe's input step chooses from (`auto`: `train`'s defaults;
     /// a fixed set is taken as given, the clock and linear terms still by the recipe).
     pub inputs: InputChoice,
+    /// The device's seek timing (`seek_schedule::seek_schedule`): the final model's output
+    /// layer is refitted to its seeks (`train::seek_refit`); None: the model as trained.
+    pub seek_schedule: Option<SeekSchedule>,
 }
 
 /// The trained own model and how its run count was chosen.
@@ -116,6 +120,8 @@ pub struct OwnModel {
     pub budget_deg: f64,
     /// Whether the estimate is within the budget.
     pub budget_met: bool,
+    /// The seek refit of the final model (None: the plan has no seek schedule).
+    pub seek_refit: Option<SeekRefit>,
 }
 
 impl OwnModel {
@@ -145,6 +151,10 @@ impl OwnModel {
                 "NOT met: a larger campaign would lower it"
             }
         );
+        if let Some(r) = &self.seek_refit {
+            s += &r.summary();
+            s.push('\n');
+        }
         s
     }
 }
@@ -196,9 +206,18 @@ pub fn own_model_from_runs(
         .into_iter()
         .chain(clock_tau_s.map(clock_spec))
         .collect();
-    let shape = choose_linear_terms(&runs, &specs, plan)?;
+    let mut shape = choose_linear_terms(&runs, &specs, plan)?;
     let learned_seek_deg = learned_seek_error_deg(&runs, &specs, plan, shape.linear_inputs)?;
+    let seek_refit = match &plan.seek_schedule {
+        Some(schedule) => {
+            let r = refit_to_seeks(&runs, &specs, &shape.trained.model, plan, schedule)?;
+            shape.trained.model = r.model.clone();
+            Some(r)
+        }
+        None => None,
+    };
     Ok(OwnModel {
+        seek_refit,
         trained: shape.trained,
         selection,
         clock_tau_s,
@@ -210,6 +229,28 @@ pub fn own_model_from_runs(
         budget_deg,
         budget_met: learned_seek_deg <= budget_deg,
     })
+}
+
+/// The final model's output layer refitted to the seeks of `schedule` on its own training
+/// runs (`train::seek_refit`; runs grouped by their first temperature reading).
+fn refit_to_seeks(
+    runs: &[Run],
+    specs: &[FeatureSpec],
+    model: &fog_core::model::format::RbfModel,
+    plan: &OwnModelPlan,
+    schedule: &SeekSchedule,
+) -> Result<SeekRefit> {
+    let ds = dataset_from_runs(runs, specs).map_err(|e| anyhow!("seek refit: {e}"))?;
+    let start_c: Vec<f64> = runs
+        .iter()
+        .map(|r| r.temp_c().first().copied().unwrap_or(f64::NAN))
+        .collect();
+    let geometry = SeekGeometry {
+        dwell_s: plan.dwell_s,
+        latitude_deg: plan.latitude_deg,
+    };
+    refit_for_seeks(model, &ds, &start_c, schedule, geometry)
+        .map_err(|e| anyhow!("seek refit: {e}"))
 }
 
 /// The model of `choose_linear_terms`: trained with or without linear terms in its RBF
@@ -354,6 +395,7 @@ mod tests {
             seed: 1,
             criterion: Criterion::seek_default(),
             inputs: InputChoice::Auto,
+            seek_schedule: None,
         }
     }
 

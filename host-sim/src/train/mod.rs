@@ -28,6 +28,7 @@ mod ols;
 mod orr;
 mod path;
 mod predict;
+pub mod seek_refit;
 pub mod seek_score;
 mod select;
 mod validate;

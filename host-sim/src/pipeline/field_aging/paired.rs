@@ -199,6 +199,7 @@ mod tests {
                     duration_s: 270.0,
                     main_dwell_s: 110.0,
                     field_record: None,
+                    position_spans_s: crate::pipeline::northseek::NO_SPANS,
                 })
                 .collect(),
             ..ArmOutcome::default()

@@ -42,7 +42,7 @@ impl AgingSubject for SimAging {
     }
 
     fn chamber(&self, plan: &AgingPlan) -> Result<Chamber> {
-        let own_plan = own_model_plan(plan)?;
+        let own_plan = own_model_plan(plan, &self.delivered)?;
         let own = train_own_model(&self.delivered, &own_plan)?;
         if plan.ambients_c.len() == 1 {
             return Ok(Chamber {
@@ -71,8 +71,12 @@ impl AgingSubject for SimAging {
 }
 
 /// `north-seek`'s own-model plan at the plan's first ambient.
-fn own_model_plan(plan: &AgingPlan) -> Result<OwnModelPlan> {
-    let dwell_s = MonteCarloConfig::paper(plan.seed).dwell_s as f64;
+fn own_model_plan(plan: &AgingPlan, params: &GyroParams) -> Result<OwnModelPlan> {
+    let seek = MonteCarloConfig {
+        latitude_deg: plan.latitude_deg,
+        ..MonteCarloConfig::paper(plan.seed)
+    };
+    let dwell_s = seek.dwell_s as f64;
     Ok(OwnModelPlan {
         ambient_c: plan.ambients_c[0],
         latitude_deg: plan.latitude_deg,
@@ -85,6 +89,9 @@ fn own_model_plan(plan: &AgingPlan) -> Result<OwnModelPlan> {
         )
         .map_err(|e| anyhow::anyhow!("criterion: {e}"))?,
         inputs: crate::train::InputChoice::Auto,
+        seek_schedule: Some(crate::pipeline::seek_schedule::seek_schedule(
+            params, &seek,
+        )?),
     })
 }
 

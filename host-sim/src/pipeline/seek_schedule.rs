@@ -1,0 +1,99 @@
+//! The device's seek timing, measured rather than re-derived: one cold start of
+//! `run_seeks` (fog-core's `NorthFinder` under its `SeekSupervisor`, the simulated
+//! turntable's moves and settling, the 10 s windows each position accepts), read back as
+//! the spans of each seek's opposite positions. The trainer's seek refit fits the model
+//! error over exactly these windows (`train::seek_refit`), so a change of dwell, table
+//! speed or sequence reaches it without a constant to update.
+
+use anyhow::{bail, Result};
+use fog_core::seeking::northfinder::SeekMode;
+
+use crate::pipeline::northseek::{run_seeks, Arm, MonteCarloConfig, PositionSpans};
+use crate::sim::GyroParams;
+use crate::train::seek_refit::{OppositePair, SeekSchedule};
+
+/// Opposite positions of a mode, by position index: 2 positions (0, 180 deg; the +90
+/// dwell only resolves the sign), 4 positions (0 and 180, 90 and 270 deg).
+fn opposite_positions(mode: SeekMode) -> &'static [(usize, usize)] {
+    match mode {
+        SeekMode::TwoPosition => &[(0, 1)],
+        SeekMode::FourPosition => &[(0, 2), (1, 3)],
+    }
+}
+
+/// The seek schedule of `cfg`'s seeks: its first start's seeks without a model, level.
+pub fn seek_schedule(params: &GyroParams, cfg: &MonteCarloConfig) -> Result<SeekSchedule> {
+    let level = MonteCarloConfig {
+        tilt_deg: 0.0,
+        heading_bias_dph: 0.0,
+        ..cfg.clone()
+    };
+    let arm = Arm {
+        model: None,
+        feed_tilt: false,
+        heading: None,
+    };
+    let out = run_seeks(params, &level, arm, level.start_seed(0))?;
+    let pairs_of = |s: &PositionSpans| -> Option<Vec<OppositePair>> {
+        opposite_positions(cfg.mode)
+            .iter()
+            .map(|&(a, b)| {
+                Some(OppositePair {
+                    first_s: s[a]?,
+                    second_s: s[b]?,
+                })
+            })
+            .collect()
+    };
+    let seeks: Vec<Vec<OppositePair>> = out
+        .seeks
+        .iter()
+        .map(|s| pairs_of(&s.position_spans_s))
+        .collect::<Option<_>>()
+        .ok_or_else(|| {
+            anyhow::anyhow!("seek schedule: a finished seek has a main position without windows")
+        })?;
+    let starts: Vec<f64> = out.seeks.iter().map(|s| s.t_start_s).collect();
+    let period_s = match starts.as_slice() {
+        [first, .., last] => (last - first) / (starts.len() - 1) as f64,
+        [_] => out.seeks[0].duration_s.max(1.0),
+        [] => bail!("seek schedule: the seek sequence finished no seek"),
+    };
+    let schedule = SeekSchedule { seeks, period_s };
+    schedule
+        .check()
+        .map_err(|e| anyhow::anyhow!("seek schedule: {e}"))?;
+    Ok(schedule)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_paper_seek_dwells_110_s_at_each_main_position_and_repeats_every_seek() {
+        let params = GyroParams::paper_default();
+        let cfg = MonteCarloConfig {
+            seeks_per_start: 3,
+            ..MonteCarloConfig::paper(1)
+        };
+        let s = seek_schedule(&params, &cfg).unwrap();
+        assert_eq!(s.seeks.len(), 3);
+        for (k, seek) in s.seeks.iter().enumerate() {
+            assert_eq!(seek.len(), 1);
+            let p = seek[0];
+            // 11 windows of 10 s at each main position, the second after the first.
+            assert!((p.first_s.1 - p.first_s.0 - 110.0).abs() < 1e-6, "{p:?}");
+            assert!((p.second_s.1 - p.second_s.0 - 110.0).abs() < 1e-6, "{p:?}");
+            assert!(p.second_s.0 > p.first_s.1, "{p:?}");
+            if k > 0 {
+                let shift = p.first_s.0 - s.seeks[k - 1][0].first_s.0;
+                assert!(
+                    (shift - s.period_s).abs() < 10.0 + 1e-6,
+                    "{shift} {}",
+                    s.period_s
+                );
+            }
+        }
+    }
+}
