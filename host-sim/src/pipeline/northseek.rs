@@ -217,6 +217,25 @@ impl SpanTracker {
         self.spans = NO_SPANS;
     }
 
+    /// Feeds `w` to the running seek and tracks which position it counted for (a motion
+    /// restart forgets the spans).
+    fn feed<T: Turntable>(
+        &mut self,
+        sup: &mut SeekSupervisor,
+        w: &fog_core::compensation::compensator::WindowResult,
+        tilt: Tilt,
+        table: &mut T,
+    ) -> Result<SupervisorEvent, QualityError> {
+        let before = sup.finder().status();
+        let event = sup.on_window(w, tilt, table);
+        if matches!(event, Ok(SupervisorEvent::Restarted(_))) {
+            self.reset();
+        } else {
+            self.on_window(w, before, &event, sup.finder().status());
+        }
+        event
+    }
+
     fn on_window(
         &mut self,
         w: &fog_core::compensation::compensator::WindowResult,
@@ -597,13 +616,7 @@ where
         temp_rate_cps = w.temp_rate_cps;
         if sup.is_seeking() {
             recorder.on_window(&w, comp.model());
-            let before = sup.finder().status();
-            let event = sup.on_window(&w, tilt, table);
-            if matches!(event, Ok(SupervisorEvent::Restarted(_))) {
-                spans.reset();
-            } else {
-                spans.on_window(&w, before, &event, sup.finder().status());
-            }
+            let event = spans.feed(&mut sup, &w, tilt, table);
             let field_record = recorder.on_event(&event);
             ledger.record(
                 event,

@@ -398,77 +398,16 @@ pub fn refit_for_seeks(
             ),
         });
     }
-    let fold_of = |g: u32| g as usize % FOLDS;
-    let mut folds = vec![Normal::new(k); FOLDS];
-    let mut pairs: Vec<PairRow> = Vec::new();
-    let mut x_raw = [0.0f32; MAX_INPUTS];
-    let mut lo = 0;
-    while lo < ds.len() {
-        let g = ds.groups[lo];
-        let hi = (lo..ds.len())
-            .find(|&i| ds.groups[i] != g)
-            .unwrap_or(ds.len());
-        // This run's basis columns (bounded by the run's length).
-        let mut basis = vec![Vec::with_capacity(hi - lo); k];
-        for (i, row) in ds.rows().enumerate().skip(lo).take(hi - lo) {
-            for (xj, &v) in x_raw.iter_mut().zip(row) {
-                *xj = v as f32;
-            }
-            for (col, m) in basis.iter_mut().zip(&units) {
-                let v = predict_f32(m, &x_raw[..row.len()]).map_err(|e| TrainError::Predict {
-                    row: i,
-                    why: e.to_string(),
-                })?;
-                col.push(f64::from(v));
-            }
-            let x: Vec<f64> = basis.iter().map(|c| c[i - lo]).collect();
-            let f = &mut folds[fold_of(g)];
-            Normal::add(&mut f.rows, &mut f.rows_rhs, &x, ds.targets_dph[i]);
-            f.yy += ds.targets_dph[i] * ds.targets_dph[i];
-            f.n += 1;
-        }
-        for p in pair_rows_of_run(ds, lo, hi, &basis, schedule) {
-            let f = &mut folds[fold_of(g)];
-            Normal::add(&mut f.pairs, &mut f.pairs_rhs, &p.x, p.y);
-            pairs.push(p);
-        }
-        lo = hi;
-    }
+    let (folds, pairs) = accumulate(ds, &units, schedule)?;
     if pairs.is_empty() {
         return Err(TrainError::BadConfig {
             option: "seek refit",
             why: "no run has rows over both positions of a seek (the runs must be cold starts timed from power-on, with rows through the seek's dwells)".into(),
         });
     }
-    let mut all = Normal::new(k);
-    for f in &folds {
-        all.yy += f.yy;
-        all.n += f.n;
-        for (t, s) in [
-            (&mut all.rows, &f.rows),
-            (&mut all.pairs, &f.pairs),
-            (&mut all.rows_rhs, &f.rows_rhs),
-            (&mut all.pairs_rhs, &f.pairs_rhs),
-        ] {
-            t.iter_mut().zip(s).for_each(|(a, b)| *a += b);
-        }
-    }
+    let all = total(&folds, k);
     let bins = start_temperature_bins(start_c);
-    let mut scores: Vec<BiasScore> = Vec::with_capacity(WEIGHT_GRID.len());
-    for &w in &WEIGHT_GRID {
-        let mut errors: Vec<(u32, usize, f64)> = Vec::with_capacity(pairs.len());
-        for (f, normal) in folds.iter().enumerate() {
-            let theta = all.solve(Some(normal), w).ok_or(TrainError::BadConfig {
-                option: "seek refit",
-                why: "the refit's normal equations are singular".into(),
-            })?;
-            errors.extend(pairs.iter().filter(|p| fold_of(p.group) == f).map(|p| {
-                let fit: f64 = p.x.iter().zip(&theta).map(|(a, b)| a * b).sum();
-                (p.group, p.pair, geometry.azimuth_deg(p.y - fit))
-            }));
-        }
-        scores.push(bias_score_deg2(&errors, &bins));
-    }
+    let scores = score_weights(&folds, &all, &pairs, &bins, geometry)?;
     let bias_rms_deg = WEIGHT_GRID
         .iter()
         .zip(&scores)
@@ -493,10 +432,7 @@ pub fn refit_for_seeks(
     let trained: Vec<f64> = params.iter().map(|&p| f64::from(get(model, p))).collect();
     let mut rms_10s_dph = (all.rms_rows(&trained), all.rms_rows(&trained));
     if weight > 0.0 {
-        let theta = all.solve(None, weight).ok_or(TrainError::BadConfig {
-            option: "seek refit",
-            why: "the refit's normal equations are singular".into(),
-        })?;
+        let theta = all.solve(None, weight).ok_or(singular())?;
         rms_10s_dph.1 = all.rms_rows(&theta);
         for (&p, &v) in params.iter().zip(&theta) {
             set(&mut refit, p, v as f32);
@@ -510,6 +446,105 @@ pub fn refit_for_seeks(
         pair_rows: pairs.len(),
         rms_10s_dph,
     })
+}
+
+/// Fold of a run (group id).
+fn fold_of(g: u32) -> usize {
+    g as usize % FOLDS
+}
+
+/// Per fold, the normal equations of its runs' 10 s rows and pair rows; and every pair row.
+fn accumulate(
+    ds: &Dataset,
+    units: &[RbfModel],
+    schedule: &SeekSchedule,
+) -> Result<(Vec<Normal>, Vec<PairRow>)> {
+    let k = units.len();
+    let mut folds = vec![Normal::new(k); FOLDS];
+    let mut pairs: Vec<PairRow> = Vec::new();
+    let mut x_raw = [0.0f32; MAX_INPUTS];
+    let mut lo = 0;
+    while lo < ds.len() {
+        let g = ds.groups[lo];
+        let hi = (lo..ds.len())
+            .find(|&i| ds.groups[i] != g)
+            .unwrap_or(ds.len());
+        // This run's basis columns (bounded by the run's length).
+        let mut basis = vec![Vec::with_capacity(hi - lo); k];
+        for (i, row) in ds.rows().enumerate().skip(lo).take(hi - lo) {
+            for (xj, &v) in x_raw.iter_mut().zip(row) {
+                *xj = v as f32;
+            }
+            for (col, m) in basis.iter_mut().zip(units) {
+                let v = predict_f32(m, &x_raw[..row.len()]).map_err(|e| TrainError::Predict {
+                    row: i,
+                    why: e.to_string(),
+                })?;
+                col.push(f64::from(v));
+            }
+            let x: Vec<f64> = basis.iter().map(|c| c[i - lo]).collect();
+            let f = &mut folds[fold_of(g)];
+            Normal::add(&mut f.rows, &mut f.rows_rhs, &x, ds.targets_dph[i]);
+            f.yy += ds.targets_dph[i] * ds.targets_dph[i];
+            f.n += 1;
+        }
+        for p in pair_rows_of_run(ds, lo, hi, &basis, schedule) {
+            let f = &mut folds[fold_of(g)];
+            Normal::add(&mut f.pairs, &mut f.pairs_rhs, &p.x, p.y);
+            pairs.push(p);
+        }
+        lo = hi;
+    }
+    Ok((folds, pairs))
+}
+
+/// The sum of the folds' normal equations.
+fn total(folds: &[Normal], k: usize) -> Normal {
+    let mut all = Normal::new(k);
+    for f in folds {
+        all.yy += f.yy;
+        all.n += f.n;
+        for (t, s) in [
+            (&mut all.rows, &f.rows),
+            (&mut all.pairs, &f.pairs),
+            (&mut all.rows_rhs, &f.rows_rhs),
+            (&mut all.pairs_rhs, &f.pairs_rhs),
+        ] {
+            t.iter_mut().zip(s).for_each(|(a, b)| *a += b);
+        }
+    }
+    all
+}
+
+/// The held-out bias score of every weight of `WEIGHT_GRID`: each fold refitted without
+/// its runs, its pairs' errors converted to azimuth and grouped by start temperature bin.
+fn score_weights(
+    folds: &[Normal],
+    all: &Normal,
+    pairs: &[PairRow],
+    bins: &[usize],
+    geometry: SeekGeometry,
+) -> Result<Vec<BiasScore>> {
+    let mut scores: Vec<BiasScore> = Vec::with_capacity(WEIGHT_GRID.len());
+    for &w in &WEIGHT_GRID {
+        let mut errors: Vec<(u32, usize, f64)> = Vec::with_capacity(pairs.len());
+        for (f, normal) in folds.iter().enumerate() {
+            let theta = all.solve(Some(normal), w).ok_or(singular())?;
+            errors.extend(pairs.iter().filter(|p| fold_of(p.group) == f).map(|p| {
+                let fit: f64 = p.x.iter().zip(&theta).map(|(a, b)| a * b).sum();
+                (p.group, p.pair, geometry.azimuth_deg(p.y - fit))
+            }));
+        }
+        scores.push(bias_score_deg2(&errors, bins));
+    }
+    Ok(scores)
+}
+
+fn singular() -> TrainError {
+    TrainError::BadConfig {
+        option: "seek refit",
+        why: "the refit's normal equations are singular".into(),
+    }
 }
 
 /// Bin of each group: groups sorted by start temperature, cut into bins of about
