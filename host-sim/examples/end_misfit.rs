@@ -12,7 +12,8 @@
 //! `t,rise` or `auto` inputs as `reproduce --qualification-inputs` would; `norefit`
 //! leaves out the recipe's seek refit (`train::seek_refit`) to show what it removed.
 //!
-//! `target/release/examples/end_misfit SEED [auto|t,rise] [norefit]` (defaults 5, auto).
+//! `target/release/examples/end_misfit SEED [auto|t,rise] [norefit]` (defaults 5, auto);
+//! with `END_MISFIT_MODEL_OUT=FILE` it also writes the model (for `north-seek --model`).
 
 use anyhow::{anyhow, Result};
 use fog_core::consts::earth_rate_horizontal_dph;
@@ -22,6 +23,7 @@ use fog_sim::pipeline::campaign_steps::simulate_checked;
 use fog_sim::pipeline::northseek::MonteCarloConfig;
 use fog_sim::pipeline::own_model::own_model_from_runs;
 use fog_sim::pipeline::reproduce::{qualification_campaign_spec, qualification_plan};
+use fog_sim::pipeline::seek_schedule::seek_schedule;
 use fog_sim::train::{dataset_from_runs, predict_batch, InputChoice};
 
 const TRUE_AZIMUTH_DEG: f64 = 108.4;
@@ -42,16 +44,26 @@ fn main() -> Result<()> {
         ambient_c: 20.0,
         ..MonteCarloConfig::paper(seed)
     };
-    let mut plan = qualification_plan(&params, &paper, &north_seek, inputs)?;
-    let schedule = plan
-        .seek_schedule
+    let mut plan = qualification_plan(&paper, &north_seek, inputs);
+    let seeks = plan
+        .seek_timing
         .clone()
-        .ok_or_else(|| anyhow!("no seek schedule"))?;
+        .ok_or_else(|| anyhow!("no seek timing"))?;
     if args.get(2).is_some_and(|a| a == "norefit") {
-        plan.seek_schedule = None;
+        plan.seek_timing = None;
     }
     let own = own_model_from_runs(&params, runs.clone(), &plan)?;
     eprint!("{}{}", own.selection.summary(), own.summary());
+    let schedule = seek_schedule(&params, &seeks, Some(&own.trained.model))?;
+    if let Ok(path) = std::env::var("END_MISFIT_MODEL_OUT") {
+        let mut buf = [0u8; fog_core::model::format::MAX_ENCODED_LEN];
+        let len = own
+            .trained
+            .model
+            .encode(&mut buf)
+            .map_err(|e| anyhow!("{e}"))?;
+        std::fs::write(path, &buf[..len])?;
+    }
     let ds = dataset_from_runs(&runs, &own.specs).map_err(|e| anyhow!("{e}"))?;
     let predicted = predict_batch(&own.trained.model, ds.rows()).map_err(|e| anyhow!("{e}"))?;
     let scale = 2.0

@@ -104,7 +104,7 @@ fn model_under_test(
             seed: 1,
             criterion: Criterion::seek_default(),
             inputs: fog_sim::train::InputChoice::Auto,
-            seek_schedule: None,
+            seek_timing: None,
         },
     )?;
     let mut specs = own.selection.chosen.specs();

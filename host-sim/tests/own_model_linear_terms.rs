@@ -34,7 +34,7 @@ fn plan() -> OwnModelPlan {
             latitude_deg: LATITUDE_DEG,
         }),
         inputs: fog_sim::train::InputChoice::Auto,
-        seek_schedule: None,
+        seek_timing: None,
     }
 }
 

@@ -15,7 +15,6 @@ use crate::pipeline::northseek::{
     MonteCarloConfig,
 };
 use crate::pipeline::own_model::{train_own_model, OwnModelPlan};
-use crate::pipeline::seek_schedule::seek_schedule;
 use crate::report::{progress_bar, write_json};
 use crate::sim::GyroParams;
 
@@ -150,7 +149,7 @@ pub fn run(args: Args) -> Result<()> {
                 seed: cfg.seed,
                 criterion,
                 inputs: args.inputs.unwrap_or(crate::train::InputChoice::Auto),
-                seek_schedule: Some(seek_schedule(&params, &cfg)?),
+                seek_timing: Some(cfg.clone()),
             };
             let own = train_own_model(&params, &plan)?;
             eprint!("{}", own.selection.summary());

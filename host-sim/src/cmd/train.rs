@@ -399,6 +399,7 @@ fn refit_to_device_seeks(
     let schedule = crate::pipeline::seek_schedule::seek_schedule(
         &crate::sim::GyroParams::paper_default(),
         &seek,
+        Some(model),
     )?;
     let start_c: Vec<f64> = runs
         .iter()

@@ -56,7 +56,8 @@ use fog_core::seeking::northfinder::SeekMode;
 
 use super::campaign::{CampaignRun, CampaignSpec};
 use super::campaign_steps::{simulate_checked, train_with_config};
-use super::northseek::noise_floor_deg;
+use super::northseek::{noise_floor_deg, MonteCarloConfig};
+use super::seek_schedule::seek_schedule;
 use crate::io::runs::Run;
 use crate::sim::GyroParams;
 use crate::train::seek_refit::{refit_for_seeks, SeekRefit, SeekSchedule};
@@ -95,9 +96,10 @@ pub struct OwnModelPlan {
     /// The input sets the recipe's input step chooses from (`auto`: `train`'s defaults;
     /// a fixed set is taken as given, the clock and linear terms still by the recipe).
     pub inputs: InputChoice,
-    /// The device's seek timing (`seek_schedule::seek_schedule`): the final model's output
-    /// layer is refitted to its seeks (`train::seek_refit`); None: the model as trained.
-    pub seek_schedule: Option<SeekSchedule>,
+    /// The Monte Carlo whose seeks the final model's output layer is refitted to
+    /// (`train::seek_refit`), their timing measured with the trained model
+    /// (`seek_schedule`); None: the model as trained.
+    pub seek_timing: Option<MonteCarloConfig>,
 }
 
 /// The trained own model and how its run count was chosen.
@@ -208,9 +210,10 @@ pub fn own_model_from_runs(
         .collect();
     let mut shape = choose_linear_terms(&runs, &specs, plan)?;
     let learned_seek_deg = learned_seek_error_deg(&runs, &specs, plan, shape.linear_inputs)?;
-    let seek_refit = match &plan.seek_schedule {
-        Some(schedule) => {
-            let r = refit_to_seeks(&runs, &specs, &shape.trained.model, plan, schedule)?;
+    let seek_refit = match &plan.seek_timing {
+        Some(seeks) => {
+            let schedule = seek_schedule(params, seeks, Some(&shape.trained.model))?;
+            let r = refit_to_seeks(&runs, &specs, &shape.trained.model, plan, &schedule)?;
             shape.trained.model = r.model.clone();
             Some(r)
         }
@@ -395,7 +398,7 @@ mod tests {
             seed: 1,
             criterion: Criterion::seek_default(),
             inputs: InputChoice::Auto,
-            seek_schedule: None,
+            seek_timing: None,
         }
     }
 

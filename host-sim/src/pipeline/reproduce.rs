@@ -21,7 +21,6 @@ use crate::pipeline::northseek::{
     build_report, run_monte_carlo, seek_table, MonteCarloConfig, PAPER_SEEK_DURATION_S,
 };
 use crate::pipeline::own_model::{own_model_from_runs, OwnModel, OwnModelPlan};
-use crate::pipeline::seek_schedule::seek_schedule;
 use crate::plots::{allan_chart, azimuth_scatter_chart, temperature_chart, write_svg, RunCurve};
 use crate::report::{
     drift_cells, fmt_minutes, progress_bar, CompensateReport, DriftStats, NorthSeekReport, Table,
@@ -280,28 +279,27 @@ fn qualification_model(params: &GyroParams, opts: &ReproduceOptions) -> Result<O
     own_model_from_runs(
         params,
         campaign.into_iter().map(|c| c.run).collect(),
-        &qualification_plan(params, plan, &opts.north_seek, opts.qualification_inputs)?,
+        &qualification_plan(plan, &opts.north_seek, opts.qualification_inputs),
     )
 }
 
 /// The own-model recipe's plan for the qualification model of campaign `plan`: the seek
 /// criterion at the Monte Carlo's `north_seek` dwell and the site's latitude, inputs from
-/// `inputs`, the final model refitted to the Monte Carlo's seeks on `params`' gyro.
+/// `inputs`, the final model refitted to the Monte Carlo's seeks.
 pub fn qualification_plan(
-    params: &GyroParams,
     plan: &CampaignSpec,
     north_seek: &MonteCarloConfig,
     inputs: InputChoice,
-) -> Result<OwnModelPlan> {
-    Ok(OwnModelPlan {
+) -> OwnModelPlan {
+    OwnModelPlan {
         ambient_c: north_seek.ambient_c,
         latitude_deg: plan.latitude_deg,
         dwell_s: f64::from(north_seek.dwell_s),
         seed: plan.seed,
         criterion: TrainConfig::default().criterion,
         inputs,
-        seek_schedule: Some(seek_schedule(params, north_seek)?),
-    })
+        seek_timing: Some(north_seek.clone()),
+    }
 }
 
 /// The qualification campaign of a paper campaign `plan`: `runs_per_ambient` cold starts at

@@ -42,7 +42,7 @@ impl AgingSubject for SimAging {
     }
 
     fn chamber(&self, plan: &AgingPlan) -> Result<Chamber> {
-        let own_plan = own_model_plan(plan, &self.delivered)?;
+        let own_plan = own_model_plan(plan)?;
         let own = train_own_model(&self.delivered, &own_plan)?;
         if plan.ambients_c.len() == 1 {
             return Ok(Chamber {
@@ -71,7 +71,7 @@ impl AgingSubject for SimAging {
 }
 
 /// `north-seek`'s own-model plan at the plan's first ambient.
-fn own_model_plan(plan: &AgingPlan, params: &GyroParams) -> Result<OwnModelPlan> {
+fn own_model_plan(plan: &AgingPlan) -> Result<OwnModelPlan> {
     let seek = MonteCarloConfig {
         latitude_deg: plan.latitude_deg,
         ..MonteCarloConfig::paper(plan.seed)
@@ -89,9 +89,7 @@ fn own_model_plan(plan: &AgingPlan, params: &GyroParams) -> Result<OwnModelPlan>
         )
         .map_err(|e| anyhow::anyhow!("criterion: {e}"))?,
         inputs: crate::train::InputChoice::Auto,
-        seek_schedule: Some(crate::pipeline::seek_schedule::seek_schedule(
-            params, &seek,
-        )?),
+        seek_timing: Some(seek),
     })
 }
 
