@@ -212,7 +212,13 @@ pub fn own_model_from_runs(
     let learned_seek_deg = learned_seek_error_deg(&runs, &specs, plan, shape.linear_inputs)?;
     let seek_refit = match &plan.seek_timing {
         Some(seeks) => {
-            let schedule = seek_schedule(params, seeks, Some(&shape.trained.model))?;
+            // At the plan's ambient, inside the model's trained range (elsewhere its
+            // windows are out of range and the finder takes none).
+            let at_ambient = MonteCarloConfig {
+                ambient_c: plan.ambient_c,
+                ..seeks.clone()
+            };
+            let schedule = seek_schedule(params, &at_ambient, Some(&shape.trained.model))?;
             let r = refit_to_seeks(&runs, &specs, &shape.trained.model, plan, &schedule)?;
             shape.trained.model = r.model.clone();
             Some(r)
