@@ -9,47 +9,15 @@
 //! `cargo test --release -p fog-sim --test own_model_linear_terms -- --nocapture` prints
 //! every figure.
 
+#[path = "common/seek_judge.rs"]
+mod seek_judge;
 #[allow(dead_code)] // the test files share the generator, each uses some of its laws
 #[path = "common/soaked.rs"]
 mod soaked;
 
-use fog_core::model::format::{FeatureSpec, RbfModel};
-use fog_sim::io::runs::Run;
-use fog_sim::pipeline::own_model::{choose_linear_terms, OwnModelPlan};
-use fog_sim::train::seek_score::{seek_azimuth_rms_deg, Criterion, SeekGeometry};
-use fog_sim::train::{dataset_from_runs, predict_batch};
+use fog_sim::pipeline::own_model::choose_linear_terms;
+use seek_judge::{plan, seek_rms_deg};
 use soaked::{clocked_specs, soaked_campaign_in, SoakedLaw, Tube, AMBIENT_C};
-
-const LATITUDE_DEG: f64 = 40.0;
-const DWELL_S: f64 = 110.0;
-
-fn plan() -> OwnModelPlan {
-    OwnModelPlan {
-        ambient_c: AMBIENT_C,
-        latitude_deg: LATITUDE_DEG,
-        dwell_s: DWELL_S,
-        seed: 1,
-        criterion: Criterion::Seek(SeekGeometry {
-            dwell_s: DWELL_S,
-            latitude_deg: LATITUDE_DEG,
-        }),
-        inputs: fog_sim::train::InputChoice::Auto,
-        seek_timing: None,
-    }
-}
-
-/// Seek azimuth rms, deg, of `model`'s residuals on `runs`.
-fn seek_rms_deg(model: &RbfModel, runs: &[Run], specs: &[FeatureSpec]) -> f64 {
-    let ds = dataset_from_runs(runs, specs).unwrap();
-    let pred = predict_batch(model, ds.rows()).unwrap();
-    let res: Vec<f64> = ds
-        .targets_dph
-        .iter()
-        .zip(&pred)
-        .map(|(y, p)| y - p)
-        .collect();
-    seek_azimuth_rms_deg(&res, &ds.groups, &ds.t_s, DWELL_S, LATITUDE_DEG)
-}
 
 /// The choice on a campaign of `law`, and both shapes' seek rms on a fresh campaign.
 struct Outcome {
@@ -62,7 +30,7 @@ fn outcome(law: SoakedLaw, tube: Tube, seed: u64) -> Outcome {
     let runs = soaked_campaign_in(law, tube, seed);
     let fresh = soaked_campaign_in(law, tube, seed + 1000);
     let specs = clocked_specs(&runs);
-    let plan = plan();
+    let plan = plan(AMBIENT_C);
     let choice = choose_linear_terms(&runs, &specs, &plan).unwrap();
     let other = fog_sim::pipeline::campaign_steps::train_with_config(
         &runs.iter().collect::<Vec<_>>(),

@@ -72,8 +72,9 @@ pub struct Args {
     /// dwell and latitude are this Monte Carlo's).
     #[arg(long, default_value = crate::train::seek_score::DEFAULT_CRITERION_NAME)]
     pub criterion: String,
-    /// The default model's inputs (as `train --inputs`): `auto` (chosen by validation) or
-    /// a set, e.g. `t,rise`; the warm-up clock and linear terms are still the recipe's.
+    /// The default model's inputs (as `train --inputs`): `auto` (chosen by validation, then
+    /// `t,rise` unless the estimated derivatives win with the warm-up clock beside both) or
+    /// a set, e.g. `t,rate`; the warm-up clock and linear terms are still the recipe's.
     /// Refused with `--model`, which brings its own inputs.
     #[arg(long, value_parser = crate::train::InputChoice::parse)]
     pub inputs: Option<crate::train::InputChoice>,

@@ -60,8 +60,9 @@ pub struct Args {
     #[arg(long = "qualification-runs", default_value_t = crate::pipeline::own_model::CAMPAIGN_RUNS)]
     pub qualification_runs: usize,
     /// The qualification model's inputs, as `train --inputs` takes them: `auto` (chosen by
-    /// validation) or a set, e.g. `t,rise` (T and the rise since power-on, no dT/dt); the
-    /// warm-up clock and the linear terms are still the recipe's.
+    /// validation, then `t,rise`, T and the rise since power-on, unless the estimated
+    /// derivatives win with the warm-up clock beside both) or a set, e.g. `t,rate,accel`;
+    /// the warm-up clock and the linear terms are still the recipe's.
     #[arg(long = "qualification-inputs", default_value = "auto", value_parser = InputChoice::parse)]
     pub qualification_inputs: InputChoice,
 }

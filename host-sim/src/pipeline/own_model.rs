@@ -47,6 +47,12 @@
 //! (`examples/seek_input_noise`, docs/northfinder.md). It enters as fog-core's
 //! `PowerOnDecay`, exp(-t / tau), with tau the campaign's own warm-up time: when its mean
 //! temperature rise reaches 1 - 1/e of the rise over the run (`warmup_time_constant_s`).
+//!
+//! With the clock, the input step ends with the derivative-free set (`t,rise`: T and the
+//! rise since power-on) as the one to beat (`choose_derivative_free`): the estimated
+//! derivatives stay only where they win by 2 standard errors run by run. On the independent
+//! generator they do in a chamber whose air wanders after power-on, and not where the runs
+//! warm along one family of curves (tests/own_model_derivative_free.rs).
 
 use std::collections::BTreeMap;
 
@@ -63,8 +69,8 @@ use crate::sim::GyroParams;
 use crate::train::seek_refit::{refit_for_seeks, SeekRefit, SeekSchedule};
 use crate::train::seek_score::{seek_azimuth_rms_deg, Criterion, SeekGeometry};
 use crate::train::{
-    choose_inputs_default, dataset_from_runs, predict_batch, InputChoice, InputSelection,
-    TrainConfig, TrainOutcome,
+    choose_in_order_with, choose_inputs_default, criterion_for, dataset_from_runs, predict_batch,
+    EstimatorChoice, InputChoice, InputSelection, InputSet, TrainConfig, TrainOutcome,
 };
 
 /// Runs of the own model's chamber campaign at its ambient (45 min each: 36 h of chamber
@@ -199,9 +205,14 @@ pub fn own_model_from_runs(
     // as the shape. (Scoring each set with the clock beside it was tried and not kept:
     // docs/northfinder.md, "The one global model over training campaigns".)
     let candidates = plan.inputs.candidates();
-    let (selection, _) = choose_inputs_default(&runs, &candidates, &train_config(plan, false))
+    let (mut selection, _) = choose_inputs_default(&runs, &candidates, &train_config(plan, false))
         .map_err(|e| anyhow!("choosing the own model's inputs: {e}"))?;
     let clock_tau_s = warmup_time_constant_s(&runs)?;
+    if let (InputChoice::Auto, Some(tau_s)) = (plan.inputs, clock_tau_s) {
+        let choice = choose_derivative_free(&runs, selection.chosen, tau_s, plan)?;
+        selection.chosen = choice.chosen;
+        selection.derivative_free = Some(choice.scores);
+    }
     let specs: Vec<FeatureSpec> = selection
         .chosen
         .specs()
@@ -237,6 +248,47 @@ pub fn own_model_from_runs(
         learned_seek_deg,
         budget_deg,
         budget_met: learned_seek_deg <= budget_deg,
+    })
+}
+
+/// What `choose_derivative_free` chose, and every set's held-out figure.
+pub struct DerivativeFreeChoice {
+    pub chosen: InputSet,
+    pub scores: EstimatorChoice,
+}
+
+/// On soaked cold starts with a warm-up clock, the derivative-free set (T and the rise
+/// since power-on, `InputSet::TempRise`) against `chosen` (the input step's set), both
+/// with the clock, scored by the plan's criterion on the rows both can use; `chosen`
+/// replaces the derivative-free set only when it is significantly better run by run
+/// (`SIGNIFICANT_GAIN_SE`).
+///
+/// Why the derivative-free set is the one to beat: for a soaked unit the first reading is
+/// its ambient and the clock its time since power-on, so T, the rise and the clock name
+/// the warm-up's state as dT/dt and d2T/dt2 do wherever the runs warm along one family of
+/// curves; the derivatives are then estimates of the same state from the first few noisy
+/// rows, whose noise the 10 s rows hardly weigh and the first seek turns into azimuth
+/// scatter (the global model's seek 1 at -40 degC: 1.21x the floor with d2T/dt2, 1.11x
+/// without; docs/northfinder.md, "Without dT/dt"). Where the runs' warm-ups differ in
+/// ways the rise and clock do not name (time constants spread run to run), the
+/// derivatives carry information and win by more than the runs' scatter.
+pub fn choose_derivative_free(
+    runs: &[Run],
+    chosen: InputSet,
+    tau_s: f64,
+    plan: &OwnModelPlan,
+) -> Result<DerivativeFreeChoice> {
+    let cfg = train_config(plan, false);
+    let criterion = criterion_for(&cfg);
+    let order = [InputSet::TempRise, chosen];
+    let (chosen, tried) = choose_in_order_with(runs, &order, &[clock_spec(tau_s)], &cfg, criterion)
+        .map_err(|e| anyhow!("derivative-free inputs: {e}"))?;
+    Ok(DerivativeFreeChoice {
+        chosen,
+        scores: EstimatorChoice {
+            criterion: criterion.describe().into(),
+            scores: tried,
+        },
     })
 }
 
@@ -482,14 +534,38 @@ mod tests {
                 FeatureKind::PowerOnDecay
             ]
         );
-        // The default still chooses by validation, and never the rate-free set.
+        assert!(
+            own.selection.derivative_free.is_none(),
+            "a given set is not re-chosen"
+        );
+        // The default ends with the derivative-free step on these soaked cold starts: the
+        // rise against the input step's set, both with the clock, and the model carries
+        // the set it chose.
         let auto = own_model_from_runs(
             &GyroParams::paper_default(),
             runs(&GyroParams::paper_default(), 6),
             &plan(),
         )
         .unwrap();
-        assert_eq!(auto.trained.model.inputs[1].kind, FeatureKind::TempRateCps);
+        let step = auto
+            .selection
+            .derivative_free
+            .as_ref()
+            .expect("a warm-up clock");
+        let tried: Vec<InputSet> = step.scores.iter().map(|s| s.set).collect();
+        assert_eq!(tried.len(), 2);
+        assert_eq!(tried[0], InputSet::TempRise);
+        assert!(tried.contains(&auto.selection.chosen));
+        let expected: Vec<FeatureKind> = auto
+            .selection
+            .chosen
+            .specs()
+            .iter()
+            .map(|s| s.kind)
+            .chain([FeatureKind::PowerOnDecay])
+            .collect();
+        let kinds: Vec<FeatureKind> = auto.trained.model.inputs.iter().map(|s| s.kind).collect();
+        assert_eq!(kinds, expected);
     }
 
     #[test]

@@ -59,9 +59,10 @@ pub enum InputSet {
     /// T and the temperature rise since power-on, no dT/dt: for soaked cold starts with
     /// the warm-up clock beside it (`own_model::clock_spec`) the same warm-up state, read
     /// without a derivative, so the first minutes carry one 10 s mean's noise instead of a
-    /// few-row slope's (docs/northfinder.md, "Without dT/dt"). Only on request (`--inputs
-    /// t,rise`): `auto` does not offer it, since without the clock it does not follow a
-    /// warm-up, and the held-out scores cannot yet tell when it wins.
+    /// few-row slope's (docs/northfinder.md, "Without dT/dt"). `train`'s `auto` does not
+    /// offer it (without the clock it does not follow a warm-up); the own-model recipe's
+    /// does, with the clock, as the set the estimated derivatives must beat
+    /// (`pipeline::own_model::choose_derivative_free`).
     #[serde(rename = "t,rise")]
     TempRise,
 }
@@ -316,6 +317,10 @@ pub struct InputSelection {
     pub scores: Vec<InputSetScore>,
     /// The third input's choice (plain d2T/dt2, then its alternatives), when there was one.
     pub estimator: Option<EstimatorChoice>,
+    /// The recipe's last step on soaked cold starts with a warm-up clock: the
+    /// derivative-free set (`t,rise`) against the chosen one, both with the clock
+    /// (`pipeline::own_model::choose_derivative_free`); None where it was not taken.
+    pub derivative_free: Option<EstimatorChoice>,
 }
 
 /// The second step of `choose_inputs`: how the third state is read, the plain d2T/dt2
@@ -343,7 +348,15 @@ impl InputSelection {
                 }
             )
         };
-        let mut s = format!("inputs: {} (by {})\n", self.chosen.name(), self.criterion);
+        let mut s = if self.scores.is_empty() {
+            format!("inputs: {} ({})\n", self.chosen.name(), self.criterion)
+        } else {
+            format!(
+                "inputs: {}; whether d2T/dt2 (by {}):\n",
+                self.chosen.name(),
+                self.criterion
+            )
+        };
         s += &self.scores.iter().map(line).collect::<String>();
         if let Some(e) = &self.estimator {
             s += &format!(
@@ -351,6 +364,13 @@ impl InputSelection {
                 e.criterion
             );
             s += &e.scores.iter().map(line).collect::<String>();
+        }
+        if let Some(d) = &self.derivative_free {
+            s += &format!(
+                "derivative-free inputs, with the warm-up clock (by {}; the estimated derivatives must win by {SIGNIFICANT_GAIN_SE} SE):\n",
+                d.criterion
+            );
+            s += &d.scores.iter().map(line).collect::<String>();
         }
         s
     }
@@ -458,6 +478,7 @@ pub fn choose_inputs(
                 criterion: "request: one set given, none chosen".into(),
                 scores: Vec::new(),
                 estimator: None,
+                derivative_free: None,
             },
             full.swap_remove(0),
         ));
@@ -494,9 +515,36 @@ pub fn choose_inputs(
             criterion: inputs_criterion.describe().into(),
             scores,
             estimator,
+            derivative_free: None,
         },
         full.swap_remove(best),
     ))
+}
+
+/// Chooses among `order` with each set's inputs followed by `extra` (the recipe's warm-up
+/// clock), scored by `criterion` on the rows every set can use, in order: a later set
+/// replaces the choice only when it is significantly better unit by unit, so `order`
+/// puts first the set that must be beaten (the one with fewer estimated inputs).
+pub fn choose_in_order_with(
+    runs: &[Run],
+    order: &[InputSet],
+    extra: &[FeatureSpec],
+    cfg: &TrainConfig,
+    criterion: &dyn InputCriterion,
+) -> Result<(InputSet, Vec<InputSetScore>)> {
+    let mut full = Vec::with_capacity(order.len());
+    for set in order {
+        let specs: Vec<FeatureSpec> = set
+            .specs()
+            .into_iter()
+            .chain(extra.iter().copied())
+            .collect();
+        full.push(dataset_from_runs(runs, &specs)?);
+    }
+    let common = common_rows(&full);
+    let all: Vec<usize> = (0..order.len()).collect();
+    let (best, scores) = choose_in_order(&all, order, &common, cfg, criterion)?;
+    Ok((order[best], scores))
 }
 
 /// `train`'s defaults (and so `north-seek`'s own model's and `reproduce`'s global

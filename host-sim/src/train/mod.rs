@@ -47,9 +47,9 @@ pub use features::{
 pub use fit::{fit_path, fit_shape, fit_width, Fit, PathFit, Shape};
 pub use gram::gram_bytes;
 pub use inputs::{
-    choose_inputs, choose_inputs_default, criterion_for, EstimatorChoice, GroupedCvRms,
-    GroupedCvSeek, InputChoice, InputCriterion, InputSelection, InputSet, InputSetScore, SetScore,
-    SIGNIFICANT_GAIN_SE,
+    choose_in_order_with, choose_inputs, choose_inputs_default, criterion_for, EstimatorChoice,
+    GroupedCvRms, GroupedCvSeek, InputChoice, InputCriterion, InputSelection, InputSet,
+    InputSetScore, SetScore, SIGNIFICANT_GAIN_SE,
 };
 pub use normalize::Normalizer;
 pub use path::StopReason;

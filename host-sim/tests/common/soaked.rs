@@ -64,6 +64,12 @@ pub enum SoakedLaw {
     UnlaggedTwoMode(f64),
     /// The lagged thermometer, nothing in d2T/dt2 (the null twin).
     LaggedNull,
+    /// The null twin's drift in a chamber whose air wanders after power-on by this
+    /// amplitude, degC, at the coil (a sinusoid of period 600-1,200 s, phase drawn per
+    /// run, zero at power-on so the start is still soaked): the measured T and dT/dt
+    /// carry the wander, the rise since power-on and the clock do not tell it from the
+    /// warm-up.
+    LaggedNullWanderingChamber(f64),
     /// The lagged thermometer; the drift is a bump in the coil temperature of this many
     /// 10 s noise sigmas (a resonance of the coil's mount, 1 degC wide, 3 degC above the
     /// ambient, which every run passes in its first half hour) instead of the temperature coefficient and the
@@ -219,8 +225,20 @@ pub fn soaked_campaign_over(
             unlagged_warmup(rise, share, fast, rng.random_range(600.0..1000.0))
         };
         let offset = REPEATABILITY_DPH * g.sample(&mut rng);
+        let (wander_c, wander_rad_s, phase) = match law {
+            SoakedLaw::LaggedNullWanderingChamber(a) => (
+                a,
+                std::f64::consts::TAU / rng.random_range(600.0..1200.0),
+                rng.random_range(0.0..std::f64::consts::TAU),
+            ),
+            _ => (0.0, 0.0, 0.0),
+        };
         let (mut t, mut rate, mut temp) = (vec![], vec![], vec![]);
-        for (k, (dt_c, rate_cps)) in w.rise_c.iter().zip(&w.rate_cps).enumerate() {
+        for (k, (rise_c, warmup_cps)) in w.rise_c.iter().zip(&w.rate_cps).enumerate() {
+            let ts = (k + 1) as f64;
+            let wander = wander_c * ((wander_rad_s * ts + phase).sin() - phase.sin());
+            let dt_c = rise_c + wander;
+            let rate_cps = warmup_cps + wander_c * wander_rad_s * (wander_rad_s * ts + phase).cos();
             let d = amb + dt_c - 25.0;
             let drift = offset
                 + match law {
@@ -230,7 +248,7 @@ pub fn soaked_campaign_over(
                     SoakedLaw::LaggedOffsetOnly => 0.0,
                     _ => k1 * d + shupe * shupe_factor(law, amb + dt_c) * rate_cps,
                 };
-            t.push((k + 1) as f64);
+            t.push(ts);
             rate.push(drift + NOISE_10S_DPH * 10f64.sqrt() * g.sample(&mut rng));
             temp.push(((amb + dt_c + 0.02 * g.sample(&mut rng)) / 0.0625).round() * 0.0625);
         }
@@ -248,6 +266,7 @@ pub fn soaked_campaign_over(
     let sigmas = match law {
         SoakedLaw::LaggedGradient(s) | SoakedLaw::UnlaggedTwoMode(s) => s,
         SoakedLaw::LaggedNull
+        | SoakedLaw::LaggedNullWanderingChamber(_)
         | SoakedLaw::LaggedTemperatureBump(_)
         | SoakedLaw::LaggedOffsetOnly
         | SoakedLaw::LaggedShupeLinearInT(_)
