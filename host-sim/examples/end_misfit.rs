@@ -22,7 +22,9 @@ use fog_sim::pipeline::campaign::CampaignSpec;
 use fog_sim::pipeline::campaign_steps::simulate_checked;
 use fog_sim::pipeline::northseek::MonteCarloConfig;
 use fog_sim::pipeline::own_model::own_model_from_runs;
-use fog_sim::pipeline::reproduce::{qualification_campaign_spec, qualification_plan};
+use fog_sim::pipeline::reproduce::{
+    qualification_campaign_spec, qualification_plan, write_model_file,
+};
 use fog_sim::pipeline::seek_schedule::seek_schedule;
 use fog_sim::train::{dataset_from_runs, predict_batch, InputChoice};
 
@@ -56,13 +58,7 @@ fn main() -> Result<()> {
     eprint!("{}{}", own.selection.summary(), own.summary());
     let schedule = seek_schedule(&params, &seeks, Some(&own.trained.model))?;
     if let Ok(path) = std::env::var("END_MISFIT_MODEL_OUT") {
-        let mut buf = [0u8; fog_core::model::format::MAX_ENCODED_LEN];
-        let len = own
-            .trained
-            .model
-            .encode(&mut buf)
-            .map_err(|e| anyhow!("{e}"))?;
-        std::fs::write(path, &buf[..len])?;
+        write_model_file(std::path::Path::new(&path), &own.trained.model)?;
     }
     let ds = dataset_from_runs(&runs, &own.specs).map_err(|e| anyhow!("{e}"))?;
     let predicted = predict_batch(&own.trained.model, ds.rows()).map_err(|e| anyhow!("{e}"))?;

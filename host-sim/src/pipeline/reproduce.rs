@@ -95,7 +95,7 @@ pub fn model_file_name(specs: &[FeatureSpec]) -> String {
 }
 
 /// Writes a model in fog-core's encoding (what `fogsim upload` sends), atomically.
-fn write_model_file(path: &Path, model: &fog_core::model::format::RbfModel) -> Result<()> {
+pub fn write_model_file(path: &Path, model: &fog_core::model::format::RbfModel) -> Result<()> {
     let mut buf = [0u8; fog_core::model::format::MAX_ENCODED_LEN];
     let len = model
         .encode(&mut buf)

@@ -388,6 +388,20 @@ fn row_keys(ds: &Dataset) -> Vec<(&str, u64)> {
         .collect()
 }
 
+/// Each set's dataset on `runs`, its inputs followed by `extra`.
+fn datasets_of(runs: &[Run], sets: &[InputSet], extra: &[FeatureSpec]) -> Result<Vec<Dataset>> {
+    sets.iter()
+        .map(|set| {
+            let specs: Vec<FeatureSpec> = set
+                .specs()
+                .into_iter()
+                .chain(extra.iter().copied())
+                .collect();
+            dataset_from_runs(runs, &specs)
+        })
+        .collect()
+}
+
 /// Each dataset restricted to the rows present in all of them.
 fn common_rows(sets: &[Dataset]) -> Vec<Dataset> {
     let mut common: Option<HashSet<(&str, u64)>> = None;
@@ -466,10 +480,7 @@ pub fn choose_inputs(
     inputs_criterion: &dyn InputCriterion,
     estimator_criterion: &dyn InputCriterion,
 ) -> Result<(InputSelection, Dataset)> {
-    let mut full = Vec::new();
-    for set in candidates {
-        full.push(dataset_from_runs(runs, &set.specs())?);
-    }
+    let mut full = datasets_of(runs, candidates, &[])?;
     if candidates.len() < 2 {
         let chosen = *candidates.first().ok_or(TrainError::EmptyDataset)?;
         return Ok((
@@ -532,16 +543,7 @@ pub fn choose_in_order_with(
     cfg: &TrainConfig,
     criterion: &dyn InputCriterion,
 ) -> Result<(InputSet, Vec<InputSetScore>)> {
-    let mut full = Vec::with_capacity(order.len());
-    for set in order {
-        let specs: Vec<FeatureSpec> = set
-            .specs()
-            .into_iter()
-            .chain(extra.iter().copied())
-            .collect();
-        full.push(dataset_from_runs(runs, &specs)?);
-    }
-    let common = common_rows(&full);
+    let common = common_rows(&datasets_of(runs, order, extra)?);
     let all: Vec<usize> = (0..order.len()).collect();
     let (best, scores) = choose_in_order(&all, order, &common, cfg, criterion)?;
     Ok((order[best], scores))
