@@ -106,6 +106,7 @@ fn model_under_test(
             inputs: fog_sim::train::InputChoice::Auto,
             seek_timing: None,
         },
+        fog_sim::pipeline::own_model::CAMPAIGN_RUNS,
     )?;
     let mut specs = own.selection.chosen.specs();
     if ["SET", "WIDTHS", "LINEAR", "DECAY", "RUNS"]

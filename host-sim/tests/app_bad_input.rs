@@ -30,6 +30,66 @@ fn rejects(dir: &Path, args: &[&str], needles: &[&str]) {
 const GOOD_RUN: &str =
     "# fog-runs v1\n# ambient_c: 20\nt_s,rate_dph,temp_c\n10,0.1,20.0\n20,0.1,20.1\n30,0.1,20.2\n";
 
+/// The options that shape the model `north-seek` trains (`--inputs`, `--training-runs`,
+/// `--save-model`): with `--model` they would be ignored, so each is refused by name; an
+/// impossible value is refused with the allowed ones.
+#[test]
+fn north_seek_training_options_are_refused_with_a_model_or_out_of_range() {
+    let dir = scratch_dir("bad-training");
+    std::fs::write(dir.join("garbage.bin"), b"not a model at all").unwrap();
+    let json = ["--json", "report.json"];
+    rejects(
+        &dir,
+        &[
+            &["north-seek", "--model", "garbage.bin", "--inputs", "t,rise"][..],
+            &json,
+        ]
+        .concat(),
+        &["--inputs", "--model garbage.bin"],
+    );
+    rejects(
+        &dir,
+        &[
+            &[
+                "north-seek",
+                "--model",
+                "garbage.bin",
+                "--save-model",
+                "m.bin",
+            ][..],
+            &json,
+        ]
+        .concat(),
+        &["--save-model", "--model garbage.bin"],
+    );
+    rejects(
+        &dir,
+        &[&["north-seek", "--training-runs", "1"][..], &json].concat(),
+        &["--training-runs 1", "2..=192"],
+    );
+    rejects(
+        &dir,
+        &[&["north-seek", "--inputs", "t,accel"][..], &json].concat(),
+        &["--inputs", "t,rise"],
+    );
+    rejects(
+        &dir,
+        &[
+            &[
+                "north-seek",
+                "--model",
+                "garbage.bin",
+                "--training-runs",
+                "96",
+            ][..],
+            &json,
+        ]
+        .concat(),
+        &["--training-runs", "--model garbage.bin"],
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn malformed_files_and_impossible_options_are_rejected() {
     let dir = scratch_dir("bad");
@@ -82,22 +142,6 @@ fn malformed_files_and_impossible_options_are_rejected() {
         &dir,
         &[&["north-seek", "--model", "garbage.bin"][..], &json].concat(),
         &["--model"],
-    );
-    // `--inputs` chooses the trained default model's inputs: with `--model` it would be
-    // ignored, so it is refused by name; an unknown set is refused with the sets listed.
-    rejects(
-        &dir,
-        &[
-            &["north-seek", "--model", "garbage.bin", "--inputs", "t,rise"][..],
-            &json,
-        ]
-        .concat(),
-        &["--inputs", "--model garbage.bin"],
-    );
-    rejects(
-        &dir,
-        &[&["north-seek", "--inputs", "t,accel"][..], &json].concat(),
-        &["--inputs", "t,rise"],
     );
     rejects(
         &dir,

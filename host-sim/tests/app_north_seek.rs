@@ -15,24 +15,31 @@ fn f(v: &Value, path: &[&str]) -> f64 {
         .unwrap_or_else(|| panic!("{path:?} missing"))
 }
 
+/// `north-seek --starts 6 --seeks 3 --json JSON EXTRA...` in `dir`, which must succeed;
+/// its JSON report.
+fn short_seek(dir: &std::path::Path, json: &str, extra: &[&str]) -> Value {
+    let args = [
+        &[
+            "north-seek",
+            "--starts",
+            "6",
+            "--seeks",
+            "3",
+            "--json",
+            json,
+        ][..],
+        extra,
+    ]
+    .concat();
+    let out = fogsim(dir, &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    serde_json::from_str(&std::fs::read_to_string(dir.join(json)).unwrap()).unwrap()
+}
+
 #[test]
 fn compensated_cold_start_seeks_beat_uncompensated_ones() {
     let dir = scratch_dir("northseek");
-    let args = [
-        "north-seek",
-        "--starts",
-        "6",
-        "--seeks",
-        "3",
-        "--json",
-        "ns.json",
-        "--threads",
-        "2",
-    ];
-    let out = fogsim(&dir, &args);
-    assert!(out.status.success(), "{}", stderr(&out));
-    let json: Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("ns.json")).unwrap()).unwrap();
+    let json = short_seek(&dir, "ns.json", &["--threads", "2"]);
     assert_eq!(json["starts"].as_u64(), Some(6));
     assert_eq!(json["seeks_per_start"].as_u64(), Some(3));
     let floor = f(&json, &["noise_floor_deg"]);
@@ -64,24 +71,21 @@ fn compensated_cold_start_seeks_beat_uncompensated_ones() {
     );
 
     // Same seed, one thread: identical report.
-    let out = fogsim(
+    short_seek(
         &dir,
-        &[
-            "north-seek",
-            "--starts",
-            "6",
-            "--seeks",
-            "3",
-            "--json",
-            "ns1.json",
-            "--threads",
-            "1",
-        ],
+        "ns1.json",
+        &["--threads", "1", "--save-model", "own.bin"],
     );
-    assert!(out.status.success(), "{}", stderr(&out));
     let a = std::fs::read_to_string(dir.join("ns.json")).unwrap();
     let b = std::fs::read_to_string(dir.join("ns1.json")).unwrap();
     assert_eq!(a, b, "the Monte Carlo depends on the thread count");
+    // The saved default model is the one the Monte Carlo ran: given back with `--model`,
+    // the same seed gives the same compensated azimuths.
+    let again = short_seek(&dir, "ns2.json", &["--model", "own.bin"]);
+    assert_eq!(
+        again["compensated"]["azimuths_deg"], json["compensated"]["azimuths_deg"],
+        "--save-model wrote another model than the one the Monte Carlo ran"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Result};
+use fog_core::model::format::RbfModel;
 use fog_core::seeking::northfinder::SeekMode;
 
 use super::check_output_file;
@@ -14,7 +15,8 @@ use crate::pipeline::northseek::{
     build_product_report, default_threads, run_monte_carlo_with_calibration, seek_table,
     MonteCarloConfig,
 };
-use crate::pipeline::own_model::{train_own_model, OwnModelPlan};
+use crate::pipeline::own_model::{train_own_model, OwnModelPlan, CAMPAIGN_RUNS};
+use crate::pipeline::reproduce::write_model_file;
 use crate::report::{progress_bar, write_json};
 use crate::sim::GyroParams;
 
@@ -78,7 +80,19 @@ pub struct Args {
     /// Refused with `--model`, which brings its own inputs.
     #[arg(long, value_parser = crate::train::InputChoice::parse)]
     pub inputs: Option<crate::train::InputChoice>,
+    /// Cold starts of the simulated chamber campaign the default model trains on, at the
+    /// seek's ambient (2..=192; each 45 min at 1 Hz) [default: 96, the own model's chamber
+    /// campaign]. Refused with `--model`.
+    #[arg(long = "training-runs")]
+    pub training_runs: Option<usize>,
+    /// Write the default model it trains here (fog-core postcard, as `train --out`), to run
+    /// the Monte Carlo again with `--model` or to `upload` it. Refused with `--model`.
+    #[arg(long = "save-model")]
+    pub save_model: Option<PathBuf>,
 }
+
+/// Most chamber runs `--training-runs` takes: every run is held in memory.
+pub const MAX_TRAINING_RUNS: usize = 2 * CAMPAIGN_RUNS;
 
 /// Turns the options into a Monte Carlo configuration, rejecting impossible values.
 pub fn config_from_args(a: &Args) -> Result<MonteCarloConfig> {
@@ -111,6 +125,66 @@ pub fn config_from_args(a: &Args) -> Result<MonteCarloConfig> {
     Ok(cfg)
 }
 
+/// The chamber runs of the default model: `--training-runs` checked, or the default; the
+/// options that only shape a trained model are refused by name with `--model`.
+fn training_runs(args: &Args) -> Result<usize> {
+    if let Some(m) = &args.model {
+        let trains = [
+            ("--inputs", args.inputs.is_some()),
+            ("--training-runs", args.training_runs.is_some()),
+            ("--save-model", args.save_model.is_some()),
+        ];
+        if let Some((flag, _)) = trains.iter().find(|(_, given)| *given) {
+            bail!(
+                "{flag} is for the model north-seek trains; --model {} is given, so none is trained",
+                m.display()
+            );
+        }
+    }
+    let runs = args.training_runs.unwrap_or(CAMPAIGN_RUNS);
+    if !(2..=MAX_TRAINING_RUNS).contains(&runs) {
+        bail!(
+            "--training-runs {runs}: must be within 2..={MAX_TRAINING_RUNS} (grouped validation needs 2 runs; every run is held in memory)"
+        );
+    }
+    Ok(runs)
+}
+
+/// The default model: the same defaults as `fogsim train` (inputs chosen by grouped
+/// validation over whole runs) plus the own-model recipe's steps for these cold starts
+/// (`own_model`), on a simulated chamber campaign of `runs` cold starts at the ambient;
+/// written to `save` when given. Returns the model and where it came from.
+fn train_default_model(
+    params: &GyroParams,
+    plan: &OwnModelPlan,
+    runs: usize,
+    save: Option<&std::path::Path>,
+) -> Result<(RbfModel, String)> {
+    let own = train_own_model(params, plan, runs)?;
+    eprint!("{}", own.selection.summary());
+    eprint!("{}", own.summary());
+    let trained = own.trained;
+    eprintln!(
+        "trained the default model on {} simulated {} degC runs (seed {}): {} centres, held-out rms {:.4} deg/h, seek {:.4} deg, chosen by held-out {}",
+        own.runs,
+        plan.ambient_c,
+        plan.seed,
+        trained.report.n_centers,
+        trained.report.heldout_rms_dph,
+        trained.report.cross_validation.best.heldout_seek_deg,
+        trained.report.criterion.name()
+    );
+    if let Some(p) = save {
+        write_model_file(p, &trained.model)?;
+        eprintln!("wrote the default model to {}", p.display());
+    }
+    let source = format!(
+        "trained on {} simulated runs at {} degC, seed {}",
+        own.runs, plan.ambient_c, plan.seed
+    );
+    Ok((trained.model, source))
+}
+
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
     let cfg = config_from_args(&args)?;
@@ -121,17 +195,13 @@ pub fn run(args: Args) -> Result<()> {
         cfg.latitude_deg,
     )
     .map_err(|e| anyhow::anyhow!("--criterion {e}"))?;
-    if let (Some(_), Some(m)) = (args.inputs, &args.model) {
-        bail!(
-            "--inputs chooses the inputs of the model north-seek trains; --model {} brings its own",
-            m.display()
-        );
-    }
+    let training_runs = training_runs(&args)?;
     let guard = match &args.model {
         Some(m) => OutputGuard::new(&[m]),
         None => OutputGuard::default(),
     };
     check_output_file(&guard, args.json.as_deref(), "--json")?;
+    check_output_file(&guard, args.save_model.as_deref(), "--save-model")?;
     let params = GyroParams::paper_default();
     let (model, source) = match &args.model {
         Some(p) => (
@@ -139,10 +209,6 @@ pub fn run(args: Args) -> Result<()> {
             p.display().to_string(),
         ),
         None => {
-            // The same defaults as `fogsim train` (inputs chosen by grouped validation
-            // over whole runs, d2T/dt2 kept where it wins) plus the time since power-on
-            // of these cold starts (`own_model`), on the chamber campaign at the
-            // ambient (`own_model::CAMPAIGN_RUNS` runs).
             let plan = OwnModelPlan {
                 ambient_c: cfg.ambient_c,
                 latitude_deg: cfg.latitude_deg,
@@ -152,27 +218,7 @@ pub fn run(args: Args) -> Result<()> {
                 inputs: args.inputs.unwrap_or(crate::train::InputChoice::Auto),
                 seek_timing: Some(cfg.clone()),
             };
-            let own = train_own_model(&params, &plan)?;
-            eprint!("{}", own.selection.summary());
-            eprint!("{}", own.summary());
-            let trained = own.trained;
-            eprintln!(
-                "trained the default model on {} simulated {} degC runs (seed {}): {} centres, held-out rms {:.4} deg/h, seek {:.4} deg, chosen by held-out {}",
-                own.runs,
-                cfg.ambient_c,
-                cfg.seed,
-                trained.report.n_centers,
-                trained.report.heldout_rms_dph,
-                trained.report.cross_validation.best.heldout_seek_deg,
-                trained.report.criterion.name()
-            );
-            (
-                trained.model,
-                format!(
-                    "trained on {} simulated runs at {} degC, seed {}",
-                    own.runs, cfg.ambient_c, cfg.seed
-                ),
-            )
+            train_default_model(&params, &plan, training_runs, args.save_model.as_deref())?
         }
     };
     let bar = progress_bar(cfg.starts, "north-seek cold starts");

@@ -9,7 +9,7 @@ use super::{AgingLaw, AgingPlan, AgingSubject, Chamber};
 use crate::pipeline::campaign::CampaignSpec;
 use crate::pipeline::campaign_steps::{simulate_checked, train_with_config};
 use crate::pipeline::northseek::{run_seeks, Arm, ArmOutcome, MonteCarloConfig};
-use crate::pipeline::own_model::{train_own_model, OwnModelPlan};
+use crate::pipeline::own_model::{train_own_model, OwnModelPlan, CAMPAIGN_RUNS};
 use crate::sim::GyroParams;
 use crate::train::seek_score::Criterion;
 
@@ -43,7 +43,7 @@ impl AgingSubject for SimAging {
 
     fn chamber(&self, plan: &AgingPlan) -> Result<Chamber> {
         let own_plan = own_model_plan(plan)?;
-        let own = train_own_model(&self.delivered, &own_plan)?;
+        let own = train_own_model(&self.delivered, &own_plan, CAMPAIGN_RUNS)?;
         if plan.ambients_c.len() == 1 {
             return Ok(Chamber {
                 centres: own.trained.report.n_centers,
