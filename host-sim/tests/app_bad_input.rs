@@ -32,9 +32,10 @@ const GOOD_RUN: &str =
 
 /// The options that shape the model `north-seek` trains (`--inputs`, `--training-runs`,
 /// `--save-model`): with `--model` they would be ignored, so each is refused by name; an
-/// impossible value is refused with the allowed ones.
+/// impossible value is refused with the allowed ones. Two outputs on one file are refused
+/// naming both flags (`north-seek`, `train`, `allan`).
 #[test]
-fn north_seek_training_options_are_refused_with_a_model_or_out_of_range() {
+fn training_options_and_colliding_outputs_are_refused_by_name() {
     let dir = scratch_dir("bad-training");
     std::fs::write(dir.join("garbage.bin"), b"not a model at all").unwrap();
     let json = ["--json", "report.json"];
@@ -86,6 +87,38 @@ fn north_seek_training_options_are_refused_with_a_model_or_out_of_range() {
         ]
         .concat(),
         &["--training-runs", "--model garbage.bin"],
+    );
+    // Two outputs on one file: the later would overwrite the earlier; refused before any
+    // work, naming both flags (as `train`'s).
+    rejects(
+        &dir,
+        &[&["north-seek", "--save-model", "report.json"][..], &json].concat(),
+        &["--json and --save-model", "report.json"],
+    );
+    std::fs::write(dir.join("good.csv"), GOOD_RUN).unwrap();
+    rejects(
+        &dir,
+        &[
+            "train",
+            "good.csv",
+            "--out",
+            "report.json",
+            "--json",
+            "report.json",
+        ],
+        &["--out and --json", "report.json"],
+    );
+    rejects(
+        &dir,
+        &[
+            "allan",
+            "good.csv",
+            "--json",
+            "report.json",
+            "--plot",
+            "report.json",
+        ],
+        &["--json and --plot", "report.json"],
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -2,7 +2,7 @@
 //! [--json FILE] [--plot FILE.svg]`: an Allan-family deviation of one column of fog-runs
 //! files with 1-sigma confidence intervals, and the IEEE Std 952 noise terms.
 
-use super::check_output_file;
+use super::{check_distinct_outputs, check_output_file};
 use crate::io::OutputGuard;
 use crate::pipeline::allan::{allan_of_files, AllanReport, DRIFT_COLUMN};
 use crate::plots::{allan_chart, write_svg};
@@ -39,6 +39,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let guard = OutputGuard::new(&args.files);
     check_output_file(&guard, args.json.as_deref(), "--json")?;
     check_output_file(&guard, args.plot.as_deref(), "--plot")?;
+    check_distinct_outputs(&[
+        ("--json", args.json.as_deref()),
+        ("--plot", args.plot.as_deref()),
+    ])?;
     let report = allan_of_files(&args.files, &args.column, args.kind, args.taus)?;
     print!("{}", render_text(&report));
     if let Some(path) = &args.json {

@@ -49,6 +49,21 @@ pub(crate) fn check_output_file(
     check_flagged(path, flag, |p| guard.check_file(p))
 }
 
+/// Refuses two output flags that name the same file (the later one would overwrite the
+/// earlier): `outputs` are (flag, path) pairs, unset paths skipped.
+pub(crate) fn check_distinct_outputs(outputs: &[(&str, Option<&Path>)]) -> anyhow::Result<()> {
+    let named: Vec<(&str, &Path)> = outputs
+        .iter()
+        .filter_map(|(flag, p)| p.map(|p| (*flag, p)))
+        .collect();
+    for (i, (flag, p)) in named.iter().enumerate() {
+        if let Some((earlier, _)) = named[..i].iter().find(|(_, q)| q == p) {
+            anyhow::bail!("{earlier} and {flag} name the same file {}", p.display());
+        }
+    }
+    Ok(())
+}
+
 /// Creates an output directory before any computation, naming the flag in the error.
 pub(crate) fn prepare_output_dir(
     guard: &OutputGuard,

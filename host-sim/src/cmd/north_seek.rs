@@ -8,7 +8,7 @@ use anyhow::{bail, Result};
 use fog_core::model::format::RbfModel;
 use fog_core::seeking::northfinder::SeekMode;
 
-use super::check_output_file;
+use super::{check_distinct_outputs, check_output_file};
 use crate::io::model::read_model;
 use crate::io::OutputGuard;
 use crate::pipeline::northseek::{
@@ -202,6 +202,10 @@ pub fn run(args: Args) -> Result<()> {
     };
     check_output_file(&guard, args.json.as_deref(), "--json")?;
     check_output_file(&guard, args.save_model.as_deref(), "--save-model")?;
+    check_distinct_outputs(&[
+        ("--json", args.json.as_deref()),
+        ("--save-model", args.save_model.as_deref()),
+    ])?;
     let params = GyroParams::paper_default();
     let (model, source) = match &args.model {
         Some(p) => (

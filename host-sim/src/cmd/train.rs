@@ -6,7 +6,7 @@
 //! checked and encoded before any file is written, and the outputs are committed
 //! together, so a failure leaves no partial output and two runs never mix theirs.
 
-use super::check_output_file;
+use super::{check_distinct_outputs, check_output_file};
 use crate::io::runs::run_files;
 use crate::io::{read_runs_binned, OutputGuard, OutputLock, StagedFiles};
 use crate::train::seek_refit::{refit_for_seeks, SeekRefit};
@@ -210,18 +210,11 @@ fn check_outputs(args: &Args, guard: &OutputGuard) -> anyhow::Result<()> {
     check_output_file(guard, Some(&args.out), "--out")?;
     check_output_file(guard, args.json.as_deref(), "--json")?;
     check_output_file(guard, args.export_design.as_deref(), "--export-design")?;
-    let named = [
-        Some(&args.out),
-        args.json.as_ref(),
-        args.export_design.as_ref(),
-    ];
-    let paths: Vec<&std::path::PathBuf> = named.into_iter().flatten().collect();
-    for (i, p) in paths.iter().enumerate() {
-        if paths[..i].contains(p) {
-            anyhow::bail!("two outputs name the same file {}", p.display());
-        }
-    }
-    Ok(())
+    check_distinct_outputs(&[
+        ("--out", Some(&args.out)),
+        ("--json", args.json.as_deref()),
+        ("--export-design", args.export_design.as_deref()),
+    ])
 }
 
 /// Every file the command reads (runs, field records), checked against the outputs;
