@@ -88,14 +88,18 @@ fn training_options_and_colliding_outputs_are_refused_by_name() {
         .concat(),
         &["--training-runs", "--model garbage.bin"],
     );
-    // Two outputs on one file: the later would overwrite the earlier; refused before any
-    // work, naming both flags (as `train`'s).
+    // Two outputs on one file, however spelled: the later would overwrite the earlier;
+    // refused before any work, naming both flags (as `train`'s).
     rejects(
         &dir,
-        &[&["north-seek", "--save-model", "report.json"][..], &json].concat(),
-        &["--json and --save-model", "report.json"],
+        &[&["north-seek", "--save-model", "./report.json"][..], &json].concat(),
+        &[
+            "--json report.json and --save-model ./report.json",
+            "same file",
+        ],
     );
     std::fs::write(dir.join("good.csv"), GOOD_RUN).unwrap();
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
     rejects(
         &dir,
         &[
@@ -104,9 +108,12 @@ fn training_options_and_colliding_outputs_are_refused_by_name() {
             "--out",
             "report.json",
             "--json",
-            "report.json",
+            "sub/../report.json",
         ],
-        &["--out and --json", "report.json"],
+        &[
+            "--out report.json and --json sub/../report.json",
+            "same file",
+        ],
     );
     rejects(
         &dir,
@@ -118,7 +125,7 @@ fn training_options_and_colliding_outputs_are_refused_by_name() {
             "--plot",
             "report.json",
         ],
-        &["--json and --plot", "report.json"],
+        &["--json report.json and --plot report.json", "same file"],
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -20,7 +20,7 @@ pub mod rig;
 pub mod train;
 pub mod upload;
 
-use crate::io::OutputGuard;
+use crate::io::{same_output, OutputGuard};
 use std::path::{Path, PathBuf};
 
 /// Names the flag of a campaign-plan error (`--ambient-c`, `--duration-min`, `--runs`); other
@@ -49,16 +49,20 @@ pub(crate) fn check_output_file(
     check_flagged(path, flag, |p| guard.check_file(p))
 }
 
-/// Refuses two output flags that name the same file (the later one would overwrite the
-/// earlier): `outputs` are (flag, path) pairs, unset paths skipped.
+/// Refuses two output flags that name the same file however spelled (the later one would
+/// overwrite the earlier): `outputs` are (flag, path) pairs, unset paths skipped.
 pub(crate) fn check_distinct_outputs(outputs: &[(&str, Option<&Path>)]) -> anyhow::Result<()> {
     let named: Vec<(&str, &Path)> = outputs
         .iter()
         .filter_map(|(flag, p)| p.map(|p| (*flag, p)))
         .collect();
     for (i, (flag, p)) in named.iter().enumerate() {
-        if let Some((earlier, _)) = named[..i].iter().find(|(_, q)| q == p) {
-            anyhow::bail!("{earlier} and {flag} name the same file {}", p.display());
+        if let Some((earlier, q)) = named[..i].iter().find(|(_, q)| same_output(q, p)) {
+            anyhow::bail!(
+                "{earlier} {} and {flag} {} name the same file",
+                q.display(),
+                p.display()
+            );
         }
     }
     Ok(())

@@ -172,6 +172,25 @@ impl OutputGuard {
     }
 }
 
+/// Whether two output paths name one file however they are spelled (`a.json`,
+/// `./a.json`, `d/../a.json`, a symlinked directory): existing files by identity (so a
+/// hard link counts too), files still to be written by their canonical directory and name.
+pub fn same_output(a: &Path, b: &Path) -> bool {
+    match (FileId::of(a), FileId::of(b)) {
+        (Some(x), Some(y)) => x.same(&y),
+        _ => output_location(a) == output_location(b),
+    }
+}
+
+/// Where an output will be written: its canonical directory and its name, or the path as
+/// spelled when the directory does not exist (then the output check reports it).
+fn output_location(path: &Path) -> PathBuf {
+    match (fs::canonicalize(parent_dir(path)), path.file_name()) {
+        (Ok(dir), Some(name)) => dir.join(name),
+        _ => path.to_path_buf(),
+    }
+}
+
 /// Creates a directory and its parents (no input check; see [`OutputGuard::prepare_dir`]).
 pub fn create_dir(dir: &Path) -> Result<(), OutputError> {
     fs::create_dir_all(dir).map_err(|e| OutputError::NotADirectory {
@@ -211,6 +230,34 @@ mod tests {
         fs::hard_link(&input, dir.join("alias.csv")).unwrap();
         let guard = OutputGuard::new(&[&input]);
         assert!(guard.check_file(&dir.join("alias.csv")).is_err());
+    }
+
+    #[test]
+    fn two_spellings_of_one_output_are_the_same_output() {
+        let dir = scratch("outputs");
+        fs::create_dir_all(dir.join("sub")).unwrap();
+        let out = dir.join("a.json");
+        assert!(same_output(&out, &dir.join(".").join("a.json")));
+        assert!(same_output(
+            &out,
+            &dir.join("sub").join("..").join("a.json")
+        ));
+        assert!(!same_output(&out, &dir.join("b.json")));
+        assert!(!same_output(&out, &dir.join("sub").join("a.json")));
+        fs::write(&out, "x").unwrap();
+        assert!(
+            same_output(&dir.join("sub/../a.json"), &out),
+            "once it exists"
+        );
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_hard_link_to_another_output_is_the_same_output() {
+        let dir = scratch("output-link");
+        fs::write(dir.join("a.json"), "x").unwrap();
+        fs::hard_link(dir.join("a.json"), dir.join("alias.json")).unwrap();
+        assert!(same_output(&dir.join("a.json"), &dir.join("alias.json")));
     }
 
     #[test]

@@ -16,7 +16,7 @@ pub mod runs;
 pub use atomic::{write_atomic, write_atomic_with, StagedFiles};
 pub use bin::{read_binned, read_runs_binned, WindowBinner};
 pub use bounded::{read_bounded, BoundedReadError};
-pub use guard::{OutputError, OutputGuard};
+pub use guard::{same_output, OutputError, OutputGuard};
 pub use lock::OutputLock;
 pub use reader::{visit_rows, RunHeader, RunReader};
 pub use runs::{read_run, read_runs, Run, RunError, RunErrorKind};

@@ -75,6 +75,9 @@ pub struct MonteCarloConfig {
     pub tilt_deg: f64,
     /// Heading-dependent bias amplitude A of A cos(input axis azimuth), deg/h (0: none).
     pub heading_bias_dph: f64,
+    /// How far above the ambient the gyro is at power-on, degC: 0 is the cold start from a
+    /// soak that every model here is trained on; above 0 a restart after a short power-off.
+    pub restart_above_ambient_c: f64,
 }
 
 impl MonteCarloConfig {
@@ -97,6 +100,7 @@ impl MonteCarloConfig {
             threads: default_threads(),
             tilt_deg: 0.0,
             heading_bias_dph: 0.0,
+            restart_above_ambient_c: 0.0,
         }
     }
 
@@ -146,7 +150,26 @@ impl MonteCarloConfig {
                 self.heading_bias_dph
             );
         }
+        if !(self.restart_above_ambient_c.is_finite()
+            && (0.0..=MAX_RESTART_ABOVE_AMBIENT_C).contains(&self.restart_above_ambient_c))
+        {
+            bail!(
+                "--restart-above-c {}: must be within 0..={MAX_RESTART_ABOVE_AMBIENT_C} degC",
+                self.restart_above_ambient_c
+            );
+        }
         Ok(())
+    }
+
+    /// The thermal state at power-on of every start.
+    pub fn start_state(&self) -> StartState {
+        if self.restart_above_ambient_c > 0.0 {
+            StartState::Restart {
+                above_ambient_c: self.restart_above_ambient_c,
+            }
+        } else {
+            StartState::Soaked
+        }
     }
 
     fn seek_config(&self) -> SeekConfig {
@@ -501,7 +524,7 @@ pub fn run_seeks(
         input_axis_vertical: false,
         raw_rate_hz: cfg.raw_rate_hz,
         seed,
-        start: StartState::Soaked,
+        start: cfg.start_state(),
     };
     let (mut gyro, mut table) =
         rig(params, &spec, cfg.turntable.clone()).map_err(|e| anyhow!("simulator: {e}"))?;
@@ -705,6 +728,10 @@ pub fn run_monte_carlo_with_calibration(
     })?;
     Ok((outcomes, heading))
 }
+
+/// Highest `restart_above_ambient_c`, degC: about the simulated gyro's powered-on rise
+/// above its ambient and then some.
+pub const MAX_RESTART_ABOVE_AMBIENT_C: f64 = 30.0;
 
 /// Headings of the heading calibration, deg.
 pub const CALIBRATION_HEADINGS: usize = 8;
@@ -927,6 +954,7 @@ pub fn build_report(
         },
         latitude_deg: cfg.latitude_deg,
         ambient_c: cfg.ambient_c,
+        restart_above_ambient_c: cfg.restart_above_ambient_c,
         true_azimuth_deg: cfg.true_azimuth_deg,
         seek_duration_s,
         max_seek_duration_s,

@@ -149,8 +149,13 @@ pub fn seek_targets_line(r: &NorthSeekReport) -> String {
         ),
     };
     let [(all, all_se, _), (first, first_se, _), (mean, mean_se, _)] = figures;
+    let kind = if r.restart_above_ambient_c > 0.0 {
+        format!("warm-restart (+{} degC)", r.restart_above_ambient_c)
+    } else {
+        "cold-start".to_string()
+    };
     format!(
-        "cold-start targets ({} starts): all seeks {all:.3} +- {all_se:.3}x floor (<= {ALL_SEEKS_OVER_FLOOR}) {}; worst of seeks 1-{FIRST_SEEKS} {first:.3} +- {first_se:.3}x (seek {}, <= {FIRST_SEEKS_OVER_FLOOR}) {}; worst |mean|/std {mean:.2} +- {mean_se:.2} (seek {}, <= {MEAN_OVER_STD}) {} -> {} ({decided})\n",
+        "{kind} targets ({} starts): all seeks {all:.3} +- {all_se:.3}x floor (<= {ALL_SEEKS_OVER_FLOOR}) {}; worst of seeks 1-{FIRST_SEEKS} {first:.3} +- {first_se:.3}x (seek {}, <= {FIRST_SEEKS_OVER_FLOOR}) {}; worst |mean|/std {mean:.2} +- {mean_se:.2} (seek {}, <= {MEAN_OVER_STD}) {} -> {} ({decided})\n",
         r.starts,
         ok(all <= ALL_SEEKS_OVER_FLOOR),
         t.worst_first_seek,

@@ -122,6 +122,8 @@ pub struct NorthSeekReport {
     pub positions: u8,
     pub latitude_deg: f64,
     pub ambient_c: f64,
+    /// Gyro temperature above the ambient at power-on, degC (0: cold start from a soak).
+    pub restart_above_ambient_c: f64,
     pub true_azimuth_deg: f64,
     /// Duration of one seek from its start to its result, s (mean over all seeks).
     pub seek_duration_s: f64,
