@@ -107,6 +107,7 @@ fn model_under_test(
             seek_timing: None,
         },
         fog_sim::pipeline::own_model::CAMPAIGN_RUNS,
+        None,
     )?;
     let mut specs = own.selection.chosen.specs();
     if ["SET", "WIDTHS", "LINEAR", "DECAY", "RUNS"]

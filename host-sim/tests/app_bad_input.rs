@@ -31,11 +31,10 @@ const GOOD_RUN: &str =
     "# fog-runs v1\n# ambient_c: 20\nt_s,rate_dph,temp_c\n10,0.1,20.0\n20,0.1,20.1\n30,0.1,20.2\n";
 
 /// The options that shape the model `north-seek` trains (`--inputs`, `--training-runs`,
-/// `--save-model`): with `--model` they would be ignored, so each is refused by name; an
-/// impossible value is refused with the allowed ones. Two outputs on one file are refused
-/// naming both flags (`north-seek`, `train`, `allan`).
+/// `--save-model`, `--training-restarts-above-c`): with `--model` they would be ignored,
+/// so each is refused by name; an impossible value is refused with the allowed ones.
 #[test]
-fn training_options_and_colliding_outputs_are_refused_by_name() {
+fn training_options_are_refused_by_name() {
     let dir = scratch_dir("bad-training");
     std::fs::write(dir.join("garbage.bin"), b"not a model at all").unwrap();
     let json = ["--json", "report.json"];
@@ -88,8 +87,41 @@ fn training_options_and_colliding_outputs_are_refused_by_name() {
         .concat(),
         &["--training-runs", "--model garbage.bin"],
     );
-    // Two outputs on one file, however spelled: the later would overwrite the earlier;
-    // refused before any work, naming both flags (as `train`'s).
+    rejects(
+        &dir,
+        &[
+            &[
+                "north-seek",
+                "--model",
+                "garbage.bin",
+                "--training-restarts-above-c",
+                "4",
+            ][..],
+            &json,
+        ]
+        .concat(),
+        &["--training-restarts-above-c", "--model garbage.bin"],
+    );
+    for bad in ["0", "31", "nan"] {
+        rejects(
+            &dir,
+            &[
+                &["north-seek", "--training-restarts-above-c", bad][..],
+                &json,
+            ]
+            .concat(),
+            &["--training-restarts-above-c", "0 < C <= 30"],
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Two outputs of one command on one file, however spelled (`./a`, `d/../a`): the later
+/// would overwrite the earlier; refused before any work, naming both flags and spellings.
+#[test]
+fn two_outputs_on_one_file_are_refused_however_spelled() {
+    let dir = scratch_dir("bad-outputs");
+    let json = ["--json", "report.json"];
     rejects(
         &dir,
         &[&["north-seek", "--save-model", "./report.json"][..], &json].concat(),

@@ -224,6 +224,7 @@ fn a_record_whose_column_candidates_are_functions_of_the_base_plants_only_other_
         seed: 3,
         latitude_deg: 39.9,
         raw_rate_hz: 1.0,
+        warm_restarts: None,
     };
     let runs: Vec<Run> = simulate_campaign(&GyroParams::paper_default(), &spec)
         .unwrap()

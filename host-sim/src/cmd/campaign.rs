@@ -99,6 +99,7 @@ impl Args {
             seed: self.seed,
             latitude_deg: self.latitude,
             raw_rate_hz: self.raw_rate_hz,
+            warm_restarts: None,
         })
     }
 }

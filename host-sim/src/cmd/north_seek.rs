@@ -11,9 +11,10 @@ use fog_core::seeking::northfinder::SeekMode;
 use super::{check_distinct_outputs, check_output_file};
 use crate::io::model::read_model;
 use crate::io::OutputGuard;
+use crate::pipeline::campaign::WarmRestarts;
 use crate::pipeline::northseek::{
     build_product_report, default_threads, run_monte_carlo_with_calibration, seek_table,
-    MonteCarloConfig,
+    MonteCarloConfig, MAX_RESTART_ABOVE_AMBIENT_C,
 };
 use crate::pipeline::own_model::{train_own_model, OwnModelPlan, CAMPAIGN_RUNS};
 use crate::pipeline::reproduce::write_model_file;
@@ -99,7 +100,15 @@ pub struct Args {
     /// the Monte Carlo again with `--model` or to `upload` it. Refused with `--model`.
     #[arg(long = "save-model")]
     pub save_model: Option<PathBuf>,
+    /// Warm restarts in the default model's chamber campaign: every third power-on is a
+    /// restart 0..C degC above the ambient (0 < C <= 30), so validation sees the restarts
+    /// the product may meet [default: cold starts only]. Refused with `--model`.
+    #[arg(long = "training-restarts-above-c")]
+    pub training_restarts_above_c: Option<f64>,
 }
+
+/// Every how many chamber power-ons one is a warm restart (`--training-restarts-above-c`).
+pub const TRAINING_RESTART_EVERY: usize = 3;
 
 /// Most chamber runs `--training-runs` takes: every run is held in memory.
 pub const MAX_TRAINING_RUNS: usize = 2 * CAMPAIGN_RUNS;
@@ -138,12 +147,16 @@ pub fn config_from_args(a: &Args) -> Result<MonteCarloConfig> {
 
 /// The chamber runs of the default model: `--training-runs` checked, or the default; the
 /// options that only shape a trained model are refused by name with `--model`.
-fn training_runs(args: &Args) -> Result<usize> {
+fn training_campaign(args: &Args) -> Result<(usize, Option<WarmRestarts>)> {
     if let Some(m) = &args.model {
         let trains = [
             ("--inputs", args.inputs.is_some()),
             ("--training-runs", args.training_runs.is_some()),
             ("--save-model", args.save_model.is_some()),
+            (
+                "--training-restarts-above-c",
+                args.training_restarts_above_c.is_some(),
+            ),
         ];
         if let Some((flag, _)) = trains.iter().find(|(_, given)| *given) {
             bail!(
@@ -158,7 +171,19 @@ fn training_runs(args: &Args) -> Result<usize> {
             "--training-runs {runs}: must be within 2..={MAX_TRAINING_RUNS} (grouped validation needs 2 runs; every run is held in memory)"
         );
     }
-    Ok(runs)
+    let warm_restarts = match args.training_restarts_above_c {
+        None => None,
+        Some(c) if c.is_finite() && c > 0.0 && c <= MAX_RESTART_ABOVE_AMBIENT_C => {
+            Some(WarmRestarts {
+                every: TRAINING_RESTART_EVERY,
+                max_above_c: c,
+            })
+        }
+        Some(c) => bail!(
+            "--training-restarts-above-c {c}: must be within 0 < C <= {MAX_RESTART_ABOVE_AMBIENT_C} degC"
+        ),
+    };
+    Ok((runs, warm_restarts))
 }
 
 /// The default model: the same defaults as `fogsim train` (inputs chosen by grouped
@@ -169,9 +194,10 @@ fn train_default_model(
     params: &GyroParams,
     plan: &OwnModelPlan,
     runs: usize,
+    warm_restarts: Option<WarmRestarts>,
     save: Option<&std::path::Path>,
 ) -> Result<(RbfModel, String)> {
-    let own = train_own_model(params, plan, runs)?;
+    let own = train_own_model(params, plan, runs, warm_restarts)?;
     eprint!("{}", own.selection.summary());
     eprint!("{}", own.summary());
     let trained = own.trained;
@@ -189,8 +215,15 @@ fn train_default_model(
         write_model_file(p, &trained.model)?;
         eprintln!("wrote the default model to {}", p.display());
     }
+    let restarts = match warm_restarts {
+        Some(w) => format!(
+            ", one power-on in {} a warm restart 0..{} degC above the ambient",
+            w.every, w.max_above_c
+        ),
+        None => String::new(),
+    };
     let source = format!(
-        "trained on {} simulated runs at {} degC, seed {}",
+        "trained on {} simulated runs at {} degC, seed {}{restarts}",
         own.runs, plan.ambient_c, plan.seed
     );
     Ok((trained.model, source))
@@ -206,7 +239,7 @@ pub fn run(args: Args) -> Result<()> {
         cfg.latitude_deg,
     )
     .map_err(|e| anyhow::anyhow!("--criterion {e}"))?;
-    let training_runs = training_runs(&args)?;
+    let (training_runs, warm_restarts) = training_campaign(&args)?;
     let guard = match &args.model {
         Some(m) => OutputGuard::new(&[m]),
         None => OutputGuard::default(),
@@ -237,7 +270,13 @@ pub fn run(args: Args) -> Result<()> {
                     ..cfg.clone()
                 }),
             };
-            train_default_model(&params, &plan, training_runs, args.save_model.as_deref())?
+            train_default_model(
+                &params,
+                &plan,
+                training_runs,
+                warm_restarts,
+                args.save_model.as_deref(),
+            )?
         }
     };
     let bar = progress_bar(cfg.starts, "north-seek cold starts");

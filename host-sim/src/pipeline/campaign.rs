@@ -4,7 +4,7 @@
 //! on the thread schedule) and written only when all succeeded.
 
 use crate::io::runs::{write_run, Run, RunError};
-use crate::sim::{simulate_run, GyroParams, RunSpec, SimError, DEFAULT_LATITUDE_DEG};
+use crate::sim::{simulate_run, GyroParams, RunSpec, SimError, StartState, DEFAULT_LATITUDE_DEG};
 use std::fmt;
 use std::path::{Path, PathBuf};
 
@@ -32,6 +32,20 @@ pub struct CampaignSpec {
     pub seed: u64,
     pub latitude_deg: f64,
     pub raw_rate_hz: f64,
+    /// Warm restarts among the power-ons (None: every power-on a cold start from a soak,
+    /// the paper's protocol).
+    pub warm_restarts: Option<WarmRestarts>,
+}
+
+/// Some power-ons of a campaign are restarts of a gyro still warm from its last run, as a
+/// chamber protocol that powers the unit off for a few minutes between runs gives.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WarmRestarts {
+    /// Every `every`-th power-on at an ambient (the last of each group) is a restart.
+    pub every: usize,
+    /// The restarts start 0..`max_above_c` degC above the ambient (uniform, drawn from
+    /// the run's seed).
+    pub max_above_c: f64,
 }
 
 impl CampaignSpec {
@@ -44,19 +58,30 @@ impl CampaignSpec {
             seed,
             latitude_deg: DEFAULT_LATITUDE_DEG,
             raw_rate_hz: 100.0,
+            warm_restarts: None,
         }
     }
 
     /// The run spec of power-on `run` (0-based) at ambient index `amb`.
     pub fn run_spec(&self, amb: usize, run: usize) -> RunSpec {
+        let seed = crate::seed::derive_seed(self.seed, amb as u64, run as u64);
+        let start = match self.warm_restarts {
+            Some(w) if w.every > 0 && run % w.every == w.every - 1 => {
+                // the top 53 bits of another derived seed: uniform in [0, 1)
+                let draw = crate::seed::derive_seed(seed, u64::MAX, 0) >> 11;
+                let u = draw as f64 / (1u64 << 53) as f64;
+                StartState::Restart {
+                    above_ambient_c: w.max_above_c * u,
+                }
+            }
+            _ => StartState::Soaked,
+        };
         RunSpec {
             minutes: self.minutes,
             latitude_deg: self.latitude_deg,
             raw_rate_hz: self.raw_rate_hz,
-            ..RunSpec::paper(
-                self.ambients_c[amb],
-                crate::seed::derive_seed(self.seed, amb as u64, run as u64),
-            )
+            start,
+            ..RunSpec::paper(self.ambients_c[amb], seed)
         }
     }
 
@@ -221,4 +246,49 @@ pub fn write_campaign(dir: &Path, runs: &[CampaignRun]) -> Result<Vec<PathBuf>, 
         written.push(path);
     }
     Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_nth_power_on_is_a_warm_restart_within_its_range_and_the_rest_are_soaked() {
+        let spec = CampaignSpec {
+            ambients_c: vec![-40.0, 20.0],
+            runs_per_ambient: 30,
+            warm_restarts: Some(WarmRestarts {
+                every: 3,
+                max_above_c: 6.0,
+            }),
+            ..CampaignSpec::paper(7)
+        };
+        let mut above = Vec::new();
+        for amb in 0..2 {
+            for run in 0..30 {
+                match spec.run_spec(amb, run).start {
+                    StartState::Restart { above_ambient_c } => {
+                        assert_eq!(run % 3, 2, "run {run} restarted");
+                        assert!((0.0..6.0).contains(&above_ambient_c));
+                        above.push(above_ambient_c);
+                    }
+                    StartState::Soaked => assert_ne!(run % 3, 2, "run {run} soaked"),
+                    StartState::Warm => panic!("run {run} warm"),
+                }
+            }
+        }
+        assert_eq!(above.len(), 20);
+        // drawn, not one value: spread over the range
+        let lo = above.iter().cloned().fold(f64::INFINITY, f64::min);
+        let hi = above.iter().cloned().fold(0.0, f64::max);
+        assert!(lo < 2.0 && hi > 4.0, "restarts {lo}..{hi} degC");
+        // the same seed gives the same campaign; without restarts every run is soaked
+        assert_eq!(spec.run_spec(1, 5), spec.run_spec(1, 5));
+        let cold = CampaignSpec {
+            warm_restarts: None,
+            ..spec.clone()
+        };
+        assert!((0..30).all(|r| cold.run_spec(0, r).start == StartState::Soaked));
+        assert_eq!(cold.run_spec(0, 2).seed, spec.run_spec(0, 2).seed);
+    }
 }

@@ -71,7 +71,7 @@ use anyhow::{anyhow, Result};
 use fog_core::model::format::{FeatureKind, FeatureSpec};
 use fog_core::seeking::northfinder::SeekMode;
 
-use super::campaign::{CampaignRun, CampaignSpec};
+use super::campaign::{CampaignRun, CampaignSpec, WarmRestarts};
 use super::campaign_steps::{simulate_checked, train_with_config};
 use super::northseek::{noise_floor_deg, MonteCarloConfig};
 use super::seek_schedule::seek_schedule;
@@ -178,13 +178,14 @@ impl OwnModel {
     }
 }
 
-/// Simulates the chamber campaign at the plan's ambient (`campaign_runs` cold starts;
-/// `CAMPAIGN_RUNS` is the default) and trains the own model on it, with the training-set
-/// error checked against the budget (see the module notes).
+/// Simulates the chamber campaign at the plan's ambient (`campaign_runs` power-ons, cold
+/// starts unless `warm_restarts`; `CAMPAIGN_RUNS` is the default) and trains the own model
+/// on it, with the training-set error checked against the budget (see the module notes).
 pub fn train_own_model(
     params: &GyroParams,
     plan: &OwnModelPlan,
     campaign_runs: usize,
+    warm_restarts: Option<WarmRestarts>,
 ) -> Result<OwnModel> {
     let campaign = simulate_checked(
         params,
@@ -192,6 +193,7 @@ pub fn train_own_model(
             ambients_c: vec![plan.ambient_c],
             runs_per_ambient: campaign_runs,
             latitude_deg: plan.latitude_deg,
+            warm_restarts,
             ..CampaignSpec::paper(plan.seed)
         },
     )?;

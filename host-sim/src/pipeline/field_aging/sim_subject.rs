@@ -43,7 +43,7 @@ impl AgingSubject for SimAging {
 
     fn chamber(&self, plan: &AgingPlan) -> Result<Chamber> {
         let own_plan = own_model_plan(plan)?;
-        let own = train_own_model(&self.delivered, &own_plan, CAMPAIGN_RUNS)?;
+        let own = train_own_model(&self.delivered, &own_plan, CAMPAIGN_RUNS, None)?;
         if plan.ambients_c.len() == 1 {
             return Ok(Chamber {
                 centres: own.trained.report.n_centers,
