@@ -316,3 +316,85 @@ proptest::proptest! {
         }
     }
 }
+
+/// `minutes` of samples whose temperature follows `temp_c(t)` (1 Hz, quantised to
+/// 0.0625 degC; gyro 100 Hz, constant rate): every closed window.
+fn run_with_temps(
+    comp: &mut Compensator,
+    minutes: f64,
+    temp_c: impl Fn(f64) -> f64,
+) -> Vec<WindowResult> {
+    let n = (minutes * 60.0 * GYRO_HZ) as u64;
+    let mut out = Vec::new();
+    for k in 1..=n {
+        let t = k as f64 / GYRO_HZ;
+        if k % GYRO_HZ as u64 == 0 {
+            comp.push_temp(TempSample {
+                t_s: t,
+                temp_c: ((temp_c(t) / 0.0625).floor() * 0.0625) as f32,
+            });
+        }
+        if let Some(r) = comp.push_gyro(GyroSample {
+            t_s: t,
+            rate_dph: 0.5,
+        }) {
+            out.push(r);
+        }
+    }
+    out
+}
+
+#[test]
+fn a_power_on_that_warms_less_than_the_models_cold_starts_is_flagged_within_the_envelope() {
+    use fog_core::model::cold_start::ColdStartEnvelope;
+    // The cold start: the synthetic warm-up at 20 degC. The envelope asks for half its
+    // rise at 60 s, 5 min and 15 min.
+    let cold = |t: f64| warmup_inputs(20.0, t)[0];
+    let rise = |t: f64| cold(t) - cold(10.0);
+    let mut m = model();
+    m.cold_start = Some(ColdStartEnvelope {
+        t_s: heapless::Vec::from_slice(&[60.0, 300.0, 900.0]).unwrap(),
+        min_rise_c: heapless::Vec::from_slice(&[
+            0.5 * rise(60.0) as f32,
+            0.5 * rise(300.0) as f32,
+            0.5 * rise(900.0) as f32,
+        ])
+        .unwrap(),
+    });
+    let mut comp = Compensator::new(config(Evaluator::F32), Some(m.clone())).unwrap();
+    let windows = run_with_temps(&mut comp, 20.0, cold);
+    assert!(windows
+        .iter()
+        .all(|w| w.status != WindowStatus::NotColdStart));
+    assert!(!comp.warm_restart());
+    // A restart: starts where the cold start is at 10 min and warms a third as far.
+    let warm = |t: f64| cold(600.0) + (cold(t) - cold(0.0)) / 3.0;
+    let mut comp = Compensator::new(config(Evaluator::F32), Some(m.clone())).unwrap();
+    let windows = run_with_temps(&mut comp, 20.0, warm);
+    assert!(comp.warm_restart());
+    let flagged: Vec<f64> = windows
+        .iter()
+        .filter(|w| w.status == WindowStatus::NotColdStart)
+        .map(|w| w.t_end_s)
+        .collect();
+    assert!(!flagged.is_empty());
+    // From the first window below the bound to the envelope's end, none after it; the
+    // drift is still computed (the window is reported, not used).
+    assert!(
+        flagged.iter().all(|&t| (60.0..=900.0).contains(&t)),
+        "{flagged:?}"
+    );
+    assert_eq!(*flagged.last().unwrap(), 900.0);
+    assert!(windows
+        .iter()
+        .filter(|w| w.status == WindowStatus::NotColdStart)
+        .all(|w| w.model_applied));
+    // Without an envelope the same restart is not flagged (v1-v4 models behave as before).
+    m.cold_start = None;
+    let mut comp = Compensator::new(config(Evaluator::F32), Some(m)).unwrap();
+    let windows = run_with_temps(&mut comp, 20.0, warm);
+    assert!(windows
+        .iter()
+        .all(|w| w.status != WindowStatus::NotColdStart));
+    assert!(!comp.warm_restart());
+}

@@ -1,6 +1,7 @@
 //! Model format: round trip, size budget, and rejection of every kind of corrupted model
 //! with the matching typed error.
 
+use fog_core::model::cold_start::{ColdStartEnvelope, MAX_COLD_START_POINTS};
 use fog_core::model::format::{
     crc32, FeatureKind, ModelError, ModelField, RbfModel, MAX_CENTERS, MAX_ENCODED_LEN,
     MODEL_MAGIC, MODEL_VERSION,
@@ -34,6 +35,7 @@ struct LooseModel {
     poly: Vec<f32>,
     heading: Option<HeadingHarmonic>,
     linear_by_t: Vec<f32>,
+    cold_start: Option<ColdStartEnvelope>,
 }
 
 impl From<&RbfModel> for LooseModel {
@@ -54,6 +56,7 @@ impl From<&RbfModel> for LooseModel {
             poly: m.poly.to_vec(),
             heading: m.heading,
             linear_by_t: m.linear_by_t.to_vec(),
+            cold_start: m.cold_start.clone(),
         }
     }
 }
@@ -329,7 +332,7 @@ fn random_bytes_never_panic() {
 }
 
 /// An older format version's bytes: version 1 ends the body after `meta`, 2 after `poly`,
-/// 3 after `heading` (postcard writes a struct as its fields back to back, so the body is
+/// 3 after `heading`, 4 after `linear_by_t` (postcard writes a struct as its fields back to back, so the body is
 /// the older fields' bytes in order).
 fn encode_version(m: &RbfModel, version: u16) -> Vec<u8> {
     let loose = LooseModel::from(m);
@@ -344,6 +347,9 @@ fn encode_version(m: &RbfModel, version: u16) -> Vec<u8> {
     }
     if version >= 3 {
         body.extend(postcard::to_allocvec(&loose.heading).unwrap());
+    }
+    if version >= 4 {
+        body.extend(postcard::to_allocvec(&loose.linear_by_t).unwrap());
     }
     wrap(&body, version)
 }
@@ -494,9 +500,10 @@ fn full_model_with_every_field_fits_the_limit() {
     m.linear_by_t
         .extend_from_slice(&[0.0, 0.02, -0.01, 0.005])
         .unwrap();
+    m.cold_start = Some(envelope(MAX_COLD_START_POINTS));
     let bytes = encode(&m);
     println!(
-        "64 centres x 4 inputs + poly + heading + linear_by_t: {} bytes",
+        "64 centres x 4 inputs + poly + heading + linear_by_t + cold_start: {} bytes",
         bytes.len()
     );
     assert!(bytes.len() <= MAX_ENCODED_LEN, "{} bytes", bytes.len());
@@ -609,6 +616,56 @@ fn temperature_coupled_linear_terms_round_trip_and_old_versions_decode_without_t
         Err(ModelError::NonFinite {
             field: ModelField::LinearByT,
             index: 1
+        })
+    ));
+}
+
+/// A cold-start envelope of `n` points (rise growing with time).
+fn envelope(n: usize) -> ColdStartEnvelope {
+    let mut e = ColdStartEnvelope {
+        t_s: heapless::Vec::new(),
+        min_rise_c: heapless::Vec::new(),
+    };
+    for k in 0..n {
+        e.t_s.push(30.0 * (1 << k) as f32).unwrap();
+        e.min_rise_c.push(0.4 * k as f32).unwrap();
+    }
+    e
+}
+
+#[test]
+fn the_cold_start_envelope_round_trips_and_old_versions_decode_without_it() {
+    let mut m = warmup_model(35, 2, 2.0, 5);
+    m.linear_by_t.extend_from_slice(&[0.0, -0.031]).unwrap();
+    let plain = m.clone();
+    m.cold_start = Some(envelope(6));
+    assert_eq!(RbfModel::decode(&encode(&m)), Ok(m.clone()));
+    // Version 4 bytes (no cold_start field) decode with none.
+    assert_eq!(RbfModel::decode(&encode_version(&m, 4)), Ok(plain.clone()));
+    // A version-5 body announced as version 4 has trailing bytes (the new field).
+    assert!(matches!(
+        RbfModel::decode(&encode_loose(&LooseModel::from(&m), 4)),
+        Err(ModelError::TrailingBytes { .. })
+    ));
+    // "None" is one byte; 6 points cost the tag, two length bytes and 12 f32.
+    assert_eq!(encode(&m).len(), encode(&plain).len() + 2 + 12 * 4);
+    // A malformed envelope is refused by the decoder, naming the field.
+    let mut bad = m.clone();
+    bad.cold_start.as_mut().unwrap().t_s[3] = 10.0;
+    assert!(matches!(
+        RbfModel::decode(&encode_loose(&LooseModel::from(&bad), MODEL_VERSION)),
+        Err(ModelError::NonFinite {
+            field: ModelField::ColdStart,
+            index: 3
+        })
+    ));
+    let mut short = m.clone();
+    short.cold_start.as_mut().unwrap().min_rise_c.truncate(4);
+    assert!(matches!(
+        short.validate(),
+        Err(ModelError::LengthMismatch {
+            field: ModelField::ColdStart,
+            ..
         })
     ));
 }

@@ -235,6 +235,7 @@ pub fn status_code(s: WindowStatus) -> u8 {
         WindowStatus::TooFewSamples => 2,
         WindowStatus::NoTemperature => 3,
         WindowStatus::FeaturesWarmingUp => 4,
+        WindowStatus::NotColdStart => 5,
         WindowStatus::InputOutOfRange { input } => 10 + input,
     }
 }

@@ -122,6 +122,15 @@ fn compensated_cold_start_seeks_beat_uncompensated_ones() {
         seek2_mean(&warm),
         seek2_mean(&json)
     );
+    // The model carries its training cold starts' envelope: every restart is found not to
+    // be one of them, and its seeks within the warm-up are refused instead of biased;
+    // no cold start was flagged.
+    let detected = |v: &Value, arm: &str| f(v, &[arm, "reliability", "warm_restarts_detected"]);
+    assert_eq!(detected(&warm, "compensated"), 6.0);
+    assert_eq!(detected(&warm, "uncompensated"), 0.0);
+    assert!(f(&warm, &["compensated", "reliability", "refused"]) > 0.0);
+    assert_eq!(detected(&json, "compensated"), 0.0);
+    assert_eq!(f(&json, &["compensated", "reliability", "refused"]), 0.0);
     for bad in ["31", "-1", "nan"] {
         let out = fogsim(
             &dir,

@@ -8,6 +8,7 @@
 //! Inputs outside the model's trained range are flagged (and the drift is evaluated at
 //! the range edge, never extrapolated).
 
+use crate::compensation::cold_start::ColdStartMonitor;
 use crate::compensation::features::{
     FeatureError, FeatureExtractor, TempRateEstimator, WindowAverager, WindowMean,
     DEFAULT_RATE_SPAN_S, EXTRACTOR_RATE_POINTS,
@@ -101,6 +102,10 @@ pub enum WindowStatus {
     FeaturesWarmingUp,
     /// Model input `input` lies outside its trained range (drift taken at the range edge).
     InputOutOfRange { input: u8 },
+    /// This power-on warmed less than the model's training cold starts did (a restart of
+    /// a warm gyro), and the window lies within the model's cold-start envelope, where the
+    /// model's warm-up drift does not apply (`compensation::cold_start`).
+    NotColdStart,
 }
 
 impl WindowStatus {
@@ -164,6 +169,9 @@ pub struct Compensator {
     aux_pending: [Option<WindowMean>; MAX_AUX],
     /// Windows (first, last index) with a reported fault.
     fault_windows: Option<(i64, i64)>,
+    /// Whether this power-on warms as a cold start (kept across model changes: it is the
+    /// power-on's, not the model's).
+    cold_start: ColdStartMonitor,
 }
 
 const DEFAULT_SPECS: [FeatureSpec; 2] = crate::model::format::PAPER_INPUTS;
@@ -233,6 +241,7 @@ impl Compensator {
             ],
             aux_pending: [None; MAX_AUX],
             fault_windows: None,
+            cold_start: ColdStartMonitor::new(),
         }
     }
 
@@ -270,6 +279,7 @@ impl Compensator {
         self.temp_pending = None;
         self.aux_pending = [None; MAX_AUX];
         self.fault_windows = None;
+        self.cold_start = ColdStartMonitor::new();
         self.cfg = cfg;
         // No model yet: a failing `set_model_from` below leaves "no model", as `new` did.
         self.has_model = false;
@@ -335,6 +345,12 @@ impl Compensator {
 
     pub fn config(&self) -> &CompensatorConfig {
         &self.cfg
+    }
+
+    /// Whether this power-on has warmed less than the model's training cold starts did
+    /// (latched until the next `configure`; always false without an envelope).
+    pub fn warm_restart(&self) -> bool {
+        self.cold_start.warm_restart()
     }
 
     /// Add a gyro sample; returns the result of the window it closed, if any.
@@ -471,6 +487,12 @@ impl Compensator {
         if let Some(t) = temp {
             if let Some(e) = self.rate_report.push(t_end, t as f32 as f64) {
                 r.temp_rate_cps = e.rate_per_s as f32;
+            }
+            if let (true, Some(envelope)) = (self.has_model, &self.model.cold_start) {
+                let flag = self.cold_start.push(envelope, t_end as f32, t as f32);
+                if flag && status.is_valid() {
+                    status = WindowStatus::NotColdStart;
+                }
             }
             // Feature history only advances on windows with a real temperature.
             match self

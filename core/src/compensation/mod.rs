@@ -5,8 +5,10 @@
 //! - `label`: the one report name of a feature (`temp_c:lag(tau_s=240)`), used by the
 //!   trainer and the diagnosis on the host;
 //! - `compensator`: the per-window pipeline the device runs after power-on (features -> model
-//!   -> compensated rate).
+//!   -> compensated rate);
+//! - `cold_start`: whether the power-on warms up as the model's training cold starts did.
 
+pub mod cold_start;
 pub mod compensator;
 pub mod features;
 pub mod label;

@@ -17,13 +17,16 @@
 //! (`heading_cal`), stored inside the model bytes so that the model's CRC and the upload
 //! signature cover it (v1 and v2 decode with none), 4 appends `linear_by_t` after
 //! `heading`: linear terms whose coefficients change with temperature (a Shupe coefficient
-//! k_S(T) = k_0 + k_1 T makes the drift k_0 dT/dt + k_1 T dT/dt; v1-v3 decode with none). Validation bounds every parameter's magnitude so that any model that decodes
+//! k_S(T) = k_0 + k_1 T makes the drift k_0 dT/dt + k_1 T dT/dt; v1-v3 decode with none), 5
+//! appends `cold_start` after `linear_by_t`: the optional envelope of the training cold
+//! starts' temperature rise (`model::cold_start`; v1-v4 decode with none). Validation bounds every parameter's magnitude so that any model that decodes
 //! gives a finite drift below `MAX_OUTPUT_DPH` at any finite input.
 
 use heapless::{String, Vec};
 use serde::de::DeserializeSeed as _;
 use serde::{Deserialize, Serialize};
 
+use crate::model::cold_start::ColdStartEnvelope;
 use crate::seeking::heading_cal::{HeadingHarmonic, MIN_HEADINGS};
 
 /// Most RBF centres a model may hold.
@@ -32,8 +35,9 @@ pub const MAX_CENTERS: usize = 64;
 pub const MAX_INPUTS: usize = 4;
 /// Magic at the start of every encoded model: "FOGM".
 pub const MODEL_MAGIC: u32 = 0x4D47_4F46;
-/// Current format version (4: temperature-coupled linear terms after the heading harmonic).
-pub const MODEL_VERSION: u16 = 4;
+/// Current format version (5: the cold-start envelope after the temperature-coupled
+/// linear terms).
+pub const MODEL_VERSION: u16 = 5;
 /// Oldest format version still decoded (1: no polynomial base).
 pub const MODEL_VERSION_OLDEST: u16 = 1;
 /// Highest power of the polynomial base in the first input.
@@ -159,6 +163,10 @@ pub struct RbfModel {
     /// range), so input j's linear coefficient is linear[j] + linear_by_t[j] t. Empty
     /// (none, also for v1-v3 models) or one per input.
     pub linear_by_t: Vec<f32, MAX_INPUTS>,
+    /// The training cold starts' least temperature rise since power-on (format version 5):
+    /// the compensator flags a power-on that rises less as not a cold start. `None`: no
+    /// check (also for v1-v4 models).
+    pub cold_start: Option<ColdStartEnvelope>,
 }
 
 /// Most auxiliary (extra sensor) channels a model may refer to.
@@ -188,6 +196,8 @@ pub enum ModelField {
     Heading,
     /// The temperature-coupled linear terms.
     LinearByT,
+    /// The cold-start envelope; index the point.
+    ColdStart,
 }
 
 impl ModelField {
@@ -209,6 +219,7 @@ impl ModelField {
             ModelField::Poly => "poly",
             ModelField::Heading => "heading",
             ModelField::LinearByT => "linear_by_t",
+            ModelField::ColdStart => "cold_start",
         }
     }
 }
@@ -401,6 +412,20 @@ impl FeatureKind {
     pub const fn needs_time_constant(self) -> bool {
         matches!(self, FeatureKind::TempLagC | FeatureKind::PowerOnDecay)
     }
+
+    /// True for kinds that take the power-on to be a cold start from a soak: the clock
+    /// since power-on, the rise since the first reading, and the lag and flat-start d2T/dt2
+    /// that start from the first reading as if it were the unit's settled state. A model
+    /// with one of them is valid only for such power-ons (`model::cold_start`).
+    pub const fn assumes_cold_start(self) -> bool {
+        matches!(
+            self,
+            FeatureKind::PowerOnDecay
+                | FeatureKind::TempRiseC
+                | FeatureKind::TempLagC
+                | FeatureKind::TempAccelFlatStartCps2
+        )
+    }
 }
 
 impl RbfModel {
@@ -427,6 +452,7 @@ impl RbfModel {
             poly: Vec::new(),
             heading: None,
             linear_by_t: Vec::new(),
+            cold_start: None,
         }
     }
 
@@ -451,6 +477,7 @@ impl RbfModel {
         copy(&mut self.poly, &src.poly);
         copy(&mut self.linear_by_t, &src.linear_by_t);
         self.heading = src.heading;
+        self.cold_start.clone_from(&src.cold_start);
         self.bias_dph = src.bias_dph;
         self.meta.gyro_id.clear();
         let _ = self.meta.gyro_id.push_str(&src.meta.gyro_id);
@@ -517,6 +544,9 @@ impl RbfModel {
             check_len(ModelField::LinearByT, n, self.linear_by_t.len())?;
         }
         check_finite(ModelField::LinearByT, &self.linear_by_t)?;
+        if let Some(c) = &self.cold_start {
+            c.validate()?;
+        }
         if let Some(i) = self.input_scale.iter().position(|&s| s <= 0.0) {
             return Err(ModelError::NonPositiveScale { input: i as u8 });
         }

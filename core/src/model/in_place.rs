@@ -32,11 +32,12 @@ const FIELDS: &[&str] = &[
     "poly",
     "heading",
     "linear_by_t",
+    "cold_start",
 ];
 
 /// Seed that fills `model` with the model being deserialised in format `version`: 1 has
 /// no `poly` (left empty), 1 and 2 no `heading` (left `None`), 1-3 no `linear_by_t` (left
-/// empty).
+/// empty), 1-4 no `cold_start` (left `None`).
 pub(crate) struct ModelInPlace<'a> {
     pub(crate) model: &'a mut RbfModel,
     pub(crate) version: u16,
@@ -54,6 +55,10 @@ impl ModelInPlace<'_> {
     fn has_linear_by_t(&self) -> bool {
         self.version >= 4
     }
+
+    fn has_cold_start(&self) -> bool {
+        self.version >= 5
+    }
 }
 
 impl<'de> DeserializeSeed<'de> for ModelInPlace<'_> {
@@ -63,7 +68,8 @@ impl<'de> DeserializeSeed<'de> for ModelInPlace<'_> {
         let n_fields = FIELDS.len()
             - usize::from(!self.has_poly())
             - usize::from(!self.has_heading())
-            - usize::from(!self.has_linear_by_t());
+            - usize::from(!self.has_linear_by_t())
+            - usize::from(!self.has_cold_start());
         let fields = &FIELDS[..n_fields];
         d.deserialize_struct("RbfModel", fields, self)
     }
@@ -96,8 +102,12 @@ impl<'de> Visitor<'de> for ModelInPlace<'_> {
     }
 
     fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<(), A::Error> {
-        let (has_poly, has_heading, has_linear_by_t) =
-            (self.has_poly(), self.has_heading(), self.has_linear_by_t());
+        let (has_poly, has_heading, has_linear_by_t, has_cold_start) = (
+            self.has_poly(),
+            self.has_heading(),
+            self.has_linear_by_t(),
+            self.has_cold_start(),
+        );
         let m = self.model;
         m.n_rbf_inputs = next(&mut seq, 0)?;
         next_vec(&mut seq, 1, &mut m.inputs)?;
@@ -126,6 +136,12 @@ impl<'de> Visitor<'de> for ModelInPlace<'_> {
         } else {
             m.linear_by_t.clear();
         }
+        // At most 2 x 8 floats: read whole, as `heading` is.
+        m.cold_start = if has_cold_start {
+            next(&mut seq, 15)?
+        } else {
+            None
+        };
         Ok(())
     }
 }

@@ -4,6 +4,8 @@
 //! decodes and evaluates it, and the evaluation paths are measured against each other here.
 //! - `format`: the `RbfModel` layout, its postcard/CRC encoding and validation (the contract
 //!   shared by trainer, diagnose and firmware); `in_place` decodes it without a large stack frame;
+//! - `cold_start`: the envelope of the training cold starts' warm-up a model may carry, so the
+//!   device can tell a warm restart from the cold starts the model knows;
 //! - `rbf`: Gaussian RBF evaluation in f32 (device) and f64 (reference), with `exp_neg`'s
 //!   exponential kernels;
 //! - `fixed`: integer-only evaluation for FPU-less parts;
@@ -12,6 +14,7 @@
 //!   and tests (they exercise the evaluation paths, so they live beside them).
 
 pub mod accuracy;
+pub mod cold_start;
 pub mod exp_neg;
 pub mod fixed;
 pub mod format;

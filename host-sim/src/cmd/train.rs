@@ -9,6 +9,7 @@
 use super::{check_distinct_outputs, check_output_file};
 use crate::io::runs::run_files;
 use crate::io::{read_runs_binned, OutputGuard, OutputLock, StagedFiles};
+use crate::train::cold_start::{self, envelope_for};
 use crate::train::seek_refit::{refit_for_seeks, SeekRefit};
 use crate::train::{
     choose_inputs_default, train_model, InputChoice, InputSelection, Method, TrainConfig,
@@ -319,6 +320,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(r) = &refit {
         outcome.model = r.model.clone();
     }
+    // The device's check that a power-on is one of these cold starts, for models whose
+    // inputs take it to be one (`train::cold_start`).
+    outcome.model.cold_start = envelope_for(&runs, &outcome.model.inputs)?;
     let report = TrainCommandReport {
         training: &outcome.report,
         input_selection: &selection,
@@ -372,6 +376,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(r) = &refit {
         println!("{}", r.summary());
     }
+    println!("{}", cold_start::summary(model.cold_start.as_ref()));
     Ok(())
 }
 

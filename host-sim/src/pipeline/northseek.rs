@@ -305,6 +305,9 @@ pub struct ArmOutcome {
     pub seeks: Vec<SeekOutcome>,
     pub refusals: Vec<Refusal>,
     pub failed_seeks: usize,
+    /// The compensator found this power-on not to be a cold start of its model's
+    /// (`WindowStatus::NotColdStart`).
+    pub warm_restart_detected: bool,
 }
 
 /// The arms of one cold start (`tilt_uncompensated` and `heading_uncalibrated` are empty
@@ -650,6 +653,7 @@ where
             );
         }
     }
+    ledger.out.warm_restart_detected = comp.warm_restart();
     Ok(ledger.out)
 }
 
@@ -842,6 +846,15 @@ pub fn seek_stats(arms: &[ArmOutcome], true_azimuth_deg: f64) -> SeekStats {
             .map(err)
             .collect()
     };
+    // A seek that no start finished (every attempt refused) has no figures: NaN.
+    let of_column = |f: fn(&[f64]) -> f64, k: usize| -> f64 {
+        let c = column(k);
+        if c.is_empty() {
+            f64::NAN
+        } else {
+            f(&c)
+        }
+    };
     let per_start = |f: fn(&[f64]) -> f64| -> f64 {
         let v: Vec<f64> = arms
             .iter()
@@ -866,9 +879,10 @@ pub fn seek_stats(arms: &[ArmOutcome], true_azimuth_deg: f64) -> SeekStats {
         max_dev_deg: all.iter().fold(0.0f64, |m, e| m.max(e.abs())),
         mean_error_deg: mean(&all),
         rms_error_deg: rms(&all),
-        per_seek_rms_error_deg: (0..n_seek).map(|k| rms(&column(k))).collect(),
-        per_seek_std_deg: (0..n_seek).map(|k| std_dev(&column(k))).collect(),
-        per_seek_mean_error_deg: (0..n_seek).map(|k| mean(&column(k))).collect(),
+        per_seek_rms_error_deg: (0..n_seek).map(|k| of_column(rms, k)).collect(),
+        per_seek_std_deg: (0..n_seek).map(|k| of_column(std_dev, k)).collect(),
+        per_seek_mean_error_deg: (0..n_seek).map(|k| of_column(mean, k)).collect(),
+        per_seek_results: (0..n_seek).map(|k| column(k).len()).collect(),
         mean_range_deg: per_start(range),
         mean_within_start_std_deg: per_start(std_dev),
         mean_reported_sigma_deg: mean(
@@ -927,6 +941,8 @@ fn reliability(arms: &[ArmOutcome]) -> SeekReliability {
         restart_rate: rate(restarted),
         latitude_flags,
         refusal_reasons: reasons,
+        warm_restarts_detected: arms.iter().filter(|a| a.warm_restart_detected).count(),
+        power_ons: arms.len(),
     }
 }
 
@@ -1063,10 +1079,15 @@ pub fn seek_table(r: &NorthSeekReport) -> String {
             ),
         };
         let v = |x: Option<&f64>| x.copied().unwrap_or(f64::NAN);
+        let cell = |x: f64, signed: bool| match (x.is_nan(), signed) {
+            (true, _) => "-".to_string(),
+            (false, true) => format!("{x:+.4}"),
+            (false, false) => format!("{x:.4}"),
+        };
         [
-            format!("{:.4}", v(rms)),
-            format!("{:+.4}", v(mean)),
-            format!("{:.4}", v(std)),
+            cell(v(rms), false),
+            cell(v(mean), true),
+            cell(v(std), false),
         ]
     };
     let rows = (0..r.uncompensated.per_seek_rms_error_deg.len())
@@ -1103,7 +1124,7 @@ pub fn reliability_line(arm: &str, r: &SeekReliability) -> String {
         .map(|(k, n)| format!("{k} x{n}"))
         .collect();
     format!(
-        "{arm}: {} attempts, {} refused ({:.2e}), {} failed seeks, {} restarted for motion ({:.2e}), {} latitude flags{}\n",
+        "{arm}: {} attempts, {} refused ({:.2e}), {} failed seeks, {} restarted for motion ({:.2e}), {} latitude flags, {} of {} power-ons found not cold starts{}\n",
         r.attempts,
         r.refused,
         r.refusal_rate,
@@ -1111,6 +1132,8 @@ pub fn reliability_line(arm: &str, r: &SeekReliability) -> String {
         r.restarted_seeks,
         r.restart_rate,
         r.latitude_flags,
+        r.warm_restarts_detected,
+        r.power_ons,
         if reasons.is_empty() {
             String::new()
         } else {

@@ -65,8 +65,6 @@
 //! generator they do in a chamber whose air wanders after power-on, and not where the runs
 //! warm along one family of curves (tests/own_model_derivative_free.rs).
 
-use std::collections::BTreeMap;
-
 use anyhow::{anyhow, Result};
 use fog_core::model::format::{FeatureKind, FeatureSpec};
 use fog_core::seeking::northfinder::SeekMode;
@@ -77,6 +75,7 @@ use super::northseek::{noise_floor_deg, MonteCarloConfig};
 use super::seek_schedule::seek_schedule;
 use crate::io::runs::Run;
 use crate::sim::GyroParams;
+use crate::train::cold_start::{envelope_for, rises_by_time, significant_rise_c};
 use crate::train::seek_refit::{refit_for_seeks, SeekRefit, SeekSchedule};
 use crate::train::seek_score::{seek_azimuth_rms_deg, Criterion, SeekGeometry};
 use crate::train::{
@@ -96,9 +95,6 @@ pub const CAMPAIGN_RUNS: usize = 96;
 /// against the Monte Carlo: the rms of the per-seek mean errors of 300 starts matched the
 /// estimate (0.0029 vs 0.0028 deg, 6 runs at 20 degC).
 pub const LEARNED_SHARE_OF_FLOOR: f64 = 0.125;
-/// Standard errors (of the runs' rises) the campaign's mean temperature rise must reach
-/// for the runs to have a warm-up the clock input can follow.
-pub const WARMUP_SIGNIFICANCE_SE: f64 = 3.0;
 /// Disjoint half-splits the learned error is averaged over (`learned_seek_error_deg`).
 pub const SPLITS: usize = 3;
 
@@ -174,6 +170,8 @@ impl OwnModel {
             s += &r.summary();
             s.push('\n');
         }
+        s += &crate::train::cold_start::summary(self.trained.model.cold_start.as_ref());
+        s.push('\n');
         s
     }
 }
@@ -254,6 +252,8 @@ pub fn own_model_from_runs(
         }
         None => None,
     };
+    // The device's check that a power-on is one of these cold starts (`train::cold_start`).
+    shape.trained.model.cold_start = envelope_for(&runs, &specs)?;
     Ok(OwnModel {
         seek_refit,
         trained: shape.trained,
@@ -384,44 +384,20 @@ pub fn clock_spec(tau_s: f64) -> FeatureSpec {
 
 /// The campaign's warm-up time, s since power-on: when the mean over the runs of the
 /// temperature rise since each run's first row reaches 1 - 1/e of its rise at the last
-/// row common to them. None when that rise is not `WARMUP_SIGNIFICANCE_SE` standard
-/// errors of the runs' own rises above zero (no warm-up to clock: a unit that does not
-/// heat, or runs that start warm).
+/// row common to them. None when that rise is not `train::cold_start::WARMUP_SIGNIFICANCE_SE`
+/// standard errors of the runs' own rises above zero (no warm-up to clock: a unit that
+/// does not heat, or runs that start warm).
 pub fn warmup_time_constant_s(runs: &[Run]) -> Result<Option<f64>> {
-    let ds = dataset_from_runs(runs, &[FeatureSpec::plain(FeatureKind::TempC)])
-        .map_err(|e| anyhow!("warm-up time: {e}"))?;
-    let groups = ds.n_groups();
-    let mut first = vec![f64::NAN; groups];
-    // Per row time: the rises of the runs that have it.
-    let mut by_t: BTreeMap<u64, (f64, Vec<f64>)> = BTreeMap::new();
-    for (i, row) in ds.rows().enumerate() {
-        let g = ds.groups[i] as usize;
-        if first[g].is_nan() {
-            first[g] = row[0];
-        }
-        let e = by_t
-            .entry(ds.t_s[i].to_bits())
-            .or_insert((ds.t_s[i], Vec::new()));
-        e.1.push(row[0] - first[g]);
-    }
-    // Rows every run has (t_s >= 0, so the bit order is the time order).
-    let rise: Vec<(f64, &Vec<f64>)> = by_t
-        .values()
-        .filter(|(_, r)| r.len() == groups)
-        .map(|(t, r)| (*t, r))
-        .collect();
-    let Some(&(_, last)) = rise.last() else {
+    let rises = rises_by_time(runs)?;
+    let Some(total) = significant_rise_c(&rises) else {
         return Ok(None);
     };
-    let n = last.len() as f64;
-    let mean = |r: &[f64]| r.iter().sum::<f64>() / r.len() as f64;
-    let total = mean(last);
-    let var = last.iter().map(|x| (x - total).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
-    if !(n >= 2.0 && total > WARMUP_SIGNIFICANCE_SE * (var / n).sqrt()) {
-        return Ok(None);
-    }
     let level = (1.0 - (-1.0f64).exp()) * total;
-    Ok(rise.iter().find(|(_, r)| mean(r) >= level).map(|&(t, _)| t))
+    let mean = |r: &[f64]| r.iter().sum::<f64>() / r.len() as f64;
+    Ok(rises
+        .iter()
+        .find(|(_, r)| mean(r) >= level)
+        .map(|&(t, _)| t))
 }
 
 /// Half-split estimate of the seek error a model on all `runs` owes to its training set:

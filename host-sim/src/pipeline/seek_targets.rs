@@ -29,6 +29,8 @@ pub struct SeekTargets {
     /// Worst |mean| / std over every seek, and which seek (1-based).
     pub worst_mean_over_std: f64,
     pub worst_mean_seek: usize,
+    /// Seeks that no start finished (every attempt refused): no figures, and not met.
+    pub seeks_without_result: usize,
     pub met: bool,
 }
 
@@ -57,12 +59,14 @@ pub fn targets_of(
     let worst = |v: &mut dyn Iterator<Item = (usize, f64)>| {
         v.fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a })
     };
+    // A seek without results (NaN) is left out of the worst figures and counted.
     let (first, first_rms) = worst(
         &mut per_seek_rms_deg
             .iter()
             .take(FIRST_SEEKS)
             .map(|&x| x / floor_deg)
-            .enumerate(),
+            .enumerate()
+            .filter(|(_, x)| !x.is_nan()),
     );
     let (mean_seek, mean_ratio) = worst(
         &mut per_seek_rms_deg
@@ -70,14 +74,18 @@ pub fn targets_of(
             .zip(per_seek_mean_deg)
             .map(|(&rms, &mean)| {
                 let std = (rms * rms - mean * mean).max(0.0).sqrt();
-                if std > 0.0 {
+                if rms.is_nan() {
+                    f64::NAN
+                } else if std > 0.0 {
                     mean.abs() / std
                 } else {
                     f64::INFINITY
                 }
             })
-            .enumerate(),
+            .enumerate()
+            .filter(|(_, x)| !x.is_nan()),
     );
+    let seeks_without_result = per_seek_rms_deg.iter().filter(|x| x.is_nan()).count();
     let all = all_std_deg / floor_deg;
     Some(SeekTargets {
         all_over_floor: all,
@@ -85,7 +93,9 @@ pub fn targets_of(
         worst_first_seek: first + 1,
         worst_mean_over_std: mean_ratio,
         worst_mean_seek: mean_seek + 1,
-        met: all <= ALL_SEEKS_OVER_FLOOR
+        seeks_without_result,
+        met: seeks_without_result == 0
+            && all <= ALL_SEEKS_OVER_FLOOR
             && first_rms <= FIRST_SEEKS_OVER_FLOOR
             && mean_ratio <= MEAN_OVER_STD,
     })
@@ -142,6 +152,10 @@ pub fn seek_targets_line(r: &NorthSeekReport) -> String {
     ];
     let ok = |b: bool| if b { "met" } else { "MISSED" };
     let decided = match decided_verdict(&figures) {
+        _ if t.seeks_without_result > 0 => format!(
+            "decided: {} seeks without a result, every attempt refused",
+            t.seeks_without_result
+        ),
         Some(_) => format!("decided at {DECIDED_SE} standard errors"),
         None => format!(
             "not decided by {} starts: a figure within {DECIDED_SE} standard errors of its target",
@@ -154,12 +168,19 @@ pub fn seek_targets_line(r: &NorthSeekReport) -> String {
     } else {
         "cold-start".to_string()
     };
+    let first_seeks = if first.is_finite() {
+        format!(
+            "{first:.3} +- {first_se:.3}x (seek {}, <= {FIRST_SEEKS_OVER_FLOOR}) {}",
+            t.worst_first_seek,
+            ok(first <= FIRST_SEEKS_OVER_FLOOR)
+        )
+    } else {
+        "none finished MISSED".to_string()
+    };
     format!(
-        "{kind} targets ({} starts): all seeks {all:.3} +- {all_se:.3}x floor (<= {ALL_SEEKS_OVER_FLOOR}) {}; worst of seeks 1-{FIRST_SEEKS} {first:.3} +- {first_se:.3}x (seek {}, <= {FIRST_SEEKS_OVER_FLOOR}) {}; worst |mean|/std {mean:.2} +- {mean_se:.2} (seek {}, <= {MEAN_OVER_STD}) {} -> {} ({decided})\n",
+        "{kind} targets ({} starts): all seeks {all:.3} +- {all_se:.3}x floor (<= {ALL_SEEKS_OVER_FLOOR}) {}; worst of seeks 1-{FIRST_SEEKS} {first_seeks}; worst |mean|/std {mean:.2} +- {mean_se:.2} (seek {}, <= {MEAN_OVER_STD}) {} -> {} ({decided})\n",
         r.starts,
         ok(all <= ALL_SEEKS_OVER_FLOOR),
-        t.worst_first_seek,
-        ok(first <= FIRST_SEEKS_OVER_FLOOR),
         t.worst_mean_seek,
         ok(mean <= MEAN_OVER_STD),
         if t.met { "MET" } else { "MISSED" }
@@ -177,6 +198,21 @@ mod tests {
         let t = targets_of(FLOOR, &[FLOOR; 6], &[0.0; 6], FLOOR).unwrap();
         assert!(t.met, "{t:?}");
         assert_eq!((t.all_over_floor, t.worst_mean_over_std), (1.0, 0.0));
+    }
+
+    #[test]
+    fn a_seek_without_results_is_a_miss_and_left_out_of_the_worst_figures() {
+        let mut rms = [FLOOR; 6];
+        let mut mean = [0.0; 6];
+        rms[0] = f64::NAN;
+        mean[0] = f64::NAN;
+        rms[2] = 1.1 * FLOOR;
+        let t = targets_of(FLOOR, &rms, &mean, FLOOR).unwrap();
+        assert!(!t.met, "{t:?}");
+        assert_eq!(t.seeks_without_result, 1);
+        assert_eq!(t.worst_first_seek, 3);
+        assert!((t.worst_first_over_floor - 1.1).abs() < 1e-12);
+        assert_eq!(t.worst_mean_over_std, 0.0);
     }
 
     #[test]

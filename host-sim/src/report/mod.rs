@@ -78,6 +78,9 @@ pub struct SeekStats {
     pub per_seek_std_deg: Vec<f64>,
     /// Mean error of each seek index over the starts, deg.
     pub per_seek_mean_error_deg: Vec<f64>,
+    /// Finished seeks per seek index (a seek every attempt of which was refused has none,
+    /// and NaN figures).
+    pub per_seek_results: Vec<usize>,
     /// Mean over starts of (max - min) of the seeks of one start: the paper's "max deviation", deg.
     pub mean_range_deg: f64,
     /// Mean over starts of the 1 sigma of the seeks of one start (the paper's std), deg.
@@ -112,6 +115,10 @@ pub struct SeekReliability {
     pub latitude_flags: usize,
     /// Refusals by reason.
     pub refusal_reasons: std::collections::BTreeMap<String, usize>,
+    /// Power-ons whose compensator found them not to be a cold start of the model's
+    /// (its cold-start envelope), of `power_ons`.
+    pub warm_restarts_detected: usize,
+    pub power_ons: usize,
 }
 
 /// `fogsim north-seek --json` output.

@@ -15,6 +15,7 @@
 
 mod assemble;
 mod candidates;
+pub mod cold_start;
 mod config;
 mod dataset;
 pub mod declared_range;

@@ -39,6 +39,7 @@ pub fn sample_model(gyro_id: &str, n_centers: usize, weight_scale: f32) -> RbfMo
         poly: Default::default(),
         heading: None,
         linear_by_t: Default::default(),
+        cold_start: None,
     };
     for i in 0..n_centers {
         let u = i as f32 / n_centers.max(1) as f32;
