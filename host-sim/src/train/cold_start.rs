@@ -123,14 +123,15 @@ pub fn cold_start_envelope(runs: &[Run]) -> Result<Option<ColdStartEnvelope>> {
 
 /// One line for people: the envelope's bounds at its first and last points.
 pub fn summary(envelope: Option<&ColdStartEnvelope>) -> String {
-    match envelope {
-        Some(e) => format!(
-            "cold-start check: a power-on must rise at least {:.2} degC by {:.0} s ... {:.2} degC by {:.0} s (training runs' mean - {BOUND_SD} sd); windows of one that rises less are flagged to {:.0} s",
-            e.min_rise_c[0],
-            e.t_s[0],
-            e.min_rise_c[e.min_rise_c.len() - 1],
-            e.end_s(),
-            e.end_s()
+    let ends = envelope.and_then(|e| {
+        Some((
+            (*e.t_s.first()?, *e.min_rise_c.first()?),
+            (*e.t_s.last()?, *e.min_rise_c.last()?),
+        ))
+    });
+    match ends {
+        Some(((t0, r0), (t1, r1))) => format!(
+            "cold-start check: a power-on must rise at least {r0:.2} degC by {t0:.0} s ... {r1:.2} degC by {t1:.0} s (training runs' mean - {BOUND_SD} sd); windows of one that rises less are flagged to {t1:.0} s"
         ),
         None => "cold-start check: none (no input takes the power-on for a cold start, or the runs show no warm-up)".into(),
     }
