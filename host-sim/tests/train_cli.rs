@@ -114,8 +114,15 @@ fn train_writes_a_valid_model_and_rejects_bad_input_without_output() {
         train_ok_printed(&runs, &dir.join("model_rise.bin"), &["--inputs", "t,rise"]);
     let kinds: Vec<FeatureKind> = rate_free.inputs.iter().map(|s| s.kind).collect();
     assert_eq!(kinds, [FeatureKind::TempC, FeatureKind::TempRiseC]);
+    // The rise takes the power-on for a cold start: the model carries its runs' envelope
+    // (format v5); T and dT/dt alone take nothing of the kind and carry none.
+    assert!(
+        rate_free.cold_start.is_some(),
+        "t,rise model without envelope"
+    );
+    assert!(lin.cold_start.is_none(), "t,rate model with an envelope");
     // --linear-by-t: beside each of them a coefficient of T x input (the dT/dt one here;
-    // T x T is the polynomial's), written in format version 4.
+    // T x T is the polynomial's), written in the current format version (4 added them).
     let coupled_path = dir.join("model_lin_t.bin");
     let (coupled, printed) = train_ok_printed(
         &runs,
@@ -129,7 +136,12 @@ fn train_writes_a_valid_model_and_rejects_bad_input_without_output() {
     assert_eq!(coupled.linear_by_t.len(), 2);
     assert!(coupled.linear_by_t[1] != 0.0);
     let bytes = std::fs::read(&coupled_path).unwrap();
-    assert_eq!(bytes[5], 4, "format version byte: {:?}", &bytes[..8]);
+    assert_eq!(
+        bytes[5] as u16,
+        fog_core::model::format::MODEL_VERSION,
+        "format version byte: {:?}",
+        &bytes[..8]
+    );
     // Without linear terms there is nothing to couple: refused by name, nothing written.
     let bad_model = dir.join("bad_model.bin");
     let err = train_refused(&runs, &bad_model, &["--linear-by-t"]);
