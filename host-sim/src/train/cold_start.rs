@@ -20,6 +20,7 @@ use std::collections::BTreeMap;
 
 use super::dataset_from_runs;
 use crate::io::runs::Run;
+use crate::stats::{mean, std_dev};
 
 /// First point of the envelope, s since power-on (the third 10 s window).
 pub const FIRST_POINT_S: f64 = 30.0;
@@ -55,22 +56,13 @@ pub fn rises_by_time(runs: &[Run]) -> Result<Vec<(f64, Vec<f64>)>> {
         .collect())
 }
 
-fn mean(r: &[f64]) -> f64 {
-    r.iter().sum::<f64>() / r.len() as f64
-}
-
-fn sd(r: &[f64]) -> f64 {
-    let m = mean(r);
-    (r.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (r.len() as f64 - 1.0).max(1.0)).sqrt()
-}
-
 /// The runs' whole rise (mean rise at their last common row) when it is
 /// `WARMUP_SIGNIFICANCE_SE` standard errors above zero; None: no warm-up.
 pub fn significant_rise_c(rises: &[(f64, Vec<f64>)]) -> Option<f64> {
     let (_, last) = rises.last()?;
     let n = last.len() as f64;
     let total = mean(last);
-    (n >= 2.0 && total > WARMUP_SIGNIFICANCE_SE * sd(last) / n.sqrt()).then_some(total)
+    (n >= 2.0 && total > WARMUP_SIGNIFICANCE_SE * std_dev(last) / n.sqrt()).then_some(total)
 }
 
 /// The envelope for a model with inputs `specs` trained on `runs`: only when an input
@@ -111,7 +103,7 @@ pub fn cold_start_envelope(runs: &[Run]) -> Result<Option<ColdStartEnvelope>> {
         if envelope.t_s.last().is_some_and(|&last| *t_s as f32 <= last) {
             continue;
         }
-        let bound = mean(r) - BOUND_SD * sd(r);
+        let bound = mean(r) - BOUND_SD * std_dev(r);
         let pushed = envelope.t_s.push(*t_s as f32).is_ok()
             && envelope.min_rise_c.push(bound as f32).is_ok();
         if !pushed {
