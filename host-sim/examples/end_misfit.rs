@@ -20,12 +20,12 @@ use fog_core::consts::earth_rate_horizontal_dph;
 use fog_sim::io::runs::Run;
 use fog_sim::pipeline::campaign::CampaignSpec;
 use fog_sim::pipeline::campaign_steps::simulate_checked;
-use fog_sim::pipeline::northseek::MonteCarloConfig;
-use fog_sim::pipeline::own_model::own_model_from_runs;
+use fog_sim::pipeline::north_seek::own_model::own_model_from_runs;
+use fog_sim::pipeline::north_seek::schedule::seek_schedule;
+use fog_sim::pipeline::north_seek::MonteCarloConfig;
 use fog_sim::pipeline::reproduce::{
     qualification_campaign_spec, qualification_plan, write_model_file,
 };
-use fog_sim::pipeline::seek_schedule::seek_schedule;
 use fog_sim::train::{dataset_from_runs, predict_batch, InputChoice};
 
 const TRUE_AZIMUTH_DEG: f64 = 108.4;

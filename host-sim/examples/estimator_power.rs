@@ -44,8 +44,8 @@ fn main() -> Result<()> {
     let runs: Vec<Run> = campaign.into_iter().map(|c| c.run).collect();
     let deployed = std::env::var("ESTIMATOR_POWER_DEPLOYED").is_ok_and(|v| v == "1");
     let clock = if deployed {
-        fog_sim::pipeline::own_model::warmup_time_constant_s(&runs)?
-            .map(fog_sim::pipeline::own_model::clock_spec)
+        fog_sim::pipeline::north_seek::own_model::warmup_time_constant_s(&runs)?
+            .map(fog_sim::pipeline::north_seek::own_model::clock_spec)
     } else {
         None
     };

@@ -16,7 +16,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use fog_core::model::format::{FeatureSpec, MAX_ENCODED_LEN};
 use fog_sim::io::runs::{list_run_files, read_runs};
 use fog_sim::pipeline::campaign_steps::train_with_config;
-use fog_sim::pipeline::own_model::{clock_spec, warmup_time_constant_s};
+use fog_sim::pipeline::north_seek::own_model::{clock_spec, warmup_time_constant_s};
 use fog_sim::train::{choose_inputs_default, InputChoice, InputSet, TrainConfig};
 
 fn main() -> Result<()> {

@@ -27,7 +27,7 @@ use fog_core::model::format::{FeatureKind, FeatureSpec, RbfModel, MAX_ENCODED_LE
 use fog_sim::io::runs::Run;
 use fog_sim::pipeline::campaign::CampaignSpec;
 use fog_sim::pipeline::campaign_steps::simulate_checked;
-use fog_sim::pipeline::own_model::{train_own_model, OwnModelPlan};
+use fog_sim::pipeline::north_seek::own_model::{train_own_model, OwnModelPlan};
 use fog_sim::sim::{GyroParams, DEFAULT_LATITUDE_DEG};
 use fog_sim::train::seek_score::Criterion;
 use fog_sim::train::{
@@ -106,7 +106,7 @@ fn model_under_test(
             inputs: fog_sim::train::InputChoice::Auto,
             seek_timing: None,
         },
-        fog_sim::pipeline::own_model::CAMPAIGN_RUNS,
+        fog_sim::pipeline::north_seek::own_model::CAMPAIGN_RUNS,
         None,
     )?;
     let mut specs = own.selection.chosen.specs();

@@ -9,38 +9,34 @@
 //! Each layer uses only the layers below it; nothing imports `cmd`.
 //!
 //! ```text
-//! cmd/        arguments, flag checks (outputs checked before any computation), printing
-//!   |         (main.rs dispatches; one module per subcommand)
-//! pipeline/   one job each: reproduce, compensate, north-seek Monte Carlo (northseek),
-//!   |         the simulated campaign; plus diagnose/ and train/ as their own pipelines
-//! engines     sim/ (gyro, thermal, turntable physics), train/ (OLS/ORR fitting),
-//!   |         diagnose/ (residual screening and fits), pipeline/compensation_replay
-//!   |         (runs replayed through fog-core's compensator)
-//! report/     JSON report structures and terminal tables; plots/ the SVG charts
-//! io/         fog-runs reader (streaming, csv crate) and writer, 10 s binning, model
-//!   |         files, import, the one atomic writer, the output guard
-//!   |         upload, monitor: the host-link clients (model upload, status/results);
-//!   |         rig: the simulated gyro + turntable served on the device's links;
-//!   |         registry: the calibration registry (SQLite: counters, models, uploads, results);
-//!   |         field: field records (pull client, record files, the field correction fit)
-//! stats/      statistics: std/rms, the one pooled within-run std, drift metrics, Allan,
-//!             windows in fog-core's convention; beside it seed (the one SplitMix64
-//!             seed mix) and fanout (the one thread fan-out, results in job order)
+//! cmd/          arguments, flag checks (outputs checked before any computation), printing
+//!   |           (main.rs dispatches; one module per subcommand)
+//! pipeline/     one job each: reproduce, compensate, north_seek/ (the cold-start Monte
+//!   |           Carlo, the own model, targets, schedule), the simulated campaign, field_aging
+//! device/       the device-facing clients: upload, monitor, field_pull, rig
+//!   |
+//! engines       train/ (OLS/ORR fit, seek scoring and refit, cold-start envelope,
+//!   |           field_correction), diagnose/ (measured-data diagnosis, its own chain of
+//!   |           stages), sim/ (gyro, thermal, turntable, tripod physics)
+//! registry/     the calibration registry (SQLite: counters, models, uploads, results,
+//!   |           field records)
+//! output/       reports (JSON report structures, terminal tables) and plots (SVG charts)
+//!   |
+//! io/           fog-runs format, streaming reader and writer, 10 s binning, model files,
+//!   |           import, field-record files, UTC stamps, the one atomic writer, the guard
+//! stats/        std/rms, the one pooled within-run std, drift metrics, Allan; beside it
+//!               seed (the one SplitMix64 seed mix) and fanout (the one thread fan-out)
 //! ```
 
 pub mod cmd;
+pub mod device;
 pub mod diagnose;
 pub mod fanout;
-pub mod field;
 pub mod io;
-pub mod monitor;
+pub mod output;
 pub mod pipeline;
-pub mod plots;
 pub mod registry;
-pub mod report;
-pub mod rig;
 pub mod seed;
 pub mod sim;
 pub mod stats;
 pub mod train;
-pub mod upload;

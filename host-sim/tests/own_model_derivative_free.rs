@@ -25,7 +25,7 @@ mod soaked;
 use fog_core::model::format::FeatureSpec;
 use fog_sim::io::runs::Run;
 use fog_sim::pipeline::campaign_steps::train_with_config;
-use fog_sim::pipeline::own_model::{
+use fog_sim::pipeline::north_seek::own_model::{
     choose_derivative_free, clock_spec, train_config, warmup_time_constant_s,
 };
 use fog_sim::train::InputSet;

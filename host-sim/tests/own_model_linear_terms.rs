@@ -15,7 +15,7 @@ mod seek_judge;
 #[path = "common/soaked.rs"]
 mod soaked;
 
-use fog_sim::pipeline::own_model::choose_linear_terms;
+use fog_sim::pipeline::north_seek::own_model::choose_linear_terms;
 use seek_judge::{plan, seek_rms_deg};
 use soaked::{clocked_specs, soaked_campaign_over, SoakedLaw, Tube, AMBIENT_C, RUNS};
 
@@ -37,7 +37,7 @@ fn outcome(law: SoakedLaw, tube: Tube, seed: u64) -> Outcome {
     let other = fog_sim::pipeline::campaign_steps::train_with_config(
         &runs.iter().collect::<Vec<_>>(),
         &specs,
-        &fog_sim::pipeline::own_model::train_config(&plan, !choice.linear_inputs),
+        &fog_sim::pipeline::north_seek::own_model::train_config(&plan, !choice.linear_inputs),
     )
     .unwrap();
     let (pure, linear) = if choice.linear_inputs {

@@ -4,8 +4,8 @@
 //! perfectly) explainable by the sensor's T and dT/dt.
 
 use fog_sim::io::runs::{format_run, Run};
+use fog_sim::output::plots::{allan_chart, startup_chart, write_svg, RunCurve};
 use fog_sim::pipeline::campaign::{simulate_campaign, CampaignSpec};
-use fog_sim::plots::{allan_chart, startup_chart, write_svg, RunCurve};
 use fog_sim::sim::{simulate_run, GyroParams, RunSpec, SimGyro, StartState};
 use fog_sim::stats::allan::{adev_of_series, Term};
 use fog_sim::stats::{max_deviation, mean, settled_mean, std_dev, time_to_spec_s, SPEC_DPH};

@@ -333,12 +333,12 @@ fn register_calibrated_variants(model_path: &Path, registry: &Path) -> (u32, u32
 
 /// Nine field records of gyro FIELD-1 (residual linear in T): six measured under `first`,
 /// three under `second`.
-fn field_records(first: u32, second: u32) -> Vec<fog_sim::field::records_file::StoredRecord> {
+fn field_records(first: u32, second: u32) -> Vec<fog_sim::io::field_records::StoredRecord> {
     use fog_core::seeking::field_record::FieldRecord;
     (0..9u32)
         .map(|i| {
             let temp_c = 15.0 + 2.0 * i as f32;
-            fog_sim::field::records_file::StoredRecord::new(
+            fog_sim::io::field_records::StoredRecord::new(
                 "FIELD-1",
                 &FieldRecord {
                     sequence: i + 1,
@@ -374,8 +374,7 @@ fn train_field_counts_records_under_a_heading_calibrated_variant_the_registry_kn
     let registry = dir.join("registry.sqlite");
     let (cal_crc, other_crc) = register_calibrated_variants(&model_path, &registry);
     let field = dir.join("field");
-    fog_sim::field::records_file::merge_into_dir(&field, &field_records(cal_crc, other_crc))
-        .unwrap();
+    fog_sim::io::field_records::merge_into_dir(&field, &field_records(cal_crc, other_crc)).unwrap();
     let train_field = |out: &Path, registry: Option<&Path>| {
         let mut args = vec![
             "train".to_string(),

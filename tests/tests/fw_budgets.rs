@@ -92,15 +92,15 @@ fn firmware_fits_its_budgets() {
 
     // Instruction counts, with a really signed model for the Ed25519 verification.
     let dir = scratch_dir("bench");
-    let key =
-        fog_sim::upload::load_signing_key(&fog_sim::upload::test_key_path()).expect("test key");
+    let key = fog_sim::device::upload::load_signing_key(&fog_sim::device::upload::test_key_path())
+        .expect("test key");
     let model = fog_core::model::synthetic::warmup_model(35, 2, 0.05, 35);
     let mut buf = [0u8; fog_core::model::format::MAX_ENCODED_LEN];
     let n = model.encode(&mut buf).expect("encode");
     std::fs::write(dir.join("model.bin"), &buf[..n]).unwrap();
     std::fs::write(
         dir.join("model.sig"),
-        fog_sim::upload::sign_model(&key, &buf[..n]),
+        fog_sim::device::upload::sign_model(&key, &buf[..n]),
     )
     .unwrap();
     let opts = QemuOptions {

@@ -22,7 +22,7 @@ mod upload_support;
 
 use fog_core::link::upload::crc32;
 use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
-use fog_sim::upload::{load_signing_key, sign_upload, test_key_path};
+use fog_sim::device::upload::{load_signing_key, sign_upload, test_key_path};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use upload_support::*;

@@ -5,7 +5,7 @@
 //!   its reset reason on the semihosting console (`FOG-BOOT n reset=...`, counted per
 //!   boot: QEMU runs without `-no-reboot`, so a reset restarts the guest) and reports
 //!   it in `DeviceStatus`; a model committed before the reset is still active after it.
-//! - The host port is flooded with garbage while the rig's gyro (`fog_sim::rig`, the
+//! - The host port is flooded with garbage while the rig's gyro (`fog_sim::device::rig`, the
 //!   bench `fogsim rig` serves) streams frames on UART1 in real time (at 200 Hz: see
 //!   `FLOOD_GYRO_HZ`): every 10 s window stays valid and no gyro frame or byte is lost.
 //!
@@ -32,9 +32,9 @@ use std::time::{Duration, Instant};
 use fog_core::link::upload::ResetCause;
 use fog_core::seeking::tilt::Tilt;
 use fog_firmware::fault_record::{BootFault, CLEAN_RUN_S};
-use fog_sim::rig::{tcp_link, Rig, RigConfig};
+use fog_sim::device::rig::{tcp_link, Rig, RigConfig};
+use fog_sim::device::upload::{ClientError, UploadClient};
 use fog_sim::sim::{GyroParams, StartState};
-use fog_sim::upload::{ClientError, UploadClient};
 use fog_tests::console::wait_line;
 use fog_tests::qemu_ready;
 use qemu_support::{polled, start, wait_boot, wait_status};

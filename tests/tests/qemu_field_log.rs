@@ -3,7 +3,7 @@
 //!
 //! The real `fog-app` keeps its models in `flash-file=models.img` and its field-record ring
 //! in `field-file=field.img` (both written through at every flash write, so they survive
-//! a QEMU restart). The world around it is the bench simulator's (`fog_sim::rig`, as in
+//! a QEMU restart). The world around it is the bench simulator's (`fog_sim::device::rig`, as in
 //! qemu_seek.rs) with a gyro whose drift law is one constant: Earth rate on the level
 //! input axis at the table heading + `BIAS_DPH` + white noise, at 25 degC with no self
 //! heating, so the residual a record must carry is known exactly. Gyro on UART1,
@@ -36,10 +36,10 @@ use fog_core::link::messages::{Command, DeviceMessage};
 use fog_core::model::rbf::predict_f64;
 use fog_core::seeking::field_record::FieldRecord;
 use fog_core::seeking::tilt::Tilt;
-use fog_sim::field::pull::pull_records;
-use fog_sim::rig::{tcp_link, Rig, RigConfig};
+use fog_sim::device::field_pull::pull_records;
+use fog_sim::device::rig::{tcp_link, Rig, RigConfig};
+use fog_sim::device::upload::UploadClient;
 use fog_sim::sim::{GyroParams, StartState};
-use fog_sim::upload::UploadClient;
 use fog_tests::console::{start_with_console, wait_line, wait_line_where};
 use fog_tests::{firmware_elf, qemu_ready, scratch_dir, KillOnDrop, QemuOptions};
 use qemu_support::{link_command, polled};

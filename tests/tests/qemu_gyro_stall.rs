@@ -1,7 +1,7 @@
 //! QEMU scenario (issue 17 item 6): the gyro link stalls in the middle of a north seek.
 //!
 //! `fog-app` runs a two-position seek (started by `Command::StartSeek` over the host
-//! link) on the bench `fogsim rig` serves (`fog_sim::rig::Rig::serve` on the test's
+//! link) on the bench `fogsim rig` serves (`fog_sim::device::rig::Rig::serve` on the test's
 //! sockets: the `sim/` FOG on UART1 at `RATE_HZ` of sample time, `SPEED` times faster
 //! than real time, its turntable on UART2, the base inclinometer on UART3). One window
 //! into the seek the rig's gyro cable is pulled (`GyroCut`) for `STALL_FRAMES` frames
@@ -29,9 +29,9 @@ use std::time::Duration;
 use fog_core::link::messages::{Command, DeviceMessage};
 use fog_core::seeking::quality::{MotionReason, SeekState};
 use fog_core::seeking::tilt::Tilt;
-use fog_sim::rig::{tcp_link, GyroCut, Rig, RigConfig};
+use fog_sim::device::rig::{tcp_link, GyroCut, Rig, RigConfig};
+use fog_sim::device::upload::UploadClient;
 use fog_sim::sim::{GyroParams, StartState};
-use fog_sim::upload::UploadClient;
 use fog_tests::console::{wait_line, wait_line_where};
 use fog_tests::qemu_ready;
 use qemu_support::*;

@@ -23,7 +23,7 @@ use std::sync::mpsc::Receiver;
 use std::time::Duration;
 
 use fog_core::link::upload::{crc32, ModelInfo};
-use fog_sim::upload::UploadClient;
+use fog_sim::device::upload::UploadClient;
 use fog_tests::console::wait_line;
 use fog_tests::{qemu_ready, scratch_dir, KillOnDrop};
 use qemu_support::boot_in;

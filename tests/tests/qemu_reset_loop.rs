@@ -20,7 +20,7 @@ use fog_core::link::messages::{Command, DeviceMessage, Refusal};
 use fog_core::link::upload::{crc32, ResetCause};
 use fog_core::seeking::quality::SeekState;
 use fog_firmware::fault_record::{BootFault, SAFE_MODE_AFTER};
-use fog_sim::upload::UploadClient;
+use fog_sim::device::upload::UploadClient;
 use fog_tests::console::wait_line;
 use fog_tests::qemu_ready;
 use qemu_support::{link_command, polled, start, wait_boot, wait_status};

@@ -2,7 +2,7 @@
 //! mps2-an386` runs a whole north seek started by `Command::StartSeek` over the host link.
 //!
 //! The world around the device is the bench simulator `fogsim rig` serves
-//! (`fog_sim::rig::Rig::serve`, the one gyro/table/inclinometer server, on the test's
+//! (`fog_sim::device::rig::Rig::serve`, the one gyro/table/inclinometer server, on the test's
 //! sockets): the `sim/` gyro on UART1 (frames at `RATE_HZ` of sample time, sent `SPEED`
 //! times faster than real time: the firmware's time base is the frame count), its
 //! turntable controller on UART2 (the ASCII protocol of `drivers::turntable`, moving at
@@ -49,11 +49,11 @@ use fog_core::link::messages::{Command, ResetReason, SeekReport, Status};
 use fog_core::seeking::heading_cal::HeadingHarmonic;
 use fog_core::seeking::quality::{SeekState, Validity};
 use fog_core::seeking::tilt::Tilt;
-use fog_sim::monitor::{monitor, CsvAppend, MonitorOptions, MonitorSummary, ResultLog};
+use fog_sim::device::monitor::{monitor, CsvAppend, MonitorOptions, MonitorSummary, ResultLog};
+use fog_sim::device::rig::{tcp_link, Rig, RigConfig, RigSummary};
+use fog_sim::device::upload::UploadClient;
 use fog_sim::registry::Registry;
-use fog_sim::rig::{tcp_link, Rig, RigConfig, RigSummary};
 use fog_sim::sim::{AuxSource, AuxTransform, DriftTerm, GyroParams, StartState};
-use fog_sim::upload::UploadClient;
 use fog_tests::console::{wait_line, wait_line_where};
 use fog_tests::{qemu_ready, scratch_dir};
 use qemu_support::{polled, start, wait_boot};

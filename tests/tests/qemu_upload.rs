@@ -1,6 +1,6 @@
 //! QEMU scenario 2 (issue 5): the real firmware binary runs under
 //! `qemu-system-arm -machine mps2-an386` with its UART0 on a loopback TCP socket; the
-//! training PC's upload client (`fog_sim::upload`, what `fogsim upload` runs) installs a
+//! training PC's upload client (`fog_sim::device::upload`, what `fogsim upload` runs) installs a
 //! signed model, a status query shows it in use, bad uploads are refused with typed
 //! errors and leave it in place, and a second model replaces it in the other slot.
 //!
@@ -14,7 +14,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use fog_core::link::upload::{crc32, ModelRejection, UploadError, UploadPhase, PROTOCOL_VERSION};
-use fog_sim::upload::{key_from_seed, sign_upload, ClientError, UploadClient};
+use fog_sim::device::upload::{key_from_seed, sign_upload, ClientError, UploadClient};
 use fog_tests::{
     connect_loopback, firmware_elf, free_loopback_port, qemu_ready, spawn_qemu, QemuOptions,
 };

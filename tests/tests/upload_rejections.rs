@@ -10,7 +10,7 @@ use fog_core::link::upload::{
 };
 use fog_core::model::format::MAX_ENCODED_LEN;
 use fog_firmware::signature::TEST_PUBLIC_KEY;
-use fog_sim::upload::{key_from_seed, sign_upload, ClientError};
+use fog_sim::device::upload::{key_from_seed, sign_upload, ClientError};
 use rand::{Rng, SeedableRng};
 use upload_support::*;
 
@@ -272,7 +272,7 @@ fn every_bad_upload_is_refused_with_its_typed_error_and_the_model_stays() {
 
 #[test]
 fn test_key_files_agree_and_bad_key_files_are_refused_clearly() {
-    use fog_sim::upload::{load_signing_key, test_key_path};
+    use fog_sim::device::upload::{load_signing_key, test_key_path};
     let key = load_signing_key(&test_key_path()).unwrap();
     assert_eq!(
         *key.pk, TEST_PUBLIC_KEY,

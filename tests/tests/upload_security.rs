@@ -13,7 +13,7 @@ use fog_core::link::upload::{
 };
 use fog_firmware::store::EmulatedModelFlash;
 use fog_firmware::upload::{SlotVerdict, UploadServer};
-use fog_sim::upload::{key_from_seed, ClientError};
+use fog_sim::device::upload::{key_from_seed, ClientError};
 use upload_support::*;
 
 fn rejected(result: Result<fog_core::link::upload::ModelInfo, ClientError>) -> UploadError {

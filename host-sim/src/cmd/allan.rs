@@ -4,9 +4,9 @@
 
 use super::{check_distinct_outputs, check_output_file};
 use crate::io::OutputGuard;
+use crate::output::plots::{allan_chart, write_svg};
+use crate::output::reports::write_json;
 use crate::pipeline::allan::{allan_of_files, AllanReport, DRIFT_COLUMN};
-use crate::plots::{allan_chart, write_svg};
-use crate::report::write_json;
 use crate::stats::allan::{Kind, TauSpacing};
 use std::fmt::Write;
 use std::path::PathBuf;

@@ -7,7 +7,7 @@ use std::ffi::OsString;
 
 use clap::error::ErrorKind;
 
-use crate::io::reader::excerpt;
+use crate::io::run_format::excerpt;
 
 /// Longest quoted value kept whole in the line, characters.
 const MAX_QUOTED_CHARS: usize = 40;

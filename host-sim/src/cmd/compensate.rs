@@ -9,9 +9,9 @@ use anyhow::{bail, Result};
 use crate::io::model::read_model;
 use crate::io::runs::read_runs;
 use crate::io::OutputGuard;
+use crate::output::reports::write_json;
 use crate::pipeline::compensate::{compensate_all, compensate_table, write_startup_plots};
 use crate::pipeline::compensation_replay::check_model_inputs;
-use crate::report::write_json;
 
 /// Options of `fogsim compensate`.
 #[derive(clap::Args, Debug)]

@@ -9,9 +9,9 @@ use anyhow::Result;
 use super::prepare_output_dir;
 use crate::cmd::reproduce::options;
 use crate::io::OutputGuard;
+use crate::output::reports::write_json;
 use crate::pipeline::campaign_steps::CampaignSpec;
 use crate::pipeline::reproduce::{reproduce, summary};
-use crate::report::write_json;
 use crate::sim::GyroParams;
 
 /// Options of `fogsim demo`.

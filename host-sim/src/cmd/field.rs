@@ -10,10 +10,10 @@ use std::time::Duration;
 use anyhow::Result;
 
 use super::upload::LinkArgs;
-use crate::field::pull::{pull_records, MAX_PULLED_RECORDS};
-use crate::field::records_file::{merge_into_dir, StoredRecord, CSV_NAME, JSON_NAME};
+use crate::device::field_pull::{pull_records, MAX_PULLED_RECORDS};
+use crate::device::upload::device_gyro_id;
+use crate::io::field_records::{merge_into_dir, StoredRecord, CSV_NAME, JSON_NAME};
 use crate::registry::{self, Registry};
-use crate::upload::device_gyro_id;
 
 /// Options of `fogsim field`.
 #[derive(clap::Args, Debug)]

@@ -8,8 +8,8 @@ use anyhow::{bail, Result};
 
 use super::check_output_file;
 use crate::io::OutputGuard;
+use crate::output::reports::write_json;
 use crate::pipeline::field_aging::{aging_table, run_aging, AgingLaw, AgingPlan};
-use crate::report::write_json;
 
 /// Options of `fogsim field aging`.
 #[derive(clap::Args, Debug)]

@@ -1,6 +1,6 @@
 //! `fogsim monitor --port PORT [--registry DB] [--csv FILE]`: live status of the north
 //! finder, every seek result stored in the calibration registry (and appended to a CSV if
-//! asked; see `crate::monitor`). On a terminal a progress bar; otherwise (a pipe, a
+//! asked; see `crate::device::monitor`). On a terminal a progress bar; otherwise (a pipe, a
 //! script) one `key=value` line per status and per result, so a script can follow it.
 
 use std::io::IsTerminal;
@@ -12,9 +12,10 @@ use fog_core::link::messages::{Command, Status};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::upload::LinkArgs;
-use crate::monitor::{monitor, CsvAppend, MonitorOptions, ResultLog};
-use crate::registry::{self, utc::now_utc, Registry, SeekRecord};
-use crate::upload::device_gyro_id;
+use crate::device::monitor::{monitor, CsvAppend, MonitorOptions, ResultLog};
+use crate::device::upload::device_gyro_id;
+use crate::io::utc::now_utc;
+use crate::registry::{self, Registry, SeekRecord};
 
 /// Options of `fogsim monitor`.
 #[derive(clap::Args, Debug)]

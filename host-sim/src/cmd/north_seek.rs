@@ -11,14 +11,14 @@ use fog_core::seeking::northfinder::SeekMode;
 use super::{check_distinct_outputs, check_output_file};
 use crate::io::model::read_model;
 use crate::io::OutputGuard;
+use crate::output::reports::{progress_bar, write_json};
 use crate::pipeline::campaign::WarmRestarts;
-use crate::pipeline::northseek::{
+use crate::pipeline::north_seek::own_model::{train_own_model, OwnModelPlan, CAMPAIGN_RUNS};
+use crate::pipeline::north_seek::{
     build_product_report, default_threads, run_monte_carlo_with_calibration, seek_table,
     MonteCarloConfig, MAX_RESTART_ABOVE_AMBIENT_C,
 };
-use crate::pipeline::own_model::{train_own_model, OwnModelPlan, CAMPAIGN_RUNS};
 use crate::pipeline::reproduce::write_model_file;
-use crate::report::{progress_bar, write_json};
 use crate::sim::GyroParams;
 
 /// Options of `fogsim north-seek`.
@@ -48,7 +48,7 @@ pub struct Args {
     )]
     pub ambient: f64,
     /// True azimuth of the table's zero, deg (the paper's was about 108.4).
-    #[arg(long = "azimuth-deg", alias = "azimuth", default_value_t = crate::pipeline::northseek::PAPER_AZIMUTH_DEG, allow_negative_numbers = true)]
+    #[arg(long = "azimuth-deg", alias = "azimuth", default_value_t = crate::pipeline::north_seek::PAPER_AZIMUTH_DEG, allow_negative_numbers = true)]
     pub azimuth: f64,
     /// Measuring time per main position, s, so that one seek fits the paper's 4 min 56 s
     /// [default: 110 for two positions, 60 for four].

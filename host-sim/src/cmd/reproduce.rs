@@ -9,10 +9,10 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 
 use crate::io::OutputGuard;
+use crate::output::reports::write_json;
 use crate::pipeline::campaign_steps::{validate_plan, CampaignSpec};
-use crate::pipeline::northseek::{default_threads, MonteCarloConfig};
+use crate::pipeline::north_seek::{default_threads, MonteCarloConfig};
 use crate::pipeline::reproduce::{reproduce, summary, validation_tables, ReproduceOptions};
-use crate::report::write_json;
 use crate::sim::GyroParams;
 use crate::train::InputChoice;
 

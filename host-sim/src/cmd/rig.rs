@@ -1,5 +1,5 @@
 //! `fogsim rig --gyro-port P --table-port P [--incl-port P] ...`: serve the simulated
-//! gyro, turntable and base inclinometer on the firmware's links (`crate::rig`), for
+//! gyro, turntable and base inclinometer on the firmware's links (`crate::device::rig`), for
 //! `fog-app` under QEMU (`cargo fw-run`) or a board on the bench. Prints the truth
 //! (azimuth of the table's zero) and the firmware arguments that must match the rig
 //! (`gyro-rate=`; `tilt-mdeg=` only without an inclinometer link), then one summary line.
@@ -10,7 +10,7 @@ use std::time::Duration;
 use anyhow::{bail, Result};
 use fog_core::seeking::tilt::Tilt;
 
-use crate::rig::{open_rig_link, Rig, RigConfig};
+use crate::device::rig::{open_rig_link, Rig, RigConfig};
 use crate::sim::{GyroParams, StartState, DEFAULT_LATITUDE_DEG};
 
 /// Options of `fogsim rig`.
@@ -178,7 +178,7 @@ pub fn run(a: Args) -> Result<()> {
         gyro.as_mut(),
         table.as_mut(),
         incl.as_mut()
-            .map(|l| l.as_mut() as &mut dyn crate::upload::Link),
+            .map(|l| l.as_mut() as &mut dyn crate::device::upload::Link),
         &stop,
     )?;
     println!(

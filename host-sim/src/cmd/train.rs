@@ -118,7 +118,7 @@ pub struct Args {
     /// Field records (`fogsim field pull --out DIR`) measured under this chamber model:
     /// each is one observation of the residual bias at its temperature state; a ridge
     /// correction linear in the model's T and dT/dt inputs is fitted to them and
-    /// folded into the model (`fog_sim::field::refine`).
+    /// folded into the model (`fog_sim::train::field_correction::refine`).
     #[arg(long)]
     pub field: Option<PathBuf>,
     /// Weight W of each field seek against the chamber model's prior (one row of weight 1
@@ -234,13 +234,13 @@ fn inputs(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
     inputs.extend(
         args.field
             .iter()
-            .map(|d| crate::field::records_file::json_path(d)),
+            .map(|d| crate::io::field_records::json_path(d)),
     );
     inputs.extend(args.registry.clone());
     Ok(inputs)
 }
 
-/// The trained model, refined with `--field` records if given (`crate::field`).
+/// The trained model, refined with `--field` records if given (`crate::train::field_correction`).
 fn field_refined(
     args: &Args,
     model: &fog_core::model::format::RbfModel,
@@ -252,8 +252,8 @@ fn field_refined(
         (Some(path), _) if !path.is_file() => {
             anyhow::bail!("--registry {}: no such registry file", path.display())
         }
-        (Some(path), _) => crate::field::registry_variants(model, path)?,
-        (None, Ok(path)) if path.is_file() => crate::field::registry_variants(model, &path)?,
+        (Some(path), _) => crate::registry::variants_of(model, path)?,
+        (None, Ok(path)) if path.is_file() => crate::registry::variants_of(model, &path)?,
         (None, _) => Vec::new(),
     };
     // The azimuth score's seeks are the ones the trainer's seek criterion scores.
@@ -261,7 +261,13 @@ fn field_refined(
         dwell_s: args.seek_dwell,
         latitude_deg: args.seek_latitude,
     };
-    let refined = crate::field::refine_with_dir(model, dir, &variants, args.field_weight, seek)?;
+    let refined = crate::train::field_correction::refine_with_dir(
+        model,
+        dir,
+        &variants,
+        args.field_weight,
+        seek,
+    )?;
     print!("{}", refined.summary());
     Ok(refined.model)
 }
@@ -388,13 +394,13 @@ fn refit_to_device_seeks(
     ds: &crate::train::Dataset,
     model: &RbfModel,
 ) -> anyhow::Result<SeekRefit> {
-    let seek = crate::pipeline::northseek::MonteCarloConfig {
+    let seek = crate::pipeline::north_seek::MonteCarloConfig {
         dwell_s: args.seek_dwell as f32,
         latitude_deg: args.seek_latitude,
-        ..crate::pipeline::northseek::MonteCarloConfig::paper(1)
+        ..crate::pipeline::north_seek::MonteCarloConfig::paper(1)
     };
     seek.validate().context("--seek-refit")?;
-    let schedule = crate::pipeline::seek_schedule::seek_schedule(
+    let schedule = crate::pipeline::north_seek::schedule::seek_schedule(
         &crate::sim::GyroParams::paper_default(),
         &seek,
         Some(model),

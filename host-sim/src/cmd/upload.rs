@@ -16,11 +16,11 @@ use anyhow::{bail, Context};
 use ed25519_compact::KeyPair;
 use fog_core::model::format::RbfModel;
 
-use crate::io::model::read_model_file;
-use crate::registry::{self, ModelRecord, Registry};
-use crate::upload::{
+use crate::device::upload::{
     describe_model, load_signing_key, open_link, sign_upload, test_key_path, UploadClient,
 };
+use crate::io::model::read_model_file;
+use crate::registry::{self, ModelRecord, Registry};
 
 /// Where the device is: shared by `upload` and `monitor`.
 #[derive(clap::Args, Debug)]
@@ -36,7 +36,7 @@ pub struct LinkArgs {
 
 impl LinkArgs {
     /// Opens the link (see `upload::open_link`).
-    pub fn open(&self) -> anyhow::Result<Box<dyn crate::upload::Link>> {
+    pub fn open(&self) -> anyhow::Result<Box<dyn crate::device::upload::Link>> {
         open_link(&self.port, self.baud).map_err(|e| e.context(format!("--port {}", self.port)))
     }
 }
@@ -154,7 +154,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 
 /// Uploads, commits and confirms with a status that the committed model is active.
 fn send(
-    client: &mut UploadClient<Box<dyn crate::upload::Link>>,
+    client: &mut UploadClient<Box<dyn crate::device::upload::Link>>,
     bytes: &[u8],
     counter: u32,
     signature: &[u8],

@@ -14,7 +14,7 @@ use std::io;
 use std::path::Path;
 
 use super::{write_atomic_with, Run};
-use crate::registry::utc::format_utc_ms;
+use crate::io::utc::format_utc_ms;
 
 /// Gyro off between two power-ons, s (a cold start needs the coil back at ambient).
 pub const OFF_GAP_S: f64 = 4.0 * 3600.0;

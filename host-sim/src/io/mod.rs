@@ -5,13 +5,16 @@
 pub mod atomic;
 pub mod bin;
 pub mod bounded;
+pub mod field_records;
 pub mod guard;
 pub mod import;
 pub mod lock;
 pub mod logger_csv;
 pub mod model;
 pub mod reader;
+pub mod run_format;
 pub mod runs;
+pub mod utc;
 
 pub use atomic::{write_atomic, write_atomic_with, StagedFiles};
 pub use bin::{read_binned, read_runs_binned, WindowBinner};

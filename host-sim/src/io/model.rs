@@ -54,3 +54,12 @@ pub fn read_model_file(path: &Path) -> Result<(Vec<u8>, RbfModel), ModelFileErro
     })?;
     Ok((bytes, model))
 }
+
+/// CRC-32 of a model's encoding (what the device reports as its model's CRC).
+pub fn model_crc32(model: &RbfModel) -> anyhow::Result<u32> {
+    let mut buf = [0u8; MAX_ENCODED_LEN];
+    let n = model
+        .encode(&mut buf)
+        .map_err(|e| anyhow::anyhow!("encoding the model: {e}"))?;
+    Ok(fog_core::link::upload::crc32(&buf[..n]))
+}

@@ -9,30 +9,12 @@ use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 
-use super::runs::{check_header, check_value, RunError, RunErrorKind, FORMAT_LINE, NUMERIC_META};
-
-/// Longest line accepted, bytes (a row of 100 columns of 25 characters is 2.5 KiB).
-pub const MAX_LINE_BYTES: usize = 64 * 1024;
-/// Longest piece of the offending text quoted in an error, characters.
-pub const MAX_EXCERPT_CHARS: usize = 200;
+use super::run_format::{
+    check_header, check_value, excerpt, RunError, RunErrorKind, FORMAT_LINE, NUMERIC_META,
+};
+pub use super::run_format::{MAX_EXCERPT_CHARS, MAX_LINE_BYTES};
 
 const BOM: &[u8] = b"\xEF\xBB\xBF";
-
-/// `text` as one line of at most [`MAX_EXCERPT_CHARS`] characters (control characters
-/// shown as U+FFFD, a cut marked with `...`).
-pub fn excerpt(text: &str) -> String {
-    let clean = |c: char| if c.is_control() { '\u{FFFD}' } else { c };
-    if text.chars().count() <= MAX_EXCERPT_CHARS {
-        return text.chars().map(clean).collect();
-    }
-    let mut s: String = text
-        .chars()
-        .take(MAX_EXCERPT_CHARS - 3)
-        .map(clean)
-        .collect();
-    s.push_str("...");
-    s
-}
 
 /// The `io::Error` payload of a line longer than [`MAX_LINE_BYTES`].
 #[derive(Debug)]

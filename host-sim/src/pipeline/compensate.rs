@@ -7,11 +7,11 @@ use std::path::Path;
 use anyhow::{bail, Result};
 
 use crate::io::runs::Run;
+use crate::output::plots::{startup_pair, write_svg, RunCurve};
+use crate::output::reports::{BeforeAfter, CompensateReport, CompensatedRun, Table};
 use crate::pipeline::compensation_replay::{
     compensate_run, drift_stats, pooled_stats, CompensatedSeries,
 };
-use crate::plots::{startup_pair, write_svg, RunCurve};
-use crate::report::{BeforeAfter, CompensateReport, CompensatedRun, Table};
 use crate::stats::SPEC_DPH;
 
 /// Compensates every run and builds the report (series kept for plots).
@@ -62,7 +62,13 @@ pub fn compensate_all(
 
 /// The per-run table printed to the terminal.
 pub fn compensate_table(report: &CompensateReport) -> String {
-    let mut t = Table::new(&[&["run", "ambient"][..], &crate::report::DRIFT_COLUMNS].concat());
+    let mut t = Table::new(
+        &[
+            &["run", "ambient"][..],
+            &crate::output::reports::DRIFT_COLUMNS,
+        ]
+        .concat(),
+    );
     let amb = |a: Option<f64>| a.map_or("-".to_string(), |a| format!("{a:+.0} degC"));
     let name = |f: &str| {
         Path::new(f)
@@ -71,9 +77,15 @@ pub fn compensate_table(report: &CompensateReport) -> String {
     };
     let mut add = |label: String,
                    ambient: String,
-                   b: &crate::report::DriftStats,
-                   a: &crate::report::DriftStats| {
-        t.row(&[&[label, ambient][..], &crate::report::drift_cells(b, a)].concat());
+                   b: &crate::output::reports::DriftStats,
+                   a: &crate::output::reports::DriftStats| {
+        t.row(
+            &[
+                &[label, ambient][..],
+                &crate::output::reports::drift_cells(b, a),
+            ]
+            .concat(),
+        );
     };
     for r in &report.runs {
         add(name(&r.file), amb(r.ambient_c), &r.before, &r.after);

@@ -17,7 +17,7 @@ use fog_core::hal::{GyroSample, TempSample};
 use fog_core::model::format::RbfModel;
 
 use crate::io::runs::Run;
-use crate::report::DriftStats;
+use crate::output::reports::DriftStats;
 use crate::stats;
 
 /// One record's drift series before and after compensation (10 s windows).

@@ -12,19 +12,21 @@ use anyhow::{anyhow, Result};
 use serde::Serialize;
 
 use crate::io::runs::Run;
+use crate::output::plots::{
+    allan_chart, azimuth_scatter_chart, temperature_chart, write_svg, RunCurve,
+};
+use crate::output::reports::{
+    drift_cells, fmt_minutes, progress_bar, CompensateReport, DriftStats, NorthSeekReport, Table,
+    DRIFT_COLUMNS,
+};
 use crate::pipeline::campaign_steps::{
     simulate_checked, split_train_validate, train_default, CampaignRun, CampaignSpec,
 };
 use crate::pipeline::compensate::{compensate_all, compensate_table, write_startup_plots};
 use crate::pipeline::compensation_replay::{pooled_stats, CompensatedSeries};
-use crate::pipeline::northseek::{
+use crate::pipeline::north_seek::own_model::{own_model_from_runs, OwnModel, OwnModelPlan};
+use crate::pipeline::north_seek::{
     build_report, run_monte_carlo, seek_table, MonteCarloConfig, PAPER_SEEK_DURATION_S,
-};
-use crate::pipeline::own_model::{own_model_from_runs, OwnModel, OwnModelPlan};
-use crate::plots::{allan_chart, azimuth_scatter_chart, temperature_chart, write_svg, RunCurve};
-use crate::report::{
-    drift_cells, fmt_minutes, progress_bar, CompensateReport, DriftStats, NorthSeekReport, Table,
-    DRIFT_COLUMNS,
 };
 use crate::sim::{GyroParams, RunSpec, SimGyro, StartState};
 use crate::stats::{allan, SPEC_DPH};

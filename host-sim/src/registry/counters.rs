@@ -8,8 +8,8 @@
 
 use rusqlite::{params, OptionalExtension, TransactionBehavior};
 
-use super::utc::now_utc;
 use super::Registry;
+use crate::io::utc::now_utc;
 
 /// Why a requested counter is refused (the issue is then not recorded).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -12,9 +12,8 @@
 
 mod counters;
 mod export;
-mod field;
+mod field_records;
 mod records;
-pub mod utc;
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -24,6 +23,7 @@ use rusqlite::{Connection, OpenFlags};
 
 pub use counters::CounterRefusal;
 pub use export::{csv_line, write_results_csv, RESULTS_CSV_HEADER};
+pub use field_records::variants_of;
 pub use records::{History, ModelRecord, SeekContext, SeekRecord, UploadRecord};
 
 /// How long a writer waits for another writer's transaction before giving up.

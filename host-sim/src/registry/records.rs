@@ -6,8 +6,8 @@ use fog_core::model::format::RbfModel;
 use fog_core::seeking::quality::Validity;
 use rusqlite::{params, Row};
 
-use super::utc::now_utc;
 use super::Registry;
+use crate::io::utc::now_utc;
 
 /// A model as the registry keeps it (identity, inputs, heading calibration).
 #[derive(Clone, Debug, PartialEq)]
@@ -51,7 +51,7 @@ impl ModelRecord {
             }),
             base_crc32: match model.heading {
                 None => Some(model_crc32),
-                Some(_) => crate::field::model_crc32(&RbfModel {
+                Some(_) => crate::io::model::model_crc32(&RbfModel {
                     heading: None,
                     ..model.clone()
                 })

@@ -8,13 +8,13 @@
 //!       + k_G d(T_h - T_c)/dt                                     gradient rate (~ d2T/dt2)
 //!       + turn-on bias + extra terms + noise
 
-use super::base::BaseMotion;
 use super::error::SimError;
 use super::noise::NoiseGen;
 use super::params::{GyroParams, SensorPlacement};
 use super::spec::{RunSpec, StartState};
 use super::terms::{TermInputs, TermState};
 use super::thermal::ThermalNet;
+use super::tripod::BaseMotion;
 use super::turntable::TableLink;
 use fog_core::consts::EARTH_RATE_DPH;
 use fog_core::hal::{Gyro, GyroSample, TempSample, TemperatureSensor};

@@ -3,7 +3,6 @@
 //! gradient-rate term, turn-on bias, pluggable extra terms), IEEE Std 952 noise, and
 //! an indexing turntable. See `docs/simulator.md` for the calibration to the paper.
 
-pub mod base;
 mod checks;
 pub mod error;
 pub mod gyro;
@@ -14,9 +13,9 @@ pub mod run;
 pub mod spec;
 pub mod terms;
 pub mod thermal;
+pub mod tripod;
 pub mod turntable;
 
-pub use base::{BaseMotion, Disturbance};
 pub use error::SimError;
 pub use gyro::{RawSample, SimGyro};
 pub use instrument::SeekInstrument;
@@ -27,4 +26,5 @@ pub use params::{
 pub use run::{rig, simulate_run, MEAN_WINDOW_S};
 pub use spec::{RunSpec, StartState, DEFAULT_LATITUDE_DEG};
 pub use terms::{AuxSource, AuxTransform, DriftTerm};
+pub use tripod::{BaseMotion, Disturbance};
 pub use turntable::{SimTurntable, TurntableError, TurntableParams};

@@ -35,6 +35,7 @@ mod select;
 mod validate;
 
 pub mod features;
+pub mod field_correction;
 
 pub use candidates::grid_candidates;
 pub use config::{Method, TrainConfig, WidthSearch};

@@ -30,7 +30,7 @@ use fog_core::seeking::tilt::Tilt;
 use fog_sim::io::runs::Run;
 use fog_sim::pipeline::campaign_steps::train_with;
 use fog_sim::pipeline::field_aging::{AgingPlan, AgingSubject, Chamber};
-use fog_sim::pipeline::northseek::{run_seeks_on, Arm, ArmOutcome, MonteCarloConfig};
+use fog_sim::pipeline::north_seek::{run_seeks_on, Arm, ArmOutcome, MonteCarloConfig};
 use fog_sim::sim::SeekInstrument;
 use fog_sim::train::seek_score::{Criterion, DEFAULT_CRITERION_NAME};
 use fog_sim::train::{choose_inputs_default, InputSet, TrainConfig};

@@ -4,7 +4,7 @@
 
 use fog_core::model::format::{FeatureSpec, RbfModel};
 use fog_sim::io::runs::Run;
-use fog_sim::pipeline::own_model::OwnModelPlan;
+use fog_sim::pipeline::north_seek::own_model::OwnModelPlan;
 use fog_sim::train::seek_score::{seek_azimuth_rms_deg, Criterion, SeekGeometry};
 use fog_sim::train::{dataset_from_runs, predict_batch};
 

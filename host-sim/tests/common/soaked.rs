@@ -35,7 +35,7 @@
 
 use fog_core::model::format::FeatureSpec;
 use fog_sim::io::runs::Run;
-use fog_sim::pipeline::own_model::{clock_spec, warmup_time_constant_s};
+use fog_sim::pipeline::north_seek::own_model::{clock_spec, warmup_time_constant_s};
 use fog_sim::train::InputSet;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -2,7 +2,7 @@
 //! sockets (qemu_faults.rs, qemu_seek.rs, ...): start it, wait for its tagged semihosting
 //! console lines (`FOG-...`), talk on its host link; boot it on a flash file in a directory
 //! (qemu_persist.rs, qemu_power_cut.rs). The gyro, table and inclinometer on the other
-//! UARTs are always the bench simulator's (`fog_sim::rig`).
+//! UARTs are always the bench simulator's (`fog_sim::device::rig`).
 #![allow(dead_code)]
 
 use std::io::Write;

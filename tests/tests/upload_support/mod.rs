@@ -11,7 +11,7 @@ use fog_core::model::format::{RbfModel, TrainingMeta, MAX_ENCODED_LEN};
 use fog_firmware::signature::TEST_PUBLIC_KEY;
 use fog_firmware::store::EmulatedModelFlash;
 use fog_firmware::upload::UploadServer;
-use fog_sim::upload::{load_signing_key, sign_upload, test_key_path, UploadClient};
+use fog_sim::device::upload::{load_signing_key, sign_upload, test_key_path, UploadClient};
 
 /// The gyro the host-test device is bound to.
 pub const TEST_GYRO: &str = "FOG-A17";

@@ -23,8 +23,8 @@ use super::lines::{check_size, BoundedLines};
 use super::mapping::{fog_runs_name, Heading, RateColumn, TempColumn, TimeColumn, TimeUnit};
 use super::timestamp::{parse_iso, Instant};
 use super::ImportError;
-use crate::io::reader::excerpt;
-use crate::io::runs::{check_value, FORMAT_LINE};
+use crate::io::run_format::excerpt;
+use crate::io::run_format::{check_value, FORMAT_LINE};
 use crate::io::{OutputGuard, StagedFiles};
 
 /// Rows whose spacings set a file's sample spacing (the default split gap).

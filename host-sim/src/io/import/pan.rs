@@ -16,7 +16,7 @@
 
 use super::lines::{check_size, BoundedLines};
 use super::ImportError;
-use crate::io::reader::excerpt;
+use crate::io::run_format::excerpt;
 use crate::io::runs::Run;
 use std::io::BufRead;
 use std::path::Path;

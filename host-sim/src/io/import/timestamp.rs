@@ -46,7 +46,7 @@ pub fn parse_iso(text: &str) -> Result<Instant, String> {
     let bad = |what: &str| {
         format!(
             "`{}` is not an ISO 8601 time ({what})",
-            crate::io::reader::excerpt(s)
+            crate::io::run_format::excerpt(s)
         )
     };
     if s.len() < 19 || !s.is_char_boundary(10) || !s.is_char_boundary(19) {

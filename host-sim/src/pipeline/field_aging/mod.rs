@@ -41,10 +41,11 @@ use anyhow::{bail, Result};
 use fog_core::model::format::RbfModel;
 use serde::Serialize;
 
-use crate::field::records_file::StoredRecord;
-use crate::field::{model_crc32, refine_with_records};
-use crate::pipeline::northseek::{Arm, ArmOutcome, MonteCarloConfig};
-use crate::report::Table;
+use crate::io::field_records::StoredRecord;
+use crate::io::model::model_crc32;
+use crate::output::reports::Table;
+use crate::pipeline::north_seek::{Arm, ArmOutcome, MonteCarloConfig};
+use crate::train::field_correction::refine_with_records;
 
 pub use laws::AgingLaw;
 pub use paired::{BiasComparison, Comparison, ErrorStats, Verdict};
@@ -90,7 +91,7 @@ impl AgingPlan {
             ambients_c: vec![20.0],
             latitude_deg: crate::sim::DEFAULT_LATITUDE_DEG,
             seed,
-            threads: crate::pipeline::northseek::default_threads(),
+            threads: crate::pipeline::north_seek::default_threads(),
         }
     }
 
@@ -315,7 +316,7 @@ pub fn run_aging_on(
                     .correction
                     .terms
                     .iter()
-                    .map(|t| crate::field::refine::kind_name(t.kind).to_string())
+                    .map(|t| crate::train::field_correction::refine::kind_name(t.kind).to_string())
                     .collect(),
                 correction_coef_dph: refined.correction.coef_dph.clone(),
                 not_fitted: refined

@@ -9,7 +9,7 @@
 
 use serde::Serialize;
 
-use crate::pipeline::northseek::{azimuth_error_deg, seek_stats, ArmOutcome, SeekOutcome};
+use crate::pipeline::north_seek::{azimuth_error_deg, seek_stats, ArmOutcome, SeekOutcome};
 use crate::stats::std_dev;
 
 /// Azimuth error of one arm over the evaluation seeks.
@@ -199,7 +199,7 @@ mod tests {
                     duration_s: 270.0,
                     main_dwell_s: 110.0,
                     field_record: None,
-                    position_spans_s: crate::pipeline::northseek::NO_SPANS,
+                    position_spans_s: crate::pipeline::north_seek::NO_SPANS,
                 })
                 .collect(),
             ..ArmOutcome::default()

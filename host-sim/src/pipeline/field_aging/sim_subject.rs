@@ -8,8 +8,8 @@ use anyhow::Result;
 use super::{AgingLaw, AgingPlan, AgingSubject, Chamber};
 use crate::pipeline::campaign::CampaignSpec;
 use crate::pipeline::campaign_steps::{simulate_checked, train_with_config};
-use crate::pipeline::northseek::{run_seeks, Arm, ArmOutcome, MonteCarloConfig};
-use crate::pipeline::own_model::{train_own_model, OwnModelPlan, CAMPAIGN_RUNS};
+use crate::pipeline::north_seek::own_model::{train_own_model, OwnModelPlan, CAMPAIGN_RUNS};
+use crate::pipeline::north_seek::{run_seeks, Arm, ArmOutcome, MonteCarloConfig};
 use crate::sim::GyroParams;
 use crate::train::seek_score::Criterion;
 
@@ -99,7 +99,7 @@ fn own_model_plan(plan: &AgingPlan) -> Result<OwnModelPlan> {
 fn chamber_at_ambients(
     delivered: &GyroParams,
     plan: &AgingPlan,
-    own: &crate::pipeline::own_model::OwnModel,
+    own: &crate::pipeline::north_seek::own_model::OwnModel,
     own_plan: &OwnModelPlan,
 ) -> Result<crate::train::TrainOutcome> {
     let campaign = simulate_checked(
@@ -115,6 +115,6 @@ fn chamber_at_ambients(
     train_with_config(
         &runs,
         &own.specs,
-        &crate::pipeline::own_model::train_config(own_plan, own.linear_inputs),
+        &crate::pipeline::north_seek::own_model::train_config(own_plan, own.linear_inputs),
     )
 }

@@ -2,7 +2,7 @@
 //! number after power-on (integer ticks), before and after compensation side by side,
 //! each seek number with a mean +/- 1 sigma bar over the cold starts.
 
-use crate::plots::chart::{Chart, Color, Mark, RefLine, Series};
+use crate::output::plots::chart::{Chart, Color, Mark, RefLine, Series};
 
 /// Horizontal offset of the two groups at one seek number.
 const GROUP_OFFSET: f64 = 0.15;

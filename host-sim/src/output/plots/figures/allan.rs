@@ -2,7 +2,7 @@
 //! fitted IEEE 952 lines (each detected term over the taus it is read from, extended
 //! thin over the rest) and their sum.
 
-use crate::plots::chart::{Band, Chart, Color, Mark, Series};
+use crate::output::plots::chart::{Band, Chart, Color, Mark, Series};
 use crate::stats::allan::{Analysis, Kind, Term};
 
 fn term_label(t: &crate::stats::allan::TermEstimate) -> String {

@@ -17,7 +17,7 @@ use fog_core::link::messages::{
 use fog_core::link::upload::{FrameReceiver, MAX_WIRE_FRAME_LEN};
 use fog_core::seeking::field_record::FieldRecord;
 
-use crate::upload::read_polled;
+use crate::device::upload::read_polled;
 
 /// Most records one pull keeps (a 16 KiB ring holds ~450).
 pub const MAX_PULLED_RECORDS: usize = 100_000;

@@ -69,11 +69,11 @@ use anyhow::{anyhow, Result};
 use fog_core::model::format::{FeatureKind, FeatureSpec};
 use fog_core::seeking::northfinder::SeekMode;
 
-use super::campaign::{CampaignRun, CampaignSpec, WarmRestarts};
-use super::campaign_steps::{simulate_checked, train_with_config};
-use super::northseek::{noise_floor_deg, MonteCarloConfig};
-use super::seek_schedule::seek_schedule;
+use super::schedule::seek_schedule;
+use super::{noise_floor_deg, MonteCarloConfig};
 use crate::io::runs::Run;
+use crate::pipeline::campaign::{CampaignRun, CampaignSpec, WarmRestarts};
+use crate::pipeline::campaign_steps::{simulate_checked, train_with_config};
 use crate::sim::GyroParams;
 use crate::train::cold_start::{envelope_for, rises_by_time, significant_rise_c};
 use crate::train::seek_refit::{refit_for_seeks, SeekRefit, SeekSchedule};

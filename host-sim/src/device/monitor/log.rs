@@ -96,7 +96,7 @@ fn check_header(path: &Path, f: &File) -> Result<()> {
     bail!(
         "--csv {}: exists and is not a fogsim results log (first line {:?}); refusing to append to it",
         path.display(),
-        crate::io::reader::excerpt(first.trim_end())
+        crate::io::run_format::excerpt(first.trim_end())
     )
 }
 

@@ -8,7 +8,7 @@
 
 use serde::Serialize;
 
-use crate::report::NorthSeekReport;
+use crate::output::reports::NorthSeekReport;
 
 /// Compensated std over all seeks, x the floor.
 pub const ALL_SEEKS_OVER_FLOOR: f64 = 1.1;

@@ -419,7 +419,7 @@ pub fn write_svg(path: &Path, chart: &Chart) -> Result<(), PlotError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::plots::chart::Series;
+    use crate::output::plots::chart::Series;
 
     #[test]
     fn renders_linear_and_log_charts() {

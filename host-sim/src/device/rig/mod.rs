@@ -27,8 +27,8 @@ use fog_core::seeking::tilt::Tilt;
 use fog_core::sensor_link::gyro_frame::GyroFrame;
 use fog_core::sensor_link::tilt_frame::{TiltFrame, TILT_FRAME_RATE_HZ};
 
+use crate::device::upload::Link;
 use crate::sim::{rig, BaseMotion, GyroParams, RunSpec, SimGyro, StartState, TurntableParams};
-use crate::upload::Link;
 
 pub use table::TableServer;
 

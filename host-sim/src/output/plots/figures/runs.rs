@@ -3,7 +3,7 @@
 //! ambient, an envelope (min..max) per ambient with its median; before/after pairs share
 //! one y axis so they can be compared by eye.
 
-use crate::plots::chart::{shared_y_range, Band, Chart, Color, Mark, RefLine, Series};
+use crate::output::plots::chart::{shared_y_range, Band, Chart, Color, Mark, RefLine, Series};
 
 /// Runs per ambient above which the ambient is drawn as an envelope instead of lines.
 pub const ENVELOPE_ABOVE_RUNS: usize = 4;

@@ -13,8 +13,8 @@ use fog_core::sensor_link::table_line::{
     deg_to_mdeg, CommandError, TableCommand, TableMotion, TableReply, TABLE_LINE_MAX,
 };
 
+use crate::device::upload::read_polled;
 use crate::sim::SimTurntable;
-use crate::upload::read_polled;
 
 /// Longest command line kept, bytes (`MOV 359.999` is 11).
 const MAX_LINE: usize = TABLE_LINE_MAX;

@@ -24,8 +24,8 @@ use fog_core::link::messages::{
 use fog_core::link::upload::{FrameReceiver, MAX_WIRE_FRAME_LEN, STATUS_REQUEST_PADDING};
 use fog_core::seeking::quality::{QualityError, SeekState};
 
+use crate::device::upload::read_polled;
 use crate::registry::{SeekContext, SeekRecord};
-use crate::upload::read_polled;
 
 /// Limits and commands of one monitoring session.
 #[derive(Clone, Debug)]

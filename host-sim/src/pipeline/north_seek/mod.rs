@@ -18,6 +18,10 @@
 //! azimuth (`fog_core::seeking::heading_cal`), applied in the compensated arm, and a fourth arm runs
 //! without it (`heading_uncalibrated`).
 
+pub mod own_model;
+pub mod schedule;
+pub mod targets;
+
 use anyhow::{anyhow, bail, Context, Result};
 use fog_core::compensation::compensator::{Compensator, CompensatorConfig};
 use fog_core::consts::earth_rate_horizontal_dph;
@@ -35,7 +39,7 @@ use fog_core::seeking::quality::{
 use fog_core::seeking::tilt::Tilt;
 use serde::Serialize;
 
-use crate::report::{NorthSeekReport, SeekReliability, SeekStats, Table};
+use crate::output::reports::{NorthSeekReport, SeekReliability, SeekStats, Table};
 use crate::sim::{
     rig, BaseMotion, GyroParams, RunSpec, SeekInstrument, StartState, TurntableParams,
 };
@@ -471,7 +475,7 @@ impl FieldRecorder {
     fn new(model: Option<&RbfModel>) -> Result<Self> {
         Ok(Self {
             seek_temp: SeekTempState::new(),
-            model_crc32: model.map(crate::field::model_crc32).transpose()?,
+            model_crc32: model.map(crate::io::model::model_crc32).transpose()?,
         })
     }
 
@@ -1107,7 +1111,7 @@ pub fn seek_table(r: &NorthSeekReport) -> String {
         r.main_dwell_s,
         r.noise_floor_deg,
         r.compensated.std_deg / r.noise_floor_deg,
-        super::seek_targets::seek_targets_line(r),
+        targets::seek_targets_line(r),
         r.seek_duration_s,
         r.max_seek_duration_s,
         r.paper_seek_duration_s,

@@ -1,11 +1,22 @@
 //! Field records in the registry (`fogsim field pull`): one row per (gyro, sequence); a
 //! record pulled again is ignored (the device's ring and the registry agree on it).
 
-use anyhow::Result;
+use std::path::Path;
 
-use super::utc::now_utc;
+use anyhow::Result;
+use fog_core::model::format::RbfModel;
+
 use super::Registry;
-use crate::field::records_file::StoredRecord;
+use crate::io::field_records::StoredRecord;
+use crate::io::model::model_crc32;
+use crate::io::utc::now_utc;
+
+/// The CRC-32s of the models the calibration registry at `registry` knows to derive from
+/// `model` (it with a heading calibration attached: `heading-cal`, then `upload`). Their
+/// records measured the same residual bias (`Registry::models_derived_from` says why).
+pub fn variants_of(model: &RbfModel, registry: &Path) -> Result<Vec<u32>> {
+    Registry::open(registry)?.models_derived_from(model_crc32(model)?)
+}
 
 impl Registry {
     /// Stores `records` in one transaction; returns how many were new.
@@ -64,7 +75,7 @@ impl Registry {
 
 #[cfg(test)]
 mod tests {
-    use crate::field::records_file::StoredRecord;
+    use crate::io::field_records::StoredRecord;
     use fog_core::seeking::field_record::FieldRecord;
 
     #[test]

@@ -1,25 +1,25 @@
-//! Field records on the host (issue 20 item 4): what the device learnt from its own seeks.
+//! The field correction of a chamber model (`fogsim train --field`): what the device
+//! learnt from its own seeks, folded back into its model.
 //!
-//! - `pull`: the host-link client that asks the device for its field records
-//!   (`GetFieldRecords`, a bounded batch per reply) until it has them all;
-//! - `records_file`: the records as `field_records.csv` + `field_records.json` in a
-//!   directory (written atomically, read back size-bounded and checked whole);
-//! - `refine`: the field correction of a chamber model: a weighted ridge fit of the
-//!   residual biases on the temperature state, its weight chosen by held-out field seeks,
-//!   folded into the model's bias and linear terms.
+//! - `refine`: a weighted ridge fit of the field records' residual biases on the
+//!   temperature state, its weight chosen by held-out field seeks, folded into the model's
+//!   bias and linear terms;
+//! - this module: which records belong to the model (its CRC-32, or a heading-calibrated
+//!   variant the registry knows), the fit on them, and the lines `train` prints.
+//!
+//! The records' file format is `io::field_records`; the pull from a device is
+//! `device::field_pull`; their table in the registry is `registry::field_records`.
 
-pub mod pull;
-pub mod records_file;
 pub mod refine;
 
 use std::path::Path;
 
 use anyhow::{bail, Result};
-use fog_core::link::upload::crc32;
-use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
+use fog_core::model::format::RbfModel;
 
+use crate::io::field_records::{self, StoredRecord};
+use crate::io::model::model_crc32;
 use crate::train::seek_score::SeekGeometry;
-use records_file::StoredRecord;
 use refine::{FieldObservation, WeightChoice};
 
 /// What `train --field` did with the field records.
@@ -36,25 +36,8 @@ pub struct FieldRefinement {
     pub correction: refine::Correction,
 }
 
-/// CRC-32 of a model's encoding (what the device reports as its model's CRC).
-pub fn model_crc32(model: &RbfModel) -> Result<u32> {
-    let mut buf = [0u8; MAX_ENCODED_LEN];
-    let n = model
-        .encode(&mut buf)
-        .map_err(|e| anyhow::anyhow!("encoding the model: {e}"))?;
-    Ok(crc32(&buf[..n]))
-}
-
-/// The CRC-32s of the models the calibration registry at `registry` knows to derive from
-/// `model` (it with a heading calibration attached: `heading-cal`, then `upload`). Their
-/// records measured the same residual bias (`Registry::models_derived_from` says why).
-pub fn registry_variants(model: &RbfModel, registry: &Path) -> Result<Vec<u32>> {
-    let reg = crate::registry::Registry::open(registry)?;
-    reg.models_derived_from(model_crc32(model)?)
-}
-
 /// Refines `model` with the records in `dir` measured under it or under one of
-/// `variants` (heading-calibrated variants of it, `registry_variants`).
+/// `variants` (heading-calibrated variants of it, `registry::variants_of`).
 pub fn refine_with_dir(
     model: &RbfModel,
     dir: &Path,
@@ -62,12 +45,12 @@ pub fn refine_with_dir(
     weight: Option<f64>,
     seek: SeekGeometry,
 ) -> Result<FieldRefinement> {
-    let records = records_file::read_dir_records(dir)?;
+    let records = field_records::read_dir_records(dir)?;
     if records.is_empty() {
         bail!(
             "--field {}: no {} there (run `fogsim field pull` first)",
             dir.display(),
-            records_file::JSON_NAME
+            field_records::JSON_NAME
         );
     }
     refine_with_records(model, &records, variants, weight, seek)
