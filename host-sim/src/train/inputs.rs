@@ -32,11 +32,11 @@ use fog_core::model::format::{FeatureKind, FeatureSpec};
 use serde::Serialize;
 
 use super::error::{Result, TrainError};
-use super::features::{dataset_from_runs, default_specs};
 use super::seek_score::{seek_azimuth_per_run, Criterion};
-use super::validate::cross_validate;
 use super::{Dataset, TrainConfig};
 use crate::io::runs::Run;
+use crate::train::data::features::{dataset_from_runs, default_specs};
+use crate::train::fit::validate::cross_validate;
 
 /// A set of model inputs `fogsim train --inputs` can name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

@@ -13,51 +13,36 @@
 //! [`dataset_from_runs`], [`TrainConfig`], [`train_model`], [`predict_batch`],
 //! [`cross_validate`].
 
-mod assemble;
-mod candidates;
 pub mod cold_start;
-mod config;
-mod dataset;
-pub mod declared_range;
-mod design;
+pub mod data;
 mod error;
-mod fit;
-mod gram;
+pub mod field_correction;
+pub mod fit;
 mod inputs;
-mod normalize;
-mod ols;
-mod orr;
-mod path;
-mod predict;
 pub mod seek_refit;
 pub mod seek_score;
-mod select;
-mod validate;
 
-pub mod features;
-pub mod field_correction;
-
-pub use candidates::grid_candidates;
-pub use config::{Method, TrainConfig, WidthSearch};
-pub use dataset::Dataset;
-pub use design::GaussianDesign;
-pub use error::{Result, TrainError};
-pub use features::{
+pub use data::dataset::Dataset;
+pub use data::features::{
     dataset_from_runs, dataset_from_runs_with_aux, default_specs, feature_name,
     feature_name_with_aux,
 };
-pub use fit::{fit_path, fit_shape, fit_width, Fit, PathFit, Shape};
-pub use gram::gram_bytes;
+pub use data::normalize::Normalizer;
+pub use error::{Result, TrainError};
+pub use fit::candidates::grid_candidates;
+pub use fit::config::{Method, TrainConfig, WidthSearch};
+pub use fit::design::GaussianDesign;
+pub use fit::gram::gram_bytes;
+pub use fit::path::StopReason;
+pub use fit::predict::predict_batch;
+pub use fit::shape::{fit_path, fit_shape, fit_width, Fit, PathFit, Shape};
+pub use fit::validate::{
+    cross_validate, fold_of_rows, pooled_std, rms, std_within_groups, CvReport, WidthScore,
+};
 pub use inputs::{
     choose_in_order_with, choose_inputs, choose_inputs_default, criterion_for, EstimatorChoice,
     GroupedCvRms, GroupedCvSeek, InputChoice, InputCriterion, InputSelection, InputSet,
     InputSetScore, SetScore, SIGNIFICANT_GAIN_SE,
-};
-pub use normalize::Normalizer;
-pub use path::StopReason;
-pub use predict::predict_batch;
-pub use validate::{
-    cross_validate, fold_of_rows, pooled_std, rms, std_within_groups, CvReport, WidthScore,
 };
 
 use fog_core::model::format::RbfModel;
@@ -111,7 +96,7 @@ pub struct TrainReport {
     pub gram_bytes: usize,
     /// How the model's declared input range (`input_min`/`input_max`, what the device
     /// checks each window against) was set from the training runs.
-    pub declared_range: Vec<declared_range::InputRange>,
+    pub declared_range: Vec<data::declared_range::InputRange>,
     /// Wall times, left out of the JSON (see `TrainTimings`).
     #[serde(skip)]
     pub timings: TrainTimings,
@@ -208,10 +193,10 @@ pub fn train_model(ds: &Dataset, cfg: &TrainConfig) -> Result<TrainOutcome> {
         });
     }
     let started = Instant::now();
-    let (cv, path) = validate::cross_validate_and_fit(ds, cfg, cfg.folds)?;
+    let (cv, path) = fit::validate::cross_validate_and_fit(ds, cfg, cfg.folds)?;
     let validation_s = started.elapsed().as_secs_f64();
     let started = Instant::now();
-    let mut fit = fit::fit_from_path(
+    let mut fit = fit::shape::fit_from_path(
         &path,
         ds,
         cfg,
@@ -223,8 +208,8 @@ pub fn train_model(ds: &Dataset, cfg: &TrainConfig) -> Result<TrainOutcome> {
     )?;
     let final_fit_s = started.elapsed().as_secs_f64();
     fit.model.meta.heldout_rms_dph = cv.best.heldout_rms_dph as f32;
-    let ranges = declared_range::declared_ranges(ds);
-    declared_range::apply(&mut fit.model, &ranges);
+    let ranges = data::declared_range::declared_ranges(ds);
+    data::declared_range::apply(&mut fit.model, &ranges);
     let pred = predict_batch(&fit.model, ds.rows())?;
     let resid: Vec<f64> = ds
         .targets_dph

@@ -24,9 +24,9 @@
 //! score exceeds the lowest by at most one standard error of the paired difference wins
 //! (the same held-out pairs score every W); W = 0 is the model as trained, kept unchanged.
 
-use super::dataset::Dataset;
 use super::error::{Result, TrainError};
 use super::seek_score::SeekGeometry;
+use crate::train::data::dataset::Dataset;
 use fog_core::model::format::RbfModel;
 use fog_core::model::format::MAX_INPUTS;
 use fog_core::model::rbf::predict_f32;

@@ -11,7 +11,7 @@
 //! with its projection on the basis removed) are updated as p_k -= a_k z, s_k -= a_k^2.
 //! A step costs O(K m), no pass over the data rows.
 
-use super::gram::GramView;
+use crate::train::fit::gram::GramView;
 
 /// Orthogonal forward-selection state over one Gram matrix.
 pub struct Selection<'a> {
@@ -204,10 +204,10 @@ mod tests {
     //! re-orthogonalisation on the n-row columns of the f32 design, every candidate
     //! re-projected at each step): same centres in the same order, same coefficients.
 
-    use super::super::design::GaussianDesign;
-    use super::super::gram::{FoldGrams, ForcedColumn, Layout};
-    use super::super::ols::select_ols;
     use super::*;
+    use crate::train::fit::design::GaussianDesign;
+    use crate::train::fit::gram::{FoldGrams, ForcedColumn, Layout};
+    use crate::train::fit::ols::select_ols;
 
     /// The former path: explicit columns, CGS2 basis, pick max (u_k'y)^2 / u_k'u_k among
     /// candidates with u_k'u_k > tol q_k'q_k, weights from R theta = z.

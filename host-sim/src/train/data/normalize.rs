@@ -3,8 +3,8 @@
 //! direction. The offsets and scales are rounded to f32 exactly as the model stores
 //! them, so the trainer sees the same normalised inputs as the device.
 
-use super::dataset::Dataset;
-use super::error::{Result, TrainError};
+use crate::train::data::dataset::Dataset;
+use crate::train::error::{Result, TrainError};
 
 /// Per-input offset and scale, plus the raw range seen in training.
 #[derive(Clone, Debug, PartialEq)]

@@ -279,7 +279,7 @@ impl<'a> GaussianRow<'a> {
         }
         let k = d2.len();
         for (o, &d) in out[nf..nf + k].iter_mut().zip(d2.iter()) {
-            *o = f64::from(super::design::gauss_exp(d * self.neg_inv_2s2));
+            *o = f64::from(crate::train::fit::design::gauss_exp(d * self.neg_inv_2s2));
         }
         out[nf + k] = l.targets[i];
     }

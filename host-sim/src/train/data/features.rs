@@ -2,9 +2,9 @@
 //! by fog-core's own feature code (so trained and deployed inputs are identical) and the
 //! target drift = rate_dph - earth_dph.
 
-use super::dataset::Dataset;
-use super::error::{Result, TrainError};
 use crate::io::runs::Run;
+use crate::train::data::dataset::Dataset;
+use crate::train::error::{Result, TrainError};
 use fog_core::compensation::features::{features_for_series, FeatureVector};
 use fog_core::compensation::label::feature_label;
 use fog_core::model::format::{FeatureKind, FeatureSpec, MAX_INPUTS};

@@ -8,8 +8,8 @@
 //! Selection stops once GCV has not improved for `GCV_PATIENCE` steps; the prefix with
 //! the lowest GCV is kept.
 
-use super::path::{PathSummary, StopReason};
-use super::select::{Added, Selection};
+use crate::train::fit::path::{PathSummary, StopReason};
+use crate::train::fit::select::{Added, Selection};
 
 /// Steps without a GCV improvement before selection stops.
 pub const GCV_PATIENCE: usize = 5;

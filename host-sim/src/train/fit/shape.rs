@@ -5,19 +5,19 @@
 //! validation can score each number of centres from one run. `WidthDesign` and
 //! `select_path` are shared with validation (`validate`), which runs them per fold.
 
-use super::assemble::{assemble, ForcedTerm, ModelParts};
-use super::candidates::grid_candidates;
-use super::config::{Method, TrainConfig};
-use super::dataset::Dataset;
-use super::design::GaussianDesign;
-use super::error::Result;
-use super::gram::{FoldGrams, ForcedColumn, GramView, Layout};
-use super::normalize::Normalizer;
-use super::ols::select_ols;
-use super::orr::select_orr;
-use super::path::PathSummary;
-use super::select::{Added, Selection};
 use crate::fanout::thread_count;
+use crate::train::data::dataset::Dataset;
+use crate::train::data::normalize::Normalizer;
+use crate::train::error::Result;
+use crate::train::fit::assemble::{assemble, ForcedTerm, ModelParts};
+use crate::train::fit::candidates::grid_candidates;
+use crate::train::fit::config::{Method, TrainConfig};
+use crate::train::fit::design::GaussianDesign;
+use crate::train::fit::gram::{FoldGrams, ForcedColumn, GramView, Layout};
+use crate::train::fit::ols::select_ols;
+use crate::train::fit::orr::select_orr;
+use crate::train::fit::path::PathSummary;
+use crate::train::fit::select::{Added, Selection};
 use fog_core::model::format::RbfModel;
 
 /// A model trained at one width, with what its selection did.
@@ -269,7 +269,7 @@ impl PathFit {
     /// The model with the first `m` centres (m <= the path's length; must have weights).
     pub fn model(&self, ds: &Dataset, cfg: &TrainConfig, width: f64, m: usize) -> Result<RbfModel> {
         let theta = self.thetas.get(m).and_then(Option::as_ref).ok_or_else(|| {
-            super::error::TrainError::Model {
+            crate::train::error::TrainError::Model {
                 why: format!("no weights for a prefix of {m} centres"),
             }
         })?;

@@ -2,7 +2,7 @@
 //! drift (deg/h) and the id of the run (group) it came from, so validation can hold
 //! out whole runs. Validation happens here once, so the fitting code can trust it.
 
-use super::error::{Result, TrainError};
+use crate::train::error::{Result, TrainError};
 use fog_core::model::format::{FeatureSpec, MAX_INPUTS};
 
 /// Rows of model inputs with their targets and run ids.

@@ -1,7 +1,7 @@
 //! Batch prediction with fog-core's deployed RBF maths, so every rms the trainer reports
 //! is the rms the device would achieve on the same inputs.
 
-use super::error::{Result, TrainError};
+use crate::train::error::{Result, TrainError};
 use fog_core::model::format::RbfModel;
 
 /// Predicted drift (deg/h) for each row of raw inputs (in `model.inputs` order).

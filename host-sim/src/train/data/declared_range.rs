@@ -19,8 +19,8 @@
 //! the report). Far-off inputs (another ambient, a faster warm-up than any unit of the
 //! population) are still flagged.
 
-use super::dataset::Dataset;
 use crate::stats::student_t::upper_quantile;
+use crate::train::data::dataset::Dataset;
 use fog_core::model::format::RbfModel;
 use serde::Serialize;
 

@@ -1,6 +1,6 @@
 //! Training options (`TrainConfig`) with the defaults `fogsim train` uses, and their checks.
 
-use super::error::{Result, TrainError};
+use crate::train::error::{Result, TrainError};
 use fog_core::model::format::MAX_CENTERS;
 use serde::Serialize;
 
@@ -68,7 +68,7 @@ pub struct TrainConfig {
     /// Worker threads for the design matrix (None: all cores).
     pub threads: Option<usize>,
     /// Which held-out score chooses the width and polynomial degree.
-    pub criterion: super::seek_score::Criterion,
+    pub criterion: crate::train::seek_score::Criterion,
 }
 
 impl Default for TrainConfig {
@@ -90,7 +90,7 @@ impl Default for TrainConfig {
             collinearity_tol: 1e-4,
             gyro_id: String::from("sim"),
             threads: None,
-            criterion: super::seek_score::Criterion::training_default(),
+            criterion: crate::train::seek_score::Criterion::training_default(),
         }
     }
 }

@@ -3,8 +3,8 @@
 //! training metadata; then lets fog-core validate it, so the trainer can only emit models
 //! the device will accept.
 
-use super::error::{Result, TrainError};
-use super::normalize::Normalizer;
+use crate::train::data::normalize::Normalizer;
+use crate::train::error::{Result, TrainError};
 use fog_core::model::format::{FeatureSpec, RbfModel, TrainingMeta, MAX_INPUTS};
 
 /// What a forced (always-present) regressor is.

@@ -9,16 +9,20 @@
 //! (`WidthSearch::Climb`) rather than scored whole. `cross_validate` is public so `diagnose` can score
 //! candidate inputs the same way.
 
-use super::assemble::ForcedTerm;
-use super::config::{Method, TrainConfig, WidthSearch};
-use super::dataset::Dataset;
-use super::error::{Result, TrainError};
-use super::fit::{path_on_gram, select_path, PathFit, SelectedPath, Shape, WidthDesign};
-use super::gram::FoldGrams;
-use super::normalize::Normalizer;
-use super::seek_score::{seek_azimuth_per_run, seek_azimuth_rms_deg, Criterion, SeekGeometry};
 use crate::fanout::{map_in_order, thread_count};
 pub use crate::stats::rms;
+use crate::train::data::dataset::Dataset;
+use crate::train::data::normalize::Normalizer;
+use crate::train::error::{Result, TrainError};
+use crate::train::fit::assemble::ForcedTerm;
+use crate::train::fit::config::{Method, TrainConfig, WidthSearch};
+use crate::train::fit::gram::FoldGrams;
+use crate::train::fit::shape::{
+    path_on_gram, select_path, PathFit, SelectedPath, Shape, WidthDesign,
+};
+use crate::train::seek_score::{
+    seek_azimuth_per_run, seek_azimuth_rms_deg, Criterion, SeekGeometry,
+};
 use fog_core::model::format::WIDTH_RANGE;
 use serde::Serialize;
 use std::time::Instant;
@@ -88,7 +92,7 @@ pub fn cross_validate(ds: &Dataset, cfg: &TrainConfig, folds: usize) -> Result<C
 /// Cross-validation (as `cross_validate`) followed by the selection path on all rows at
 /// the best width and degree, from the Gram validation already accumulated (the folds'
 /// Grams summed): the final fit costs no pass over the rows.
-pub(super) fn cross_validate_and_fit(
+pub(crate) fn cross_validate_and_fit(
     ds: &Dataset,
     cfg: &TrainConfig,
     folds: usize,

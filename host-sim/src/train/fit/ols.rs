@@ -4,8 +4,8 @@
 //! training rms <= `target_dph` (the paper's criterion: the gyro's bias spec), or
 //! 1 - sum(err) < rho (rho > 0; relative to y'y, which a static bias can dominate).
 
-use super::path::{PathSummary, StopReason};
-use super::select::{Added, Selection};
+use crate::train::fit::path::{PathSummary, StopReason};
+use crate::train::fit::select::{Added, Selection};
 
 /// Runs OLS selection on a state that already holds the forced terms.
 pub fn select_ols(
