@@ -69,8 +69,9 @@ use anyhow::{anyhow, Result};
 use fog_core::model::format::{FeatureKind, FeatureSpec};
 use fog_core::seeking::northfinder::SeekMode;
 
+use super::config::MonteCarloConfig;
 use super::schedule::seek_schedule;
-use super::{noise_floor_deg, MonteCarloConfig};
+use super::summary::noise_floor_deg;
 use crate::io::runs::Run;
 use crate::pipeline::campaign::{CampaignRun, CampaignSpec, WarmRestarts};
 use crate::pipeline::campaign_steps::{simulate_checked, train_with_config};

@@ -17,7 +17,8 @@ use anyhow::{bail, Result};
 use fog_core::model::format::RbfModel;
 use fog_core::seeking::northfinder::SeekMode;
 
-use crate::pipeline::north_seek::{run_seeks, Arm, MonteCarloConfig, PositionSpans};
+use super::config::MonteCarloConfig;
+use super::seeks::{run_seeks, Arm, PositionSpans};
 use crate::sim::GyroParams;
 use crate::train::seek_refit::{OppositePair, SeekSchedule};
 
