@@ -2,7 +2,7 @@
 //! its own segment): the ARW and bias instability come back near the simulator's, the
 //! JSON and the plot are written; bad input gets one error line and no output.
 
-mod app_support;
+use crate::app_support;
 
 use app_support::{fogsim, scratch_dir, stderr};
 use fog_sim::sim::{GyroParams, RunSpec, SimGyro, StartState};

@@ -1,7 +1,7 @@
 //! Bad input to `compensate`, `north-seek`, `reproduce`: a one-line error naming the file,
 //! line or option, a non-zero exit, no panic and no output file.
 
-mod app_support;
+use crate::app_support;
 
 use std::path::Path;
 

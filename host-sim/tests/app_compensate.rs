@@ -2,7 +2,7 @@
 //! simulated cold starts lowers the drift std, the largest deviation and the time to spec,
 //! and the plots are written.
 
-mod app_support;
+use crate::app_support;
 
 use app_support::{campaign_and_model, fogsim, scratch_dir, stderr};
 use serde_json::Value;

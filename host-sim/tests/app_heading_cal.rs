@@ -2,10 +2,9 @@
 //! coefficients and from a real `diagnose` report (the independent generator's campaign
 //! with a heading bias between runs), bad input refused whole, and no input overwritten.
 
-mod app_support;
+use crate::app_support;
 
-#[path = "common/independent.rs"]
-mod independent;
+use crate::common::independent;
 
 use app_support::{fogsim, scratch_dir, stderr};
 use fog_core::model::format::RbfModel;

@@ -3,7 +3,7 @@
 //! clearly better than the uncompensated one. Also: the Monte Carlo is deterministic and
 //! does not depend on the thread count.
 
-mod app_support;
+use crate::app_support;
 
 use app_support::{fogsim, scratch_dir, stderr};
 use serde_json::Value;

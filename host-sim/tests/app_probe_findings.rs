@@ -3,7 +3,7 @@
 //! that was ignored (exit 0) or reported under another name, and clap's errors spread
 //! over several lines. Each must now fail with one line naming the flag.
 
-mod app_support;
+use crate::app_support;
 
 use app_support::{fogsim, scratch_dir, stderr};
 

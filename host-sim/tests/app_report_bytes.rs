@@ -5,7 +5,7 @@
 //! runs that fan out use a different thread count the second time, so a result that
 //! depended on scheduling would show too. Small campaign, a few seconds in all.
 
-mod app_support;
+use crate::app_support;
 
 use std::path::Path;
 

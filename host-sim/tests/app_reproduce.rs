@@ -2,7 +2,7 @@
 //! qualification campaign of six runs per temperature): the report holds every section
 //! for the three models, per-ambient held-out figures, the paper-vs-us table and the plots.
 
-mod app_support;
+use crate::app_support;
 
 use app_support::{fogsim, scratch_dir, stderr};
 use serde_json::Value;

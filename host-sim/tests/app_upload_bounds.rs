@@ -3,7 +3,7 @@
 //! is refused by its size before it is read, with a short message, before any connection
 //! (the port named is closed: reaching it would be another error).
 
-mod app_support;
+use crate::app_support;
 
 use app_support::{fogsim, scratch_dir, stderr};
 

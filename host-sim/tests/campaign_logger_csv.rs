@@ -4,7 +4,7 @@
 //! its units gives back every run of the campaign, row for row, within the logged
 //! digits; and a log path that cannot be a file is refused by its flag, nothing written.
 
-mod app_support;
+use crate::app_support;
 
 use app_support::{fogsim, scratch_dir, stderr};
 use fog_sim::io::runs::read_runs;

@@ -1,8 +1,7 @@
 //! `diagnose` on bad input: clear errors or stated exclusions, never a panic.
 
 #[allow(dead_code)]
-#[path = "common/planted.rs"]
-mod planted;
+use crate::common::planted;
 use fog_sim::diagnose::selection::power::PowerCheck;
 use fog_sim::diagnose::{diagnose, DiagnoseError};
 use fog_sim::io::runs::Run;

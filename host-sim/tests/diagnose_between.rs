@@ -5,13 +5,11 @@
 //! against 0.005 deg/h turn-on repeatability) and at 2 repeatability sigmas, rank first at
 //! 1 repeatability sigma (the documented power limit), and nothing be named in the nulls.
 
-#[path = "common/independent.rs"]
-mod independent;
+use crate::common::independent;
 use fog_sim::diagnose::diagnose;
 use independent::{campaign, Hidden};
 
-#[path = "common/seeds.rs"]
-mod seeds;
+use crate::common::seeds;
 use seeds::seeds;
 
 /// `named_required`: the family-wise decision must name it; otherwise it must rank first

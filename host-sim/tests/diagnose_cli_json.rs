@@ -2,8 +2,7 @@
 //! schema, plots are written, and the cross-check with the OLS trainer is included.
 
 #[allow(dead_code)]
-#[path = "common/planted.rs"]
-mod planted;
+use crate::common::planted;
 use fog_sim::cmd::diagnose::{run, Args};
 use planted::{campaign, Effect, Shape};
 

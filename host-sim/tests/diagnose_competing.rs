@@ -10,15 +10,12 @@
 //! is never the rejected one. Per seed: what is named (gain, p) and every competitor
 //! with its verdict. Seeds: `DIAG_SEEDS` (default 11, 22, 33).
 
-#[path = "common/independent.rs"]
-#[allow(dead_code)] // the heading variants are used by diagnose_between
-mod independent;
+use crate::common::independent;
 use fog_sim::diagnose::diagnose;
 use independent::{campaign, Hidden, PowerOnLaw};
 use rayon::prelude::*;
 
-#[path = "common/seeds.rs"]
-mod seeds;
+use crate::common::seeds;
 
 const DECAY: &str = "t_s:decay";
 const ACCEL: &str = "temp_c:accel";

@@ -6,15 +6,12 @@
 //! chosen derivative windows and, for the named cause, the device's causal estimate are
 //! printed per seed. Seeds: `DIAG_SEEDS` (default 11, 22, 33).
 
-#[path = "common/independent.rs"]
-#[allow(dead_code)] // the heading variants are used by diagnose_between
-mod independent;
+use crate::common::independent;
 use fog_sim::diagnose::diagnose;
 use independent::{campaign, Hidden};
 use rayon::prelude::*;
 
-#[path = "common/seeds.rs"]
-mod seeds;
+use crate::common::seeds;
 
 /// One line per seed: (right?, what happened).
 fn per_seed(hidden: Hidden) -> Vec<(bool, String)> {

@@ -16,7 +16,7 @@
 //! what is measured. Measured figures and the 316,800-row campaign (226 B/row whole,
 //! 167 B/row slope from 63,360 rows): docs/diagnose.md, "Memory".
 
-mod app_support;
+use crate::app_support;
 
 use std::path::Path;
 use std::process::Command;

@@ -7,12 +7,9 @@
 //! rest is printed. Full table: `DIAG_SEEDS=11,22,33,44,55,66 cargo test -p fog-sim --test
 //! diagnose_novel -- --nocapture --test-threads=2`.
 
-#[path = "common/novel.rs"]
-mod novel;
-#[path = "common/peer.rs"]
-mod peer;
-#[path = "common/seeds.rs"]
-mod seeds;
+use crate::common::novel;
+use crate::common::peer;
+use crate::common::seeds;
 
 use novel::{campaign, Family, Shape, Variant, VARIANTS};
 use serde_json::Value;

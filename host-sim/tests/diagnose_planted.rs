@@ -2,13 +2,11 @@
 //! name the right column and transform with positive held-out gain, and name nothing
 //! when nothing is planted, over several seeds (cases run in parallel threads).
 
-#[path = "common/planted.rs"]
-mod planted;
+use crate::common::planted;
 use fog_sim::diagnose::diagnose;
 use planted::{campaign, Effect, Shape};
 
-#[path = "common/seeds.rs"]
-mod seeds;
+use crate::common::seeds;
 use seeds::seeds;
 
 fn check(effect: Effect) {

@@ -4,9 +4,7 @@
 //! gives back the ARW, the thermometer's quantum is found, the warm-up is not called a
 //! step; the twin campaign with one planted 0.1 deg/h jump has exactly that step.
 
-#[path = "common/independent.rs"]
-#[allow(dead_code)] // the heading variant is used by diagnose_between
-mod independent;
+use crate::common::independent;
 use fog_sim::diagnose::input::rawrows::read_runs;
 use fog_sim::io::runs::write_run;
 use independent::{campaign, Hidden, NOISE_10S_DPH};

@@ -9,12 +9,11 @@
 //! ambient set is in docs/diagnose.md, "honest sigmas": about 1 ratio in 20 falls outside,
 //! so extra seeds will show an occasional FAIL line by design).
 
-mod app_support;
+use crate::app_support;
 
 use std::path::Path;
 
-#[path = "common/seeds.rs"]
-mod seeds;
+use crate::common::seeds;
 
 fn fogsim(args: &[&str]) {
     app_support::fogsim_ok(args);

@@ -6,8 +6,7 @@
 //! different physical laws (`common/single_record.rs`); the unbuffered rule (before
 //! issue 9 item 5) runs next to the buffered one for comparison.
 
-#[path = "common/single_record.rs"]
-mod single_record;
+use crate::common::single_record;
 use fog_sim::diagnose::diagnose_with;
 use fog_sim::diagnose::validation::buffer::BufferRule;
 use single_record::{record, Law};

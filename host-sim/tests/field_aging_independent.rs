@@ -12,8 +12,7 @@
 //! `FOG_FIELD_AGING_FULL=1` (`FOG_FIELD_AGING_SEED=N`, default 1): the whole table (the three laws, 5 / 20 / 50 field seeks, 30
 //! evaluation starts x 6 seeks), printed (`--nocapture`) for docs/field.md.
 
-#[path = "common/field_gyro.rs"]
-mod field_gyro;
+use crate::common::field_gyro;
 
 use field_gyro::{IndependentAging, IndependentLaw};
 use fog_sim::pipeline::field_aging::{aging_table, run_aging_on, AgingPlan, AgingReport, Verdict};

@@ -3,7 +3,7 @@
 //! the command line, read back as fog-runs and compared with the values it was made from.
 //! Also: splitting one long log into power-on runs, and bad input refused whole.
 
-mod app_support;
+use crate::app_support;
 
 use app_support::{fogsim, scratch_dir, stderr};
 use fog_sim::io::runs::{read_run, read_runs};

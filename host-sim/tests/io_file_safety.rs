@@ -3,7 +3,7 @@
 //! outlive a failure, and the fog-runs reader accepts a BOM and names file:line(:column)
 //! for non-UTF-8 bytes, absurd values and over-long input, with bounded messages.
 
-mod app_support;
+use crate::app_support;
 
 use std::fs;
 use std::path::Path;

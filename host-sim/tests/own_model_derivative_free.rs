@@ -16,11 +16,9 @@
 //! `cargo test --release -p fog-sim --test own_model_derivative_free -- --nocapture`
 //! prints every figure.
 
-#[path = "common/seek_judge.rs"]
-mod seek_judge;
+use crate::common::seek_judge;
 #[allow(dead_code)] // the test files share the generator, each uses some of its laws
-#[path = "common/soaked.rs"]
-mod soaked;
+use crate::common::soaked;
 
 use fog_core::model::format::FeatureSpec;
 use fog_sim::io::runs::Run;

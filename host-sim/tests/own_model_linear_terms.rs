@@ -9,11 +9,9 @@
 //! `cargo test --release -p fog-sim --test own_model_linear_terms -- --nocapture` prints
 //! every figure.
 
-#[path = "common/seek_judge.rs"]
-mod seek_judge;
+use crate::common::seek_judge;
 #[allow(dead_code)] // the test files share the generator, each uses some of its laws
-#[path = "common/soaked.rs"]
-mod soaked;
+use crate::common::soaked;
 
 use fog_sim::pipeline::north_seek::own_model::choose_linear_terms;
 use seek_judge::{plan, seek_rms_deg};

@@ -22,7 +22,7 @@
 //! `FOG_PROBE_SEED` changes the order and the random faults; `FOG_PROBE_FOGSIM=PATH`
 //! probes another `fogsim` binary (the release build, or main's).
 
-mod app_support;
+use crate::app_support;
 
 use std::ffi::{OsStr, OsString};
 use std::os::unix::ffi::{OsStrExt, OsStringExt};

@@ -1,7 +1,7 @@
 //! `fogsim campaign` end to end: the paper's file layout, determinism across
 //! invocations, and one-line errors with no output for impossible options.
 
-mod app_support;
+use crate::app_support;
 
 use fog_sim::io::runs::read_runs;
 use std::path::PathBuf;

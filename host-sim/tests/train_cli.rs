@@ -1,7 +1,7 @@
 //! `fogsim train` end to end on small fog-runs files: a valid model file is written and
 //! decodes with fog-core; bad input gives a one-line error, a non-zero exit and no file.
 
-mod app_support;
+use crate::app_support;
 
 use fog_core::model::format::{FeatureKind, RbfModel};
 use std::path::Path;

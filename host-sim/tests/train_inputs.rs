@@ -4,7 +4,7 @@
 //! brings nothing material) and drift unrelated to temperature (the null: neither helps).
 //! Also: outputs locked against a second `train`, and too few runs refused before reading.
 
-mod app_support;
+use crate::app_support;
 
 use app_support::{fogsim, scratch_dir, stderr};
 use fog_core::model::format::{FeatureKind, RbfModel};

@@ -18,13 +18,10 @@
 //! a claim that it must be chosen (docs/northfinder.md). On the null twin (lagged, nothing
 //! in d2T/dt2) no d2T/dt2 at all.
 
-mod app_support;
-#[path = "common/independent.rs"]
-#[allow(dead_code)] // the heading variants are used by diagnose_between
-mod independent;
+use crate::app_support;
+use crate::common::independent;
 #[allow(dead_code)] // the test files share the generator, each uses some of its laws
-#[path = "common/soaked.rs"]
-mod soaked;
+use crate::common::soaked;
 
 use app_support::{fogsim, scratch_dir, stderr};
 use fog_sim::io::runs::{write_run, Run};

@@ -16,8 +16,7 @@
 //! figure.
 
 #[allow(dead_code)] // the test files share the generator, each uses some of its laws
-#[path = "common/soaked.rs"]
-mod soaked;
+use crate::common::soaked;
 
 use fog_core::model::format::RbfModel;
 use fog_sim::pipeline::campaign_steps::train_with_config;

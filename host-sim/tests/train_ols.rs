@@ -2,7 +2,7 @@
 //! function, error-reduction ratio bookkeeping, the rho and max-count stops, joint
 //! linear terms, determinism and rejection of bad input.
 
-mod train_support;
+use crate::train_support;
 
 use fog_core::model::format::RbfModel;
 use fog_sim::train::{

@@ -2,7 +2,7 @@
 //! points) trains on an n x K design (K <= `max_candidates` grid candidates), and a
 //! training set whose design would exceed the memory limit is refused up front.
 
-mod train_support;
+use crate::train_support;
 
 use fog_core::model::format::MAX_CENTERS;
 use fog_sim::train::{fit_width, train_model, TrainConfig, TrainError};

@@ -7,9 +7,7 @@
 //! seek score it optimises. The null twin is the same campaign with nothing hidden; the
 //! twin with a different law plants a d2T/dt2 term the inputs cannot see.
 
-#[path = "common/independent.rs"]
-#[allow(dead_code)] // only the null and d2T/dt2 campaigns are used here
-mod independent;
+use crate::common::independent;
 
 use fog_sim::io::bin::WindowBinner;
 use fog_sim::io::runs::Run;

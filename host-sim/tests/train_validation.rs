@@ -2,7 +2,7 @@
 //! validation rather than training error, and Orr's regularised GCV-stopped selection
 //! is compared with plain OLS on held-out runs.
 
-mod train_support;
+use crate::train_support;
 
 use fog_sim::train::{cross_validate, fold_of_rows, Method, TrainConfig, WidthSearch};
 use train_support::{campaign, shupe_like};

@@ -2,7 +2,7 @@
 //! answers to host commands (`App::command`), the status it reports, a commanded seek to
 //! its `Result`, and the BIT word `BitMonitor` derives from the firmware's counters.
 
-mod app_support;
+use crate::app_support;
 
 use app_support::InstantTable;
 use fog_core::hal::{GyroSample, TempSample};

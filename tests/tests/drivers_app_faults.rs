@@ -3,7 +3,7 @@
 //! the driver's own error; a temperature sensor that fails marks its window invalid and
 //! the north finder never gets a result from it.
 
-mod app_support;
+use crate::app_support;
 
 use std::cell::Cell;
 

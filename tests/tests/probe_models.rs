@@ -18,7 +18,7 @@
 //! `FOG_PROBE_MODEL_MUTANTS=1200000 cargo test --release -p fog-tests --test probe_models -- --nocapture`.
 //! `FOG_PROBE_SEED` picks the mutants.
 
-mod upload_support;
+use crate::upload_support;
 
 use fog_core::link::upload::crc32;
 use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};

@@ -12,7 +12,7 @@
 //! --release -p fog-tests --test protocol_fuzz probe -- --nocapture`), seeded by
 //! `FOG_PROBE_SEED`.
 
-mod upload_support;
+use crate::upload_support;
 
 use std::sync::atomic::{AtomicU64, Ordering};
 

@@ -20,8 +20,8 @@
 //! Skips loudly without QEMU / the target unless FOG_REQUIRE_QEMU=1. Every wait is
 //! bounded; QEMU is killed when the test ends.
 
-mod qemu_support;
-mod upload_support;
+use crate::qemu_support;
+use crate::upload_support;
 
 use std::io::Write;
 use std::net::TcpStream;

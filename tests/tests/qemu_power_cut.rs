@@ -14,8 +14,8 @@
 //! Skips loudly without QEMU / the target unless FOG_REQUIRE_QEMU=1. Every wait is
 //! bounded; QEMU is killed when each run ends.
 
-mod qemu_support;
-mod upload_support;
+use crate::qemu_support;
+use crate::upload_support;
 
 use std::net::TcpStream;
 use std::path::Path;

@@ -8,7 +8,7 @@
 //! bounded; QEMU is killed when the test ends (pass or fail).
 //! `FOG_UPLOAD_ELF=/path/to/elf` runs the scenario against another firmware image.
 
-mod upload_support;
+use crate::upload_support;
 
 use std::path::PathBuf;
 use std::time::Duration;

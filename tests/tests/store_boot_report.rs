@@ -5,7 +5,7 @@
 //! corrupt or in use), a flipped header byte, a flipped model byte, a model for another
 //! gyro.
 
-mod upload_support;
+use crate::upload_support;
 
 use embedded_storage::nor_flash::{NorFlash, ReadNorFlash};
 use fog_firmware::store::{slot_len, EmulatedModelFlash, ModelStore, SlotDefect};

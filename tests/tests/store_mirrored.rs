@@ -4,7 +4,7 @@
 //! fails at any write leaves an image that boots to a complete model (the old one) and
 //! makes the store keep its slot; an image of the wrong size is refused whole.
 
-mod upload_support;
+use crate::upload_support;
 
 use embedded_storage::nor_flash::NorFlash;
 use fog_core::model::format::MAX_ENCODED_LEN;

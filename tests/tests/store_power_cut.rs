@@ -13,7 +13,7 @@
 //! `FOG_PROBE_POWER_CUTS=9000 cargo test --release -p fog-tests --test store_power_cut
 //! probe -- --nocapture`), seeded by `FOG_PROBE_SEED`.
 
-mod upload_support;
+use crate::upload_support;
 
 use embedded_storage::nor_flash::{NorFlash, ReadNorFlash};
 use fog_core::link::upload::ModelInfo;

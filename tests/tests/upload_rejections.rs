@@ -3,7 +3,7 @@
 //! issue lists is refused with its typed error and the running model stays in place,
 //! also after a reboot.
 
-mod upload_support;
+use crate::upload_support;
 
 use fog_core::link::upload::{
     crc32, ModelInfo, ModelRejection, Request, Response, UploadError, UploadPhase, MAX_CHUNK_LEN,

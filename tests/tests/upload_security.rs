@@ -4,7 +4,7 @@
 //! abort or add to one), slot signatures re-checked at boot, and the reply budget
 //! (never more bytes out than in; a short bad frame gets no reply).
 
-mod upload_support;
+use crate::upload_support;
 
 use fog_core::link::messages::HostFrame;
 use fog_core::link::upload::{

@@ -1,0 +1,11 @@
+//! Generators and judges shared by several test modules.
+
+pub mod field_gyro;
+pub mod independent;
+pub mod novel;
+pub mod peer;
+pub mod planted;
+pub mod seeds;
+pub mod seek_judge;
+pub mod single_record;
+pub mod soaked;
