@@ -7,9 +7,11 @@
 //! error enum instead of panicking on data.
 //!
 //! Map of the crate, one folder per concern (each `mod.rs` says what is in it):
-//! - [`model`]: the RBF drift model: its stored/wire `format`, and its evaluation paths
-//!   (`rbf` f32/f64, `fixed` integer-only, `accuracy` of one against the other, `synthetic`
-//!   models for benchmarks and tests);
+//! - [`model`]: the RBF drift model, the crate's ground floor (it imports from no other
+//!   folder): its stored/wire `format` with what it is built from (`error`, the stored
+//!   `heading` harmonic and `cold_start` envelope, the project's `crc`), its decoder
+//!   (`in_place`), and its evaluation paths (`rbf` f32/f64, `fixed` integer-only, `accuracy`
+//!   of one against the other, `synthetic` models for benchmarks and tests);
 //! - [`compensation`]: sensor streams -> model inputs (`features`, named by `label`) ->
 //!   drift-free 10 s windows (`compensator`);
 //! - [`seeking`]: compensated windows -> azimuth (`northfinder`, `tilt`, `heading_cal`,
@@ -23,7 +25,7 @@
 //! Two small files stay at the root because more than one concern uses them and none owns
 //! them: [`consts`] (Earth rate, the 10 s window; used by compensation, seeking and the
 //! host) and [`numeric`] (exact float helpers that keep libm's f64 routines out of the
-//! firmware; used by compensation, seeking and `consts`).
+//! firmware; used by model, compensation, seeking and `consts`).
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
 

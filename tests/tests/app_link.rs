@@ -304,7 +304,7 @@ fn the_bit_word_follows_each_counter() {
 /// cleared by a model without one or by running without a model.
 #[test]
 fn the_heading_correction_follows_the_active_model() {
-    use fog_core::seeking::heading_cal::HeadingHarmonic;
+    use fog_core::model::heading::HeadingHarmonic;
     let harmonic = HeadingHarmonic {
         cos_dph: -0.04,
         sin_dph: 0.07,

@@ -46,7 +46,7 @@ use std::time::{Duration, Instant};
 use fog_core::consts::EARTH_RATE_DPH;
 use fog_core::link::bit::{BitItem, BitWord};
 use fog_core::link::messages::{Command, ResetReason, SeekReport, Status};
-use fog_core::seeking::heading_cal::HeadingHarmonic;
+use fog_core::model::heading::HeadingHarmonic;
 use fog_core::seeking::quality::{SeekState, Validity};
 use fog_core::seeking::tilt::Tilt;
 use fog_sim::monitor::{monitor, CsvAppend, MonitorOptions, MonitorSummary, ResultLog};

@@ -15,7 +15,7 @@ pub mod refine;
 use std::path::Path;
 
 use anyhow::{bail, Result};
-use fog_core::link::upload::crc32;
+use fog_core::model::crc::crc32;
 use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
 
 use crate::train::seek_score::SeekGeometry;

@@ -4,7 +4,8 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use fog_core::model::format::{ModelError, RbfModel, MAX_ENCODED_LEN};
+use fog_core::model::error::ModelError;
+use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
 
 use super::bounded::{read_bounded, BoundedReadError};
 

@@ -24,8 +24,9 @@ use fog_core::consts::earth_rate_horizontal_dph;
 use fog_core::hal::{Gyro, GyroSample, TempSample, TemperatureSensor, Turntable};
 use fog_core::link::bit::{evaluate, BitInputs, BitLimits, BitWord};
 use fog_core::model::format::RbfModel;
+use fog_core::model::heading::HeadingHarmonic;
 use fog_core::seeking::field_record::{record_of_seek, FieldRecord, SeekTempState};
-use fog_core::seeking::heading_cal::{calibrate, HeadingDwell, HeadingHarmonic};
+use fog_core::seeking::heading_cal::{calibrate, HeadingDwell};
 use fog_core::seeking::northfinder::{
     NorthFinder, SeekConfig, SeekMode, SeekStatus, MAX_POSITIONS,
 };
