@@ -6,8 +6,8 @@ mod app_support;
 
 use app_support::InstantTable;
 use fog_core::hal::{GyroSample, TempSample};
-use fog_core::link::bit::{BitItem, BitLimits, BitWord};
 use fog_core::link::messages::{Command, DeviceMessage, Refusal, ResetReason, SeekReport};
+use fog_core::seeking::bit::{BitItem, BitLimits, BitWord};
 use fog_core::seeking::quality::{QualityError, SeekState, Validity};
 use fog_core::seeking::tilt::{earth_rate_on_axis_dph, Tilt};
 use fog_firmware::app::{App, AppConfig, BoardStatus, SeekOutcome};

@@ -7,8 +7,11 @@
 //!   dwells at known headings;
 //! - `quality`: what surrounds a seek (refusal, base-motion restarts, progress, predicted sigma);
 //! - `field_record`: what a completed two-position seek teaches (residual bias at its
-//!   temperature state), kept by the device and refined into the model by the host.
+//!   temperature state), kept by the device and refined into the model by the host;
+//! - `bit`: the built-in-test word and the rule that a failed item blocks seeking (the
+//!   supervisor in `quality` applies it; the link carries the word in the status).
 
+pub mod bit;
 pub mod field_record;
 pub mod heading_cal;
 pub mod northfinder;

@@ -22,9 +22,9 @@ use anyhow::{anyhow, bail, Context, Result};
 use fog_core::compensation::compensator::{Compensator, CompensatorConfig};
 use fog_core::consts::earth_rate_horizontal_dph;
 use fog_core::hal::{Gyro, GyroSample, TempSample, TemperatureSensor, Turntable};
-use fog_core::link::bit::{evaluate, BitInputs, BitLimits, BitWord};
 use fog_core::model::format::RbfModel;
 use fog_core::model::heading::HeadingHarmonic;
+use fog_core::seeking::bit::{evaluate, BitInputs, BitLimits, BitWord};
 use fog_core::seeking::field_record::{record_of_seek, FieldRecord, SeekTempState};
 use fog_core::seeking::heading_cal::{calibrate, HeadingDwell};
 use fog_core::seeking::northfinder::{
