@@ -77,9 +77,10 @@ use fog_firmware::app::{App, AppConfig, BoardStatus, SeekOutcome};
 use fog_firmware::bit_monitor::{BitCounters, BitMonitor};
 use fog_firmware::boot_args::{BootArgs, Inject};
 use fog_firmware::clock::Clock;
+use fog_firmware::drivers::base_inclinometer::BaseInclinometer;
 use fog_firmware::drivers::fog_serial::FogSerialGyro;
 use fog_firmware::drivers::inclinometer::{
-    BaseInclinometer, Inclinometer, SimulatedInclinometer, SIMULATED_NOISE_DEG,
+    Inclinometer, SimulatedInclinometer, SIMULATED_NOISE_DEG,
 };
 use fog_firmware::drivers::serial_inclinometer::SerialInclinometer;
 use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig};
