@@ -2,12 +2,13 @@
 //! with the matching typed error.
 
 use fog_core::model::cold_start::{ColdStartEnvelope, MAX_COLD_START_POINTS};
+use fog_core::model::crc::crc32;
+use fog_core::model::error::{ModelError, ModelField};
 use fog_core::model::format::{
-    crc32, FeatureKind, ModelError, ModelField, RbfModel, MAX_CENTERS, MAX_ENCODED_LEN,
-    MODEL_MAGIC, MODEL_VERSION,
+    FeatureKind, RbfModel, MAX_CENTERS, MAX_ENCODED_LEN, MODEL_MAGIC, MODEL_VERSION,
 };
+use fog_core::model::heading::HeadingHarmonic;
 use fog_core::model::synthetic::warmup_model;
-use fog_core::seeking::heading_cal::HeadingHarmonic;
 use serde::Serialize;
 
 fn encode(m: &RbfModel) -> Vec<u8> {

@@ -5,8 +5,8 @@
 use fog_core::compensation::compensator::{WindowResult, WindowStatus};
 use fog_core::consts::earth_rate_horizontal_dph;
 use fog_core::hal::{TableState, Turntable};
+use fog_core::model::heading::HeadingHarmonic;
 use fog_core::model::synthetic::SplitMix64;
-use fog_core::seeking::heading_cal::HeadingHarmonic;
 use fog_core::seeking::northfinder::{
     NorthFinder, SeekConfig, SeekError, SeekMode, SeekResult, SeekStatus,
 };

@@ -20,13 +20,13 @@ use fog_core::compensation::compensator::{
     Compensator, CompensatorConfig, CompensatorError, WindowResult,
 };
 use fog_core::hal::{GyroSample, TableState, TempSample, Turntable};
-use fog_core::link::bit::BitWord;
 use fog_core::link::messages::{
     Command, DeviceMessage, FaultState, Refusal, ResetReason, SeekReport, Status, LINK_VERSION,
 };
 use fog_core::model::format::RbfModel;
+use fog_core::model::heading::HeadingHarmonic;
+use fog_core::seeking::bit::BitWord;
 use fog_core::seeking::field_record::{record_of_seek, FieldRecord, SeekTempState};
-use fog_core::seeking::heading_cal::HeadingHarmonic;
 use fog_core::seeking::northfinder::{NorthFinder, SeekConfig, SeekError, SeekMode, SeekResult};
 use fog_core::seeking::quality::{
     MotionReason, QualityConfig, QualityError, SeekSupervisor, SupervisorEvent, Validity,

@@ -9,7 +9,7 @@
 //! not end with a turntable driver error within `TABLE_FAULT_HOLD_S`), model (a verified
 //! model is in use), flash (both model slots verified at boot).
 
-use fog_core::link::bit::{evaluate, BitInputs, BitLimits, BitWord};
+use fog_core::seeking::bit::{evaluate, BitInputs, BitLimits, BitWord};
 
 /// How long a turntable driver error keeps the turntable item failed, s.
 pub const TABLE_FAULT_HOLD_S: f64 = 60.0;

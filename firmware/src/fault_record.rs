@@ -16,7 +16,8 @@
 //! `src/bin/target/`) only moves [`RawRecord`]s in and out of that RAM.
 
 use fog_core::link::messages::FaultState;
-use fog_core::link::upload::{crc32, ResetCause, ResetRecord};
+use fog_core::link::upload::{ResetCause, ResetRecord};
+use fog_core::model::crc::crc32;
 
 /// Faults in a row that put the device in safe mode. One fault may be a glitch and a
 /// second its after-effect (a watchdog reset while recovering); a third with no clean

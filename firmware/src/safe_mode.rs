@@ -7,10 +7,10 @@
 //! upload server run, so the operator sees the reason and can install a good model,
 //! which clears the record and lets the boot go on.
 
-use fog_core::link::bit::{BitItem, BitWord};
 use fog_core::link::messages::{
     Command, DeviceMessage, FaultState, Refusal, ResetReason, Status, LINK_VERSION,
 };
+use fog_core::seeking::bit::{BitItem, BitWord};
 use fog_core::seeking::quality::SeekState;
 use fog_core::seeking::tilt::Tilt;
 

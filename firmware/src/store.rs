@@ -26,7 +26,8 @@ pub mod mirrored;
 pub mod ram_flash;
 
 use embedded_storage::nor_flash::NorFlash;
-use fog_core::link::upload::{CRC32, SIGNATURE_LEN};
+use fog_core::link::upload::SIGNATURE_LEN;
+use fog_core::model::crc::CRC32;
 use fog_core::model::format::MAX_ENCODED_LEN;
 
 /// Slot magic "FOGS".

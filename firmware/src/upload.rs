@@ -39,7 +39,9 @@ use fog_core::link::upload::{
     MAX_CHUNK_LEN, MAX_WIRE_FRAME_LEN, PROTOCOL_VERSION, SESSION_IDLE_TIMEOUT_S, SIGNATURE_LEN,
     SIGNED_PREFIX_LEN,
 };
-use fog_core::model::format::{ModelError, RbfModel, MAX_ENCODED_LEN};
+use fog_core::model::crc::crc32;
+use fog_core::model::error::ModelError;
+use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
 use heapless::String;
 
 use crate::signature::verify_model;
@@ -661,7 +663,7 @@ fn commit<F: NorFlash>(
     }
     *s.session = Session::Idle;
     let end = SIGNED_PREFIX_LEN + model_len as usize;
-    if fog_core::link::upload::crc32(&s.buf[SIGNED_PREFIX_LEN..end]) != model_crc32 {
+    if crc32(&s.buf[SIGNED_PREFIX_LEN..end]) != model_crc32 {
         return Err(UploadError::ModelCrcMismatch);
     }
     let signature: &[u8; SIGNATURE_LEN] = signature

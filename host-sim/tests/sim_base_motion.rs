@@ -4,7 +4,7 @@
 
 use fog_core::compensation::compensator::{Compensator, CompensatorConfig};
 use fog_core::hal::GyroSample;
-use fog_core::link::bit::BitWord;
+use fog_core::seeking::bit::BitWord;
 use fog_core::seeking::northfinder::{NorthFinder, SeekConfig, SeekMode};
 use fog_core::seeking::quality::{MotionReason, QualityConfig, SeekSupervisor, SupervisorEvent};
 use fog_core::seeking::tilt::Tilt;

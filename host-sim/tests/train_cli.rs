@@ -323,7 +323,7 @@ fn register_calibrated_variants(model_path: &Path, registry: &Path) -> (u32, u32
     let mut reg = Registry::open(registry).unwrap();
     let cal_record = ModelRecord::of(&cal_model, &cal_bytes);
     let other_record = ModelRecord::of(&other, &buf[..n]);
-    let trained_crc = fog_core::link::upload::crc32(&std::fs::read(model_path).unwrap());
+    let trained_crc = fog_core::model::crc::crc32(&std::fs::read(model_path).unwrap());
     assert_eq!(cal_record.base_crc32, Some(trained_crc));
     assert_ne!(other_record.base_crc32, Some(trained_crc));
     reg.record_model(&cal_record).unwrap();

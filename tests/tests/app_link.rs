@@ -6,8 +6,8 @@ use crate::app_support;
 
 use app_support::InstantTable;
 use fog_core::hal::{GyroSample, TempSample};
-use fog_core::link::bit::{BitItem, BitLimits, BitWord};
 use fog_core::link::messages::{Command, DeviceMessage, Refusal, ResetReason, SeekReport};
+use fog_core::seeking::bit::{BitItem, BitLimits, BitWord};
 use fog_core::seeking::quality::{QualityError, SeekState, Validity};
 use fog_core::seeking::tilt::{earth_rate_on_axis_dph, Tilt};
 use fog_firmware::app::{App, AppConfig, BoardStatus, SeekOutcome};
@@ -304,7 +304,7 @@ fn the_bit_word_follows_each_counter() {
 /// cleared by a model without one or by running without a model.
 #[test]
 fn the_heading_correction_follows_the_active_model() {
-    use fog_core::seeking::heading_cal::HeadingHarmonic;
+    use fog_core::model::heading::HeadingHarmonic;
     let harmonic = HeadingHarmonic {
         cos_dph: -0.04,
         sin_dph: 0.07,

@@ -20,7 +20,7 @@
 
 use crate::upload_support;
 
-use fog_core::link::upload::crc32;
+use fog_core::model::crc::crc32;
 use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
 use fog_sim::device::upload::{load_signing_key, sign_upload, test_key_path};
 use rand::{Rng, SeedableRng};

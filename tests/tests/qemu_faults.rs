@@ -88,7 +88,7 @@ fn qemu_panic_resets_reports_its_line_and_keeps_the_model() {
         .expect("the committed model survived the reset");
     assert_eq!(
         (active.security_counter, active.model_crc32),
-        (counter, fog_core::link::upload::crc32(&bytes))
+        (counter, fog_core::model::crc::crc32(&bytes))
     );
 }
 

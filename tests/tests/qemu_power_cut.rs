@@ -22,7 +22,8 @@ use std::path::Path;
 use std::sync::mpsc::Receiver;
 use std::time::Duration;
 
-use fog_core::link::upload::{crc32, ModelInfo};
+use fog_core::link::upload::ModelInfo;
+use fog_core::model::crc::crc32;
 use fog_sim::device::upload::UploadClient;
 use fog_tests::console::wait_line;
 use fog_tests::{qemu_ready, scratch_dir, KillOnDrop};

@@ -17,7 +17,8 @@ use crate::upload_support;
 use std::time::Duration;
 
 use fog_core::link::messages::{Command, DeviceMessage, Refusal};
-use fog_core::link::upload::{crc32, ResetCause};
+use fog_core::link::upload::ResetCause;
+use fog_core::model::crc::crc32;
 use fog_core::seeking::quality::SeekState;
 use fog_firmware::fault_record::{BootFault, SAFE_MODE_AFTER};
 use fog_sim::device::upload::UploadClient;

@@ -44,9 +44,9 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use fog_core::consts::EARTH_RATE_DPH;
-use fog_core::link::bit::{BitItem, BitWord};
 use fog_core::link::messages::{Command, ResetReason, SeekReport, Status};
-use fog_core::seeking::heading_cal::HeadingHarmonic;
+use fog_core::model::heading::HeadingHarmonic;
+use fog_core::seeking::bit::{BitItem, BitWord};
 use fog_core::seeking::quality::{SeekState, Validity};
 use fog_core::seeking::tilt::Tilt;
 use fog_sim::device::monitor::{monitor, CsvAppend, MonitorOptions, MonitorSummary, ResultLog};

@@ -13,7 +13,8 @@ use crate::upload_support;
 use std::path::PathBuf;
 use std::time::Duration;
 
-use fog_core::link::upload::{crc32, ModelRejection, UploadError, UploadPhase, PROTOCOL_VERSION};
+use fog_core::link::upload::{ModelRejection, UploadError, UploadPhase, PROTOCOL_VERSION};
+use fog_core::model::crc::crc32;
 use fog_sim::device::upload::{key_from_seed, sign_upload, ClientError, UploadClient};
 use fog_tests::{
     connect_loopback, firmware_elf, free_loopback_port, qemu_ready, spawn_qemu, QemuOptions,

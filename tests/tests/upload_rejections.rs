@@ -6,8 +6,9 @@
 use crate::upload_support;
 
 use fog_core::link::upload::{
-    crc32, ModelInfo, ModelRejection, Request, Response, UploadError, UploadPhase, MAX_CHUNK_LEN,
+    ModelInfo, ModelRejection, Request, Response, UploadError, UploadPhase, MAX_CHUNK_LEN,
 };
+use fog_core::model::crc::crc32;
 use fog_core::model::format::MAX_ENCODED_LEN;
 use fog_firmware::signature::TEST_PUBLIC_KEY;
 use fog_sim::device::upload::{key_from_seed, sign_upload, ClientError};

@@ -216,7 +216,7 @@ fn tamper_newest_signature(flash: EmulatedModelFlash) -> EmulatedModelFlash {
     let seq = |base: usize| u32::from_le_bytes(raw[base + 8..base + 12].try_into().unwrap());
     let base = if seq(slot_len) > seq(0) { slot_len } else { 0 };
     raw[base + 30] ^= 0x01;
-    let crc = fog_core::link::upload::crc32(&raw[base..base + 88]);
+    let crc = fog_core::model::crc::crc32(&raw[base..base + 88]);
     raw[base + 88..base + 92].copy_from_slice(&crc.to_le_bytes());
     let mut out = EmulatedModelFlash::new();
     out.write(0, &raw).unwrap();

@@ -14,8 +14,9 @@ use crate::compensation::features::{
     DEFAULT_RATE_SPAN_S, EXTRACTOR_RATE_POINTS,
 };
 use crate::hal::{GyroSample, TempSample};
+use crate::model::error::ModelError;
 use crate::model::fixed::{FixedError, FixedModel};
-use crate::model::format::{FeatureSpec, ModelError, RbfModel, MAX_AUX, MAX_INPUTS};
+use crate::model::format::{FeatureSpec, RbfModel, MAX_AUX, MAX_INPUTS};
 use crate::model::rbf::{predict_f32, RbfError};
 
 /// Which evaluator computes the drift.

@@ -12,10 +12,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::link::bit::BitWord;
 use crate::link::upload::{
     decode_message, encode_frame, FrameError, Request, ResetCause, Response,
 };
+use crate::seeking::bit::BitWord;
 use crate::seeking::field_record::FieldRecord;
 use crate::seeking::quality::{MotionReason, QualityError, SeekState, Validity};
 use crate::seeking::tilt::Tilt;
@@ -227,9 +227,9 @@ pub fn decode<'a, T: Deserialize<'a>>(payload: &'a [u8]) -> Result<T, FrameError
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::link::bit::BitItem;
     use crate::link::upload::{FrameReceiver, MAX_WIRE_FRAME_LEN};
     use crate::model::synthetic::SplitMix64;
+    use crate::seeking::bit::BitItem;
     use crate::seeking::quality::FinderFault;
 
     fn status(bit: u16) -> Status {

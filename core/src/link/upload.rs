@@ -5,7 +5,8 @@
 //! Wire format of one frame (both directions):
 //! `COBS( postcard(message) ++ crc32_le(postcard(message)) ) ++ 0x00`
 //! - postcard: compact serde encoding (varints, enum tag = variant index);
-//! - CRC-32/ISO-HDLC (the zlib/Ethernet CRC) over the postcard bytes, little-endian;
+//! - CRC-32/ISO-HDLC (the zlib/Ethernet CRC, `model::crc`) over the postcard bytes,
+//!   little-endian;
 //! - COBS removes every zero byte so `0x00` marks the end of a frame; a receiver
 //!   resynchronises at the next `0x00` after any garbage, and empty frames are ignored.
 //!
@@ -25,7 +26,8 @@
 //! preceded by [`STATUS_REQUEST_PADDING`] zero bytes (empty frames, ignored), which pay
 //! for the longer status reply.
 
-use crate::model::format::ModelError;
+use crate::model::crc::crc32;
+use crate::model::error::ModelError;
 use heapless::String;
 use serde::{Deserialize, Serialize};
 
@@ -67,14 +69,6 @@ pub fn signed_prefix(security_counter: u32, gyro_id: &str) -> Option<[u8; SIGNED
     p[16..20].copy_from_slice(&security_counter.to_le_bytes());
     p[20..20 + id.len()].copy_from_slice(id);
     Some(p)
-}
-
-/// CRC-32/ISO-HDLC, the checksum of frames and of whole models in `Begin`.
-pub const CRC32: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC);
-
-/// CRC-32/ISO-HDLC of `bytes` (same value as zlib's `crc32`).
-pub fn crc32(bytes: &[u8]) -> u32 {
-    CRC32.checksum(bytes)
 }
 
 /// PC -> device.

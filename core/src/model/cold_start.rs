@@ -12,7 +12,7 @@
 use heapless::Vec;
 use serde::{Deserialize, Serialize};
 
-use crate::model::format::{ModelError, ModelField};
+use crate::model::error::{ModelError, ModelField};
 
 /// Most points of an envelope.
 pub const MAX_COLD_START_POINTS: usize = 8;

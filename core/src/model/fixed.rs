@@ -21,7 +21,8 @@
 //! Worst error against the f64 reference: see `docs/core.md` (measured by the
 //! `fixed_worst_error_*` tests: `cargo test -p fog-core --test rbf_accuracy fixed_worst -- --nocapture`).
 
-use crate::model::format::{ModelError, RbfModel, MAX_CENTERS, MAX_INPUTS, MAX_POLY_DEGREE};
+use crate::model::error::ModelError;
+use crate::model::format::{RbfModel, MAX_CENTERS, MAX_INPUTS, MAX_POLY_DEGREE};
 use crate::model::rbf::RbfError;
 
 /// Fraction bits of normalised inputs and centres.

@@ -2,8 +2,10 @@
 //!
 //! CONTRACT (shared by trainer, diagnose, firmware): the struct layout below is
 //! the one every crate builds against. Encoding is postcard of `WireModel`
-//! (magic, version, body, CRC-32 of the body bytes); decoding validates sizes,
-//! finiteness, positive widths and ranges and returns a `ModelError`.
+//! (magic, version, body, CRC-32 of the body bytes); decoding (`model::in_place`, above
+//! this file) validates sizes, finiteness, positive widths and ranges and returns a
+//! `ModelError` (`model::error`, below it, with the stored sub-records `model::heading` and
+//! `model::cold_start` and the CRC `model::crc`).
 //!
 //! drift_dph = bias_dph + sum_j (linear[j] + linear_by_t[j] * t) * xn_j + sum_k poly[k-1] * t^k
 //!             + sum_i weights[i] * exp(-||xn - c_i||^2 / (2 widths[i]^2))
@@ -14,7 +16,7 @@
 //!
 //! Format versions: 1 has no `poly` (decoded with an empty one), 2 appends `poly` after
 //! `meta`, 3 appends `heading` after `poly`: the optional heading harmonic of the bias
-//! (`heading_cal`), stored inside the model bytes so that the model's CRC and the upload
+//! (`model::heading`, fitted by `seeking::heading_cal`), stored inside the model bytes so that the model's CRC and the upload
 //! signature cover it (v1 and v2 decode with none), 4 appends `linear_by_t` after
 //! `heading`: linear terms whose coefficients change with temperature (a Shupe coefficient
 //! k_S(T) = k_0 + k_1 T makes the drift k_0 dT/dt + k_1 T dT/dt; v1-v3 decode with none), 5
@@ -23,11 +25,12 @@
 //! gives a finite drift below `MAX_OUTPUT_DPH` at any finite input.
 
 use heapless::{String, Vec};
-use serde::de::DeserializeSeed as _;
 use serde::{Deserialize, Serialize};
 
 use crate::model::cold_start::ColdStartEnvelope;
-use crate::seeking::heading_cal::{HeadingHarmonic, MIN_HEADINGS};
+use crate::model::crc::crc32;
+use crate::model::error::{check_finite, check_len, ModelError, ModelField};
+use crate::model::heading::{HeadingHarmonic, MIN_HEADINGS};
 
 /// Most RBF centres a model may hold.
 pub const MAX_CENTERS: usize = 64;
@@ -174,109 +177,7 @@ pub const MAX_AUX: usize = 4;
 /// Bytes reserved in front of the body while encoding (varint magic + version + length).
 const HEADER_RESERVE: usize = 5 + 3 + 3;
 
-/// Which part of a model a validation error is about.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum ModelField {
-    Inputs,
-    InputOffset,
-    InputScale,
-    InputMin,
-    InputMax,
-    Linear,
-    Centers,
-    Widths,
-    Weights,
-    Bias,
-    HeldoutRms,
-    TimeConstant,
-    Poly,
-    /// The heading harmonic; index 0 a, 1 b, 2 sigma a, 3 sigma b, 4 correlation,
-    /// 5 n_headings.
-    Heading,
-    /// The temperature-coupled linear terms.
-    LinearByT,
-    /// The cold-start envelope; index the point.
-    ColdStart,
-}
-
-impl ModelField {
-    /// Field name as written in `RbfModel`.
-    pub const fn name(self) -> &'static str {
-        match self {
-            ModelField::Inputs => "inputs",
-            ModelField::InputOffset => "input_offset",
-            ModelField::InputScale => "input_scale",
-            ModelField::InputMin => "input_min",
-            ModelField::InputMax => "input_max",
-            ModelField::Linear => "linear",
-            ModelField::Centers => "centers",
-            ModelField::Widths => "widths",
-            ModelField::Weights => "weights",
-            ModelField::Bias => "bias_dph",
-            ModelField::HeldoutRms => "meta.heldout_rms_dph",
-            ModelField::TimeConstant => "inputs[].tau_s",
-            ModelField::Poly => "poly",
-            ModelField::Heading => "heading",
-            ModelField::LinearByT => "linear_by_t",
-            ModelField::ColdStart => "cold_start",
-        }
-    }
-}
-
-/// Why a model could not be encoded, decoded or accepted.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum ModelError {
-    /// The output buffer cannot hold the encoded model.
-    BufferTooSmall { needed_at_least: u16 },
-    /// The encoded model is larger than `MAX_ENCODED_LEN`.
-    TooLarge { len: u32 },
-    /// The bytes end before the model does.
-    Truncated,
-    /// The first field is not `MODEL_MAGIC`.
-    BadMagic { found: u32 },
-    /// A format version this code does not understand.
-    UnsupportedVersion { found: u16 },
-    /// CRC-32 of the body does not match the stored one.
-    CrcMismatch { stored: u32, computed: u32 },
-    /// Bytes left over after the CRC.
-    TrailingBytes { count: u16 },
-    /// The body is not a well-formed postcard `RbfModel`.
-    Malformed,
-    /// Zero inputs.
-    NoInputs,
-    /// More inputs than `MAX_INPUTS`.
-    TooManyInputs { count: u16 },
-    /// More centres than `MAX_CENTERS`.
-    TooManyCenters { count: u16 },
-    /// `n_rbf_inputs` is larger than the number of inputs, or 0 with centres present.
-    BadRbfInputCount { n_rbf_inputs: u8, n_inputs: u8 },
-    /// A per-input or per-centre vector has the wrong length.
-    LengthMismatch {
-        field: ModelField,
-        expected: u16,
-        found: u16,
-    },
-    /// A NaN or infinite number.
-    NonFinite { field: ModelField, index: u16 },
-    /// An input scale that is not > 0.
-    NonPositiveScale { input: u8 },
-    /// A Gaussian width that is not > 0.
-    NonPositiveWidth { center: u16 },
-    /// Trained range with min > max.
-    BadRange { input: u8 },
-    /// A lag/decay input without a positive time constant, or a negative one elsewhere.
-    BadTimeConstant { input: u8 },
-    /// An auxiliary channel index >= `MAX_AUX`.
-    BadAuxChannel { input: u8, channel: u8 },
-    /// A parameter outside its allowed magnitude (see the bound constants).
-    OutOfBounds { field: ModelField, index: u16 },
-    /// The worst case of |bias| + sum |linear| XN_CLAMP + sum |poly_k| t^k + sum |w|
-    /// exceeds `MAX_OUTPUT_DPH` (value in deg/h, saturated to u32).
-    OutputUnbounded { worst_dph: u32 },
-}
-
+/// The messages of `model::error::ModelError`, written here beside the limits they quote.
 impl core::fmt::Display for ModelError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match *self {
@@ -356,44 +257,19 @@ impl core::error::Error for ModelError {}
 
 /// Counts written before the body so that oversize models get a precise error.
 #[derive(Serialize, Deserialize)]
-struct BodyCounts {
-    n_inputs: u16,
-    n_centers: u16,
+pub(crate) struct BodyCounts {
+    pub(crate) n_inputs: u16,
+    pub(crate) n_centers: u16,
 }
 
 /// The outer envelope: postcard of (magic, version, body bytes, CRC-32 of the body bytes).
 #[derive(Serialize, Deserialize)]
-struct WireModel<'a> {
-    magic: u32,
-    version: u16,
+pub(crate) struct WireModel<'a> {
+    pub(crate) magic: u32,
+    pub(crate) version: u16,
     #[serde(borrow)]
-    body: &'a [u8],
-    crc32: u32,
-}
-
-/// CRC-32 (IEEE 802.3, as zlib/PNG) used for the model body: the protocol's, one copy.
-pub use crate::link::upload::crc32;
-
-fn check_finite(field: ModelField, values: &[f32]) -> Result<(), ModelError> {
-    match values.iter().position(|v| !v.is_finite()) {
-        Some(i) => Err(ModelError::NonFinite {
-            field,
-            index: i as u16,
-        }),
-        None => Ok(()),
-    }
-}
-
-fn check_len(field: ModelField, expected: usize, found: usize) -> Result<(), ModelError> {
-    if expected == found {
-        Ok(())
-    } else {
-        Err(ModelError::LengthMismatch {
-            field,
-            expected: expected as u16,
-            found: found as u16,
-        })
-    }
+    pub(crate) body: &'a [u8],
+    pub(crate) crc32: u32,
 }
 
 impl FeatureKind {
@@ -763,91 +639,5 @@ impl RbfModel {
             return Err(ModelError::TooLarge { len: total as u32 });
         }
         Ok(total)
-    }
-
-    /// Decode and fully validate an encoded model.
-    pub fn decode(bytes: &[u8]) -> Result<RbfModel, ModelError> {
-        let mut model = RbfModel::empty();
-        model.decode_into(bytes)?;
-        Ok(model)
-    }
-
-    /// `decode` into `self`, in place: the model is read element by element into the
-    /// existing storage (`model::in_place`), never built on the stack, so a device can
-    /// decode into a `static`. On error `self` holds a partly decoded model: decode again
-    /// or discard it.
-    pub fn decode_into(&mut self, bytes: &[u8]) -> Result<(), ModelError> {
-        if bytes.len() > MAX_ENCODED_LEN {
-            return Err(ModelError::TooLarge {
-                len: bytes.len() as u32,
-            });
-        }
-        // Magic and version first, so a foreign or newer file gets the precise error.
-        let (magic, rest) = postcard::take_from_bytes::<u32>(bytes).map_err(map_postcard)?;
-        if magic != MODEL_MAGIC {
-            return Err(ModelError::BadMagic { found: magic });
-        }
-        let (version, _) = postcard::take_from_bytes::<u16>(rest).map_err(map_postcard)?;
-        if !(MODEL_VERSION_OLDEST..=MODEL_VERSION).contains(&version) {
-            return Err(ModelError::UnsupportedVersion { found: version });
-        }
-        let (wire, trailing) =
-            postcard::take_from_bytes::<WireModel<'_>>(bytes).map_err(map_postcard)?;
-        if !trailing.is_empty() {
-            return Err(ModelError::TrailingBytes {
-                count: trailing.len() as u16,
-            });
-        }
-        let computed = crc32(wire.body);
-        if computed != wire.crc32 {
-            return Err(ModelError::CrcMismatch {
-                stored: wire.crc32,
-                computed,
-            });
-        }
-        let (counts, model_bytes) = postcard::take_from_bytes::<BodyCounts>(wire.body)
-            .map_err(|_| ModelError::Malformed)?;
-        if counts.n_inputs as usize > MAX_INPUTS {
-            return Err(ModelError::TooManyInputs {
-                count: counts.n_inputs,
-            });
-        }
-        if counts.n_centers as usize > MAX_CENTERS {
-            return Err(ModelError::TooManyCenters {
-                count: counts.n_centers,
-            });
-        }
-        let mut de = postcard::Deserializer::from_bytes(model_bytes);
-        crate::model::in_place::ModelInPlace {
-            model: self,
-            version,
-        }
-        .deserialize(&mut de)
-        .map_err(|_| ModelError::Malformed)?;
-        let left = de.finalize().map_err(|_| ModelError::Malformed)?;
-        let model = &*self;
-        if !left.is_empty() {
-            return Err(ModelError::TrailingBytes {
-                count: left.len() as u16,
-            });
-        }
-        check_len(
-            ModelField::Inputs,
-            counts.n_inputs as usize,
-            model.inputs.len(),
-        )?;
-        check_len(
-            ModelField::Centers,
-            counts.n_centers as usize,
-            model.centers.len(),
-        )?;
-        model.validate()
-    }
-}
-
-fn map_postcard(e: postcard::Error) -> ModelError {
-    match e {
-        postcard::Error::DeserializeUnexpectedEnd => ModelError::Truncated,
-        _ => ModelError::Malformed,
     }
 }

@@ -1,11 +1,17 @@
-//! Deserialising an `RbfModel` body straight into existing storage.
+//! Decoding an encoded model into existing storage: `RbfModel::decode` and
+//! `RbfModel::decode_into` check the envelope (size, magic, version, CRC-32, counts) and
+//! read the body straight into a `&mut RbfModel`.
 //!
 //! The derived `Deserialize` builds every field as a local, then the struct, then the
 //! `Result`s around it: at `opt-level = "z"` that is an ~8 KB stack frame for a ~1.7 KB
 //! model, the largest one at the firmware's boot. `ModelInPlace` reads the same postcard
 //! wire format (the fields in declaration order, each vector as length + elements)
 //! directly into a `&mut RbfModel`, element by element, so the decoder's frame holds
-//! one element at a time. `RbfModel::decode_into` uses it.
+//! one element at a time.
+//!
+//! The decoder sits above `format` (whose layout, limits and envelope it reads) rather
+//! than inside it, so that `format` does not reach back up into the reader: the files of
+//! `model` import one way.
 
 use core::fmt;
 
@@ -13,7 +19,100 @@ use heapless::Vec;
 use serde::de::{self, DeserializeSeed, Deserializer, SeqAccess, Visitor};
 use serde::Deserialize;
 
-use crate::model::format::RbfModel;
+use crate::model::crc::crc32;
+use crate::model::error::{check_len, ModelError, ModelField};
+use crate::model::format::{
+    BodyCounts, RbfModel, WireModel, MAX_CENTERS, MAX_ENCODED_LEN, MAX_INPUTS, MODEL_MAGIC,
+    MODEL_VERSION, MODEL_VERSION_OLDEST,
+};
+
+impl RbfModel {
+    /// Decode and fully validate an encoded model.
+    pub fn decode(bytes: &[u8]) -> Result<RbfModel, ModelError> {
+        let mut model = RbfModel::empty();
+        model.decode_into(bytes)?;
+        Ok(model)
+    }
+
+    /// `decode` into `self`, in place: the model is read element by element into the
+    /// existing storage (`ModelInPlace`), never built on the stack, so a device can
+    /// decode into a `static`. On error `self` holds a partly decoded model: decode again
+    /// or discard it.
+    pub fn decode_into(&mut self, bytes: &[u8]) -> Result<(), ModelError> {
+        if bytes.len() > MAX_ENCODED_LEN {
+            return Err(ModelError::TooLarge {
+                len: bytes.len() as u32,
+            });
+        }
+        // Magic and version first, so a foreign or newer file gets the precise error.
+        let (magic, rest) = postcard::take_from_bytes::<u32>(bytes).map_err(map_postcard)?;
+        if magic != MODEL_MAGIC {
+            return Err(ModelError::BadMagic { found: magic });
+        }
+        let (version, _) = postcard::take_from_bytes::<u16>(rest).map_err(map_postcard)?;
+        if !(MODEL_VERSION_OLDEST..=MODEL_VERSION).contains(&version) {
+            return Err(ModelError::UnsupportedVersion { found: version });
+        }
+        let (wire, trailing) =
+            postcard::take_from_bytes::<WireModel<'_>>(bytes).map_err(map_postcard)?;
+        if !trailing.is_empty() {
+            return Err(ModelError::TrailingBytes {
+                count: trailing.len() as u16,
+            });
+        }
+        let computed = crc32(wire.body);
+        if computed != wire.crc32 {
+            return Err(ModelError::CrcMismatch {
+                stored: wire.crc32,
+                computed,
+            });
+        }
+        let (counts, model_bytes) = postcard::take_from_bytes::<BodyCounts>(wire.body)
+            .map_err(|_| ModelError::Malformed)?;
+        if counts.n_inputs as usize > MAX_INPUTS {
+            return Err(ModelError::TooManyInputs {
+                count: counts.n_inputs,
+            });
+        }
+        if counts.n_centers as usize > MAX_CENTERS {
+            return Err(ModelError::TooManyCenters {
+                count: counts.n_centers,
+            });
+        }
+        let mut de = postcard::Deserializer::from_bytes(model_bytes);
+        ModelInPlace {
+            model: self,
+            version,
+        }
+        .deserialize(&mut de)
+        .map_err(|_| ModelError::Malformed)?;
+        let left = de.finalize().map_err(|_| ModelError::Malformed)?;
+        let model = &*self;
+        if !left.is_empty() {
+            return Err(ModelError::TrailingBytes {
+                count: left.len() as u16,
+            });
+        }
+        check_len(
+            ModelField::Inputs,
+            counts.n_inputs as usize,
+            model.inputs.len(),
+        )?;
+        check_len(
+            ModelField::Centers,
+            counts.n_centers as usize,
+            model.centers.len(),
+        )?;
+        model.validate()
+    }
+}
+
+fn map_postcard(e: postcard::Error) -> ModelError {
+    match e {
+        postcard::Error::DeserializeUnexpectedEnd => ModelError::Truncated,
+        _ => ModelError::Malformed,
+    }
+}
 
 /// The struct's field names (postcard only uses their count).
 const FIELDS: &[&str] = &[
@@ -38,9 +137,9 @@ const FIELDS: &[&str] = &[
 /// Seed that fills `model` with the model being deserialised in format `version`: 1 has
 /// no `poly` (left empty), 1 and 2 no `heading` (left `None`), 1-3 no `linear_by_t` (left
 /// empty), 1-4 no `cold_start` (left `None`).
-pub(crate) struct ModelInPlace<'a> {
-    pub(crate) model: &'a mut RbfModel,
-    pub(crate) version: u16,
+struct ModelInPlace<'a> {
+    model: &'a mut RbfModel,
+    version: u16,
 }
 
 impl ModelInPlace<'_> {

@@ -32,7 +32,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::compensation::compensator::WindowResult;
-use crate::link::upload::CRC32;
+use crate::model::crc::CRC32;
 use crate::model::format::{FeatureKind, RbfModel};
 
 /// Bytes of one encoded record (a multiple of every supported flash word: 1, 2, 4 bytes).

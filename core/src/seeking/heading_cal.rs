@@ -4,7 +4,8 @@
 //! version 3, covered by the model's CRC and the upload signature; `fogsim heading-cal`
 //! attaches it). There is no separate calibration record: the harmonic lives only under
 //! the model's CRC and signature (a standalone "FHCL" record existed and was removed when
-//! the device stopped reading it).
+//! the device stopped reading it). The harmonic itself (`model::heading::HeadingHarmonic`)
+//! is defined in `model`, which stores it; this file is the fit that produces it.
 //!
 //! Exists because such a bias, a cos(alpha) + b sin(alpha) with alpha the input axis azimuth,
 //! is the same harmonic as Earth rate: no seek can separate it, so it has to be measured once
@@ -16,71 +17,9 @@
 //! squares (weights 1 / sigma_k^2). The covariance is (J^T W J)^-1, scaled up by the reduced
 //! chi-square when the residuals scatter more than the dwell sigmas say.
 
-use serde::{Deserialize, Serialize};
-
+use crate::model::heading::{HeadingHarmonic, MIN_HEADINGS};
 use crate::numeric::sin_cos_deg;
 use crate::seeking::tilt::{earth_rate_on_axis_dph, Tilt};
-
-/// Fewest headings a calibration accepts (three unknowns plus one degree of freedom).
-pub const MIN_HEADINGS: usize = 4;
-
-/// The bias harmonic a cos(alpha) + b sin(alpha) of the input axis azimuth alpha.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct HeadingHarmonic {
-    /// a, deg/h.
-    pub cos_dph: f32,
-    /// b, deg/h.
-    pub sin_dph: f32,
-    /// 1-sigma of a and b and their correlation coefficient.
-    pub cos_sigma_dph: f32,
-    pub sin_sigma_dph: f32,
-    pub correlation: f32,
-    /// Headings the calibration used.
-    pub n_headings: u16,
-}
-
-impl HeadingHarmonic {
-    /// Bias at input axis azimuth `alpha_deg`, deg/h.
-    pub fn bias_dph(&self, alpha_deg: f64) -> f64 {
-        let (s, c) = sin_cos_deg(alpha_deg);
-        self.cos_dph as f64 * c + self.sin_dph as f64 * s
-    }
-
-    /// Amplitude sqrt(a^2 + b^2), deg/h.
-    pub fn amplitude_dph(&self) -> f32 {
-        libm::sqrtf(self.cos_dph * self.cos_dph + self.sin_dph * self.sin_dph)
-    }
-
-    /// Phase atan2(b, a): the azimuth of largest bias, deg.
-    pub fn phase_deg(&self) -> f32 {
-        libm::atan2f(self.sin_dph, self.cos_dph).to_degrees()
-    }
-
-    /// 1-sigma of the amplitude, deg/h (linearised).
-    pub fn amplitude_sigma_dph(&self) -> f32 {
-        let (a, b) = (self.cos_dph, self.sin_dph);
-        let amp2 = a * a + b * b;
-        if amp2 <= 0.0 {
-            return self.cos_sigma_dph.max(self.sin_sigma_dph);
-        }
-        let (sa, sb) = (self.cos_sigma_dph, self.sin_sigma_dph);
-        let var = a * a * sa * sa + b * b * sb * sb + 2.0 * a * b * self.correlation * sa * sb;
-        libm::sqrtf(var.max(0.0) / amp2)
-    }
-
-    /// 1-sigma of the phase, deg (linearised; large when the amplitude is near 0).
-    pub fn phase_sigma_deg(&self) -> f32 {
-        let (a, b) = (self.cos_dph, self.sin_dph);
-        let amp2 = a * a + b * b;
-        if amp2 <= 0.0 {
-            return 180.0;
-        }
-        let (sa, sb) = (self.cos_sigma_dph, self.sin_sigma_dph);
-        let var = b * b * sa * sa + a * a * sb * sb - 2.0 * a * b * self.correlation * sa * sb;
-        (libm::sqrtf(var.max(0.0)) / amp2).to_degrees().min(180.0)
-    }
-}
 
 /// One calibration dwell.
 #[derive(Clone, Copy, Debug, PartialEq)]

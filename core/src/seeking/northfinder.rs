@@ -31,8 +31,8 @@
 use crate::compensation::compensator::WindowResult;
 use crate::consts::earth_rate_horizontal_dph;
 use crate::hal::{TableState, Turntable};
+use crate::model::heading::HeadingHarmonic;
 use crate::numeric::wrap_360_deg as wrap_360;
-use crate::seeking::heading_cal::HeadingHarmonic;
 use crate::seeking::tilt::{axis_coefficients, AxisCoefficients, Tilt};
 
 /// Most table positions in one seek.

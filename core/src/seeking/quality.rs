@@ -17,7 +17,7 @@
 use crate::compensation::compensator::WindowResult;
 use crate::consts::{EARTH_RATE_DPH, WINDOW_S};
 use crate::hal::Turntable;
-use crate::link::bit::{BitItem, BitWord};
+use crate::seeking::bit::{BitItem, BitWord};
 use crate::seeking::northfinder::{
     NorthFinder, SeekConfig, SeekError, SeekMode, SeekResult, SeekStatus,
 };
@@ -519,8 +519,8 @@ mod tests {
     use super::*;
     use crate::compensation::compensator::WindowStatus;
     use crate::hal::TableState;
-    use crate::link::bit::BitItem;
     use crate::model::synthetic::SplitMix64;
+    use crate::seeking::bit::BitItem;
     use crate::seeking::tilt::earth_rate_on_axis_dph;
 
     /// Table that settles 5 s after every command.

@@ -68,18 +68,19 @@ use cortex_m_rt::entry;
 use embedded_hal_nb::serial::{Read as _, Write as _};
 use fog_core::compensation::compensator::Compensator;
 use fog_core::hal::Gyro;
-use fog_core::link::bit::BitLimits;
 use fog_core::link::messages::{Command, DeviceMessage, FaultState, Refusal, ResetReason};
 use fog_core::link::upload::ResetRecord;
+use fog_core::seeking::bit::BitLimits;
 use fog_core::seeking::field_record::FieldRecord;
 use fog_core::seeking::tilt::Tilt;
 use fog_firmware::app::{App, AppConfig, BoardStatus, SeekOutcome};
 use fog_firmware::bit_monitor::{BitCounters, BitMonitor};
 use fog_firmware::boot_args::{BootArgs, Inject};
 use fog_firmware::clock::Clock;
+use fog_firmware::drivers::base_inclinometer::BaseInclinometer;
 use fog_firmware::drivers::fog_serial::FogSerialGyro;
 use fog_firmware::drivers::inclinometer::{
-    BaseInclinometer, Inclinometer, SimulatedInclinometer, SIMULATED_NOISE_DEG,
+    Inclinometer, SimulatedInclinometer, SIMULATED_NOISE_DEG,
 };
 use fog_firmware::drivers::serial_inclinometer::SerialInclinometer;
 use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig};

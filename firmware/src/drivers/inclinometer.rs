@@ -1,7 +1,9 @@
 //! The base-tilt sensor as one trait, so the application reads "an inclinometer" whether it
 //! is the SCL3300 on SPI (a board), one streaming frames on a UART
 //! (`serial_inclinometer`: QEMU with `fogsim rig --incl-port`) or a simulated one (QEMU
-//! without an inclinometer link); `BaseInclinometer` is the one a binary chose at boot.
+//! without an inclinometer link); `base_inclinometer::BaseInclinometer` is the one a binary
+//! chose at boot. This file holds the trait, its SCL3300 implementation and the simulated
+//! part; the drivers that implement it import it from here, and nothing here names them.
 //!
 //! The simulated part returns a fixed tilt (given on the QEMU command line) plus white
 //! noise of the SCL3300's order (0.003 deg per 1 Hz reading in inclination mode 4, the
@@ -12,8 +14,6 @@ use fog_core::model::synthetic::SplitMix64;
 use fog_core::seeking::tilt::Tilt;
 
 use super::scl3300::{Scl3300, Scl3300Error};
-use super::serial_inclinometer::{SerialInclinometer, SerialInclinometerError};
-use embedded_hal_nb::serial::Read;
 
 /// A two-axis base-tilt sensor.
 pub trait Inclinometer {
@@ -72,31 +72,5 @@ impl Inclinometer for SimulatedInclinometer {
             pitch_deg: self.tilt.pitch_deg + self.noise(),
             roll_deg: self.tilt.roll_deg + self.noise(),
         })
-    }
-}
-
-/// The inclinometer chosen at boot: the serial link's, or the simulated one.
-pub enum BaseInclinometer<S> {
-    Serial(SerialInclinometer<S>),
-    Simulated(SimulatedInclinometer),
-}
-
-impl<S: Read<u8>> BaseInclinometer<S> {
-    /// Drains the serial link (every main-loop pass); nothing to do for the simulated one.
-    pub fn poll(&mut self) {
-        if let Self::Serial(s) = self {
-            s.poll();
-        }
-    }
-}
-
-impl<S: Read<u8>> Inclinometer for BaseInclinometer<S> {
-    type Error = SerialInclinometerError;
-
-    fn read_tilt(&mut self) -> Result<Tilt, SerialInclinometerError> {
-        match self {
-            Self::Serial(s) => s.read_tilt(),
-            Self::Simulated(s) => s.read_tilt().map_err(|never| match never {}),
-        }
     }
 }

@@ -2,6 +2,7 @@
 //! that the same code runs on any MCU HAL and against `embedded-hal-mock` on the host.
 //! Each one implements the matching `fog_core::hal` trait.
 
+pub mod base_inclinometer;
 pub mod fog_serial;
 pub mod inclinometer;
 pub mod scl3300;

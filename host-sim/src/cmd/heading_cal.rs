@@ -11,7 +11,7 @@
 //!
 //! From `diagnose --json`: `between_run.heading` gives amplitude A (deg/h) and the phase
 //! (deg, the azimuth of largest bias), so a = A cos(phase), b = A sin(phase), the
-//! convention of `fog_core::seeking::heading_cal::HeadingHarmonic` (phase = atan2(b, a)). The
+//! convention of `fog_core::model::heading::HeadingHarmonic` (phase = atan2(b, a)). The
 //! 1-sigma of a and b is the leave-one-run-out rms of the run offsets with the harmonic
 //! times sqrt(2 / runs) (least squares over runs spread round the circle), unless
 //! `--sigma-dph` is given.
@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 use fog_core::model::format::MAX_ENCODED_LEN;
-use fog_core::seeking::heading_cal::HeadingHarmonic;
+use fog_core::model::heading::HeadingHarmonic;
 use serde::Deserialize;
 
 use super::check_output_file;

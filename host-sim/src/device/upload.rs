@@ -16,10 +16,11 @@ use anyhow::Context;
 use ed25519_compact::{KeyPair, Seed};
 use fog_core::link::messages::{DeviceFrame, HostFrame};
 use fog_core::link::upload::{
-    crc32, decode_message, encode_frame, signed_prefix, DeviceStatus, FrameError, FrameReceiver,
+    decode_message, encode_frame, signed_prefix, DeviceStatus, FrameError, FrameReceiver,
     ModelInfo, Request, Response, UploadError, MAX_CHUNK_LEN, MAX_WIRE_FRAME_LEN, PROTOCOL_VERSION,
     SIGNATURE_LEN, STATUS_REQUEST_PADDING,
 };
+use fog_core::model::crc::crc32;
 
 /// The repository's TEST signing seed (public! see keys/README.md).
 pub fn test_key_path() -> PathBuf {

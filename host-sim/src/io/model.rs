@@ -4,7 +4,8 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use fog_core::model::format::{ModelError, RbfModel, MAX_ENCODED_LEN};
+use fog_core::model::error::ModelError;
+use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
 
 use super::bounded::{read_bounded, BoundedReadError};
 
@@ -61,5 +62,5 @@ pub fn model_crc32(model: &RbfModel) -> anyhow::Result<u32> {
     let n = model
         .encode(&mut buf)
         .map_err(|e| anyhow::anyhow!("encoding the model: {e}"))?;
-    Ok(fog_core::link::upload::crc32(&buf[..n]))
+    Ok(fog_core::model::crc::crc32(&buf[..n]))
 }

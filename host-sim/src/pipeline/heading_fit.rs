@@ -10,7 +10,8 @@
 
 use anyhow::{bail, Result};
 use fog_core::model::format::RbfModel;
-use fog_core::seeking::heading_cal::{calibrate, HeadingDwell, HeadingHarmonic};
+use fog_core::model::heading::HeadingHarmonic;
+use fog_core::seeking::heading_cal::{calibrate, HeadingDwell};
 use fog_core::seeking::tilt::Tilt;
 
 use crate::io::runs::Run;

@@ -35,7 +35,7 @@ impl ModelRecord {
             .iter()
             .map(|i| format!("{:?}", i.kind))
             .collect();
-        let model_crc32 = fog_core::link::upload::crc32(bytes);
+        let model_crc32 = fog_core::model::crc::crc32(bytes);
         Self {
             gyro_id: model.meta.gyro_id.to_string(),
             model_crc32,

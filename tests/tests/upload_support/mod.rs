@@ -78,7 +78,7 @@ pub fn patch_body(encoded: &[u8], patch: impl FnOnce(&mut Vec<u8>)) -> Vec<u8> {
         postcard::from_bytes(encoded).expect("envelope decodes");
     let mut body = body.to_vec();
     patch(&mut body);
-    let crc = fog_core::model::format::crc32(&body);
+    let crc = fog_core::model::crc::crc32(&body);
     postcard::to_allocvec(&(magic, version, body.as_slice(), crc)).expect("re-encodes")
 }
 

@@ -161,8 +161,8 @@ fn handle(
 mod tests {
     use super::*;
     use crate::registry::{Registry, RESULTS_CSV_HEADER};
-    use fog_core::link::bit::BitWord;
     use fog_core::link::messages::{ResetReason, LINK_VERSION};
+    use fog_core::seeking::bit::BitWord;
     use fog_core::seeking::quality::SeekState;
     use fog_core::seeking::quality::Validity;
     use fog_core::seeking::tilt::Tilt;

@@ -3,7 +3,8 @@
 
 use anyhow::{anyhow, bail, Context, Result};
 use fog_core::model::format::RbfModel;
-use fog_core::seeking::heading_cal::{calibrate, HeadingDwell, HeadingHarmonic};
+use fog_core::model::heading::HeadingHarmonic;
+use fog_core::seeking::heading_cal::{calibrate, HeadingDwell};
 use fog_core::seeking::tilt::Tilt;
 
 use super::config::MonteCarloConfig;

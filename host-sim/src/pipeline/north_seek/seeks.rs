@@ -6,10 +6,10 @@
 use anyhow::{anyhow, bail, Result};
 use fog_core::compensation::compensator::{Compensator, CompensatorConfig};
 use fog_core::hal::{Gyro, GyroSample, TempSample, TemperatureSensor, Turntable};
-use fog_core::link::bit::{evaluate, BitInputs, BitLimits, BitWord};
 use fog_core::model::format::RbfModel;
+use fog_core::model::heading::HeadingHarmonic;
+use fog_core::seeking::bit::{evaluate, BitInputs, BitLimits, BitWord};
 use fog_core::seeking::field_record::{record_of_seek, FieldRecord, SeekTempState};
-use fog_core::seeking::heading_cal::HeadingHarmonic;
 use fog_core::seeking::northfinder::{NorthFinder, SeekStatus, MAX_POSITIONS};
 use fog_core::seeking::quality::{
     QualityConfig, QualityError, SeekSupervisor, SupervisorEvent, Validity,

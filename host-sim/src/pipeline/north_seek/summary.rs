@@ -2,7 +2,7 @@
 //! per-seek statistics, refusals and reliability, the JSON report and the terminal tables.
 
 use fog_core::consts::earth_rate_horizontal_dph;
-use fog_core::seeking::heading_cal::HeadingHarmonic;
+use fog_core::model::heading::HeadingHarmonic;
 use fog_core::seeking::northfinder::SeekMode;
 use fog_core::seeking::quality::QualityError;
 use serde::Serialize;

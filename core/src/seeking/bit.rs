@@ -4,6 +4,10 @@
 //! Exists so that the firmware, the status message and `fogsim monitor` agree on what each
 //! bit means, and so that the rule is a pure, host-tested function. A bit SET means the item
 //! FAILED, so 0 is "all good" and a new item added later reads as passing on old hosts.
+//!
+//! It lives in `seeking` because the rule is the seek's: the seek supervisor (`quality`)
+//! refuses to start or continue on a failed item; the link (`link::messages`) only carries
+//! the word in the status, so it imports it from here, never the other way round.
 
 use serde::{Deserialize, Serialize};
 
