@@ -5,7 +5,7 @@
 //! coefficient close to the planted one, and re-simulating with the emitted term (same
 //! seeds) must bring the simulator closer to the "measured" campaign than without it.
 
-use fog_sim::diagnose::{diagnose, library::transforms::Transform};
+use fog_sim::diagnose::{candidates::transforms::Transform, diagnose};
 use fog_sim::io::runs::Run;
 use fog_sim::sim::{
     simulate_run, AuxSource, AuxTransform, DriftTerm, GyroParams, RunSpec, StartState,

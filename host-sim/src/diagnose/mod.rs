@@ -13,16 +13,16 @@
 //! [`validation`] (folds over whole runs or buffered blocks, the sign-flip test) and
 //! [`linalg`] serve every stage.
 
-pub mod base;
-pub mod between;
+pub mod baseline;
+pub mod between_runs;
+pub mod candidates;
 pub mod error;
 pub mod input;
-pub mod library;
 pub mod linalg;
 pub mod memprobe;
 pub mod report;
 pub mod selection;
-pub mod simulator;
+pub mod sim_fit;
 pub mod uncertainty;
 pub mod validation;
 
@@ -31,7 +31,7 @@ pub use report::Report;
 pub use selection::cause::Cause;
 
 use crate::io::runs::Run;
-use base::models::Stacked;
+use baseline::models::Stacked;
 use input::Exclusion;
 use report::{
     Azimuth, CampaignSummary, CandidateRow, Competitor, DriftStd, Extended, ModelSummary,
@@ -94,7 +94,7 @@ pub fn diagnose_with(
     let (folds, mut st, choice) = layout_and_base(&campaign, rule)?;
     let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
     let latitude = latitude_of(&campaign);
-    let meta = library::generic::metadata(runs);
+    let meta = candidates::generic::metadata(runs);
     let (library, cap_note) = library_of(&campaign, &meta, st.temp_rate_half_s);
     let (choice, mut screening, base_rule, between_run, groups) =
         screen_both(&campaign, &meta, &folds, &st, choice, &library, latitude)?;
@@ -104,7 +104,7 @@ pub fn diagnose_with(
     let cause = named.map(|s| Cause::from(&s.scored.cand));
     let (sim_design, sim) = simulator_stage(&campaign, &folds, &st, named)?;
     let causal_derivative = named
-        .and_then(|s| library::causal::check(&campaign, &folds, base, &s.scored.cand, &s.cols));
+        .and_then(|s| candidates::causal::check(&campaign, &folds, base, &s.scored.cand, &s.cols));
     let (extended, ext_resid) = extended_model(base, &screening);
     let named_feature = named.map(|s| uncertainty::NamedFeature {
         label: s.scored.cand.label(),
@@ -134,7 +134,7 @@ pub fn diagnose_with(
         smallest_attainable_p,
         power_check.as_ref(),
     );
-    let sim_terms = simulator::simterm::terms_per_run(runs, cause.as_ref(), &sim.effect_coef);
+    let sim_terms = sim_fit::drift_terms::terms_per_run(runs, cause.as_ref(), &sim.effect_coef);
     let cause_column = cause.as_ref().map(|c| c.column.clone());
     let report = Report {
         campaign: CampaignSummary {
@@ -190,19 +190,19 @@ pub fn diagnose_with(
 
 /// The validation layout, the stacked campaign and the base: buffers between time blocks
 /// are sized on the base with the device's dT/dt span; the base and its dT/dt window are
-/// then chosen on that layout (`base::bases::choose_with_rate_window`).
+/// then chosen on that layout (`baseline::choice::choose_with_rate_window`).
 fn layout_and_base(
     campaign: &input::Campaign,
     rule: validation::buffer::BufferRule,
-) -> Result<(Folds, Stacked, base::bases::BaseChoice), DiagnoseError> {
+) -> Result<(Folds, Stacked, baseline::choice::BaseChoice), DiagnoseError> {
     memprobe::stage("input::prepare");
-    let device_rate = Stacked::with_rate_half_width(campaign, base::bases::device_rate_half_s());
+    let device_rate = Stacked::with_rate_half_width(campaign, baseline::choice::device_rate_half_s());
     let run_lengths: Vec<usize> = campaign.runs.iter().map(|s| s.t_s.len()).collect();
     let (folds, device_choice) =
         validation::buffer::choose_buffered(Folds::new(&run_lengths)?, &device_rate, rule)?;
     memprobe::stage("layout: device-rate stack + buffered folds");
     let (st, choice) =
-        base::bases::choose_with_rate_window(campaign, &folds, (device_rate, device_choice))?;
+        baseline::choice::choose_with_rate_window(campaign, &folds, (device_rate, device_choice))?;
     memprobe::stage("layout_and_base");
     Ok((folds, st, choice))
 }
@@ -216,14 +216,14 @@ fn simulator_stage(
     named: Option<&selection::screen::Step>,
 ) -> Result<
     (
-        simulator::simfit::SimDesign,
-        simulator::simfit::SimCalibration,
+        sim_fit::calibrate::SimDesign,
+        sim_fit::calibrate::SimCalibration,
     ),
     DiagnoseError,
 > {
-    let sim_design = simulator::simfit::SimDesign::new(campaign);
+    let sim_design = sim_fit::calibrate::SimDesign::new(campaign);
     memprobe::stage("SimDesign::new");
-    let sim = simulator::simfit::calibrate(
+    let sim = sim_fit::calibrate::calibrate(
         &sim_design,
         &folds.run_rows,
         &st.y,
@@ -248,7 +248,7 @@ fn azimuth(
     campaign: &input::Campaign,
     folds: &Folds,
     st: &Stacked,
-    base: &base::bases::BaseFit,
+    base: &baseline::choice::BaseFit,
     ext_resid: &[f64],
     latitude: f64,
 ) -> Option<Azimuth> {
@@ -277,20 +277,20 @@ fn competing(screening: &Screening, unit_names: &[String]) -> Vec<Competitor> {
 /// The generic library and, if the cap left candidates out, a note saying so.
 fn library_of(
     campaign: &input::Campaign,
-    meta: &[library::generic::MetaColumn],
+    meta: &[candidates::generic::MetaColumn],
     rate_half_s: f64,
 ) -> (
-    Vec<library::transforms::Candidate>,
+    Vec<candidates::transforms::Candidate>,
     Option<selection::screen::Skipped>,
 ) {
-    let (library, left_out) = library::generic::enumerate(campaign, meta, rate_half_s);
+    let (library, left_out) = candidates::generic::enumerate(campaign, meta, rate_half_s);
     memprobe::stage("library");
     let note = (left_out > 0).then(|| {
         (
             format!("{left_out} candidates"),
             format!(
                 "library capped at {} candidates",
-                library::generic::MAX_CANDIDATES
+                candidates::generic::MAX_CANDIDATES
             ),
         )
     });
@@ -303,23 +303,23 @@ fn library_of(
 /// selections, how the base was chosen and the number of sequences.
 fn screen_both(
     campaign: &input::Campaign,
-    meta: &[library::generic::MetaColumn],
+    meta: &[candidates::generic::MetaColumn],
     folds: &Folds,
     st: &Stacked,
-    choice: base::bases::BaseChoice,
-    library: &[library::transforms::Candidate],
+    choice: baseline::choice::BaseChoice,
+    library: &[candidates::transforms::Candidate],
     latitude_deg: f64,
 ) -> Result<
     (
-        base::bases::BaseChoice,
+        baseline::choice::BaseChoice,
         Screening,
         selection::parsimony::BaseRule,
-        between::BetweenRun,
+        between_runs::BetweenRun,
         f64,
     ),
     DiagnoseError,
 > {
-    let groups = if between::runs_held_out_whole(folds) {
+    let groups = if between_runs::runs_held_out_whole(folds) {
         2.0
     } else {
         1.0
@@ -333,7 +333,7 @@ fn screen_both(
         groups,
         selection::screen::MAX_STEPS,
     )?;
-    let run_level = between::prepare(
+    let run_level = between_runs::prepare(
         campaign,
         meta,
         folds,
@@ -342,8 +342,8 @@ fn screen_both(
         choice.levels.as_ref(),
     );
     let between_run = match run_level {
-        Ok(p) => between::finish(p, groups, latitude_deg),
-        Err(note) => between::BetweenRun {
+        Ok(p) => between_runs::finish(p, groups, latitude_deg),
+        Err(note) => between_runs::BetweenRun {
             turn_on_repeatability_dph: f64::NAN,
             offsets_heldout_rms_dph: f64::NAN,
             offsets_from: String::new(),
@@ -360,7 +360,7 @@ fn screen_both(
 
 /// The base extended by every named within-run cause (the base itself when nothing is
 /// named), and its held-out residual.
-fn extended_model(base: &base::bases::BaseFit, screening: &Screening) -> (Extended, Vec<f64>) {
+fn extended_model(base: &baseline::choice::BaseFit, screening: &Screening) -> (Extended, Vec<f64>) {
     let mut inputs = base.spec.inputs();
     inputs.extend(screening.steps.iter().map(|s| s.scored.cand.label()));
     let cv = screening.final_cv(base);
@@ -380,9 +380,9 @@ fn extended_model(base: &base::bases::BaseFit, screening: &Screening) -> (Extend
 fn named_causes(
     folds: &Folds,
     st: &Stacked,
-    base: &base::bases::BaseFit,
+    base: &baseline::choice::BaseFit,
     screening: &Screening,
-    between_run: &between::BetweenRun,
+    between_run: &between_runs::BetweenRun,
     latitude_deg: f64,
 ) -> Vec<NamedCause> {
     let sigma = |r: &[f64]| {
@@ -434,7 +434,7 @@ fn named_causes(
 
 /// The chosen base and every base tried, for the report.
 fn base_summary(
-    choice: &base::bases::BaseChoice,
+    choice: &baseline::choice::BaseChoice,
     rule: selection::parsimony::BaseRule,
     st: &Stacked,
     campaign: &input::Campaign,
@@ -445,7 +445,7 @@ fn base_summary(
         poly_degree_t: base.spec.poly_degree_t,
         uses_rate: base.spec.uses_rate,
         rate_half_width_s: st.temp_rate_half_s,
-        rate_effective_half_width_s: library::derivatives::effective_half_width_s(
+        rate_effective_half_width_s: candidates::derivatives::effective_half_width_s(
             &campaign
                 .runs
                 .iter()
@@ -503,7 +503,7 @@ fn to_exclusion((column, reason): &selection::screen::Skipped) -> Exclusion {
 fn cause_in_words(
     cause: Option<&Cause>,
     all: &[NamedCause],
-    between_run: &between::BetweenRun,
+    between_run: &between_runs::BetweenRun,
     coef: &[f64],
     smallest_attainable_p: f64,
     power_check: Option<&selection::power::PowerCheck>,
@@ -534,15 +534,15 @@ fn cause_in_words(
 
 /// The simulator before/after and the terms added (listed for the first run).
 fn simulation_summary(
-    sim: simulator::simfit::SimCalibration,
+    sim: sim_fit::calibrate::SimCalibration,
     sim_terms: &[Vec<crate::sim::DriftTerm>],
     cause_column: Option<&str>,
 ) -> Simulation {
-    let terms: Vec<simulator::simterm::TermSummary> = sim_terms
+    let terms: Vec<sim_fit::drift_terms::TermSummary> = sim_terms
         .first()
         .into_iter()
         .flatten()
-        .map(|t| simulator::simterm::summarize(t, cause_column.unwrap_or("")))
+        .map(|t| sim_fit::drift_terms::summarize(t, cause_column.unwrap_or("")))
         .collect();
     Simulation {
         before_rms_dph: sim.before_rms_dph,

@@ -10,7 +10,7 @@
 pub mod rawrows;
 
 use super::error::DiagnoseError;
-use crate::diagnose::library::derivatives::{self, WidthChoice};
+use crate::diagnose::candidates::derivatives::{self, WidthChoice};
 use crate::io::runs::Run;
 
 /// Window length the model works on, s.

@@ -8,12 +8,12 @@ pub mod plots;
 pub mod residuals;
 
 use crate::diagnose::input::Exclusion;
-use crate::diagnose::library::transforms::Transform;
+use crate::diagnose::candidates::transforms::Transform;
 use crate::diagnose::report::azimuth::AzimuthEffect;
 use crate::diagnose::report::residuals::Structure;
 use crate::diagnose::selection::cause::Cause;
-use crate::diagnose::simulator::simfit::SimCalibration;
-use crate::diagnose::simulator::simterm::TermSummary;
+use crate::diagnose::sim_fit::calibrate::SimCalibration;
+use crate::diagnose::sim_fit::drift_terms::TermSummary;
 use serde::Serialize;
 use std::fmt::Write as _;
 
@@ -34,12 +34,12 @@ pub struct ModelSummary {
     pub width_factor: f64,
     pub ridge: f64,
     /// Every base tried with its held-out rms (the reference of the parsimony rule, `rule`).
-    pub tried: Vec<crate::diagnose::base::bases::BaseScore>,
+    pub tried: Vec<crate::diagnose::baseline::choice::BaseScore>,
     /// Set when T, time and lags of T are nearly collinear.
     pub collinearity_warning: Option<String>,
     /// Which law holds across runs (shared with random turn-on offsets, or free offsets),
     /// chosen on held-out runs (None for time-block layouts).
-    pub levels: Option<crate::diagnose::base::bases::LevelChoice>,
+    pub levels: Option<crate::diagnose::baseline::choice::LevelChoice>,
     /// How the base was chosen (issue 18 item 6: parsimony).
     pub rule: crate::diagnose::selection::parsimony::BaseRule,
 }
@@ -141,10 +141,10 @@ pub struct Report {
     pub base: ModelSummary,
     pub residual_structure: Structure,
     pub outliers: crate::diagnose::report::outliers::Outliers,
-    pub between_run: crate::diagnose::between::BetweenRun,
+    pub between_run: crate::diagnose::between_runs::BetweenRun,
     /// Half-width of every `rate` / `accel` window, chosen per column by leave-one-out
     /// validation of the local polynomial on the column itself.
-    pub derivative_widths: Vec<crate::diagnose::library::derivatives::WidthChoice>,
+    pub derivative_widths: Vec<crate::diagnose::candidates::derivatives::WidthChoice>,
     pub candidates: Vec<CandidateRow>,
     /// Every named cause, within and between runs, most important first.
     pub named_causes: Vec<NamedCause>,
@@ -156,7 +156,7 @@ pub struct Report {
     pub extended: Extended,
     /// For a named `rate` / `accel` cause: the device's causal estimate, its delay and
     /// held-out gain next to the centred one.
-    pub causal_derivative: Option<crate::diagnose::library::causal::CausalCheck>,
+    pub causal_derivative: Option<crate::diagnose::candidates::causal::CausalCheck>,
     pub drift_std: DriftStd,
     pub azimuth: Option<Azimuth>,
     /// +/- (block bootstrap) on every fitted coefficient, ratios to the simulator.
@@ -344,8 +344,8 @@ fn write_levels(s: &mut String, r: &Report) {
                     "{}/{} {:.4} +/- {:.4}",
                     b.spec.name,
                     match v.law {
-                        crate::diagnose::base::levels::Law::Shared => "shared",
-                        crate::diagnose::base::levels::Law::Free => "free",
+                        crate::diagnose::baseline::levels::Law::Shared => "shared",
+                        crate::diagnose::baseline::levels::Law::Free => "free",
                     },
                     v.score.heldout_rms_dph,
                     v.score.standard_error_dph
@@ -363,7 +363,7 @@ fn write_levels(s: &mut String, r: &Report) {
         "  levels chosen: {} ({}), {:.4} +/- {:.4} deg/h: the simplest within one standard error of the best, {} {:.4} +/- {:.4}; \
          turn-on repeatability {:.4} deg/h",
         l.base,
-        crate::diagnose::base::bases::law_name(l.law),
+        crate::diagnose::baseline::choice::law_name(l.law),
         l.score.heldout_rms_dph,
         l.score.standard_error_dph,
         l.best,
@@ -422,7 +422,7 @@ fn write_residual(s: &mut String, r: &Report) {
 /// The validated derivative windows, one line per column.
 fn write_derivative_widths(
     s: &mut String,
-    widths: &[crate::diagnose::library::derivatives::WidthChoice],
+    widths: &[crate::diagnose::candidates::derivatives::WidthChoice],
 ) {
     let _ = writeln!(
         s,
@@ -450,7 +450,7 @@ fn write_derivative_widths(
 }
 
 /// The named derivative as the device would compute it (causal), next to the centred one.
-fn write_causal(s: &mut String, c: &crate::diagnose::library::causal::CausalCheck) {
+fn write_causal(s: &mut String, c: &crate::diagnose::candidates::causal::CausalCheck) {
     let causal: Vec<String> = c
         .causal
         .iter()

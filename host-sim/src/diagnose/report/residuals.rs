@@ -1,7 +1,7 @@
 //! Where the baseline's held-out residual has structure: by time since power-on, per
 //! ambient temperature, and against each signal (within-run correlation).
 
-use crate::diagnose::base::models::Stacked;
+use crate::diagnose::baseline::models::Stacked;
 use crate::diagnose::input::Campaign;
 use crate::diagnose::validation::cv::Folds;
 use serde::Serialize;

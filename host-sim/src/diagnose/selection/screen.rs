@@ -26,10 +26,10 @@
 //! competing explanations: the data cannot tell them apart. The steps stop when nothing
 //! passes or after `MAX_STEPS`.
 
-use crate::diagnose::base::bases::BaseFit;
+use crate::diagnose::baseline::choice::BaseFit;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
-use crate::diagnose::library::transforms::Candidate;
+use crate::diagnose::candidates::transforms::Candidate;
 use crate::diagnose::validation::cv::{CvResult, Folds, Offsets};
 use crate::diagnose::validation::signflip::{max_t_pvalues, paired_pvalue};
 

@@ -16,7 +16,7 @@
 //! loser is reported as separated; otherwise both stay, "not distinguishable on this
 //! data", with the units where they differ most, which is where more data would decide.
 
-use crate::diagnose::base::bases::BaseFit;
+use crate::diagnose::baseline::choice::BaseFit;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::validation::cv::{CvResult, Folds};
 use crate::diagnose::validation::signflip::{paired_pvalue, smallest_p};

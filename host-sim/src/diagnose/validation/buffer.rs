@@ -22,8 +22,8 @@
 //! (~70 candidates), and shifting a warm-up or cool-down record wraps its end onto its
 //! start, a jump no physical record has; the buffer keeps the sign-flip family test.
 
-use crate::diagnose::base::bases::{choose, BaseChoice};
-use crate::diagnose::base::models::Stacked;
+use crate::diagnose::baseline::choice::{choose, BaseChoice};
+use crate::diagnose::baseline::models::Stacked;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::validation::cv::{Folds, Offsets};
 

@@ -11,7 +11,7 @@
 //! multiplies the (centred) feature by one of the base's inputs (T - mean T, dT/dt).
 
 use crate::diagnose::input::Series;
-use crate::diagnose::library::derivatives;
+use crate::diagnose::candidates::derivatives;
 use serde::Serialize;
 
 /// How a column is turned into a feature.
@@ -202,7 +202,7 @@ impl Candidate {
                 .map(|l| {
                     x.iter()
                         .map(|v| {
-                            crate::diagnose::library::generic::level_weight(*v, *l, &self.levels)
+                            crate::diagnose::candidates::generic::level_weight(*v, *l, &self.levels)
                         })
                         .collect()
                 })

@@ -13,11 +13,11 @@
 //! this measures how well the simulator's physics can reproduce the record, not how well
 //! a black box fits it.
 
-use crate::diagnose::base::levels::LevelSystems;
+use crate::diagnose::baseline::levels::LevelSystems;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
 use crate::diagnose::linalg::solve_spd;
-use crate::diagnose::simulator::thermal::{self, Curves, ThermalFit};
+use crate::diagnose::sim_fit::thermal::{self, Curves, ThermalFit};
 use crate::diagnose::validation::design::{columns, Design, WithColumns};
 use crate::stats::rms;
 use serde::Serialize;

@@ -15,7 +15,7 @@
 //! reported as such); about 20 per column.
 
 use crate::diagnose::input::Campaign;
-use crate::diagnose::library::transforms::{BaseInput, Candidate, Source, Transform};
+use crate::diagnose::candidates::transforms::{BaseInput, Candidate, Source, Transform};
 use crate::io::runs::Run;
 
 /// Cap on the library's size (the rest are reported as skipped).

@@ -13,12 +13,12 @@
 //! shuffled across runs) is reported next to each candidate as a check. The run-level
 //! library: the run mean (angles: circular-mean harmonic) of every extra column, the
 //! ambient, and every metadata key that varies between runs (numbers as values,
-//! categories as levels; `library::generic::metadata`).
+//! categories as levels; `candidates::generic::metadata`).
 
-use crate::diagnose::base::bases::BaseFit;
-use crate::diagnose::base::models::Stacked;
+use crate::diagnose::baseline::choice::BaseFit;
+use crate::diagnose::baseline::models::Stacked;
 use crate::diagnose::input::Campaign;
-use crate::diagnose::library::generic::MetaColumn;
+use crate::diagnose::candidates::generic::MetaColumn;
 use crate::diagnose::linalg::solve_spd;
 use crate::diagnose::selection::screen::{ALPHA, FLIP_SEED, MIN_GAIN_PCT};
 use crate::diagnose::validation::cv::Folds;
@@ -183,7 +183,7 @@ pub fn enumerate(c: &Campaign, meta: &[MetaColumn]) -> Vec<RunCandidate> {
     for m in meta.iter().filter(|m| m.run_values.len() == c.runs.len()) {
         let levels = m
             .categorical
-            .then(|| crate::diagnose::library::generic::few_levels(m.run_values.iter().copied()))
+            .then(|| crate::diagnose::candidates::generic::few_levels(m.run_values.iter().copied()))
             .flatten();
         let (label, features) = match levels {
             Some(l) => {
@@ -327,7 +327,7 @@ pub fn heading_effect(column: &str, coef: &[f64], latitude_deg: f64) -> HeadingE
 pub enum LevelModel {
     Free(Vec<f64>),
     Shared(
-        std::sync::Arc<crate::diagnose::base::levels::LevelSystems>,
+        std::sync::Arc<crate::diagnose::baseline::levels::LevelSystems>,
         f64,
     ),
 }
@@ -383,7 +383,7 @@ pub fn prepare(
     folds: &Folds,
     st: &Stacked,
     base: &BaseFit,
-    levels: Option<&crate::diagnose::base::bases::LevelChoice>,
+    levels: Option<&crate::diagnose::baseline::choice::LevelChoice>,
 ) -> Result<Prepared, String> {
     if !runs_held_out_whole(folds) {
         return Err("between-run effects need >= 4 runs held out whole".into());
@@ -394,7 +394,7 @@ pub fn prepare(
             format!(
                 "{} ({})",
                 l.base,
-                crate::diagnose::base::bases::law_name(l.law)
+                crate::diagnose::baseline::choice::law_name(l.law)
             ),
         ),
         None => (
@@ -406,7 +406,7 @@ pub fn prepare(
     let offsets_rms_dph =
         loo_gains(&offsets, &lens, &vec![vec![]; offsets.len()]).map_or(f64::NAN, |(_, r0, _)| r0);
     let shared = levels
-        .filter(|l| l.law == crate::diagnose::base::levels::Law::Shared)
+        .filter(|l| l.law == crate::diagnose::baseline::levels::Law::Shared)
         .and_then(|l| Some((l.systems.clone()?, l.theta)));
     let model = match shared {
         Some((lv, th)) if lv.heldout_level_errors(th).is_some() => LevelModel::Shared(lv, th),

@@ -8,8 +8,8 @@
 //! named on it (`selection::parsimony`, issue 18 item 6). Every score, its standard error
 //! and the paired p that the lowest beats it are reported.
 
-use crate::diagnose::base::levels::{score, Law, LevelSystems, Score};
-use crate::diagnose::base::models::{fit_rbf, Stacked, RIDGES};
+use crate::diagnose::baseline::levels::{score, Law, LevelSystems, Score};
+use crate::diagnose::baseline::models::{fit_rbf, Stacked, RIDGES};
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::validation::cv::{CvResult, Folds, Prepared};
 use crate::diagnose::validation::design::Design;
@@ -59,7 +59,7 @@ pub struct BaseFit {
     pub width_factor: f64,
     pub ridge: f64,
     /// The RBF basis (None for polynomial and constant bases).
-    pub basis: Option<crate::diagnose::base::basis::RbfBasis>,
+    pub basis: Option<crate::diagnose::baseline::rbf_basis::RbfBasis>,
 }
 
 impl BaseFit {

@@ -3,10 +3,10 @@
 //! as a linear term or as a further RBF input. Width and ridge are chosen on held-out
 //! data from a small grid, the same way for every model, so comparisons are fair.
 
-use crate::diagnose::base::basis::{RbfBasis, RbfDesign};
+use crate::diagnose::baseline::rbf_basis::{RbfBasis, RbfDesign};
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
-use crate::diagnose::library::derivatives;
+use crate::diagnose::candidates::derivatives;
 use crate::diagnose::validation::cv::{CvResult, Folds, Prepared};
 use std::sync::Arc;
 

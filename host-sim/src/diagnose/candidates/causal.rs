@@ -10,9 +10,9 @@
 //! column) gets fog-core's trailing least-squares fit (`TempRateEstimator`'s quadratic
 //! term) instead, and the report says it is not on the device.
 
-use crate::diagnose::base::bases::BaseFit;
+use crate::diagnose::baseline::choice::BaseFit;
 use crate::diagnose::input::Campaign;
-use crate::diagnose::library::transforms::{Candidate, Source, Transform};
+use crate::diagnose::candidates::transforms::{Candidate, Source, Transform};
 use crate::diagnose::validation::cv::Folds;
 use fog_core::compensation::features::{
     features_for_series, FeatureVector, TempRateEstimator, DEFAULT_ACCEL_SPAN_S,
@@ -184,7 +184,7 @@ pub fn check(
         .iter()
         .map(|s| (s.t_s.as_slice(), s.t_s.as_slice()))
         .collect();
-    let dt = crate::diagnose::library::derivatives::median_spacing_s(
+    let dt = crate::diagnose::candidates::derivatives::median_spacing_s(
         &runs,
         crate::diagnose::input::WINDOW_S,
     );
