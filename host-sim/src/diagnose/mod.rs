@@ -196,7 +196,8 @@ fn layout_and_base(
     rule: validation::buffer::BufferRule,
 ) -> Result<(Folds, Stacked, baseline::choice::BaseChoice), DiagnoseError> {
     memprobe::stage("input::prepare");
-    let device_rate = Stacked::with_rate_half_width(campaign, baseline::choice::device_rate_half_s());
+    let device_rate =
+        Stacked::with_rate_half_width(campaign, baseline::choice::device_rate_half_s());
     let run_lengths: Vec<usize> = campaign.runs.iter().map(|s| s.t_s.len()).collect();
     let (folds, device_choice) =
         validation::buffer::choose_buffered(Folds::new(&run_lengths)?, &device_rate, rule)?;
@@ -445,7 +446,7 @@ fn base_summary(
         poly_degree_t: base.spec.poly_degree_t,
         uses_rate: base.spec.uses_rate,
         rate_half_width_s: st.temp_rate_half_s,
-        rate_effective_half_width_s: candidates::derivatives::effective_half_width_s(
+        rate_effective_half_width_s: input::derivatives::effective_half_width_s(
             &campaign
                 .runs
                 .iter()

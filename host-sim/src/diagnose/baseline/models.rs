@@ -5,8 +5,8 @@
 
 use crate::diagnose::baseline::rbf_basis::{RbfBasis, RbfDesign};
 use crate::diagnose::error::DiagnoseError;
+use crate::diagnose::input::derivatives;
 use crate::diagnose::input::Campaign;
-use crate::diagnose::candidates::derivatives;
 use crate::diagnose::validation::cv::{CvResult, Folds, Prepared};
 use std::sync::Arc;
 

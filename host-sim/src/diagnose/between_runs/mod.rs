@@ -17,8 +17,8 @@
 
 use crate::diagnose::baseline::choice::BaseFit;
 use crate::diagnose::baseline::models::Stacked;
-use crate::diagnose::input::Campaign;
 use crate::diagnose::candidates::generic::MetaColumn;
+use crate::diagnose::input::Campaign;
 use crate::diagnose::linalg::solve_spd;
 use crate::diagnose::selection::screen::{ALPHA, FLIP_SEED, MIN_GAIN_PCT};
 use crate::diagnose::validation::cv::Folds;

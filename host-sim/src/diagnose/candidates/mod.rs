@@ -3,6 +3,5 @@
 //! inputs; `generic`) and what the device can compute of it causally.
 
 pub mod causal;
-pub mod derivatives;
 pub mod generic;
 pub mod transforms;

@@ -7,8 +7,8 @@ pub mod outliers;
 pub mod plots;
 pub mod residuals;
 
-use crate::diagnose::input::Exclusion;
 use crate::diagnose::candidates::transforms::Transform;
+use crate::diagnose::input::Exclusion;
 use crate::diagnose::report::azimuth::AzimuthEffect;
 use crate::diagnose::report::residuals::Structure;
 use crate::diagnose::selection::cause::Cause;
@@ -144,7 +144,7 @@ pub struct Report {
     pub between_run: crate::diagnose::between_runs::BetweenRun,
     /// Half-width of every `rate` / `accel` window, chosen per column by leave-one-out
     /// validation of the local polynomial on the column itself.
-    pub derivative_widths: Vec<crate::diagnose::candidates::derivatives::WidthChoice>,
+    pub derivative_widths: Vec<crate::diagnose::input::derivatives::WidthChoice>,
     pub candidates: Vec<CandidateRow>,
     /// Every named cause, within and between runs, most important first.
     pub named_causes: Vec<NamedCause>,
@@ -422,7 +422,7 @@ fn write_residual(s: &mut String, r: &Report) {
 /// The validated derivative windows, one line per column.
 fn write_derivative_widths(
     s: &mut String,
-    widths: &[crate::diagnose::candidates::derivatives::WidthChoice],
+    widths: &[crate::diagnose::input::derivatives::WidthChoice],
 ) {
     let _ = writeln!(
         s,

@@ -26,9 +26,9 @@
 use crate::diagnose::baseline::choice::{complexity, BaseChoice, BaseScore};
 use crate::diagnose::baseline::levels::{ratio_estimate, score};
 use crate::diagnose::baseline::models::Stacked;
+use crate::diagnose::candidates::transforms::Candidate;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
-use crate::diagnose::candidates::transforms::Candidate;
 use crate::diagnose::selection::screen::{screen, Screening};
 use crate::diagnose::validation::cv::Folds;
 use serde::Serialize;

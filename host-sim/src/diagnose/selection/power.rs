@@ -20,9 +20,9 @@
 
 use crate::diagnose::baseline::choice::{self, BaseFit};
 use crate::diagnose::baseline::models::Stacked;
+use crate::diagnose::candidates::transforms::Candidate;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
-use crate::diagnose::candidates::transforms::Candidate;
 use crate::diagnose::report::residuals::demeaned_by_run;
 use crate::diagnose::selection::screen::{self, Screening};
 use crate::diagnose::validation::cv::Folds;

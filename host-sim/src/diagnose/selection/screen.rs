@@ -27,9 +27,9 @@
 //! passes or after `MAX_STEPS`.
 
 use crate::diagnose::baseline::choice::BaseFit;
+use crate::diagnose::candidates::transforms::Candidate;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
-use crate::diagnose::candidates::transforms::Candidate;
 use crate::diagnose::validation::cv::{CvResult, Folds, Offsets};
 use crate::diagnose::validation::signflip::{max_t_pvalues, paired_pvalue};
 
