@@ -37,7 +37,8 @@ use report::{
     Azimuth, CampaignSummary, CandidateRow, Competitor, DriftStd, Extended, ModelSummary,
     NamedCause, Simulation,
 };
-use selection::screen::{Scored, Screening};
+use selection::scored::Scored;
+use selection::screen::Screening;
 use validation::cv::Folds;
 
 /// Everything the diagnosis computed: the report plus the series the plots need.
@@ -370,7 +371,7 @@ fn extended_model(base: &baseline::choice::BaseFit, screening: &Screening) -> (E
         Extended {
             inputs,
             heldout_rms_dph: cv.rms(),
-            gain_pct: selection::screen::gain_pct(base.cv.rms(), cv.rms()),
+            gain_pct: selection::scored::gain_pct(base.cv.rms(), cv.rms()),
         },
         cv.residual.clone(),
     )

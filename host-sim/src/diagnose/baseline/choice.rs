@@ -188,10 +188,11 @@ pub fn choose_with_rate_window(
     let Ok(loo) = choose(folds, &st) else {
         return Ok((back_to_device(st), device));
     };
-    let gains = crate::diagnose::selection::screen::unit_gains(&device.chosen.cv, &loo.chosen.cv);
+    let gains =
+        crate::diagnose::validation::signflip::unit_gains(&device.chosen.cv, &loo.chosen.cv);
     let p = crate::diagnose::validation::signflip::paired_pvalue(
         &gains,
-        crate::diagnose::selection::screen::FLIP_SEED,
+        crate::diagnose::validation::signflip::FLIP_SEED,
     );
     if loo.chosen.cv.rms() < device.chosen.cv.rms() && p < RATE_WINDOW_ALPHA {
         Ok((st, loo))
@@ -439,7 +440,7 @@ fn paired_against_best(scores: &mut [BaseScore], best: &str) {
             .collect();
         s.paired_p_vs_best = Some(crate::diagnose::validation::signflip::paired_pvalue(
             &gains,
-            crate::diagnose::selection::screen::FLIP_SEED,
+            crate::diagnose::validation::signflip::FLIP_SEED,
         ));
     }
 }

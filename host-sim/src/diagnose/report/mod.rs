@@ -172,11 +172,11 @@ pub fn nothing_named(
     smallest_attainable_p: f64,
     power_check: Option<&crate::diagnose::selection::power::PowerCheck>,
 ) -> String {
-    if smallest_attainable_p >= crate::diagnose::selection::screen::ALPHA {
+    if smallest_attainable_p >= crate::diagnose::selection::scored::ALPHA {
         return format!(
             "cannot decide: no test power (smallest reachable p {smallest_attainable_p:.4} >= alpha {} with this \
              few validation units); absence of a named cause says nothing about the drift",
-            crate::diagnose::selection::screen::ALPHA
+            crate::diagnose::selection::scored::ALPHA
         );
     }
     match power_check.map(|pc| (pc, pc.planted.as_deref())) {
@@ -234,12 +234,12 @@ pub fn render_text(r: &Report) -> String {
 /// Header: campaign size, validation layout, test power, exclusions.
 fn write_campaign(s: &mut String, c: &CampaignSummary) {
     let _ = writeln!(s, "fogsim diagnose: {} runs, {} points (10 s means, or one row per slower sample); validation: {}", c.runs, c.points, c.validation);
-    if c.smallest_attainable_p >= crate::diagnose::selection::screen::ALPHA {
+    if c.smallest_attainable_p >= crate::diagnose::selection::scored::ALPHA {
         let _ = writeln!(
             s,
             "  note: with this few validation units the smallest attainable p is {:.3} >= alpha {}: no cause can be named",
             c.smallest_attainable_p,
-            crate::diagnose::selection::screen::ALPHA
+            crate::diagnose::selection::scored::ALPHA
         );
     }
     if let Some((pc, planted)) = c

@@ -24,6 +24,7 @@ use crate::diagnose::candidates::transforms::Candidate;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
 use crate::diagnose::report::residuals::demeaned_by_run;
+use crate::diagnose::selection::scored::ALPHA;
 use crate::diagnose::selection::screen::{self, Screening};
 use crate::diagnose::validation::cv::Folds;
 use serde::Serialize;
@@ -80,7 +81,7 @@ pub fn check(
     rerun: Rerun<'_>,
 ) -> Result<Option<PowerCheck>, DiagnoseError> {
     let reachable =
-        crate::diagnose::validation::signflip::smallest_p(folds.unit_rows.len()) < screen::ALPHA;
+        crate::diagnose::validation::signflip::smallest_p(folds.unit_rows.len()) < ALPHA;
     if !silent || !reachable || screening.scored.is_empty() {
         return Ok(None);
     }
