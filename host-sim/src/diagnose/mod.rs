@@ -92,7 +92,8 @@ pub fn diagnose_with(
     rule: validation::buffer::BufferRule,
 ) -> Result<Diagnosis, DiagnoseError> {
     let campaign = input::prepare(runs)?;
-    let (folds, mut st, choice) = layout_and_base(&campaign, rule)?;
+    memprobe::stage("input::prepare");
+    let (folds, mut st, choice) = baseline::layout::layout_and_base(&campaign, rule)?;
     let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
     let latitude = latitude_of(&campaign);
     let meta = candidates::generic::metadata(runs);
@@ -187,26 +188,6 @@ pub fn diagnose_with(
         cause_feature: named.and_then(|s| s.cols.first().cloned()),
         sim_terms,
     })
-}
-
-/// The validation layout, the stacked campaign and the base: buffers between time blocks
-/// are sized on the base with the device's dT/dt span; the base and its dT/dt window are
-/// then chosen on that layout (`baseline::choice::choose_with_rate_window`).
-fn layout_and_base(
-    campaign: &input::Campaign,
-    rule: validation::buffer::BufferRule,
-) -> Result<(Folds, Stacked, baseline::choice::BaseChoice), DiagnoseError> {
-    memprobe::stage("input::prepare");
-    let device_rate =
-        Stacked::with_rate_half_width(campaign, baseline::choice::device_rate_half_s());
-    let run_lengths: Vec<usize> = campaign.runs.iter().map(|s| s.t_s.len()).collect();
-    let (folds, device_choice) =
-        validation::buffer::choose_buffered(Folds::new(&run_lengths)?, &device_rate, rule)?;
-    memprobe::stage("layout: device-rate stack + buffered folds");
-    let (st, choice) =
-        baseline::choice::choose_with_rate_window(campaign, &folds, (device_rate, device_choice))?;
-    memprobe::stage("layout_and_base");
-    Ok((folds, st, choice))
 }
 
 /// The simulator's physics calibrated to the campaign (`simulator`), with its design

@@ -2,6 +2,7 @@
 //! temperature law across runs or free run levels, chosen on held-out runs.
 
 pub mod choice;
+pub mod layout;
 pub mod levels;
 pub mod models;
 pub mod rbf_basis;
