@@ -39,7 +39,7 @@ use report::{
 };
 use selection::scored::Scored;
 use selection::screen::Screening;
-use validation::cv::Folds;
+use validation::folds::Folds;
 
 /// Everything the diagnosis computed: the report plus the series the plots need.
 #[derive(Clone, Debug)]

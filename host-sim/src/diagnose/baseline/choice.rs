@@ -11,8 +11,9 @@
 use crate::diagnose::baseline::levels::{score, Law, LevelSystems, Score};
 use crate::diagnose::baseline::models::{fit_rbf, Stacked, RIDGES};
 use crate::diagnose::error::DiagnoseError;
-use crate::diagnose::validation::cv::{CvResult, Folds, Prepared};
+use crate::diagnose::validation::cv::{CvResult, Prepared};
 use crate::diagnose::validation::design::Design;
+use crate::diagnose::validation::folds::Folds;
 use serde::Serialize;
 
 /// Highest polynomial degree in T tried.
@@ -453,7 +454,7 @@ fn unit_score(folds: &Folds, cv: &CvResult) -> Score {
 
 /// Both level treatments of one base, scored leaving one run out (run-grouped layouts).
 fn level_scores(folds: &Folds, st: &Stacked, f: &BaseFit) -> Vec<LevelScore> {
-    if folds.offsets != crate::diagnose::validation::cv::Offsets::PerUnit {
+    if folds.offsets != crate::diagnose::validation::folds::Offsets::PerUnit {
         return vec![];
     }
     let design = f.raw_design();

@@ -11,7 +11,7 @@ use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
 use crate::diagnose::memprobe;
 use crate::diagnose::validation::buffer::{correlated_lag, BufferRule};
-use crate::diagnose::validation::cv::{Folds, Offsets};
+use crate::diagnose::validation::folds::{Folds, Offsets};
 
 /// The validation layout, the stacked campaign and the base: buffers between time blocks
 /// are sized on the base with the device's dT/dt span; the base and its dT/dt window are

@@ -7,7 +7,8 @@ use crate::diagnose::baseline::rbf_basis::{RbfBasis, RbfDesign};
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::derivatives;
 use crate::diagnose::input::Campaign;
-use crate::diagnose::validation::cv::{CvResult, Folds, Prepared};
+use crate::diagnose::validation::cv::{CvResult, Prepared};
+use crate::diagnose::validation::folds::Folds;
 use std::sync::Arc;
 
 /// Width factors tried (x mean centre spacing).

@@ -22,7 +22,7 @@ use crate::diagnose::input::Campaign;
 use crate::diagnose::linalg::solve_spd;
 use crate::diagnose::selection::scored::ALPHA;
 use crate::diagnose::selection::screen::MIN_GAIN_PCT;
-use crate::diagnose::validation::cv::Folds;
+use crate::diagnose::validation::folds::Folds;
 use crate::diagnose::validation::signflip::{max_t_pvalues, FLIP_SEED};
 use fog_core::consts::EARTH_RATE_DPH;
 use rand::seq::SliceRandom;
@@ -374,7 +374,7 @@ pub struct Prepared {
 
 /// Whether the layout holds runs out whole (the between-run stage needs it).
 pub fn runs_held_out_whole(folds: &Folds) -> bool {
-    folds.offsets == crate::diagnose::validation::cv::Offsets::PerUnit
+    folds.offsets == crate::diagnose::validation::folds::Offsets::PerUnit
 }
 
 /// Offsets, level model and candidates; `Err` (with the reason) when runs are too few.

@@ -13,7 +13,7 @@
 use crate::diagnose::baseline::choice::BaseFit;
 use crate::diagnose::candidates::transforms::{Candidate, Source, Transform};
 use crate::diagnose::input::Campaign;
-use crate::diagnose::validation::cv::Folds;
+use crate::diagnose::validation::folds::Folds;
 use fog_core::compensation::features::{
     features_for_series, FeatureVector, TempRateEstimator, DEFAULT_ACCEL_SPAN_S,
     DEFAULT_RATE_SPAN_S, EXTRACTOR_RATE_POINTS,

@@ -6,7 +6,7 @@
 use crate::diagnose::selection::scored::ALPHA;
 use crate::diagnose::selection::screen::Rival;
 use crate::diagnose::selection::separate::Verdict;
-use crate::diagnose::validation::cv::Folds;
+use crate::diagnose::validation::folds::Folds;
 use serde::Serialize;
 
 /// A candidate the held-out data could not tell from a named cause over all units

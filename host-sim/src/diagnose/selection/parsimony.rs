@@ -30,7 +30,7 @@ use crate::diagnose::candidates::transforms::Candidate;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
 use crate::diagnose::selection::screen::{screen, Screening};
-use crate::diagnose::validation::cv::Folds;
+use crate::diagnose::validation::folds::Folds;
 use serde::Serialize;
 
 /// The rule, as the report states it.

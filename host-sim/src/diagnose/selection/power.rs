@@ -23,10 +23,9 @@ use crate::diagnose::baseline::models::Stacked;
 use crate::diagnose::candidates::transforms::Candidate;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
-use crate::diagnose::report::residuals::demeaned_by_run;
 use crate::diagnose::selection::scored::ALPHA;
 use crate::diagnose::selection::screen::{self, Screening};
-use crate::diagnose::validation::cv::Folds;
+use crate::diagnose::validation::folds::{demeaned_by_run, Folds};
 use serde::Serialize;
 
 /// Size of the planted effect, in within-run rms of the base's held-out residual.

@@ -30,7 +30,8 @@ use crate::diagnose::baseline::choice::BaseFit;
 use crate::diagnose::candidates::transforms::Candidate;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
-use crate::diagnose::validation::cv::{CvResult, Folds, Offsets};
+use crate::diagnose::validation::cv::CvResult;
+use crate::diagnose::validation::folds::{Folds, Offsets};
 use crate::diagnose::validation::signflip::{
     max_t_pvalues, paired_pvalue, sse_drop, unit_gains, FLIP_SEED,
 };

@@ -18,7 +18,8 @@
 
 use crate::diagnose::baseline::choice::BaseFit;
 use crate::diagnose::error::DiagnoseError;
-use crate::diagnose::validation::cv::{CvResult, Folds};
+use crate::diagnose::validation::cv::CvResult;
+use crate::diagnose::validation::folds::Folds;
 use crate::diagnose::validation::signflip::{paired_pvalue, smallest_p, FLIP_SEED};
 
 use super::scored::{Scored, ALPHA};

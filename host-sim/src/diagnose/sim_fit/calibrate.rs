@@ -33,7 +33,7 @@ pub const LAW_TERMS: [(&str, &str); 5] = [
 ];
 
 /// Fewest runs for the law shared across runs (else free run offsets).
-pub const MIN_RUNS_SHARED: usize = crate::diagnose::validation::cv::MIN_RUNS_GROUPED;
+pub const MIN_RUNS_SHARED: usize = crate::diagnose::validation::folds::MIN_RUNS_GROUPED;
 
 /// Fitted simulator parameters and how well they reproduce the measurements.
 #[derive(Clone, Debug, Serialize)]

@@ -18,8 +18,9 @@ use crate::diagnose::baseline::models::Stacked;
 use crate::diagnose::sim_fit::calibrate::SimDesign;
 use crate::diagnose::uncertainty::bootstrap::{draws, Estimate, REPLICATES};
 use crate::diagnose::uncertainty::jackknife::delete_one;
-use crate::diagnose::validation::cv::{Folds, Offsets, Prepared, UnitSystems};
+use crate::diagnose::validation::cv::{Prepared, UnitSystems};
 use crate::diagnose::validation::design::WithColumns;
+use crate::diagnose::validation::folds::{Folds, Offsets};
 use serde::Serialize;
 
 /// A measured coefficient against the simulator's value.

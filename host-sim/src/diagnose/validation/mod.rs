@@ -4,4 +4,5 @@
 pub mod buffer;
 pub mod cv;
 pub mod design;
+pub mod folds;
 pub mod signflip;
