@@ -14,35 +14,33 @@
 //! library: the run mean (angles: circular-mean harmonic) of every extra column, the
 //! ambient, and every metadata key that varies between runs (numbers as values,
 //! categories as levels; `candidates::generic::metadata`).
+//!
+//! Files: `run_features` (the offsets and the run-level library), `loo` (the run-level
+//! fits and the permutation check), `heading` (a heading harmonic as azimuth error);
+//! this file runs the steps, and `screen_both` runs the within-run selection and this
+//! one with alpha shared between them.
 
-use crate::diagnose::baseline::choice::BaseFit;
+pub mod heading;
+pub mod loo;
+pub mod run_features;
+
+use crate::diagnose::baseline::choice::{BaseChoice, BaseFit};
 use crate::diagnose::baseline::models::Stacked;
 use crate::diagnose::candidates::generic::MetaColumn;
+use crate::diagnose::candidates::transforms::Candidate;
+use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
-use crate::diagnose::linalg::solve_spd;
+use crate::diagnose::memprobe;
+use crate::diagnose::selection::parsimony::{choose_and_screen, BaseRule};
 use crate::diagnose::selection::scored::ALPHA;
-use crate::diagnose::selection::screen::MIN_GAIN_PCT;
+use crate::diagnose::selection::screen::{Screening, MAX_STEPS, MIN_GAIN_PCT};
 use crate::diagnose::validation::folds::Folds;
 use crate::diagnose::validation::signflip::{max_t_pvalues, FLIP_SEED};
-use fog_core::consts::EARTH_RATE_DPH;
-use rand::seq::SliceRandom;
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
-/// Run-level permutations for the check p-value.
-pub const PERMUTATIONS: usize = 4_000;
-/// Seed of the permutations (results are deterministic).
-pub const PERM_SEED: u64 = 0xBE7_3EE2;
-
-/// One run-level candidate: `features[r]` holds run r's feature values.
-#[derive(Clone, Debug)]
-pub struct RunCandidate {
-    pub label: String,
-    pub column: String,
-    pub harmonic: bool,
-    pub features: Vec<Vec<f64>>,
-}
+use heading::{heading_effect, HeadingEffect};
+use loo::{fit, loo_errors, loo_gains, permutation_p};
+use run_features::{enumerate, run_offsets, RunCandidate};
 
 /// One scored run-level candidate, for the report.
 #[derive(Clone, Debug, Serialize)]
@@ -59,21 +57,6 @@ pub struct RunRow {
     pub significant: bool,
     /// Fitted coefficients on all runs (intercept first), deg/h per unit.
     pub coef: Vec<f64>,
-}
-
-/// A named heading harmonic in north-seeking terms.
-#[derive(Clone, Debug, Serialize)]
-pub struct HeadingEffect {
-    pub column: String,
-    pub amplitude_dph: f64,
-    /// Heading of maximum bias, deg.
-    pub phase_deg: f64,
-    pub latitude_deg: f64,
-    /// Two-position seek at psi = 90 deg: bias difference 2 A cos(psi - phase) over
-    /// 2 Omega_H sin psi, deg.
-    pub azimuth_error_at_90_deg: f64,
-    /// Largest over the seek headings where |sin psi| >= 0.5 (A / (Omega_H / 2)), deg.
-    pub azimuth_error_bound_deg: f64,
 }
 
 /// The between-run analysis.
@@ -95,232 +78,6 @@ pub struct BetweenRun {
     pub heading: Option<HeadingEffect>,
     /// Why the analysis was not run, if it was not.
     pub note: Option<String>,
-}
-
-fn mean(v: &[f64]) -> f64 {
-    v.iter().sum::<f64>() / v.len().max(1) as f64
-}
-
-/// Run offsets left by the base fitted on every run: mean over the run of drift minus
-/// the base's prediction (the base itself carries no offset).
-pub fn run_offsets(folds: &Folds, st: &Stacked, base: &BaseFit) -> Vec<f64> {
-    let design = base.raw_design();
-    let w = base
-        .prepared
-        .fit_all(folds, &[])
-        .map(|(w, _)| w)
-        .unwrap_or_default();
-    let mut row = vec![0.0; design.width()];
-    folds
-        .run_rows
-        .iter()
-        .map(|r| {
-            let resid: Vec<f64> = r
-                .clone()
-                .map(|i| {
-                    design.row(i, &mut row);
-                    st.y[i] - row.iter().zip(&w).map(|(c, wj)| c * wj).sum::<f64>()
-                })
-                .collect();
-            mean(&resid)
-        })
-        .collect()
-}
-
-/// Run-level candidates: the harmonic (cos, sin of the run's circular mean) of every
-/// `*_deg` column, the run mean of every other extra column, the ambient, and every
-/// metadata key (value, or indicators of all but its commonest level).
-pub fn enumerate(c: &Campaign, meta: &[MetaColumn]) -> Vec<RunCandidate> {
-    let mut out = Vec::new();
-    for (j, name) in c.extra_names.iter().enumerate() {
-        if name.ends_with("_deg") {
-            let f = c
-                .runs
-                .iter()
-                .map(|s| {
-                    let cs = mean(
-                        &s.extras[j]
-                            .iter()
-                            .map(|a| a.to_radians().cos())
-                            .collect::<Vec<_>>(),
-                    );
-                    let sn = mean(
-                        &s.extras[j]
-                            .iter()
-                            .map(|a| a.to_radians().sin())
-                            .collect::<Vec<_>>(),
-                    );
-                    let ang = sn.atan2(cs);
-                    vec![ang.cos(), ang.sin()]
-                })
-                .collect();
-            out.push(RunCandidate {
-                label: format!("{name}:run_harmonic"),
-                column: name.clone(),
-                harmonic: true,
-                features: f,
-            });
-        } else {
-            out.push(RunCandidate {
-                label: format!("{name}:run_mean"),
-                column: name.clone(),
-                harmonic: false,
-                features: c.runs.iter().map(|s| vec![mean(&s.extras[j])]).collect(),
-            });
-        }
-    }
-    if c.runs.iter().all(|s| s.ambient_c.is_some()) {
-        out.push(RunCandidate {
-            label: "ambient_c:run_value".into(),
-            column: "ambient_c".into(),
-            harmonic: false,
-            features: c
-                .runs
-                .iter()
-                .map(|s| vec![s.ambient_c.unwrap_or(0.0)])
-                .collect(),
-        });
-    }
-    for m in meta.iter().filter(|m| m.run_values.len() == c.runs.len()) {
-        let levels = m
-            .categorical
-            .then(|| crate::diagnose::candidates::generic::few_levels(m.run_values.iter().copied()))
-            .flatten();
-        let (label, features) = match levels {
-            Some(l) => {
-                let count = |v: f64| m.run_values.iter().filter(|x| **x == v).count();
-                let reference = l.iter().copied().max_by_key(|v| count(*v)).unwrap_or(0.0);
-                let shown: Vec<f64> = l.into_iter().filter(|v| *v != reference).collect();
-                (
-                    format!("# {}:levels", m.key),
-                    m.run_values
-                        .iter()
-                        .map(|x| shown.iter().map(|v| f64::from(u8::from(x == v))).collect())
-                        .collect(),
-                )
-            }
-            None => (
-                format!("# {}:run_value", m.key),
-                m.run_values.iter().map(|x| vec![*x]).collect(),
-            ),
-        };
-        out.push(RunCandidate {
-            label,
-            column: m.key.clone(),
-            harmonic: false,
-            features,
-        });
-    }
-    out.retain(|c| varies(&c.features));
-    out
-}
-
-fn varies(f: &[Vec<f64>]) -> bool {
-    let k = f.first().map_or(0, Vec::len);
-    (0..k).any(|j| {
-        let v: Vec<f64> = f.iter().map(|x| x[j]).collect();
-        let m = mean(&v);
-        v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() > 1e-12 * (1.0 + m * m) * v.len() as f64
-    })
-}
-
-/// Least squares o = a + b . f over `rows` (small ridge for stability).
-fn fit(o: &[f64], f: &[Vec<f64>], rows: &[usize]) -> Option<Vec<f64>> {
-    let q = 1 + f.first().map_or(0, Vec::len);
-    let mut a = vec![0.0; q * q];
-    let mut b = vec![0.0; q];
-    for &r in rows {
-        let x: Vec<f64> = std::iter::once(1.0).chain(f[r].iter().copied()).collect();
-        for i in 0..q {
-            b[i] += x[i] * o[r];
-            for j in 0..q {
-                a[i * q + j] += x[i] * x[j];
-            }
-        }
-    }
-    for i in 0..q {
-        a[i * q + i] += 1e-9 * (1.0 + a[i * q + i]);
-    }
-    solve_spd(&mut a, &mut b, q).ok()?;
-    Some(b)
-}
-
-fn predict(coef: &[f64], f: &[f64]) -> f64 {
-    coef[0] + coef[1..].iter().zip(f).map(|(c, x)| c * x).sum::<f64>()
-}
-
-/// Leave-one-run-out errors of the offsets under o = a + b . f (f empty: the mean).
-fn loo_errors(o: &[f64], f: &[Vec<f64>]) -> Option<Vec<f64>> {
-    let n = o.len();
-    (0..n)
-        .map(|r| {
-            let rows: Vec<usize> = (0..n).filter(|&i| i != r).collect();
-            let coef = fit(o, f, &rows)?;
-            Some(o[r] - predict(&coef, &f[r]))
-        })
-        .collect()
-}
-
-/// Per-run held-out gains (run's points x drop in squared offset error, leave one run
-/// out), the leave-one-out rms without and with the candidate.
-pub fn loo_gains(o: &[f64], lens: &[usize], f: &[Vec<f64>]) -> Option<(Vec<f64>, f64, f64)> {
-    let n = o.len();
-    let mut gains = Vec::with_capacity(n);
-    let (mut ss0, mut ss1) = (0.0, 0.0);
-    for r in 0..n {
-        let rows: Vec<usize> = (0..n).filter(|&i| i != r).collect();
-        let m = rows.iter().map(|&i| o[i]).sum::<f64>() / rows.len() as f64;
-        let coef = fit(o, f, &rows)?;
-        let e0 = o[r] - m;
-        let e1 = o[r] - predict(&coef, &f[r]);
-        ss0 += e0 * e0;
-        ss1 += e1 * e1;
-        gains.push(lens[r] as f64 * (e0 * e0 - e1 * e1));
-    }
-    Some((gains, (ss0 / n as f64).sqrt(), (ss1 / n as f64).sqrt()))
-}
-
-/// Run-level permutation p of the total gain (features shuffled across runs).
-pub fn permutation_p(o: &[f64], lens: &[usize], f: &[Vec<f64>]) -> f64 {
-    let Some((g, _, _)) = loo_gains(o, lens, f) else {
-        return 1.0;
-    };
-    let obs: f64 = g.iter().sum();
-    let mut rng = ChaCha8Rng::seed_from_u64(PERM_SEED);
-    let mut perm: Vec<Vec<f64>> = f.to_vec();
-    let mut hits = 1usize;
-    for _ in 0..PERMUTATIONS {
-        perm.shuffle(&mut rng);
-        if let Some((gp, _, _)) = loo_gains(o, lens, &perm) {
-            if gp.iter().sum::<f64>() >= obs - 1e-12 * obs.abs() {
-                hits += 1;
-            }
-        }
-    }
-    hits as f64 / (PERMUTATIONS + 1) as f64
-}
-
-/// A heading harmonic's amplitude, phase and two-position azimuth error.
-pub fn heading_effect(column: &str, coef: &[f64], latitude_deg: f64) -> HeadingEffect {
-    let (a, b) = (
-        coef.get(1).copied().unwrap_or(0.0),
-        coef.get(2).copied().unwrap_or(0.0),
-    );
-    let amp = a.hypot(b);
-    let phase = b.atan2(a);
-    let omega_h = (EARTH_RATE_DPH * latitude_deg.to_radians().cos())
-        .abs()
-        .max(1e-9);
-    // at psi = 90 deg: 2 A cos(90 deg - phase) / (2 Omega_H sin 90 deg)
-    let at_90 = (amp * phase.sin() / omega_h).atan().to_degrees();
-    HeadingEffect {
-        column: column.to_owned(),
-        amplitude_dph: amp,
-        phase_deg: phase.to_degrees().rem_euclid(360.0),
-        latitude_deg,
-        azimuth_error_at_90_deg: at_90,
-        azimuth_error_bound_deg: (amp / (0.5 * omega_h)).atan().to_degrees(),
-    }
 }
 
 /// The run levels the between-run stage explains: the offsets the chosen base leaves
@@ -446,7 +203,7 @@ pub fn finish(p: Prepared, groups: f64, latitude_deg: f64) -> BetweenRun {
     let mut named_idx: Vec<usize> = Vec::new();
     let mut first_rows = Vec::new();
     let mut e0 = p.model.errors(&given);
-    for k in 1..=crate::diagnose::selection::screen::MAX_STEPS {
+    for k in 1..=MAX_STEPS {
         let Some(before) = e0.clone() else { break };
         let mut rows = Vec::new();
         let mut gains = Vec::new();
@@ -525,34 +282,43 @@ pub fn finish(p: Prepared, groups: f64, latitude_deg: f64) -> BetweenRun {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_heading_harmonic_in_the_offsets_is_recovered() {
-        let n = 12;
-        let lens = vec![100; n];
-        let f: Vec<Vec<f64>> = (0..n)
-            .map(|r| {
-                let h = (r as f64 * 97.0).to_radians();
-                vec![h.cos(), h.sin()]
-            })
-            .collect();
-        let jitter = |r: usize| 0.002 * ((r as f64 * 12.9898).sin() * 43_758.5).fract();
-        let o: Vec<f64> = (0..n)
-            .map(|r| 0.5 + 0.03 * f[r][0] - 0.01 * f[r][1] + jitter(r))
-            .collect();
-        let (g, rms0, rms1) = loo_gains(&o, &lens, &f).unwrap();
-        assert!(rms1 < 0.2 * rms0, "{rms0} -> {rms1}");
-        assert!(g.iter().sum::<f64>() > 0.0);
-        assert!(permutation_p(&o, &lens, &f) < 0.01);
-        let all: Vec<usize> = (0..n).collect();
-        let e = heading_effect("heading_deg", &fit(&o, &f, &all).unwrap(), 40.0);
-        assert!((e.amplitude_dph - 0.0316).abs() < 0.002, "{e:?}");
-        assert!((e.phase_deg - 341.6).abs() < 3.0, "{e:?}");
-        let unrelated: Vec<Vec<f64>> = (0..n).map(|r| vec![((r * 5) % 7) as f64]).collect();
-        let flat: Vec<f64> = (0..n).map(jitter).collect();
-        assert!(permutation_p(&flat, &lens, &unrelated) > 0.01);
-    }
+/// The base by parsimony (`selection::parsimony`) with its within-run selection, then
+/// the between-run selection on it; alpha shared between the two sequences (Bonferroni;
+/// one sequence when runs are too few for the between-run one). Returns the base, both
+/// selections, how the base was chosen and the number of sequences.
+pub fn screen_both(
+    campaign: &Campaign,
+    meta: &[MetaColumn],
+    folds: &Folds,
+    st: &Stacked,
+    choice: BaseChoice,
+    library: &[Candidate],
+    latitude_deg: f64,
+) -> Result<(BaseChoice, Screening, BaseRule, BetweenRun, f64), DiagnoseError> {
+    let groups = if runs_held_out_whole(folds) { 2.0 } else { 1.0 };
+    let (choice, screening, base_rule) =
+        choose_and_screen(campaign, folds, st, choice, library, groups, MAX_STEPS)?;
+    let run_level = prepare(
+        campaign,
+        meta,
+        folds,
+        st,
+        &choice.chosen,
+        choice.levels.as_ref(),
+    );
+    let between_run = match run_level {
+        Ok(p) => finish(p, groups, latitude_deg),
+        Err(note) => BetweenRun {
+            turn_on_repeatability_dph: f64::NAN,
+            offsets_heldout_rms_dph: f64::NAN,
+            offsets_from: String::new(),
+            rows: vec![],
+            named: None,
+            named_steps: vec![],
+            heading: None,
+            note: Some(note),
+        },
+    };
+    memprobe::stage("screen_both");
+    Ok((choice, screening, base_rule, between_run, groups))
 }

@@ -1,7 +1,9 @@
 //! The diagnosis as data (JSON, the schema and more) and as words (stdout).
 
+pub mod assemble;
 pub mod azimuth;
 pub mod competing;
+pub mod diagnosis;
 pub mod olscheck;
 pub mod outliers;
 pub mod plots;
