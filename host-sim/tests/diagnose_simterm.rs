@@ -154,7 +154,7 @@ fn close_the_loop(
     let cause = r.named_cause.as_ref().unwrap_or_else(|| {
         panic!(
             "a cause must be named:\n{}",
-            fog_sim::diagnose::report::render_text(r)
+            fog_sim::diagnose::report::text::render_text(r)
         )
     });
     assert_eq!(cause.column, column, "named {}", cause.label());
@@ -203,7 +203,7 @@ fn close_the_loop(
             "simulation.term.{key} missing: {term}"
         );
     }
-    assert!(fog_sim::diagnose::report::render_text(r).contains("simulator extended with: "));
+    assert!(fog_sim::diagnose::report::text::render_text(r).contains("simulator extended with: "));
     let p = r
         .candidates
         .iter()

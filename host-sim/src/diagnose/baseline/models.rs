@@ -34,7 +34,7 @@ pub struct Stacked {
 
 impl Stacked {
     /// Stacks drift, time, temperature and dT/dt (a centred local polynomial over
-    /// +/-`rate_half_s`, `derivatives`; the window is chosen with the base, `bases`).
+    /// +/-`rate_half_s`, `input::derivatives`; the window is chosen with the base, `baseline::choice`).
     pub fn with_rate_half_width(c: &Campaign, rate_half_s: f64) -> Self {
         let cat = |f: &dyn Fn(&crate::diagnose::input::Series) -> Vec<f64>| {
             c.runs.iter().flat_map(f).collect::<Vec<f64>>()

@@ -1,4 +1,4 @@
-//! Effects that live between runs: a bias constant within a run but different from run to
+//! Stage 5, between runs. Effects that live between runs: a bias constant within a run but different from run to
 //! run (a heading-dependent magnetic bias when each run has its own heading; a
 //! dependence on the chamber ambient or on a column's run mean). Within-run screening
 //! cannot see them: the free run offset absorbs them. Here the run offsets left by the

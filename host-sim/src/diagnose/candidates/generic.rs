@@ -8,7 +8,7 @@
 //! dT/dt are the base's inputs). For time since the start: a power-on decay on the same
 //! time scales. Metadata keys that vary between runs enter as run-constant columns
 //! (their products with the base's inputs are within-run candidates; their values and
-//! levels are run-level candidates, `between`).
+//! levels are run-level candidates, `between_runs`).
 //!
 //! Memory time scales are the record's: from twice the row spacing, doubling, to half the
 //! shortest run. The size is bounded: at most `MAX_CANDIDATES` (the rest are skipped and
@@ -43,7 +43,7 @@ pub struct MetaColumn {
 /// Metadata keys that vary between runs and are present in all of them: numbers as
 /// they are, other values as categories when there are 2..=`MAX_LEVELS` of them and
 /// fewer than runs (a value unique to each run is a name, not a level). `ambient_c` and
-/// `latitude_deg` are left out: `between` and the azimuth already use them.
+/// `latitude_deg` are left out: `between_runs` and the azimuth already use them.
 pub fn metadata(runs: &[Run]) -> Vec<MetaColumn> {
     let Some(first) = runs.first() else {
         return vec![];

@@ -1,4 +1,5 @@
-//! Turns fog-runs records into the checked, 10 s series `diagnose` works on.
+//! Stage 1, input: turns fog-runs records into the checked, 10 s series `diagnose` works
+//! on, with each column's derivative widths (`derivatives`).
 //!
 //! Required signals (`t_s`, `rate_dph`, `temp_c`) must be present, finite, of equal
 //! length, with strictly increasing time: otherwise the whole campaign is refused.

@@ -12,9 +12,10 @@ use crate::diagnose::input::{Campaign, Exclusion};
 use crate::diagnose::memprobe;
 use crate::diagnose::report::azimuth::{azimuth_effect, DEFAULT_LATITUDE_DEG};
 use crate::diagnose::report::competing::competitor;
+use crate::diagnose::report::text::nothing_named;
 use crate::diagnose::report::{
-    nothing_named, Azimuth, CampaignSummary, CandidateRow, Competitor, DriftStd, Extended,
-    ModelSummary, NamedCause, Simulation,
+    Azimuth, CampaignSummary, CandidateRow, Competitor, DriftStd, Extended, ModelSummary,
+    NamedCause, Simulation,
 };
 use crate::diagnose::selection::cause::Cause;
 use crate::diagnose::selection::parsimony::BaseRule;

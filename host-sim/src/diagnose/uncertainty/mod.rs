@@ -1,4 +1,4 @@
-//! +/- on every coefficient the report states (item 5 of issue 9): the chosen base's
+//! Stage 7, uncertainty: +/- on every coefficient the report states (item 5 of issue 9): the chosen base's
 //! temperature sensitivity and rate coefficient (and, for a polynomial base, its
 //! coefficients in physical units), the named extension's coefficient(s), the calibrated
 //! simulator's bias slope, curvature, Shupe coefficient and noise, and the
