@@ -1,4 +1,4 @@
-//! diagnose's k-means (`diagnose::base::basis::kmeans`: Lloyd from a farthest-point start, 12
+//! diagnose's k-means (`diagnose::baseline::rbf_basis::kmeans`: Lloyd from a farthest-point start, 12
 //! iterations) against linfa-clustering's `KMeans` (k-means++ start, seeded Xoshiro, the same
 //! 12-iteration cap, `n_runs` 1 and its default 10), on the inputs diagnose places RBF centres
 //! on: z-scored (T, dT/dt) points of a simulated paper campaign, and the 3-d twin
@@ -11,7 +11,7 @@
 //! `cargo bench -p fog-sim --bench diagnose_kmeans -- --warm-up-time 1 --measurement-time 3`
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use fog_sim::diagnose::base::basis::kmeans;
+use fog_sim::diagnose::baseline::rbf_basis::kmeans;
 use linfa::traits::Fit;
 use linfa::DatasetBase;
 use linfa_clustering::KMeans;

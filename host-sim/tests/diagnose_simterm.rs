@@ -5,7 +5,7 @@
 //! coefficient close to the planted one, and re-simulating with the emitted term (same
 //! seeds) must bring the simulator closer to the "measured" campaign than without it.
 
-use fog_sim::diagnose::{diagnose, library::transforms::Transform};
+use fog_sim::diagnose::{candidates::transforms::Transform, diagnose};
 use fog_sim::io::runs::Run;
 use fog_sim::sim::{
     simulate_run, AuxSource, AuxTransform, DriftTerm, GyroParams, RunSpec, StartState,
@@ -154,7 +154,7 @@ fn close_the_loop(
     let cause = r.named_cause.as_ref().unwrap_or_else(|| {
         panic!(
             "a cause must be named:\n{}",
-            fog_sim::diagnose::report::render_text(r)
+            fog_sim::diagnose::report::text::render_text(r)
         )
     });
     assert_eq!(cause.column, column, "named {}", cause.label());
@@ -203,7 +203,7 @@ fn close_the_loop(
             "simulation.term.{key} missing: {term}"
         );
     }
-    assert!(fog_sim::diagnose::report::render_text(r).contains("simulator extended with: "));
+    assert!(fog_sim::diagnose::report::text::render_text(r).contains("simulator extended with: "));
     let p = r
         .candidates
         .iter()

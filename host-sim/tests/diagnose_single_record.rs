@@ -117,7 +117,7 @@ fn tallies(sigmas: f64) -> Tally {
 /// Largest count of false names consistent with the family-wise level over `records`
 /// independent records: the 99 % quantile of Binomial(records, ALPHA).
 fn allowed_false_names(records: usize) -> usize {
-    let alpha = fog_sim::diagnose::selection::screen::ALPHA;
+    let alpha = fog_sim::diagnose::selection::scored::ALPHA;
     let mut cdf = 0.0;
     for k in 0..=records {
         let ln_choose: f64 = (1..=k)

@@ -30,7 +30,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     memprobe::stage("read_runs");
     let mut d = diagnose(&runs).context("diagnose")?;
     d.report.raw_rows = Some(raw);
-    print!("{}", report::render_text(&d.report));
+    print!("{}", report::text::render_text(&d.report));
     if args.outputs.plots.is_none() {
         // Only the plots read the per-row series (memory: freed before the cross-check).
         d.drop_series();

@@ -31,7 +31,7 @@ use crate::pipeline::heading_fit::{fit_from_runs, short_number};
 use fog_core::model::format::MAX_HEADING_HARMONIC_DPH;
 use std::io::Read;
 
-/// The diagnose column that is the input axis azimuth (`diagnose::simulator::simterm`).
+/// The diagnose column that is the input axis azimuth (`diagnose::sim_fit::drift_terms`).
 const AZIMUTH_COLUMN: &str = "heading_deg";
 
 /// Options of `fogsim heading-cal`.

@@ -1,84 +1,52 @@
 //! `diagnose`: from a measured campaign to what the simulation and the paper's model get
 //! wrong, the cause, the extended model and its held-out gain (issues 4, 9 and 18).
 //!
-//! The pipeline, one folder per stage: [`input`] checks the runs and averages them to
-//! 10 s ([`input::rawrows`] streams the files and analyses the raw rows on the way);
-//! [`base`] chooses the base model on held-out data, with one temperature law across runs
-//! or free run levels; [`library`] builds every candidate feature from the record's
-//! columns; [`selection`] ranks them by held-out gain, tests them family-wise and checks
-//! the test's power when nothing is named; [`between`] does the same for run-level
-//! effects; [`simulator`] calibrates the simulator's physics and maps the named cause
-//! onto it; [`uncertainty`] puts block-bootstrap ranges on every coefficient; [`report`]
-//! states the result, plots it and translates it into north-seeking error.
-//! [`validation`] (folds over whole runs or buffered blocks, the sign-flip test) and
-//! [`linalg`] serve every stage.
+//! The pipeline, one folder per stage, each importing only the stages before it (and the
+//! ground floor below):
+//!
+//! [`input`] -> [`baseline`] -> [`candidates`] -> [`selection`] -> [`between_runs`] ->
+//! [`sim_fit`] -> [`uncertainty`] -> [`report`]
+//!
+//! - [`input`] checks the runs, averages them to 10 s and chooses each column's
+//!   derivative widths ([`input::rawrows`] streams the files and analyses the raw rows);
+//! - [`baseline`] chooses the base model and the validation layout on held-out data, with
+//!   one temperature law across runs or free run levels;
+//! - [`candidates`] builds every candidate feature from the record's columns;
+//! - [`selection`] ranks them by held-out gain, tests them family-wise, separates the
+//!   named cause from its rivals and checks the test's power when nothing is named;
+//! - [`between_runs`] does the same for run-level effects, alpha shared with the
+//!   within-run sequence;
+//! - [`sim_fit`] calibrates the simulator's physics to the record and maps the named
+//!   cause onto its drift terms;
+//! - [`uncertainty`] puts block-bootstrap ranges on every coefficient;
+//! - [`report`] assembles the result, states it, plots it and translates it into
+//!   north-seeking error.
+//!
+//! Ground floor, used by every stage and importing none: [`validation`] (folds over
+//! whole runs or buffered time blocks, the ridge fits on them, the sign-flip test,
+//! designs), [`linalg`], [`error`], [`memprobe`]. This file only calls the stages in
+//! order and hands their outputs on.
 
-pub mod base;
-pub mod between;
+pub mod baseline;
+pub mod between_runs;
+pub mod candidates;
 pub mod error;
 pub mod input;
-pub mod library;
 pub mod linalg;
 pub mod memprobe;
 pub mod report;
 pub mod selection;
-pub mod simulator;
+pub mod sim_fit;
 pub mod uncertainty;
 pub mod validation;
 
 pub use error::DiagnoseError;
+pub use report::diagnosis::Diagnosis;
 pub use report::Report;
 pub use selection::cause::Cause;
 
 use crate::io::runs::Run;
-use base::models::Stacked;
-use input::Exclusion;
-use report::{
-    Azimuth, CampaignSummary, CandidateRow, Competitor, DriftStd, Extended, ModelSummary,
-    NamedCause, Simulation,
-};
-use selection::screen::{Scored, Screening};
-use validation::cv::Folds;
-
-/// Everything the diagnosis computed: the report plus the series the plots need.
-#[derive(Clone, Debug)]
-pub struct Diagnosis {
-    pub report: Report,
-    pub run_names: Vec<String>,
-    pub run_rows: Vec<std::ops::Range<usize>>,
-    /// Validation units (runs, or time blocks of a few long records).
-    pub unit_rows: Vec<std::ops::Range<usize>>,
-    pub t_s: Vec<f64>,
-    /// What `t_s` is, for axis labels: since power-on, or since the record's start.
-    pub time_axis: String,
-    pub temp_c: Vec<f64>,
-    /// Drift with run offsets removed as the fits see it, deg/h.
-    pub drift_dph: Vec<f64>,
-    pub baseline_residual: Vec<f64>,
-    pub extended_residual: Vec<f64>,
-    /// The named cause's first feature column (stacked), if any.
-    pub cause_feature: Option<Vec<f64>>,
-    /// The named effect as `fog_sim::sim` drift terms, per run in `run_names` order
-    /// (empty lists when nothing is named): add them with `GyroParams::with_term`.
-    pub sim_terms: Vec<Vec<crate::sim::DriftTerm>>,
-}
-
-impl Diagnosis {
-    /// Frees the per-row series (only the plots read them; the report keeps everything
-    /// else): five or six values per row the later stages of the command need not hold.
-    pub fn drop_series(&mut self) {
-        for v in [
-            &mut self.t_s,
-            &mut self.temp_c,
-            &mut self.drift_dph,
-            &mut self.baseline_residual,
-            &mut self.extended_residual,
-        ] {
-            *v = Vec::new();
-        }
-        self.cause_feature = None;
-    }
-}
+use report::assemble;
 
 /// Runs the whole diagnosis on a campaign.
 pub fn diagnose(runs: &[Run]) -> Result<Diagnosis, DiagnoseError> {
@@ -91,21 +59,22 @@ pub fn diagnose_with(
     rule: validation::buffer::BufferRule,
 ) -> Result<Diagnosis, DiagnoseError> {
     let campaign = input::prepare(runs)?;
-    let (folds, mut st, choice) = layout_and_base(&campaign, rule)?;
+    memprobe::stage("input::prepare");
+    let (folds, mut st, choice) = baseline::layout::layout_and_base(&campaign, rule)?;
     let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
-    let latitude = latitude_of(&campaign);
-    let meta = library::generic::metadata(runs);
-    let (library, cap_note) = library_of(&campaign, &meta, st.temp_rate_half_s);
+    let latitude = assemble::latitude_of(&campaign);
+    let meta = candidates::generic::metadata(runs);
+    let (library, cap_note) = candidates::library_of(&campaign, &meta, st.temp_rate_half_s);
     let (choice, mut screening, base_rule, between_run, groups) =
-        screen_both(&campaign, &meta, &folds, &st, choice, &library, latitude)?;
+        between_runs::screen_both(&campaign, &meta, &folds, &st, choice, &library, latitude)?;
     let base = &choice.chosen;
     screening.skipped.extend(cap_note);
     let named = screening.steps.first();
     let cause = named.map(|s| Cause::from(&s.scored.cand));
-    let (sim_design, sim) = simulator_stage(&campaign, &folds, &st, named)?;
+    let (sim_design, sim) = sim_fit::calibrate_stage(&campaign, &folds, &st, named)?;
     let causal_derivative = named
-        .and_then(|s| library::causal::check(&campaign, &folds, base, &s.scored.cand, &s.cols));
-    let (extended, ext_resid) = extended_model(base, &screening);
+        .and_then(|s| candidates::causal::check(&campaign, &folds, base, &s.scored.cand, &s.cols));
+    let (extended, ext_resid) = assemble::extended_model(base, &screening);
     let named_feature = named.map(|s| uncertainty::NamedFeature {
         label: s.scored.cand.label(),
         cols: &s.cols,
@@ -115,8 +84,9 @@ pub fn diagnose_with(
     // needed past here: freed before the later stages' own per-row peaks (memory).
     memprobe::stage("uncertainty::estimate");
     drop(sim_design);
-    let azimuth = azimuth(&campaign, &folds, &st, base, &ext_resid, latitude);
-    let named_causes = named_causes(&folds, &st, base, &screening, &between_run, latitude);
+    let azimuth = assemble::azimuth(&campaign, &folds, &st, base, &ext_resid, latitude);
+    let named_causes =
+        assemble::named_causes(&folds, &st, base, &screening, &between_run, latitude);
     let smallest_attainable_p = validation::signflip::smallest_p(folds.unit_rows.len());
     let silent = cause.is_none() && between_run.named.is_none();
     let rerun = selection::power::Rerun {
@@ -126,7 +96,7 @@ pub fn diagnose_with(
     let power_check =
         selection::power::check(silent, &campaign, &folds, &mut st, base, &screening, rerun)?;
     memprobe::stage("power::check");
-    let words = cause_in_words(
+    let words = assemble::cause_in_words(
         cause.as_ref(),
         &named_causes,
         &between_run,
@@ -134,29 +104,31 @@ pub fn diagnose_with(
         smallest_attainable_p,
         power_check.as_ref(),
     );
-    let sim_terms = simulator::simterm::terms_per_run(runs, cause.as_ref(), &sim.effect_coef);
+    let sim_terms = sim_fit::drift_terms::terms_per_run(runs, cause.as_ref(), &sim.effect_coef);
     let cause_column = cause.as_ref().map(|c| c.column.clone());
     let report = Report {
-        campaign: CampaignSummary {
-            runs: campaign.runs.len(),
-            points: campaign.points(),
-            validation: folds.describe(),
-            excluded_columns: campaign.exclusions.clone(),
-            skipped_candidates: screening.skipped.iter().map(to_exclusion).collect(),
-            library_size: library.len(),
+        campaign: assemble::campaign_summary(
+            &campaign,
+            &folds,
+            &screening,
+            library.len(),
             smallest_attainable_p,
             power_check,
-        },
-        base: base_summary(&choice, base_rule, &st, &campaign),
+        ),
+        base: assemble::base_summary(&choice, base_rule, &st, &campaign),
         residual_structure: report::residuals::structure(&campaign, &folds, &st, &base.cv.residual),
         outliers: report::outliers::locate(&folds, &run_names, &st.t_s, &st.y, &base.cv.residual),
         between_run,
         derivative_widths: campaign.derivative_widths.clone(),
-        candidates: screening.scored.iter().map(candidate_row).collect(),
+        candidates: screening
+            .scored
+            .iter()
+            .map(assemble::candidate_row)
+            .collect(),
         named_causes,
         named_cause: cause,
         cause_in_words: words,
-        competing: competing(
+        competing: assemble::competing(
             &screening,
             &report::competing::unit_names(&folds, &run_names),
         ),
@@ -164,13 +136,13 @@ pub fn diagnose_with(
             .steps
             .iter()
             .find_map(|s| s.parsimony_note.clone()),
-        drift_std: drift_std(&folds, &st.y, &base.cv.residual, &ext_resid),
+        drift_std: assemble::drift_std(&folds, &st.y, &base.cv.residual, &ext_resid),
         extended,
         causal_derivative,
         azimuth,
         uncertainty,
         raw_rows: None,
-        simulation: simulation_summary(sim, &sim_terms, cause_column.as_deref()),
+        simulation: assemble::simulation_summary(sim, &sim_terms, cause_column.as_deref()),
     };
     Ok(Diagnosis {
         report,
@@ -178,7 +150,7 @@ pub fn diagnose_with(
         run_rows: folds.run_rows.clone(),
         unit_rows: folds.unit_rows.clone(),
         t_s: st.t_s.clone(),
-        time_axis: time_axis(runs),
+        time_axis: report::diagnosis::time_axis(runs),
         temp_c: st.temp_c.to_vec(),
         drift_dph: base.prepared.target().to_vec(),
         baseline_residual: base.cv.residual.clone(),
@@ -186,384 +158,4 @@ pub fn diagnose_with(
         cause_feature: named.and_then(|s| s.cols.first().cloned()),
         sim_terms,
     })
-}
-
-/// The validation layout, the stacked campaign and the base: buffers between time blocks
-/// are sized on the base with the device's dT/dt span; the base and its dT/dt window are
-/// then chosen on that layout (`base::bases::choose_with_rate_window`).
-fn layout_and_base(
-    campaign: &input::Campaign,
-    rule: validation::buffer::BufferRule,
-) -> Result<(Folds, Stacked, base::bases::BaseChoice), DiagnoseError> {
-    memprobe::stage("input::prepare");
-    let device_rate = Stacked::with_rate_half_width(campaign, base::bases::device_rate_half_s());
-    let run_lengths: Vec<usize> = campaign.runs.iter().map(|s| s.t_s.len()).collect();
-    let (folds, device_choice) =
-        validation::buffer::choose_buffered(Folds::new(&run_lengths)?, &device_rate, rule)?;
-    memprobe::stage("layout: device-rate stack + buffered folds");
-    let (st, choice) =
-        base::bases::choose_with_rate_window(campaign, &folds, (device_rate, device_choice))?;
-    memprobe::stage("layout_and_base");
-    Ok((folds, st, choice))
-}
-
-/// The simulator's physics calibrated to the campaign (`simulator`), with its design
-/// (the uncertainty stage refits on it).
-fn simulator_stage(
-    campaign: &input::Campaign,
-    folds: &Folds,
-    st: &Stacked,
-    named: Option<&selection::screen::Step>,
-) -> Result<
-    (
-        simulator::simfit::SimDesign,
-        simulator::simfit::SimCalibration,
-    ),
-    DiagnoseError,
-> {
-    let sim_design = simulator::simfit::SimDesign::new(campaign);
-    memprobe::stage("SimDesign::new");
-    let sim = simulator::simfit::calibrate(
-        &sim_design,
-        &folds.run_rows,
-        &st.y,
-        named.map(|s| s.cols.as_slice()),
-    )?;
-    memprobe::stage("simulator::calibrate");
-    Ok((sim_design, sim))
-}
-
-/// The campaign's latitude (the first run that states one), else the default.
-fn latitude_of(campaign: &input::Campaign) -> f64 {
-    campaign
-        .runs
-        .iter()
-        .find_map(|s| s.latitude_deg)
-        .unwrap_or(report::azimuth::DEFAULT_LATITUDE_DEG)
-}
-
-/// The azimuth effect of the base's and the extended model's residuals, when the
-/// campaign has a heading column.
-fn azimuth(
-    campaign: &input::Campaign,
-    folds: &Folds,
-    st: &Stacked,
-    base: &base::bases::BaseFit,
-    ext_resid: &[f64],
-    latitude: f64,
-) -> Option<Azimuth> {
-    let has_heading = campaign.extra_names.iter().any(|n| n.contains("heading"));
-    has_heading.then(|| Azimuth {
-        baseline: report::azimuth::azimuth_effect(folds, &st.t_s, &base.cv.residual, latitude),
-        extended: report::azimuth::azimuth_effect(folds, &st.t_s, ext_resid, latitude),
-    })
-}
-
-/// Every candidate within one standard error of a named cause, with the cause and what
-/// the units where they differ said.
-fn competing(screening: &Screening, unit_names: &[String]) -> Vec<Competitor> {
-    screening
-        .steps
-        .iter()
-        .flat_map(|s| {
-            let named = s.scored.cand.label();
-            s.rivals
-                .iter()
-                .map(move |r| report::competing::competitor(&named, r, unit_names))
-        })
-        .collect()
-}
-
-/// The generic library and, if the cap left candidates out, a note saying so.
-fn library_of(
-    campaign: &input::Campaign,
-    meta: &[library::generic::MetaColumn],
-    rate_half_s: f64,
-) -> (
-    Vec<library::transforms::Candidate>,
-    Option<selection::screen::Skipped>,
-) {
-    let (library, left_out) = library::generic::enumerate(campaign, meta, rate_half_s);
-    memprobe::stage("library");
-    let note = (left_out > 0).then(|| {
-        (
-            format!("{left_out} candidates"),
-            format!(
-                "library capped at {} candidates",
-                library::generic::MAX_CANDIDATES
-            ),
-        )
-    });
-    (library, note)
-}
-
-/// The base by parsimony (`selection::parsimony`) with its within-run selection, then
-/// the between-run selection on it; alpha shared between the two sequences (Bonferroni;
-/// one sequence when runs are too few for the between-run one). Returns the base, both
-/// selections, how the base was chosen and the number of sequences.
-fn screen_both(
-    campaign: &input::Campaign,
-    meta: &[library::generic::MetaColumn],
-    folds: &Folds,
-    st: &Stacked,
-    choice: base::bases::BaseChoice,
-    library: &[library::transforms::Candidate],
-    latitude_deg: f64,
-) -> Result<
-    (
-        base::bases::BaseChoice,
-        Screening,
-        selection::parsimony::BaseRule,
-        between::BetweenRun,
-        f64,
-    ),
-    DiagnoseError,
-> {
-    let groups = if between::runs_held_out_whole(folds) {
-        2.0
-    } else {
-        1.0
-    };
-    let (choice, screening, base_rule) = selection::parsimony::choose_and_screen(
-        campaign,
-        folds,
-        st,
-        choice,
-        library,
-        groups,
-        selection::screen::MAX_STEPS,
-    )?;
-    let run_level = between::prepare(
-        campaign,
-        meta,
-        folds,
-        st,
-        &choice.chosen,
-        choice.levels.as_ref(),
-    );
-    let between_run = match run_level {
-        Ok(p) => between::finish(p, groups, latitude_deg),
-        Err(note) => between::BetweenRun {
-            turn_on_repeatability_dph: f64::NAN,
-            offsets_heldout_rms_dph: f64::NAN,
-            offsets_from: String::new(),
-            rows: vec![],
-            named: None,
-            named_steps: vec![],
-            heading: None,
-            note: Some(note),
-        },
-    };
-    memprobe::stage("screen_both");
-    Ok((choice, screening, base_rule, between_run, groups))
-}
-
-/// The base extended by every named within-run cause (the base itself when nothing is
-/// named), and its held-out residual.
-fn extended_model(base: &base::bases::BaseFit, screening: &Screening) -> (Extended, Vec<f64>) {
-    let mut inputs = base.spec.inputs();
-    inputs.extend(screening.steps.iter().map(|s| s.scored.cand.label()));
-    let cv = screening.final_cv(base);
-    memprobe::stage("extended_model + causal::check");
-    (
-        Extended {
-            inputs,
-            heldout_rms_dph: cv.rms(),
-            gain_pct: selection::screen::gain_pct(base.cv.rms(), cv.rms()),
-        },
-        cv.residual.clone(),
-    )
-}
-
-/// Every named cause, within and between runs, ranked by the drop in held-out squared
-/// error it brings (the two are in the same units: (deg/h)^2 x points).
-fn named_causes(
-    folds: &Folds,
-    st: &Stacked,
-    base: &base::bases::BaseFit,
-    screening: &Screening,
-    between_run: &between::BetweenRun,
-    latitude_deg: f64,
-) -> Vec<NamedCause> {
-    let sigma = |r: &[f64]| {
-        report::azimuth::azimuth_effect(folds, &st.t_s, r, latitude_deg).azimuth_sigma_deg
-    };
-    let mut out: Vec<NamedCause> = Vec::new();
-    let mut before = &base.cv;
-    for (k, s) in screening.steps.iter().enumerate() {
-        out.push(NamedCause {
-            label: s.scored.cand.label(),
-            level: "within runs",
-            conditional_gain_pct: s.scored.gain_pct,
-            heldout_sse_drop: before.unit_sse.iter().sum::<f64>()
-                - s.cv.unit_sse.iter().sum::<f64>(),
-            p_value: s.scored.p_value,
-            step: k + 1,
-            azimuth_sigma_deg_before: Some(sigma(&before.residual)),
-            azimuth_sigma_deg_after: Some(sigma(&s.cv.residual)),
-            azimuth_error_bound_deg: None,
-        });
-        before = &s.cv;
-    }
-    let points: Vec<f64> = folds.run_rows.iter().map(|r| r.len() as f64).collect();
-    let total_points: f64 = points.iter().sum();
-    let mut level_rms = between_run.offsets_heldout_rms_dph;
-    for (k, r) in between_run.named_steps.iter().enumerate() {
-        let drop = total_points * (level_rms.powi(2) - r.heldout_offset_rms_dph.powi(2));
-        level_rms = r.heldout_offset_rms_dph;
-        let heading = between_run
-            .heading
-            .as_ref()
-            .filter(|h| r.label.starts_with(&h.column));
-        out.push(NamedCause {
-            label: r.label.clone(),
-            level: "between runs",
-            conditional_gain_pct: r.gain_pct,
-            heldout_sse_drop: drop,
-            p_value: r.p_value,
-            step: k + 1,
-            azimuth_sigma_deg_before: None,
-            azimuth_sigma_deg_after: None,
-            azimuth_error_bound_deg: heading.map(|h| h.azimuth_error_bound_deg),
-        });
-    }
-    out.sort_by(|a, b| b.heldout_sse_drop.total_cmp(&a.heldout_sse_drop));
-    memprobe::stage("azimuth + named_causes");
-    out
-}
-
-/// The chosen base and every base tried, for the report.
-fn base_summary(
-    choice: &base::bases::BaseChoice,
-    rule: selection::parsimony::BaseRule,
-    st: &Stacked,
-    campaign: &input::Campaign,
-) -> ModelSummary {
-    let base = &choice.chosen;
-    ModelSummary {
-        name: base.spec.name.clone(),
-        poly_degree_t: base.spec.poly_degree_t,
-        uses_rate: base.spec.uses_rate,
-        rate_half_width_s: st.temp_rate_half_s,
-        rate_effective_half_width_s: library::derivatives::effective_half_width_s(
-            &campaign
-                .runs
-                .iter()
-                .map(|s| (s.t_s.as_slice(), s.temp_c.as_slice()))
-                .collect::<Vec<_>>(),
-            1,
-            st.temp_rate_half_s,
-        ),
-        inputs: base.spec.inputs(),
-        heldout_rms_dph: base.cv.rms(),
-        centres: base.centres,
-        width_factor: base.width_factor,
-        ridge: base.ridge,
-        tried: choice.scores.clone(),
-        collinearity_warning: choice.collinearity_warning.clone(),
-        levels: choice.levels.clone(),
-        rule,
-    }
-}
-
-fn candidate_row(s: &Scored) -> CandidateRow {
-    CandidateRow {
-        label: s.cand.label(),
-        column: s.cand.column.clone(),
-        transform: s.cand.transform,
-        tau_s: s.cand.tau_s,
-        heldout_rms_dph: s.heldout_rms_dph,
-        gain_pct: s.gain_pct,
-        p_value: s.p_value,
-        significant: s.significant,
-        units_improved: s.units_improved,
-    }
-}
-
-/// Pooled within-run drift std of the raw drift, the base's and the extension's held-out
-/// residuals.
-fn drift_std(folds: &Folds, y: &[f64], base_resid: &[f64], ext_resid: &[f64]) -> DriftStd {
-    let pooled = |v: &[f64]| crate::stats::pooled_std_of_rows(&folds.run_rows, v);
-    DriftStd {
-        uncompensated_dph: pooled(y),
-        baseline_heldout_dph: pooled(base_resid),
-        extended_heldout_dph: pooled(ext_resid),
-    }
-}
-
-fn to_exclusion((column, reason): &selection::screen::Skipped) -> Exclusion {
-    Exclusion {
-        column: column.clone(),
-        reason: reason.clone(),
-    }
-}
-
-/// The first within-run cause in words (and the others' labels), else the between-run
-/// one, else why nothing is named.
-fn cause_in_words(
-    cause: Option<&Cause>,
-    all: &[NamedCause],
-    between_run: &between::BetweenRun,
-    coef: &[f64],
-    smallest_attainable_p: f64,
-    power_check: Option<&selection::power::PowerCheck>,
-) -> String {
-    let others: Vec<String> = all
-        .iter()
-        .filter(|n| cause.is_none_or(|c| c.label() != n.label))
-        .map(|n| {
-            format!(
-                "{} ({}, {:+.1} %)",
-                n.label, n.level, n.conditional_gain_pct
-            )
-        })
-        .collect();
-    let also = if others.is_empty() {
-        String::new()
-    } else {
-        format!("; also named: {}", others.join(", "))
-    };
-    match (cause, &between_run.named) {
-        (Some(c), _) => format!("{}{also}", c.in_words(coef)),
-        (None, Some(b)) => {
-            format!("no within-run cause; between runs: {b} (see the heading / run-level lines)")
-        }
-        (None, None) => report::nothing_named(smallest_attainable_p, power_check),
-    }
-}
-
-/// The simulator before/after and the terms added (listed for the first run).
-fn simulation_summary(
-    sim: simulator::simfit::SimCalibration,
-    sim_terms: &[Vec<crate::sim::DriftTerm>],
-    cause_column: Option<&str>,
-) -> Simulation {
-    let terms: Vec<simulator::simterm::TermSummary> = sim_terms
-        .first()
-        .into_iter()
-        .flatten()
-        .map(|t| simulator::simterm::summarize(t, cause_column.unwrap_or("")))
-        .collect();
-    Simulation {
-        before_rms_dph: sim.before_rms_dph,
-        after_rms_dph: sim.after_rms_dph.unwrap_or(sim.before_rms_dph),
-        term: terms.first().cloned(),
-        terms,
-        calibration: sim,
-    }
-}
-
-/// "time since power-on" when every run says how it was powered on (`start` metadata)
-/// and none says it is not a power-on record; else the record's own time.
-fn time_axis(runs: &[Run]) -> String {
-    let power_on = runs.iter().all(|r| r.meta_value("start").is_some())
-        && !runs.iter().any(|r| {
-            r.meta_value("note")
-                .is_some_and(|n| n.contains("not a power-on"))
-        });
-    if power_on {
-        "time since power-on".into()
-    } else {
-        "t_s (time since the record's start)".into()
-    }
 }

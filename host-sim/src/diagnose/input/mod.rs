@@ -1,4 +1,5 @@
-//! Turns fog-runs records into the checked, 10 s series `diagnose` works on.
+//! Stage 1, input: turns fog-runs records into the checked, 10 s series `diagnose` works
+//! on, with each column's derivative widths (`derivatives`).
 //!
 //! Required signals (`t_s`, `rate_dph`, `temp_c`) must be present, finite, of equal
 //! length, with strictly increasing time: otherwise the whole campaign is refused.
@@ -7,14 +8,14 @@
 //! Raw-rate records are averaged into 10 s windows (the paper's protocol); slower
 //! records (e.g. one mean per burst) are kept as they are.
 
+pub mod derivatives;
 pub mod rawrows;
+pub mod window;
 
 use super::error::DiagnoseError;
-use crate::diagnose::library::derivatives::{self, WidthChoice};
 use crate::io::runs::Run;
-
-/// Window length the model works on, s.
-pub const WINDOW_S: f64 = 10.0;
+use derivatives::WidthChoice;
+use window::{window_bins, WINDOW_S};
 
 /// One run as 10 s means: drift = rate - Earth rate, and every extra column.
 #[derive(Clone, Debug)]
@@ -277,27 +278,6 @@ fn to_series(run: &Run, extra_names: &[String]) -> Series {
         temp_c: mean_of(temp),
         extras: extras.iter().map(|v| mean_of(v)).collect(),
     }
-}
-
-/// Row ranges `[start, end)` forming the 10 s windows; one row per window when the
-/// record is already at 10 s or slower.
-fn window_bins(t: &[f64]) -> Vec<(usize, usize)> {
-    let mut dt: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-    dt.sort_by(f64::total_cmp);
-    let median = dt.get(dt.len() / 2).copied().unwrap_or(WINDOW_S);
-    if median >= 0.95 * WINDOW_S {
-        return (0..t.len()).map(|i| (i, i + 1)).collect();
-    }
-    let mut bins = Vec::new();
-    let mut start = 0;
-    for i in 1..=t.len() {
-        let same = i < t.len() && (t[i] / WINDOW_S).floor() == (t[start] / WINDOW_S).floor();
-        if !same {
-            bins.push((start, i));
-            start = i;
-        }
-    }
-    bins
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 //! held-out residual (what compensation leaves) is cut into back-to-back dwell pairs
 //! and the rms of db is turned into azimuth error at psi = 90 deg (the best case).
 
-use crate::diagnose::validation::cv::Folds;
+use crate::diagnose::validation::folds::Folds;
 use fog_core::consts::EARTH_RATE_DPH;
 use serde::Serialize;
 

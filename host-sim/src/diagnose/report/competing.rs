@@ -3,9 +3,10 @@
 //! fields and in one sentence: separated (which one lost, where, by how much, p), or not
 //! distinguishable on this data (and which units would decide), or no test power.
 
-use crate::diagnose::selection::screen::{Rival, ALPHA};
+use crate::diagnose::selection::scored::ALPHA;
+use crate::diagnose::selection::screen::Rival;
 use crate::diagnose::selection::separate::Verdict;
-use crate::diagnose::validation::cv::Folds;
+use crate::diagnose::validation::folds::Folds;
 use serde::Serialize;
 
 /// A candidate the held-out data could not tell from a named cause over all units

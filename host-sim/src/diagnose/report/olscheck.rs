@@ -4,7 +4,7 @@
 //! with the cause as a linear-only input. Run by the command, not inside `diagnose`
 //! (it retrains per fold and width, so it is slower than the fixed-basis screening).
 
-use crate::diagnose::library::transforms::Transform;
+use crate::diagnose::candidates::transforms::Transform;
 use crate::diagnose::selection::cause::Cause;
 use crate::io::runs::Run;
 use crate::train::{cross_validate, dataset_from_runs_with_aux, TrainConfig};

@@ -7,7 +7,7 @@
 //! `FALSE_ALARMS` rows of the whole record would be flagged by chance (so it grows with
 //! the record length rather than being a fixed "3 sigma").
 
-use crate::diagnose::validation::cv::Folds;
+use crate::diagnose::validation::folds::Folds;
 use serde::Serialize;
 
 /// Expected chance exceedances over the whole record.

@@ -5,7 +5,7 @@
 //! in a panel right of the plot, never over the data; axes are padded so no point sits
 //! on the frame; the time axis says what the record's time is.
 
-use crate::diagnose::Diagnosis;
+use crate::diagnose::report::diagnosis::Diagnosis;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};

@@ -1,9 +1,9 @@
 //! Where the baseline's held-out residual has structure: by time since power-on, per
 //! ambient temperature, and against each signal (within-run correlation).
 
-use crate::diagnose::base::models::Stacked;
+use crate::diagnose::baseline::models::Stacked;
 use crate::diagnose::input::Campaign;
-use crate::diagnose::validation::cv::Folds;
+use crate::diagnose::validation::folds::{demeaned_by_run, Folds};
 use serde::Serialize;
 
 /// Ambients closer than this belong to one group, degC.
@@ -47,16 +47,6 @@ fn slice(label: String, r: impl Iterator<Item = f64>) -> Slice {
         mean_dph: mean,
         rms_dph: rms,
     }
-}
-
-/// `v` with each run's own mean removed (`runs`: the rows of each run).
-pub fn demeaned_by_run(runs: &[std::ops::Range<usize>], v: &[f64]) -> Vec<f64> {
-    let mut out = v.to_vec();
-    for r in runs {
-        let m = v[r.clone()].iter().sum::<f64>() / r.len() as f64;
-        out[r.clone()].iter_mut().for_each(|x| *x -= m);
-    }
-    out
 }
 
 /// Within-run Pearson correlation.

@@ -1,9 +1,9 @@
 //! The named cause: which column, under which transform, drives the drift, and what that
 //! means physically. A domain type of its own so that the report, the simulator mapping
-//! (`simterm`) and the OLS cross-check (`olscheck`) share it without depending on each
+//! (`sim_fit::drift_terms`) and the OLS cross-check (`olscheck`) share it without depending on each
 //! other.
 
-use crate::diagnose::library::transforms::{BaseInput, Candidate, Source, Transform};
+use crate::diagnose::candidates::transforms::{BaseInput, Candidate, Source, Transform};
 use serde::Serialize;
 
 /// The named cause.
@@ -128,7 +128,7 @@ impl Cause {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::diagnose::library::transforms::Source;
+    use crate::diagnose::candidates::transforms::Source;
 
     #[test]
     fn a_cause_is_labelled_like_the_candidate_it_comes_from() {

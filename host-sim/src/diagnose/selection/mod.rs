@@ -5,5 +5,6 @@
 pub mod cause;
 pub mod parsimony;
 pub mod power;
+pub mod scored;
 pub mod screen;
 pub mod separate;

@@ -23,14 +23,14 @@
 //! Cost: one more selection for each simpler base within one standard error as a base,
 //! simplest first, until one is within it with its causes too.
 
-use crate::diagnose::base::bases::{complexity, BaseChoice, BaseScore};
-use crate::diagnose::base::levels::{ratio_estimate, score};
-use crate::diagnose::base::models::Stacked;
+use crate::diagnose::baseline::choice::{complexity, BaseChoice, BaseScore};
+use crate::diagnose::baseline::levels::{ratio_estimate, score};
+use crate::diagnose::baseline::models::Stacked;
+use crate::diagnose::candidates::transforms::Candidate;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
-use crate::diagnose::library::transforms::Candidate;
 use crate::diagnose::selection::screen::{screen, Screening};
-use crate::diagnose::validation::cv::Folds;
+use crate::diagnose::validation::folds::Folds;
 use serde::Serialize;
 
 /// The rule, as the report states it.

@@ -18,14 +18,14 @@
 //! step) is run. If any planted shape is not named, the report says "cannot decide: no
 //! test power at 1 sigma" for that shape instead of "no significant cause".
 
-use crate::diagnose::base::bases::{self, BaseFit};
-use crate::diagnose::base::models::Stacked;
+use crate::diagnose::baseline::choice::{self, BaseFit};
+use crate::diagnose::baseline::models::Stacked;
+use crate::diagnose::candidates::transforms::Candidate;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
-use crate::diagnose::library::transforms::Candidate;
-use crate::diagnose::report::residuals::demeaned_by_run;
+use crate::diagnose::selection::scored::ALPHA;
 use crate::diagnose::selection::screen::{self, Screening};
-use crate::diagnose::validation::cv::Folds;
+use crate::diagnose::validation::folds::{demeaned_by_run, Folds};
 use serde::Serialize;
 
 /// Size of the planted effect, in within-run rms of the base's held-out residual.
@@ -80,7 +80,7 @@ pub fn check(
     rerun: Rerun<'_>,
 ) -> Result<Option<PowerCheck>, DiagnoseError> {
     let reachable =
-        crate::diagnose::validation::signflip::smallest_p(folds.unit_rows.len()) < screen::ALPHA;
+        crate::diagnose::validation::signflip::smallest_p(folds.unit_rows.len()) < ALPHA;
     if !silent || !reachable || screening.scored.is_empty() {
         return Ok(None);
     }
@@ -94,7 +94,7 @@ pub fn check(
         };
         let with_effect: Vec<f64> = st.y.iter().zip(&planted).map(|(y, e)| y + e).collect();
         let drift = std::mem::replace(&mut st.y, with_effect);
-        let chosen = bases::choose(folds, st);
+        let chosen = choice::choose(folds, st);
         st.y = drift;
         let replanted_base = chosen?.chosen;
         let again = screen::screen(
@@ -180,7 +180,7 @@ fn plantable(
         let cols = screen::stacked_columns(campaign, &scored.cand);
         let drift = std::mem::replace(&mut st.y, unit_sum(runs, &cols));
         drop(cols);
-        let fit = bases::fit(folds, st, &base.spec);
+        let fit = choice::fit(folds, st, &base.spec);
         let feature = std::mem::replace(&mut st.y, drift);
         let Ok(fit) = fit else {
             continue;

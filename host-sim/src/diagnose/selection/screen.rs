@@ -26,40 +26,23 @@
 //! competing explanations: the data cannot tell them apart. The steps stop when nothing
 //! passes or after `MAX_STEPS`.
 
-use crate::diagnose::base::bases::BaseFit;
+use crate::diagnose::baseline::choice::BaseFit;
+use crate::diagnose::candidates::transforms::Candidate;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
-use crate::diagnose::library::transforms::Candidate;
-use crate::diagnose::validation::cv::{CvResult, Folds, Offsets};
-use crate::diagnose::validation::signflip::{max_t_pvalues, paired_pvalue};
+use crate::diagnose::validation::cv::CvResult;
+use crate::diagnose::validation::folds::{Folds, Offsets};
+use crate::diagnose::validation::signflip::{
+    max_t_pvalues, paired_pvalue, sse_drop, unit_gains, FLIP_SEED,
+};
 
+use super::scored::{gain_pct, Scored, ALPHA};
 use super::separate::{find, refit_pair, separate, Pair, Separation, Verdict};
 
-/// Family-wise significance level.
-pub const ALPHA: f64 = 0.01;
 /// Smallest held-out gain worth naming, % of rms.
 pub const MIN_GAIN_PCT: f64 = 0.2;
 /// Most causes named within runs.
 pub const MAX_STEPS: usize = 4;
-/// Seed of the sign-flip patterns (results are deterministic).
-pub const FLIP_SEED: u64 = 0x0D1A_605E;
-
-/// One scored candidate at one step.
-#[derive(Clone, Debug)]
-pub struct Scored {
-    pub cand: Candidate,
-    /// Held-out squared error per validation unit, with the candidate.
-    pub unit_sse: Vec<f64>,
-    pub heldout_rms_dph: f64,
-    /// Held-out gain over the model of the previous step, %.
-    pub gain_pct: f64,
-    /// Family-wise p (max-T over the library, x groups).
-    pub p_value: f64,
-    pub significant: bool,
-    /// Share of validation units whose held-out error dropped.
-    pub units_improved: f64,
-}
-
 /// A candidate the data cannot tell from a named cause.
 #[derive(Clone, Debug)]
 pub struct Rival {
@@ -120,10 +103,6 @@ fn has_within_unit_variation(folds: &Folds, col: &[f64]) -> bool {
         })
         .sum();
     within > 1e-10 * total && within > 1e-200
-}
-
-pub fn gain_pct(base: f64, ext: f64) -> f64 {
-    100.0 * (1.0 - ext / base)
 }
 
 /// Runs the stepwise selection (see the module header); `groups` is the number of
@@ -422,13 +401,4 @@ pub fn bounded_gains(base: &CvResult, cand: &CvResult) -> Vec<f64> {
         .zip(&base.unit_sse)
         .map(|(g, b)| g.clamp(-b, *b))
         .collect()
-}
-
-/// Per-unit drop in held-out squared error from `from` to `to`.
-pub fn unit_gains(from: &CvResult, to: &CvResult) -> Vec<f64> {
-    sse_drop(&from.unit_sse, &to.unit_sse)
-}
-
-fn sse_drop(from: &[f64], to: &[f64]) -> Vec<f64> {
-    from.iter().zip(to).map(|(a, b)| a - b).collect()
 }

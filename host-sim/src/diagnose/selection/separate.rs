@@ -16,12 +16,13 @@
 //! loser is reported as separated; otherwise both stay, "not distinguishable on this
 //! data", with the units where they differ most, which is where more data would decide.
 
-use crate::diagnose::base::bases::BaseFit;
+use crate::diagnose::baseline::choice::BaseFit;
 use crate::diagnose::error::DiagnoseError;
-use crate::diagnose::validation::cv::{CvResult, Folds};
-use crate::diagnose::validation::signflip::{paired_pvalue, smallest_p};
+use crate::diagnose::validation::cv::CvResult;
+use crate::diagnose::validation::folds::Folds;
+use crate::diagnose::validation::signflip::{paired_pvalue, smallest_p, FLIP_SEED};
 
-use super::screen::{Scored, ALPHA, FLIP_SEED};
+use super::scored::{Scored, ALPHA};
 
 /// Share of the total squared disagreement the separating units must hold.
 pub const SEPARATING_SHARE: f64 = 0.8;

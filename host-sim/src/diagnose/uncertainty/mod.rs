@@ -1,4 +1,4 @@
-//! +/- on every coefficient the report states (item 5 of issue 9): the chosen base's
+//! Stage 7, uncertainty: +/- on every coefficient the report states (item 5 of issue 9): the chosen base's
 //! temperature sensitivity and rate coefficient (and, for a polynomial base, its
 //! coefficients in physical units), the named extension's coefficient(s), the calibrated
 //! simulator's bias slope, curvature, Shupe coefficient and noise, and the
@@ -13,13 +13,14 @@
 pub mod bootstrap;
 pub mod jackknife;
 
-use crate::diagnose::base::bases::{zscore_params, BaseFit};
-use crate::diagnose::base::models::Stacked;
-use crate::diagnose::simulator::simfit::SimDesign;
+use crate::diagnose::baseline::choice::{zscore_params, BaseFit};
+use crate::diagnose::baseline::models::Stacked;
+use crate::diagnose::sim_fit::calibrate::SimDesign;
 use crate::diagnose::uncertainty::bootstrap::{draws, Estimate, REPLICATES};
 use crate::diagnose::uncertainty::jackknife::delete_one;
-use crate::diagnose::validation::cv::{Folds, Offsets, Prepared, UnitSystems};
+use crate::diagnose::validation::cv::{Prepared, UnitSystems};
 use crate::diagnose::validation::design::WithColumns;
+use crate::diagnose::validation::folds::{Folds, Offsets};
 use serde::Serialize;
 
 /// A measured coefficient against the simulator's value.
@@ -272,14 +273,14 @@ fn extension_estimates(
 
 /// Median row spacing within runs, s.
 fn row_spacing_s(folds: &Folds, t_s: &[f64]) -> f64 {
-    let mut d = crate::diagnose::simulator::simfit::within_run_differences(&folds.run_rows, t_s);
+    let mut d = crate::diagnose::sim_fit::calibrate::within_run_differences(&folds.run_rows, t_s);
     d.sort_by(f64::total_cmp);
     d.get(d.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
 /// The calibrated simulator's linear stage with ranges, and the ratios to the simulator.
 /// With runs held out whole the law shared across runs is jackknifed (one run left out at
-/// a time, `simfit::fit_shared`), else the free-offset fit over time blocks.
+/// a time, `calibrate::fit_shared`), else the free-offset fit over time blocks.
 fn simulator_estimates(
     sim: &SimDesign,
     folds: &Folds,
@@ -289,11 +290,11 @@ fn simulator_estimates(
     let counts = &delete_one(folds.unit_rows.len());
     let jackknife: Make = |n, u, v, r| Estimate::jackknife(n, u, v, r);
     let t_mean = sim.t_mean_c;
-    let n_law = crate::diagnose::simulator::simfit::LAW_TERMS.len();
+    let n_law = crate::diagnose::sim_fit::calibrate::LAW_TERMS.len();
     // The law's rows on demand, shared with the design (never copied as columns).
     let prepared = Prepared::from_design(folds, sim.law.clone(), &st.y, 0.0);
     let extra: &[Vec<f64>] = named.map_or(&[], |n| n.cols);
-    let mut names: Vec<(String, &str)> = crate::diagnose::simulator::simfit::LAW_TERMS
+    let mut names: Vec<(String, &str)> = crate::diagnose::sim_fit::calibrate::LAW_TERMS
         .iter()
         .map(|(n, u)| ((*n).to_owned(), *u))
         .collect();
@@ -304,13 +305,13 @@ fn simulator_estimates(
     }
     let sys = prepared.unit_systems(folds, extra);
     let shared = (folds.offsets == Offsets::PerUnit
-        && folds.run_rows.len() >= crate::diagnose::simulator::simfit::MIN_RUNS_SHARED)
+        && folds.run_rows.len() >= crate::diagnose::sim_fit::calibrate::MIN_RUNS_SHARED)
         .then(|| {
             let design = WithColumns {
                 design: sim.law.as_ref(),
                 extra,
             };
-            crate::diagnose::simulator::simfit::fit_shared(&folds.run_rows, &design, &st.y)
+            crate::diagnose::sim_fit::calibrate::fit_shared(&folds.run_rows, &design, &st.y)
         })
         .flatten();
     let mut out = match shared {

@@ -21,11 +21,9 @@
 //! Why not circular-shift permutations: they need every candidate refitted per shift
 //! (~70 candidates), and shifting a warm-up or cool-down record wraps its end onto its
 //! start, a jump no physical record has; the buffer keeps the sign-flip family test.
-
-use crate::diagnose::base::bases::{choose, BaseChoice};
-use crate::diagnose::base::models::Stacked;
-use crate::diagnose::error::DiagnoseError;
-use crate::diagnose::validation::cv::{Folds, Offsets};
+//!
+//! This file holds the rule and the correlation length; the passes that alternate it with
+//! the base choice are the baseline stage's (`baseline::layout`).
 
 /// How the buffer between time blocks is set.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -66,57 +64,6 @@ pub fn correlated_lag(runs: &[std::ops::Range<usize>], resid: &[f64], cap: usize
         .find(|&k| pooled_acf(runs, resid, k + 1) < bound)
         .unwrap_or(cap)
 }
-
-/// Median row spacing of the stacked record, s.
-fn row_spacing_s(folds: &Folds, t_s: &[f64]) -> f64 {
-    let mut d: Vec<f64> = folds
-        .run_rows
-        .iter()
-        .flat_map(|r| t_s[r.clone()].windows(2).map(|w| w[1] - w[0]))
-        .collect();
-    d.sort_by(f64::total_cmp);
-    d.get(d.len() / 2).copied().unwrap_or(0.0)
-}
-
-/// The layout with its buffer and the base chosen on it.
-pub fn choose_buffered(
-    folds: Folds,
-    st: &Stacked,
-    rule: BufferRule,
-) -> Result<(Folds, BaseChoice), DiagnoseError> {
-    let mut choice = choose(&folds, st)?;
-    if folds.offsets == Offsets::PerUnit || rule == BufferRule::None {
-        return Ok((folds, choice));
-    }
-    let shortest_run = folds.run_rows.iter().map(|r| r.len()).min().unwrap_or(0);
-    let spacing = row_spacing_s(&folds, &st.t_s);
-    let original = folds.clone();
-    let mut folds = folds;
-    // A base whose neighbours trained it hides the noise's memory (its held-out residual
-    // is high-passed); each pass measures it on the residual of the previous, buffered,
-    // layout until the correlation length stops growing.
-    let mut lag = 0;
-    for _ in 0..MAX_PASSES {
-        let next = correlated_lag(
-            &folds.run_rows,
-            &choice.chosen.cv.residual,
-            shortest_run / 2,
-        );
-        if next <= lag {
-            break;
-        }
-        lag = next;
-        folds = original
-            .clone()
-            .with_min_block_len(lag)
-            .with_buffer(lag, spacing);
-        choice = choose(&folds, st)?;
-    }
-    Ok((folds, choice))
-}
-
-/// Passes of the correlation-length measurement (it grows as buffers unmask it).
-pub const MAX_PASSES: usize = 4;
 
 #[cfg(test)]
 mod tests {

@@ -1,7 +1,10 @@
-//! Held-out validation shared by every stage: folds over whole runs (or buffered time
-//! blocks of single records) and the sign-flip test that respects run offsets.
+//! Ground floor: held-out validation shared by every stage, importing none of them: the
+//! layouts (`folds`: whole runs, or buffered time blocks of single records), the ridge
+//! fits on them (`cv`), the buffer rule (`buffer`), the design rows (`design`) and the
+//! sign-flip test that respects run offsets (`signflip`).
 
 pub mod buffer;
 pub mod cv;
 pub mod design;
+pub mod folds;
 pub mod signflip;

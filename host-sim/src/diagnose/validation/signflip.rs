@@ -6,8 +6,12 @@
 //! distribution. The max over all candidates of each flipped total (Westfall-Young
 //! single-step max-T) makes the p-values hold for the whole family of candidates.
 
+use crate::diagnose::validation::cv::CvResult;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+
+/// Seed of the sign-flip patterns (results are deterministic).
+pub const FLIP_SEED: u64 = 0x0D1A_605E;
 
 /// Exhaustive enumeration up to this many units, random flips beyond.
 pub const MAX_EXACT_UNITS: usize = 13;
@@ -84,6 +88,16 @@ pub fn smallest_p(units: usize) -> f64 {
 /// One-sided paired p-value that `gains` (per unit) are positive, by sign flips.
 pub fn paired_pvalue(gains: &[f64], seed: u64) -> f64 {
     max_t_pvalues(&[gains.to_vec()], seed)[0]
+}
+
+/// Per-unit drop in held-out squared error from `from` to `to`.
+pub fn unit_gains(from: &CvResult, to: &CvResult) -> Vec<f64> {
+    sse_drop(&from.unit_sse, &to.unit_sse)
+}
+
+/// Per-unit drop `from - to`.
+pub fn sse_drop(from: &[f64], to: &[f64]) -> Vec<f64> {
+    from.iter().zip(to).map(|(a, b)| a - b).collect()
 }
 
 #[cfg(test)]

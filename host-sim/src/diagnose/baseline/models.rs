@@ -3,11 +3,12 @@
 //! as a linear term or as a further RBF input. Width and ridge are chosen on held-out
 //! data from a small grid, the same way for every model, so comparisons are fair.
 
-use crate::diagnose::base::basis::{RbfBasis, RbfDesign};
+use crate::diagnose::baseline::rbf_basis::{RbfBasis, RbfDesign};
 use crate::diagnose::error::DiagnoseError;
+use crate::diagnose::input::derivatives;
 use crate::diagnose::input::Campaign;
-use crate::diagnose::library::derivatives;
-use crate::diagnose::validation::cv::{CvResult, Folds, Prepared};
+use crate::diagnose::validation::cv::{CvResult, Prepared};
+use crate::diagnose::validation::folds::Folds;
 use std::sync::Arc;
 
 /// Width factors tried (x mean centre spacing).
@@ -33,7 +34,7 @@ pub struct Stacked {
 
 impl Stacked {
     /// Stacks drift, time, temperature and dT/dt (a centred local polynomial over
-    /// +/-`rate_half_s`, `derivatives`; the window is chosen with the base, `bases`).
+    /// +/-`rate_half_s`, `input::derivatives`; the window is chosen with the base, `baseline::choice`).
     pub fn with_rate_half_width(c: &Campaign, rate_half_s: f64) -> Self {
         let cat = |f: &dyn Fn(&crate::diagnose::input::Series) -> Vec<f64>| {
             c.runs.iter().flat_map(f).collect::<Vec<f64>>()

@@ -10,8 +10,8 @@
 //! quantiles; levels are indicators of all but the most common value; a product
 //! multiplies the (centred) feature by one of the base's inputs (T - mean T, dT/dt).
 
+use crate::diagnose::input::derivatives;
 use crate::diagnose::input::Series;
-use crate::diagnose::library::derivatives;
 use serde::Serialize;
 
 /// How a column is turned into a feature.
@@ -185,7 +185,7 @@ impl Candidate {
         let tau = self.tau_s.unwrap_or(0.0);
         let half_s = self
             .half_s
-            .unwrap_or(2.0 * crate::diagnose::input::WINDOW_S);
+            .unwrap_or(2.0 * crate::diagnose::input::window::WINDOW_S);
         match self.transform {
             Transform::Value => vec![x.to_vec()],
             Transform::Rate => vec![derivatives::centred(&s.t_s, x, 1, half_s)],
@@ -201,9 +201,7 @@ impl Candidate {
                 .iter()
                 .map(|l| {
                     x.iter()
-                        .map(|v| {
-                            crate::diagnose::library::generic::level_weight(*v, *l, &self.levels)
-                        })
+                        .map(|v| level_weight(*v, *l, &self.levels))
                         .collect()
                 })
                 .collect(),
@@ -211,6 +209,22 @@ impl Candidate {
                 .chain(natural_spline(x, &self.knots))
                 .collect(),
         }
+    }
+}
+
+/// Membership of `x` in `level` among the sorted `levels`: 1 on the level, falling
+/// linearly to 0 at the neighbouring levels (a window mean of a switch between adjacent
+/// levels is split in the right shares), 0 beyond.
+pub fn level_weight(x: f64, level: f64, levels: &[f64]) -> f64 {
+    let i = levels.iter().position(|l| *l == level).unwrap_or(0);
+    let below = i.checked_sub(1).map(|j| levels[j]);
+    let above = levels.get(i + 1).copied();
+    if x == level {
+        1.0
+    } else if x < level {
+        below.map_or(0.0, |b| ((x - b) / (level - b)).max(0.0))
+    } else {
+        above.map_or(0.0, |a| ((a - x) / (a - level)).max(0.0))
     }
 }
 

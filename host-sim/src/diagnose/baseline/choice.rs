@@ -8,11 +8,12 @@
 //! named on it (`selection::parsimony`, issue 18 item 6). Every score, its standard error
 //! and the paired p that the lowest beats it are reported.
 
-use crate::diagnose::base::levels::{score, Law, LevelSystems, Score};
-use crate::diagnose::base::models::{fit_rbf, Stacked, RIDGES};
+use crate::diagnose::baseline::levels::{score, Law, LevelSystems, Score};
+use crate::diagnose::baseline::models::{fit_rbf, Stacked, RIDGES};
 use crate::diagnose::error::DiagnoseError;
-use crate::diagnose::validation::cv::{CvResult, Folds, Prepared};
+use crate::diagnose::validation::cv::{CvResult, Prepared};
 use crate::diagnose::validation::design::Design;
+use crate::diagnose::validation::folds::Folds;
 use serde::Serialize;
 
 /// Highest polynomial degree in T tried.
@@ -59,7 +60,7 @@ pub struct BaseFit {
     pub width_factor: f64,
     pub ridge: f64,
     /// The RBF basis (None for polynomial and constant bases).
-    pub basis: Option<crate::diagnose::base::basis::RbfBasis>,
+    pub basis: Option<crate::diagnose::baseline::rbf_basis::RbfBasis>,
 }
 
 impl BaseFit {
@@ -188,10 +189,11 @@ pub fn choose_with_rate_window(
     let Ok(loo) = choose(folds, &st) else {
         return Ok((back_to_device(st), device));
     };
-    let gains = crate::diagnose::selection::screen::unit_gains(&device.chosen.cv, &loo.chosen.cv);
+    let gains =
+        crate::diagnose::validation::signflip::unit_gains(&device.chosen.cv, &loo.chosen.cv);
     let p = crate::diagnose::validation::signflip::paired_pvalue(
         &gains,
-        crate::diagnose::selection::screen::FLIP_SEED,
+        crate::diagnose::validation::signflip::FLIP_SEED,
     );
     if loo.chosen.cv.rms() < device.chosen.cv.rms() && p < RATE_WINDOW_ALPHA {
         Ok((st, loo))
@@ -439,7 +441,7 @@ fn paired_against_best(scores: &mut [BaseScore], best: &str) {
             .collect();
         s.paired_p_vs_best = Some(crate::diagnose::validation::signflip::paired_pvalue(
             &gains,
-            crate::diagnose::selection::screen::FLIP_SEED,
+            crate::diagnose::validation::signflip::FLIP_SEED,
         ));
     }
 }
@@ -452,7 +454,7 @@ fn unit_score(folds: &Folds, cv: &CvResult) -> Score {
 
 /// Both level treatments of one base, scored leaving one run out (run-grouped layouts).
 fn level_scores(folds: &Folds, st: &Stacked, f: &BaseFit) -> Vec<LevelScore> {
-    if folds.offsets != crate::diagnose::validation::cv::Offsets::PerUnit {
+    if folds.offsets != crate::diagnose::validation::folds::Offsets::PerUnit {
         return vec![];
     }
     let design = f.raw_design();

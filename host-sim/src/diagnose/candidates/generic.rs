@@ -8,14 +8,14 @@
 //! dT/dt are the base's inputs). For time since the start: a power-on decay on the same
 //! time scales. Metadata keys that vary between runs enter as run-constant columns
 //! (their products with the base's inputs are within-run candidates; their values and
-//! levels are run-level candidates, `between`).
+//! levels are run-level candidates, `between_runs`).
 //!
 //! Memory time scales are the record's: from twice the row spacing, doubling, to half the
 //! shortest run. The size is bounded: at most `MAX_CANDIDATES` (the rest are skipped and
 //! reported as such); about 20 per column.
 
+use crate::diagnose::candidates::transforms::{BaseInput, Candidate, Source, Transform};
 use crate::diagnose::input::Campaign;
-use crate::diagnose::library::transforms::{BaseInput, Candidate, Source, Transform};
 use crate::io::runs::Run;
 
 /// Cap on the library's size (the rest are reported as skipped).
@@ -43,7 +43,7 @@ pub struct MetaColumn {
 /// Metadata keys that vary between runs and are present in all of them: numbers as
 /// they are, other values as categories when there are 2..=`MAX_LEVELS` of them and
 /// fewer than runs (a value unique to each run is a name, not a level). `ambient_c` and
-/// `latitude_deg` are left out: `between` and the azimuth already use them.
+/// `latitude_deg` are left out: `between_runs` and the azimuth already use them.
 pub fn metadata(runs: &[Run]) -> Vec<MetaColumn> {
     let Some(first) = runs.first() else {
         return vec![];
@@ -124,22 +124,6 @@ pub fn few_levels(v: impl Iterator<Item = f64>) -> Option<Vec<f64>> {
     let mut levels: Vec<f64> = frequent.into_iter().map(|(v, _)| v).collect();
     levels.sort_by(f64::total_cmp);
     (levels.len() >= 2 && covered as f64 >= LEVEL_COVERAGE * n as f64).then_some(levels)
-}
-
-/// Membership of `x` in `level` among the sorted `levels`: 1 on the level, falling
-/// linearly to 0 at the neighbouring levels (a window mean of a switch between adjacent
-/// levels is split in the right shares), 0 beyond.
-pub fn level_weight(x: f64, level: f64, levels: &[f64]) -> f64 {
-    let i = levels.iter().position(|l| *l == level).unwrap_or(0);
-    let below = i.checked_sub(1).map(|j| levels[j]);
-    let above = levels.get(i + 1).copied();
-    if x == level {
-        1.0
-    } else if x < level {
-        below.map_or(0.0, |b| ((x - b) / (level - b)).max(0.0))
-    } else {
-        above.map_or(0.0, |a| ((a - x) / (a - level)).max(0.0))
-    }
 }
 
 /// The levels to indicate: all but the most common one (the reference).
@@ -354,6 +338,7 @@ fn metadata_products(meta: &[MetaColumn], blank: &Blank) -> Vec<Candidate> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::diagnose::candidates::transforms::level_weight;
 
     #[test]
     fn levels_are_found_only_for_few_values_and_the_reference_is_the_commonest() {

@@ -10,10 +10,10 @@
 //! column) gets fog-core's trailing least-squares fit (`TempRateEstimator`'s quadratic
 //! term) instead, and the report says it is not on the device.
 
-use crate::diagnose::base::bases::BaseFit;
+use crate::diagnose::baseline::choice::BaseFit;
+use crate::diagnose::candidates::transforms::{Candidate, Source, Transform};
 use crate::diagnose::input::Campaign;
-use crate::diagnose::library::transforms::{Candidate, Source, Transform};
-use crate::diagnose::validation::cv::Folds;
+use crate::diagnose::validation::folds::Folds;
 use fog_core::compensation::features::{
     features_for_series, FeatureVector, TempRateEstimator, DEFAULT_ACCEL_SPAN_S,
     DEFAULT_RATE_SPAN_S, EXTRACTOR_RATE_POINTS,
@@ -184,9 +184,9 @@ pub fn check(
         .iter()
         .map(|s| (s.t_s.as_slice(), s.t_s.as_slice()))
         .collect();
-    let dt = crate::diagnose::library::derivatives::median_spacing_s(
+    let dt = crate::diagnose::input::derivatives::median_spacing_s(
         &runs,
-        crate::diagnose::input::WINDOW_S,
+        crate::diagnose::input::window::WINDOW_S,
     );
     let matched_span = 2.0 * half_s;
     let estimators: Vec<Estimator> = match device_kind(cand) {

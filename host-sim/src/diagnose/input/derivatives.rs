@@ -17,6 +17,9 @@
 //! run), widened on the side that has samples until it holds p + 2 points; nothing is
 //! padded or mirrored. Cost: one (p + 1)-square solve per point, half-width and column,
 //! on the 10 s means (never on raw rows).
+//!
+//! Part of the input stage: the widths are chosen once per column when the campaign is
+//! prepared, and every later stage (baseline, candidates) reads them from there.
 
 use nalgebra::{Matrix4, Vector4};
 use serde::Serialize;
@@ -200,7 +203,7 @@ pub struct WidthChoice {
 /// spacing) with the smallest leave-one-out mean square (the narrowest on a tie). `None`
 /// when no grid point can be validated (every run has fewer than `order + 3` samples).
 pub fn choose(column: &str, runs: &[(&[f64], &[f64])], order: usize) -> Option<WidthChoice> {
-    let dt = median_spacing_s(runs, crate::diagnose::input::WINDOW_S);
+    let dt = median_spacing_s(runs, super::window::WINDOW_S);
     let grid: Vec<GridScore> = HALF_WIDTHS_ROWS
         .iter()
         .map(|k| k * dt)

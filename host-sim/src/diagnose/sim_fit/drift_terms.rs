@@ -1,7 +1,7 @@
 //! Maps the named cause and its fitted coefficient(s) onto the project's simulator
 //! (`fog_sim::sim::DriftTerm`), so the effect found in measured data can be re-simulated.
 //!
-//! The coefficients come from [`crate::diagnose::simulator::simfit`], fitted on the *raw* transformed signal
+//! The coefficients come from [`crate::diagnose::sim_fit::calibrate`], fitted on the *raw* transformed signal
 //! (no normalisation), so they are already in the simulator's units: deg/h per unit of
 //! the column (value, lag), per unit/s (rate), per unit/s^2 (accel), deg/h at power-on
 //! (decay), deg/h per cos/sin (harmonic). Mapping of sources:
@@ -17,7 +17,7 @@
 //!   other `*_deg:harmonic` -> two series, cos and sin of the run's column;
 //! - `earth_dph:*` -> the true input rate with the same transform (a scale-factor error).
 
-use crate::diagnose::library::transforms::Transform;
+use crate::diagnose::candidates::transforms::Transform;
 use crate::diagnose::selection::cause::Cause;
 use crate::io::runs::Run;
 use crate::sim::{AuxSource, AuxTransform, DriftTerm};

@@ -13,11 +13,11 @@
 //! this measures how well the simulator's physics can reproduce the record, not how well
 //! a black box fits it.
 
-use crate::diagnose::base::levels::LevelSystems;
+use crate::diagnose::baseline::levels::LevelSystems;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
 use crate::diagnose::linalg::solve_spd;
-use crate::diagnose::simulator::thermal::{self, Curves, ThermalFit};
+use crate::diagnose::sim_fit::thermal::{self, Curves, ThermalFit};
 use crate::diagnose::validation::design::{columns, Design, WithColumns};
 use crate::stats::rms;
 use serde::Serialize;
@@ -33,7 +33,7 @@ pub const LAW_TERMS: [(&str, &str); 5] = [
 ];
 
 /// Fewest runs for the law shared across runs (else free run offsets).
-pub const MIN_RUNS_SHARED: usize = crate::diagnose::validation::cv::MIN_RUNS_GROUPED;
+pub const MIN_RUNS_SHARED: usize = crate::diagnose::validation::folds::MIN_RUNS_GROUPED;
 
 /// Fitted simulator parameters and how well they reproduce the measurements.
 #[derive(Clone, Debug, Serialize)]

@@ -1,0 +1,28 @@
+//! Stage 3, the candidate library: every feature a column or metadata key can offer
+//! (values, smooth functions, derivatives, memory, levels, products with the base's
+//! inputs; `generic`) and what the device can compute of it causally.
+
+pub mod causal;
+pub mod generic;
+pub mod transforms;
+
+use crate::diagnose::input::Campaign;
+use crate::diagnose::memprobe;
+
+/// The generic library and, if the cap left candidates out, a note saying so (the
+/// candidate's label and the reason, as the selection lists skipped candidates).
+pub fn library_of(
+    campaign: &Campaign,
+    meta: &[generic::MetaColumn],
+    rate_half_s: f64,
+) -> (Vec<transforms::Candidate>, Option<(String, String)>) {
+    let (library, left_out) = generic::enumerate(campaign, meta, rate_half_s);
+    memprobe::stage("library");
+    let note = (left_out > 0).then(|| {
+        (
+            format!("{left_out} candidates"),
+            format!("library capped at {} candidates", generic::MAX_CANDIDATES),
+        )
+    });
+    (library, note)
+}

@@ -1,6 +1,0 @@
-//! Stage 6, back to the simulator: its physics calibrated to the record and the named cause
-//! mapped onto its drift terms.
-
-pub mod simfit;
-pub mod simterm;
-pub mod thermal;
