@@ -18,9 +18,9 @@ use fog_core::model::cold_start::{ColdStartEnvelope, MAX_COLD_START_POINTS};
 use fog_core::model::format::{FeatureKind, FeatureSpec};
 use std::collections::BTreeMap;
 
-use super::dataset_from_runs;
 use crate::io::runs::Run;
 use crate::stats::{mean, std_dev};
+use crate::train::data::features::dataset_from_runs;
 
 /// First point of the envelope, s since power-on (the third 10 s window).
 pub const FIRST_POINT_S: f64 = 30.0;

@@ -33,9 +33,10 @@ use serde::Serialize;
 
 use super::error::{Result, TrainError};
 use super::seek_score::{seek_azimuth_per_run, Criterion};
-use super::{Dataset, TrainConfig};
 use crate::io::runs::Run;
+use crate::train::data::dataset::Dataset;
 use crate::train::data::features::{dataset_from_runs, default_specs};
+use crate::train::fit::config::TrainConfig;
 use crate::train::fit::validate::cross_validate;
 
 /// A set of model inputs `fogsim train --inputs` can name.
