@@ -90,6 +90,8 @@ fn small_reproduce_writes_report_and_plots() {
         "-40 and +60 degC"
     );
     for f in [
+        "model_paper/startup_after.svg",
+        "model_paper/azimuth_scatter.svg",
         "model_extended/startup_after.svg",
         "model_extended/azimuth_scatter.svg",
         "model_qualification/startup_after.svg",
@@ -107,6 +109,13 @@ fn small_reproduce_writes_report_and_plots() {
         let svg = std::fs::read_to_string(dir.join("plots").join(f))
             .unwrap_or_else(|e| panic!("{f}: {e}"));
         assert!(svg.contains("</svg>"), "{f}");
+    }
+    // The pictures at the top are the recommended model's (the last one, the
+    // qualification model here), not the paper inputs'.
+    let read = |f: &str| std::fs::read(dir.join("plots").join(f)).unwrap();
+    for f in ["startup_after.svg", "azimuth_scatter.svg"] {
+        assert!(read(f) == read(&format!("model_qualification/{f}")), "{f}");
+        assert!(read(f) != read(&format!("model_paper/{f}")), "{f}");
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

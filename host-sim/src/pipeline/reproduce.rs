@@ -223,15 +223,26 @@ pub fn reproduce(params: &GyroParams, opts: &ReproduceOptions) -> Result<Reprodu
         let north_seek_other_ambients =
             seek_other_ambients(params, &opts.north_seek, &trained.model, &source)?;
         if let Some(dir) = &opts.plots {
-            write_model_plots(
-                dir,
-                &heldout,
-                &series,
-                &north_seek,
-                opts.north_seek.ambient_c,
-                &label,
-                plot_tag,
-            )?;
+            // Every model's plots in its own folder; the recommended one (the last: the
+            // qualification model when there is one, else the inputs chosen by
+            // validation) also at the top, so the first pictures are of the model to use.
+            let recommended = k + 1 == n_models;
+            let tags = if recommended {
+                vec![plot_tag, ""]
+            } else {
+                vec![plot_tag]
+            };
+            for tag in tags {
+                write_model_plots(
+                    dir,
+                    &heldout,
+                    &series,
+                    &north_seek,
+                    opts.north_seek.ambient_c,
+                    &label,
+                    tag,
+                )?;
+            }
         }
         let targets = measure_targets(&per_ambient, &north_seek);
         models.push(ModelResult {
@@ -345,7 +356,8 @@ struct Fitted {
     model_file: String,
     /// What its north-seek report says it was trained on.
     source: String,
-    /// Suffix of its plot folder beside `--plots` (empty: the plots at the top).
+    /// Suffix of its plot folder `model<tag>/` beside `--plots` (the recommended model's
+    /// plots are also written at the top).
     plot_tag: &'static str,
     trained: crate::train::TrainOutcome,
     validation: CompensateReport,
@@ -384,7 +396,7 @@ fn fit_paper_campaign_models(
                 "{label}, trained on runs 1-{} of every campaign temperature",
                 opts.n_train
             ),
-            plot_tag: if k == 0 { "" } else { "_extended" },
+            plot_tag: if k == 0 { "_paper" } else { "_extended" },
             trained,
             validation,
             series,
