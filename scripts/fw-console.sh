@@ -7,7 +7,7 @@
 # The two never mix: defmt-semihosting writes only to stdout, the text lines only to
 # stderr. Usage:
 #   scripts/fw-console.sh [--seconds N] [firmware-arg ...]    e.g. gyro-rate=200
-# UART0..2 (host, gyro, turntable) are not connected here (serial null); docs/firmware.md
+# UART0..2 (host, gyro, turntable) are not connected here (serial null); docs/guide/firmware.md
 # gives the QEMU line with the three ports for a rig. The ELF is the `cargo fw-build
 # --target-dir target/fw` one (FOG_APP_ELF overrides).
 set -euo pipefail

@@ -1,6 +1,6 @@
 #!/bin/sh
 # Runs a firmware ELF (fog-app) under QEMU with its four UARTs on loopback TCP: the
-# runner behind `cargo fw-run` (.cargo/config.toml), see docs/firmware.md "Running fog-app".
+# runner behind `cargo fw-run` (.cargo/config.toml), see docs/guide/firmware.md "Running fog-app".
 #
 #   scripts/fw-qemu.sh ELF [FIRMWARE-ARGUMENT...]
 #
@@ -10,7 +10,7 @@
 # UART3, inclinometer  (fogsim rig):    QEMU connects to 127.0.0.1:$FOG_INCL_PORT (4447)
 #   (unused when the firmware argument tilt-mdeg= selects the simulated inclinometer)
 # The rig's ports are retried every second until the rig listens. Firmware arguments
-# (docs/firmware.md, "Firmware arguments") go to the firmware through semihosting; they
+# (docs/guide/firmware.md, "Firmware arguments") go to the firmware through semihosting; they
 # cannot contain a comma.
 set -eu
 if [ $# -lt 1 ]; then

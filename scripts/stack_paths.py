@@ -3,7 +3,7 @@
 
 Why: the painted QEMU replay (tests/tests/qemu_replay.rs) says *how much* stack the boot
 and the sample loop use; this says *which functions* use it, so a growth can be traced
-to a frame (docs/stack.md). A frame is what the prologue reserves: `push`/`push.w`
+to a frame (docs/explain/stack.md). A frame is what the prologue reserves: `push`/`push.w`
 registers x 4 B, `vpush` registers x 4/8 B, `sub`/`subw`/`sub.w sp, #N`. Edges are
 direct calls and tail branches (`bl`, `b.w`, `b` to another symbol); indirect calls
 (`blx rN`) are not followed, so a path is a lower bound where those occur, and

@@ -1,7 +1,7 @@
 //! Fills fog-core's BIT word from the firmware's real counters, once per BIT period.
 //!
 //! Exists so that the rule "which counter means which item" is plain host-testable code and
-//! not buried in a board's main loop. Inputs per item (docs/northfinder.md, "Built-in test"):
+//! not buried in a board's main loop. Inputs per item (docs/explain/northfinder.md, "Built-in test"):
 //! gyro link age (clock time since the last decoded sample), frame-error rate (CRC errors
 //! over CRC errors + good frames since the previous evaluation), temperature (latest reading)
 //! and its rate (difference of consecutive readings over their sample-time distance),

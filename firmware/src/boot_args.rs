@@ -1,7 +1,7 @@
 //! The firmware's program arguments (semihosting, QEMU only), parsed in one place so
 //! that an argument the firmware does not know, or a value it cannot read, is refused
 //! at boot with its name instead of being ignored (a typo such as `gyro-rat=200` used to
-//! run silently at 2 kHz). docs/firmware.md lists every argument in one table; this
+//! run silently at 2 kHz). docs/guide/firmware.md lists every argument in one table; this
 //! parser is the source of that table. Hardware builds have no arguments.
 
 use crate::fault_record::BootFault;

@@ -27,7 +27,7 @@
 //! model it is decoded into, 4,500 B: [`UploadBuffers`]) can live elsewhere, e.g. in a
 //! zero-initialised `static` ([`UploadServer::with_buffers`]): the firmware then builds
 //! and moves only the small rest, and no model is ever decoded onto the stack
-//! (docs/stack.md).
+//! (docs/explain/stack.md).
 
 use core::borrow::BorrowMut;
 
@@ -680,7 +680,7 @@ fn commit<F: NorFlash>(
     }
     // The counter must be above every counter either slot holds, and counter 0 is
     // never accepted (not even on an empty store): with floor 0 any counter-0 model
-    // could otherwise replace any other again and again (docs/upload.md).
+    // could otherwise replace any other again and again (docs/reference/link-protocol.md).
     let floor = s.store.security_floor();
     if security_counter <= floor {
         return Err(UploadError::Rollback {

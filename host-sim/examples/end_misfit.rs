@@ -1,7 +1,7 @@
 //! Does the final qualification model carry a warm-up misfit at one ambient that its
 //! seeks turn into a bias? The held-out scores that choose the model are the fold models',
 //! which pick their own centres and so do not share the final fit's particular misfit
-//! (docs/northfinder.md, "Without dT/dt"). This scores the final model itself: its
+//! (docs/record/northfinder.md, "Without dT/dt"). This scores the final model itself: its
 //! residuals on its own training runs, each run's first three seeks in the Monte Carlo's
 //! timing (the measured `pipeline::seek_schedule`: the rows whose 10 s interval lies in
 //! each main position's accepted windows; azimuth error -(e0 - e180) / (2 Omega_H sin

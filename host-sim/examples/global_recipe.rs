@@ -10,7 +10,7 @@
 //! `fogsim north-seek --model`.
 //!
 //! `target/release/examples/global_recipe DIR OUT [auto|t,rate|t,rate,accel|t,rate,rise]`
-//! (docs/northfinder.md, "The one global model over training campaigns").
+//! (docs/record/northfinder.md, "The one global model over training campaigns").
 
 use anyhow::{anyhow, bail, Context, Result};
 use fog_core::model::format::{FeatureSpec, MAX_ENCODED_LEN};

@@ -2,7 +2,7 @@
 //! K, R (seeded; tau0 = 1 s, 2^17 samples). Each generator has a twin with a different
 //! physical law at a matched scale (the fit must put it in another term, not this one)
 //! and a null (the term absent: it must not be detected). A mixed N + B + K series is
-//! the realistic gyro. Printed numbers are the ones in docs/allan.md.
+//! the realistic gyro. Printed numbers are the ones in docs/explain/allan.md.
 
 use fog_sim::stats::allan::{adev_of_series, Term};
 use rand::SeedableRng;

@@ -40,7 +40,7 @@ fn short_seek(dir: &std::path::Path, json: &str, extra: &[&str]) -> Value {
 fn compensated_cold_start_seeks_beat_uncompensated_ones() {
     let dir = scratch_dir("northseek");
     // 24 chamber runs, not the default 96: this test is about the command, not about how
-    // good the default model is (docs/northfinder.md measures that).
+    // good the default model is (docs/record/northfinder.md measures that).
     let json = short_seek(
         &dir,
         "ns.json",

@@ -14,7 +14,7 @@
 //! on demand (154 before: at these sizes the peak is still the trainer cross-check's, the
 //! diagnosis' own gain shows on long campaigns). The bound is 200 B/row, 27-34 % above
 //! what is measured. Measured figures and the 316,800-row campaign (226 B/row whole,
-//! 167 B/row slope from 63,360 rows): docs/diagnose.md, "Memory".
+//! 167 B/row slope from 63,360 rows): docs/record/diagnose.md, "Memory".
 
 use crate::app_support;
 

@@ -3,7 +3,7 @@
 //! seed, `fog_sim::diagnose` (through its public entry point and the JSON of its report, so
 //! that a restructured engine still runs here) and the generic peer of `common/peer.rs`
 //! are run side by side; one table row per case. The assertions hold what both achieve on
-//! the CI seeds (see docs/diagnose.md, "Effects the library was not written around"); the
+//! the CI seeds (see docs/record/diagnose.md, "Effects the library was not written around"); the
 //! rest is printed. Full table: `DIAG_SEEDS=11,22,33,44,55,66 cargo test -p fog-sim --test
 //! diagnose_novel -- --nocapture --test-threads=2`.
 
@@ -178,7 +178,7 @@ fn run_family(family: Family) -> Vec<Row> {
 }
 
 /// Asserts `holds` on the CI seed's row of `variant` (other seeds are printed only; the
-/// 6-seed table in docs/diagnose.md says how often each claim holds there).
+/// 6-seed table in docs/record/diagnose.md says how often each claim holds there).
 fn assert_ci(rows: &[Row], variant: Variant, what: &str, holds: impl Fn(&Row) -> bool) {
     let bad: Vec<&str> = rows
         .iter()

@@ -6,7 +6,7 @@
 //! default seeds 7 and 8 at a small size (6 and 12 runs, 1 Hz raw rows), more via
 //! `DIAG_SEEDS=7,8,9,...`. No allowance beyond the stated 2 sigma (the jackknife over runs
 //! on the t scale, `diagnose/uncertainty/jackknife.rs`; its coverage over 20 seeds per
-//! ambient set is in docs/diagnose.md, "honest sigmas": about 1 ratio in 20 falls outside,
+//! ambient set is in docs/record/diagnose.md, "honest sigmas": about 1 ratio in 20 falls outside,
 //! so extra seeds will show an occasional FAIL line by design).
 
 use crate::app_support;

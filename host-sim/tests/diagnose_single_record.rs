@@ -2,7 +2,7 @@
 //! (AR(1) bias wander or a rate random walk) and nothing planted, the family-wise rule
 //! must not name anything more often than its level allows, and a real planted effect in
 //! one record must be named without naming wrong columns more often than the level
-//! allows (its power is low here and measured, see docs/diagnose.md). Two generators with
+//! allows (its power is low here and measured, see docs/record/diagnose.md). Two generators with
 //! different physical laws (`common/single_record.rs`); the unbuffered rule (before
 //! issue 9 item 5) runs next to the buffered one for comparison.
 

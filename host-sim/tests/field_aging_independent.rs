@@ -10,7 +10,7 @@
 //! nothing is refined (no test power).
 //!
 //! `FOG_FIELD_AGING_FULL=1` (`FOG_FIELD_AGING_SEED=N`, default 1): the whole table (the three laws, 5 / 20 / 50 field seeks, 30
-//! evaluation starts x 6 seeks), printed (`--nocapture`) for docs/field.md.
+//! evaluation starts x 6 seeks), printed (`--nocapture`) for docs/record/field.md.
 
 use crate::common::field_gyro;
 

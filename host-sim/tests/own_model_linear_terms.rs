@@ -83,7 +83,7 @@ fn the_null_twin_keeps_the_pure_rbf() {
 /// chosen. On this generator the two shapes are within 1 % of each other on every law in
 /// the thin tube (3 % in the wide one): its
 /// warm-ups are smooth enough for the Gaussians alone, unlike the simulator's -40 degC
-/// campaign (docs/northfinder.md).
+/// campaign (docs/record/northfinder.md).
 #[test]
 fn the_chosen_shape_does_as_well_on_a_fresh_campaign() {
     for law in [SoakedLaw::LaggedNull, SoakedLaw::LaggedTemperatureBump(3.0)] {

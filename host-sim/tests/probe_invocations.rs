@@ -15,7 +15,7 @@
 //! is probed too (as a number unless listed below as a file, name or text flag).
 //!
 //! `cargo test` runs `FOG_PROBE_INVOCATIONS` invocations (default 60, a few seconds);
-//! the figures in docs/robustness.md come from
+//! the figures in docs/record/robustness.md come from
 //! `cargo build --release -p fog-sim` then `FOG_PROBE_INVOCATIONS=5600
 //! FOG_PROBE_FOGSIM=target/release/fogsim cargo test -p fog-sim --test probe_invocations --
 //! --nocapture` (the release binary probed).

@@ -15,7 +15,7 @@
 //! chosen and the flat start must cost nothing. Measured there (seeds 1-3): the flat start
 //! ties the plain fit (held-out seek 0.00731 / 0.00629 / 0.00606 deg against 0.00719 /
 //! 0.00653 / 0.00609), it does not win significantly, so this generator does not support
-//! a claim that it must be chosen (docs/northfinder.md). On the null twin (lagged, nothing
+//! a claim that it must be chosen (docs/record/northfinder.md). On the null twin (lagged, nothing
 //! in d2T/dt2) no d2T/dt2 at all.
 
 use crate::app_support;

@@ -10,7 +10,7 @@
 //! the planted one; for the step, the step's secant over the campaign's temperatures.
 //!
 //! Whether the shape helps a seek is measured on the simulator, not here:
-//! docs/northfinder.md ("Linear terms whose coefficients change with T").
+//! docs/record/northfinder.md ("Linear terms whose coefficients change with T").
 //!
 //! `cargo test --release -p fog-sim --test train_linear_by_t -- --nocapture` prints every
 //! figure.

@@ -33,7 +33,7 @@ pub fn start_with_console(
     let stderr = qemu.0.stderr.take().expect("piped");
     std::thread::spawn(move || {
         // Semihosting stderr carries the text lines (defmt's binary frames go to
-        // stdout, docs/firmware.md "The console: two channels"); keep the tagged ones.
+        // stdout, docs/guide/firmware.md "The console: two channels"); keep the tagged ones.
         let mut reader = BufReader::new(stderr);
         let mut line = Vec::new();
         while reader.read_until(b'\n', &mut line).is_ok_and(|n| n > 0) {

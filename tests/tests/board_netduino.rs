@@ -1,5 +1,5 @@
 //! The STM32F407 board binary on QEMU 7.2's `netduinoplus2` (an STM32F405 model: same
-//! memory map and core): how far it runs, as docs/firmware.md says.
+//! memory map and core): how far it runs, as docs/guide/firmware.md says.
 //!
 //! QEMU models that machine's USARTs, timers, SPI, ADC, SYSCFG and EXTI, and maps RCC,
 //! the flash interface, IWDG, I2C, DMA and GPIO as unimplemented (reads 0, writes

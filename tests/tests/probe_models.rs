@@ -14,7 +14,7 @@
 //! body), so the decoder's own checks are probed, not only the CRC.
 //!
 //! `cargo test` runs `FOG_PROBE_MODEL_MUTANTS` mutants (default 3,000); the figures in
-//! docs/robustness.md come from
+//! docs/record/robustness.md come from
 //! `FOG_PROBE_MODEL_MUTANTS=1200000 cargo test --release -p fog-tests --test probe_models -- --nocapture`.
 //! `FOG_PROBE_SEED` picks the mutants.
 

@@ -8,7 +8,7 @@
 //! The probe of issue 17 (`probe_frame_streams_...`) runs the same streams, plus gyro
 //! frame streams with bytes flipped, dropped and inserted, through the host-link and
 //! the gyro-frame decoders: `FOG_PROBE_FRAME_STREAMS` streams (default 5,000; the
-//! figures in docs/robustness.md come from `FOG_PROBE_FRAME_STREAMS=1000000 cargo test
+//! figures in docs/record/robustness.md come from `FOG_PROBE_FRAME_STREAMS=1000000 cargo test
 //! --release -p fog-tests --test protocol_fuzz probe -- --nocapture`), seeded by
 //! `FOG_PROBE_SEED`.
 

@@ -38,7 +38,7 @@ const WAIT: Duration = Duration::from_secs(30);
 /// Bound on fog-app's painted boot stack peak with a model in use (store scan, Ed25519
 /// re-check, model decode, configuration): measured 13,668 B, bound +1,436 B (10.5 %).
 /// The model decoded on the stack again (+1,664 B: 15,332 B) trips it; it was 29,660 B
-/// with the upload server and the model built by value (docs/stack.md).
+/// with the upload server and the model built by value (docs/explain/stack.md).
 const BOOT_STACK_BOUND_B: usize = 15_104;
 
 /// One QEMU process on `file` (relative to `dir`): QEMU, the host link, the console.
@@ -74,7 +74,7 @@ fn first_boot_status(client: &mut UploadClient<TcpStream>) -> DeviceStatus {
 }
 
 /// The painted stack peak of a boot that verified and decoded a stored model
-/// (`FOG-STACK boot_peak_bytes=N of=M`, fog-app's console), bounded: docs/stack.md.
+/// (`FOG-STACK boot_peak_bytes=N of=M`, fog-app's console), bounded: docs/explain/stack.md.
 fn check_boot_stack(console: &Receiver<String>) {
     let line = wait_line(console, "FOG-STACK boot_peak_bytes=", WAIT);
     let field = |key: &str| -> usize {
@@ -88,7 +88,7 @@ fn check_boot_stack(console: &Receiver<String>) {
     assert!(
         peak > 256 && peak < BOOT_STACK_BOUND_B,
         "fog-app boot stack peak {peak} bytes is implausible or over {BOOT_STACK_BOUND_B} B \
-         (a model or the upload server built by value on the stack? docs/stack.md)"
+         (a model or the upload server built by value on the stack? docs/explain/stack.md)"
     );
     if let Ok(path) = std::env::var("FOG_BUDGETS_BOOT_STACK_OUT") {
         let row = format!(

@@ -309,7 +309,7 @@ fn scenario_with(
         field("construct_peak"),
     );
     assert_eq!(boot, decode.max(construct), "boot peak is the larger phase");
-    // Regression bounds: the figures measured by scripts/budgets.sh (docs/stack.md) plus a
+    // Regression bounds: the figures measured by scripts/budgets.sh (docs/explain/stack.md) plus a
     // stated margin for compiler changes. Sample loop 5,912 B, bound 8 KiB (+39 %). Model
     // decode (argument parsing, the 2 KiB file buffer, `decode_into`) 6,620 B, bound
     // 7,680 B (+1,060 B, 16 %). Application construction (compensator configured in place,
@@ -331,7 +331,7 @@ fn scenario_with(
     assert!(
         construct < CONSTRUCT_BOUND_B,
         "construction stack peak {construct} bytes over {CONSTRUCT_BOUND_B} B \
-         (a large value built on the stack and moved? docs/stack.md)"
+         (a large value built on the stack and moved? docs/explain/stack.md)"
     );
     if let (Ok(path), "f32") = (std::env::var("FOG_BUDGETS_STACK_OUT"), tag) {
         let rows = format!(

@@ -9,7 +9,7 @@
 //! The probe of issue 17 (`probe_power_cut_...`) cuts power at every flash operation
 //! of whole uploads to the upload server (real client, `UploadServer`, reboot on the
 //! cut flash), over seeded random models and histories, until `FOG_PROBE_POWER_CUTS`
-//! cuts (default 400, one upload; the figures in docs/robustness.md come from
+//! cuts (default 400, one upload; the figures in docs/record/robustness.md come from
 //! `FOG_PROBE_POWER_CUTS=9000 cargo test --release -p fog-tests --test store_power_cut
 //! probe -- --nocapture`), seeded by `FOG_PROBE_SEED`.
 

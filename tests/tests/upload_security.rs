@@ -208,7 +208,7 @@ fn slot_signatures_are_rechecked_at_boot() {
 }
 
 /// Flips a signature bit of the slot with the higher sequence number and recomputes
-/// its header CRC (layout: docs/upload.md, `fog_firmware::store`).
+/// its header CRC (layout: docs/reference/link-protocol.md, `fog_firmware::store`).
 fn tamper_newest_signature(flash: EmulatedModelFlash) -> EmulatedModelFlash {
     use embedded_storage::nor_flash::{NorFlash, ReadNorFlash};
     let slot_len = fog_firmware::store::slot_len(256);

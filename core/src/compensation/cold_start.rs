@@ -9,7 +9,7 @@
 //! window within the envelope's span (`WindowStatus::NotColdStart`), so the north finder
 //! refuses those windows instead of returning an azimuth biased by a warm-up that is not
 //! there. Past the span the flag ends: the gyro has then warmed as far as a cold start
-//! would have (what a restart still costs after it is measured in docs/northfinder.md).
+//! would have (what a restart still costs after it is measured in docs/record/northfinder.md).
 
 use crate::model::cold_start::ColdStartEnvelope;
 

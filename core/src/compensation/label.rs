@@ -1,7 +1,7 @@
 //! The one format of a feature's name in reports, shared by the trainer (model inputs)
 //! and the diagnosis (candidate causes): `<column>:<transform>`, with the time constant
 //! of a lag or decay as `(tau_s=<whole seconds>)`, e.g. `temp_c:lag(tau_s=240)`, as the
-//! README's fog-runs format notes document.
+//! fog-runs format page (docs/reference/formats.md) documents.
 //!
 //! It lives beside the feature definitions (not in the host's report layer) so that the
 //! trainer and the diagnosis take it from below. A `Display` value, not a `String`, so the

@@ -5,7 +5,7 @@
 //! Why: a model trained on cold starts from a soak takes the time since power-on and the
 //! rise since the first reading as the warm-up's state. A restart of a gyro that is still
 //! warm rises less, and the model then subtracts a cold start's warm-up drift that is not
-//! there (docs/northfinder.md, "Warm restarts": a restart 1 degC above the ambient already
+//! there (docs/record/northfinder.md, "Warm restarts": a restart 1 degC above the ambient already
 //! biases the first seek by more than its std). The envelope lets the device see that its
 //! power-on is not one the model knows (`compensation::cold_start::ColdStartMonitor`).
 

@@ -18,7 +18,7 @@
 //! - polynomial base: Horner in i128 on t = xn_0 (Q.28) held to input 0's trained range;
 //!   temperature-coupled linear terms: (t xn_j >> 28) times their Q.`w_frac` coefficient.
 //!
-//! Worst error against the f64 reference: see `docs/core.md` (measured by the
+//! Worst error against the f64 reference: see `docs/explain/core.md` (measured by the
 //! `fixed_worst_error_*` tests: `cargo test -p fog-core --test rbf_accuracy fixed_worst -- --nocapture`).
 
 use crate::model::error::ModelError;

@@ -593,7 +593,7 @@ fn report_slots(report: [fog_firmware::upload::SlotVerdict; 2]) {
 
 /// The boot's painted stack peak (store scan, signature re-check, model decode,
 /// configuration), under QEMU as a plain `FOG-STACK` line that `qemu_persist.rs` bounds
-/// (docs/stack.md). Hardware builds do not paint.
+/// (docs/explain/stack.md). Hardware builds do not paint.
 fn report_boot_stack() {
     #[cfg(feature = "log-semihosting")]
     semihosting::eprintln!(
@@ -625,7 +625,7 @@ fn window_line(
 }
 
 /// What the QEMU scenarios ask for through semihosting arguments
-/// (`fog_firmware::boot_args`; every one is listed in docs/firmware.md): faults to
+/// (`fog_firmware::boot_args`; every one is listed in docs/guide/firmware.md): faults to
 /// inject (first boot only), the gyro rate (QEMU's serial backend cannot deliver the
 /// 24 kB/s of a 2 kHz gyro in real time), the seek dwell, the simulated tilt and the
 /// power-cut point of the flash image. An argument the firmware does not know, or a

@@ -4,7 +4,7 @@
 //! in the heap's middle stays resident: on the 316,800-row campaign the process kept
 //! 81.5 MB resident after the diagnosis, 45 MB with this policy. A fixed threshold gives
 //! every block of 128 KiB or more its own mapping, returned to the system when freed,
-//! so the peak RSS follows the live data (docs/diagnose.md, "Memory"). Allocation only:
+//! so the peak RSS follows the live data (docs/record/diagnose.md, "Memory"). Allocation only:
 //! results are the same bytes.
 
 /// Blocks of at least this many bytes get their own mapping.

@@ -22,7 +22,7 @@ pub const TRAIN_RUNS: usize = 3;
 /// Cold starts per ambient of the qualification campaign by default. Fewer than the own
 /// model's chamber campaign (`own_model::CAMPAIGN_RUNS`, at one ambient): the one global
 /// model pools them over the campaign's 11 ambients, and with 48 per ambient it meets the
-/// seek targets in 18 of 18 cells (docs/northfinder.md, "The derivative-free step").
+/// seek targets in 18 of 18 cells (docs/record/northfinder.md, "The derivative-free step").
 pub const QUALIFICATION_RUNS: usize = 48;
 
 /// Most cold starts per ambient `--qualification-runs` takes: twice the default; every

@@ -85,7 +85,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         );
     }
     if args.security_counter == Some(0) {
-        bail!("--security-counter 0: counter 0 is never accepted (counters start at 1; docs/upload.md)");
+        bail!("--security-counter 0: counter 0 is never accepted (counters start at 1; docs/reference/link-protocol.md)");
     }
     // Check everything local first: a bad file, key or registry never reaches the device.
     let prepared = match &args.model {

@@ -281,7 +281,7 @@ pub const QUALIFICATION_MODEL_FILE: &str = "model_qualification.bin";
 /// `opts.qualification_runs` cold starts at each of the campaign's ambients, from its own
 /// seed stream. Why: the paper's 3 runs per ambient leave the first seeks' model error
 /// above the targets for every recipe tried (0-1 of 18 cells), and 48 runs per ambient
-/// meet them in 14 of 18 (docs/northfinder.md, "The one global model over training
+/// meet them in 14 of 18 (docs/record/northfinder.md, "The one global model over training
 /// campaigns").
 fn qualification_model(params: &GyroParams, opts: &ReproduceOptions) -> Result<OwnModel> {
     let plan = &opts.campaign;

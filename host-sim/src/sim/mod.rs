@@ -1,7 +1,7 @@
 //! The FOG physics simulator (seeded, deterministic): two-node thermal model after
 //! power-on, temperature sensor, drift physics (temperature bias, Shupe rate term,
 //! gradient-rate term, turn-on bias, pluggable extra terms), IEEE Std 952 noise, and
-//! an indexing turntable. See `docs/simulator.md` for the calibration to the paper.
+//! an indexing turntable. See `docs/explain/simulator.md` for the calibration to the paper.
 
 mod checks;
 pub mod error;

@@ -115,7 +115,7 @@ pub struct GyroParams {
 
 impl GyroParams {
     /// The default gyro, calibrated to the paper at 20 degC (largest startup deviation
-    /// ~0.17 deg/h, ~15 min to the 0.021 deg/h spec; see `docs/simulator.md`).
+    /// ~0.17 deg/h, ~15 min to the 0.021 deg/h spec; see `docs/explain/simulator.md`).
     pub fn paper_default() -> Self {
         Self {
             thermal: ThermalParams {

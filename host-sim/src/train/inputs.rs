@@ -18,7 +18,7 @@
 //! reading is its ambient, so (T, dT/dt, T - T_first) tells the ambient a row warms up
 //! from as d2T/dt2 does, without a second derivative of the first few noisy rows (one
 //! global model, seek 1: the plain d2T/dt2's dwell means scatter 0.010-0.016 deg of azimuth
-//! from start to start, the rise's 0.002-0.006, docs/northfinder.md). Why a flat-start
+//! from start to start, the rise's 0.002-0.006, docs/record/northfinder.md). Why a flat-start
 //! d2T/dt2 is a candidate: right after power-on the plain fit
 //! has 3..18 rows and its dwell means carry the thermometer noise divided by 10..20 s,
 //! which the first seek turns into azimuth scatter; the flat prior removes that noise but
@@ -60,7 +60,7 @@ pub enum InputSet {
     /// T and the temperature rise since power-on, no dT/dt: for soaked cold starts with
     /// the warm-up clock beside it (`own_model::clock_spec`) the same warm-up state, read
     /// without a derivative, so the first minutes carry one 10 s mean's noise instead of a
-    /// few-row slope's (docs/northfinder.md, "Without dT/dt"). `train`'s `auto` does not
+    /// few-row slope's (docs/record/northfinder.md, "Without dT/dt"). `train`'s `auto` does not
     /// offer it (without the clock it does not follow a warm-up); the own-model recipe's
     /// does, with the clock, as the set the estimated derivatives must beat
     /// (`pipeline::own_model::choose_derivative_free`).

@@ -134,7 +134,7 @@ fn size_chosen_by(
     };
     // Whatever criterion chose the width and degree, each fold's number of centres is
     // chosen by held-out residual energy (`validate`): choosing it by the held-out seek
-    // error picked 1 centre for `north-seek`'s own 20 degC model (docs/northfinder.md).
+    // error picked 1 centre for `north-seek`'s own 20 degC model (docs/record/northfinder.md).
     let cv = "cross-validation (held-out 10 s residual energy)";
     match cv_centers {
         Some(_) if stop == StopReason::MaxCenters && n == cfg.max_centers => {

@@ -7,7 +7,7 @@
 //! not noise) becomes the same bias in every seek from there, which more starts do not
 //! average away. The held-out scores that choose the shape do not see it: it belongs to
 //! the final fit's particular centres, which the fold models do not share
-//! (docs/northfinder.md, "Without dT/dt").
+//! (docs/record/northfinder.md, "Without dT/dt").
 //!
 //! So the final model's linear parameters (centre weights, bias, polynomial and linear
 //! terms; centres and widths stay) are refitted by least squares to the 10 s rows plus,

@@ -4,7 +4,7 @@
 //! store that cannot be used is a fatal boot error (recorded, reset), never a halt.
 //! The server's large state (`UploadBuffers`: frames, model bytes, the decoded model) is
 //! the binary's `static`, handed in: what is built here and moved is a few hundred bytes,
-//! and the stored models are decoded in place (docs/stack.md).
+//! and the stored models are decoded in place (docs/explain/stack.md).
 
 use embedded_storage::nor_flash::NorFlash;
 use fog_core::link::upload::ResetRecord;

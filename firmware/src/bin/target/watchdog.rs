@@ -4,7 +4,7 @@
 //! NMI handler records `Watchdog` as the reset reason and resets at once.
 //! Registers: LOAD +0x0, CONTROL +0x8 (bit0 INTEN, bit1 RESEN), INTCLR +0xC (any write
 //! clears the interrupt and reloads the counter: the "feed"), LOCK +0xC00.
-//! The STM32 board uses its IWDG instead (same policy, see docs/firmware.md).
+//! The STM32 board uses its IWDG instead (same policy, see docs/guide/firmware.md).
 
 use core::ptr::write_volatile;
 

@@ -113,7 +113,7 @@ fn mean_nearest_distance(c: &[Vec<f64>]) -> f64 {
 /// Lloyd's k-means from a farthest-point start (deterministic: no seed, no RNG stream).
 ///
 /// Kept hand-written after measuring it against linfa-clustering 0.8.1's `KMeans`
-/// (`benches/diagnose_kmeans.rs`, docs/diagnose.md "Libraries"): on z-scored campaign
+/// (`benches/diagnose_kmeans.rs`, docs/record/diagnose.md "Libraries"): on z-scored campaign
 /// points (n 500 / 5,000, k 8 / 24, 2-d and 3-d) linfa with one run is not better
 /// (inertia 0.89-1.02x ours) and 1.4-6.3x slower at n = 500; its default 10 runs lowers the
 /// inertia by 0.5-14.5% but costs 7.6-47x the time, and diagnose runs k-means for every

@@ -8,7 +8,7 @@
 //! the per-unit scores, so at the base stage a base too simple for the drift (T without
 //! T^2) sits within one standard error of the lowest; the effect's own test then runs on
 //! a residual that still holds the simpler base's misfit and loses its power. Measured
-//! (docs/diagnose.md, "Parsimony (item 6)"): a 1-sigma (supply_v - 24) x dT/dt product,
+//! (docs/record/diagnose.md, "Parsimony (item 6)"): a 1-sigma (supply_v - 24) x dT/dt product,
 //! +29.7 % and p 0.0005 on poly_t2_rate, fell to +19.1 % and p 0.024 on poly_t1_rate,
 //! whose base score was 0.00020 deg/h (0.3 of a standard error) above poly_t2_rate's but
 //! 0.0046 deg/h (4 paired standard errors) above it once the product was in.

@@ -79,7 +79,7 @@ pub struct AgingPlan {
 }
 
 impl AgingPlan {
-    /// The measurement in docs/field.md: three laws, 5 / 20 / 50 field seeks (6 per power-on),
+    /// The measurement in docs/record/field.md: three laws, 5 / 20 / 50 field seeks (6 per power-on),
     /// 30 evaluation starts x 6 seeks, 20 degC.
     pub fn standard(seed: u64) -> Self {
         Self {
@@ -412,7 +412,7 @@ fn collect_field_records(
     })
 }
 
-/// The aging table printed by `fogsim field aging` (and copied into docs/field.md).
+/// The aging table printed by `fogsim field aging` (and copied into docs/record/field.md).
 pub fn aging_table(r: &AgingReport) -> String {
     let mut t = Table::new(&[
         "law",

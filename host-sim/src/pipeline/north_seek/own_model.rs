@@ -8,12 +8,12 @@
 //! gyro and sensor noise, their run-to-run warm-up differences, and the shape validation
 //! picked from them) comes back the same in every start: a systematic, per-seek azimuth
 //! bias that no number of seeks averages out. With 3 runs it was the largest error of
-//! seeks 1-3 (`docs/northfinder.md`, per-seek tables: -0.013 deg in seek 1 at 20 degC).
+//! seeks 1-3 (`docs/record/northfinder.md`, per-seek tables: -0.013 deg in seek 1 at 20 degC).
 //!
 //! How many runs: the whole chamber campaign, `CAMPAIGN_RUNS` (96 runs at the ambient,
 //! 72 h of chamber time). What the model learns from its runs' noise is a different bias
 //! in each seek, the same in every start, and its rms falls as 1/sqrt(runs). Measured over
-//! 18 campaigns (-40, 20, +60 degC x seeds 1-6, 1,000 starts each; docs/northfinder.md,
+//! 18 campaigns (-40, 20, +60 degC x seeds 1-6, 1,000 starts each; docs/record/northfinder.md,
 //! "The own model's run count"): the rms of the per-seek mean errors was 0.00167 deg with
 //! 48 runs (the Monte Carlo's own 0.0005 deg removed), 0.113 x the floor against the
 //! budget's 0.125, and one cell's worst seek mean missed the 0.3 std target (0.32); with
@@ -31,7 +31,7 @@
 //! 1 was 1.17x the floor with a mean of 0.47 std). Stopping at the first run count that met
 //! the budget (6, 12, 24 or 48 runs, the rule until 2026-11-26) trained 7 of 18
 //! campaigns (3 ambients x 6 seeds) on fewer than 48 runs, and 5 of those 7 missed the
-//! seek targets (docs/northfinder.md, "Six training campaigns per ambient"). Nor does it
+//! seek targets (docs/record/northfinder.md, "Six training campaigns per ambient"). Nor does it
 //! tell one campaign's learned error from another's: over six campaigns at +60 degC it
 //! read 0.0010-0.0015 deg while the Monte Carlo's per-seek means had an rms of 0.0008 to
 //! 0.0027 deg, hardly in the same order (with the seek refit done in the halves as well it
@@ -46,7 +46,7 @@
 //! simulator), a thin tube; Gaussians fitted to the tube get the drift's change across it
 //! (the Shupe and gradient terms are linear in the rates) only as well as the tube's few
 //! runs at its edge allow, while a linear term extends it. Measured over six campaigns per
-//! ambient (docs/northfinder.md): chosen this way the targets are met in 17 of 18 cells
+//! ambient (docs/record/northfinder.md): chosen this way the targets are met in 17 of 18 cells
 //! (-40 degC 5 of 6), against 14 of 18 without linear terms (-40 degC 2 of 6) and 16 of 18
 //! with them forced on every model.
 //!
@@ -55,7 +55,7 @@
 //! heats faster (its dissipation, 2 % 1-sigma in the simulator) from a later row of an
 //! average one. Without it the model follows only half of the dissipation's effect on the
 //! drift in the first two minutes, which was the whole excess of seek 1 at -40 degC
-//! (`examples/seek_input_noise`, docs/northfinder.md). It enters as fog-core's
+//! (`examples/seek_input_noise`, docs/record/northfinder.md). It enters as fog-core's
 //! `PowerOnDecay`, exp(-t / tau), with tau the campaign's own warm-up time: when its mean
 //! temperature rise reaches 1 - 1/e of the rise over the run (`warmup_time_constant_s`).
 //!
@@ -220,7 +220,7 @@ pub fn own_model_from_runs(
     let budget_deg = LEARNED_SHARE_OF_FLOOR * floor_deg;
     // `train`'s defaults, with the plan's criterion choosing the d2T/dt2 estimator as well
     // as the shape. (Scoring each set with the clock beside it was tried and not kept:
-    // docs/northfinder.md, "The one global model over training campaigns".)
+    // docs/record/northfinder.md, "The one global model over training campaigns".)
     let candidates = plan.inputs.candidates();
     let (mut selection, _) = choose_inputs_default(&runs, &candidates, &train_config(plan, false))
         .map_err(|e| anyhow!("choosing the own model's inputs: {e}"))?;
@@ -288,7 +288,7 @@ pub struct DerivativeFreeChoice {
 /// curves; the derivatives are then estimates of the same state from the first few noisy
 /// rows, whose noise the 10 s rows hardly weigh and the first seek turns into azimuth
 /// scatter (the global model's seek 1 at -40 degC: 1.21x the floor with d2T/dt2, 1.11x
-/// without; docs/northfinder.md, "Without dT/dt"). Where the runs' warm-ups differ in
+/// without; docs/record/northfinder.md, "Without dT/dt"). Where the runs' warm-ups differ in
 /// ways the rise and clock do not name (time constants spread run to run), the
 /// derivatives carry information and win by more than the runs' scatter.
 pub fn choose_derivative_free(

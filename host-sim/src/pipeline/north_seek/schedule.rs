@@ -11,7 +11,7 @@
 //! and every seek takes 277 s instead of 267 s. Measured without the model, the refit of
 //! such a model (seed 1's qualification model) was fitted to windows 10 s off in seek 1 and
 //! 100 s off by seek 10, and put a -0.012 deg bias into seek 1 at -40 and +60 degC
-//! (docs/northfinder.md, "The seek refit").
+//! (docs/record/northfinder.md, "The seek refit").
 
 use anyhow::{bail, Result};
 use fog_core::model::format::RbfModel;

@@ -4,7 +4,7 @@
 //! data order); the cell grows until at most `max_candidates` cells are occupied. Every
 //! training point then lies within about width/3 per axis of a candidate, so the
 //! reduction removes only near-duplicate candidates (held-out accuracy unchanged:
-//! `docs/trainer.md`). A grid rather than k-means: one pass, no iterations, no seed,
+//! `docs/explain/trainer.md`). A grid rather than k-means: one pass, no iterations, no seed,
 //! and it keeps candidates in sparsely sampled corners that k-means would average away.
 
 use std::collections::HashMap;
