@@ -86,7 +86,10 @@ fn concurrent_writer_processes_and_threads_never_share_a_counter_nor_lose_a_row(
             Command::new(std::env::current_exe().unwrap())
                 .args([
                     "--exact",
-                    "writer_process",
+                    // The test's full name in the crate's one test binary (`module::name`).
+                    concat!(module_path!(), "::writer_process")
+                        .split_once("::")
+                        .map_or("writer_process", |(_, name)| name),
                     "--nocapture",
                     "--test-threads",
                     "1",
