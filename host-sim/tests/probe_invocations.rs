@@ -8,7 +8,10 @@
 //! of its `--help` with the value missing, malformed (`abc`, empty, `nan`, `inf`,
 //! `1e400`, not UTF-8) or unknown (text flags); every input file replaced by a bad file
 //! (missing, empty, binary, truncated inside its last row, a 3 GiB sparse file, a
-//! directory, `/dev/zero`, not UTF-8, a non-UTF-8 name); every output pointed at an input.
+//! directory, `/dev/zero`, not UTF-8, a non-UTF-8 name; for `train --field DIR`, a
+//! directory whose field-record file is each of these, or of another format, with a
+//! record out of range, or measured under another model); every output pointed at an
+//! input.
 //! That catalogue is run first (in a seeded order); past it, seeded random faults of
 //! the same kinds (random garbage, random overflowing exponents, random bytes, random
 //! cuts and bit flips). The subcommands and flags come from `fogsim --help` (nested:
@@ -17,9 +20,10 @@
 //!
 //! `cargo test` runs `FOG_PROBE_INVOCATIONS` invocations (default 60, a few seconds);
 //! the figures in docs/robustness.md come from
-//! `cargo build --release -p fog-sim` then `FOG_PROBE_INVOCATIONS=5600
-//! FOG_PROBE_FOGSIM=target/release/fogsim cargo test -p fog-sim --test probe_invocations --
-//! --nocapture` (the release binary probed).
+//! `FOG_PROBE_INVOCATIONS=5600 cargo test -p fog-sim --test integration
+//! probe_invocations:: -- --nocapture` (the test profile's fogsim), or with
+//! `cargo build --release -p fog-sim` first and `FOG_PROBE_FOGSIM=target/release/fogsim`
+//! (the release binary probed).
 //! `FOG_PROBE_SEED` changes the order and the random faults; `FOG_PROBE_FOGSIM=PATH`
 //! probes another `fogsim` binary (the release build, or main's).
 
