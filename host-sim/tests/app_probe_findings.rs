@@ -137,3 +137,33 @@ fn a_one_byte_file_is_not_taken_for_an_empty_registry() {
     );
     assert_eq!(std::fs::read(dir.join("one.bin")).unwrap(), [0u8]);
 }
+
+#[test]
+fn field_pull_refuses_a_bad_registry_before_the_link() {
+    // Opened only after the pull: the dead link's error was reported instead (after its
+    // 10 s of retries), and a directory was skipped as "no registry".
+    let dir = scratch_dir("probe-findings-field-pull");
+    std::fs::create_dir_all(dir.join("reg-dir")).unwrap();
+    std::fs::write(dir.join("reg.bin"), [0u8, 0xFF, 0x13, 0x37]).unwrap();
+    for registry in ["reg-dir", "reg.bin"] {
+        one_line_naming(
+            &dir,
+            &[
+                "field",
+                "pull",
+                "--port",
+                "tcp:127.0.0.1:9",
+                "--registry",
+                registry,
+                "--out",
+                "records",
+            ],
+            registry,
+        );
+    }
+    assert_eq!(
+        std::fs::read(dir.join("reg.bin")).unwrap(),
+        [0u8, 0xFF, 0x13, 0x37]
+    );
+    assert!(!dir.join("records").exists());
+}

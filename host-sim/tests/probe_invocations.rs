@@ -8,17 +8,22 @@
 //! of its `--help` with the value missing, malformed (`abc`, empty, `nan`, `inf`,
 //! `1e400`, not UTF-8) or unknown (text flags); every input file replaced by a bad file
 //! (missing, empty, binary, truncated inside its last row, a 3 GiB sparse file, a
-//! directory, `/dev/zero`, not UTF-8, a non-UTF-8 name); every output pointed at an input.
+//! directory, `/dev/zero`, not UTF-8, a non-UTF-8 name; for `train --field DIR`, a
+//! directory whose field-record file is each of these, or of another format, with a
+//! record out of range, or measured under another model); every output pointed at an
+//! input.
 //! That catalogue is run first (in a seeded order); past it, seeded random faults of
 //! the same kinds (random garbage, random overflowing exponents, random bytes, random
-//! cuts and bit flips). The flags come from each subcommand's `--help`, so a new flag
-//! is probed too (as a number unless listed below as a file, name or text flag).
+//! cuts and bit flips). The subcommands and flags come from `fogsim --help` (nested:
+//! `field pull`, `registry show`, ...): a test fails when a command has no base command
+//! here or a value flag is in none of the lists below (file, name, text, number).
 //!
 //! `cargo test` runs `FOG_PROBE_INVOCATIONS` invocations (default 60, a few seconds);
 //! the figures in docs/record/robustness.md come from
-//! `cargo build --release -p fog-sim` then `FOG_PROBE_INVOCATIONS=5600
-//! FOG_PROBE_FOGSIM=target/release/fogsim cargo test -p fog-sim --test probe_invocations --
-//! --nocapture` (the release binary probed).
+//! `FOG_PROBE_INVOCATIONS=5600 cargo test -p fog-sim --test integration
+//! probe_invocations:: -- --nocapture` (the test profile's fogsim), or with
+//! `cargo build --release -p fog-sim` first and `FOG_PROBE_FOGSIM=target/release/fogsim`
+//! (the release binary probed).
 //! `FOG_PROBE_SEED` changes the order and the random faults; `FOG_PROBE_FOGSIM=PATH`
 //! probes another `fogsim` binary (the release build, or main's).
 
@@ -43,7 +48,15 @@ const ADDRESS_SPACE_KIB: u64 = 4 * 1024 * 1024;
 const HUGE_SPARSE_BYTES: u64 = 3 << 30;
 
 /// Flags whose value is a file the command reads.
-const INPUT_FLAGS: &[&str] = &["--model", "--key", "--from-diagnose", "--from-runs"];
+const INPUT_FLAGS: &[&str] = &[
+    "--model",
+    "--key",
+    "--from-diagnose",
+    "--from-runs",
+    "--field",
+];
+/// Of `INPUT_FLAGS`, those whose value is a directory (of field records).
+const DIR_INPUT_FLAGS: &[&str] = &["--field"];
 /// Flags whose value is a file or directory the command writes.
 const OUTPUT_FLAGS: &[&str] = &[
     "--out",
@@ -53,6 +66,7 @@ const OUTPUT_FLAGS: &[&str] = &[
     "--export-design",
     "--csv",
     "--logger-csv",
+    "--save-model",
 ];
 /// Flags with a free-text value: only a missing or non-UTF-8 value is bad for certain.
 const FREE_TEXT_FLAGS: &[&str] = &["--gyro-id", "--gyro"];
@@ -81,6 +95,64 @@ const NAME_FLAGS: &[&str] = &[
     "--gyro-port",
     "--table-port",
     "--width-search",
+    "--incl-port",
+    "--laws",
+];
+/// Flags with a number (or a list of numbers) for value.
+const NUMBER_FLAGS: &[&str] = &[
+    "--a-dph",
+    "--ambient-c",
+    "--azimuth-deg",
+    "--b-dph",
+    "--baud",
+    "--collinearity-tol",
+    "--connect-timeout-s",
+    "--duration-min",
+    "--duration-s",
+    "--dwell-s",
+    "--eval-starts",
+    "--field-seeks",
+    "--field-seeks-per-start",
+    "--field-weight",
+    "--folds",
+    "--from",
+    "--gyro-baud",
+    "--heading-bias-dph",
+    "--heading-deg",
+    "--headings-deg",
+    "--incl-baud",
+    "--latitude-deg",
+    "--max-candidates",
+    "--max-centers",
+    "--n-headings",
+    "--pitch-deg",
+    "--poly-degrees",
+    "--positions",
+    "--qualification-runs",
+    "--rate-hz",
+    "--raw-rate-hz",
+    "--restart-above-c",
+    "--results",
+    "--rho",
+    "--roll-deg",
+    "--runs",
+    "--security-counter",
+    "--seed",
+    "--seek-dwell-s",
+    "--seek-latitude-deg",
+    "--seeks",
+    "--sigma-dph",
+    "--speed",
+    "--split-gap-s",
+    "--starts",
+    "--table-baud",
+    "--target-dph",
+    "--threads",
+    "--tilt-deg",
+    "--timeout-s",
+    "--training-restarts-above-c",
+    "--training-runs",
+    "--widths",
 ];
 /// Malformed numbers: bad for every numeric flag.
 const BAD_NUMBERS: &[&str] = &["abc", "", "nan", "inf", "-inf", "1e400", "-1e400", "0x10"];
@@ -115,6 +187,20 @@ const SUBS: &[Sub] = &[
         base: &[
             "--out",
             "!out/m.bin",
+            "@runs/run4.csv",
+            "@runs/run5.csv",
+            "@runs/run6.csv",
+        ],
+    },
+    // `--field DIR`: a directory of field records measured under the model this base
+    // trains (written in `fixtures`); its bad files are put inside the directory.
+    Sub {
+        words: &["train"],
+        base: &[
+            "--out",
+            "!out/mf.bin",
+            "--field",
+            "@field",
             "@runs/run4.csv",
             "@runs/run5.csv",
             "@runs/run6.csv",
@@ -211,6 +297,36 @@ const SUBS: &[Sub] = &[
         base: &["--registry", "@reg.sqlite", "--csv", "!out/r.csv"],
     },
     Sub {
+        words: &["field", "pull"],
+        base: &[
+            "--port",
+            "tcp:127.0.0.1:9",
+            "--timeout-s",
+            "1",
+            "--registry",
+            "@reg.sqlite",
+            "--out",
+            "!out/field",
+        ],
+    },
+    Sub {
+        words: &["field", "aging"],
+        base: &[
+            "--laws",
+            "none",
+            "--field-seeks",
+            "5",
+            "--eval-starts",
+            "1",
+            "--seeks",
+            "1",
+            "--threads",
+            "1",
+            "--json",
+            "!out/aging.json",
+        ],
+    },
+    Sub {
         words: &["rig"],
         base: &[
             "--gyro-port",
@@ -279,6 +395,41 @@ fn help_flags(words: &[&str]) -> Vec<(String, bool)> {
         .collect()
 }
 
+/// The subcommands `fogsim <words> --help` lists (its `Commands:` section), `help` left
+/// out.
+fn help_commands(words: &[&str]) -> Vec<String> {
+    let out = Command::new(fogsim_exe())
+        .args(words)
+        .arg("--help")
+        .output()
+        .expect("fogsim --help runs");
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| !l.trim().is_empty())
+        .filter_map(|l| l.split_whitespace().next().map(str::to_string))
+        .filter(|c| c != "help")
+        .collect()
+}
+
+/// Every command of `fogsim <words> --help` that has no subcommands of its own, as its
+/// words (`field pull`, `registry show`, ...), found recursively.
+fn leaf_commands(words: &[String]) -> Vec<Vec<String>> {
+    let as_str: Vec<&str> = words.iter().map(String::as_str).collect();
+    let subs = help_commands(&as_str);
+    if subs.is_empty() {
+        return vec![words.to_vec()];
+    }
+    subs.into_iter()
+        .flat_map(|c| {
+            let mut w = words.to_vec();
+            w.push(c);
+            leaf_commands(&w)
+        })
+        .collect()
+}
+
 /// One bad invocation: its arguments and the words the error line must contain (any
 /// one of them).
 #[derive(Clone, Debug)]
@@ -294,6 +445,9 @@ struct Fixtures {
     /// Inputs that must never change: (path, bytes).
     inputs: Vec<(PathBuf, Vec<u8>)>,
     bad_files: Vec<(&'static str, PathBuf)>,
+    /// For a directory input (`train --field DIR`): directories whose field-record file
+    /// is bad (and a few that are not directories).
+    bad_dirs: Vec<(&'static str, PathBuf)>,
 }
 
 const LOGGER: &str = "t,r,T\n0,0.01,20.0\n0.1,0.02,20.0\n0.2,0.01,20.1\n0.3,0.03,20.1\n";
@@ -334,6 +488,8 @@ fn fixtures() -> Fixtures {
             bad.join(OsStr::from_bytes(b"no-such-\xFF\xFE.csv")),
         ),
     ];
+    field_records_of_the_train_base(&dir);
+    let bad_dirs = bad_field_dirs(&dir, &bad);
     let mut inputs = Vec::new();
     for p in walk(&dir) {
         // The registry is a store the tools open read-write: not compared.
@@ -346,6 +502,140 @@ fn fixtures() -> Fixtures {
         dir,
         inputs,
         bad_files,
+        bad_dirs,
+    }
+}
+
+/// The `Sub` of `words` whose base has (`with`) or has not `flag`.
+fn sub_of(words: &[&str], flag: &str, with: bool) -> &'static Sub {
+    SUBS.iter()
+        .find(|s| s.words == words && s.base.contains(&flag) == with)
+        .unwrap()
+}
+
+/// `dir/field/`: field records measured under the model the `train` base trains (its
+/// CRC-32, from one run of that base here), written by the library's own writer; then
+/// the `train --field` base must succeed on them (else its faults would fail for
+/// another reason).
+fn field_records_of_the_train_base(dir: &Path) {
+    use fog_core::seeking::field_record::FieldRecord;
+    use fog_sim::io::field_records::{merge_into_dir, StoredRecord};
+    let out = dir.join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    let plain = sub_of(&["train"], "--field", false);
+    let o = run(dir, &base_args(plain));
+    assert_eq!(o.code, Some(0), "the train base fails: {}", o.stderr);
+    let model_path = out.join("m.bin");
+    let model =
+        fog_core::model::format::RbfModel::decode(&std::fs::read(&model_path).unwrap()).unwrap();
+    let crc = fog_sim::io::model::model_crc32(&model).unwrap();
+    let records: Vec<StoredRecord> = (0..8u32)
+        .map(|i| {
+            let temp_c = 15.0 + 1.5 * i as f32;
+            StoredRecord::new(
+                "sim",
+                &FieldRecord {
+                    sequence: i + 1,
+                    temp_c,
+                    temp_rate_cps: 0.001 * (i % 3) as f32,
+                    t_since_power_on_s: 600.0,
+                    residual_bias_dph: 0.002 * (temp_c - 20.0),
+                    model_crc32: Some(crc),
+                    ..FieldRecord::ZERO
+                },
+            )
+        })
+        .collect();
+    merge_into_dir(&dir.join("field"), &records).unwrap();
+    let with_field = sub_of(&["train"], "--field", true);
+    let o = run(dir, &base_args(with_field));
+    assert_eq!(
+        o.code,
+        Some(0),
+        "the train --field base fails: {}",
+        o.stderr
+    );
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// Directories of bad field records, each a fault of `dir/field/`'s record file, or not a
+/// directory.
+fn bad_field_dirs(dir: &Path, bad: &Path) -> Vec<(&'static str, PathBuf)> {
+    use fog_sim::io::field_records::{merge_into_dir, read_dir_records, JSON_NAME};
+    let good = std::fs::read(dir.join("field").join(JSON_NAME)).unwrap();
+    let text = String::from_utf8(good.clone()).unwrap();
+    let with_json = |name: &str, json: &[u8]| {
+        let d = bad.join(name);
+        std::fs::create_dir_all(&d).unwrap();
+        std::fs::write(d.join(JSON_NAME), json).unwrap();
+        d
+    };
+    let no_records = bad.join("field-no-records");
+    std::fs::create_dir_all(&no_records).unwrap();
+    let huge = bad.join("field-huge");
+    std::fs::create_dir_all(&huge).unwrap();
+    let file = std::fs::File::create(huge.join(JSON_NAME)).unwrap();
+    file.set_len(HUGE_SPARSE_BYTES).unwrap();
+    let a_directory = bad.join("field-json-a-directory");
+    std::fs::create_dir_all(a_directory.join(JSON_NAME)).unwrap();
+    let dev_zero = bad.join("field-dev-zero");
+    std::fs::create_dir_all(&dev_zero).unwrap();
+    std::os::unix::fs::symlink("/dev/zero", dev_zero.join(JSON_NAME)).unwrap();
+    let mut binary = vec![0u8, 0xFF, 0x13, 0x37];
+    binary.extend((0..4000u32).map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8));
+    // The gyro id "sim" made "s\xFF\xFE".
+    let at = text.find("\"sim\"").unwrap() + 2;
+    let mut not_utf8 = good.clone();
+    not_utf8.splice(at..at + 2, [0xFF, 0xFE]);
+    // Written by the library: one record's residual bias out of range (1e30 dph), and
+    // every record's model CRC-32 changed (measured under another model).
+    let records = read_dir_records(&dir.join("field")).unwrap();
+    let mut implausible_records = records.clone();
+    implausible_records[3].residual_bias_dph = 1e30;
+    let implausible = bad.join("field-implausible");
+    merge_into_dir(&implausible, &implausible_records).unwrap();
+    let mut other_model = records;
+    for r in &mut other_model {
+        r.model_crc32 = r.model_crc32.map(|c| c ^ 1);
+    }
+    let other = bad.join("field-other-model");
+    merge_into_dir(&other, &other_model).unwrap();
+    vec![
+        ("missing file", no_records),
+        ("empty file", with_json("field-empty", b"")),
+        ("binary file", with_json("field-binary", &binary)),
+        (
+            "truncated JSON",
+            with_json("field-truncated", &cut_inside_last_row(&good)),
+        ),
+        ("huge sparse file", huge),
+        ("directory", a_directory),
+        ("/dev/zero", dev_zero),
+        ("non-UTF-8 content", with_json("field-not-utf8", &not_utf8)),
+        (
+            "another format",
+            with_json(
+                "field-other-format",
+                br#"{"format":"fog-runs","version":1,"records":[]}"#,
+            ),
+        ),
+        ("implausible record", implausible),
+        ("records of another model", other),
+        ("a file, not a directory", bad.join("binary.bin")),
+        (
+            "non-UTF-8 name",
+            bad.join(OsStr::from_bytes(b"field-\xFF\xFE")),
+        ),
+    ]
+}
+
+/// The bad files for the input at `path` (relative to the scratch directory): bad
+/// directories for a directory.
+fn bad_inputs<'a>(fx: &'a Fixtures, path: &OsStr) -> &'a [(&'static str, PathBuf)] {
+    if fx.dir.join(path).is_dir() {
+        &fx.bad_dirs
+    } else {
+        &fx.bad_files
     }
 }
 
@@ -470,7 +760,12 @@ fn catalogue(fx: &Fixtures) -> Vec<Case> {
                 });
             }
             if kind == FlagKind::Input && !sub.base.contains(&flag.as_str()) {
-                for (what, file) in &fx.bad_files {
+                let bad = if DIR_INPUT_FLAGS.contains(&flag.as_str()) {
+                    &fx.bad_dirs
+                } else {
+                    &fx.bad_files
+                };
+                for (what, file) in bad {
                     cases.push(Case {
                         kind: what,
                         args: with_value(sub, &flag, file.clone().into_os_string()),
@@ -483,11 +778,11 @@ fn catalogue(fx: &Fixtures) -> Vec<Case> {
         for (i, a) in sub.base.iter().enumerate() {
             let at = offset + i;
             let mut names: Vec<String> = flag_before(sub, at).into_iter().collect();
-            if a.starts_with('@') {
+            if let Some(input) = a.strip_prefix('@') {
                 // A registry that is absent is created, and SQLite takes an empty file
                 // for an empty database: neither is a bad file there.
                 let registry = a.ends_with(".sqlite");
-                for (what, file) in &fx.bad_files {
+                for (what, file) in bad_inputs(fx, OsStr::new(input)) {
                     let creates = ["empty file", "missing file", "non-UTF-8 name"];
                     if registry && creates.contains(what) {
                         continue;
@@ -575,11 +870,15 @@ fn random_case(fx: &Fixtures, rng: &mut ChaCha8Rng, n: usize) -> Case {
     let mut args = base_args(sub);
     let good = fx.dir.join(lossy(&args[at]));
     let path = fx.dir.join("bad").join(format!("random-{n}"));
-    let bytes = if good.is_dir() {
-        std::fs::read(good.join("run4.csv")).unwrap()
+    // A directory of field records: its record file is the one made bad.
+    let json = fog_sim::io::field_records::JSON_NAME;
+    let (bytes, bad_file) = if good.is_dir() {
+        std::fs::create_dir_all(&path).unwrap();
+        (std::fs::read(good.join(json)).unwrap(), path.join(json))
     } else {
-        std::fs::read(&good).unwrap()
+        (std::fs::read(&good).unwrap(), path.clone())
     };
+    // A JSON with a bit flipped may still be valid: cut or NUL only, as a run.
     let is_model = good.extension() == Some(OsStr::new("bin"));
     // A cut or a NUL inside a SQLite file may still be a database: random bytes only.
     let is_registry = good.extension() == Some(OsStr::new("sqlite"));
@@ -611,7 +910,7 @@ fn random_case(fx: &Fixtures, rng: &mut ChaCha8Rng, n: usize) -> Case {
             b
         }
     };
-    std::fs::write(&path, bad).unwrap();
+    std::fs::write(&bad_file, bad).unwrap();
     let mut names: Vec<String> = flag_before(sub, at).into_iter().collect();
     names.push(file_name(&path));
     args[at] = path.into_os_string();
@@ -733,6 +1032,51 @@ fn count_from_env(var: &str, default: u64) -> u64 {
     }
 }
 
+/// A subcommand or a value flag added to `fogsim` later cannot be left out: every command
+/// of `fogsim --help` (nested ones too) has a base command here, every `Sub` is such a
+/// command, and every value flag of each is in exactly one of the lists above (a new flag
+/// must be classified, not probed as a number by default).
+#[test]
+fn the_catalogue_has_every_subcommand_and_every_flag_is_classified() {
+    let leaves: Vec<String> = leaf_commands(&[]).iter().map(|w| w.join(" ")).collect();
+    let in_subs: Vec<String> = SUBS.iter().map(|s| s.words.join(" ")).collect();
+    assert!(
+        leaves.contains(&"field pull".to_string()) && leaves.contains(&"allan".to_string()),
+        "`fogsim --help` not read: {leaves:?}"
+    );
+    let missing: Vec<&String> = leaves.iter().filter(|l| !in_subs.contains(l)).collect();
+    assert!(
+        missing.is_empty(),
+        "commands of `fogsim --help` with no base command in SUBS: {missing:?}"
+    );
+    let stale: Vec<&String> = in_subs.iter().filter(|s| !leaves.contains(s)).collect();
+    assert!(
+        stale.is_empty(),
+        "SUBS entries that are no command of `fogsim --help`: {stale:?}"
+    );
+    let lists = [
+        INPUT_FLAGS,
+        OUTPUT_FLAGS,
+        FREE_TEXT_FLAGS,
+        STORE_FLAGS,
+        NAME_FLAGS,
+        NUMBER_FLAGS,
+    ];
+    let mut unclassified = Vec::new();
+    for sub in SUBS {
+        for (flag, takes_value) in help_flags(sub.words) {
+            let n = lists.iter().filter(|l| l.contains(&flag.as_str())).count();
+            if takes_value && n != 1 {
+                unclassified.push(format!("{} {flag} (in {n} lists)", sub.words.join(" ")));
+            }
+        }
+    }
+    assert!(
+        unclassified.is_empty(),
+        "value flags not in exactly one of the flag lists: {unclassified:?}"
+    );
+}
+
 #[test]
 fn bad_invocations_fail_with_one_line_naming_the_fault_and_change_no_input() {
     let n = count_from_env("FOG_PROBE_INVOCATIONS", 60) as usize;
@@ -769,6 +1113,7 @@ fn bad_invocations_fail_with_one_line_naming_the_fault_and_change_no_input() {
             }
         }
         let _ = std::fs::remove_dir_all(fx.dir.join("out"));
+        let _ = std::fs::remove_dir_all(fx.dir.join("bad").join(format!("random-{i}")));
         // What a failed run left (e.g. a registry created before the link failed), and
         // this case's random file.
         for p in walk(&fx.dir) {

@@ -61,6 +61,14 @@ fn pull(a: PullArgs) -> Result<()> {
         anyhow::bail!("--out {}: exists and is not a directory", a.out.display());
     }
     let reg_path = registry::resolve(a.registry.as_deref())?;
+    // An existing registry is opened (a bad one refused) before the link, as `monitor`
+    // does: checked only after the pull, a directory, `/dev/zero` or a file that is not
+    // SQLite was reported as the link's error, or (not a regular file) skipped as absent.
+    let mut reg = if reg_path.exists() {
+        Some(Registry::open(&reg_path)?)
+    } else {
+        None
+    };
     let mut link = a.link.open()?;
     let gyro_id = device_gyro_id(&mut link)?;
     let records = pull_records(
@@ -74,8 +82,7 @@ fn pull(a: PullArgs) -> Result<()> {
         .map(|r| StoredRecord::new(&gyro_id, r))
         .collect();
     let (in_dir, added_dir) = merge_into_dir(&a.out, &stored)?;
-    let registry_note = if reg_path.is_file() {
-        let mut reg = Registry::open(&reg_path)?;
+    let registry_note = if let Some(reg) = &mut reg {
         let added = reg.insert_field_records(&stored)?;
         format!("registry={} registry_added={added}", reg_path.display())
     } else {
