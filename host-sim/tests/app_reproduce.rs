@@ -89,6 +89,14 @@ fn small_reproduce_writes_report_and_plots() {
         2,
         "-40 and +60 degC"
     );
+    check_plots(&dir.join("plots"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Every model's plots in its folder, the campaign's at the top, and the top's startup and
+/// azimuth plots the recommended model's (the last one, the qualification model here), not
+/// the paper inputs'.
+fn check_plots(plots: &std::path::Path) {
     for f in [
         "model_paper/startup_after.svg",
         "model_paper/azimuth_scatter.svg",
@@ -97,7 +105,7 @@ fn small_reproduce_writes_report_and_plots() {
         "model_qualification/startup_after.svg",
         "model_qualification/azimuth_scatter.svg",
     ] {
-        assert!(dir.join("plots").join(f).exists(), "{f}");
+        assert!(plots.join(f).exists(), "{f}");
     }
     for f in [
         "startup_before.svg",
@@ -106,16 +114,14 @@ fn small_reproduce_writes_report_and_plots() {
         "allan.svg",
         "azimuth_scatter.svg",
     ] {
-        let svg = std::fs::read_to_string(dir.join("plots").join(f))
-            .unwrap_or_else(|e| panic!("{f}: {e}"));
+        let svg = std::fs::read_to_string(plots.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
         assert!(svg.contains("</svg>"), "{f}");
     }
     // The pictures at the top are the recommended model's (the last one, the
     // qualification model here), not the paper inputs'.
-    let read = |f: &str| std::fs::read(dir.join("plots").join(f)).unwrap();
+    let read = |f: &str| std::fs::read(plots.join(f)).unwrap();
     for f in ["startup_after.svg", "azimuth_scatter.svg"] {
         assert!(read(f) == read(&format!("model_qualification/{f}")), "{f}");
         assert!(read(f) != read(&format!("model_paper/{f}")), "{f}");
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }

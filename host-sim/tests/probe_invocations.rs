@@ -372,14 +372,19 @@ fn classify(flag: &str, takes_value: bool) -> FlagKind {
     }
 }
 
-/// The long flags of `fogsim <words> --help` and whether each takes a value.
-fn help_flags(words: &[&str]) -> Vec<(String, bool)> {
+/// What `fogsim <words> --help` prints.
+fn help_text(words: &[&str]) -> String {
     let out = Command::new(fogsim_exe())
         .args(words)
         .arg("--help")
         .output()
         .expect("fogsim --help runs");
-    String::from_utf8_lossy(&out.stdout)
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// The long flags of `fogsim <words> --help` and whether each takes a value.
+fn help_flags(words: &[&str]) -> Vec<(String, bool)> {
+    help_text(words)
         .lines()
         .filter_map(|l| {
             let l = l.trim_start().trim_start_matches("-h, ");
@@ -398,12 +403,7 @@ fn help_flags(words: &[&str]) -> Vec<(String, bool)> {
 /// The subcommands `fogsim <words> --help` lists (its `Commands:` section), `help` left
 /// out.
 fn help_commands(words: &[&str]) -> Vec<String> {
-    let out = Command::new(fogsim_exe())
-        .args(words)
-        .arg("--help")
-        .output()
-        .expect("fogsim --help runs");
-    String::from_utf8_lossy(&out.stdout)
+    help_text(words)
         .lines()
         .skip_while(|l| !l.starts_with("Commands:"))
         .skip(1)
@@ -518,8 +518,7 @@ fn sub_of(words: &[&str], flag: &str, with: bool) -> &'static Sub {
 /// the `train --field` base must succeed on them (else its faults would fail for
 /// another reason).
 fn field_records_of_the_train_base(dir: &Path) {
-    use fog_core::seeking::field_record::FieldRecord;
-    use fog_sim::io::field_records::{merge_into_dir, StoredRecord};
+    use fog_sim::io::field_records::merge_into_dir;
     let out = dir.join("out");
     std::fs::create_dir_all(&out).unwrap();
     let plain = sub_of(&["train"], "--field", false);
@@ -529,23 +528,7 @@ fn field_records_of_the_train_base(dir: &Path) {
     let model =
         fog_core::model::format::RbfModel::decode(&std::fs::read(&model_path).unwrap()).unwrap();
     let crc = fog_sim::io::model::model_crc32(&model).unwrap();
-    let records: Vec<StoredRecord> = (0..8u32)
-        .map(|i| {
-            let temp_c = 15.0 + 1.5 * i as f32;
-            StoredRecord::new(
-                "sim",
-                &FieldRecord {
-                    sequence: i + 1,
-                    temp_c,
-                    temp_rate_cps: 0.001 * (i % 3) as f32,
-                    t_since_power_on_s: 600.0,
-                    residual_bias_dph: 0.002 * (temp_c - 20.0),
-                    model_crc32: Some(crc),
-                    ..FieldRecord::ZERO
-                },
-            )
-        })
-        .collect();
+    let records = app_support::linear_field_records("sim", 8, 1.5, |_| Some(crc));
     merge_into_dir(&dir.join("field"), &records).unwrap();
     let with_field = sub_of(&["train"], "--field", true);
     let o = run(dir, &base_args(with_field));

@@ -334,24 +334,9 @@ fn register_calibrated_variants(model_path: &Path, registry: &Path) -> (u32, u32
 /// Nine field records of gyro FIELD-1 (residual linear in T): six measured under `first`,
 /// three under `second`.
 fn field_records(first: u32, second: u32) -> Vec<fog_sim::io::field_records::StoredRecord> {
-    use fog_core::seeking::field_record::FieldRecord;
-    (0..9u32)
-        .map(|i| {
-            let temp_c = 15.0 + 2.0 * i as f32;
-            fog_sim::io::field_records::StoredRecord::new(
-                "FIELD-1",
-                &FieldRecord {
-                    sequence: i + 1,
-                    temp_c,
-                    temp_rate_cps: 0.001 * (i % 3) as f32,
-                    t_since_power_on_s: 600.0,
-                    residual_bias_dph: 0.002 * (temp_c - 20.0),
-                    model_crc32: Some(if i < 6 { first } else { second }),
-                    ..FieldRecord::ZERO
-                },
-            )
-        })
-        .collect()
+    app_support::linear_field_records("FIELD-1", 9, 2.0, |i| {
+        Some(if i < 6 { first } else { second })
+    })
 }
 
 /// `fogsim train`, its model with a heading calibration attached (`heading-cal`), the

@@ -70,3 +70,32 @@ pub fn campaign_and_model(dir: &Path, runs: usize) -> Vec<PathBuf> {
         })
         .collect()
 }
+
+/// `n` field records of gyro `gyro_id`, one every `temp_step_c` from 15 degC, whose
+/// residual bias is 0.002 deg/h per degC from 20 degC (what `train --field` can fit);
+/// record `i` (0-based) measured under the model `model_crc32(i)`.
+pub fn linear_field_records(
+    gyro_id: &str,
+    n: u32,
+    temp_step_c: f32,
+    model_crc32: impl Fn(u32) -> Option<u32>,
+) -> Vec<fog_sim::io::field_records::StoredRecord> {
+    use fog_core::seeking::field_record::FieldRecord;
+    (0..n)
+        .map(|i| {
+            let temp_c = 15.0 + temp_step_c * i as f32;
+            fog_sim::io::field_records::StoredRecord::new(
+                gyro_id,
+                &FieldRecord {
+                    sequence: i + 1,
+                    temp_c,
+                    temp_rate_cps: 0.001 * (i % 3) as f32,
+                    t_since_power_on_s: 600.0,
+                    residual_bias_dph: 0.002 * (temp_c - 20.0),
+                    model_crc32: model_crc32(i),
+                    ..FieldRecord::ZERO
+                },
+            )
+        })
+        .collect()
+}
