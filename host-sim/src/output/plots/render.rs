@@ -136,10 +136,14 @@ fn integer_label(v: &f64) -> String {
     }
 }
 
+/// Below this a tick value is the zero tick, off by the rounding of the tick steps' sum
+/// (a zero tick read `7e-18`); no quantity this tool plots is that small.
+const ZERO_TICK: f64 = 1e-12;
+
 /// Compact numbers for tick labels (1e-3 instead of 0.0010000).
 fn number_label(v: &f64) -> String {
     let a = v.abs();
-    if *v == 0.0 {
+    if a < ZERO_TICK {
         "0".into()
     } else if !(1e-3..1e5).contains(&a) {
         format!("{v:.0e}")
@@ -420,6 +424,14 @@ pub fn write_svg(path: &Path, chart: &Chart) -> Result<(), PlotError> {
 mod tests {
     use super::*;
     use crate::output::plots::chart::Series;
+
+    #[test]
+    fn a_zero_tick_off_by_rounding_reads_zero() {
+        assert_eq!(number_label(&7e-18), "0");
+        assert_eq!(number_label(&-3e-17), "0");
+        assert_eq!(number_label(&0.02), "0.02");
+        assert_eq!(number_label(&-0.0004), "-4e-4");
+    }
 
     #[test]
     fn renders_linear_and_log_charts() {
