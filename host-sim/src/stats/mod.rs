@@ -20,6 +20,11 @@ pub fn mean(x: &[f64]) -> f64 {
     x.iter().sum::<f64>() / x.len() as f64
 }
 
+/// Mean, 0 for an empty slice (where "nothing" should add nothing, as in sums of means).
+pub fn mean_or_zero(x: &[f64]) -> f64 {
+    x.iter().sum::<f64>() / x.len().max(1) as f64
+}
+
 /// Sample standard deviation (n - 1); 0 for fewer than two values.
 pub fn std_dev(x: &[f64]) -> f64 {
     if x.len() < 2 {

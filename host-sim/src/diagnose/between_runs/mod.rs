@@ -36,6 +36,7 @@ use crate::diagnose::selection::scored::ALPHA;
 use crate::diagnose::selection::screen::{Screening, MAX_STEPS, MIN_GAIN_PCT};
 use crate::diagnose::validation::folds::Folds;
 use crate::diagnose::validation::signflip::{max_t_pvalues, FLIP_SEED};
+use crate::stats::rms;
 use serde::Serialize;
 
 use heading::{heading_effect, HeadingEffect};
@@ -188,10 +189,6 @@ fn joined(given: &[Vec<f64>], cand: &[Vec<f64>]) -> Vec<Vec<f64>> {
         .zip(cand)
         .map(|(g, c)| g.iter().chain(c).copied().collect())
         .collect()
-}
-
-fn rms(e: &[f64]) -> f64 {
-    (e.iter().map(|v| v * v).sum::<f64>() / e.len().max(1) as f64).sqrt()
 }
 
 /// Step-wise selection of run-level causes (see the module header); `groups` sequences

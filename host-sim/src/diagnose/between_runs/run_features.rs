@@ -7,6 +7,7 @@ use crate::diagnose::baseline::models::Stacked;
 use crate::diagnose::candidates::generic::{few_levels, MetaColumn};
 use crate::diagnose::input::Campaign;
 use crate::diagnose::validation::folds::Folds;
+use crate::stats::mean_or_zero;
 
 /// One run-level candidate: `features[r]` holds run r's feature values.
 #[derive(Clone, Debug)]
@@ -15,10 +16,6 @@ pub struct RunCandidate {
     pub column: String,
     pub harmonic: bool,
     pub features: Vec<Vec<f64>>,
-}
-
-fn mean(v: &[f64]) -> f64 {
-    v.iter().sum::<f64>() / v.len().max(1) as f64
 }
 
 /// Run offsets left by the base fitted on every run: mean over the run of drift minus
@@ -42,7 +39,7 @@ pub fn run_offsets(folds: &Folds, st: &Stacked, base: &BaseFit) -> Vec<f64> {
                     st.y[i] - row.iter().zip(&w).map(|(c, wj)| c * wj).sum::<f64>()
                 })
                 .collect();
-            mean(&resid)
+            mean_or_zero(&resid)
         })
         .collect()
 }
@@ -58,13 +55,13 @@ pub fn enumerate(c: &Campaign, meta: &[MetaColumn]) -> Vec<RunCandidate> {
                 .runs
                 .iter()
                 .map(|s| {
-                    let cs = mean(
+                    let cs = mean_or_zero(
                         &s.extras[j]
                             .iter()
                             .map(|a| a.to_radians().cos())
                             .collect::<Vec<_>>(),
                     );
-                    let sn = mean(
+                    let sn = mean_or_zero(
                         &s.extras[j]
                             .iter()
                             .map(|a| a.to_radians().sin())
@@ -85,7 +82,11 @@ pub fn enumerate(c: &Campaign, meta: &[MetaColumn]) -> Vec<RunCandidate> {
                 label: format!("{name}:run_mean"),
                 column: name.clone(),
                 harmonic: false,
-                features: c.runs.iter().map(|s| vec![mean(&s.extras[j])]).collect(),
+                features: c
+                    .runs
+                    .iter()
+                    .map(|s| vec![mean_or_zero(&s.extras[j])])
+                    .collect(),
             });
         }
     }
@@ -139,7 +140,7 @@ fn varies(f: &[Vec<f64>]) -> bool {
     let k = f.first().map_or(0, Vec::len);
     (0..k).any(|j| {
         let v: Vec<f64> = f.iter().map(|x| x[j]).collect();
-        let m = mean(&v);
+        let m = mean_or_zero(&v);
         v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() > 1e-12 * (1.0 + m * m) * v.len() as f64
     })
 }

@@ -17,6 +17,7 @@
 use crate::diagnose::candidates::transforms::{BaseInput, Candidate, Source, Transform};
 use crate::diagnose::input::Campaign;
 use crate::io::runs::Run;
+use crate::stats::mean_or_zero;
 
 /// Cap on the library's size (the rest are reported as skipped).
 pub const MAX_CANDIDATES: usize = 400;
@@ -176,10 +177,6 @@ fn knots_at(sorted: &[f64], qs: &[f64]) -> Option<Vec<f64>> {
     k.windows(2).all(|w| w[1] > w[0]).then_some(k)
 }
 
-fn mean(v: &[f64]) -> f64 {
-    v.iter().sum::<f64>() / v.len().max(1) as f64
-}
-
 /// The whole library: within-run candidates of every column and of the run-constant
 /// metadata (products only), in a fixed order; and how many were left out by the cap.
 pub fn enumerate(
@@ -192,7 +189,7 @@ pub fn enumerate(
         .iter()
         .flat_map(|s| s.temp_c.iter().copied())
         .collect();
-    let temp_mean = mean(&temps);
+    let temp_mean = mean_or_zero(&temps);
     let blank = |column: &str, source, transform| Candidate {
         column: column.to_owned(),
         source,
@@ -253,7 +250,7 @@ fn column_candidates(
         .iter()
         .flat_map(|s| s.extras[i].iter().copied())
         .collect();
-    let centre = mean(&pooled);
+    let centre = mean_or_zero(&pooled);
     for tr in [Transform::Value, Transform::Rate, Transform::Accel] {
         out.push(blank(name, src, tr));
     }
@@ -320,7 +317,7 @@ fn metadata_products(meta: &[MetaColumn], blank: &Blank) -> Vec<Candidate> {
                 ..blank(&m.key, Source::Meta, Transform::Levels)
             },
             None => Candidate {
-                centres: (mean(&m.run_values), temp_mean),
+                centres: (mean_or_zero(&m.run_values), temp_mean),
                 run_values: m.run_values.clone(),
                 ..blank(&m.key, Source::Meta, Transform::Value)
             },

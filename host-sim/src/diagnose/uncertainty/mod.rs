@@ -21,6 +21,7 @@ use crate::diagnose::uncertainty::jackknife::delete_one;
 use crate::diagnose::validation::cv::{Prepared, UnitSystems};
 use crate::diagnose::validation::design::WithColumns;
 use crate::diagnose::validation::folds::{Folds, Offsets};
+use crate::stats::mean_or_zero;
 use serde::Serialize;
 
 /// A measured coefficient against the simulator's value.
@@ -143,10 +144,6 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-fn mean(v: &[f64]) -> f64 {
-    v.iter().sum::<f64>() / v.len().max(1) as f64
-}
-
 /// Mean partial derivatives of each base column over the rows, w.r.t. T and dT/dt.
 fn mean_partials(base: &BaseFit, st: &Stacked) -> (Vec<f64>, Vec<f64>) {
     if let Some(b) = &base.basis {
@@ -183,7 +180,7 @@ fn mean_partials(base: &BaseFit, st: &Stacked) -> (Vec<f64>, Vec<f64>) {
     let z: Vec<f64> = st.temp_c.iter().map(|t| (t - m) / sd).collect();
     let mut d_t: Vec<f64> = (1..=degree)
         .map(|k| {
-            mean(
+            mean_or_zero(
                 &z.iter()
                     .map(|x| k as f64 * x.powi(k as i32 - 1) / sd)
                     .collect::<Vec<_>>(),

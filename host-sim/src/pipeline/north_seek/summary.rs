@@ -12,6 +12,7 @@ use super::seeks::{ArmOutcome, SeekOutcome, StartOutcome};
 use super::targets;
 use crate::output::reports::{NorthSeekReport, SeekReliability, SeekStats, Table};
 use crate::sim::GyroParams;
+use crate::stats::mean_or_zero;
 use crate::stats::{rms, std_dev};
 /// Signed azimuth difference a - b wrapped to [-180, 180), deg.
 pub fn azimuth_error_deg(a: f64, b: f64) -> f64 {
@@ -39,10 +40,6 @@ pub fn noise_floor_deg(
         }
     };
     rad.to_degrees()
-}
-
-fn mean(v: &[f64]) -> f64 {
-    v.iter().sum::<f64>() / v.len().max(1) as f64
 }
 
 /// Statistics of one arm over the starts, against the true azimuth: the finished seeks
@@ -77,7 +74,7 @@ pub fn seek_stats(arms: &[ArmOutcome], true_azimuth_deg: f64) -> SeekStats {
             .iter()
             .map(|a| f(&a.seeks.iter().map(err).collect::<Vec<_>>()))
             .collect();
-        mean(&v)
+        mean_or_zero(&v)
     };
     let range = |v: &[f64]| -> f64 {
         let (lo, hi) = v
@@ -94,15 +91,15 @@ pub fn seek_stats(arms: &[ArmOutcome], true_azimuth_deg: f64) -> SeekStats {
     SeekStats {
         std_deg: std_dev(&all),
         max_dev_deg: all.iter().fold(0.0f64, |m, e| m.max(e.abs())),
-        mean_error_deg: mean(&all),
+        mean_error_deg: mean_or_zero(&all),
         rms_error_deg: rms(&all),
         per_seek_rms_error_deg: (0..n_seek).map(|k| of_column(rms, k)).collect(),
         per_seek_std_deg: (0..n_seek).map(|k| of_column(std_dev, k)).collect(),
-        per_seek_mean_error_deg: (0..n_seek).map(|k| of_column(mean, k)).collect(),
+        per_seek_mean_error_deg: (0..n_seek).map(|k| of_column(mean_or_zero, k)).collect(),
         per_seek_results: (0..n_seek).map(|k| column(k).len()).collect(),
         mean_range_deg: per_start(range),
         mean_within_start_std_deg: per_start(std_dev),
-        mean_reported_sigma_deg: mean(
+        mean_reported_sigma_deg: mean_or_zero(
             &arms
                 .iter()
                 .flat_map(|a| &a.seeks)
