@@ -13,7 +13,6 @@
 use crate::common::independent;
 use fog_sim::diagnose::diagnose;
 use independent::{campaign, Hidden, PowerOnLaw};
-use rayon::prelude::*;
 
 use crate::common::seeds;
 
@@ -22,47 +21,49 @@ const ACCEL: &str = "temp_c:accel";
 
 /// One line per seed: (right?, what happened). `wrong`: the law that must not be named.
 fn per_seed(hidden: Hidden, wrong: &str) -> Vec<(bool, String)> {
-    seeds::seeds()
-        .into_par_iter()
-        .map(|seed| {
-            let (runs, expected) = campaign(hidden, seed);
-            let r = diagnose(&runs).expect("diagnose runs").report;
-            let first = r.named_causes.first();
-            let right_first = match expected {
-                Some(e) => first.is_some_and(|c| c.label.starts_with(e)),
-                None => first.is_none(),
-            };
-            let wrong_named = r.named_causes.iter().any(|c| c.label.starts_with(wrong));
-            let truth_rejected = r.competing.iter().any(|c| {
-                c.verdict == "separated" && expected.is_some_and(|e| c.candidate.starts_with(e))
-            });
-            let named: Vec<String> = r
-                .named_causes
-                .iter()
-                .map(|c| format!("{} {:+.2}% p {:.4}", c.label, c.conditional_gain_pct, c.p_value))
-                .collect();
-            let competing: Vec<String> = r
-                .competing
-                .iter()
-                .map(|c| format!("{} vs {}: {}", c.candidate, c.named, c.in_words))
-                .collect();
-            let wrong_rank = r
-                .candidates
-                .iter()
-                .position(|c| {
-                    fog_core::compensation::label::feature_label(&c.column, c.transform.name(), c.tau_s)
-                        .to_string()
-                        .starts_with(wrong)
-                })
-                .map(|i| (i + 1, r.candidates[i].gain_pct, r.candidates[i].p_value));
-            let ok = right_first && !wrong_named && !truth_rejected;
-            let line = format!(
+    seeds::per_seed_parallel(|seed| {
+        let (runs, expected) = campaign(hidden, seed);
+        let r = diagnose(&runs).expect("diagnose runs").report;
+        let first = r.named_causes.first();
+        let right_first = match expected {
+            Some(e) => first.is_some_and(|c| c.label.starts_with(e)),
+            None => first.is_none(),
+        };
+        let wrong_named = r.named_causes.iter().any(|c| c.label.starts_with(wrong));
+        let truth_rejected = r.competing.iter().any(|c| {
+            c.verdict == "separated" && expected.is_some_and(|e| c.candidate.starts_with(e))
+        });
+        let named: Vec<String> = r
+            .named_causes
+            .iter()
+            .map(|c| {
+                format!(
+                    "{} {:+.2}% p {:.4}",
+                    c.label, c.conditional_gain_pct, c.p_value
+                )
+            })
+            .collect();
+        let competing: Vec<String> = r
+            .competing
+            .iter()
+            .map(|c| format!("{} vs {}: {}", c.candidate, c.named, c.in_words))
+            .collect();
+        let wrong_rank = r
+            .candidates
+            .iter()
+            .position(|c| {
+                fog_core::compensation::label::feature_label(&c.column, c.transform.name(), c.tau_s)
+                    .to_string()
+                    .starts_with(wrong)
+            })
+            .map(|i| (i + 1, r.candidates[i].gain_pct, r.candidates[i].p_value));
+        let ok = right_first && !wrong_named && !truth_rejected;
+        let line = format!(
                 "{hidden:?} seed {seed}: truth {expected:?}; named {named:?}; competing {competing:?}; \
                  best {wrong} (rank, gain %, p) {wrong_rank:?}"
             );
-            (ok, line)
-        })
-        .collect()
+        (ok, line)
+    })
 }
 
 fn check(hidden: Hidden, wrong: &str) {

@@ -9,38 +9,37 @@
 use crate::common::independent;
 use fog_sim::diagnose::diagnose;
 use independent::{campaign, Hidden};
-use rayon::prelude::*;
 
 use crate::common::seeds;
 
 /// One line per seed: (right?, what happened).
 fn per_seed(hidden: Hidden) -> Vec<(bool, String)> {
-    seeds::seeds()
-        .into_par_iter()
-        .map(|seed| {
-            let (runs, expected) = campaign(hidden, seed);
-            let r = diagnose(&runs).expect("diagnose runs").report;
-            let named = r.named_cause.as_ref().map(|c| c.label());
-            // a named derivative must come with the device's causal estimate and
-            // its measured delay (half the trailing span for a least-squares fit)
-            let causal_ok = r.causal_derivative.as_ref().is_some_and(|c| {
-                !c.causal.is_empty()
-                    && c.causal.iter().all(|k| (k.delay_s - k.span_s / 2.0).abs() < 1.0)
-            });
-            let ok = named.as_deref() == expected
-                && (expected.is_none() || (r.extended.gain_pct > 0.0 && causal_ok));
-            let accel = r
-                .candidates
-                .iter()
-                .position(|c| c.column == "temp_c" && c.transform.name() == "accel")
-                .map(|i| (i + 1, &r.candidates[i]));
-            let widths: Vec<String> = r
-                .derivative_widths
-                .iter()
-                .filter(|w| w.column == "temp_c")
-                .map(|w| format!("{} +/-{:.0} s", w.derivative, w.half_width_s))
-                .collect();
-            let line = format!(
+    seeds::per_seed_parallel(|seed| {
+        let (runs, expected) = campaign(hidden, seed);
+        let r = diagnose(&runs).expect("diagnose runs").report;
+        let named = r.named_cause.as_ref().map(|c| c.label());
+        // a named derivative must come with the device's causal estimate and
+        // its measured delay (half the trailing span for a least-squares fit)
+        let causal_ok = r.causal_derivative.as_ref().is_some_and(|c| {
+            !c.causal.is_empty()
+                && c.causal
+                    .iter()
+                    .all(|k| (k.delay_s - k.span_s / 2.0).abs() < 1.0)
+        });
+        let ok = named.as_deref() == expected
+            && (expected.is_none() || (r.extended.gain_pct > 0.0 && causal_ok));
+        let accel = r
+            .candidates
+            .iter()
+            .position(|c| c.column == "temp_c" && c.transform.name() == "accel")
+            .map(|i| (i + 1, &r.candidates[i]));
+        let widths: Vec<String> = r
+            .derivative_widths
+            .iter()
+            .filter(|w| w.column == "temp_c")
+            .map(|w| format!("{} +/-{:.0} s", w.derivative, w.half_width_s))
+            .collect();
+        let line = format!(
                 "{hidden:?} seed {seed}: named {named:?}; temp_c:accel rank {:?} gain {:+.2}% p {:.4}; base {}; \
                  base dT/dt +/-{:.0} s; temp_c windows {widths:?}; top {:?} {:+.2}% p {:.4}",
                 accel.map(|a| a.0),
@@ -52,18 +51,22 @@ fn per_seed(hidden: Hidden) -> Vec<(bool, String)> {
                 r.candidates.first().map_or(f64::NAN, |c| c.gain_pct),
                 r.candidates.first().map_or(f64::NAN, |c| c.p_value),
             );
-            let causal = r.causal_derivative.as_ref().map(|c| {
-                let k: Vec<String> = c
-                    .causal
-                    .iter()
-                    .map(|k| format!("span {:.0} s delay {:.1} s gain {:+.2}%", k.span_s, k.delay_s, k.gain_pct))
-                    .collect();
-                format!("centred {:+.2}% vs causal {k:?}", c.centred_gain_pct)
-            });
-            let line = format!("{line}; causal: {causal:?}");
-            (ok, line)
-        })
-        .collect()
+        let causal = r.causal_derivative.as_ref().map(|c| {
+            let k: Vec<String> = c
+                .causal
+                .iter()
+                .map(|k| {
+                    format!(
+                        "span {:.0} s delay {:.1} s gain {:+.2}%",
+                        k.span_s, k.delay_s, k.gain_pct
+                    )
+                })
+                .collect();
+            format!("centred {:+.2}% vs causal {k:?}", c.centred_gain_pct)
+        });
+        let line = format!("{line}; causal: {causal:?}");
+        (ok, line)
+    })
 }
 
 fn check(hidden: Hidden) {

@@ -7,45 +7,48 @@ use fog_sim::diagnose::diagnose;
 use planted::{campaign, Effect, Shape};
 
 use crate::common::seeds;
-use seeds::seeds;
 
 fn check(effect: Effect) {
-    let results: Vec<String> = std::thread::scope(|s| {
-        let handles: Vec<_> = seeds()
-            .into_iter()
-            .map(|seed| {
-                s.spawn(move || {
-                    let (runs, expected) = campaign(effect, seed, Shape::default());
-                    let d = diagnose(&runs).expect("diagnose runs");
-                    let r = &d.report;
-                    let named = r.named_cause.as_ref().map(|c| (c.column.clone(), c.transform.name()));
-                    let ok = match (&expected, &named) {
-                        (None, None) => true,
-                        (Some((c, t)), Some((nc, nt))) => c == nc && t == nt && r.extended.gain_pct > 0.0,
-                        _ => false,
-                    };
-                    let top: Vec<String> = r
-                        .candidates
-                        .iter()
-                        .take(4)
-                        .map(|c| format!("{}:{}({:?}) {:+.2}% p{:.4}", c.column, c.transform.name(), c.tau_s, c.gain_pct, c.p_value))
-                        .collect();
-                    let between = r.between_run.rows.first().map(|x| {
-                        format!("{} {:+.1}% fw p {:.4} perm p {:.4}", x.label, x.gain_pct, x.p_value, x.permutation_p)
-                    });
-                    let line = format!(
+    let results: Vec<String> = seeds::per_seed_parallel(|seed| {
+        let (runs, expected) = campaign(effect, seed, Shape::default());
+        let d = diagnose(&runs).expect("diagnose runs");
+        let r = &d.report;
+        let named = r
+            .named_cause
+            .as_ref()
+            .map(|c| (c.column.clone(), c.transform.name()));
+        let ok = match (&expected, &named) {
+            (None, None) => true,
+            (Some((c, t)), Some((nc, nt))) => c == nc && t == nt && r.extended.gain_pct > 0.0,
+            _ => false,
+        };
+        let top: Vec<String> = r
+            .candidates
+            .iter()
+            .take(4)
+            .map(|c| {
+                format!(
+                    "{}:{}({:?}) {:+.2}% p{:.4}",
+                    c.column,
+                    c.transform.name(),
+                    c.tau_s,
+                    c.gain_pct,
+                    c.p_value
+                )
+            })
+            .collect();
+        let between = r.between_run.rows.first().map(|x| {
+            format!(
+                "{} {:+.1}% fw p {:.4} perm p {:.4}",
+                x.label, x.gain_pct, x.p_value, x.permutation_p
+            )
+        });
+        let line = format!(
                         "{effect:?} seed {seed}: expected {expected:?}, named {named:?} (between runs {:?}), gain {:+.2}%, base {:.4} -> {:.4}; top {top:?}; best between-run {between:?}",
                         r.between_run.named, r.extended.gain_pct, r.base.heldout_rms_dph, r.extended.heldout_rms_dph
                     );
-                    (ok, line)
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().expect("case thread"))
-            .map(|(ok, l)| format!("{} {l}", if ok { "ok  " } else { "FAIL" }))
-            .collect()
+        let mark = if ok { "ok  " } else { "FAIL" };
+        format!("{mark} {line}")
     });
     for l in &results {
         println!("{l}");

@@ -1,6 +1,6 @@
 //! Small dense linear algebra for the least-squares fits (Cholesky on normal equations),
 //! by nalgebra: measured 1.4-1.5x faster than the former hand-written Cholesky at n = 24
-//! and 40 and equal at n = 6 (benches/diagnose_solve.rs, docs/record/diagnose.md).
+//! and 40 and equal at n = 6 (bench/benches/diagnose_solve.rs, docs/record/diagnose.md).
 
 /// The matrix was not (numerically) positive definite.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

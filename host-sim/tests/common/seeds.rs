@@ -15,3 +15,18 @@ pub fn seeds() -> Vec<u64> {
         .filter(|v| !v.is_empty())
         .unwrap_or_else(|| SEEDS.to_vec())
 }
+
+/// `case(seed)` for every seed of [`seeds`], one thread a seed, results in seed order.
+pub fn per_seed_parallel<T: Send>(case: impl Fn(u64) -> T + Sync) -> Vec<T> {
+    let case = &case;
+    std::thread::scope(|s| {
+        let handles: Vec<_> = seeds()
+            .into_iter()
+            .map(|seed| s.spawn(move || case(seed)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("seed thread"))
+            .collect()
+    })
+}

@@ -285,18 +285,21 @@ fn fit_linear(
     y: &[f64],
 ) -> Result<BaseFit, DiagnoseError> {
     let mut prepared = Prepared::from_design(folds, design, y, RIDGES[0]);
-    let mut best: Option<(f64, CvResult)> = None;
-    for ridge in RIDGES {
-        prepared.set_ridge(ridge);
-        let Ok(cv) = prepared.validate(folds) else {
+    let mut best: Option<(f64, f64)> = None;
+    for (ridge, cv) in RIDGES
+        .into_iter()
+        .zip(prepared.validate_ridges(folds, &RIDGES))
+    {
+        let Ok(cv) = cv else {
             continue;
         };
-        if best.as_ref().is_none_or(|b| cv.rms() < b.1.rms()) {
-            best = Some((ridge, cv));
+        if best.is_none_or(|b| cv.rms() < b.1) {
+            best = Some((ridge, cv.rms()));
         }
     }
-    let (ridge, cv) = best.ok_or(DiagnoseError::Singular { what: "base fit" })?;
+    let (ridge, _) = best.ok_or(DiagnoseError::Singular { what: "base fit" })?;
     prepared.set_ridge(ridge);
+    let cv = prepared.validate(folds)?;
     Ok(BaseFit {
         spec,
         prepared,

@@ -84,38 +84,46 @@ pub fn fit_rbf(
     let k_max = centre_count(y.len(), inputs.len());
     // Only the best setting is remembered and rebuilt at the end. Designs are rows
     // computed on demand (`RbfDesign`): only the inputs are held, never n x centres.
-    let mut best: Option<(usize, f64, f64, f64)> = None;
+    let mut best: Option<(usize, f64, f64, f64, RbfBasis)> = None;
     // The inputs are shared, never copied (memory: the stacked columns serve every fit).
     let shared_inputs = Arc::new(inputs);
     let shared_linear = Arc::new(linear);
-    let design = |k: usize, wf: f64| {
-        let views: Vec<&[f64]> = shared_inputs.iter().map(|c| c.as_slice()).collect();
-        let basis = RbfBasis::fit(&views, k, wf);
+    let views: Vec<&[f64]> = shared_inputs.iter().map(|c| c.as_slice()).collect();
+    let design = |basis: &RbfBasis| {
         let rows = RbfDesign {
             basis: basis.clone(),
             inputs: shared_inputs.clone(),
             linear: shared_linear.clone(),
         };
-        let prepared = Prepared::from_design(folds, Arc::new(rows), y, RIDGES[0]);
-        (basis, prepared)
+        Prepared::from_design(folds, Arc::new(rows), y, RIDGES[0])
     };
+    let mut tried_k = Vec::with_capacity(CENTRE_FRACTIONS.len());
     for frac in CENTRE_FRACTIONS {
         let k = ((k_max as f64 * frac).round() as usize).max(3);
+        if tried_k.contains(&k) {
+            continue; // the same fits again: a tie never replaces the best
+        }
+        tried_k.push(k);
+        // k-means once per centre count: the centres do not depend on the width.
+        let unit = RbfBasis::fit_centres(&views, k);
         for wf in WIDTH_FACTORS {
-            let (_, mut prepared) = design(k, wf);
-            for ridge in RIDGES {
-                prepared.set_ridge(ridge);
-                let Ok(cv) = prepared.validate(folds) else {
+            let basis = unit.with_width_factor(wf);
+            let prepared = design(&basis);
+            for (ridge, cv) in RIDGES
+                .into_iter()
+                .zip(prepared.validate_ridges(folds, &RIDGES))
+            {
+                let Ok(cv) = cv else {
                     continue;
                 };
-                if best.is_none_or(|b| cv.rms() < b.3) {
-                    best = Some((k, wf, ridge, cv.rms()));
+                if best.as_ref().is_none_or(|b| cv.rms() < b.3) {
+                    best = Some((k, wf, ridge, cv.rms(), basis.clone()));
                 }
             }
         }
     }
-    let (k, wf, ridge, _) = best.ok_or(DiagnoseError::Singular { what: "RBF fit" })?;
-    let (basis, mut prepared) = design(k, wf);
+    let (k, wf, ridge, _, basis) = best.ok_or(DiagnoseError::Singular { what: "RBF fit" })?;
+    let mut prepared = design(&basis);
     prepared.set_ridge(ridge);
     let cv = prepared.validate(folds)?;
     Ok(RbfFit {

@@ -16,6 +16,20 @@ impl RbfBasis {
     /// normalisation, `k` k-means centres (deterministic farthest-point start), and
     /// width = `width_factor` x the mean distance from a centre to its nearest other centre.
     pub fn fit(inputs: &[&[f64]], k: usize, width_factor: f64) -> Self {
+        Self::fit_centres(inputs, k).with_width_factor(width_factor)
+    }
+
+    /// The same basis with its width `width_factor` x this one's (the centres are kept:
+    /// k-means does not depend on the width, so a width grid needs one k-means run).
+    pub fn with_width_factor(&self, width_factor: f64) -> Self {
+        Self {
+            width: width_factor * self.width,
+            ..self.clone()
+        }
+    }
+
+    /// [`RbfBasis::fit`] with width factor 1: the width is the mean nearest-centre spacing.
+    pub fn fit_centres(inputs: &[&[f64]], k: usize) -> Self {
         let d = inputs.len();
         let n = inputs.first().map_or(0, |c| c.len());
         let mut mean = vec![0.0; d];
@@ -38,7 +52,7 @@ impl RbfBasis {
             mean,
             scale,
             centres,
-            width: width_factor * spacing,
+            width: spacing,
         }
     }
 
@@ -113,7 +127,7 @@ fn mean_nearest_distance(c: &[Vec<f64>]) -> f64 {
 /// Lloyd's k-means from a farthest-point start (deterministic: no seed, no RNG stream).
 ///
 /// Kept hand-written after measuring it against linfa-clustering 0.8.1's `KMeans`
-/// (`benches/diagnose_kmeans.rs`, docs/record/diagnose.md "Libraries"): on z-scored campaign
+/// (`bench/benches/diagnose_kmeans.rs`, docs/record/diagnose.md "Libraries"): on z-scored campaign
 /// points (n 500 / 5,000, k 8 / 24, 2-d and 3-d) linfa with one run is not better
 /// (inertia 0.89-1.02x ours) and 1.4-6.3x slower at n = 500; its default 10 runs lowers the
 /// inertia by 0.5-14.5% but costs 7.6-47x the time, and diagnose runs k-means for every
@@ -129,6 +143,18 @@ pub fn kmeans<P: AsRef<[f64]>>(pts: &[P], k: usize) -> Vec<Vec<f64>> {
 pub fn kmeans_flat(flat: &[f64], d: usize, k: usize) -> Vec<Vec<f64>> {
     let d = d.max(1);
     lloyd(flat.len() / d, |i| &flat[i * d..(i + 1) * d], k)
+}
+
+/// Index of the centre nearest to `p`, the first of equals (one distance per centre).
+fn nearest_centre(p: &[f64], centres: &[Vec<f64>]) -> u32 {
+    let mut best = (0usize, f64::INFINITY);
+    for (c, centre) in centres.iter().enumerate() {
+        let d = dist2(p, centre);
+        if c == 0 || d.total_cmp(&best.1) == std::cmp::Ordering::Less {
+            best = (c, d);
+        }
+    }
+    best.0 as u32
 }
 
 /// Lloyd's iterations of [`kmeans`] on `n` points given by `point`.
@@ -158,10 +184,7 @@ fn lloyd<'a>(n: usize, point: impl Fn(usize) -> &'a [f64], k: usize) -> Vec<Vec<
     for _ in 0..12 {
         let mut changed = false;
         for (i, a) in assign.iter_mut().enumerate() {
-            let p = point(i);
-            let best = (0..centres.len())
-                .min_by(|&a, &b| dist2(p, &centres[a]).total_cmp(&dist2(p, &centres[b])))
-                .unwrap_or(0) as u32;
+            let best = nearest_centre(point(i), &centres);
             changed |= best != *a;
             *a = best;
         }

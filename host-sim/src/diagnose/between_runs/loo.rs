@@ -18,12 +18,14 @@ pub fn fit(o: &[f64], f: &[Vec<f64>], rows: &[usize]) -> Option<Vec<f64>> {
     let q = 1 + f.first().map_or(0, Vec::len);
     let mut a = vec![0.0; q * q];
     let mut b = vec![0.0; q];
+    // The row [1, f[r]...] read in place (no allocation a row: this runs for every
+    // permutation of every candidate).
     for &r in rows {
-        let x: Vec<f64> = std::iter::once(1.0).chain(f[r].iter().copied()).collect();
+        let x = |i: usize| if i == 0 { 1.0 } else { f[r][i - 1] };
         for i in 0..q {
-            b[i] += x[i] * o[r];
+            b[i] += x(i) * o[r];
             for j in 0..q {
-                a[i * q + j] += x[i] * x[j];
+                a[i * q + j] += x(i) * x(j);
             }
         }
     }

@@ -112,24 +112,27 @@ struct RunRows<'a> {
 }
 
 impl RunRows<'_> {
-    /// The basis at row `k` for (tau_1, tau_2, L): [1, mode 1, mode 2] of the reading.
-    fn basis(&self, k: usize, t1: f64, t2: f64, lag_s: f64) -> [f64; 3] {
-        let t = self.t_s[k];
-        let lag = if lag_s > 0.0 {
-            window_factor(lag_s, self.row_s) * (-t / lag_s).exp()
-        } else {
-            0.0
-        };
-        let mode = |tau: f64| window_factor(tau, self.row_s) * (-t / tau).exp() - lag_s / tau * lag;
-        [1.0, mode(t1), mode(t2)]
+    /// The basis at every row for (tau_1, tau_2, L): [1, mode 1, mode 2] of the reading.
+    /// The window factors depend on the time constants only, so they are computed once.
+    fn basis(&self, t1: f64, t2: f64, lag_s: f64) -> Vec<[f64; 3]> {
+        let w_lag = (lag_s > 0.0).then(|| window_factor(lag_s, self.row_s));
+        let (w1, w2) = (window_factor(t1, self.row_s), window_factor(t2, self.row_s));
+        self.t_s
+            .iter()
+            .map(|&t| {
+                let lag = w_lag.map_or(0.0, |w| w * (-t / lag_s).exp());
+                let mode = |w: f64, tau: f64| w * (-t / tau).exp() - lag_s / tau * lag;
+                [1.0, mode(w1, t1), mode(w2, t2)]
+            })
+            .collect()
     }
 
     /// Least squares of the reading on the basis: (coefficients, sum of squares).
     fn fit(&self, t1: f64, t2: f64, lag_s: f64) -> ([f64; 3], f64) {
+        let basis = self.basis(t1, t2, lag_s);
         let mut a = [0.0; 9];
         let mut b = [0.0; 3];
-        for (k, &temp) in self.temp_c.iter().enumerate() {
-            let z = self.basis(k, t1, t2, lag_s);
+        for (z, &temp) in basis.iter().zip(self.temp_c) {
             for r in 0..3 {
                 b[r] += z[r] * temp;
                 for q in 0..3 {
@@ -145,14 +148,10 @@ impl RunRows<'_> {
             let n = self.temp_c.len().max(1) as f64;
             coef = [self.temp_c.iter().sum::<f64>() / n, 0.0, 0.0];
         }
-        let sse = self
-            .temp_c
+        let sse = basis
             .iter()
-            .enumerate()
-            .map(|(k, &temp)| {
-                let z = self.basis(k, t1, t2, lag_s);
-                (temp - z.iter().zip(&coef).map(|(u, v)| u * v).sum::<f64>()).powi(2)
-            })
+            .zip(self.temp_c)
+            .map(|(z, &temp)| (temp - z.iter().zip(&coef).map(|(u, v)| u * v).sum::<f64>()).powi(2))
             .sum();
         (coef, sse)
     }

@@ -196,6 +196,39 @@ impl Prepared {
         folds: &Folds,
         extra: &[Vec<f64>],
     ) -> Result<CvResult, DiagnoseError> {
+        let mut residual = vec![0.0; folds.rows()];
+        let scores = self.held_out(folds, extra, &[self.ridge], Some(&mut residual));
+        let mut cv = scores
+            .into_iter()
+            .next()
+            .unwrap_or(Err(DiagnoseError::Singular {
+                what: "held-out fit",
+            }))?;
+        cv.residual = residual;
+        Ok(cv)
+    }
+
+    /// Held-out scores of this design alone at each relative ridge of `ridges`, without
+    /// the per-row residual (`CvResult::residual` empty): the systems are built once and
+    /// every row's design computed once for all the ridges, which is what a ridge grid
+    /// costs (the same sums in the same order as [`Prepared::validate`] at each ridge).
+    pub fn validate_ridges(
+        &self,
+        folds: &Folds,
+        ridges: &[f64],
+    ) -> Vec<Result<CvResult, DiagnoseError>> {
+        self.held_out(folds, &[], ridges, None)
+    }
+
+    /// Held-out validation of this design plus `extra` at each of `ridges`; the held-out
+    /// residual of the first ridge goes to `residual` when given.
+    fn held_out(
+        &self,
+        folds: &Folds,
+        extra: &[Vec<f64>],
+        ridges: &[f64],
+        mut residual: Option<&mut Vec<f64>>,
+    ) -> Vec<Result<CvResult, DiagnoseError>> {
         let (grams, xty, ex) = self.augmented(folds, extra);
         let buffered = (folds.buffer_points > 0).then(|| self.augmented_excluded(folds, &ex));
         let (excl_g, excl_c) = buffered.as_ref().map_or((&grams, &xty), |(g, c)| (g, c));
@@ -203,40 +236,71 @@ impl Prepared {
         let total_g = sum_all(&grams);
         let total_c = sum_all(&xty);
         let diag_scale: Vec<f64> = (0..q).map(|i| total_g[i * q + i]).collect();
-        let mut unit_sse = Vec::with_capacity(folds.unit_rows.len());
-        let mut residual = vec![0.0; folds.rows()];
+        let mut unit_sse = vec![Vec::with_capacity(folds.unit_rows.len()); ridges.len()];
+        let mut singular = vec![false; ridges.len()];
         let mut a = vec![0.0; q];
         for (u, r) in folds.unit_rows.iter().enumerate() {
-            let mut m: Vec<f64> = total_g.iter().zip(&excl_g[u]).map(|(t, g)| t - g).collect();
-            let mut b: Vec<f64> = total_c.iter().zip(&excl_c[u]).map(|(t, g)| t - g).collect();
-            add_ridge(&mut m, &diag_scale, q, self.ridge);
-            solve_spd(&mut m, &mut b, q).map_err(|_| DiagnoseError::Singular {
-                what: "held-out fit",
-            })?;
-            let mut sse = 0.0;
+            let weights: Vec<Option<Vec<f64>>> = ridges
+                .iter()
+                .zip(singular.iter_mut())
+                .map(|(&ridge, singular)| {
+                    let mut m: Vec<f64> =
+                        total_g.iter().zip(&excl_g[u]).map(|(t, g)| t - g).collect();
+                    let mut b: Vec<f64> =
+                        total_c.iter().zip(&excl_c[u]).map(|(t, g)| t - g).collect();
+                    add_ridge(&mut m, &diag_scale, q, ridge);
+                    *singular |= solve_spd(&mut m, &mut b, q).is_err();
+                    (!*singular).then_some(b)
+                })
+                .collect();
+            let mut sse = vec![0.0; ridges.len()];
             for row in r.clone() {
-                let e = self.y[row] - self.predict(u, row, &ex, &b, &mut a);
-                residual[row] = e;
-                sse += e * e;
+                self.full_row(u, row, &ex, &mut a);
+                for (k, w) in weights.iter().enumerate() {
+                    let Some(w) = w else { continue };
+                    let e = self.y[row] - dot(&a, w);
+                    if k == 0 {
+                        if let Some(res) = residual.as_deref_mut() {
+                            res[row] = e;
+                        }
+                    }
+                    sse[k] += e * e;
+                }
             }
-            unit_sse.push(sse);
+            unit_sse.iter_mut().zip(sse).for_each(|(s, e)| s.push(e));
         }
-        Ok(CvResult {
-            unit_sse,
-            points: residual.len(),
-            residual,
-        })
+        unit_sse
+            .into_iter()
+            .zip(singular)
+            .map(|(unit_sse, singular)| {
+                if singular {
+                    return Err(DiagnoseError::Singular {
+                        what: "held-out fit",
+                    });
+                }
+                Ok(CvResult {
+                    unit_sse,
+                    points: folds.rows(),
+                    residual: Vec::new(),
+                })
+            })
+            .collect()
     }
 
-    /// The fitted value at `row` (of unit `unit`) of this design plus the adjusted `ex`
-    /// columns with weights `w`; `a` is scratch (`w.len()` long).
-    fn predict(&self, unit: usize, row: usize, ex: &[Vec<f64>], w: &[f64], a: &mut [f64]) -> f64 {
+    /// Row `row` (of unit `unit`) of this design plus the adjusted `ex` columns into `a`.
+    fn full_row(&self, unit: usize, row: usize, ex: &[Vec<f64>], a: &mut [f64]) {
         let p = self.width();
         self.adjusted_row(unit, row, &mut a[..p]);
         for (o, e) in a[p..].iter_mut().zip(ex) {
             *o = e[row];
         }
-        a.iter().zip(w).map(|(c, w)| c * w).sum()
+    }
+
+    /// The fitted value at `row` (of unit `unit`) of this design plus the adjusted `ex`
+    /// columns with weights `w`; `a` is scratch (`w.len()` long).
+    fn predict(&self, unit: usize, row: usize, ex: &[Vec<f64>], w: &[f64], a: &mut [f64]) -> f64 {
+        self.full_row(unit, row, ex, a);
+        dot(a, w)
     }
 
     /// Fitted values of this design plus the adjusted `ex` columns with weights `w`, for

@@ -1,6 +1,6 @@
 //! Criterion benchmark of one drift evaluation: f32 (`libm::expf`) vs integer-only fixed
 //! point, for 35 centres (the paper's gyro 008) and 64 (the format's maximum), 2 inputs
-//! (T, dT/dt). Run: `cargo bench -p fog-core --bench rbf`.
+//! (T, dT/dt). Run: `cargo bench -p fog-bench --bench rbf`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use fog_core::model::fixed::FixedModel;

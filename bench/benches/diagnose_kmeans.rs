@@ -8,7 +8,7 @@
 //! point to its nearest centre, computed here the same way for both) and whether linfa's
 //! centres are bit-identical for the same input and seed twice, and with 1 vs 2 rayon threads
 //! (diagnose's outputs must be byte-reproducible).
-//! `cargo bench -p fog-sim --bench diagnose_kmeans -- --warm-up-time 1 --measurement-time 3`
+//! `cargo bench -p fog-bench --bench diagnose_kmeans -- --warm-up-time 1 --measurement-time 3`
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use fog_sim::diagnose::baseline::rbf_basis::kmeans;

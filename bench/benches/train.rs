@@ -1,7 +1,7 @@
 //! Trainer benchmarks at the paper's full campaign size (11 ambients x 3 runs x 270
 //! points = ~8,900 candidate centres): design build, one selection pass over all
 //! candidates, and complete OLS / Orr fits at one width.
-//! `cargo bench -p fog-sim --bench train`
+//! `cargo bench -p fog-bench --bench train`
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use fog_sim::train::{fit_width, grid_candidates, GaussianDesign, Method, Normalizer, TrainConfig};
