@@ -10,5 +10,6 @@ mod in_place;
 mod model_codec;
 mod northfinder;
 mod rbf_accuracy;
+mod seek_sequence;
 mod temp_rise;
 mod window_index_exact;

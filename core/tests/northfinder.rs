@@ -1,6 +1,7 @@
 //! North finder on synthetic 10 s windows and a mock turntable: noiseless headings all
 //! around the circle, bias steps between dwells, white noise against the analytic floor,
-//! four positions, timeouts and invalid windows.
+//! four positions, timeouts and invalid windows (the time-symmetric sequences in
+//! `seek_sequence`).
 
 use fog_core::compensation::compensator::{WindowResult, WindowStatus};
 use fog_core::consts::earth_rate_horizontal_dph;
@@ -12,20 +13,28 @@ use fog_core::seeking::northfinder::{
 };
 use fog_core::seeking::tilt::{earth_rate_on_axis_dph, Tilt};
 
-const LAT_DEG: f64 = 39.9;
+pub(crate) const LAT_DEG: f64 = 39.9;
+
+/// Every seek mode: forward and time-symmetric.
+pub(crate) const ALL_MODES: [SeekMode; 4] = [
+    SeekMode::TwoPosition,
+    SeekMode::FourPosition,
+    SeekMode::TwoPositionSymmetric,
+    SeekMode::FourPositionSymmetric,
+];
 
 /// Turntable that reaches any heading `move_s` after the command.
-struct MockTable {
-    heading_deg: f32,
+pub(crate) struct MockTable {
+    pub(crate) heading_deg: f32,
     target_deg: f32,
     commanded_at_s: f64,
-    now_s: f64,
+    pub(crate) now_s: f64,
     move_s: f64,
     stuck: bool,
 }
 
 impl MockTable {
-    fn new(move_s: f64) -> Self {
+    pub(crate) fn new(move_s: f64) -> Self {
         MockTable {
             heading_deg: 0.0,
             target_deg: 0.0,
@@ -56,7 +65,7 @@ impl Turntable for MockTable {
     }
 }
 
-fn window(t_end_s: f64, rate_dph: f64, status: WindowStatus) -> WindowResult {
+pub(crate) fn window(t_end_s: f64, rate_dph: f64, status: WindowStatus) -> WindowResult {
     WindowResult {
         t_start_s: t_end_s - 10.0,
         t_end_s,
@@ -76,7 +85,7 @@ fn window(t_end_s: f64, rate_dph: f64, status: WindowStatus) -> WindowResult {
 }
 
 /// Run one seek. `rate(t_end, table_heading)` gives each window's mean rate.
-fn run_seek(
+pub(crate) fn run_seek(
     cfg: SeekConfig,
     t0_s: f64,
     rate: impl FnMut(f64, f32) -> f64,
@@ -110,11 +119,11 @@ fn run_tilted_seek(
 }
 
 /// Earth rate seen at table heading h for azimuth A of table heading 0.
-fn earth(az_deg: f64, h_deg: f32) -> f64 {
+pub(crate) fn earth(az_deg: f64, h_deg: f32) -> f64 {
     earth_rate_horizontal_dph(LAT_DEG) * (az_deg + h_deg as f64).to_radians().cos()
 }
 
-fn ang_err(a: f64, b: f64) -> f64 {
+pub(crate) fn ang_err(a: f64, b: f64) -> f64 {
     let d = (a - b).rem_euclid(360.0);
     if d > 180.0 {
         d - 360.0
@@ -123,7 +132,7 @@ fn ang_err(a: f64, b: f64) -> f64 {
     }
 }
 
-fn cfg(mode: SeekMode, start_heading_deg: f32) -> SeekConfig {
+pub(crate) fn cfg(mode: SeekMode, start_heading_deg: f32) -> SeekConfig {
     SeekConfig {
         mode,
         latitude_deg: LAT_DEG,
@@ -134,7 +143,7 @@ fn cfg(mode: SeekMode, start_heading_deg: f32) -> SeekConfig {
 
 #[test]
 fn noiseless_two_and_four_positions_all_around_the_circle() {
-    for mode in [SeekMode::TwoPosition, SeekMode::FourPosition] {
+    for mode in ALL_MODES {
         for h0 in [0.0f32, 37.0] {
             for k in 0..720 {
                 let az = k as f64 * 0.5;
@@ -191,7 +200,13 @@ fn bias_step_between_dwells_gives_the_analytic_error() {
 }
 
 /// Std of azimuth errors over many noisy seeks, and the mean reported sigma.
-fn noisy_stats(mode: SeekMode, az: f64, arw_dpsh: f64, seeks: usize, seed: u64) -> (f64, f64) {
+pub(crate) fn noisy_stats(
+    mode: SeekMode,
+    az: f64,
+    arw_dpsh: f64,
+    seeks: usize,
+    seed: u64,
+) -> (f64, f64) {
     let sigma_w = arw_dpsh * 60.0 / 10f64.sqrt(); // 10 s mean of white noise, deg/h
     let mut rng = SplitMix64::new(seed);
     let mut gauss = move || {
@@ -385,7 +400,7 @@ fn noiseless_tilted_seeks_all_around_the_circle_up_to_30_deg() {
         (0.0, 30.0),
         (30.0, -30.0),
     ];
-    for mode in [SeekMode::TwoPosition, SeekMode::FourPosition] {
+    for mode in ALL_MODES {
         for h0 in [0.0f32, 37.0] {
             for &(p, r) in &tilts {
                 let tilt = Tilt {
@@ -434,7 +449,7 @@ fn heading_calibration_removes_the_magnetic_harmonic() {
         correlation: 0.0,
         n_headings: 8,
     };
-    for mode in [SeekMode::TwoPosition, SeekMode::FourPosition] {
+    for mode in ALL_MODES {
         let mut worst_raw = 0.0f64;
         for k in 0..36 {
             let az = 3.0 + 10.0 * k as f64;

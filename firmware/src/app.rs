@@ -336,10 +336,8 @@ where
                 }
             }
             Command::StartSeek { positions } => {
-                let mode = match positions {
-                    2 => SeekMode::TwoPosition,
-                    4 => SeekMode::FourPosition,
-                    _ => return refused(Refusal::BadPositions),
+                let Some(mode) = SeekMode::from_code(positions) else {
+                    return refused(Refusal::BadPositions);
                 };
                 if self.supervisor.is_seeking() {
                     return refused(Refusal::Quality(QualityError::Busy));
@@ -390,11 +388,8 @@ where
             tilt: r.tilt,
             duration_s: r.duration_s as f32,
             t_end_s: r.t_end_s,
-            // The mode (2 or 4, as in `StartSeek`), not the dwells (2 + the ambiguity one).
-            positions: match r.mode {
-                SeekMode::TwoPosition => 2,
-                SeekMode::FourPosition => 4,
-            },
+            // The mode as in `StartSeek` (2 or 4, 0x82 / 0x84 symmetric), not the dwells.
+            positions: r.mode.code(),
             validity,
         }
     }

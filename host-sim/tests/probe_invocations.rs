@@ -97,6 +97,7 @@ const NAME_FLAGS: &[&str] = &[
     "--width-search",
     "--incl-port",
     "--laws",
+    "--sequence",
 ];
 /// Flags with a number (or a list of numbers) for value.
 const NUMBER_FLAGS: &[&str] = &[

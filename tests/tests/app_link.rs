@@ -236,6 +236,40 @@ fn a_four_position_seek_at_the_wrong_latitude_is_flagged() {
     );
 }
 
+/// A time-symmetric seek over the link (`positions` 0x82, `SeekMode::code`): a gyro whose
+/// bias drifts linearly in time gives the truth and the report names the sequence; the
+/// forward seek on the same gyro errs (the twin), and a byte that is no mode is refused.
+#[test]
+fn a_symmetric_seek_over_the_link_cancels_a_linear_drift() {
+    let (lat, truth) = (39.9, 108.4);
+    let seek = |positions: u8| {
+        let mut a = app();
+        let r = drive(
+            &mut a,
+            Tilt::LEVEL,
+            |t, h| earth_rate_on_axis_dph(lat, truth, Tilt::LEVEL, h) + 0.2 + 1e-3 * t,
+            |a, i, t_s| {
+                if i == 105 {
+                    let c = Command::StartSeek { positions };
+                    assert_eq!(a.command(c, t_s), Some(DeviceMessage::Accepted));
+                }
+            },
+            &mut Vec::new(),
+        );
+        (r.positions, r.azimuth_deg - truth)
+    };
+    let (code, err) = seek(0x82);
+    assert_eq!(code, 0x82);
+    assert!(err.abs() < 1e-3, "{err}");
+    let (code, err) = seek(2);
+    assert_eq!(code, 2);
+    assert!(err.abs() > 0.02, "{err}");
+    assert_eq!(
+        app().command(Command::StartSeek { positions: 0x80 }, 0.0),
+        Some(DeviceMessage::Refused(Refusal::BadPositions))
+    );
+}
+
 fn good(now_s: f64) -> BitCounters {
     BitCounters {
         now_s,

@@ -61,6 +61,9 @@ impl From<ResetCause> for ResetReason {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Command {
     /// Start a seek with 2 or 4 positions; answered with `Accepted` or `Refused`.
+    /// `positions` is `SeekMode::code`: 2 or 4, or 0x82 / 0x84 for the time-symmetric
+    /// sequences (added without a version change: 2 and 4 keep their bytes and meaning, a
+    /// device that predates them refuses 0x82 / 0x84 with `BadPositions`).
     StartSeek { positions: u8 },
     /// Site latitude, deg; refused while seeking or outside |lat| < 85.
     SetLatitude { latitude_deg: f32 },
@@ -190,6 +193,7 @@ pub struct SeekReport {
     pub duration_s: f32,
     /// End of the seek, s since power-on.
     pub t_end_s: f64,
+    /// The seek's `SeekMode::code` (as in `StartSeek`).
     pub positions: u8,
     pub validity: Validity,
 }

@@ -265,10 +265,12 @@ impl SeekTempState {
 /// The residual bias of a completed two-position seek: the half-sum of its two main
 /// positions' compensated rates (headings 0 and 180 deg apart; the short ambiguity dwell
 /// at +90 deg is not used), deg/h. `None` for a four-position seek (its bias is its own
-/// estimate, not recorded here) or if the two main positions are not opposite.
+/// estimate, not recorded here) or if the two main positions are not opposite. A
+/// time-symmetric two-position seek counts: its positions average both visits, so the
+/// half-sum is the bias at the seek's mean time, as for the forward seek.
 pub fn two_position_residual_dph(result: &crate::seeking::northfinder::SeekResult) -> Option<f64> {
     use crate::seeking::northfinder::SeekMode;
-    if result.mode != SeekMode::TwoPosition || result.n_positions < 2 {
+    if result.mode.forward() != SeekMode::TwoPosition || result.n_positions < 2 {
         return None;
     }
     let (a, b) = (&result.positions[0], &result.positions[1]);
@@ -294,7 +296,7 @@ pub fn record_of_seek(
 ) -> Option<FieldRecord> {
     use crate::seeking::northfinder::SeekMode;
     use crate::seeking::quality::Validity;
-    if validity != Validity::Valid || result.mode != SeekMode::TwoPosition {
+    if validity != Validity::Valid || result.mode.forward() != SeekMode::TwoPosition {
         return None;
     }
     let residual_dph = two_position_residual_dph(result)?;

@@ -1,6 +1,8 @@
 //! North seeking: turning compensated windows at known table headings into an azimuth.
 //!
 //! - `northfinder`: the two- and four-position seek as a non-blocking state machine;
+//! - `sequence`: each seek mode's position sequence (forward, or time-symmetric so that a
+//!   drift linear in time cancels);
 //! - `tilt`: the Earth rate seen by a gyro on a tilted turntable (shared by the seek and the
 //!   heading calibration);
 //! - `heading_cal`: the heading-dependent bias harmonic (`model::heading`), estimated from
@@ -16,4 +18,5 @@ pub mod field_record;
 pub mod heading_cal;
 pub mod northfinder;
 pub mod quality;
+pub mod sequence;
 pub mod tilt;

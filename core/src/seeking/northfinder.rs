@@ -12,6 +12,10 @@
 //!   |sin psi| < `direct_sine_below()` of 0/180 deg, where acos is ill-conditioned, the
 //!   +90 dwell's sine enters directly: psi = atan2(s, c).
 //! - Four positions (h0 + 0/90/180/270): psi = atan2(w4 - w2, w1 - w3); bias and scale factor cancel.
+//! - Either in a time-symmetric sequence (`sequence`: 0, 180, 90, 180, 0 or 0, 90, 180, 270,
+//!   180, 90, 0): each heading is visited twice (the turning point once for twice the dwell)
+//!   and its windows are averaged together, so every position's mean has the same mean
+//!   time and a drift linear in time cancels; the solution is the forward mode's.
 //!
 //! Tilt (see `tilt`): with the base pitched/rolled the reading is
 //! w(h) = Omega_H (cos A P(h) + sin A Q(h)) + V(h) + bias; both modes solve the two bias-free
@@ -35,18 +39,12 @@ use crate::model::heading::HeadingHarmonic;
 use crate::numeric::wrap_360_deg as wrap_360;
 use crate::seeking::tilt::{axis_coefficients, AxisCoefficients, Tilt};
 
-/// Most table positions in one seek.
+/// Most table positions in one seek (distinct headings; a symmetric sequence visits each
+/// twice, see `sequence`).
 pub const MAX_POSITIONS: usize = 4;
 
-/// Two or four positions.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum SeekMode {
-    /// h0, h0+180, then a short dwell at h0+90 to resolve the acos ambiguity.
-    TwoPosition,
-    /// h0, h0+90, h0+180, h0+270 with atan2 (cancels bias and scale factor).
-    FourPosition,
-}
+use crate::seeking::sequence::{Dwell, Step};
+pub use crate::seeking::sequence::{SeekMode, MAX_STEPS};
 
 /// Seek settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -57,9 +55,10 @@ pub struct SeekConfig {
     pub latitude_deg: f64,
     /// Table heading of the first position, deg.
     pub start_heading_deg: f32,
-    /// Measuring time per main position, s (rounded up to whole windows).
+    /// Measuring time per visit of a main position, s (rounded up to whole windows); a
+    /// symmetric sequence visits each twice (`SeekMode::main_dwells_per_position`).
     pub dwell_s: f32,
-    /// Measuring time at h0+90 for the two-position ambiguity, s (> 0).
+    /// Measuring time at h0+90 for the two-position ambiguity, s (> 0; one visit).
     pub ambiguity_dwell_s: f32,
     /// Extra wait after the table reports `Settled`, s.
     pub settle_s: f32,
@@ -131,7 +130,7 @@ impl core::fmt::Display for SeekError {
 
 impl core::error::Error for SeekError {}
 
-/// What one position measured.
+/// What one position measured (over all its visits in a symmetric sequence).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct PositionMean {
@@ -140,6 +139,7 @@ pub struct PositionMean {
     /// Mean of the compensated window rates, deg/h.
     pub mean_rate_dph: f64,
     /// Standard deviation of the mean (window scatter / sqrt(n)), deg/h; 0 with one window.
+    /// Over two visits the scatter includes the change between them (conservative).
     pub sigma_dph: f64,
     /// Windows used.
     pub n_windows: u16,
@@ -160,7 +160,7 @@ pub struct SeekResult {
     /// Bias estimated from the dwells, deg/h.
     pub bias_dph: f64,
     pub mode: SeekMode,
-    /// Per-position means, in the order measured; `n_positions` used.
+    /// Per-position means, in the order first measured; `n_positions` used.
     pub positions: [PositionMean; MAX_POSITIONS],
     pub n_positions: u8,
     /// Mean base tilt over the windows used (level if none was given), deg.
@@ -179,6 +179,8 @@ pub enum SeekStatus {
     Moving {
         position: u8,
     },
+    /// `position` here and in `Moving` is the step of the sequence (`SeekMode::steps`),
+    /// `windows` the valid windows of this visit.
     Dwelling {
         position: u8,
         windows: u16,
@@ -194,10 +196,17 @@ enum Phase {
     Dwelling { accept_from_s: f64 },
 }
 
+/// The windows of one position, over all its visits.
 #[derive(Clone, Copy, Debug, Default)]
 struct Accumulator {
     sum: f64,
     sum_sq: f64,
+    n: u16,
+}
+
+/// The current visit (step of the sequence).
+#[derive(Clone, Copy, Debug, Default)]
+struct Visit {
     n: u16,
     invalid: u16,
     duration_s: f64,
@@ -209,8 +218,10 @@ pub struct NorthFinder {
     cfg: SeekConfig,
     omega_h_dph: f64,
     phase: Phase,
-    position: u8,
+    /// Step of the sequence (`SeekMode::steps`).
+    step: u8,
     acc: [Accumulator; MAX_POSITIONS],
+    visit: Visit,
     t_start_s: f64,
     last: Option<SeekResult>,
     /// Sums of the tilt of the windows used in this seek.
@@ -229,7 +240,7 @@ impl NorthFinder {
             && pos(cfg.move_timeout_s)
             && cfg.settle_s.is_finite()
             && cfg.settle_s >= 0.0
-            && (cfg.mode == SeekMode::FourPosition || pos(cfg.ambiguity_dwell_s));
+            && (cfg.mode.forward() == SeekMode::FourPosition || pos(cfg.ambiguity_dwell_s));
         if !ok {
             return Err(SeekError::BadConfig);
         }
@@ -237,8 +248,9 @@ impl NorthFinder {
             cfg,
             omega_h_dph: earth_rate_horizontal_dph(cfg.latitude_deg),
             phase: Phase::Idle,
-            position: 0,
+            step: 0,
             acc: [Accumulator::default(); MAX_POSITIONS],
+            visit: Visit::default(),
             t_start_s: 0.0,
             last: None,
             tilt_sum_deg: [0.0; 2],
@@ -256,35 +268,57 @@ impl NorthFinder {
         self.omega_h_dph
     }
 
-    /// Number of positions of the configured mode.
+    /// Number of positions (distinct headings, the ambiguity dwell's included) of the
+    /// configured mode.
     pub fn n_positions(&self) -> usize {
-        match self.cfg.mode {
-            SeekMode::TwoPosition => 3,
-            SeekMode::FourPosition => 4,
-        }
+        self.cfg.mode.offsets_deg().len()
+    }
+
+    /// Number of dwells (steps) of the configured mode's sequence.
+    pub fn n_steps(&self) -> usize {
+        self.cfg.mode.steps().len()
     }
 
     /// Table heading of position `k`, deg in [0, 360).
     pub fn heading_of(&self, k: usize) -> f32 {
-        let offset = match (self.cfg.mode, k) {
-            (SeekMode::TwoPosition, 0) => 0.0,
-            (SeekMode::TwoPosition, 1) => 180.0,
-            (SeekMode::TwoPosition, _) => 90.0,
-            (SeekMode::FourPosition, k) => 90.0 * k as f64,
-        };
+        let offset = self.cfg.mode.offsets_deg().get(k).copied().unwrap_or(0.0);
         wrap_360(self.cfg.start_heading_deg as f64 + offset) as f32
+    }
+
+    /// Step `k` of the sequence (the last one beyond its end).
+    fn step_of(&self, k: usize) -> Step {
+        let steps = self.cfg.mode.steps();
+        steps.get(k).or(steps.last()).copied().unwrap_or(Step {
+            position: 0,
+            dwell: Dwell::Main,
+        })
+    }
+
+    /// Main measuring time per position, s (all its visits).
+    fn main_s_per_position(&self) -> f32 {
+        self.cfg.dwell_s * self.cfg.mode.main_dwells_per_position() as f32
+    }
+
+    /// 10 s windows a main position collects over all its visits.
+    pub fn main_windows_per_position(&self) -> u16 {
+        (0..self.n_steps())
+            .filter(|&k| self.step_of(k).position == 0)
+            .map(|k| self.windows_needed(k))
+            .fold(0, u16::saturating_add)
     }
 
     /// Two positions: below this |sin psi| the azimuth comes from atan2 with the +90 dwell's
     /// direct sine instead of acos. It is where both have the same white-noise variance:
     /// dc / |sin psi| with var(dc) = N^2 / (2 tau) equals ds with var(ds) = N^2 / tau_90,
-    /// i.e. |sin psi| = sqrt(tau_90 / (2 tau)) (0.29 for 120 s / 20 s dwells).
+    /// i.e. |sin psi| = sqrt(tau_90 / (2 tau)) (0.29 for 120 s / 20 s dwells); tau is the
+    /// main time per position over all its visits.
     pub fn direct_sine_below(&self) -> f64 {
         // f32 inputs, so f32 `sqrtf` loses nothing.
-        (libm::sqrtf(self.cfg.ambiguity_dwell_s / (2.0 * self.cfg.dwell_s)) as f64).min(0.5)
+        (libm::sqrtf(self.cfg.ambiguity_dwell_s / (2.0 * self.main_s_per_position())) as f64)
+            .min(0.5)
     }
 
-    /// 10 s windows position `k` needs (its dwell rounded up to whole windows).
+    /// 10 s windows step `k` of the sequence needs (its dwell rounded up to whole windows).
     pub fn windows_needed(&self, k: usize) -> u16 {
         let n = self.dwell_of(k) / crate::consts::WINDOW_S as f64;
         let whole = crate::numeric::floor_i64(n);
@@ -296,10 +330,12 @@ impl NorthFinder {
         .clamp(1, u16::MAX as i64) as u16
     }
 
+    /// Measuring time of step `k`, s.
     fn dwell_of(&self, k: usize) -> f64 {
-        match (self.cfg.mode, k) {
-            (SeekMode::TwoPosition, 2) => self.cfg.ambiguity_dwell_s as f64,
-            _ => self.cfg.dwell_s as f64,
+        match self.step_of(k).dwell {
+            Dwell::Main => self.cfg.dwell_s as f64,
+            Dwell::Double => 2.0 * self.cfg.dwell_s as f64,
+            Dwell::Ambiguity => self.cfg.ambiguity_dwell_s as f64,
         }
     }
 
@@ -313,11 +349,11 @@ impl NorthFinder {
         match self.phase {
             Phase::Idle => SeekStatus::Idle,
             Phase::Moving { .. } => SeekStatus::Moving {
-                position: self.position,
+                position: self.step,
             },
             Phase::Dwelling { .. } => SeekStatus::Dwelling {
-                position: self.position,
-                windows: self.acc.get(self.position as usize).map_or(0, |a| a.n),
+                position: self.step,
+                windows: self.visit.n,
             },
         }
     }
@@ -341,6 +377,7 @@ impl NorthFinder {
             return Err(SeekError::BadConfig);
         }
         self.acc = [Accumulator::default(); MAX_POSITIONS];
+        self.visit = Visit::default();
         self.tilt_sum_deg = [0.0; 2];
         self.tilt_n = 0;
         self.t_start_s = t_now_s;
@@ -353,8 +390,10 @@ impl NorthFinder {
         k: usize,
         t_now_s: f64,
     ) -> Result<(), SeekError> {
-        self.position = k as u8;
-        if let Err(_e) = table.command_heading(self.heading_of(k)) {
+        self.step = k as u8;
+        self.visit = Visit::default();
+        let heading = self.heading_of(self.step_of(k).position as usize);
+        if let Err(_e) = table.command_heading(heading) {
             self.phase = Phase::Idle;
             return Err(SeekError::Turntable);
         }
@@ -383,7 +422,7 @@ impl NorthFinder {
                     if t_now_s - since_s > self.cfg.move_timeout_s as f64 {
                         self.phase = Phase::Idle;
                         return Err(SeekError::TableTimeout {
-                            position: self.position,
+                            position: self.step,
                         });
                     }
                 }
@@ -455,30 +494,32 @@ impl NorthFinder {
         if w.t_start_s < accept_from_s - 1e-6 {
             return Ok(self.status());
         }
-        let k = self.position as usize;
-        let a = &mut self.acc[k];
+        let k = self.step as usize;
+        let p = (self.step_of(k).position as usize).min(MAX_POSITIONS - 1);
         if w.status.is_valid() && w.compensated_dph.is_finite() {
             let v = w.compensated_dph as f64;
+            let a = &mut self.acc[p];
             a.sum += v;
             a.sum_sq += v * v;
-            a.n += 1;
-            a.duration_s += w.t_end_s - w.t_start_s;
+            a.n = a.n.saturating_add(1);
+            self.visit.n = self.visit.n.saturating_add(1);
+            self.visit.duration_s += w.t_end_s - w.t_start_s;
             if tilt.within(90.0) {
                 self.tilt_sum_deg[0] += tilt.pitch_deg as f64;
                 self.tilt_sum_deg[1] += tilt.roll_deg as f64;
                 self.tilt_n += 1;
             }
         } else {
-            a.invalid += 1;
-            if a.invalid > self.cfg.max_invalid_windows {
+            self.visit.invalid = self.visit.invalid.saturating_add(1);
+            if self.visit.invalid > self.cfg.max_invalid_windows {
                 self.phase = Phase::Idle;
                 return Err(SeekError::TooManyInvalidWindows {
-                    position: self.position,
+                    position: self.step,
                 });
             }
         }
-        if a.duration_s + 1e-6 >= self.dwell_of(k) {
-            if k + 1 < self.n_positions() {
+        if self.visit.duration_s + 1e-6 >= self.dwell_of(k) {
+            if k + 1 < self.n_steps() {
                 self.go_to(table, k + 1, w.t_end_s)?;
             } else {
                 // Done is reported exactly once, by the window that completes the seek;
@@ -527,8 +568,8 @@ impl NorthFinder {
         // Two equations, linear in (X, Y) = Omega_H (cos A, sin A) (see `tilt`):
         // c = P0 X + Q0 Y + V0 from the two opposite main dwells, q = P90 X + Q90 Y + V90
         // from the quadrature dwell(s); the bias cancels in both.
-        let (k_c, k_q, c, q, var_c, var_q, bias) = match self.cfg.mode {
-            SeekMode::TwoPosition => {
+        let (k_c, k_q, c, q, var_c, var_q, bias) = match self.cfg.mode.forward() {
+            SeekMode::TwoPosition | SeekMode::TwoPositionSymmetric => {
                 let bias = 0.5 * (m[0] + m[1]);
                 let var_c = (v[0] + v[1]) / 4.0;
                 (
@@ -541,7 +582,7 @@ impl NorthFinder {
                     bias,
                 )
             }
-            SeekMode::FourPosition => (
+            SeekMode::FourPosition | SeekMode::FourPositionSymmetric => (
                 coeff(0),
                 coeff(1),
                 0.5 * (m[0] - m[2]),
@@ -553,9 +594,11 @@ impl NorthFinder {
         };
         let direct =
             solve_pair(k_c, k_q, c, q, var_c, var_q).ok_or(SeekError::InconsistentRates)?;
-        let (az_rad, sigma_rad) = match self.cfg.mode {
-            SeekMode::FourPosition => (direct.azimuth_rad, direct.sigma_rad),
-            SeekMode::TwoPosition => {
+        let (az_rad, sigma_rad) = match self.cfg.mode.forward() {
+            SeekMode::FourPosition | SeekMode::FourPositionSymmetric => {
+                (direct.azimuth_rad, direct.sigma_rad)
+            }
+            SeekMode::TwoPosition | SeekMode::TwoPositionSymmetric => {
                 // c - V0 = Omega_H R0 cos(A - d0): acos of the two long dwells, the sign (and,
                 // near A - d0 = 0/180 deg, where acos is ill-conditioned, the whole angle) from
                 // the quadrature dwell.

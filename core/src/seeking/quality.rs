@@ -339,7 +339,7 @@ impl SeekSupervisor {
         if !self.seeking {
             return 0.0;
         }
-        let n = self.finder.n_positions();
+        let n = self.finder.n_steps();
         let total: u32 = (0..n).map(|k| self.finder.windows_needed(k) as u32).sum();
         let (pos, windows) = match self.finder.status() {
             SeekStatus::Dwelling { position, windows } => (position as usize, windows as u32),
@@ -370,7 +370,7 @@ impl SeekSupervisor {
             let f = self.window_floor_dph();
             f * f
         };
-        let n_main = self.finder.windows_needed(0).max(1) as f64;
+        let n_main = self.finder.main_windows_per_position().max(1) as f64;
         // c = (m0 - m180) / 2 has var_w / (2 n); azimuth sigma = sigma_c / Omega_H.
         let sigma_c = libm::sqrtf((var_w / (2.0 * n_main)) as f32) as f64;
         let rad = sigma_c / self.finder.omega_h_dph();
@@ -573,11 +573,21 @@ mod tests {
         predicted: f32,
     }
 
-    /// Runs a seek; `site_lat` is the true latitude, the finder is told 39.9 deg.
-    /// `disturb(t)` adds a rate (deg/h) and a tilt change (deg) at time t.
+    /// Runs a four-position seek (`run_mode`).
     fn run(site_lat: f64, noise_dph: f64, disturb: impl Fn(f64) -> (f64, f32)) -> Outcome {
+        run_mode(SeekMode::FourPosition, site_lat, noise_dph, disturb)
+    }
+
+    /// Runs a seek of `mode` with 60 s dwells; `site_lat` is the true latitude, the finder
+    /// is told 39.9 deg. `disturb(t)` adds a rate (deg/h) and a tilt change (deg) at time t.
+    fn run_mode(
+        mode: SeekMode,
+        site_lat: f64,
+        noise_dph: f64,
+        disturb: impl Fn(f64) -> (f64, f32),
+    ) -> Outcome {
         let cfg = SeekConfig {
-            mode: SeekMode::FourPosition,
+            mode,
             dwell_s: 60.0,
             ..SeekConfig::default()
         };
@@ -667,6 +677,51 @@ mod tests {
             o.result,
             Err(QualityError::TooMuchMotion(MotionReason::TiltChange { .. }))
         ));
+    }
+
+    /// The symmetric sequences under the same checks: a still seek is valid with monotone
+    /// progress and a fair prediction (its main windows are both visits'), a rate jump in
+    /// the last visit restarts the seek naming that step, a wrong latitude is flagged.
+    #[test]
+    fn symmetric_sequences_pass_the_same_checks() {
+        // The window that ends at `bump_s` is the third of the last step (5 s table moves).
+        for (mode, bump_s, last_step) in [
+            (SeekMode::TwoPositionSymmetric, 280.0, 4),
+            (SeekMode::FourPositionSymmetric, 520.0, 6),
+        ] {
+            let o = run_mode(mode, 39.9, 0.02, |_| (0.0, 0.0));
+            let (r, v) = o.result.unwrap();
+            assert_eq!(v, Validity::Valid, "{mode:?}");
+            assert!(o.events.iter().all(|e| *e == SupervisorEvent::Running));
+            assert!(o.progress.windows(2).all(|p| p[1] >= p[0]), "{mode:?}");
+            assert!(*o.progress.last().unwrap() > 0.9, "{mode:?}");
+            let ratio = o.predicted as f64 / r.sigma_deg;
+            assert!((0.5..2.0).contains(&ratio), "{mode:?} {ratio}");
+            let o = run_mode(mode, 39.9, 0.02, |t| {
+                (
+                    if (bump_s - 5.0..bump_s + 5.0).contains(&t) {
+                        5.0
+                    } else {
+                        0.0
+                    },
+                    0.0,
+                )
+            });
+            assert!(
+                matches!(
+                    o.events.iter().find(|e| **e != SupervisorEvent::Running),
+                    Some(SupervisorEvent::Restarted(MotionReason::RateJump { position, .. }))
+                        if *position == last_step
+                ),
+                "{mode:?} {:?}",
+                o.events.iter().find(|e| **e != SupervisorEvent::Running)
+            );
+            let o = run_mode(mode, 65.0, 0.005, |_| (0.0, 0.0));
+            assert!(
+                matches!(o.result, Ok((_, Validity::LatitudeMismatch { .. }))),
+                "{mode:?}"
+            );
+        }
     }
 
     #[test]

@@ -15,8 +15,8 @@ use crate::output::reports::{progress_bar, write_json};
 use crate::pipeline::campaign::WarmRestarts;
 use crate::pipeline::north_seek::own_model::{train_own_model, OwnModelPlan, CAMPAIGN_RUNS};
 use crate::pipeline::north_seek::{
-    build_product_report, default_threads, run_monte_carlo_with_calibration, seek_table,
-    MonteCarloConfig, MAX_RESTART_ABOVE_AMBIENT_C,
+    build_product_report, default_dwell_s, default_threads, run_monte_carlo_with_calibration,
+    seek_table, MonteCarloConfig, MAX_RESTART_ABOVE_AMBIENT_C,
 };
 use crate::pipeline::reproduce::write_model_file;
 use crate::sim::GyroParams;
@@ -36,6 +36,11 @@ pub struct Args {
     /// Table positions per seek: 2 (paper) or 4.
     #[arg(long, default_value_t = 2)]
     pub positions: u8,
+    /// Order of the positions: `forward` (one pass, the paper's) or `symmetric` (there and
+    /// back, symmetric in time: 0, 180, 90, 180, 0 or 0, 90, 180, 270, 180, 90, 0 deg, so a
+    /// drift linear in time cancels; each position is visited twice for `--dwell-s`).
+    #[arg(long, value_enum, default_value_t = Sequence::Forward)]
+    pub sequence: Sequence,
     /// Site latitude, deg (north positive).
     #[arg(long = "latitude-deg", alias = "latitude", default_value_t = crate::sim::DEFAULT_LATITUDE_DEG, allow_negative_numbers = true)]
     pub latitude: f64,
@@ -50,8 +55,9 @@ pub struct Args {
     /// True azimuth of the table's zero, deg (the paper's was about 108.4).
     #[arg(long = "azimuth-deg", alias = "azimuth", default_value_t = crate::pipeline::north_seek::PAPER_AZIMUTH_DEG, allow_negative_numbers = true)]
     pub azimuth: f64,
-    /// Measuring time per main position, s, so that one seek fits the paper's 4 min 56 s
-    /// [default: 110 for two positions, 60 for four].
+    /// Measuring time per visit of a main position, s, so that one seek fits the paper's
+    /// 4 min 56 s [default: 110 for two positions, 60 for four; symmetric: 50 for two, 20 for
+    /// four (`default_dwell_s`)].
     #[arg(long = "dwell-s", alias = "dwell", allow_negative_numbers = true)]
     pub dwell: Option<f32>,
     /// Seed of the whole Monte Carlo (and of the default training campaign).
@@ -113,12 +119,21 @@ pub const TRAINING_RESTART_EVERY: usize = 3;
 /// Most chamber runs `--training-runs` takes: every run is held in memory.
 pub const MAX_TRAINING_RUNS: usize = 2 * CAMPAIGN_RUNS;
 
+/// `--sequence`: the positions in one pass or there and back.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Sequence {
+    Forward,
+    Symmetric,
+}
+
 /// Turns the options into a Monte Carlo configuration, rejecting impossible values.
 pub fn config_from_args(a: &Args) -> Result<MonteCarloConfig> {
-    let mode = match a.positions {
-        2 => SeekMode::TwoPosition,
-        4 => SeekMode::FourPosition,
-        p => bail!("--positions {p}: must be 2 or 4"),
+    let mode = match (a.positions, a.sequence) {
+        (2, Sequence::Forward) => SeekMode::TwoPosition,
+        (4, Sequence::Forward) => SeekMode::FourPosition,
+        (2, Sequence::Symmetric) => SeekMode::TwoPositionSymmetric,
+        (4, Sequence::Symmetric) => SeekMode::FourPositionSymmetric,
+        (p, _) => bail!("--positions {p}: must be 2 or 4"),
     };
     if !(a.ambient.is_finite() && (-60.0..=100.0).contains(&a.ambient)) {
         bail!("--ambient-c {}: must be within -60..=100 degC", a.ambient);
@@ -130,10 +145,7 @@ pub fn config_from_args(a: &Args) -> Result<MonteCarloConfig> {
         latitude_deg: a.latitude,
         ambient_c: a.ambient,
         true_azimuth_deg: a.azimuth,
-        dwell_s: a.dwell.unwrap_or(match mode {
-            SeekMode::TwoPosition => 110.0,
-            SeekMode::FourPosition => 60.0,
-        }),
+        dwell_s: a.dwell.unwrap_or(default_dwell_s(mode)),
         seed: a.seed,
         threads: a.threads.unwrap_or_else(default_threads),
         tilt_deg: a.tilt_deg,
@@ -294,8 +306,10 @@ pub fn run(args: Args) -> Result<()> {
         "cold starts".to_string()
     };
     println!(
-        "north-seek Monte Carlo: {} {starts} x {} seeks, {} positions, {} degC, latitude {} deg, true azimuth {} deg",
-        report.starts, report.seeks_per_start, report.positions, report.ambient_c, report.latitude_deg, report.true_azimuth_deg
+        "north-seek Monte Carlo: {} {starts} x {} seeks, {} positions{}, {} degC, latitude {} deg, true azimuth {} deg",
+        report.starts, report.seeks_per_start, report.positions,
+        if report.symmetric { " (time-symmetric sequence)" } else { "" },
+        report.ambient_c, report.latitude_deg, report.true_azimuth_deg
     );
     print!("{}", seek_table(report));
     if let Some(t) = &product.tilt_uncompensated {

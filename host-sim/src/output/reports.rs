@@ -127,6 +127,10 @@ pub struct NorthSeekReport {
     pub starts: usize,
     pub seeks_per_start: usize,
     pub positions: u8,
+    /// The positions in a time-symmetric sequence (`--sequence symmetric`); written only
+    /// when true, so a forward seek's report keeps its bytes.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub symmetric: bool,
     pub latitude_deg: f64,
     pub ambient_c: f64,
     /// Gyro temperature above the ambient at power-on, degC (0: cold start from a soak).

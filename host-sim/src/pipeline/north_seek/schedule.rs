@@ -22,12 +22,17 @@ use super::seeks::{run_seeks, Arm, PositionSpans};
 use crate::sim::GyroParams;
 use crate::train::seek_refit::{OppositePair, SeekSchedule};
 
-/// Opposite positions of a mode, by position index: 2 positions (0, 180 deg; the +90
-/// dwell only resolves the sign), 4 positions (0 and 180, 90 and 270 deg).
+/// Opposite positions of a mode, by step of its sequence (`SeekMode::steps`): 2 positions
+/// (0, 180 deg; the +90 dwell only resolves the sign), 4 positions (0 and 180, 90 and 270
+/// deg). A symmetric sequence's difference is the mean of its visits' differences, one
+/// pair per visit in time order (0/180 out and back; the doubled 270 deg dwell pairs with
+/// both 90 deg visits).
 fn opposite_positions(mode: SeekMode) -> &'static [(usize, usize)] {
     match mode {
         SeekMode::TwoPosition => &[(0, 1)],
         SeekMode::FourPosition => &[(0, 2), (1, 3)],
+        SeekMode::TwoPositionSymmetric => &[(0, 1), (3, 4)],
+        SeekMode::FourPositionSymmetric => &[(0, 2), (1, 3), (3, 5), (4, 6)],
     }
 }
 
@@ -129,6 +134,35 @@ mod tests {
         assert!(rated.period_s > plain.period_s + 5.0, "{plain:?} {rated:?}");
         for p in rated.seeks.iter().flatten() {
             assert!((p.first_s.1 - p.first_s.0 - 110.0).abs() < 1e-6, "{p:?}");
+        }
+    }
+
+    #[test]
+    fn the_symmetric_seek_pairs_each_visit_and_centres_both_positions_on_one_time() {
+        let params = GyroParams::paper_default();
+        let mode = SeekMode::TwoPositionSymmetric;
+        let cfg = MonteCarloConfig {
+            seeks_per_start: 2,
+            mode,
+            dwell_s: super::super::default_dwell_s(mode),
+            ..MonteCarloConfig::paper(1)
+        };
+        let s = seek_schedule(&params, &cfg, None).unwrap();
+        let mid = |(a, b): (f64, f64)| 0.5 * (a + b);
+        for seek in &s.seeks {
+            let [out, back] = seek.as_slice() else {
+                panic!("{seek:?}")
+            };
+            for p in [out, back] {
+                assert!((p.first_s.1 - p.first_s.0 - 50.0).abs() < 1e-6, "{p:?}");
+                assert!((p.second_s.1 - p.second_s.0 - 50.0).abs() < 1e-6, "{p:?}");
+                assert!(p.second_s.0 > p.first_s.1, "{p:?}");
+            }
+            // 0 deg is out.first and back.second, 180 deg out.second and back.first: the
+            // same mean time, so a drift linear in time cancels in their difference.
+            let t0 = 0.5 * (mid(out.first_s) + mid(back.second_s));
+            let t180 = 0.5 * (mid(out.second_s) + mid(back.first_s));
+            assert!((t0 - t180).abs() < 1e-6, "{t0} {t180}");
         }
     }
 

@@ -10,7 +10,7 @@ use fog_core::model::format::RbfModel;
 use fog_core::model::heading::HeadingHarmonic;
 use fog_core::seeking::bit::{evaluate, BitInputs, BitLimits, BitWord};
 use fog_core::seeking::field_record::{record_of_seek, FieldRecord, SeekTempState};
-use fog_core::seeking::northfinder::{NorthFinder, SeekStatus, MAX_POSITIONS};
+use fog_core::seeking::northfinder::{NorthFinder, SeekStatus, MAX_STEPS};
 use fog_core::seeking::quality::{
     QualityConfig, QualityError, SeekSupervisor, SupervisorEvent, Validity,
 };
@@ -32,7 +32,8 @@ pub struct SeekOutcome {
     pub sigma_deg: f64,
     pub t_start_s: f64,
     pub duration_s: f64,
-    /// Dwell actually used per main position, s (windows x 10 s).
+    /// Measuring time actually used per main position, s (windows x 10 s, both visits of
+    /// a symmetric sequence).
     pub main_dwell_s: f64,
     /// The field record the device would keep for this seek (`record_of_seek`: residual
     /// bias = half-sum of the two positions at the seek's temperature state; sequence 0,
@@ -42,13 +43,14 @@ pub struct SeekOutcome {
     pub position_spans_s: PositionSpans,
 }
 
-/// Where each position's accepted 10 s windows lie, s since power-on: the first window's
-/// start and the last one's end, by position index (None for a position not dwelt at).
+/// Where each step's accepted 10 s windows lie, s since power-on: the first window's
+/// start and the last one's end, by step of the sequence (`SeekMode::steps`; a forward
+/// sequence's steps are its positions; None for a step not dwelt at).
 /// What the trainer's seek refit reads the device's seek timing from (`seek_schedule`).
-pub type PositionSpans = [Option<(f64, f64)>; MAX_POSITIONS];
+pub type PositionSpans = [Option<(f64, f64)>; MAX_STEPS];
 
 /// No position dwelt at yet.
-pub const NO_SPANS: PositionSpans = [None; MAX_POSITIONS];
+pub const NO_SPANS: PositionSpans = [None; MAX_STEPS];
 
 /// The running seek's `PositionSpans`: a window counts for the position the finder was
 /// dwelling at when it arrived if, after it, that position has one window more, the
@@ -360,6 +362,22 @@ pub fn run_seeks(
     run_seeks_on(&mut gyro, &mut table, cfg, arm)
 }
 
+/// When `run_seeks_on` gives up, s since power-on. A generous bound: every attempt of every
+/// seek restarted as often as the supervisor allows, each taking twice its nominal time
+/// (the longer of 3 dwells + 60 s and the sequence's windows with two per step for turns).
+fn time_limit_s(cfg: &MonteCarloConfig, finder: &NorthFinder, max_restarts: u8) -> f64 {
+    let worst_attempts = (MAX_ATTEMPTS_PER_SEEK * (1 + max_restarts as usize)) as f64;
+    let window_s = fog_core::consts::WINDOW_S as f64;
+    let nominal_s = (0..finder.n_steps())
+        .map(|k| (finder.windows_needed(k) as f64 + 2.0) * window_s)
+        .sum::<f64>();
+    INIT_S
+        + cfg.seeks_per_start as f64
+            * worst_attempts
+            * 2.0
+            * (3.0 * cfg.dwell_s as f64 + 60.0).max(nominal_s)
+}
+
 /// `run_seeks` on any gyro and turntable behind fog-core's traits (the gyro powered on at
 /// t = 0, the table at its zero): the seeks of one power-on, as the device runs them.
 pub fn run_seeks_on<G, T>(
@@ -393,11 +411,7 @@ where
     let mut inclinometer = TiltMean::default();
     let temp_every = ((temp_period_s / dt_s).round() as u64).max(1);
     let poll_every = ((1.0 / dt_s).round() as u64).max(1);
-    // Generous bound: every attempt of every seek restarted as often as the supervisor
-    // allows, each taking twice its nominal time.
-    let worst_attempts = (MAX_ATTEMPTS_PER_SEEK * (1 + quality.max_restarts as usize)) as f64;
-    let t_limit_s = INIT_S
-        + cfg.seeks_per_start as f64 * worst_attempts * 2.0 * (3.0 * cfg.dwell_s as f64 + 60.0);
+    let t_limit_s = time_limit_s(cfg, sup.finder(), quality.max_restarts);
     let mut ledger = SeekLedger {
         wanted: cfg.seeks_per_start,
         index: 0,

@@ -20,8 +20,10 @@ pub fn azimuth_error_deg(a: f64, b: f64) -> f64 {
 }
 
 /// White-noise floor of the azimuth, deg, for angle random walk `arw_dpsh` (deg/sqrt(h)):
-/// two positions N / (sqrt(2 tau) Omega_H |sin psi|) with tau the dwell per position;
-/// four positions sqrt(2) N / (Omega_H sqrt(T_total)), T_total = 4 tau.
+/// two positions N / (sqrt(2 tau) Omega_H |sin psi|) with tau the measuring time per
+/// position; four positions sqrt(2) N / (Omega_H sqrt(T_total)), T_total = 4 tau. A
+/// symmetric sequence has the floor of its forward mode with tau the time over both
+/// visits (its cost is the turns' share of the seek, which shortens tau).
 pub fn noise_floor_deg(
     arw_dpsh: f64,
     mode: SeekMode,
@@ -31,11 +33,11 @@ pub fn noise_floor_deg(
 ) -> f64 {
     let omega_h = earth_rate_horizontal_dph(latitude_deg);
     let tau_h = dwell_s / 3600.0;
-    let rad = match mode {
-        SeekMode::TwoPosition => {
+    let rad = match mode.forward() {
+        SeekMode::TwoPosition | SeekMode::TwoPositionSymmetric => {
             arw_dpsh / ((2.0 * tau_h).sqrt() * omega_h * psi_deg.to_radians().sin().abs())
         }
-        SeekMode::FourPosition => {
+        SeekMode::FourPosition | SeekMode::FourPositionSymmetric => {
             std::f64::consts::SQRT_2 * arw_dpsh / (omega_h * (4.0 * tau_h).sqrt())
         }
     };
@@ -178,10 +180,8 @@ pub fn build_report(
     NorthSeekReport {
         starts: cfg.starts,
         seeks_per_start: cfg.seeks_per_start,
-        positions: match cfg.mode {
-            SeekMode::TwoPosition => 2,
-            SeekMode::FourPosition => 4,
-        },
+        positions: cfg.mode.main_positions(),
+        symmetric: cfg.mode.is_symmetric(),
         latitude_deg: cfg.latitude_deg,
         ambient_c: cfg.ambient_c,
         restart_above_ambient_c: cfg.restart_above_ambient_c,

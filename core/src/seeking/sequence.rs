@@ -1,0 +1,225 @@
+//! The seek modes as position sequences: at which table heading each dwell of a seek is,
+//! for how long, and in what order. The north finder's state machine walks the table; its
+//! solution reads the per-heading means, so a new sequence is a new table, not new code.
+//!
+//! Why time-symmetric sequences: a two-position seek (0, 180 deg) differences two dwells
+//! taken one after the other, so any drift left after compensation that changes during
+//! the seek, d(t) = d0 + d1 t + d2 t^2 / 2, enters the difference as d1 times the time
+//! between the dwells, and that is azimuth error (d1 / (2 Omega_H sin psi) per second of
+//! separation). Visiting every heading twice, in a sequence that reads the same forwards
+//! and backwards in time (`TwoPositionSymmetric`: 0, 180, 90, 180, 0 deg), gives each
+//! heading's mean the same mean time, the middle of the seek, so the d1 term cancels in
+//! every difference without any model of the drift; what is left is the curvature d2
+//! (and the white noise). The price: twice the turns, so less measuring time in the same
+//! seek time.
+//!
+//! The two visits of a heading count as one position (one `PositionMean`); their windows
+//! are averaged together, which weights the visits equally because each visit collects
+//! the same number of valid windows. The heading at the turning point of a symmetric
+//! sequence is visited once for twice the dwell (`Dwell::Double`): the same mean time,
+//! and no turn onto the heading the table is already at.
+
+/// The seek modes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum SeekMode {
+    /// h0, h0+180, then a short dwell at h0+90 to resolve the acos ambiguity.
+    TwoPosition,
+    /// h0, h0+90, h0+180, h0+270 with atan2 (cancels bias and scale factor).
+    FourPosition,
+    /// The two positions in time-symmetric order: h0, h0+180, the ambiguity dwell at
+    /// h0+90 in the middle, h0+180, h0: a drift linear in time cancels.
+    TwoPositionSymmetric,
+    /// The four positions there and back: h0, +90, +180, +270 (twice the dwell), +180, +90,
+    /// h0: a drift linear in time cancels.
+    FourPositionSymmetric,
+}
+
+/// How long one step of a sequence measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dwell {
+    /// `SeekConfig::dwell_s`.
+    Main,
+    /// Twice `dwell_s`: the turning point of a symmetric sequence.
+    Double,
+    /// `SeekConfig::ambiguity_dwell_s`.
+    Ambiguity,
+}
+
+/// One dwell of a sequence: the position (index of the heading, see `offsets_deg`) and
+/// how long.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Step {
+    pub position: u8,
+    pub dwell: Dwell,
+}
+
+const fn step(position: u8, dwell: Dwell) -> Step {
+    Step { position, dwell }
+}
+
+/// Most steps of a sequence.
+pub const MAX_STEPS: usize = 7;
+
+const TWO: [Step; 3] = [
+    step(0, Dwell::Main),
+    step(1, Dwell::Main),
+    step(2, Dwell::Ambiguity),
+];
+const TWO_SYMMETRIC: [Step; 5] = [
+    step(0, Dwell::Main),
+    step(1, Dwell::Main),
+    step(2, Dwell::Ambiguity),
+    step(1, Dwell::Main),
+    step(0, Dwell::Main),
+];
+const FOUR: [Step; 4] = [
+    step(0, Dwell::Main),
+    step(1, Dwell::Main),
+    step(2, Dwell::Main),
+    step(3, Dwell::Main),
+];
+const FOUR_SYMMETRIC: [Step; 7] = [
+    step(0, Dwell::Main),
+    step(1, Dwell::Main),
+    step(2, Dwell::Main),
+    step(3, Dwell::Double),
+    step(2, Dwell::Main),
+    step(1, Dwell::Main),
+    step(0, Dwell::Main),
+];
+
+/// The high bit of the link's `positions` byte that marks a time-symmetric sequence.
+pub const SYMMETRIC_CODE_BIT: u8 = 0x80;
+
+impl SeekMode {
+    /// The dwells in time order.
+    pub const fn steps(self) -> &'static [Step] {
+        match self {
+            SeekMode::TwoPosition => &TWO,
+            SeekMode::TwoPositionSymmetric => &TWO_SYMMETRIC,
+            SeekMode::FourPosition => &FOUR,
+            SeekMode::FourPositionSymmetric => &FOUR_SYMMETRIC,
+        }
+    }
+
+    /// Table heading of each position, deg from the start heading (two positions: 0, 180
+    /// and the ambiguity dwell's 90).
+    pub const fn offsets_deg(self) -> &'static [f64] {
+        match self.forward() {
+            SeekMode::TwoPosition => &[0.0, 180.0, 90.0],
+            _ => &[0.0, 90.0, 180.0, 270.0],
+        }
+    }
+
+    /// The mode with the same positions in one pass: the geometry the solution uses.
+    pub const fn forward(self) -> SeekMode {
+        match self {
+            SeekMode::TwoPosition | SeekMode::TwoPositionSymmetric => SeekMode::TwoPosition,
+            SeekMode::FourPosition | SeekMode::FourPositionSymmetric => SeekMode::FourPosition,
+        }
+    }
+
+    /// True for the time-symmetric sequences.
+    pub const fn is_symmetric(self) -> bool {
+        matches!(
+            self,
+            SeekMode::TwoPositionSymmetric | SeekMode::FourPositionSymmetric
+        )
+    }
+
+    /// Main table positions: 2 or 4 (what `StartSeek` and the CLI call `positions`).
+    pub const fn main_positions(self) -> u8 {
+        match self.forward() {
+            SeekMode::TwoPosition => 2,
+            _ => 4,
+        }
+    }
+
+    /// Measuring time at each main position, in units of `dwell_s` (2 for the symmetric
+    /// sequences: two visits, or one double dwell).
+    pub const fn main_dwells_per_position(self) -> u8 {
+        if self.is_symmetric() {
+            2
+        } else {
+            1
+        }
+    }
+
+    /// The mode as the link's `positions` byte: 2 or 4, with `SYMMETRIC_CODE_BIT` set for
+    /// a symmetric sequence (0x82, 0x84). 2 and 4 keep their meaning, so old bytes decode
+    /// the same; a device without the symmetric sequences refuses 0x82/0x84.
+    pub const fn code(self) -> u8 {
+        let sym = if self.is_symmetric() {
+            SYMMETRIC_CODE_BIT
+        } else {
+            0
+        };
+        self.main_positions() | sym
+    }
+
+    /// The mode of a `positions` byte (`code`), `None` for any other byte.
+    pub const fn from_code(code: u8) -> Option<SeekMode> {
+        match code {
+            2 => Some(SeekMode::TwoPosition),
+            4 => Some(SeekMode::FourPosition),
+            0x82 => Some(SeekMode::TwoPositionSymmetric),
+            0x84 => Some(SeekMode::FourPositionSymmetric),
+            _ => None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ALL: [SeekMode; 4] = [
+        SeekMode::TwoPosition,
+        SeekMode::FourPosition,
+        SeekMode::TwoPositionSymmetric,
+        SeekMode::FourPositionSymmetric,
+    ];
+
+    #[test]
+    fn codes_round_trip_and_the_old_bytes_keep_their_modes() {
+        for m in ALL {
+            assert_eq!(SeekMode::from_code(m.code()), Some(m));
+        }
+        assert_eq!(SeekMode::TwoPosition.code(), 2);
+        assert_eq!(SeekMode::FourPosition.code(), 4);
+        assert_eq!(SeekMode::from_code(3), None);
+        assert_eq!(SeekMode::from_code(0x80), None);
+    }
+
+    /// Each position's mean time (dwell-weighted step index, turns taken as one step)
+    /// is the middle of a symmetric sequence; every position is measured as long as every
+    /// other main one.
+    #[test]
+    fn symmetric_sequences_centre_every_position_and_weigh_them_alike() {
+        for m in [
+            SeekMode::TwoPositionSymmetric,
+            SeekMode::FourPositionSymmetric,
+        ] {
+            let s = m.steps();
+            assert!(s.len() <= MAX_STEPS);
+            let mid = (s.len() - 1) as f64 / 2.0;
+            for p in 0..m.offsets_deg().len() as u8 {
+                let at: Vec<usize> = (0..s.len()).filter(|&k| s[k].position == p).collect();
+                let mean = at.iter().sum::<usize>() as f64 / at.len() as f64;
+                assert_eq!(mean, mid, "{m:?} position {p}");
+                let units: u8 = at
+                    .iter()
+                    .map(|&k| match s[k].dwell {
+                        Dwell::Main => 1,
+                        Dwell::Double => 2,
+                        Dwell::Ambiguity => 0,
+                    })
+                    .sum();
+                assert!(units == 0 || units == m.main_dwells_per_position(), "{m:?}");
+            }
+            // Palindromic: the dwells read the same backwards (equal turns both ways).
+            assert!(s.iter().eq(s.iter().rev()), "{m:?}");
+        }
+    }
+}
