@@ -43,6 +43,7 @@ mod registry_concurrency;
 mod sim_base_motion;
 mod sim_calibration;
 mod sim_campaign;
+mod sim_fleet;
 mod sim_rig;
 mod sim_runs;
 mod train_cli;

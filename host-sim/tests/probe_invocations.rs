@@ -54,6 +54,7 @@ const INPUT_FLAGS: &[&str] = &[
     "--from-diagnose",
     "--from-runs",
     "--field",
+    "--unit-spread",
 ];
 /// Of `INPUT_FLAGS`, those whose value is a directory (of field records).
 const DIR_INPUT_FLAGS: &[&str] = &["--field"];
@@ -153,6 +154,8 @@ const NUMBER_FLAGS: &[&str] = &[
     "--timeout-s",
     "--training-restarts-above-c",
     "--training-runs",
+    "--type-seed",
+    "--units",
     "--widths",
 ];
 /// Malformed numbers: bad for every numeric flag.
@@ -181,6 +184,25 @@ const SUBS: &[Sub] = &[
             "1",
             "--headings-deg",
             "0,180",
+        ],
+    },
+    // A fleet, so that `--unit-spread`'s bad files are read (without `--units` it is refused
+    // unread); with a heading, which `--heading-bias-dph` needs.
+    Sub {
+        words: &["campaign"],
+        base: &[
+            "--out",
+            "!out/fleet",
+            "--units",
+            "2",
+            "--ambient-c",
+            "20",
+            "--runs",
+            "1",
+            "--duration-min",
+            "1",
+            "--headings-deg",
+            "0",
         ],
     },
     Sub {

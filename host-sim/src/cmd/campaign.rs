@@ -1,16 +1,21 @@
 //! `fogsim campaign`: simulate the paper's test campaign into a directory of fog-runs
-//! v1 files (one per power-on, 10 s means, Earth rate in `earth_dph`).
+//! v1 files (one per power-on, 10 s means, Earth rate in `earth_dph`), for one gyro or
+//! for a fleet of units of its type (`--units`).
 
 use super::check_output_file;
 use crate::io::logger_csv::write_logger_csv;
+use crate::io::read_bounded;
+use crate::io::run_format::excerpt;
 use crate::io::OutputGuard;
 use crate::pipeline::campaign::{
     simulate_campaign, write_campaign, CampaignSpec, PAPER_AMBIENTS_C, PAPER_MINUTES, PAPER_RUNS,
 };
+use crate::pipeline::fleet::{simulate_fleet, FleetType, MAX_UNITS};
 use crate::pipeline::heading_campaign::{check_headings, simulate_heading_campaign};
-use crate::sim::{GyroParams, DEFAULT_LATITUDE_DEG};
-use anyhow::{bail, Context};
-use std::path::PathBuf;
+use crate::sim::unit_spread::MAX_SPREAD_FILE_BYTES;
+use crate::sim::{GyroParams, TypeSpread, DEFAULT_LATITUDE_DEG};
+use anyhow::{anyhow, bail, Context};
+use std::path::{Path, PathBuf};
 
 /// Options of `fogsim campaign`.
 #[derive(clap::Args, Debug)]
@@ -56,6 +61,22 @@ pub struct Args {
     /// `fogsim import` in docs/workflow.md.
     #[arg(long)]
     pub logger_csv: Option<PathBuf>,
+    /// Make a fleet: this many units of the gyro type (1..=999), each with every power-on
+    /// above and its physical parameters drawn about the type's by --unit-spread. Files
+    /// are prefixed by the unit (`u001_`), with `unit_id` and `type_id` metadata. Without
+    /// it: one gyro, the type itself.
+    #[arg(long)]
+    pub units: Option<usize>,
+    /// How the units differ (needs --units): `default` (docs/explain/simulator.md,
+    /// "Fleets"), `none` (units differ only in their runs' noise, turn-on bias and soak)
+    /// or a spread file of `parameter: spread` lines (docs/reference/formats.md)
+    /// [default: default].
+    #[arg(long)]
+    pub unit_spread: Option<PathBuf>,
+    /// Seed the units are drawn from (needs --units): the same type seed gives the same
+    /// units whatever --seed, which seeds their runs [default: 1].
+    #[arg(long)]
+    pub type_seed: Option<u64>,
 }
 
 impl Args {
@@ -104,6 +125,50 @@ impl Args {
     }
 }
 
+impl Args {
+    /// The fleet of `--units`, `--unit-spread` and `--type-seed` (None: one gyro).
+    fn fleet(&self) -> anyhow::Result<Option<(FleetType, usize)>> {
+        let Some(units) = self.units else {
+            // checked here, not by clap: its message would name --units, not the flag given
+            if let Some(p) = &self.unit_spread {
+                bail!("--unit-spread {}: needs --units", p.display());
+            }
+            if let Some(s) = self.type_seed {
+                bail!("--type-seed {s}: needs --units");
+            }
+            return Ok(None);
+        };
+        if !(1..=MAX_UNITS).contains(&units) {
+            bail!("--units {units}: must be within 1..={MAX_UNITS}");
+        }
+        let (spread, label) = match self.unit_spread.as_deref() {
+            None => (TypeSpread::default_spread(), "default".to_string()),
+            Some(p) if p.as_os_str() == "default" => {
+                (TypeSpread::default_spread(), "default".to_string())
+            }
+            Some(p) if p.as_os_str() == "none" => (TypeSpread::none(), "none".to_string()),
+            Some(p) => (read_spread_file(p)?, spread_file_label(p)),
+        };
+        let mut fleet = FleetType::paper(spread, &label, self.type_seed.unwrap_or(1));
+        fleet.params = fleet.params.with_heading_bias(self.heading_bias_dph);
+        Ok(Some((fleet, units)))
+    }
+}
+
+/// A spread file (`--unit-spread FILE`), read whole within its size limit.
+fn read_spread_file(path: &Path) -> anyhow::Result<TypeSpread> {
+    let at = || format!("--unit-spread {}", path.display());
+    let bytes = read_bounded(path, MAX_SPREAD_FILE_BYTES).map_err(|e| anyhow!("{}: {e}", at()))?;
+    let text = std::str::from_utf8(&bytes).map_err(|_| anyhow!("{}: not UTF-8 text", at()))?;
+    TypeSpread::parse(text).map_err(|e| anyhow!("{}: {e}", at()))
+}
+
+/// The `unit_spread` metadata of a spread file: `file NAME` (its name, not its path).
+fn spread_file_label(path: &Path) -> String {
+    let name = path.file_name().unwrap_or(path.as_os_str());
+    format!("file {}", excerpt(&name.to_string_lossy()))
+}
+
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let spec = args.to_spec()?;
@@ -118,13 +183,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             args.heading_bias_dph
         );
     }
-    let runs = match &args.headings_deg {
-        Some(h) => {
-            check_headings(h).map_err(|e| anyhow::anyhow!("--headings-deg: {e}"))?;
+    if let Some(h) = &args.headings_deg {
+        check_headings(h).map_err(|e| anyhow!("--headings-deg: {e}"))?;
+    }
+    let fleet = args.fleet()?;
+    let runs = match (&fleet, &args.headings_deg) {
+        (Some((fleet, units)), h) => simulate_fleet(fleet, *units, &spec, h.as_deref())?,
+        (None, Some(h)) => {
             let params = GyroParams::paper_default().with_heading_bias(args.heading_bias_dph);
             simulate_heading_campaign(&params, &spec, h)?
         }
-        None => simulate_campaign(&GyroParams::paper_default(), &spec)?,
+        (None, None) => simulate_campaign(&GyroParams::paper_default(), &spec)?,
     };
     let files = write_campaign(&args.out, &runs)?;
     if let Some(log) = &args.logger_csv {
@@ -136,8 +205,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             log.display()
         );
     }
+    let units = fleet.as_ref().map_or(String::new(), |(f, n)| {
+        format!(
+            "{n} units of {} (type seed {}, spread {}) x ",
+            f.type_id, f.type_seed, f.spread_label
+        )
+    });
     println!(
-        "fogsim campaign: wrote {} runs ({} ambients x {}{} power-ons, {} min, seed {}) to {}",
+        "fogsim campaign: wrote {} runs ({units}{} ambients x {}{} power-ons, {} min, seed {}) to {}",
         files.len(),
         spec.ambients_c.len(),
         args.headings_deg

@@ -89,23 +89,34 @@ impl CampaignSpec {
     /// (`power_ons_per_run` of them per ambient and run: the headings of a heading
     /// campaign, else 1) exceed `MAX_CAMPAIGN_RECORD_S`. Called before anything is simulated.
     pub fn check_record_size(&self, power_ons_per_run: usize) -> Result<(), CampaignError> {
+        self.check_record_size_with(&[(power_ons_per_run, "headings", "--headings-deg")])
+    }
+
+    /// `check_record_size` with every ambient and run repeated by each of `factors`:
+    /// (count, what it counts, the flag that sets it), e.g. the headings and the units of
+    /// a fleet.
+    pub fn check_record_size_with(
+        &self,
+        factors: &[(usize, &str, &str)],
+    ) -> Result<(), CampaignError> {
+        let repeats: f64 = factors.iter().map(|f| f.0 as f64).product();
         let record_s = self.ambients_c.len() as f64
             * self.runs_per_ambient as f64
-            * power_ons_per_run as f64
+            * repeats
             * self.minutes
             * 60.0;
         if record_s > MAX_CAMPAIGN_RECORD_S {
-            let headings = if power_ons_per_run > 1 {
-                format!(" x {power_ons_per_run} headings")
-            } else {
-                String::new()
-            };
+            let shown = factors.iter().filter(|f| f.0 > 1);
+            let times: String = shown
+                .clone()
+                .map(|f| format!(" x {} {}", f.0, f.1))
+                .collect();
+            let flags: String = shown.map(|f| format!(", {}", f.2)).collect();
             return Err(CampaignError::Spec(format!(
-                "{} ambients x {} runs{headings} x {} min = {record_s:.3e} s of 1 Hz records, more than the {MAX_CAMPAIGN_RECORD_S:.0} s a campaign holds in memory (lower --runs, --duration-min{}, or the number of ambients)",
+                "{} ambients x {} runs{times} x {} min = {record_s:.3e} s of 1 Hz records, more than the {MAX_CAMPAIGN_RECORD_S:.0} s a campaign holds in memory (lower --runs, --duration-min{flags}, or the number of ambients)",
                 self.ambients_c.len(),
                 self.runs_per_ambient,
                 self.minutes,
-                if power_ons_per_run > 1 { ", --headings-deg" } else { "" },
             )));
         }
         Ok(())

@@ -1,6 +1,8 @@
 //! Generators and judges shared by several test modules.
 
 pub mod field_gyro;
+pub mod fleet_independent;
+pub mod fleet_judge;
 pub mod independent;
 pub mod novel;
 pub mod peer;
