@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Reference numbers for host-sim/tests/allan_vs_allantools.rs, from allantools.
 
-Usage: ALLAN_EXPORT_DIR=DIR cargo test -p fog-sim --test integration allan_vs_allantools:: -- --ignored
+Usage: ALLAN_EXPORT_DIR=DIR cargo test -p fog-sim --test integration allan_vs_allantools::export
        python3 scripts/allantools_reference.py DIR > reference.rs.txt
 Prints Rust constants: per series and deviation kind the octave (tau, dev) pairs
 (allantools oadev, mdev, ohdev, tdev, totdev on the rate as data_type='freq', rate=1),

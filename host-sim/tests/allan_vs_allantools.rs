@@ -1,6 +1,6 @@
 //! `stats::allan` against allantools on the same series. The series are generated here
-//! (ChaCha8, fixed seeds); `cargo test -p fog-sim --test allan_vs_allantools -- --ignored`
-//! with ALLAN_EXPORT_DIR set writes them as text, and `scripts/allantools_reference.py`
+//! (ChaCha8, fixed seeds); `cargo test -p fog-sim --test integration
+//! allan_vs_allantools::export` with ALLAN_EXPORT_DIR set writes them as text, and `scripts/allantools_reference.py`
 //! computes allantools' figures from those files. The numbers below are its output
 //! (module `reference`: the version and the calls are in its first lines).
 
@@ -38,14 +38,29 @@ fn series(which: usize) -> Vec<f64> {
     }
 }
 
+/// Writes the series as text (17 significant digits) into ALLAN_EXPORT_DIR, for
+/// `scripts/allantools_reference.py`; without it into a directory of its own, and reads
+/// them back: the exported files are the compared series, bit for bit.
 #[test]
-#[ignore = "writes the series for scripts/allantools_reference.py"]
 fn export_series_for_allantools() {
-    let dir =
-        std::path::PathBuf::from(std::env::var("ALLAN_EXPORT_DIR").expect("ALLAN_EXPORT_DIR"));
+    let dir = std::env::var("ALLAN_EXPORT_DIR").map_or_else(
+        |_| std::env::temp_dir().join(format!("fog_allan_export_{}", std::process::id())),
+        std::path::PathBuf::from,
+    );
+    std::fs::create_dir_all(&dir).unwrap();
     for i in 0..3 {
         let text: String = series(i).iter().map(|v| format!("{v:.17e}\n")).collect();
-        std::fs::write(dir.join(format!("series{i}.txt")), text).unwrap();
+        let file = dir.join(format!("series{i}.txt"));
+        std::fs::write(&file, text).unwrap();
+        let back: Vec<f64> = std::fs::read_to_string(&file)
+            .unwrap()
+            .lines()
+            .map(|l| l.parse().unwrap())
+            .collect();
+        assert_eq!(back, series(i), "series {i} does not survive its export");
+    }
+    if std::env::var_os("ALLAN_EXPORT_DIR").is_none() {
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }
 

@@ -63,17 +63,16 @@ fn outcome(law: SoakedLaw, tube: Tube, seed: u64) -> Outcome {
 }
 
 /// The turn-on offset alone: nothing for linear terms to follow, and the pure RBF (the
-/// tie's side) is kept. Measured: held-out seek 0.00431 / 0.00432 deg (seed 1), 0.00412 /
-/// 0.00413 (seed 2), pure / linear.
+/// tie's side) is kept. Measured: held-out seek 0.00431 / 0.00432 deg (seed 1), pure /
+/// linear; seed 2 (0.00412 / 0.00413) was run too and dropped from the suite: one seed
+/// fails on the regression this guards (linear terms taken on a tie), at half the time.
 #[test]
 fn the_null_twin_keeps_the_pure_rbf() {
-    for seed in 1..=2 {
-        let o = outcome(SoakedLaw::LaggedOffsetOnly, Tube::Thin, seed);
-        assert!(
-            !o.linear_chosen,
-            "seed {seed}: linear terms chosen on a drift that follows nothing"
-        );
-    }
+    let o = outcome(SoakedLaw::LaggedOffsetOnly, Tube::Thin, 1);
+    assert!(
+        !o.linear_chosen,
+        "linear terms chosen on a drift that follows nothing"
+    );
 }
 
 /// On the law linear in T and dT/dt and on its twin with a bump in T, the shape chosen by
