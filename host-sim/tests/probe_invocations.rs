@@ -1083,6 +1083,49 @@ fn the_catalogue_has_every_subcommand_and_every_flag_is_classified() {
     );
 }
 
+/// docs/reference/cli.md has a section headed by every command of `fogsim --help`
+/// (`` ## `fogsim north-seek` ``, `` ### `fogsim field pull` ``), and that section or its
+/// parent command's (a flag shared by `registry show` and `registry export`) names every
+/// long flag the command's `--help` lists, in backticks: the reference cannot fall behind
+/// the tool.
+#[test]
+fn the_cli_reference_names_every_command_and_flag() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/reference/cli.md");
+    let page = std::fs::read_to_string(&path).expect("docs/reference/cli.md");
+    let section = |words: &[String]| -> Option<String> {
+        let name = format!("`fogsim {}`", words.join(" "));
+        let start = page
+            .lines()
+            .position(|l| l.starts_with('#') && l.trim_start_matches('#').trim() == name)?;
+        let body: Vec<&str> = page
+            .lines()
+            .skip(start + 1)
+            .take_while(|l| !l.starts_with("## ") && !l.starts_with("### "))
+            .collect();
+        Some(body.join("\n"))
+    };
+    let mut missing = Vec::new();
+    for words in leaf_commands(&[]) {
+        if section(&words).is_none() {
+            missing.push(format!("no section `fogsim {}`", words.join(" ")));
+            continue;
+        }
+        let sections: Vec<String> = (1..=words.len())
+            .filter_map(|k| section(&words[..k]))
+            .collect();
+        let as_str: Vec<&str> = words.iter().map(String::as_str).collect();
+        for (flag, _) in help_flags(&as_str) {
+            if !sections.iter().any(|s| s.contains(&format!("`{flag}"))) {
+                missing.push(format!("`fogsim {}`: {flag}", words.join(" ")));
+            }
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "docs/reference/cli.md is behind `fogsim --help`: {missing:#?}"
+    );
+}
+
 #[test]
 fn bad_invocations_fail_with_one_line_naming_the_fault_and_change_no_input() {
     let n = count_from_env("FOG_PROBE_INVOCATIONS", 60) as usize;
