@@ -4,6 +4,7 @@
 
 pub mod causal;
 pub mod generic;
+pub mod metadata;
 pub mod transforms;
 
 use crate::diagnose::input::Campaign;
@@ -13,7 +14,7 @@ use crate::diagnose::memprobe;
 /// candidate's label and the reason, as the selection lists skipped candidates).
 pub fn library_of(
     campaign: &Campaign,
-    meta: &[generic::MetaColumn],
+    meta: &[metadata::MetaColumn],
     rate_half_s: f64,
 ) -> (Vec<transforms::Candidate>, Option<(String, String)>) {
     let (library, left_out) = generic::enumerate(campaign, meta, rate_half_s);
