@@ -20,6 +20,7 @@ mod app_report_bytes;
 mod app_reproduce;
 mod app_upload_bounds;
 mod campaign_logger_csv;
+mod diagnose_aging;
 mod diagnose_bad_input;
 mod diagnose_between;
 mod diagnose_cli_json;

@@ -63,7 +63,7 @@ pub fn diagnose_with(
     let (folds, mut st, choice) = baseline::layout::layout_and_base(&campaign, rule)?;
     let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
     let latitude = assemble::latitude_of(&campaign);
-    let meta = candidates::generic::metadata(runs);
+    let meta = candidates::metadata::metadata(runs);
     let (library, cap_note) = candidates::library_of(&campaign, &meta, st.temp_rate_half_s);
     let (choice, mut screening, base_rule, between_run, groups) =
         between_runs::screen_both(&campaign, &meta, &folds, &st, choice, &library, latitude)?;

@@ -1,5 +1,6 @@
 //! Generators and judges shared by several test modules.
 
+pub mod aging;
 pub mod field_gyro;
 pub mod fleet_independent;
 pub mod fleet_judge;

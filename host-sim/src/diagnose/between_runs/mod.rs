@@ -12,8 +12,10 @@
 //! until nothing passes; the steps are gated, so no split over them). A run-level permutation test (features
 //! shuffled across runs) is reported next to each candidate as a check. The run-level
 //! library: the run mean (angles: circular-mean harmonic) of every extra column, the
-//! ambient, and every metadata key that varies between runs (numbers as values,
-//! categories as levels; `candidates::generic::metadata`).
+//! ambient, every metadata key that varies between runs whatever its type (numbers as
+//! values, times as days since the earliest run, versions by rank, categories as levels;
+//! `candidates::metadata`), and the runs' order (by a time key, else as given); the
+//! report counts them per family.
 //!
 //! Files: `run_features` (the offsets and the run-level library), `loo` (the run-level
 //! fits and the permutation check), `heading` (a heading harmonic as azimuth error);
@@ -26,7 +28,7 @@ pub mod run_features;
 
 use crate::diagnose::baseline::choice::{BaseChoice, BaseFit};
 use crate::diagnose::baseline::models::Stacked;
-use crate::diagnose::candidates::generic::MetaColumn;
+use crate::diagnose::candidates::metadata::MetaColumn;
 use crate::diagnose::candidates::transforms::Candidate;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
@@ -41,7 +43,7 @@ use serde::Serialize;
 
 use heading::{heading_effect, HeadingEffect};
 use loo::{fit, loo_errors, loo_gains, permutation_p};
-use run_features::{enumerate, run_offsets, RunCandidate};
+use run_features::{enumerate, family_counts, run_offsets, Family, FamilyCount, RunCandidate};
 
 /// One scored run-level candidate, for the report.
 #[derive(Clone, Debug, Serialize)]
@@ -77,6 +79,9 @@ pub struct BetweenRun {
     /// Every named run-level effect, in the order named, with its conditional gain.
     pub named_steps: Vec<RunRow>,
     pub heading: Option<HeadingEffect>,
+    /// How many run-level candidates each family of operators contributed (every family,
+    /// zero included; empty when the analysis was not run).
+    pub candidate_families: Vec<FamilyCount>,
     /// Why the analysis was not run, if it was not.
     pub note: Option<String>,
 }
@@ -264,7 +269,7 @@ pub fn finish(p: Prepared, groups: f64, latitude_deg: f64) -> BetweenRun {
     let heading = named_idx
         .iter()
         .zip(&named_steps)
-        .find(|(i, _)| p.cands[**i].harmonic)
+        .find(|(i, _)| p.cands[**i].family == Family::Harmonic)
         .map(|(i, r)| heading_effect(&p.cands[*i].column, &r.coef, latitude_deg));
     first_rows.sort_by(|a, b| b.gain_pct.total_cmp(&a.gain_pct));
     BetweenRun {
@@ -275,6 +280,7 @@ pub fn finish(p: Prepared, groups: f64, latitude_deg: f64) -> BetweenRun {
         named: named_steps.first().map(|r| r.label.clone()),
         named_steps,
         heading,
+        candidate_families: family_counts(&p.cands),
         note: None,
     }
 }
@@ -313,6 +319,7 @@ pub fn screen_both(
             named: None,
             named_steps: vec![],
             heading: None,
+            candidate_families: vec![],
             note: Some(note),
         },
     };

@@ -7,16 +7,17 @@
 //! inputs (T - mean T, dT/dt). For the temperature: d2/dt2 and memory (its value and
 //! dT/dt are the base's inputs). For time since the start: a power-on decay on the same
 //! time scales. Metadata keys that vary between runs enter as run-constant columns
-//! (their products with the base's inputs are within-run candidates; their values and
-//! levels are run-level candidates, `between_runs`).
+//! (`metadata`: numbers, times as days, versions by rank, categories; their products with
+//! the base's inputs are within-run candidates; their values and levels are run-level
+//! candidates, `between_runs`).
 //!
 //! Memory time scales are the record's: from twice the row spacing, doubling, to half the
 //! shortest run. The size is bounded: at most `MAX_CANDIDATES` (the rest are skipped and
 //! reported as such); about 20 per column.
 
+use crate::diagnose::candidates::metadata::{MetaColumn, MetaKind};
 use crate::diagnose::candidates::transforms::{BaseInput, Candidate, Source, Transform};
 use crate::diagnose::input::Campaign;
-use crate::io::runs::Run;
 use crate::stats::mean_or_zero;
 
 /// Cap on the library's size (the rest are reported as skipped).
@@ -30,76 +31,6 @@ pub const SPLINE_KNOTS: [&[f64]; 2] = [
 ];
 /// Longest memory time scale, as a fraction of the shortest run.
 pub const LONGEST_TAU_FRACTION: f64 = 0.5;
-
-/// A metadata key as a run-constant column.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MetaColumn {
-    pub key: String,
-    /// Per run: the number, or the index of the value among the sorted distinct values.
-    pub run_values: Vec<f64>,
-    /// Whether the values are category codes (then only levels make sense).
-    pub categorical: bool,
-}
-
-/// Metadata keys that vary between runs and are present in all of them: numbers as
-/// they are, other values as categories when there are 2..=`MAX_LEVELS` of them and
-/// fewer than runs (a value unique to each run is a name, not a level). `ambient_c` and
-/// `latitude_deg` are left out: `between_runs` and the azimuth already use them.
-pub fn metadata(runs: &[Run]) -> Vec<MetaColumn> {
-    let Some(first) = runs.first() else {
-        return vec![];
-    };
-    let mut out = Vec::new();
-    for (key, _) in &first.meta {
-        if key == "ambient_c" || key == "latitude_deg" {
-            continue;
-        }
-        let numbers: Option<Vec<f64>> = runs.iter().map(|r| r.meta_f64(key)).collect();
-        let column = if let Some(v) = numbers {
-            MetaColumn {
-                key: key.clone(),
-                run_values: v,
-                categorical: false,
-            }
-        } else {
-            let Some(words) = runs
-                .iter()
-                .map(|r| r.meta_value(key).map(str::trim))
-                .collect::<Option<Vec<&str>>>()
-            else {
-                continue;
-            };
-            let mut distinct: Vec<&str> = words.clone();
-            distinct.sort_unstable();
-            distinct.dedup();
-            if distinct.len() > MAX_LEVELS || distinct.len() >= runs.len() {
-                continue;
-            }
-            MetaColumn {
-                key: key.clone(),
-                run_values: words
-                    .iter()
-                    .map(|w| distinct.iter().position(|d| d == w).unwrap_or(0) as f64)
-                    .collect(),
-                categorical: true,
-            }
-        };
-        let lo = column
-            .run_values
-            .iter()
-            .copied()
-            .fold(f64::INFINITY, f64::min);
-        let hi = column
-            .run_values
-            .iter()
-            .copied()
-            .fold(f64::NEG_INFINITY, f64::max);
-        if hi > lo {
-            out.push(column);
-        }
-    }
-    out
-}
 
 /// Share of the rows the levels must cover (window means of a switching column fall
 /// between its levels where it switched within the window).
@@ -304,7 +235,7 @@ fn metadata_products(meta: &[MetaColumn], blank: &Blank) -> Vec<Candidate> {
     let temp_mean = blank("temp_c", Source::Temp, Transform::Value).centres.1;
     let mut out = Vec::new();
     for m in meta {
-        let levels = if m.categorical {
+        let levels = if m.kind == MetaKind::Category {
             few_levels(m.run_values.iter().copied())
         } else {
             None

@@ -1,9 +1,11 @@
 //! Stage 3, the candidate library: every feature a column or metadata key can offer
 //! (values, smooth functions, derivatives, memory, levels, products with the base's
-//! inputs; `generic`) and what the device can compute of it causally.
+//! inputs; `generic`), metadata of every type as run-constant columns (`metadata`) and
+//! what the device can compute of it causally.
 
 pub mod causal;
 pub mod generic;
+pub mod metadata;
 pub mod transforms;
 
 use crate::diagnose::input::Campaign;
@@ -13,7 +15,7 @@ use crate::diagnose::memprobe;
 /// candidate's label and the reason, as the selection lists skipped candidates).
 pub fn library_of(
     campaign: &Campaign,
-    meta: &[generic::MetaColumn],
+    meta: &[metadata::MetaColumn],
     rate_half_s: f64,
 ) -> (Vec<transforms::Candidate>, Option<(String, String)>) {
     let (library, left_out) = generic::enumerate(campaign, meta, rate_half_s);

@@ -339,6 +339,16 @@ fn write_candidates(s: &mut String, r: &Report) {
         "  between runs (run offsets left by {}: rms {:.4} deg/h about their leave-one-out mean; turn-on repeatability {:.4} deg/h; p in the same family):",
         b.offsets_from, b.offsets_heldout_rms_dph, b.turn_on_repeatability_dph
     );
+    let families: Vec<String> = b
+        .candidate_families
+        .iter()
+        .map(|f| format!("{} {}", f.family, f.candidates))
+        .collect();
+    let _ = writeln!(
+        s,
+        "  run-level candidates per family: {}",
+        families.join(", ")
+    );
     for row in b.rows.iter().take(4) {
         let _ = writeln!(
             s,
