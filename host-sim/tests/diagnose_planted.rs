@@ -26,16 +26,7 @@ fn check(effect: Effect) {
             .candidates
             .iter()
             .take(4)
-            .map(|c| {
-                format!(
-                    "{}:{}({:?}) {:+.2}% p{:.4}",
-                    c.column,
-                    c.transform.name(),
-                    c.tau_s,
-                    c.gain_pct,
-                    c.p_value
-                )
-            })
+            .map(seeds::candidate_line)
             .collect();
         let between = r.between_run.rows.first().map(|x| {
             format!(

@@ -41,16 +41,10 @@ fn run(law: Law, sigmas: f64, seed: u64, rule: BufferRule) -> Outcome {
     let d = diagnose_with(&runs, rule).expect("diagnose a single record");
     let r = &d.report;
     let named = r.named_cause.as_ref().map(|c| c.label());
-    let top = r.candidates.first().map(|c| {
-        format!(
-            "{}:{}({:?}) {:+.2}% p{:.4}",
-            c.column,
-            c.transform.name(),
-            c.tau_s,
-            c.gain_pct,
-            c.p_value
-        )
-    });
+    let top = r
+        .candidates
+        .first()
+        .map(crate::common::seeds::candidate_line);
     let line = format!(
         "{law:?} x{sigmas} seed {seed} {rule:?}: {}, smallest p {:.4}, base {} {:.4}, named {named:?}, top {top:?}",
         r.campaign.validation, r.campaign.smallest_attainable_p, r.base.name, r.base.heldout_rms_dph

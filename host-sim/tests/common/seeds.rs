@@ -30,3 +30,16 @@ pub fn per_seed_parallel<T: Send>(case: impl Fn(u64) -> T + Sync) -> Vec<T> {
             .collect()
     })
 }
+
+/// One ranked candidate of a diagnosis, as the diagnose tests print it:
+/// `column:transform(tau) +gain% p`.
+pub fn candidate_line(c: &fog_sim::diagnose::report::CandidateRow) -> String {
+    format!(
+        "{}:{}({:?}) {:+.2}% p{:.4}",
+        c.column,
+        c.transform.name(),
+        c.tau_s,
+        c.gain_pct,
+        c.p_value
+    )
+}
