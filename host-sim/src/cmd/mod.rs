@@ -18,6 +18,7 @@ pub mod registry;
 pub mod reproduce;
 pub mod rig;
 pub mod train;
+pub mod train_type;
 pub mod upload;
 
 use crate::io::{same_output, OutputGuard};

@@ -14,6 +14,7 @@ use crate::io::OutputGuard;
 use crate::output::reports::{progress_bar, write_json};
 use crate::pipeline::campaign::WarmRestarts;
 use crate::pipeline::north_seek::own_model::{train_own_model, OwnModelPlan, CAMPAIGN_RUNS};
+use crate::pipeline::north_seek::unit_recipe::{recipe_model, UnitRecipe, RECIPE_AMBIENTS_C};
 use crate::pipeline::north_seek::{
     build_product_report, default_dwell_s, default_threads, run_monte_carlo_with_calibration,
     seek_table, MonteCarloConfig, MAX_RESTART_ABOVE_AMBIENT_C,
@@ -111,6 +112,29 @@ pub struct Args {
     /// the product may meet [default: cold starts only]. Refused with `--model`.
     #[arg(long = "training-restarts-above-c")]
     pub training_restarts_above_c: Option<f64>,
+    /// Seek with a unit of a simulated fleet calibrated as a production line would: a type
+    /// learnt from this many other units of its design (3..=60), then the unit's own
+    /// `--unit-runs` cold starts with the type as the prior (`fogsim train --type`); 0: the
+    /// unit's runs alone (the type-free recipe). The seeking unit is U1 of the fleet drawn
+    /// from `--seed` and never one of the type's. Refused with `--model` and `--training-runs`.
+    #[arg(long = "type-units")]
+    pub type_units: Option<usize>,
+    /// The seeking unit's own cold starts (2..=96), spread over `--unit-ambients-c` in turn
+    /// [default: 6]. Needs `--type-units`.
+    #[arg(long = "unit-runs", requires = "type_units")]
+    pub unit_runs: Option<usize>,
+    /// Ambients of the unit's cold starts, degC [default: -40,20,60]. Needs `--type-units`.
+    #[arg(
+        long = "unit-ambients-c",
+        value_delimiter = ',',
+        allow_negative_numbers = true,
+        requires = "type_units"
+    )]
+    pub unit_ambients_c: Option<Vec<f64>>,
+    /// Cold starts of each type unit at each of -40, 20 and +60 degC [default: 2]. Needs
+    /// `--type-units`.
+    #[arg(long = "type-runs-per-ambient", requires = "type_units")]
+    pub type_runs_per_ambient: Option<usize>,
 }
 
 /// Every how many chamber power-ons one is a warm restart (`--training-restarts-above-c`).
@@ -160,6 +184,19 @@ pub fn config_from_args(a: &Args) -> Result<MonteCarloConfig> {
 /// The chamber runs of the default model: `--training-runs` checked, or the default; the
 /// options that only shape a trained model are refused by name with `--model`.
 fn training_campaign(args: &Args) -> Result<(usize, Option<WarmRestarts>)> {
+    if args.type_units.is_some() {
+        let owns = [
+            ("--model", args.model.is_some()),
+            ("--training-runs", args.training_runs.is_some()),
+            (
+                "--training-restarts-above-c",
+                args.training_restarts_above_c.is_some(),
+            ),
+        ];
+        if let Some((flag, _)) = owns.iter().find(|(_, given)| *given) {
+            bail!("{flag}: --type-units makes the model from a type and the unit's own runs");
+        }
+    }
     if let Some(m) = &args.model {
         let trains = [
             ("--inputs", args.inputs.is_some()),
@@ -241,6 +278,21 @@ fn train_default_model(
     Ok((trained.model, source))
 }
 
+/// `--type-units` and its companions as a recipe (None without `--type-units`).
+fn recipe_of(args: &Args) -> Option<UnitRecipe> {
+    Some(UnitRecipe {
+        type_units: args.type_units?,
+        type_runs_per_ambient: args.type_runs_per_ambient.unwrap_or(2),
+        type_ambients_c: RECIPE_AMBIENTS_C.to_vec(),
+        unit_runs: args.unit_runs.unwrap_or(6),
+        unit_ambients_c: args
+            .unit_ambients_c
+            .clone()
+            .unwrap_or_else(|| RECIPE_AMBIENTS_C.to_vec()),
+        seed: args.seed,
+    })
+}
+
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
     let cfg = config_from_args(&args)?;
@@ -252,6 +304,9 @@ pub fn run(args: Args) -> Result<()> {
     )
     .map_err(|e| anyhow::anyhow!("--criterion {e}"))?;
     let (training_runs, warm_restarts) = training_campaign(&args)?;
+    if let Some(r) = recipe_of(&args) {
+        r.check()?;
+    }
     let guard = match &args.model {
         Some(m) => OutputGuard::new(&[m]),
         None => OutputGuard::default(),
@@ -262,7 +317,7 @@ pub fn run(args: Args) -> Result<()> {
         ("--json", args.json.as_deref()),
         ("--save-model", args.save_model.as_deref()),
     ])?;
-    let params = GyroParams::paper_default();
+    let mut params = GyroParams::paper_default();
     let (model, source) = match &args.model {
         Some(p) => (
             read_model(p).map_err(|e| anyhow::anyhow!("--model {e}"))?,
@@ -282,13 +337,39 @@ pub fn run(args: Args) -> Result<()> {
                     ..cfg.clone()
                 }),
             };
-            train_default_model(
-                &params,
-                &plan,
-                training_runs,
-                warm_restarts,
-                args.save_model.as_deref(),
-            )?
+            match recipe_of(&args) {
+                Some(recipe) => {
+                    let made = recipe_model(&recipe, &plan)?;
+                    eprint!("{}", made.summary);
+                    params = made.unit_params.clone();
+                    if let Some(p) = args.save_model.as_deref() {
+                        write_model_file(p, &made.model)?;
+                        eprintln!("wrote the unit's model to {}", p.display());
+                    }
+                    let source = match recipe.type_units {
+                        0 => format!(
+                            "unit U1 of a simulated fleet (seed {}), trained on its own {} runs ({:.1} chamber h)",
+                            recipe.seed, recipe.unit_runs, made.unit_chamber_h
+                        ),
+                        n => format!(
+                            "unit U1 of a simulated fleet (seed {}): type from {n} units x {} runs ({:.1} chamber h), unit calibration from {} runs ({:.1} chamber h)",
+                            recipe.seed,
+                            made.type_runs / n,
+                            made.type_chamber_h,
+                            recipe.unit_runs,
+                            made.unit_chamber_h
+                        ),
+                    };
+                    (made.model, source)
+                }
+                None => train_default_model(
+                    &params,
+                    &plan,
+                    training_runs,
+                    warm_restarts,
+                    args.save_model.as_deref(),
+                )?,
+            }
         }
     };
     let bar = progress_bar(cfg.starts, "north-seek cold starts");

@@ -130,8 +130,32 @@ pub struct Args {
     /// measured under this model or under a variant of it the registry recorded at upload
     /// (the model with a heading calibration attached). Read only; used with `--field`.
     /// Default: $XDG_DATA_HOME/fogsim/registry.sqlite, if it exists.
-    #[arg(long, requires = "field")]
+    /// With `--type-out` or `--type`, the type, its units' runs and the unit
+    /// calibration are recorded in it.
+    #[arg(long)]
     pub registry: Option<PathBuf>,
+    /// Learn a gyro type from these runs and write it here (JSON): the runs are several
+    /// units' cold starts, each naming its unit in `unit_id` metadata (and its type in
+    /// `type_id`: one type only). The shared drift model (also written to `--out`) and
+    /// the unit terms (offset, warm-up gain, a linear term per input) are fitted in turn;
+    /// the terms' mean and unit-to-unit spread are the prior of `--type`
+    /// (`fog_sim::train::type_unit`).
+    #[arg(long = "type-out", conflicts_with_all = ["type_model", "field", "seek_refit"])]
+    pub type_out: Option<PathBuf>,
+    /// Calibrate one unit from its own runs with this type (from `--type-out`) as the
+    /// prior: the unit terms and the prior's weight are chosen by leave-one-run-out, and
+    /// the unit is first tested against its type (`--misfit`). Writes an ordinary model.
+    /// The shape options apply only to the unit's own model (`--misfit own`).
+    #[arg(long = "type", conflicts_with_all = ["field", "seek_refit"])]
+    pub type_model: Option<PathBuf>,
+    /// With `--type`: a unit outside its type is `refuse`d (nothing written) or trained on
+    /// its `own` runs alone [default: refuse].
+    #[arg(long, value_enum)]
+    pub misfit: Option<crate::train::type_unit::MisfitPolicy>,
+    /// With `--type`: fit this many unit terms, in the type's order [default: chosen by
+    /// leave-one-run-out, at most one per run].
+    #[arg(long = "unit-terms")]
+    pub unit_terms: Option<usize>,
 }
 
 fn parse_width_search(s: &str) -> Result<WidthSearch, String> {
@@ -211,10 +235,12 @@ fn check_outputs(args: &Args, guard: &OutputGuard) -> anyhow::Result<()> {
     check_output_file(guard, Some(&args.out), "--out")?;
     check_output_file(guard, args.json.as_deref(), "--json")?;
     check_output_file(guard, args.export_design.as_deref(), "--export-design")?;
+    check_output_file(guard, args.type_out.as_deref(), "--type-out")?;
     check_distinct_outputs(&[
         ("--out", Some(&args.out)),
         ("--json", args.json.as_deref()),
         ("--export-design", args.export_design.as_deref()),
+        ("--type-out", args.type_out.as_deref()),
     ])
 }
 
@@ -237,6 +263,22 @@ fn inputs(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
             .map(|d| crate::io::field_records::json_path(d)),
     );
     inputs.extend(args.registry.clone());
+    inputs.extend(args.type_model.clone());
+    if args.registry.is_some()
+        && args.field.is_none()
+        && args.type_out.is_none()
+        && args.type_model.is_none()
+    {
+        anyhow::bail!("--registry: needs --field, --type-out or --type (what it reads or records)");
+    }
+    for (flag, given) in [
+        ("--misfit", args.misfit.is_some()),
+        ("--unit-terms", args.unit_terms.is_some()),
+    ] {
+        if given && args.type_model.is_none() {
+            anyhow::bail!("{flag}: needs --type TYPE (a unit calibration)");
+        }
+    }
     Ok(inputs)
 }
 
@@ -273,7 +315,7 @@ fn field_refined(
 }
 
 /// Stages one output (see [`StagedFiles`]), naming it on failure.
-fn stage(staged: &mut StagedFiles, path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+pub(super) fn stage(staged: &mut StagedFiles, path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     staged
         .stage(path, bytes)
         .with_context(|| format!("writing {}", path.display()))
@@ -298,6 +340,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Some(&args.out),
         args.json.as_ref(),
         args.export_design.as_ref(),
+        args.type_out.as_ref(),
     ]
     .into_iter()
     .flatten()
@@ -306,7 +349,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let _lock = OutputLock::acquire(&outputs).map_err(anyhow::Error::msg)?;
     // Grouped validation holds out whole runs: too few files is refused before reading.
     let files = run_files(&args.runs)?;
-    let needed = cfg.folds.max(2);
+    // (a unit calibration holds out one run at a time: `calibrate::MIN_UNIT_RUNS`)
+    let needed = match args.type_model {
+        Some(_) => crate::train::type_unit::calibrate::MIN_UNIT_RUNS,
+        None => cfg.folds.max(2),
+    };
     if files.len() < needed {
         anyhow::bail!(
             "{} run file(s): grouped validation holds out whole runs (one per file) and needs at least {needed}",
@@ -314,6 +361,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         );
     }
     let runs = read_runs_binned(&args.runs)?;
+    if let Some(path) = &args.type_model {
+        if super::train_type::calibrate(&args, path, &runs)? {
+            return Ok(());
+        }
+    }
+    if let Some(path) = &args.type_out {
+        return super::train_type::learn(&args, &cfg, &candidates, path, &runs);
+    }
     let (selection, ds) = choose_inputs_default(&runs, &candidates, &cfg)?;
     if args.inputs == InputChoice::Auto {
         print!("{}", selection.summary());

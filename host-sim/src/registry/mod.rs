@@ -1,7 +1,8 @@
 //! The calibration registry: one SQLite database (rusqlite, SQLite compiled in) that keeps,
 //! per gyro id, what must outlive a session: the security counters issued (so none is
 //! ever reused), the models sent (CRC-32, inputs, heading calibration), every upload with
-//! its outcome and every seek result `monitor` received.
+//! its outcome and every seek result `monitor` received; and the factory's record of gyro
+//! types, their units' runs and every unit calibration (`fleet`).
 //!
 //! Why a database: counters must be issued exactly once even when two uploads run at the
 //! same time, and results must be stored whole or not at all under concurrent monitors.
@@ -13,6 +14,7 @@
 mod counters;
 mod export;
 mod field_records;
+mod fleet;
 mod records;
 
 use std::path::{Path, PathBuf};
@@ -24,6 +26,7 @@ use rusqlite::{Connection, OpenFlags};
 pub use counters::CounterRefusal;
 pub use export::{csv_line, write_results_csv, RESULTS_CSV_HEADER};
 pub use field_records::variants_of;
+pub use fleet::UnitCalibrationRecord;
 pub use records::{History, ModelRecord, SeekContext, SeekRecord, UploadRecord};
 
 /// How long a writer waits for another writer's transaction before giving up.
@@ -32,8 +35,10 @@ pub const BUSY_TIMEOUT: Duration = Duration::from_secs(30);
 /// `PRAGMA application_id` of a fogsim registry ("FOGR"): tells ours from any other database.
 const APPLICATION_ID: i64 = 0x464F_4752;
 /// Schema version (`PRAGMA user_version`). 2: `models.base_crc32` (the model a heading
-/// calibration was attached to; `migrate` adds the column to a schema-1 registry).
-const SCHEMA_VERSION: i64 = 2;
+/// calibration was attached to; `migrate` adds the column to a schema-1 registry). 3: the
+/// fleet's tables (`fleet`: types, units' runs, unit calibrations), created in any older
+/// registry when it is opened.
+const SCHEMA_VERSION: i64 = 3;
 
 const SCHEMA: &str = "
 CREATE TABLE IF NOT EXISTS counters (
@@ -214,6 +219,7 @@ impl Registry {
             bail!("schema version {version} is newer than this fogsim's {SCHEMA_VERSION}");
         }
         tx.execute_batch(SCHEMA)?;
+        tx.execute_batch(fleet::FLEET_SCHEMA)?;
         migrate(&tx)?;
         tx.execute_batch(&format!(
             "PRAGMA application_id = {APPLICATION_ID}; PRAGMA user_version = {SCHEMA_VERSION};"

@@ -21,6 +21,7 @@ pub mod fit;
 mod inputs;
 pub mod seek_refit;
 pub mod seek_score;
+pub mod type_unit;
 
 pub use data::dataset::Dataset;
 pub use data::features::{

@@ -30,6 +30,7 @@ pub mod schedule;
 mod seeks;
 mod summary;
 pub mod targets;
+pub mod unit_recipe;
 
 pub use config::*;
 pub use monte_carlo::*;

@@ -1,0 +1,155 @@
+//! `fogsim train --type-out TYPE` (learn a gyro type from several units' runs) and
+//! `fogsim train --type TYPE` (calibrate one unit from its own runs with the type as the
+//! prior): the two steps of `train::type_unit`, with `train`'s outputs, locks and
+//! staging, and the calibration registry as the factory's record of both.
+
+use std::path::Path;
+
+use anyhow::{anyhow, bail, Result};
+use fog_core::model::format::MAX_ENCODED_LEN;
+
+use super::train::{stage, Args};
+use crate::io::runs::Run;
+use crate::io::StagedFiles;
+use crate::registry::{Registry, UnitCalibrationRecord};
+use crate::train::cold_start::envelope_for;
+use crate::train::seek_score::SeekGeometry;
+use crate::train::type_unit::type_model::learn_type;
+use crate::train::type_unit::{calibrate_unit, unit_id_of, MisfitPolicy, TypeModel, UnitPlan};
+use crate::train::{choose_inputs_default, train_model, InputSet, TrainConfig};
+
+/// The model's encoding, with `gyro_id` written into it.
+fn encoded(model: &fog_core::model::format::RbfModel, gyro_id: &str) -> Result<(Vec<u8>, u32)> {
+    let mut m = model.clone();
+    m.meta.gyro_id.clear();
+    m.meta
+        .gyro_id
+        .push_str(gyro_id)
+        .map_err(|_| anyhow!("--gyro-id {gyro_id}: at most 16 bytes"))?;
+    let mut buf = [0u8; MAX_ENCODED_LEN];
+    let len = m
+        .encode(&mut buf)
+        .map_err(|e| anyhow!("encoding the model: {e}"))?;
+    Ok((
+        buf[..len].to_vec(),
+        fog_core::model::crc::crc32(&buf[..len]),
+    ))
+}
+
+/// `--type-out`: learns the type, writes it, the shared model (`--out`) and `--json` (the
+/// type file's content), and records it when `--registry` is given.
+pub fn learn(
+    args: &Args,
+    cfg: &TrainConfig,
+    candidates: &[InputSet],
+    type_path: &Path,
+    runs: &[Run],
+) -> Result<()> {
+    let mut train = |runs: Vec<Run>| -> Result<fog_core::model::format::RbfModel> {
+        let (_, ds) = choose_inputs_default(&runs, candidates, cfg)?;
+        let mut model = train_model(&ds, cfg)?.model;
+        model.cold_start = envelope_for(&runs, &model.inputs)?;
+        Ok(model)
+    };
+    let ty = learn_type(runs, None, &mut train)?;
+    let (model_bytes, crc) = encoded(&ty.model, &cfg.gyro_id)?;
+    let type_bytes = ty.to_bytes()?;
+    let mut staged = StagedFiles::default();
+    stage(&mut staged, &args.out, &model_bytes)?;
+    stage(&mut staged, type_path, &type_bytes)?;
+    if let Some(j) = &args.json {
+        stage(&mut staged, j, &type_bytes)?;
+    }
+    if let Some(db) = &args.registry {
+        let unit_runs: Vec<(String, String)> = runs
+            .iter()
+            .map(|r| {
+                (
+                    r.meta_value("unit_id").unwrap_or("").trim().to_string(),
+                    r.name(),
+                )
+            })
+            .collect();
+        let json = String::from_utf8(type_bytes.clone())?;
+        Registry::open(db)?.record_type(
+            &ty.file.type_id,
+            ty.file.units.len(),
+            crc,
+            &json,
+            &unit_runs,
+        )?;
+    }
+    staged.commit()?;
+    print!("{}", ty.summary());
+    println!(
+        "wrote type {} to {} and its shared model (CRC-32 {crc:08x}) to {}",
+        ty.file.type_id,
+        type_path.display(),
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// `--type`: calibrates the unit. Ok(true): done (written, or nothing to write); Ok(false):
+/// the unit is outside its type and `--misfit own` asks for the ordinary training.
+pub fn calibrate(args: &Args, type_path: &Path, runs: &[Run]) -> Result<bool> {
+    let ty = TypeModel::read(type_path)?;
+    let unit = unit_id_of(runs, &args.gyro_id)?;
+    let plan = UnitPlan {
+        seek: SeekGeometry {
+            dwell_s: args.seek_dwell,
+            latitude_deg: args.seek_latitude,
+        },
+        terms: args.unit_terms,
+    };
+    let cal = calibrate_unit(&ty, runs, &unit, &plan)?;
+    print!("{}", cal.summary());
+    let policy = args.misfit.unwrap_or(MisfitPolicy::Refuse);
+    let misfit = cal.misfit.outside();
+    let (bytes, crc) = encoded(&cal.model, &args.gyro_id)?;
+    let mut record = UnitCalibrationRecord {
+        unit_id: unit.clone(),
+        type_id: ty.file.type_id.clone(),
+        runs: cal.runs,
+        terms: cal.term_names[..cal.terms].join(", "),
+        prior_weight: cal.prior_weight,
+        misfit: cal.misfit.lines().join("; "),
+        outcome: "calibrated".into(),
+        model_crc32: Some(crc),
+    };
+    if misfit {
+        record.outcome = match policy {
+            MisfitPolicy::Refuse => "refused (misfit)".into(),
+            MisfitPolicy::Own => "own model (misfit)".into(),
+        };
+        record.model_crc32 = None;
+    }
+    if let Some(db) = &args.registry {
+        let names: Vec<String> = runs.iter().map(Run::name).collect();
+        Registry::open(db)?.record_unit_calibration(&record, &names)?;
+    }
+    if misfit {
+        return match policy {
+            MisfitPolicy::Refuse => bail!(
+                "unit {unit}: outside its type {} (above); nothing written (`--misfit own` trains it on its own runs alone)",
+                ty.file.type_id
+            ),
+            MisfitPolicy::Own => {
+                println!("unit {unit}: outside its type: trained on its own runs alone (--misfit own)");
+                Ok(false)
+            }
+        };
+    }
+    let mut staged = StagedFiles::default();
+    stage(&mut staged, &args.out, &bytes)?;
+    if let Some(j) = &args.json {
+        stage(&mut staged, j, &serde_json::to_vec_pretty(&cal)?)?;
+    }
+    staged.commit()?;
+    println!(
+        "wrote unit {unit}'s model (CRC-32 {crc:08x}, gyro id {}) to {}",
+        args.gyro_id,
+        args.out.display()
+    );
+    Ok(true)
+}

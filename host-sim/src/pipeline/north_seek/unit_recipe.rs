@@ -1,0 +1,223 @@
+//! `north-seek --type-units N --unit-runs K`: the seeking gyro's model as a production line
+//! would make it, from a type learnt on N other units of its design and K of its own cold
+//! starts (`train::type_unit`), or with N = 0 from its K runs alone (the type-free recipe:
+//! the own-model recipe on those runs).
+//!
+//! The fleet is the simulator's (`pipeline::fleet`, the paper's gyro as the type, the
+//! default unit spread, drawn from the Monte Carlo's seed): the seeking unit is U1 and the
+//! type's units are U2..U(N+1), so the seeking unit is never among them and the same U1 is
+//! calibrated whatever N. The type's units each run `type_runs_per_ambient` cold starts at
+//! every type ambient; the unit's K runs are spread over the unit ambients in turn (run i
+//! at ambient i mod n). The Monte Carlo then seeks with the unit's own parameters.
+
+use anyhow::{anyhow, Result};
+use fog_core::model::format::RbfModel;
+
+use super::own_model::{own_model_from_runs, OwnModelPlan};
+use crate::io::runs::Run;
+use crate::pipeline::campaign::{CampaignSpec, PAPER_MINUTES};
+use crate::pipeline::fleet::{fleet_runs, unit_id, FleetType};
+use crate::sim::{GyroParams, TypeSpread};
+use crate::train::seek_score::SeekGeometry;
+use crate::train::type_unit::type_model::learn_type;
+use crate::train::type_unit::{calibrate_unit, TypeModel, UnitCalibration, UnitPlan};
+
+/// Ambients of the type's and the unit's chamber runs by default, degC.
+pub const RECIPE_AMBIENTS_C: [f64; 3] = [-40.0, 20.0, 60.0];
+/// Most type units (every unit's runs are held in memory).
+pub const MAX_TYPE_UNITS: usize = 60;
+/// Most unit runs.
+pub const MAX_UNIT_RUNS: usize = 96;
+/// Index of the seeking unit in the fleet (U1).
+pub const SEEKING_UNIT: usize = 0;
+
+/// The recipe asked for.
+#[derive(Clone, Debug)]
+pub struct UnitRecipe {
+    /// Units the type is learnt from (0: no type, the unit's runs alone).
+    pub type_units: usize,
+    pub type_runs_per_ambient: usize,
+    pub type_ambients_c: Vec<f64>,
+    pub unit_runs: usize,
+    pub unit_ambients_c: Vec<f64>,
+    /// The fleet's seed (units and runs).
+    pub seed: u64,
+}
+
+/// The seeking unit's model and where it came from.
+pub struct RecipeModel {
+    pub model: RbfModel,
+    /// The seeking unit's parameters (what the Monte Carlo seeks with).
+    pub unit_params: GyroParams,
+    pub type_model: Option<TypeModel>,
+    pub calibration: Option<UnitCalibration>,
+    pub type_runs: usize,
+    /// Chamber hours of the type (all its units) and of the unit, soaks not counted.
+    pub type_chamber_h: f64,
+    pub unit_chamber_h: f64,
+    pub summary: String,
+}
+
+impl UnitRecipe {
+    pub fn check(&self) -> Result<()> {
+        if self.type_units > MAX_TYPE_UNITS || self.type_units == 1 || self.type_units == 2 {
+            return Err(anyhow!(
+                "--type-units {}: must be 0 (no type) or 3..={MAX_TYPE_UNITS} (a type's spread needs 3 units)",
+                self.type_units
+            ));
+        }
+        if !(2..=MAX_UNIT_RUNS).contains(&self.unit_runs) {
+            return Err(anyhow!(
+                "--unit-runs {}: must be within 2..={MAX_UNIT_RUNS} (one run is held out)",
+                self.unit_runs
+            ));
+        }
+        if !(1..=16).contains(&self.type_runs_per_ambient) {
+            return Err(anyhow!(
+                "--type-runs-per-ambient {}: must be within 1..=16",
+                self.type_runs_per_ambient
+            ));
+        }
+        for (flag, list) in [
+            ("--unit-ambients-c", &self.unit_ambients_c),
+            ("--type-ambients-c", &self.type_ambients_c),
+        ] {
+            if list.is_empty()
+                || list
+                    .iter()
+                    .any(|a| !(a.is_finite() && (-60.0..=100.0).contains(a)))
+            {
+                return Err(anyhow!(
+                    "{flag}: one or more ambients within -60..=100 degC"
+                ));
+            }
+        }
+        if self.type_units > 0 && self.type_runs_per_ambient * self.type_ambients_c.len() < 2 {
+            return Err(anyhow!(
+                "--type-runs-per-ambient {}: each type unit needs at least 2 runs",
+                self.type_runs_per_ambient
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The runs of unit `u`: `count` cold starts spread over `ambients` in turn.
+fn unit_runs(
+    fleet: &FleetType,
+    u: usize,
+    ambients: &[f64],
+    count: usize,
+    seed: u64,
+) -> Result<Vec<Run>> {
+    let n = ambients.len();
+    let plan = CampaignSpec {
+        ambients_c: ambients.to_vec(),
+        runs_per_ambient: count.div_ceil(n),
+        seed,
+        ..CampaignSpec::paper(seed)
+    };
+    let runs = fleet_runs(fleet, u, &plan, None).map_err(|e| anyhow!("{e}"))?;
+    // file order is ambient-major: run r at ambient a is index a * per + r
+    let per = plan.runs_per_ambient;
+    Ok((0..count)
+        .map(|i| runs[(i % n) * per + i / n].run.clone())
+        .collect())
+}
+
+/// Makes the seeking unit's model by `recipe` (see the module notes); `plan` is the
+/// own-model recipe's plan (the seek's ambient, dwell, criterion and seek timing).
+pub fn recipe_model(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<RecipeModel> {
+    recipe.check()?;
+    let fleet = FleetType::paper(TypeSpread::default_spread(), "default", recipe.seed);
+    let unit_params = fleet.unit(SEEKING_UNIT).map_err(|e| anyhow!("{e}"))?;
+    let own = unit_runs(
+        &fleet,
+        SEEKING_UNIT,
+        &recipe.unit_ambients_c,
+        recipe.unit_runs,
+        recipe.seed,
+    )?;
+    let hours = |runs: usize| runs as f64 * PAPER_MINUTES / 60.0;
+    if recipe.type_units == 0 {
+        let trained = own_model_from_runs(&fleet.params, own, plan)?;
+        let summary = format!(
+            "type-free recipe: unit {} trained on its own {} runs ({:.1} chamber h)\n{}",
+            unit_id(SEEKING_UNIT),
+            recipe.unit_runs,
+            hours(recipe.unit_runs),
+            trained.summary()
+        );
+        return Ok(RecipeModel {
+            model: trained.trained.model,
+            unit_params,
+            type_model: None,
+            calibration: None,
+            type_runs: 0,
+            type_chamber_h: 0.0,
+            unit_chamber_h: hours(recipe.unit_runs),
+            summary,
+        });
+    }
+    let per_unit = recipe.type_runs_per_ambient * recipe.type_ambients_c.len();
+    let mut pooled = Vec::with_capacity(recipe.type_units * per_unit);
+    for u in 1..=recipe.type_units {
+        pooled.extend(unit_runs(
+            &fleet,
+            u,
+            &recipe.type_ambients_c,
+            per_unit,
+            recipe.seed,
+        )?);
+    }
+    let type_runs = pooled.len();
+    // every round's shared model, to report the one the type kept
+    let mut rounds = Vec::new();
+    // The shared model without the seek refit: its output layer is the unit terms' to fit
+    // (a refit to pooled seeks trades the 10 s fit the backfitting needs for seek bias
+    // averaged over units, and chose the grid's largest weight).
+    let shared_plan = OwnModelPlan {
+        seek_timing: None,
+        ..plan.clone()
+    };
+    let ty = learn_type(&pooled, None, &mut |runs| {
+        let own = own_model_from_runs(&fleet.params, runs, &shared_plan)?;
+        let model = own.trained.model.clone();
+        rounds.push(own);
+        Ok(model)
+    })?;
+    drop(pooled);
+    let shared = rounds
+        .into_iter()
+        .find(|o| o.trained.model == ty.model)
+        .ok_or_else(|| anyhow!("the type's shared model is none of the rounds'"))?;
+    let unit_plan = UnitPlan {
+        seek: SeekGeometry {
+            dwell_s: plan.dwell_s,
+            latitude_deg: plan.latitude_deg,
+        },
+        terms: None,
+    };
+    let cal = calibrate_unit(&ty, &own, &unit_id(SEEKING_UNIT), &unit_plan)?;
+    let summary = format!(
+        "type: {} units x {per_unit} runs ({:.1} chamber h); shared model ({} centres, inputs {}):\n{}{}{}{}",
+        recipe.type_units,
+        hours(type_runs),
+        shared.trained.report.n_centers,
+        shared.trained.report.inputs.join(", "),
+        shared.selection.summary(),
+        shared.summary(),
+        ty.summary(),
+        cal.summary()
+    );
+    Ok(RecipeModel {
+        model: cal.model.clone(),
+        unit_params,
+        type_model: Some(ty),
+        calibration: Some(cal),
+        type_runs,
+        type_chamber_h: hours(type_runs),
+        unit_chamber_h: hours(recipe.unit_runs),
+        summary,
+    })
+}

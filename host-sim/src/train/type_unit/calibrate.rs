@@ -1,0 +1,331 @@
+//! The unit calibration: one gyro's own few cold starts, with its type as the prior
+//! (`fogsim train UNIT_RUNS --type TYPE.json --out MODEL`).
+//!
+//! The unit's drift is the type's shared model corrected by the first m of the type's
+//! unit terms (in the type's order: the terms the fleet shows units differ in most
+//! first), fitted by least squares on the unit's runs with a Gaussian prior at the type's
+//! mean and spread of weight W (in runs: W = 1 counts the prior like one more run; W = 0
+//! is the unit's own least squares). The terms not fitted stay at the type's mean.
+//!
+//! m and W are chosen together by leaving one of the unit's runs out at a time: every
+//! candidate is fitted on the other runs and scored on the held-out run by the seek score
+//! the trainer uses (`seek_score`: the azimuth error of back-to-back two-position seeks
+//! on the residual), then the fewest terms whose held-out mean square is within one
+//! standard error (over the held-out runs) of the best are kept. m = 0 is the type alone.
+//!
+//! Before anything is fitted, the unit's own estimates are tested against the type
+//! (`misfit`): a unit outside its type is said, term by term, and by default refused;
+//! it is never silently pulled to the type (`MisfitPolicy`).
+
+use anyhow::{anyhow, bail, Result};
+use serde::Serialize;
+
+use super::misfit::{test_unit, Misfit};
+use super::solve::{own_estimate, solve, Prior, UnitRows};
+use super::terms::fold;
+use super::type_model::TypeModel;
+use crate::io::runs::Run;
+use crate::train::dataset_from_runs;
+use crate::train::seek_score::{seek_azimuth_per_run, SeekGeometry};
+use fog_core::model::format::RbfModel;
+
+/// Fewest runs of a unit: one is held out, one fits.
+pub const MIN_UNIT_RUNS: usize = 2;
+/// Prior weights tried, in runs (0: the unit's own least squares).
+pub const PRIOR_WEIGHTS: [f64; 10] = [0.0, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0, 1000.0];
+
+/// What to do with a unit outside its type.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+pub enum MisfitPolicy {
+    /// Say so and write nothing.
+    Refuse,
+    /// Say so and train the unit on its own runs alone (the type-free recipe).
+    Own,
+}
+
+/// How the unit is calibrated.
+#[derive(Clone, Copy, Debug)]
+pub struct UnitPlan {
+    pub seek: SeekGeometry,
+    /// Fix the number of unit terms (None: chosen by leave-one-run-out).
+    pub terms: Option<usize>,
+}
+
+/// One candidate's held-out score.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct UnitCandidate {
+    pub terms: usize,
+    pub prior_weight: f64,
+    /// Held-out seek azimuth rms, deg (all held-out runs' pairs).
+    pub heldout_seek_deg: f64,
+    /// Per held-out run: mean square of its seek azimuth errors, deg^2.
+    #[serde(skip)]
+    pub per_run: Vec<f64>,
+}
+
+/// A calibrated unit.
+#[derive(Clone, Debug, Serialize)]
+pub struct UnitCalibration {
+    pub unit_id: String,
+    pub type_id: String,
+    pub runs: usize,
+    /// Unit terms fitted (the type's first `terms` in its order) and the prior's weight.
+    pub terms: usize,
+    pub term_names: Vec<String>,
+    pub prior_weight: f64,
+    /// Every term's coefficient (fitted or the type's mean), model units.
+    pub coefficients: Vec<f64>,
+    /// Held-out seek rms of the type alone and of the chosen calibration, deg.
+    pub type_alone_seek_deg: f64,
+    pub chosen_seek_deg: f64,
+    pub candidates: Vec<UnitCandidate>,
+    pub misfit: Misfit,
+    #[serde(skip)]
+    pub model: RbfModel,
+}
+
+impl UnitCalibration {
+    pub fn summary(&self) -> String {
+        let mut s = String::new();
+        for l in self.misfit.lines() {
+            s += &l;
+            s.push('\n');
+        }
+        let fitted = if self.terms == 0 {
+            "none (the type alone)".to_string()
+        } else {
+            self.term_names[..self.terms].join(", ")
+        };
+        s += &format!(
+            "unit {} calibrated on {} runs against type {}: unit terms fitted: {fitted}; prior weight {} runs; held-out seek rms {:.4} deg ({:.4} with the type alone), chosen by leave-one-run-out\n",
+            self.unit_id, self.runs, self.type_id, self.prior_weight, self.chosen_seek_deg, self.type_alone_seek_deg
+        );
+        s
+    }
+}
+
+/// The unit's id: its runs' `unit_id` (one), else `fallback`.
+pub fn unit_id_of(runs: &[Run], fallback: &str) -> Result<String> {
+    let mut ids: Vec<&str> = runs
+        .iter()
+        .filter_map(|r| r.meta_value("unit_id"))
+        .map(str::trim)
+        .collect();
+    ids.sort_unstable();
+    ids.dedup();
+    match ids.as_slice() {
+        [] => Ok(fallback.into()),
+        [one] => Ok((*one).into()),
+        many => bail!(
+            "runs of {} units ({}): a unit calibration is one unit's",
+            many.len(),
+            many.join(", ")
+        ),
+    }
+}
+
+/// Checks that `runs` may be calibrated against `ty`: one unit, of this type, not one of the
+/// type's own units, with enough runs for `plan`.
+pub fn check_unit_runs(ty: &TypeModel, runs: &[Run], unit_id: &str, plan: &UnitPlan) -> Result<()> {
+    for r in runs {
+        if let Some(t) = r.meta_value("type_id").map(str::trim) {
+            if t != ty.file.type_id {
+                bail!(
+                    "{}: a unit of type `{t}`, the type model is `{}`",
+                    r.name(),
+                    ty.file.type_id
+                );
+            }
+        }
+    }
+    if ty.file.units.iter().any(|u| u.unit_id == unit_id) {
+        bail!(
+            "unit {unit_id} is one the type was learnt from: calibrate units the type has not seen"
+        );
+    }
+    if runs.len() < MIN_UNIT_RUNS {
+        bail!(
+            "unit {unit_id}: {} run(s); a unit calibration needs at least {MIN_UNIT_RUNS} (one is held out to choose the prior's weight)",
+            runs.len()
+        );
+    }
+    let p = ty.file.terms.len();
+    if let Some(m) = plan.terms {
+        if m > p {
+            bail!("--unit-terms {m}: the type has {p} unit terms");
+        }
+        if m > runs.len() {
+            bail!("unit {unit_id}: {} runs for {m} unit terms (--unit-terms): needs at least one run per term", runs.len());
+        }
+    }
+    Ok(())
+}
+
+/// Calibrates one unit (see the module notes). The misfit test is part of the result;
+/// what to do with a misfit is the caller's (`MisfitPolicy`).
+pub fn calibrate_unit(
+    ty: &TypeModel,
+    runs: &[Run],
+    unit_id: &str,
+    plan: &UnitPlan,
+) -> Result<UnitCalibration> {
+    check_unit_runs(ty, runs, unit_id, plan)?;
+    let model = &ty.model;
+    let terms = ty.terms();
+    let names: Vec<String> = ty.file.terms.iter().map(|t| t.name.clone()).collect();
+    let ds = dataset_from_runs(runs, &model.inputs).map_err(|e| anyhow!("unit {unit_id}: {e}"))?;
+    let rows = UnitRows::new(model, &terms, &ds)?;
+    let (mean, spread) = (ty.mean(), ty.spread());
+    let prior = Prior {
+        mean: &mean,
+        spread: &spread,
+    };
+    let (own, se) = own_estimate(&rows)?;
+    let misfit = test_unit(
+        unit_id,
+        &names,
+        &own,
+        &se,
+        &mean,
+        &spread,
+        ty.file.units.len(),
+        rows.runs,
+    );
+    // At most one term per run: more cannot be told apart by leaving runs out.
+    let most = plan.terms.unwrap_or(terms.len().min(rows.runs));
+    let counts: Vec<usize> = match plan.terms {
+        Some(m) => vec![m],
+        None => (0..=most).collect(),
+    };
+    let mut candidates = Vec::new();
+    for &m in &counts {
+        let kept: Vec<usize> = ty.file.order[..m].to_vec();
+        let weights: &[f64] = if m == 0 {
+            &[f64::INFINITY]
+        } else {
+            &PRIOR_WEIGHTS
+        };
+        for &w in weights {
+            if let Some(c) = held_out(&rows, &kept, prior, w, plan.seek) {
+                candidates.push(UnitCandidate {
+                    terms: m,
+                    prior_weight: w,
+                    ..c
+                });
+            }
+        }
+    }
+    let type_alone = candidates
+        .iter()
+        .find(|c| c.terms == 0)
+        .map_or(f64::NAN, |c| c.heldout_seek_deg);
+    let chosen = choose(&candidates).ok_or_else(|| {
+        anyhow!("unit {unit_id}: no unit calibration could be scored on held-out runs")
+    })?;
+    let kept: Vec<usize> = ty.file.order[..chosen.terms].to_vec();
+    let coef =
+        solve(&rows, &kept, Some(prior), chosen.prior_weight, |_| false).ok_or_else(|| {
+            anyhow!("unit {unit_id}: the unit terms cannot be solved on all its runs")
+        })?;
+    let folded = fold(model, &terms, &coef)?;
+    let ordered: Vec<String> = ty.file.order.iter().map(|&k| names[k].clone()).collect();
+    Ok(UnitCalibration {
+        unit_id: unit_id.into(),
+        type_id: ty.file.type_id.clone(),
+        runs: rows.runs,
+        terms: chosen.terms,
+        term_names: ordered,
+        prior_weight: chosen.prior_weight,
+        coefficients: coef,
+        type_alone_seek_deg: type_alone,
+        chosen_seek_deg: chosen.heldout_seek_deg,
+        candidates,
+        misfit,
+        model: folded,
+    })
+}
+
+/// Leave-one-run-out score of fitting `kept` with prior weight `w` (infinite: the prior's mean).
+fn held_out(
+    rows: &UnitRows,
+    kept: &[usize],
+    prior: Prior,
+    w: f64,
+    seek: SeekGeometry,
+) -> Option<UnitCandidate> {
+    let mut per_run = Vec::with_capacity(rows.runs);
+    let (mut ss, mut pairs) = (0.0, 0usize);
+    for r in 0..rows.runs {
+        let coef = if w.is_infinite() {
+            prior.mean.to_vec()
+        } else {
+            solve(rows, kept, Some(prior), w, |x| x == r)?
+        };
+        let range = rows.rows_of(r);
+        let res = rows.corrected(range.clone(), &coef);
+        let groups = vec![0u32; res.len()];
+        let run = seek_azimuth_per_run(
+            &res,
+            &groups,
+            &rows.t_s[range],
+            seek.dwell_s,
+            seek.latitude_deg,
+        );
+        let (s, n) = run
+            .iter()
+            .fold((0.0, 0), |(s, n), x| (s + x.sum_sq_deg2, n + x.pairs));
+        if n > 0 {
+            per_run.push(s / n as f64);
+        } else {
+            per_run.push(f64::NAN);
+        }
+        ss += s;
+        pairs += n;
+    }
+    if pairs == 0 {
+        return None;
+    }
+    Some(UnitCandidate {
+        terms: kept.len(),
+        prior_weight: w,
+        heldout_seek_deg: (ss / pairs as f64).sqrt(),
+        per_run,
+    })
+}
+
+/// The best candidate per term count, then the fewest terms within one standard error
+/// (over held-out runs, paired) of the best.
+fn choose(cands: &[UnitCandidate]) -> Option<UnitCandidate> {
+    let best = cands
+        .iter()
+        .min_by(|a, b| a.heldout_seek_deg.total_cmp(&b.heldout_seek_deg))?;
+    let mut counts: Vec<usize> = cands.iter().map(|c| c.terms).collect();
+    counts.sort_unstable();
+    counts.dedup();
+    for m in counts {
+        let Some(c) = cands
+            .iter()
+            .filter(|c| c.terms == m)
+            .min_by(|a, b| a.heldout_seek_deg.total_cmp(&b.heldout_seek_deg))
+        else {
+            continue;
+        };
+        let d: Vec<f64> = c
+            .per_run
+            .iter()
+            .zip(&best.per_run)
+            .map(|(a, b)| a - b)
+            .filter(|v| v.is_finite())
+            .collect();
+        let n = d.len() as f64;
+        if n < 2.0 {
+            return Some(best.clone());
+        }
+        let mean = d.iter().sum::<f64>() / n;
+        let sd = (d.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+        if mean <= sd / n.sqrt() {
+            return Some(c.clone());
+        }
+    }
+    Some(best.clone())
+}

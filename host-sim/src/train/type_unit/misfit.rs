@@ -1,0 +1,145 @@
+//! Whether a unit belongs to its type: each unit term's own estimate (least squares on the
+//! unit's runs, no prior) against the type's value, in units of the type's spread and the
+//! estimate's own error together,
+//!
+//!   z = (own - type mean) / sqrt(spread^2 + se^2)     (se: jackknife over the unit's runs)
+//!
+//! tested family-wise over the terms (Bonferroni at `FAMILY_ALPHA`) against Student's t
+//! with the Welch-Satterthwaite degrees of freedom of the two variances (the spread from
+//! the type's units - 1, the se from the unit's runs - 1): with few runs the se is itself
+//! uncertain and a normal quantile would call noise a misfit. A term whose test could not
+//! see even a unit `POWER_SIGMAS` spreads out (its se too large, e.g. T and dT/dt from
+//! runs at one ambient) has no test power, and is said to have none.
+
+use serde::Serialize;
+
+use crate::stats::student_t::upper_quantile;
+
+/// Family-wise false-alarm rate of the misfit test over a unit's terms.
+pub const FAMILY_ALPHA: f64 = 0.01;
+/// A term's test has power when a unit this many type spreads out would be flagged.
+pub const POWER_SIGMAS: f64 = 5.0;
+
+/// One term's test.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TermTest {
+    pub name: String,
+    /// The unit's own estimate and its jackknife standard error, model units.
+    pub own: f64,
+    pub se: f64,
+    /// The type's mean and spread, model units.
+    pub type_mean: f64,
+    pub type_spread: f64,
+    /// (own - mean) / sqrt(spread^2 + se^2).
+    pub z: f64,
+    /// Critical |z| at the family-wise rate.
+    pub critical: f64,
+    pub has_power: bool,
+    pub outside: bool,
+}
+
+/// The misfit test of one unit.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Misfit {
+    pub unit_id: String,
+    pub terms: Vec<TermTest>,
+}
+
+impl Misfit {
+    /// Whether any term is outside the type.
+    pub fn outside(&self) -> bool {
+        self.terms.iter().any(|t| t.outside)
+    }
+
+    /// One line per term outside (`unit U3: Shupe coefficient 4.1 sigma outside the type
+    /// (critical 3.2)`), then one naming the terms without test power.
+    pub fn lines(&self) -> Vec<String> {
+        let mut v: Vec<String> = self
+            .terms
+            .iter()
+            .filter(|t| t.outside)
+            .map(|t| {
+                format!(
+                    "unit {}: {} {:.1} sigma outside the type (critical {:.1}, family-wise {FAMILY_ALPHA})",
+                    self.unit_id,
+                    t.name,
+                    t.z.abs(),
+                    t.critical
+                )
+            })
+            .collect();
+        let blind: Vec<&str> = self
+            .terms
+            .iter()
+            .filter(|t| !t.has_power)
+            .map(|t| t.name.as_str())
+            .collect();
+        if !blind.is_empty() {
+            v.push(format!(
+                "unit {}: no test power for {} (its runs cannot tell a unit {POWER_SIGMAS} spreads out)",
+                self.unit_id,
+                blind.join(", ")
+            ));
+        }
+        if v.is_empty() {
+            v.push(format!(
+                "unit {}: every term within its type (largest |z| {:.1})",
+                self.unit_id,
+                self.terms.iter().map(|t| t.z.abs()).fold(0.0, f64::max)
+            ));
+        }
+        v
+    }
+}
+
+/// Tests a unit's own estimates against the type (see the module notes).
+#[allow(clippy::too_many_arguments)]
+pub fn test_unit(
+    unit_id: &str,
+    names: &[String],
+    own: &[f64],
+    se: &[f64],
+    type_mean: &[f64],
+    type_spread: &[f64],
+    type_units: usize,
+    unit_runs: usize,
+) -> Misfit {
+    let p = own.len().max(1) as f64;
+    let tail = FAMILY_ALPHA / (2.0 * p);
+    let dof_type = (type_units as f64 - 1.0).max(1.0);
+    let dof_unit = (unit_runs as f64 - 1.0).max(1.0);
+    let terms = (0..own.len())
+        .map(|k| {
+            let s2 = type_spread[k] * type_spread[k];
+            let e2 = if se[k].is_finite() {
+                se[k] * se[k]
+            } else {
+                f64::INFINITY
+            };
+            let total = (s2 + e2).sqrt();
+            let dof = (s2 + e2).powi(2) / (s2 * s2 / dof_type + e2 * e2 / dof_unit);
+            let critical = if dof.is_finite() {
+                upper_quantile(tail, dof.max(1.0))
+            } else {
+                f64::INFINITY
+            };
+            let z = (own[k] - type_mean[k]) / total;
+            let has_power = total.is_finite() && critical * total <= POWER_SIGMAS * type_spread[k];
+            TermTest {
+                name: names[k].clone(),
+                own: own[k],
+                se: se[k],
+                type_mean: type_mean[k],
+                type_spread: type_spread[k],
+                z: if z.is_finite() { z } else { 0.0 },
+                critical,
+                has_power,
+                outside: z.is_finite() && z.abs() > critical,
+            }
+        })
+        .collect();
+    Misfit {
+        unit_id: unit_id.into(),
+        terms,
+    }
+}

@@ -1,0 +1,159 @@
+//! The unit terms of a type model: what may differ from one unit of a gyro type to the
+//! next, written as corrections to the type's shared drift model that fold exactly into an
+//! ordinary device model.
+//!
+//! A unit's drift is the type's prediction p(x) corrected by
+//!
+//!   c(x) = offset + gain (p(x) - bias) + sum_j l_j xn_j      (xn_j: the model's normalised input j)
+//!
+//! The offset is the unit's own constant bias (deg/h), the gain scales the type's whole
+//! warm-up shape (a unit whose Shupe or gradient coefficients are all a few % larger), and
+//! each l_j is a linear term in one of the type's inputs: in T it is the unit's own
+//! temperature coefficient, in dT/dt its own Shupe coefficient, in the warm-up clock its own
+//! warm-up amplitude. These are the parameters physics says vary between units of one
+//! design; they are also exactly what fog-core's model format carries (bias, the output
+//! weights and the linear terms), so a calibrated unit is an ordinary model, read by every
+//! firmware that reads the type's.
+//!
+//! Every column of the design is evaluated with fog-core's own prediction (a model that has
+//! only that term), so whatever the device does to an input (normalisation, clamping) the
+//! fit sees too, and `fold` is exact up to the f32 rounding of the stored coefficients.
+
+use anyhow::{bail, Result};
+use fog_core::model::format::{FeatureKind, RbfModel};
+
+use crate::train::{predict_batch, Dataset};
+
+/// One unit term of a type model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UnitTerm {
+    /// A constant, deg/h.
+    Offset,
+    /// A factor on the type's prediction less its bias: 0 is the type's shape.
+    Gain,
+    /// A linear term in the model's normalised input j, deg/h per normalised unit.
+    Linear(usize),
+}
+
+/// Every unit term a model can carry: the offset, the gain, then one linear term per input.
+pub fn unit_terms(model: &RbfModel) -> Vec<UnitTerm> {
+    let mut t = vec![UnitTerm::Offset, UnitTerm::Gain];
+    t.extend((0..model.inputs.len()).map(UnitTerm::Linear));
+    t
+}
+
+/// The term's name in reports and files, in the physics' words where they fit.
+pub fn term_name(model: &RbfModel, term: UnitTerm) -> String {
+    match term {
+        UnitTerm::Offset => "offset".into(),
+        UnitTerm::Gain => "warm-up gain".into(),
+        UnitTerm::Linear(j) => match model.inputs.get(j).map(|s| s.kind) {
+            Some(FeatureKind::TempC) => "temperature coefficient".into(),
+            Some(FeatureKind::TempRateCps) => "Shupe coefficient".into(),
+            Some(FeatureKind::TempAccelCps2 | FeatureKind::TempAccelFlatStartCps2) => {
+                "gradient (d2T/dt2) coefficient".into()
+            }
+            Some(FeatureKind::TempRiseC) => "rise coefficient".into(),
+            Some(FeatureKind::PowerOnDecay) => "warm-up clock amplitude".into(),
+            Some(FeatureKind::TempLagC) => "lagged-temperature coefficient".into(),
+            _ => format!("input {j} coefficient"),
+        },
+    }
+}
+
+/// The term's coefficient in raw units, and that unit: a linear term per unit of its input
+/// (deg/h per degC for T, per degC/s for dT/dt, ...), the offset in deg/h, the gain as is.
+pub fn raw_coefficient(model: &RbfModel, term: UnitTerm, coef: f64) -> (f64, &'static str) {
+    match term {
+        UnitTerm::Offset => (coef, "deg/h"),
+        UnitTerm::Gain => (coef, "(factor)"),
+        UnitTerm::Linear(j) => {
+            let scale = model.input_scale.get(j).map_or(1.0, |s| f64::from(*s));
+            let unit = match model.inputs.get(j).map(|s| s.kind) {
+                Some(FeatureKind::TempC | FeatureKind::TempRiseC | FeatureKind::TempLagC) => {
+                    "deg/h per degC"
+                }
+                Some(FeatureKind::TempRateCps) => "deg/h per degC/s",
+                Some(FeatureKind::TempAccelCps2 | FeatureKind::TempAccelFlatStartCps2) => {
+                    "deg/h per degC/s^2"
+                }
+                _ => "deg/h per unit",
+            };
+            (coef / scale, unit)
+        }
+    }
+}
+
+/// The type's prediction and one design column per term (row order of `ds`), each
+/// evaluated with fog-core's maths.
+pub fn design(model: &RbfModel, terms: &[UnitTerm], ds: &Dataset) -> Result<Design> {
+    let pred = predict_batch(model, ds.rows())?;
+    let bias = f64::from(model.bias_dph);
+    let mut columns = Vec::with_capacity(terms.len());
+    for &t in terms {
+        columns.push(match t {
+            UnitTerm::Offset => vec![1.0; ds.len()],
+            UnitTerm::Gain => pred.iter().map(|p| p - bias).collect(),
+            UnitTerm::Linear(j) => predict_batch(&only_linear(model, j), ds.rows())?,
+        });
+    }
+    Ok(Design { pred, columns })
+}
+
+/// A model's prediction and the unit terms' design columns on some rows.
+#[derive(Clone, Debug)]
+pub struct Design {
+    pub pred: Vec<f64>,
+    /// `columns[k][i]`: term k's regressor on row i.
+    pub columns: Vec<Vec<f64>>,
+}
+
+/// `model` with every term zero but a linear coefficient of 1 on input j.
+fn only_linear(model: &RbfModel, j: usize) -> RbfModel {
+    let mut m = model.clone();
+    m.bias_dph = 0.0;
+    m.weights.iter_mut().for_each(|w| *w = 0.0);
+    m.poly.iter_mut().for_each(|p| *p = 0.0);
+    m.linear_by_t.iter_mut().for_each(|p| *p = 0.0);
+    for (k, l) in m.linear.iter_mut().enumerate() {
+        *l = if k == j { 1.0 } else { 0.0 };
+    }
+    m
+}
+
+/// The type model with the unit terms' coefficients folded in: an ordinary device model.
+pub fn fold(model: &RbfModel, terms: &[UnitTerm], coef: &[f64]) -> Result<RbfModel> {
+    let mut out = model.clone();
+    let gain = terms
+        .iter()
+        .zip(coef)
+        .find(|(t, _)| **t == UnitTerm::Gain)
+        .map_or(0.0, |(_, c)| *c);
+    let factor = 1.0 + gain;
+    let scale = |v: &mut f32| *v = (f64::from(*v) * factor) as f32;
+    out.weights.iter_mut().for_each(scale);
+    out.poly.iter_mut().for_each(scale);
+    out.linear.iter_mut().for_each(scale);
+    out.linear_by_t.iter_mut().for_each(scale);
+    for (&t, &c) in terms.iter().zip(coef) {
+        match t {
+            UnitTerm::Offset => out.bias_dph = (f64::from(out.bias_dph) + c) as f32,
+            UnitTerm::Gain => {}
+            UnitTerm::Linear(j) => match out.linear.get_mut(j) {
+                Some(l) => *l = (f64::from(*l) + c) as f32,
+                None => bail!("unit term on input {j}: the model has no such input"),
+            },
+        }
+    }
+    let finite = out.bias_dph.is_finite()
+        && out.weights.iter().chain(&out.poly).all(|v| v.is_finite())
+        && out
+            .linear
+            .iter()
+            .chain(&out.linear_by_t)
+            .all(|v| v.is_finite());
+    if !finite {
+        bail!("the unit terms make the model not finite: not folded");
+    }
+    Ok(out)
+}
