@@ -16,10 +16,10 @@
 //! device/       the device-facing clients: upload, monitor, field_pull, rig
 //!   |
 //! engines       train/ (OLS/ORR fit, seek scoring and refit, cold-start envelope,
-//!   |           field_correction), diagnose/ (measured-data diagnosis, its own chain of
+//!   |           field_correction, type_unit: type and unit calibration), diagnose/ (measured-data diagnosis, its own chain of
 //!   |           stages), sim/ (gyro, thermal, turntable, tripod physics)
 //! registry/     the calibration registry (SQLite: counters, models, uploads, results,
-//!   |           field records)
+//!   |           field records, gyro types, units' runs, unit calibrations)
 //! output/       reports (JSON report structures, terminal tables) and plots (SVG charts)
 //!   |
 //! io/           fog-runs format, streaming reader and writer, 10 s binning, model files,

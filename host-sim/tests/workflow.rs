@@ -146,7 +146,7 @@ fn check_field_step(walk: &Walk, dir: &Path) {
         pull.contains("pulled=1 ") && pull.contains("registry_added=1"),
         "{pull}"
     );
-    let refined = walk.output_of("fogsim train runs --out model-field.fogm");
+    let refined = walk.output_of("fogsim train runs --type type.json --out model-field.fogm");
     assert!(
         refined
             .contains("field refinement: 1 field seeks used (1 of them under heading-calibrated")
@@ -182,7 +182,9 @@ fn the_workflow_page_runs_as_written_and_finds_north() {
     let commands = page_commands(&page);
     for step in [
         "fogsim import",
-        "fogsim train",
+        "fogsim campaign --out fleet --units",
+        "fogsim train fleet --type-out",
+        "fogsim train runs --type",
         "fogsim compensate",
         "fogsim heading-cal --from-runs",
         "cargo fw-run",
@@ -190,7 +192,7 @@ fn the_workflow_page_runs_as_written_and_finds_north() {
         "fogsim upload",
         "fogsim monitor",
         "fogsim field pull",
-        "fogsim train runs --out model-field.fogm",
+        "fogsim train runs --type type.json --out model-field.fogm",
         "fogsim registry show",
     ] {
         assert!(

@@ -145,8 +145,9 @@ pub struct Args {
     /// Calibrate one unit from its own runs with this type (from `--type-out`) as the
     /// prior: the unit terms and the prior's weight are chosen by leave-one-run-out, and
     /// the unit is first tested against its type (`--misfit`). Writes an ordinary model.
-    /// The shape options apply only to the unit's own model (`--misfit own`).
-    #[arg(long = "type", conflicts_with_all = ["field", "seek_refit"])]
+    /// The shape options apply only to the unit's own model (`--misfit own`); `--field`
+    /// refines the calibrated model.
+    #[arg(long = "type", conflicts_with = "seek_refit")]
     pub type_model: Option<PathBuf>,
     /// With `--type`: a unit outside its type is `refuse`d (nothing written) or trained on
     /// its `own` runs alone [default: refuse].
@@ -283,7 +284,7 @@ fn inputs(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
 }
 
 /// The trained model, refined with `--field` records if given (`crate::train::field_correction`).
-fn field_refined(
+pub(super) fn field_refined(
     args: &Args,
     model: &fog_core::model::format::RbfModel,
 ) -> anyhow::Result<fog_core::model::format::RbfModel> {

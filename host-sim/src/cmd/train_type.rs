@@ -106,7 +106,11 @@ pub fn calibrate(args: &Args, type_path: &Path, runs: &[Run]) -> Result<bool> {
     print!("{}", cal.summary());
     let policy = args.misfit.unwrap_or(MisfitPolicy::Refuse);
     let misfit = cal.misfit.outside();
-    let (bytes, crc) = encoded(&cal.model, &args.gyro_id)?;
+    let model = match misfit {
+        true => cal.model.clone(),
+        false => super::train::field_refined(args, &cal.model)?,
+    };
+    let (bytes, crc) = encoded(&model, &args.gyro_id)?;
     let mut record = UnitCalibrationRecord {
         unit_id: unit.clone(),
         type_id: ty.file.type_id.clone(),
