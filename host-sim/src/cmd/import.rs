@@ -43,6 +43,12 @@ pub struct Args {
     /// Site latitude, deg (written as `latitude_deg` metadata).
     #[arg(long, allow_hyphen_values = true)]
     pub latitude_deg: Option<f64>,
+    /// Earth rate along the gyro's input axis, deg/h (e.g. 15.041 sin(latitude) for a
+    /// vertical axis), written as `earth_dph` metadata: training and diagnosis then see
+    /// the drift (rate - earth), as in simulated runs, and runs of other gyros recorded so
+    /// can share one type (`train --type-out`). Without it the records' drift includes it.
+    #[arg(long, allow_hyphen_values = true)]
+    pub earth_dph: Option<f64>,
     /// Gyro id (written as `gyro` metadata).
     #[arg(long)]
     pub gyro_id: Option<String>,
@@ -82,6 +88,12 @@ impl Args {
             keep: self.keep.clone(),
             columns: self.columns.clone(),
             latitude_deg: self.latitude_deg,
+            earth_dph: match self.earth_dph {
+                Some(e) if !(e.is_finite() && e.abs() <= fog_core::consts::EARTH_RATE_DPH) => {
+                    anyhow::bail!("--earth-dph {e}: must be within +-15.041 deg/h (Earth rate)")
+                }
+                e => e,
+            },
             gyro_id: self.gyro_id.clone(),
             heading,
             split_gap_s: self.split_gap_s,
@@ -119,6 +131,9 @@ fn run_pan(args: &Args) -> anyhow::Result<()> {
         "all" => vec![0, 1, 2],
         other => anyhow::bail!("--axis {other}: expected x, y, z or all"),
     };
+    if args.earth_dph.is_some() {
+        anyhow::bail!("--earth-dph: for a logger's mapping (--time, --rate, --temp); the PAN preset writes its own (0: its axes are not levelled)");
+    }
     let [input] = &args.input[..] else {
         anyhow::bail!(
             "the PAN preset reads one recording; for other logs give --time, --rate and --temp"

@@ -278,6 +278,38 @@ fn train_default_model(
     Ok((trained.model, source))
 }
 
+/// `--type-units`: the seeking unit's model by the recipe, and where it came from; `params`
+/// becomes the unit's (what the Monte Carlo seeks with).
+fn recipe_unit_model(
+    recipe: &UnitRecipe,
+    plan: &OwnModelPlan,
+    args: &Args,
+    params: &mut GyroParams,
+) -> Result<(RbfModel, String)> {
+    let made = recipe_model(recipe, plan)?;
+    eprint!("{}", made.summary);
+    *params = made.unit_params.clone();
+    if let Some(p) = args.save_model.as_deref() {
+        write_model_file(p, &made.model)?;
+        eprintln!("wrote the unit's model to {}", p.display());
+    }
+    let source = match recipe.type_units {
+        0 => format!(
+            "unit U1 of a simulated fleet (seed {}), trained on its own {} runs ({:.1} chamber h)",
+            recipe.seed, recipe.unit_runs, made.unit_chamber_h
+        ),
+        n => format!(
+            "unit U1 of a simulated fleet (seed {}): type from {n} units x {} runs ({:.1} chamber h), unit calibration from {} runs ({:.1} chamber h)",
+            recipe.seed,
+            made.type_runs / n,
+            made.type_chamber_h,
+            recipe.unit_runs,
+            made.unit_chamber_h
+        ),
+    };
+    Ok((made.model, source))
+}
+
 /// `--type-units` and its companions as a recipe (None without `--type-units`).
 fn recipe_of(args: &Args) -> Option<UnitRecipe> {
     Some(UnitRecipe {
@@ -338,30 +370,7 @@ pub fn run(args: Args) -> Result<()> {
                 }),
             };
             match recipe_of(&args) {
-                Some(recipe) => {
-                    let made = recipe_model(&recipe, &plan)?;
-                    eprint!("{}", made.summary);
-                    params = made.unit_params.clone();
-                    if let Some(p) = args.save_model.as_deref() {
-                        write_model_file(p, &made.model)?;
-                        eprintln!("wrote the unit's model to {}", p.display());
-                    }
-                    let source = match recipe.type_units {
-                        0 => format!(
-                            "unit U1 of a simulated fleet (seed {}), trained on its own {} runs ({:.1} chamber h)",
-                            recipe.seed, recipe.unit_runs, made.unit_chamber_h
-                        ),
-                        n => format!(
-                            "unit U1 of a simulated fleet (seed {}): type from {n} units x {} runs ({:.1} chamber h), unit calibration from {} runs ({:.1} chamber h)",
-                            recipe.seed,
-                            made.type_runs / n,
-                            made.type_chamber_h,
-                            recipe.unit_runs,
-                            made.unit_chamber_h
-                        ),
-                    };
-                    (made.model, source)
-                }
+                Some(recipe) => recipe_unit_model(&recipe, &plan, &args, &mut params)?,
                 None => train_default_model(
                     &params,
                     &plan,

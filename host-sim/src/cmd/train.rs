@@ -322,6 +322,25 @@ pub(super) fn stage(staged: &mut StagedFiles, path: &Path, bytes: &[u8]) -> anyh
         .with_context(|| format!("writing {}", path.display()))
 }
 
+/// Too few run files are refused before reading: grouped validation holds out whole runs
+/// (a unit calibration one at a time: `calibrate::MIN_UNIT_RUNS`).
+fn check_run_count(args: &Args, cfg: &TrainConfig) -> anyhow::Result<()> {
+    // Grouped validation holds out whole runs: too few files is refused before reading.
+    let files = run_files(&args.runs)?;
+    // (a unit calibration holds out one run at a time: `calibrate::MIN_UNIT_RUNS`)
+    let needed = match args.type_model {
+        Some(_) => crate::train::type_unit::calibrate::MIN_UNIT_RUNS,
+        None => cfg.folds.max(2),
+    };
+    if files.len() < needed {
+        anyhow::bail!(
+            "{} run file(s): grouped validation holds out whole runs (one per file) and needs at least {needed}",
+            files.len()
+        );
+    }
+    Ok(())
+}
+
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let cfg = args.config()?;
@@ -348,19 +367,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     .map(|p| p.as_path())
     .collect();
     let _lock = OutputLock::acquire(&outputs).map_err(anyhow::Error::msg)?;
-    // Grouped validation holds out whole runs: too few files is refused before reading.
-    let files = run_files(&args.runs)?;
-    // (a unit calibration holds out one run at a time: `calibrate::MIN_UNIT_RUNS`)
-    let needed = match args.type_model {
-        Some(_) => crate::train::type_unit::calibrate::MIN_UNIT_RUNS,
-        None => cfg.folds.max(2),
-    };
-    if files.len() < needed {
-        anyhow::bail!(
-            "{} run file(s): grouped validation holds out whole runs (one per file) and needs at least {needed}",
-            files.len()
-        );
-    }
+    check_run_count(&args, &cfg)?;
     let runs = read_runs_binned(&args.runs)?;
     if let Some(path) = &args.type_model {
         if super::train_type::calibrate(&args, path, &runs)? {

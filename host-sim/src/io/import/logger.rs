@@ -48,6 +48,9 @@ pub struct LoggerSpec {
     /// Column names of a header-less file (its first line is data).
     pub columns: Option<Vec<String>>,
     pub latitude_deg: Option<f64>,
+    /// Earth rate along the input axis, deg/h (written as `earth_dph` metadata: the
+    /// records' drift is then rate - earth, as in simulated runs); None: not written.
+    pub earth_dph: Option<f64>,
     pub gyro_id: Option<String>,
     pub heading: Heading,
     /// Gap that starts a new run, s (None: from the data).
@@ -440,6 +443,9 @@ fn run_meta(spec: &LoggerSpec, file: &str, dialect: Dialect) -> Vec<(String, Str
     }
     if let Some(l) = spec.latitude_deg {
         meta.push(("latitude_deg".to_owned(), format!("{l}")));
+    }
+    if let Some(e) = spec.earth_dph {
+        meta.push(("earth_dph".to_owned(), format!("{e}")));
     }
     meta.push(("source".to_owned(), excerpt(file)));
     meta.push((

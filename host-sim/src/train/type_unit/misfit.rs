@@ -143,3 +143,87 @@ pub fn test_unit(
         terms,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn names() -> Vec<String> {
+        vec!["offset".into(), "Shupe coefficient".into()]
+    }
+
+    #[test]
+    fn a_unit_far_outside_is_named_and_one_inside_is_not() {
+        let (mean, spread) = ([0.0, 1.0], [0.1, 0.1]);
+        let out = test_unit(
+            "U3",
+            &names(),
+            &[0.02, 1.9],
+            &[0.05, 0.05],
+            &mean,
+            &spread,
+            10,
+            6,
+        );
+        assert!(out.outside());
+        let lines = out.lines().join("\n");
+        assert!(
+            lines.contains("unit U3: Shupe coefficient 8.0 sigma outside the type"),
+            "{lines}"
+        );
+        let inside = test_unit(
+            "U4",
+            &names(),
+            &[0.02, 1.15],
+            &[0.05, 0.05],
+            &mean,
+            &spread,
+            10,
+            6,
+        );
+        assert!(!inside.outside(), "{:?}", inside.lines());
+    }
+
+    #[test]
+    fn a_term_the_runs_cannot_see_has_no_test_power() {
+        let (mean, spread) = ([0.0, 1.0], [0.1, 0.1]);
+        // an se of 10 spreads: even a unit 5 spreads out would not be flagged
+        let out = test_unit(
+            "U5",
+            &names(),
+            &[0.0, 3.0],
+            &[0.01, 1.0],
+            &mean,
+            &spread,
+            10,
+            6,
+        );
+        assert!(!out.terms[1].has_power && out.terms[0].has_power);
+        assert!(out
+            .lines()
+            .iter()
+            .any(|l| l.contains("no test power for Shupe coefficient")));
+        // few runs: the critical value grows (Student's t), so noise is not a misfit
+        let few = test_unit(
+            "U6",
+            &names(),
+            &[0.0, 1.0],
+            &[0.1, 0.1],
+            &mean,
+            &spread,
+            10,
+            2,
+        );
+        let many = test_unit(
+            "U6",
+            &names(),
+            &[0.0, 1.0],
+            &[0.1, 0.1],
+            &mean,
+            &spread,
+            10,
+            30,
+        );
+        assert!(few.terms[0].critical > many.terms[0].critical);
+    }
+}

@@ -157,3 +157,75 @@ pub fn fold(model: &RbfModel, terms: &[UnitTerm], coef: &[f64]) -> Result<RbfMod
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fog_core::model::format::FeatureSpec;
+
+    /// T and dT/dt with linear terms and a T polynomial, no Gaussians.
+    fn model() -> RbfModel {
+        let mut m = RbfModel::empty();
+        m.n_rbf_inputs = 0;
+        for (k, off, scale, lin) in [
+            (FeatureKind::TempC, 25.0f32, 10.0f32, 0.02f32),
+            (FeatureKind::TempRateCps, 0.0, 0.01, 0.15),
+        ] {
+            m.inputs.push(FeatureSpec::plain(k)).unwrap();
+            m.input_offset.push(off).unwrap();
+            m.input_scale.push(scale).unwrap();
+            m.input_min.push(-40.0).unwrap();
+            m.input_max.push(80.0).unwrap();
+            m.linear.push(lin).unwrap();
+        }
+        m.poly.push(0.004).unwrap();
+        m.bias_dph = 0.3;
+        m
+    }
+
+    fn dataset(m: &RbfModel) -> Dataset {
+        let specs: Vec<FeatureSpec> = m.inputs.iter().copied().collect();
+        let mut ds = Dataset::with_specs(specs, vec!["t".into(), "rate".into()]).unwrap();
+        let rows: Vec<Vec<f64>> = (0..50)
+            .map(|i| vec![-30.0 + 1.7 * i as f64, 0.012 * (-(i as f64) / 9.0).exp()])
+            .collect();
+        let t: Vec<f64> = (0..50).map(|i| 10.0 * i as f64).collect();
+        ds.push_group("r", &rows, &vec![0.0; 50], &t).unwrap();
+        ds
+    }
+
+    #[test]
+    fn folded_terms_predict_what_the_design_says() {
+        let m = model();
+        let ds = dataset(&m);
+        let terms = unit_terms(&m);
+        assert_eq!(terms.len(), 4);
+        let coef = [0.011, -0.07, 0.004, -0.02];
+        let d = design(&m, &terms, &ds).unwrap();
+        let folded = fold(&m, &terms, &coef).unwrap();
+        let after = predict_batch(&folded, ds.rows()).unwrap();
+        for (i, a) in after.iter().enumerate() {
+            let want = d.pred[i]
+                + d.columns
+                    .iter()
+                    .zip(&coef)
+                    .map(|(c, b)| c[i] * b)
+                    .sum::<f64>();
+            assert!(
+                (a - want).abs() < 2e-6 * (1.0 + want.abs()),
+                "row {i}: {a} vs {want}"
+            );
+        }
+        // the gain scales the shape and leaves the bias: a pure offset changes only it
+        let only_offset = fold(&m, &terms, &[0.05, 0.0, 0.0, 0.0]).unwrap();
+        assert_eq!(only_offset.linear, m.linear);
+        assert!((only_offset.bias_dph - 0.35).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_term_that_makes_the_model_not_finite_is_refused() {
+        let m = model();
+        let terms = unit_terms(&m);
+        assert!(fold(&m, &terms, &[0.0, 0.0, f64::INFINITY, 0.0]).is_err());
+    }
+}

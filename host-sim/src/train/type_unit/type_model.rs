@@ -186,9 +186,12 @@ impl TypeModel {
     }
 }
 
+/// Each unit's id and the indices of its runs.
+pub type UnitRuns = Vec<(String, Vec<usize>)>;
+
 /// The runs of each unit (its `unit_id` metadata), in order of first appearance, after
 /// checking they are one type's: every run names its unit, and no two `type_id`s mix.
-pub fn runs_by_unit(runs: &[Run]) -> Result<(String, Vec<(String, Vec<usize>)>)> {
+pub fn runs_by_unit(runs: &[Run]) -> Result<(String, UnitRuns)> {
     let mut types: BTreeMap<String, usize> = BTreeMap::new();
     let mut units: Vec<(String, Vec<usize>)> = Vec::new();
     for (i, r) in runs.iter().enumerate() {
@@ -421,7 +424,7 @@ fn to_hex(bytes: &[u8]) -> String {
 }
 
 fn from_hex(s: &str) -> Result<Vec<u8>> {
-    if s.len() % 2 != 0 || s.len() > 2 * MAX_ENCODED_LEN {
+    if !s.len().is_multiple_of(2) || s.len() > 2 * MAX_ENCODED_LEN {
         bail!("its model is not hex of at most {MAX_ENCODED_LEN} bytes");
     }
     (0..s.len())
