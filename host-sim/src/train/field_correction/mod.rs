@@ -3,14 +3,21 @@
 //!
 //! - `refine`: a weighted ridge fit of the field records' residual biases on the
 //!   temperature state, its weight chosen by held-out field seeks, folded into the model's
-//!   bias and linear terms;
+//!   bias and linear terms; it runs `terms` (which terms the field can carry, coverage),
+//!   `weight` (the held-out choice of the weight and the terms kept) and `fit` (the
+//!   observations, the ridge fit and its fold), and re-exports their public items;
 //! - this module: which records belong to the model (its CRC-32, or a heading-calibrated
 //!   variant the registry knows), the fit on them, and the lines `train` prints.
 //!
 //! The records' file format is `io::field_records`; the pull from a device is
 //! `device::field_pull`; their table in the registry is `registry::field_records`.
 
+mod fit;
 pub mod refine;
+mod terms;
+#[cfg(test)]
+mod test_fixtures;
+mod weight;
 
 use std::path::Path;
 
