@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use anyhow::{anyhow, bail, Result};
-use fog_core::model::format::MAX_ENCODED_LEN;
+use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
 
 use super::train::{stage, Args};
 use crate::io::runs::Run;
@@ -18,14 +18,20 @@ use crate::train::type_unit::type_model::learn_type;
 use crate::train::type_unit::{calibrate_unit, unit_id_of, MisfitPolicy, TypeModel, UnitPlan};
 use crate::train::{choose_inputs_default, train_model, InputSet, TrainConfig};
 
-/// The model's encoding, with `gyro_id` written into it.
-fn encoded(model: &fog_core::model::format::RbfModel, gyro_id: &str) -> Result<(Vec<u8>, u32)> {
+/// `model` for the device `gyro_id` (written into its metadata).
+fn for_gyro(model: &RbfModel, gyro_id: &str) -> Result<RbfModel> {
     let mut m = model.clone();
     m.meta.gyro_id.clear();
     m.meta
         .gyro_id
         .push_str(gyro_id)
         .map_err(|_| anyhow!("--gyro-id {gyro_id}: at most 16 bytes"))?;
+    Ok(m)
+}
+
+/// The model's encoding for the device `gyro_id`, and its CRC-32.
+fn encoded(model: &RbfModel, gyro_id: &str) -> Result<(Vec<u8>, u32)> {
+    let m = for_gyro(model, gyro_id)?;
     let mut buf = [0u8; MAX_ENCODED_LEN];
     let len = m
         .encode(&mut buf)
@@ -45,7 +51,7 @@ pub fn learn(
     type_path: &Path,
     runs: &[Run],
 ) -> Result<()> {
-    let mut train = |runs: Vec<Run>| -> Result<fog_core::model::format::RbfModel> {
+    let mut train = |runs: Vec<Run>| -> Result<RbfModel> {
         let (_, ds) = choose_inputs_default(&runs, candidates, cfg)?;
         let mut model = train_model(&ds, cfg)?.model;
         model.cold_start = envelope_for(&runs, &model.inputs)?;
@@ -106,9 +112,11 @@ pub fn calibrate(args: &Args, type_path: &Path, runs: &[Run]) -> Result<bool> {
     print!("{}", cal.summary());
     let policy = args.misfit.unwrap_or(MisfitPolicy::Refuse);
     let misfit = cal.misfit.outside();
+    // the device's model (its gyro id in it) is what field records were measured under
+    let device_model = for_gyro(&cal.model, &args.gyro_id)?;
     let model = match misfit {
-        true => cal.model.clone(),
-        false => super::train::field_refined(args, &cal.model)?,
+        true => device_model,
+        false => super::train::field_refined(args, &device_model)?,
     };
     let (bytes, crc) = encoded(&model, &args.gyro_id)?;
     let mut record = UnitCalibrationRecord {
