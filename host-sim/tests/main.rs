@@ -55,5 +55,6 @@ mod train_linear_by_t;
 mod train_ols;
 mod train_scale;
 mod train_seek_criterion;
+mod train_type;
 mod train_validation;
 mod workflow;

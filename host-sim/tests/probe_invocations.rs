@@ -55,6 +55,7 @@ const INPUT_FLAGS: &[&str] = &[
     "--from-runs",
     "--field",
     "--unit-spread",
+    "--type",
 ];
 /// Of `INPUT_FLAGS`, those whose value is a directory (of field records).
 const DIR_INPUT_FLAGS: &[&str] = &["--field"];
@@ -68,6 +69,7 @@ const OUTPUT_FLAGS: &[&str] = &[
     "--csv",
     "--logger-csv",
     "--save-model",
+    "--type-out",
 ];
 /// Flags with a free-text value: only a missing or non-UTF-8 value is bad for certain.
 const FREE_TEXT_FLAGS: &[&str] = &["--gyro-id", "--gyro"];
@@ -99,6 +101,7 @@ const NAME_FLAGS: &[&str] = &[
     "--incl-port",
     "--laws",
     "--sequence",
+    "--misfit",
 ];
 /// Flags with a number (or a list of numbers) for value.
 const NUMBER_FLAGS: &[&str] = &[
@@ -112,6 +115,7 @@ const NUMBER_FLAGS: &[&str] = &[
     "--duration-min",
     "--duration-s",
     "--dwell-s",
+    "--earth-dph",
     "--eval-starts",
     "--field-seeks",
     "--field-seeks-per-start",
@@ -154,7 +158,12 @@ const NUMBER_FLAGS: &[&str] = &[
     "--timeout-s",
     "--training-restarts-above-c",
     "--training-runs",
+    "--type-runs-per-ambient",
     "--type-seed",
+    "--type-units",
+    "--unit-ambients-c",
+    "--unit-runs",
+    "--unit-terms",
     "--units",
     "--widths",
 ];
@@ -229,6 +238,35 @@ const SUBS: &[Sub] = &[
             "@runs/run6.csv",
         ],
     },
+    // A gyro type learnt from a small fleet (`fleet/`: units U1..U3 of 2 runs each, written
+    // in `fixtures`), and unit U4 calibrated against it (`type.json`, made in `fixtures` by
+    // the first of these bases; the second must then succeed).
+    Sub {
+        words: &["train"],
+        base: &[
+            "--type-out",
+            "!out/type.json",
+            "--out",
+            "!out/shared.bin",
+            "@fleet/u1r1.csv",
+            "@fleet/u1r2.csv",
+            "@fleet/u2r1.csv",
+            "@fleet/u2r2.csv",
+            "@fleet/u3r1.csv",
+            "@fleet/u3r2.csv",
+        ],
+    },
+    Sub {
+        words: &["train"],
+        base: &[
+            "--type",
+            "@type.json",
+            "--out",
+            "!out/unit.bin",
+            "@fleet/u4r1.csv",
+            "@fleet/u4r2.csv",
+        ],
+    },
     Sub {
         words: &["compensate"],
         base: &[
@@ -242,6 +280,23 @@ const SUBS: &[Sub] = &[
     Sub {
         words: &["north-seek"],
         base: &["--model", "@model.bin", "--starts", "1", "--seeks", "1"],
+    },
+    // The unit recipe: a type from 3 simulated units of 3 runs, the unit's own 2 (about 4 s
+    // when it runs whole; every fault here stops it before it trains).
+    Sub {
+        words: &["north-seek"],
+        base: &[
+            "--type-units",
+            "3",
+            "--unit-runs",
+            "2",
+            "--type-runs-per-ambient",
+            "1",
+            "--starts",
+            "1",
+            "--seeks",
+            "1",
+        ],
     },
     Sub {
         words: &["reproduce"],
@@ -512,6 +567,7 @@ fn fixtures() -> Fixtures {
         ),
     ];
     field_records_of_the_train_base(&dir);
+    fleet_and_type_of_the_type_bases(&dir);
     let bad_dirs = bad_field_dirs(&dir, &bad);
     let mut inputs = Vec::new();
     for p in walk(&dir) {
@@ -561,6 +617,48 @@ fn field_records_of_the_train_base(dir: &Path) {
         "the train --field base fails: {}",
         o.stderr
     );
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// `dir/fleet/`: four simulated units of one type, 2 cold starts each (`u1r1.csv` ..
+/// `u4r2.csv`); `dir/type.json`: the type the `train --type-out` base learns from U1..U3;
+/// then the `train --type` base (U4 against it) must succeed.
+fn fleet_and_type_of_the_type_bases(dir: &Path) {
+    use fog_sim::pipeline::campaign::CampaignSpec;
+    use fog_sim::pipeline::fleet::{fleet_runs, FleetType};
+    let fleet = FleetType::paper(fog_sim::sim::TypeSpread::default_spread(), "default", 3);
+    let plan = CampaignSpec {
+        ambients_c: vec![20.0],
+        runs_per_ambient: 2,
+        minutes: 15.0,
+        raw_rate_hz: 10.0,
+        ..CampaignSpec::paper(5)
+    };
+    std::fs::create_dir_all(dir.join("fleet")).unwrap();
+    for u in 0..4 {
+        for (r, c) in fleet_runs(&fleet, u, &plan, None)
+            .unwrap()
+            .iter()
+            .enumerate()
+        {
+            let path = dir.join(format!("fleet/u{}r{}.csv", u + 1, r + 1));
+            fog_sim::io::runs::write_run(path, &c.run).unwrap();
+        }
+    }
+    let out = dir.join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    let learn = sub_of(&["train"], "--type-out", true);
+    let o = run(dir, &base_args(learn));
+    assert_eq!(
+        o.code,
+        Some(0),
+        "the train --type-out base fails: {}",
+        o.stderr
+    );
+    std::fs::rename(out.join("type.json"), dir.join("type.json")).unwrap();
+    let calibrate = sub_of(&["train"], "--type", true);
+    let o = run(dir, &base_args(calibrate));
+    assert_eq!(o.code, Some(0), "the train --type base fails: {}", o.stderr);
     std::fs::remove_dir_all(&out).unwrap();
 }
 

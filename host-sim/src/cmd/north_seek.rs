@@ -121,19 +121,18 @@ pub struct Args {
     pub type_units: Option<usize>,
     /// The seeking unit's own cold starts (2..=96), spread over `--unit-ambients-c` in turn
     /// [default: 6]. Needs `--type-units`.
-    #[arg(long = "unit-runs", requires = "type_units")]
+    #[arg(long = "unit-runs")]
     pub unit_runs: Option<usize>,
     /// Ambients of the unit's cold starts, degC [default: -40,20,60]. Needs `--type-units`.
     #[arg(
         long = "unit-ambients-c",
         value_delimiter = ',',
-        allow_negative_numbers = true,
-        requires = "type_units"
+        allow_negative_numbers = true
     )]
     pub unit_ambients_c: Option<Vec<f64>>,
     /// Cold starts of each type unit at each of -40, 20 and +60 degC [default: 2]. Needs
     /// `--type-units`.
-    #[arg(long = "type-runs-per-ambient", requires = "type_units")]
+    #[arg(long = "type-runs-per-ambient")]
     pub type_runs_per_ambient: Option<usize>,
 }
 
@@ -184,6 +183,18 @@ pub fn config_from_args(a: &Args) -> Result<MonteCarloConfig> {
 /// The chamber runs of the default model: `--training-runs` checked, or the default; the
 /// options that only shape a trained model are refused by name with `--model`.
 fn training_campaign(args: &Args) -> Result<(usize, Option<WarmRestarts>)> {
+    // By name (clap's `requires` names only the missing `--type-units`, not the flag given).
+    let shapes_recipe = [
+        ("--unit-runs", args.unit_runs.is_some()),
+        ("--unit-ambients-c", args.unit_ambients_c.is_some()),
+        (
+            "--type-runs-per-ambient",
+            args.type_runs_per_ambient.is_some(),
+        ),
+    ];
+    if let (None, Some((flag, _))) = (args.type_units, shapes_recipe.iter().find(|(_, g)| *g)) {
+        bail!("{flag}: needs --type-units N (the unit recipe it shapes)");
+    }
     if args.type_units.is_some() {
         let owns = [
             ("--model", args.model.is_some()),

@@ -1,0 +1,645 @@
+//! Type and unit calibration (`fogsim train --type-out` / `--type`, `train::type_unit`):
+//! end to end on the simulator's fleet (outputs, reports and the registry's record; the
+//! same commands give the same bytes); on an independent fleet (`common::fleet_independent`)
+//! a unit outside its type is flagged and one inside it is not, its null twin flags no
+//! unit, and the unit calibration does no worse on held-out seeks than the type alone; the
+//! CLI refuses an odd unit by default and trains it alone with `--misfit own`; bad input
+//! gets one line and writes nothing.
+
+use crate::app_support;
+use crate::common::fleet_independent::{fleet, FleetLaw};
+
+use fog_core::model::format::RbfModel;
+use fog_sim::io::model::read_model;
+use fog_sim::io::runs::{write_run, Run};
+use fog_sim::registry::Registry;
+use fog_sim::train::seek_score::SeekGeometry;
+use fog_sim::train::type_unit::type_model::learn_type;
+use fog_sim::train::type_unit::{calibrate_unit, TypeModel, UnitCalibration, UnitPlan};
+use fog_sim::train::{dataset_from_runs, default_specs, train_model, TrainConfig};
+use std::path::{Path, PathBuf};
+use std::process::Output;
+use std::time::Instant;
+
+/// `fogsim ARGS` in `dir` (paths relative to it).
+fn fogsim(dir: &Path, args: &[&str]) -> Output {
+    app_support::fogsim(dir, args)
+}
+
+/// `fogsim ARGS` in `dir`, which must succeed; its stdout.
+fn fogsim_ok(dir: &Path, args: &[&str]) -> String {
+    let o = fogsim(dir, args);
+    assert!(
+        o.status.success(),
+        "fogsim {args:?}: {}",
+        app_support::stderr(&o)
+    );
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// `fogsim campaign` of `units` units into `dir/fleet` (20 min cold starts at 10 Hz, every
+/// unit at every ambient `runs` times).
+fn sim_fleet(dir: &Path, units: usize, ambients_c: &str, runs: usize) {
+    fogsim_ok(
+        dir,
+        &[
+            "campaign",
+            "--out",
+            "fleet",
+            "--units",
+            &units.to_string(),
+            "--ambient-c",
+            ambients_c,
+            "--runs",
+            &runs.to_string(),
+            "--duration-min",
+            "20",
+            "--raw-rate-hz",
+            "10",
+            "--seed",
+            "3",
+            "--type-seed",
+            "5",
+        ],
+    );
+}
+
+/// The files of `dir/sub` whose names start with `prefix`, as `sub/name`, in name order.
+fn files(dir: &Path, sub: &str, prefix: &str) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir.join(sub))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(prefix))
+        .map(|n| format!("{sub}/{n}"))
+        .collect();
+    v.sort();
+    v
+}
+
+/// The runs of units `units` (1-based) of the simulator's fleet in `dir/fleet`.
+fn unit_files(dir: &Path, units: &[usize]) -> Vec<String> {
+    units
+        .iter()
+        .flat_map(|u| files(dir, "fleet", &format!("u{u:03}_")))
+        .collect()
+}
+
+/// `fogsim train RUNS EXTRA...` as arguments.
+fn train_args<'a>(runs: &'a [String], extra: &[&'a str]) -> Vec<&'a str> {
+    let mut a = vec!["train"];
+    a.extend(runs.iter().map(String::as_str));
+    a.extend_from_slice(extra);
+    a
+}
+
+#[test]
+fn the_cli_learns_a_type_from_three_units_and_calibrates_a_fourth_with_reports_and_registry() {
+    let t0 = Instant::now();
+    let dir = app_support::scratch_dir("type-cli");
+    sim_fleet(&dir, 4, "-40,20,60", 1);
+    let type_runs = unit_files(&dir, &[1, 2, 3]);
+    let unit_runs = unit_files(&dir, &[4]);
+    assert_eq!((type_runs.len(), unit_runs.len()), (9, 3));
+    let learnt = fogsim_ok(
+        &dir,
+        &train_args(
+            &type_runs,
+            &[
+                "--type-out",
+                "type.json",
+                "--out",
+                "shared.model",
+                "--registry",
+                "reg.sqlite",
+                "--json",
+                "type_report.json",
+            ],
+        ),
+    );
+    assert!(
+        learnt.contains("wrote type paper_default to type.json"),
+        "{learnt}"
+    );
+    let calibrated = fogsim_ok(
+        &dir,
+        &train_args(
+            &unit_runs,
+            &[
+                "--type",
+                "type.json",
+                "--out",
+                "u4.model",
+                "--gyro-id",
+                "U4",
+                "--registry",
+                "reg.sqlite",
+                "--json",
+                "u4.json",
+            ],
+        ),
+    );
+    assert!(calibrated.contains("wrote unit U4's model"), "{calibrated}");
+
+    // the type: three units of three runs, its shared model the one written beside it
+    let ty = TypeModel::read(&dir.join("type.json")).unwrap();
+    assert_eq!(ty.file.type_id, "paper_default");
+    let units: Vec<(&str, usize)> = ty
+        .file
+        .units
+        .iter()
+        .map(|u| (u.unit_id.as_str(), u.runs))
+        .collect();
+    assert_eq!(units, [("U1", 3), ("U2", 3), ("U3", 3)]);
+    let shared = read_model(&dir.join("shared.model")).unwrap();
+    assert_eq!(shared, ty.model);
+    // `--json` of `--type-out` is the type file's content
+    assert_eq!(
+        std::fs::read(dir.join("type_report.json")).unwrap(),
+        std::fs::read(dir.join("type.json")).unwrap()
+    );
+    // the unit's model: an ordinary model of the type's inputs, with its gyro id
+    let unit_bytes = std::fs::read(dir.join("u4.model")).unwrap();
+    let unit = read_model(&dir.join("u4.model")).unwrap();
+    assert_eq!(unit.meta.gyro_id.as_str(), "U4");
+    assert_eq!(unit.inputs, ty.model.inputs);
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("u4.json")).unwrap()).unwrap();
+    assert_eq!(report["unit_id"], "U4");
+    assert_eq!(report["type_id"], "paper_default");
+    assert_eq!(report["runs"], 3);
+    assert_eq!(
+        report["misfit"]["terms"].as_array().unwrap().len(),
+        ty.file.terms.len()
+    );
+    let chosen_seek_deg = report["chosen_seek_deg"].as_f64().unwrap();
+    let type_alone_seek_deg = report["type_alone_seek_deg"].as_f64().unwrap();
+    assert!(chosen_seek_deg <= type_alone_seek_deg, "{report}");
+
+    // the registry: the type's units and runs, and the unit's calibration by its model's CRC
+    let reg = Registry::open(&dir.join("reg.sqlite")).unwrap();
+    assert_eq!(
+        reg.type_units("paper_default").unwrap(),
+        [("U1".to_string(), 3), ("U2".into(), 3), ("U3".into(), 3)]
+    );
+    let cals = reg.unit_calibrations("U4").unwrap();
+    assert_eq!(cals.len(), 1, "{cals:?}");
+    assert_eq!(cals[0].type_id, "paper_default");
+    assert_eq!(cals[0].runs, 3);
+    assert_eq!(cals[0].outcome, "calibrated");
+    assert_eq!(
+        cals[0].model_crc32,
+        Some(fog_core::model::crc::crc32(&unit_bytes))
+    );
+    assert!(reg.unit_calibrations("U1").unwrap().is_empty());
+    drop(reg);
+    println!(
+        "type from 3 units x 3 runs, unit U4 on 3 runs: held-out seek {chosen_seek_deg:.4} deg \
+         ({type_alone_seek_deg:.4} with the type alone); {:.1} s",
+        t0.elapsed().as_secs_f64()
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn the_same_commands_write_the_same_type_and_unit_model_bytes() {
+    let t0 = Instant::now();
+    let dir = app_support::scratch_dir("type-bytes");
+    // the smallest fleet a type and a unit calibration take: 3 + 1 units of 2 runs
+    sim_fleet(&dir, 4, "20", 2);
+    let type_runs = unit_files(&dir, &[1, 2, 3]);
+    let unit_runs = unit_files(&dir, &[4]);
+    let outputs = ["type.json", "shared.model", "unit.model", "unit.json"];
+    let mut bytes: Vec<Vec<Vec<u8>>> = Vec::new();
+    for round in ["a", "b"] {
+        std::fs::create_dir_all(dir.join(round)).unwrap();
+        let p = |name: &str| format!("{round}/{name}");
+        let (ty, shared, model, json) =
+            (p(outputs[0]), p(outputs[1]), p(outputs[2]), p(outputs[3]));
+        fogsim_ok(
+            &dir,
+            &train_args(&type_runs, &["--type-out", &ty, "--out", &shared]),
+        );
+        fogsim_ok(
+            &dir,
+            &train_args(
+                &unit_runs,
+                &["--type", &ty, "--out", &model, "--json", &json],
+            ),
+        );
+        bytes.push(
+            outputs
+                .iter()
+                .map(|o| std::fs::read(dir.join(round).join(o)).unwrap())
+                .collect(),
+        );
+    }
+    for (k, name) in outputs.iter().enumerate() {
+        assert!(!bytes[0][k].is_empty(), "{name} is empty");
+        assert!(
+            bytes[0][k] == bytes[1][k],
+            "{name} differs between two runs"
+        );
+    }
+    println!("same bytes twice: {:.1} s", t0.elapsed().as_secs_f64());
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+// ---- the independent fleet, library level ----
+
+/// The independent fleets' size for the misfit decisions: 6 units (the type from 5), each
+/// with 2 cold starts of 30 min at -10 and at +30 degC (two ambients, so that temperature
+/// and dT/dt terms are told apart).
+const UNITS: usize = 6;
+const AMBIENTS_C: [f64; 2] = [-10.0, 30.0];
+const RUNS_PER_AMBIENT: usize = 2;
+const MINUTES: usize = 30;
+
+/// The shared model's trainer: the paper's inputs with linear terms (fixed, so that the
+/// type's unit terms are offset, warm-up gain, temperature and Shupe coefficients).
+fn train_shared(runs: Vec<Run>) -> anyhow::Result<RbfModel> {
+    let cfg = TrainConfig {
+        linear_on_rbf_inputs: true,
+        ..Default::default()
+    };
+    let ds = dataset_from_runs(&runs, &default_specs())?;
+    Ok(train_model(&ds, &cfg)?.model)
+}
+
+/// Unit `unit` (1-based) of the independent fleet `law` (seed `seed`) calibrated against a
+/// type learnt from every other unit.
+fn calibrated(law: FleetLaw, seed: u64, unit: usize) -> (TypeModel, UnitCalibration) {
+    let f = fleet(law, UNITS, &AMBIENTS_C, RUNS_PER_AMBIENT, MINUTES, seed);
+    let id = format!("U{unit}");
+    let (own, others): (Vec<Run>, Vec<Run>) = f
+        .runs
+        .into_iter()
+        .partition(|r| r.meta_value("unit_id") == Some(id.as_str()));
+    let ty = learn_type(&others, Some("independent"), &mut train_shared).unwrap();
+    let plan = UnitPlan {
+        seek: SeekGeometry::default_site(),
+        terms: None,
+    };
+    let cal = calibrate_unit(&ty, &own, &id, &plan).unwrap();
+    (ty, cal)
+}
+
+/// The largest |z| / critical over the unit's terms (> 1: outside its type).
+fn worst_ratio(cal: &UnitCalibration) -> f64 {
+    cal.misfit
+        .terms
+        .iter()
+        .map(|t| t.z.abs() / t.critical)
+        .fold(0.0, f64::max)
+}
+
+/// Measured at this size, seeds 1..=12: the odd unit's largest |z| / critical was 2.3 to
+/// 8.2 (largest |z| 12 to 39 against critical values of 4.6 to 8; the flagged terms are
+/// mostly the warm-up gain, the offset and the temperature coefficient, which take up the
+/// reversed Shupe term with it, sometimes the Shupe coefficient itself); the normal last
+/// unit's was 0.08 to 0.72 (largest |z| 0.6 to 4.9), and its held-out seek rms 0.0089 to
+/// 0.0133 deg against 0.0089 to 0.0262 with the type alone (equal at the one seed where
+/// no term was fitted). Smaller fleets were not robust (measured with the trainer on one
+/// thread): with 4 units of 2 runs (the type from 3) the odd unit was missed at 1 seed of
+/// 12 (0.94), with 8 units of 1 run per ambient at 5 of 12. Only the last unit is tested:
+/// over every unit of the `Type` fleet in turn (18 seeds x 6 units) 5 of 108 normal units
+/// were flagged (up to 1.43), against the misfit test's nominal family-wise rate of 1 %.
+#[test]
+fn an_independent_odd_unit_is_outside_its_type_and_a_normal_unit_is_within_it() {
+    let t0 = Instant::now();
+    for seed in 1..=3 {
+        let (ty, odd) = calibrated(FleetLaw::OddUnit, seed, UNITS);
+        let lines = odd.misfit.lines();
+        println!(
+            "seed {seed}: odd unit: worst |z|/critical {:.2}: {lines:?}",
+            worst_ratio(&odd)
+        );
+        assert!(odd.misfit.outside(), "seed {seed}: {lines:?}");
+        let names: Vec<&str> = ty.file.terms.iter().map(|t| t.name.as_str()).collect();
+        let flagged: Vec<&String> = lines
+            .iter()
+            .filter(|l| l.contains("sigma outside the type"))
+            .collect();
+        assert!(!flagged.is_empty(), "seed {seed}: {lines:?}");
+        for l in flagged {
+            assert!(
+                l.starts_with(&format!("unit U{UNITS}: "))
+                    && names.iter().any(|n| l.contains(&format!(": {n} "))),
+                "seed {seed}: `{l}` names no term of {names:?}"
+            );
+        }
+
+        let (_, normal) = calibrated(FleetLaw::Type, seed, UNITS);
+        println!(
+            "seed {seed}: normal unit: worst |z|/critical {:.2}; held-out seek {:.4} deg \
+             ({:.4} with the type alone), {} unit terms",
+            worst_ratio(&normal),
+            normal.chosen_seek_deg,
+            normal.type_alone_seek_deg,
+            normal.terms
+        );
+        assert!(
+            !normal.misfit.outside(),
+            "seed {seed}: {:?}",
+            normal.misfit.lines()
+        );
+        assert!(
+            normal.chosen_seek_deg <= normal.type_alone_seek_deg,
+            "seed {seed}: {} > {}",
+            normal.chosen_seek_deg,
+            normal.type_alone_seek_deg
+        );
+    }
+    println!("{:.1} s", t0.elapsed().as_secs_f64());
+}
+
+/// Measured (seeds 1..=18, every unit in turn): the null twin's largest |z| / critical was
+/// at most 0.71 (|z| at most 3.6); seed 1 here: at most 0.34.
+#[test]
+fn the_independent_null_twin_flags_no_unit() {
+    let t0 = Instant::now();
+    for unit in 1..=UNITS {
+        let (_, cal) = calibrated(FleetLaw::Identical, 1, unit);
+        println!("unit U{unit}: worst |z|/critical {:.2}", worst_ratio(&cal));
+        assert!(!cal.misfit.outside(), "U{unit}: {:?}", cal.misfit.lines());
+    }
+    println!("{:.1} s", t0.elapsed().as_secs_f64());
+}
+
+// ---- the CLI on the independent fleet ----
+
+/// Writes the independent fleet `law` (seed 1) into `dir/indep/` as fog-runs files with
+/// `type_id` metadata.
+fn write_independent(dir: &Path, law: FleetLaw, units: usize, runs_per_ambient: usize) {
+    let f = fleet(law, units, &AMBIENTS_C, runs_per_ambient, MINUTES, 1);
+    std::fs::create_dir_all(dir.join("indep")).unwrap();
+    for mut run in f.runs {
+        run.meta.push(("type_id".into(), "independent".into()));
+        write_run(dir.join("indep").join(run.name()), &run).unwrap();
+    }
+}
+
+/// The runs of unit `u` of the independent fleet in `dir/indep`.
+fn indep_files(dir: &Path, units: &[usize]) -> Vec<String> {
+    units
+        .iter()
+        .flat_map(|u| files(dir, "indep", &format!("fleet1_u{u:03}_")))
+        .collect()
+}
+
+#[test]
+fn the_cli_refuses_an_odd_unit_by_default_and_trains_it_alone_with_misfit_own() {
+    let t0 = Instant::now();
+    let dir = app_support::scratch_dir("type-odd");
+    write_independent(&dir, FleetLaw::OddUnit, UNITS, RUNS_PER_AMBIENT);
+    let type_runs = indep_files(&dir, &[1, 2, 3, 4, 5]);
+    let odd_runs = indep_files(&dir, &[UNITS]);
+    fogsim_ok(
+        &dir,
+        &train_args(
+            &type_runs,
+            &["--type-out", "type.json", "--out", "shared.model"],
+        ),
+    );
+    let unit = |extra: &[&str]| {
+        let mut a = vec!["--type", "type.json", "--out", "u6.model"];
+        a.extend_from_slice(extra);
+        a.extend(["--registry", "reg.sqlite"]);
+        fogsim(&dir, &train_args(&odd_runs, &a))
+    };
+    let refused = unit(&[]);
+    let out = String::from_utf8_lossy(&refused.stdout);
+    let err = app_support::stderr(&refused);
+    assert!(!refused.status.success(), "{out}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("unit U6: outside its type independent") && err.contains("nothing written"),
+        "{err}"
+    );
+    assert!(
+        out.lines()
+            .any(|l| l.starts_with("unit U6: ") && l.contains(" sigma outside the type")),
+        "{out}"
+    );
+    assert!(!dir.join("u6.model").exists());
+
+    let own = unit(&["--misfit", "own"]);
+    let out = String::from_utf8_lossy(&own.stdout);
+    assert!(own.status.success(), "{}", app_support::stderr(&own));
+    assert!(
+        out.contains("unit U6: outside its type: trained on its own runs alone"),
+        "{out}"
+    );
+    read_model(&dir.join("u6.model")).unwrap();
+    let outcomes: Vec<String> = Registry::open(&dir.join("reg.sqlite"))
+        .unwrap()
+        .unit_calibrations("U6")
+        .unwrap()
+        .into_iter()
+        .map(|c| c.outcome)
+        .collect();
+    assert_eq!(outcomes, ["refused (misfit)", "own model (misfit)"]);
+    println!("{:.1} s", t0.elapsed().as_secs_f64());
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Copies `runs` (relative to `dir`) into `dir/sub/` with their `# type_id:` line set to
+/// `type_id`.
+fn with_type_id(dir: &Path, runs: &[String], sub: &str, type_id: &str) {
+    std::fs::create_dir_all(dir.join(sub)).unwrap();
+    let (from, to) = (
+        "\n# type_id: independent\n",
+        format!("\n# type_id: {type_id}\n"),
+    );
+    for r in runs {
+        let text = std::fs::read_to_string(dir.join(r)).unwrap();
+        assert!(text.contains(from), "{r}");
+        let name = Path::new(r).file_name().unwrap();
+        std::fs::write(dir.join(sub).join(name), text.replace(from, &to)).unwrap();
+    }
+}
+
+/// The bad-input fleet in `dir/indep/`: 5 independent units of 2 runs (one per ambient), of
+/// type `independent`; copies of U3's and U4's runs of type `other_design` in `dir/other/`.
+fn bad_input_fleet(dir: &Path) {
+    write_independent(dir, FleetLaw::Type, 5, 1);
+    with_type_id(dir, &indep_files(dir, &[3, 4]), "other", "other_design");
+}
+
+/// The runs a bad-input case names: `U1+U2` (units), `U3'` (U3 of `other_design`), `U4[0]`
+/// (U4's first run), joined by `+`.
+fn case_runs(dir: &Path, key: &str) -> Vec<String> {
+    key.split('+')
+        .flat_map(|k| match k {
+            "U3'" | "U4'" => {
+                let u = &k[1..2];
+                files(dir, "other", &format!("fleet1_u00{u}_"))
+            }
+            "U4[0]" => indep_files(dir, &[4])[..1].to_vec(),
+            _ => indep_files(dir, &[k[1..].parse().unwrap()]),
+        })
+        .collect()
+}
+
+/// Runs every `(runs, options, what the line must say)` of `cases` as `fogsim train`
+/// (`TERMS+1`: one more than the type's unit terms), each refused by `check_refused`.
+fn refuse_all(dir: &Path, cases: &[(&str, &str, &str)], terms: usize) {
+    for (runs, options, needle) in cases {
+        let runs = case_runs(dir, runs);
+        let options = options.replace("TERMS+1", &(terms + 1).to_string());
+        let options: Vec<&str> = options.split_whitespace().collect();
+        let needle = needle.replace("TERMS+1", &(terms + 1).to_string());
+        let needle = needle.replace("TERMS", &terms.to_string());
+        check_refused(dir, &train_args(&runs, &options), &needle);
+    }
+}
+
+#[test]
+fn bad_type_learning_inputs_fail_with_one_line_and_write_nothing() {
+    let t0 = Instant::now();
+    let dir = app_support::scratch_dir("type-bad-learn");
+    bad_input_fleet(&dir);
+    let learn = "--type-out out.type.json --out out.model";
+    let cases = [
+        (
+            "U1+U2+U3'",
+            learn,
+            "runs of 2 types mixed: independent (4 runs), other_design (2 runs)",
+        ),
+        (
+            "U1+U2",
+            learn,
+            "2 unit(s): a type's unit-to-unit spread needs at least 3 units",
+        ),
+        (
+            "U1+U2+U3",
+            "--type-out out.type.json --out out.model --type type.json",
+            "--type",
+        ),
+        (
+            "U4",
+            "--out out.model --misfit own",
+            "--misfit: needs --type TYPE",
+        ),
+        (
+            "U4",
+            "--out out.model --unit-terms 1",
+            "--unit-terms: needs --type TYPE",
+        ),
+        (
+            "U4",
+            "--out out.model --registry out.sqlite",
+            "--registry: needs --field, --type-out or --type",
+        ),
+    ];
+    refuse_all(&dir, &cases, 0);
+    println!(
+        "{} bad invocations: {:.1} s",
+        cases.len(),
+        t0.elapsed().as_secs_f64()
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn bad_unit_calibration_inputs_fail_with_one_line_and_write_nothing() {
+    let t0 = Instant::now();
+    let dir = app_support::scratch_dir("type-bad-unit");
+    bad_input_fleet(&dir);
+    let type_runs = indep_files(&dir, &[1, 2, 3]);
+    let learn = ["--type-out", "type.json", "--out", "shared.model"];
+    fogsim_ok(&dir, &train_args(&type_runs, &learn));
+    // a truncated type file, and one whose model is not hex
+    let type_text = std::fs::read_to_string(dir.join("type.json")).unwrap();
+    let half = &type_text[..type_text.len() / 2];
+    std::fs::write(dir.join("truncated.json"), half).unwrap();
+    let mut file: serde_json::Value = serde_json::from_str(&type_text).unwrap();
+    let hex = file["model_hex"].as_str().unwrap().to_string();
+    file["model_hex"] = format!("zz{}", &hex[2..]).into();
+    std::fs::write(dir.join("not-hex.json"), file.to_string()).unwrap();
+    let terms = file["terms"].as_array().unwrap().len();
+    let cal = "--type type.json --out out.model";
+    let cases = [
+        ("U4[0]", cal, "1 run file(s)"),
+        ("U1", cal, "unit U1 is one the type was learnt from"),
+        (
+            "U4",
+            "--type type.json --out out.model --unit-terms 3",
+            "unit U4: 2 runs for 3 unit terms (--unit-terms)",
+        ),
+        (
+            "U4",
+            "--type type.json --out out.model --unit-terms TERMS+1",
+            "--unit-terms TERMS+1: the type has TERMS unit terms",
+        ),
+        (
+            "U4'",
+            cal,
+            "a unit of type `other_design`, the type model is `independent`",
+        ),
+        (
+            "U4+U5",
+            cal,
+            "runs of 2 units (U4, U5): a unit calibration is one unit's",
+        ),
+        (
+            "U4",
+            "--type truncated.json --out out.model",
+            "truncated.json: not a type file",
+        ),
+        (
+            "U4",
+            "--type not-hex.json --out out.model",
+            "not-hex.json: its model is not hex",
+        ),
+        (
+            "U4",
+            "--type shared.model --out out.model",
+            "shared.model: not a type file",
+        ),
+    ];
+    refuse_all(&dir, &cases, terms);
+    let seek = ["--starts", "1", "--seeks", "1", "--json", "out.json"];
+    // a type file where a model is expected
+    check_refused(
+        &dir,
+        &[&["north-seek", "--model", "type.json"], &seek[..]].concat(),
+        "--model type.json: more than 2048 bytes, a model is at most 2048 bytes",
+    );
+    // a unit recipe's option without the recipe, named (not only the missing flag)
+    check_refused(
+        &dir,
+        &[
+            &["north-seek", "--model", "shared.model", "--unit-runs", "3"],
+            &seek[..],
+        ]
+        .concat(),
+        "--unit-runs: needs --type-units",
+    );
+    // the faults, not the rest, made them fail: U4 is calibrated without them
+    let u4 = indep_files(&dir, &[4]);
+    let good: Vec<&str> = cal.split_whitespace().collect();
+    fogsim_ok(&dir, &train_args(&u4, &good));
+    assert!(dir.join("out.model").exists());
+    println!(
+        "{} bad invocations: {:.1} s",
+        cases.len() + 2,
+        t0.elapsed().as_secs_f64()
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// `fogsim ARGS` in `dir` must fail with one line on stderr containing `needle`, and leave
+/// no `out.*` behind.
+fn check_refused(dir: &Path, args: &[&str], needle: &str) {
+    let o = fogsim(dir, args);
+    let err = app_support::stderr(&o);
+    assert!(!o.status.success(), "{args:?} accepted");
+    assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+    assert!(err.contains(needle), "{args:?}: `{err}` lacks `{needle}`");
+    let left: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.file_name().unwrap().to_string_lossy().starts_with("out."))
+        .collect();
+    assert!(left.is_empty(), "{args:?} left {left:?}");
+}
