@@ -228,15 +228,11 @@ pub fn runs_by_unit(runs: &[Run]) -> Result<(String, UnitRuns)> {
     Ok((type_id, units))
 }
 
-/// Learns the type from `runs` (several units' cold starts) against `model`, the shared
-/// model trained on those runs.
-pub fn fit_type(
-    model: &RbfModel,
-    runs: &[Run],
-    type_id_override: Option<&str>,
-) -> Result<TypeModel> {
+/// The runs of each unit after checking they can make a type: one type, at least
+/// `MIN_TYPE_UNITS` units of at least `MIN_RUNS_PER_UNIT` runs (checked before any
+/// training, so bad input is refused at once).
+pub fn check_type_runs(runs: &[Run]) -> Result<(String, UnitRuns)> {
     let (type_id, units) = runs_by_unit(runs)?;
-    let type_id = type_id_override.map_or(type_id, str::to_string);
     if units.len() < MIN_TYPE_UNITS {
         bail!(
             "{} unit(s): a type's unit-to-unit spread needs at least {MIN_TYPE_UNITS} units to be tested",
@@ -249,6 +245,18 @@ pub fn fit_type(
             v.len()
         );
     }
+    Ok((type_id, units))
+}
+
+/// Learns the type from `runs` (several units' cold starts) against `model`, the shared
+/// model trained on those runs.
+pub fn fit_type(
+    model: &RbfModel,
+    runs: &[Run],
+    type_id_override: Option<&str>,
+) -> Result<TypeModel> {
+    let (type_id, units) = check_type_runs(runs)?;
+    let type_id = type_id_override.map_or(type_id, str::to_string);
     let terms = unit_terms(model);
     let p = terms.len();
     let mut fitted = Vec::with_capacity(units.len());
@@ -341,6 +349,7 @@ pub fn learn_type(
     type_id: Option<&str>,
     train: &mut dyn FnMut(Vec<Run>) -> Result<RbfModel>,
 ) -> Result<TypeModel> {
+    check_type_runs(runs)?;
     let shared = train(runs.to_vec())?;
     let mut ty = fit_type(&shared, runs, type_id)?;
     let mut history = vec![ty.file.unit_residual_rms_dph];
