@@ -138,7 +138,9 @@ mod tests {
             .conn
             .query_row("PRAGMA user_version", [], |r| r.get(0))
             .unwrap();
-        assert_eq!(version, 2);
+        // schema 1 -> the current one: base_crc32 added, the fleet's tables created
+        assert_eq!(version, 3);
+        assert!(reg.type_units("any").unwrap().is_empty());
         assert!(reg.models_derived_from(10).unwrap().is_empty());
         let h = reg.history("G7").unwrap();
         assert_eq!(h.models[0].1.base_crc32, None);
