@@ -130,10 +130,10 @@ pub struct Args {
         allow_negative_numbers = true
     )]
     pub unit_ambients_c: Option<Vec<f64>>,
-    /// Cold starts of each type unit at each of -40, 20 and +60 degC [default: 2]. Needs
-    /// `--type-units`.
-    #[arg(long = "type-runs-per-ambient")]
-    pub type_runs_per_ambient: Option<usize>,
+    /// Cold starts of each type unit (2..=48), spread over -40, 20 and +60 degC in turn
+    /// [default: 6]. Needs `--type-units`.
+    #[arg(long = "type-unit-runs")]
+    pub type_unit_runs: Option<usize>,
 }
 
 /// Every how many chamber power-ons one is a warm restart (`--training-restarts-above-c`).
@@ -187,10 +187,7 @@ fn training_campaign(args: &Args) -> Result<(usize, Option<WarmRestarts>)> {
     let shapes_recipe = [
         ("--unit-runs", args.unit_runs.is_some()),
         ("--unit-ambients-c", args.unit_ambients_c.is_some()),
-        (
-            "--type-runs-per-ambient",
-            args.type_runs_per_ambient.is_some(),
-        ),
+        ("--type-unit-runs", args.type_unit_runs.is_some()),
     ];
     if let (None, Some((flag, _))) = (args.type_units, shapes_recipe.iter().find(|(_, g)| *g)) {
         bail!("{flag}: needs --type-units N (the unit recipe it shapes)");
@@ -325,7 +322,7 @@ fn recipe_unit_model(
 fn recipe_of(args: &Args) -> Option<UnitRecipe> {
     Some(UnitRecipe {
         type_units: args.type_units?,
-        type_runs_per_ambient: args.type_runs_per_ambient.unwrap_or(2),
+        type_unit_runs: args.type_unit_runs.unwrap_or(6),
         type_ambients_c: RECIPE_AMBIENTS_C.to_vec(),
         unit_runs: args.unit_runs.unwrap_or(6),
         unit_ambients_c: args

@@ -6,8 +6,8 @@
 //! The fleet is the simulator's (`pipeline::fleet`, the paper's gyro as the type, the
 //! default unit spread, drawn from the Monte Carlo's seed): the seeking unit is U1 and the
 //! type's units are U2..U(N+1), so the seeking unit is never among them and the same U1 is
-//! calibrated whatever N. The type's units each run `type_runs_per_ambient` cold starts at
-//! every type ambient; the unit's K runs are spread over the unit ambients in turn (run i
+//! calibrated whatever N. The type's units each run `type_unit_runs` cold starts spread
+//! over the type ambients in turn; the unit's K runs are spread over the unit ambients in turn (run i
 //! at ambient i mod n). The Monte Carlo then seeks with the unit's own parameters.
 
 use anyhow::{anyhow, Result};
@@ -36,7 +36,8 @@ pub const SEEKING_UNIT: usize = 0;
 pub struct UnitRecipe {
     /// Units the type is learnt from (0: no type, the unit's runs alone).
     pub type_units: usize,
-    pub type_runs_per_ambient: usize,
+    /// Cold starts of each type unit, spread over `type_ambients_c` in turn.
+    pub type_unit_runs: usize,
     pub type_ambients_c: Vec<f64>,
     pub unit_runs: usize,
     pub unit_ambients_c: Vec<f64>,
@@ -72,10 +73,10 @@ impl UnitRecipe {
                 self.unit_runs
             ));
         }
-        if !(1..=16).contains(&self.type_runs_per_ambient) {
+        if !(2..=48).contains(&self.type_unit_runs) {
             return Err(anyhow!(
-                "--type-runs-per-ambient {}: must be within 1..=16",
-                self.type_runs_per_ambient
+                "--type-unit-runs {}: must be within 2..=48 (a type unit's error is measured by leaving one run out)",
+                self.type_unit_runs
             ));
         }
         for (flag, list) in [
@@ -91,12 +92,6 @@ impl UnitRecipe {
                     "{flag}: one or more ambients within -60..=100 degC"
                 ));
             }
-        }
-        if self.type_units > 0 && self.type_runs_per_ambient * self.type_ambients_c.len() < 2 {
-            return Err(anyhow!(
-                "--type-runs-per-ambient {}: each type unit needs at least 2 runs",
-                self.type_runs_per_ambient
-            ));
         }
         Ok(())
     }
@@ -159,7 +154,7 @@ pub fn recipe_model(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<RecipeMo
             summary,
         });
     }
-    let per_unit = recipe.type_runs_per_ambient * recipe.type_ambients_c.len();
+    let per_unit = recipe.type_unit_runs;
     let mut pooled = Vec::with_capacity(recipe.type_units * per_unit);
     for u in 1..=recipe.type_units {
         pooled.extend(unit_runs(
