@@ -60,6 +60,24 @@ pub struct UnitCalibrationRecord {
     pub model_crc32: Option<u32>,
 }
 
+/// One run of a unit, in the role it played (`type`: a type was learnt from it; `unit`: a
+/// unit calibration).
+fn record_unit_run(
+    tx: &rusqlite::Transaction,
+    unit_id: &str,
+    run: &str,
+    type_id: &str,
+    role: &str,
+    now: &str,
+) -> Result<()> {
+    tx.execute(
+        "INSERT OR REPLACE INTO unit_runs (unit_id, run, type_id, role, recorded_utc)
+         VALUES (?1, ?2, ?3, ?4, ?5)",
+        params![unit_id, run, type_id, role, now],
+    )?;
+    Ok(())
+}
+
 impl Registry {
     /// Records a type (replacing an earlier fit of the same id) and the runs of its units,
     /// in one transaction.
@@ -81,11 +99,7 @@ impl Registry {
             params![type_id, now, units as i64, runs.len() as i64, i64::from(model_crc32), type_json],
         )?;
         for (unit, run) in runs {
-            tx.execute(
-                "INSERT OR REPLACE INTO unit_runs (unit_id, run, type_id, role, recorded_utc)
-                 VALUES (?1, ?2, ?3, 'type', ?4)",
-                params![unit, run, type_id, now],
-            )?;
+            record_unit_run(&tx, unit, run, type_id, "type", &now)?;
         }
         tx.commit()?;
         Ok(())
@@ -117,11 +131,7 @@ impl Registry {
             ],
         )?;
         for run in runs {
-            tx.execute(
-                "INSERT OR REPLACE INTO unit_runs (unit_id, run, type_id, role, recorded_utc)
-                 VALUES (?1, ?2, ?3, 'unit', ?4)",
-                params![rec.unit_id, run, rec.type_id, now],
-            )?;
+            record_unit_run(&tx, &rec.unit_id, run, &rec.type_id, "unit", &now)?;
         }
         tx.commit()?;
         Ok(())

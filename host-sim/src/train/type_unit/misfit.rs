@@ -76,7 +76,7 @@ impl Misfit {
             .collect();
         if !blind.is_empty() {
             v.push(format!(
-                "unit {}: no test power for {} (its runs cannot tell a unit {POWER_SIGMAS} spreads out)",
+                "unit {}: no test power for {} (its runs cannot tell a unit {POWER_SIGMAS} spreads out: more of its runs, at more ambients, or a type from more units give the test power)",
                 self.unit_id,
                 blind.join(", ")
             ));

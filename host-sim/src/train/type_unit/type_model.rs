@@ -169,6 +169,17 @@ impl TypeModel {
                 );
             }
         }
+        if let Some(u) = file
+            .units
+            .iter()
+            .find(|u| u.estimate.len() != p || u.se.len() != p)
+        {
+            bail!(
+                "unit {}: {} estimates for {p} unit terms",
+                u.unit_id,
+                u.estimate.len()
+            );
+        }
         if file.units.len() < MIN_TYPE_UNITS {
             bail!(
                 "{} units: a type needs at least {MIN_TYPE_UNITS}",
