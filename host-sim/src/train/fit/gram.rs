@@ -47,6 +47,10 @@ impl Layout<'_> {
     }
 }
 
+/// Blocks a fold's rows are summed in: fixed, so that the thread count never changes the
+/// order of a floating-point sum (enough blocks to keep 2-16 threads busy).
+const SUM_BLOCKS: usize = 16;
+
 /// Per-fold Gram matrices of one extended design, plus their total.
 pub struct FoldGrams {
     p: usize,
@@ -66,29 +70,32 @@ pub fn gram_bytes(columns: usize) -> usize {
 }
 
 impl FoldGrams {
-    /// Accumulates G_f = A_f'A_f for every fold f (`fold[i]` < `folds` for every row i)
-    /// over `threads` threads (each accumulates its own share of a fold's rows). Folds are
-    /// accumulated one after the other, so at most `threads` partial Grams exist beside
-    /// the fold Grams (memory: folds + 1 + threads Grams, not folds x threads), and only
-    /// the current fold's row list is held; every sum is the same, in the same order.
+    /// Accumulates G_f = A_f'A_f for every fold f (`fold[i]` < `folds` for every row i).
+    /// A fold's rows are cut into `SUM_BLOCKS` blocks whatever the thread count, each block
+    /// accumulated on its own and the blocks added in block order: every sum is the same,
+    /// in the same order, on any machine (same seed, same bytes). The blocks run
+    /// `threads` at a time and folds one after the other, so at most `threads` partial
+    /// Grams exist beside the fold Grams (memory: folds + 1 + threads Grams), and only the
+    /// current fold's row list is held.
     pub fn build(layout: &Layout<'_>, fold: &[usize], folds: usize, threads: usize) -> Self {
         let p = layout.n_columns();
-        let parts = threads.max(1);
+        let parts = threads.clamp(1, SUM_BLOCKS);
         let mut fold_grams: Vec<Vec<f64>> = Vec::with_capacity(folds);
         let mut fold_rows = Vec::with_capacity(folds);
         for f in 0..folds {
             let rows: Vec<usize> = (0..fold.len()).filter(|&i| fold[i] == f).collect();
-            let share = rows.len().div_ceil(parts).max(1);
-            let shares = map_in_order(parts, parts, |part| {
-                let start = (part * share).min(rows.len());
-                let end = (start + share).min(rows.len());
-                accumulate(layout, &rows[start..end])
-            });
+            let block = rows.len().div_ceil(SUM_BLOCKS).max(1);
             let mut g = vec![0.0; p * p];
-            for s in &shares {
-                g.iter_mut().zip(s).for_each(|(a, b)| *a += b);
+            for round in (0..SUM_BLOCKS).step_by(parts) {
+                let shares = map_in_order(parts.min(SUM_BLOCKS - round), parts, |k| {
+                    let start = ((round + k) * block).min(rows.len());
+                    let end = (start + block).min(rows.len());
+                    accumulate(layout, &rows[start..end])
+                });
+                for s in &shares {
+                    g.iter_mut().zip(s).for_each(|(a, b)| *a += b);
+                }
             }
-            drop(shares);
             mirror_upper(&mut g, p);
             fold_rows.push(rows.len());
             fold_grams.push(g);
@@ -390,8 +397,12 @@ mod tests {
                 r
             })
             .collect();
-        for threads in [1, 2, 3] {
+        let one_thread = FoldGrams::build(&layout, &fold, 3, 1);
+        for threads in [1, 2, 3, 5] {
             let grams = FoldGrams::build(&layout, &fold, 3, threads);
+            // the same sums in the same order, bit for bit, on any thread count
+            assert_eq!(grams.total, one_thread.total, "{threads} threads");
+            assert_eq!(grams.folds, one_thread.folds, "{threads} threads");
             for f in 0..3 {
                 let (held, train) = (grams.fold(f), grams.without_fold(f));
                 assert_eq!(held.n_rows() + train.n_rows(), 53);
