@@ -401,10 +401,9 @@ fn the_cli_refuses_an_odd_unit_by_default_and_trains_it_alone_with_misfit_own() 
         ),
     );
     let unit = |extra: &[&str]| {
-        let mut a = vec!["--type", "type.json", "--out", "u6.model"];
+        let mut a = vec!["--out", "u6.model"];
         a.extend_from_slice(extra);
-        a.extend(["--registry", "reg.sqlite"]);
-        fogsim(&dir, &train_args(&odd_runs, &a))
+        unit_runs_cmd(&dir, &odd_runs, &a)
     };
     let refused = unit(&[]);
     let out = String::from_utf8_lossy(&refused.stdout);
@@ -430,16 +429,57 @@ fn the_cli_refuses_an_odd_unit_by_default_and_trains_it_alone_with_misfit_own() 
         "{out}"
     );
     read_model(&dir.join("u6.model")).unwrap();
-    let outcomes: Vec<String> = Registry::open(&dir.join("reg.sqlite"))
+
+    // Two runs are too few for the ordinary training: refused before anything is
+    // trained, said in one line, recorded as such.
+    let two = unit_runs_cmd(
+        &dir,
+        &odd_runs[..2],
+        &["--misfit", "own", "--out", "u6b.model"],
+    );
+    let err = app_support::stderr(&two);
+    assert!(!two.status.success());
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("2 run(s) are too few to train it on its own")
+            && err.contains("nothing written"),
+        "{err}"
+    );
+    assert!(!dir.join("u6b.model").exists());
+
+    let records = Registry::open(&dir.join("reg.sqlite"))
         .unwrap()
         .unit_calibrations("U6")
-        .unwrap()
-        .into_iter()
-        .map(|c| c.outcome)
-        .collect();
-    assert_eq!(outcomes, ["refused (misfit)", "own model (misfit)"]);
+        .unwrap();
+    let outcomes: Vec<&str> = records.iter().map(|c| c.outcome.as_str()).collect();
+    assert_eq!(
+        outcomes,
+        [
+            "refused (misfit)",
+            "own model (misfit)",
+            "refused (misfit, too few runs of its own)"
+        ]
+    );
+    // the own model's record carries the CRC of the model written
+    let written = std::fs::read(dir.join("u6.model")).unwrap();
+    assert_eq!(
+        records[1].model_crc32,
+        Some(fog_core::model::crc::crc32(&written))
+    );
+    assert_eq!(
+        (records[0].model_crc32, records[2].model_crc32),
+        (None, None)
+    );
     println!("{:.1} s", t0.elapsed().as_secs_f64());
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// `fogsim train RUNS --type type.json --registry reg.sqlite EXTRA` in `dir`.
+fn unit_runs_cmd<'a>(dir: &Path, runs: &'a [String], extra: &[&'a str]) -> std::process::Output {
+    let mut a = vec!["--type", "type.json"];
+    a.extend_from_slice(extra);
+    a.extend(["--registry", "reg.sqlite"]);
+    fogsim(dir, &train_args(runs, &a))
 }
 
 /// Copies `runs` (relative to `dir`) into `dir/sub/` with their `# type_id:` line set to
@@ -559,7 +599,11 @@ fn bad_unit_calibration_inputs_fail_with_one_line_and_write_nothing() {
     let terms = file["terms"].as_array().unwrap().len();
     let cal = "--type type.json --out out.model";
     let cases = [
-        ("U4[0]", cal, "1 run file(s)"),
+        (
+            "U4[0]",
+            cal,
+            "1 run file(s): a unit calibration holds out one run at a time",
+        ),
         ("U1", cal, "unit U1 is one the type was learnt from"),
         (
             "U4",
@@ -615,6 +659,16 @@ fn bad_unit_calibration_inputs_fail_with_one_line_and_write_nothing() {
         .concat(),
         "--unit-runs: needs --type-units",
     );
+    // the type-free recipe trains the unit's runs as any model: too few for its folds
+    check_refused(
+        &dir,
+        &[
+            &["north-seek", "--type-units", "0", "--unit-runs", "2"],
+            &seek[..],
+        ]
+        .concat(),
+        "--unit-runs 2: --type-units 0 trains the unit on its own runs alone",
+    );
     // the faults, not the rest, made them fail: U4 is calibrated without them
     let u4 = indep_files(&dir, &[4]);
     let good: Vec<&str> = cal.split_whitespace().collect();
@@ -622,7 +676,7 @@ fn bad_unit_calibration_inputs_fail_with_one_line_and_write_nothing() {
     assert!(dir.join("out.model").exists());
     println!(
         "{} bad invocations: {:.1} s",
-        cases.len() + 2,
+        cases.len() + 3,
         t0.elapsed().as_secs_f64()
     );
     std::fs::remove_dir_all(dir).unwrap();

@@ -1,6 +1,8 @@
 //! `fogsim demo`: the README's main job. A shorter `reproduce` (six temperatures, four runs
 //! each, the full 30 x 6 north-seek Monte Carlo) that finishes in about a minute on two
-//! cores in release mode, with progress bars, a readable table and SVG plots in `out/demo/`.
+//! cores in release mode, with progress bars, a readable table and SVG plots in `out/demo/`;
+//! then the production recipe (`pipeline::north_seek::recipe_compare`): a unit calibrated
+//! from 6 of its own cold starts with a type of 10 units, beside the same 6 runs alone.
 
 use std::path::PathBuf;
 
@@ -11,6 +13,8 @@ use crate::cmd::reproduce::options;
 use crate::io::OutputGuard;
 use crate::output::reports::write_json;
 use crate::pipeline::campaign_steps::CampaignSpec;
+use crate::pipeline::north_seek::recipe_compare::{compare_recipes, recipe_table};
+use crate::pipeline::north_seek::MonteCarloConfig;
 use crate::pipeline::reproduce::{reproduce, summary};
 use crate::sim::GyroParams;
 
@@ -58,8 +62,18 @@ pub fn run(args: Args) -> Result<()> {
         .iter()
         .map(|m| m.model_file.as_str())
         .collect();
+    let recipes = compare_recipes(
+        &MonteCarloConfig {
+            starts: args.starts,
+            ambient_c: 20.0,
+            ..MonteCarloConfig::paper(args.seed)
+        },
+        &args.out,
+    )?;
+    print!("\n{}", recipe_table(&recipes));
+    write_json(&args.out.join("recipes.json"), &recipes)?;
     println!(
-        "\nplots, report.json and the models ({}) written to {} ({:.1} s)",
+        "\nplots, report.json, recipes.json and the models ({}) written to {} ({:.1} s)",
         files.join(", "),
         args.out.display(),
         started.elapsed().as_secs_f64()

@@ -18,7 +18,6 @@ pub mod registry;
 pub mod reproduce;
 pub mod rig;
 pub mod train;
-pub mod train_type;
 pub mod upload;
 
 use crate::io::{same_output, OutputGuard};

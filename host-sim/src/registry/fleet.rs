@@ -55,7 +55,8 @@ pub struct UnitCalibrationRecord {
     pub prior_weight: f64,
     /// The misfit test's lines, joined by `; `.
     pub misfit: String,
-    /// `calibrated`, `refused (misfit)` or `own model (misfit)`.
+    /// `calibrated`, `refused (misfit)`, `refused (misfit, too few runs of its own)` or
+    /// `own model (misfit)` (its CRC that of the own model written).
     pub outcome: String,
     pub model_crc32: Option<u32>,
 }

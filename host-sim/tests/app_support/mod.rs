@@ -30,12 +30,40 @@ pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
-/// A fresh, empty directory for one test.
+/// A fresh, empty directory for one test. It stays after the test (to look at when one
+/// fails); the same test's directories of earlier test processes that have ended are
+/// removed here, so at most one per test is left behind.
 pub fn scratch_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("fogsim-app-{name}-{}", std::process::id()));
+    let prefix = format!("fogsim-app-{name}-");
+    let tmp = std::env::temp_dir();
+    remove_stale_scratch(&tmp, &prefix);
+    let d = tmp.join(format!("{prefix}{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
+}
+
+/// Removes `tmp/<prefix><pid>` directories whose process has ended (Linux: no
+/// `/proc/<pid>`; elsewhere nothing is removed).
+fn remove_stale_scratch(tmp: &Path, prefix: &str) {
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(tmp) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(pid) = name.to_str().and_then(|n| n.strip_prefix(prefix)) else {
+            continue;
+        };
+        let ended = !pid.is_empty()
+            && pid.bytes().all(|b| b.is_ascii_digit())
+            && !Path::new("/proc").join(pid).exists();
+        if ended {
+            let _ = std::fs::remove_dir_all(entry.path());
+        }
+    }
 }
 
 /// Writes `runs` simulated 45-min cold starts at 20 degC into `dir/runs/` and a model

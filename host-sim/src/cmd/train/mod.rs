@@ -6,219 +6,26 @@
 //! checked and encoded before any file is written, and the outputs are committed
 //! together, so a failure leaves no partial output and two runs never mix theirs.
 
+mod args;
+mod finish;
+mod type_unit;
+
+pub use args::Args;
+use finish::{field_refined, stage};
+
 use super::{check_distinct_outputs, check_output_file};
 use crate::io::runs::run_files;
 use crate::io::{read_runs_binned, OutputGuard, OutputLock, StagedFiles};
 use crate::train::cold_start::{self, envelope_for};
 use crate::train::seek_refit::{refit_for_seeks, SeekRefit};
 use crate::train::{
-    choose_inputs_default, train_model, InputChoice, InputSelection, Method, TrainConfig,
-    TrainOutcome, TrainReport, Verdict, WidthSearch, GUARD_RATIO,
+    choose_inputs_default, train_model, InputChoice, InputSelection, TrainConfig, TrainOutcome,
+    TrainReport, Verdict, GUARD_RATIO,
 };
 use anyhow::Context;
 use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
 use serde::Serialize;
-use std::path::Path;
-use std::path::PathBuf;
-
-/// Options of `fogsim train`.
-#[derive(clap::Args, Debug)]
-pub struct Args {
-    /// fog-runs files or directories of them (read in name order); one run per file.
-    #[arg(required = true)]
-    pub runs: Vec<PathBuf>,
-    /// Output model file (fog-core postcard encoding, CRC-protected).
-    #[arg(long)]
-    pub out: PathBuf,
-    /// Most RBF centres (1..=64).
-    #[arg(long, default_value_t = TrainConfig::default().max_centers)]
-    pub max_centers: usize,
-    /// Optional OLS stop: end selection once the residual energy is below rho * y'y
-    /// (0 <= rho < 1; 0 = off). y'y includes the static bias, so on real gyros a relative
-    /// stop fires early; by default grouped validation picks the number of centres.
-    #[arg(long, default_value_t = TrainConfig::default().rho)]
-    pub rho: f64,
-    /// Optional OLS stop: end selection once the training rms reaches this, deg/h (the
-    /// paper's criterion, e.g. the gyro's bias spec).
-    #[arg(long)]
-    pub target_dph: Option<f64>,
-    /// Polynomial degrees in T tried by grouped validation.
-    #[arg(long, value_delimiter = ',', default_values_t = TrainConfig::default().poly_degrees)]
-    pub poly_degrees: Vec<usize>,
-    /// Most candidate centres (grid over the normalised inputs).
-    #[arg(long, default_value_t = TrainConfig::default().max_candidates)]
-    pub max_candidates: usize,
-    /// Write the model even if held-out validation shows it does not clearly help.
-    #[arg(long)]
-    pub force: bool,
-    /// Benchmarks: also write the normalised training points, targets, chosen width and
-    /// candidate indices here as JSON (`bench/sklearn_omp.py` rebuilds the same design).
-    #[arg(long)]
-    pub export_design: Option<PathBuf>,
-    /// Selection method: `ols` (Chen-Cowan-Grant) or `orr` (regularised, GCV stop).
-    #[arg(long, default_value = "ols", value_parser = parse_method)]
-    pub method: Method,
-    /// Gaussian widths (sigma, normalised input units) tried by grouped validation.
-    #[arg(long, value_delimiter = ',', default_values_t = TrainConfig::default().width_candidates)]
-    pub widths: Vec<f64>,
-    /// How the widths are searched: `climb` (from the middle width towards lower held-out
-    /// error, stopping when both neighbours of the best are worse) or `full` (all).
-    #[arg(long, default_value = "climb", value_parser = parse_width_search)]
-    pub width_search: WidthSearch,
-    /// Folds of the grouped (whole runs held out) cross-validation.
-    #[arg(long, default_value_t = TrainConfig::default().folds)]
-    pub folds: usize,
-    /// Drop a candidate once less than this fraction of its energy is new (orthogonal
-    /// to the selection); larger values give smaller, better-conditioned weights.
-    #[arg(long, default_value_t = TrainConfig::default().collinearity_tol)]
-    pub collinearity_tol: f64,
-    /// Also fit linear terms in the RBF inputs (e.g. a Shupe term linear in dT/dt) under
-    /// the Gaussians, jointly with the centres.
-    #[arg(long)]
-    pub linear_inputs: bool,
-    /// Let those linear terms' coefficients change with temperature: a term in T x input
-    /// beside each (e.g. a Shupe coefficient k_0 + k_1 T); needs `--linear-inputs`. The
-    /// model is then written in format version 4.
-    #[arg(long)]
-    pub linear_by_t: bool,
-    /// Model inputs: `t,rate` (T, dT/dt), `t,rate,accel` (and d2T/dt2, computed by
-    /// fog-core as on the device), `t,rate,accel_flat` (d2T/dt2 with the series flat
-    /// before power-on), `t,rate,rise` (the temperature rise since power-on instead of
-    /// d2T/dt2), `t,rise` (T and the rise, no dT/dt; only on request) or `auto` (each scored by grouped cross-validation over whole runs on the
-    /// same points: the inputs by the 10 s rms, how d2T/dt2's third state is read by
-    /// `--criterion`; a later set must win run by run).
-    #[arg(long, default_value = "auto", value_parser = InputChoice::parse)]
-    pub inputs: InputChoice,
-    /// Gyro id stored in the model (at most 16 bytes).
-    #[arg(long, default_value = "sim")]
-    pub gyro_id: String,
-    /// Held-out score that chooses the model: `seek` (azimuth error of two-position seeks
-    /// of `--seek-dwell-s` at `--seek-latitude-deg`) or `rms10s` (10 s residual rms).
-    #[arg(long, default_value = crate::train::seek_score::DEFAULT_CRITERION_NAME)]
-    pub criterion: String,
-    /// Dwell per position of the seeks the `seek` criterion scores (and `--field`'s
-    /// azimuth score), s.
-    #[arg(long = "seek-dwell-s", default_value_t = crate::train::seek_score::DEFAULT_SEEK_DWELL_S)]
-    pub seek_dwell: f64,
-    /// Site latitude of the seeks the `seek` criterion scores (and `--field`'s azimuth
-    /// score), deg.
-    #[arg(long = "seek-latitude-deg", default_value_t = crate::sim::DEFAULT_LATITUDE_DEG, allow_negative_numbers = true)]
-    pub seek_latitude: f64,
-    /// Refit the final model's output layer to the seeks of the north finder's own
-    /// sequence at `--seek-dwell-s` and `--seek-latitude-deg` (the simulated device's
-    /// timing, measured), with the weight of a seek pair chosen over folds of runs
-    /// (`fog_sim::train::seek_refit`). The runs must be cold starts timed from power-on:
-    /// the seeks are counted from t = 0. `north-seek` and `reproduce` do this for the
-    /// models they train.
-    #[arg(long)]
-    pub seek_refit: bool,
-    /// Write the training report as JSON here.
-    #[arg(long)]
-    pub json: Option<PathBuf>,
-    /// Field records (`fogsim field pull --out DIR`) measured under this chamber model:
-    /// each is one observation of the residual bias at its temperature state; a ridge
-    /// correction linear in the model's T and dT/dt inputs is fitted to them and
-    /// folded into the model (`fog_sim::train::field_correction::refine`).
-    #[arg(long)]
-    pub field: Option<PathBuf>,
-    /// Weight W of each field seek against the chamber model's prior (one row of weight 1
-    /// per correction coefficient). Default: chosen, with the terms, by leave-one-power-on-out.
-    /// Given without `--field`, it is refused by name.
-    #[arg(long)]
-    pub field_weight: Option<f64>,
-    /// Calibration registry (SQLite) whose models tell which field records count: those
-    /// measured under this model or under a variant of it the registry recorded at upload
-    /// (the model with a heading calibration attached). Read only; used with `--field`.
-    /// Default: $XDG_DATA_HOME/fogsim/registry.sqlite, if it exists.
-    /// With `--type-out` or `--type`, the type, its units' runs and the unit
-    /// calibration are recorded in it.
-    #[arg(long)]
-    pub registry: Option<PathBuf>,
-    /// Learn a gyro type from these runs and write it here (JSON): the runs are several
-    /// units' cold starts, each naming its unit in `unit_id` metadata (and its type in
-    /// `type_id`: one type only). The shared drift model (also written to `--out`) and
-    /// the unit terms (offset, warm-up gain, a linear term per input) are fitted in turn;
-    /// the terms' mean and unit-to-unit spread are the prior of `--type`
-    /// (`fog_sim::train::type_unit`).
-    #[arg(long = "type-out", conflicts_with_all = ["type_model", "field", "seek_refit"])]
-    pub type_out: Option<PathBuf>,
-    /// Calibrate one unit from its own runs with this type (from `--type-out`) as the
-    /// prior: the unit terms and the prior's weight are chosen by leave-one-run-out, and
-    /// the unit is first tested against its type (`--misfit`). Writes an ordinary model.
-    /// The shape options apply only to the unit's own model (`--misfit own`); `--field`
-    /// refines the calibrated model.
-    #[arg(long = "type", conflicts_with = "seek_refit")]
-    pub type_model: Option<PathBuf>,
-    /// With `--type`: a unit outside its type is `refuse`d (nothing written) or trained on
-    /// its `own` runs alone [default: refuse].
-    #[arg(long, value_enum)]
-    pub misfit: Option<crate::train::type_unit::MisfitPolicy>,
-    /// With `--type`: fit this many unit terms, in the type's order [default: chosen by
-    /// leave-one-run-out, at most one per run].
-    #[arg(long = "unit-terms")]
-    pub unit_terms: Option<usize>,
-}
-
-fn parse_width_search(s: &str) -> Result<WidthSearch, String> {
-    match s {
-        "climb" => Ok(WidthSearch::Climb),
-        "full" => Ok(WidthSearch::Full),
-        _ => Err(format!(
-            "`{s}` is not a width search (use `climb` or `full`)"
-        )),
-    }
-}
-
-fn parse_method(s: &str) -> Result<Method, String> {
-    match s {
-        "ols" => Ok(Method::Ols),
-        "orr" | "orr-gcv" => Ok(Method::OrrGcv),
-        _ => Err(format!("`{s}` is not a method (use `ols` or `orr`)")),
-    }
-}
-
-impl Args {
-    /// The training configuration these options ask for.
-    pub fn config(&self) -> anyhow::Result<TrainConfig> {
-        // Each seek parameter named by its flag (checked also under `rms10s`, which does
-        // not use them: a bad flag is never ignored).
-        if !(self.seek_dwell.is_finite() && self.seek_dwell > 0.0) {
-            anyhow::bail!(
-                "--seek-dwell-s {}: must be a positive number of seconds",
-                self.seek_dwell
-            );
-        }
-        if self.seek_latitude.is_nan() || self.seek_latitude.abs() >= 85.0 {
-            anyhow::bail!(
-                "--seek-latitude-deg {}: must be within -85..85 deg",
-                self.seek_latitude
-            );
-        }
-        let criterion = crate::train::seek_score::Criterion::parse(
-            &self.criterion,
-            self.seek_dwell,
-            self.seek_latitude,
-        )
-        .map_err(|e| anyhow::anyhow!("--criterion {e}"))?;
-        Ok(TrainConfig {
-            criterion,
-            method: self.method,
-            rho: self.rho,
-            target_dph: self.target_dph,
-            poly_degrees: self.poly_degrees.clone(),
-            max_candidates: self.max_candidates,
-            max_centers: self.max_centers,
-            width_candidates: self.widths.clone(),
-            width_search: self.width_search,
-            folds: self.folds,
-            collinearity_tol: self.collinearity_tol,
-            linear_on_rbf_inputs: self.linear_inputs,
-            linear_by_t: self.linear_by_t,
-            gyro_id: self.gyro_id.clone(),
-            ..TrainConfig::default()
-        })
-    }
-}
+use std::path::{Path, PathBuf};
 
 /// `train --json`: the training report, what `--inputs` chose, and the gyro id written.
 #[derive(Serialize)]
@@ -229,6 +36,20 @@ pub struct TrainCommandReport<'a> {
     pub gyro_id: &'a str,
     /// `--seek-refit`: how the output layer was refitted (None without it).
     pub seek_refit: Option<&'a SeekRefit>,
+}
+
+/// Every output the command may write (locked for the whole command).
+fn output_paths(args: &Args) -> Vec<&Path> {
+    [
+        Some(&args.out),
+        args.json.as_ref(),
+        args.export_design.as_ref(),
+        args.type_out.as_ref(),
+    ]
+    .into_iter()
+    .flatten()
+    .map(|p| p.as_path())
+    .collect()
 }
 
 /// Checks the outputs before anything is read: creatable, not inputs, distinct.
@@ -283,60 +104,25 @@ fn inputs(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
     Ok(inputs)
 }
 
-/// The trained model, refined with `--field` records if given (`crate::train::field_correction`).
-pub(super) fn field_refined(
-    args: &Args,
-    model: &fog_core::model::format::RbfModel,
-) -> anyhow::Result<fog_core::model::format::RbfModel> {
-    let Some(dir) = &args.field else {
-        return Ok(model.clone());
-    };
-    let variants = match (&args.registry, crate::registry::default_path()) {
-        (Some(path), _) if !path.is_file() => {
-            anyhow::bail!("--registry {}: no such registry file", path.display())
-        }
-        (Some(path), _) => crate::registry::variants_of(model, path)?,
-        (None, Ok(path)) if path.is_file() => crate::registry::variants_of(model, &path)?,
-        (None, _) => Vec::new(),
-    };
-    // The azimuth score's seeks are the ones the trainer's seek criterion scores.
-    let seek = crate::train::seek_score::SeekGeometry {
-        dwell_s: args.seek_dwell,
-        latitude_deg: args.seek_latitude,
-    };
-    let refined = crate::train::field_correction::refine_with_dir(
-        model,
-        dir,
-        &variants,
-        args.field_weight,
-        seek,
-    )?;
-    print!("{}", refined.summary());
-    Ok(refined.model)
-}
-
-/// Stages one output (see [`StagedFiles`]), naming it on failure.
-pub(super) fn stage(staged: &mut StagedFiles, path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
-    staged
-        .stage(path, bytes)
-        .with_context(|| format!("writing {}", path.display()))
-}
-
-/// Too few run files are refused before reading: grouped validation holds out whole runs
-/// (a unit calibration one at a time: `calibrate::MIN_UNIT_RUNS`).
+/// Too few run files are refused before reading: grouped validation holds out whole runs,
+/// a unit calibration one run at a time (`calibrate::MIN_UNIT_RUNS`).
 fn check_run_count(args: &Args, cfg: &TrainConfig) -> anyhow::Result<()> {
-    // Grouped validation holds out whole runs: too few files is refused before reading.
-    let files = run_files(&args.runs)?;
-    // (a unit calibration holds out one run at a time: `calibrate::MIN_UNIT_RUNS`)
-    let needed = match args.type_model {
-        Some(_) => crate::train::type_unit::calibrate::MIN_UNIT_RUNS,
-        None => cfg.folds.max(2),
-    };
-    if files.len() < needed {
-        anyhow::bail!(
-            "{} run file(s): grouped validation holds out whole runs (one per file) and needs at least {needed}",
-            files.len()
-        );
+    let files = run_files(&args.runs)?.len();
+    match args.type_model {
+        Some(_) => {
+            let needed = crate::train::type_unit::calibrate::MIN_UNIT_RUNS;
+            anyhow::ensure!(
+                files >= needed,
+                "{files} run file(s): a unit calibration holds out one run at a time to choose the type's weight and needs at least {needed}"
+            );
+        }
+        None => {
+            let needed = cfg.folds.max(2);
+            anyhow::ensure!(
+                files >= needed,
+                "{files} run file(s): grouped validation holds out whole runs (one per file) and needs at least {needed}"
+            );
+        }
     }
     Ok(())
 }
@@ -356,26 +142,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     // and held until the command ends.
     let guard = OutputGuard::new(&inputs(&args)?);
     check_outputs(&args, &guard)?;
-    let outputs: Vec<&Path> = [
-        Some(&args.out),
-        args.json.as_ref(),
-        args.export_design.as_ref(),
-        args.type_out.as_ref(),
-    ]
-    .into_iter()
-    .flatten()
-    .map(|p| p.as_path())
-    .collect();
-    let _lock = OutputLock::acquire(&outputs).map_err(anyhow::Error::msg)?;
+    let _lock = OutputLock::acquire(&output_paths(&args)).map_err(anyhow::Error::msg)?;
     check_run_count(&args, &cfg)?;
     let runs = read_runs_binned(&args.runs)?;
-    if let Some(path) = &args.type_model {
-        if super::train_type::calibrate(&args, path, &runs)? {
-            return Ok(());
-        }
-    }
+    let own_record = match &args.type_model {
+        Some(path) => match type_unit::calibrate(&args, path, &runs, cfg.folds.max(2))? {
+            type_unit::Calibrated::Done => return Ok(()),
+            type_unit::Calibrated::Own(record) => Some(record),
+        },
+        None => None,
+    };
     if let Some(path) = &args.type_out {
-        return super::train_type::learn(&args, &cfg, &candidates, path, &runs);
+        return type_unit::learn(&args, &cfg, &candidates, path, &runs);
     }
     let (selection, ds) = choose_inputs_default(&runs, &candidates, &cfg)?;
     if args.inputs == InputChoice::Auto {
@@ -441,6 +219,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         )?;
     }
     staged.commit().context("committing the outputs")?;
+    if let Some(record) = own_record {
+        type_unit::record_own(&args, record, &runs, &buf[..len])?;
+    }
     print!("{}", summary(&outcome, runs.len(), len));
     if let Some(r) = &refit {
         println!("{}", r.summary());

@@ -8,7 +8,8 @@ use std::path::Path;
 use anyhow::{anyhow, bail, Result};
 use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
 
-use super::train::{stage, Args};
+use super::args::Args;
+use super::finish::{field_refined, stage};
 use crate::io::runs::Run;
 use crate::io::StagedFiles;
 use crate::registry::{Registry, UnitCalibrationRecord};
@@ -44,7 +45,7 @@ fn encoded(model: &RbfModel, gyro_id: &str) -> Result<(Vec<u8>, u32)> {
 
 /// `--type-out`: learns the type, writes it, the shared model (`--out`) and `--json` (the
 /// type file's content), and records it when `--registry` is given.
-pub fn learn(
+pub(super) fn learn(
     args: &Args,
     cfg: &TrainConfig,
     candidates: &[InputSet],
@@ -96,9 +97,23 @@ pub fn learn(
     Ok(())
 }
 
-/// `--type`: calibrates the unit. Ok(true): done (written, or nothing to write); Ok(false):
-/// the unit is outside its type and `--misfit own` asks for the ordinary training.
-pub fn calibrate(args: &Args, type_path: &Path, runs: &[Run]) -> Result<bool> {
+/// What `--type` leaves to the caller.
+pub(super) enum Calibrated {
+    /// Done: the unit's model written (or nothing to write) and recorded.
+    Done,
+    /// The unit is outside its type and `--misfit own` asks for the ordinary training on
+    /// its runs alone; the record is written once that model is (with its CRC).
+    Own(UnitCalibrationRecord),
+}
+
+/// `--type`: calibrates the unit. `min_own_runs`: the run count the ordinary training
+/// needs, checked before anything is recorded when `--misfit own` falls back to it.
+pub(super) fn calibrate(
+    args: &Args,
+    type_path: &Path,
+    runs: &[Run],
+    min_own_runs: usize,
+) -> Result<Calibrated> {
     let ty = TypeModel::read(type_path)?;
     let unit = unit_id_of(runs, &args.gyro_id)?;
     let plan = UnitPlan {
@@ -116,7 +131,7 @@ pub fn calibrate(args: &Args, type_path: &Path, runs: &[Run]) -> Result<bool> {
     let device_model = for_gyro(&cal.model, &args.gyro_id)?;
     let model = match misfit {
         true => device_model,
-        false => super::train::field_refined(args, &device_model)?,
+        false => field_refined(args, &device_model)?,
     };
     let (bytes, crc) = encoded(&model, &args.gyro_id)?;
     let mut record = UnitCalibrationRecord {
@@ -130,28 +145,34 @@ pub fn calibrate(args: &Args, type_path: &Path, runs: &[Run]) -> Result<bool> {
         model_crc32: Some(crc),
     };
     if misfit {
-        record.outcome = match policy {
-            MisfitPolicy::Refuse => "refused (misfit)".into(),
-            MisfitPolicy::Own => "own model (misfit)".into(),
-        };
         record.model_crc32 = None;
-    }
-    if let Some(db) = &args.registry {
-        let names: Vec<String> = runs.iter().map(Run::name).collect();
-        Registry::open(db)?.record_unit_calibration(&record, &names)?;
-    }
-    if misfit {
-        return match policy {
-            MisfitPolicy::Refuse => bail!(
-                "unit {unit}: outside its type {} (above); nothing written (`--misfit own` trains it on its own runs alone)",
-                ty.file.type_id
-            ),
-            MisfitPolicy::Own => {
-                println!("unit {unit}: outside its type: trained on its own runs alone (--misfit own)");
-                Ok(false)
+        let type_id = &ty.file.type_id;
+        match policy {
+            MisfitPolicy::Refuse => {
+                record.outcome = "refused (misfit)".into();
+                record_unit(args, &record, runs)?;
+                bail!(
+                    "unit {unit}: outside its type {type_id} (above); nothing written (`--misfit own` trains it on its own runs alone)"
+                );
             }
-        };
+            MisfitPolicy::Own if runs.len() < min_own_runs => {
+                record.outcome = "refused (misfit, too few runs of its own)".into();
+                record_unit(args, &record, runs)?;
+                bail!(
+                    "unit {unit}: outside its type {type_id} (above), and {} run(s) are too few to train it on its own (`--misfit own` needs at least {min_own_runs}); nothing written",
+                    runs.len()
+                );
+            }
+            MisfitPolicy::Own => {
+                record.outcome = "own model (misfit)".into();
+                println!(
+                    "unit {unit}: outside its type: trained on its own runs alone (--misfit own)"
+                );
+                return Ok(Calibrated::Own(record));
+            }
+        }
     }
+    record_unit(args, &record, runs)?;
     let mut staged = StagedFiles::default();
     stage(&mut staged, &args.out, &bytes)?;
     if let Some(j) = &args.json {
@@ -163,5 +184,26 @@ pub fn calibrate(args: &Args, type_path: &Path, runs: &[Run]) -> Result<bool> {
         args.gyro_id,
         args.out.display()
     );
-    Ok(true)
+    Ok(Calibrated::Done)
+}
+
+/// `--misfit own`: records the unit's own model (`record`) once it is written, with the
+/// CRC-32 of the bytes written.
+pub(super) fn record_own(
+    args: &Args,
+    mut record: UnitCalibrationRecord,
+    runs: &[Run],
+    model_bytes: &[u8],
+) -> Result<()> {
+    record.model_crc32 = Some(fog_core::model::crc::crc32(model_bytes));
+    record_unit(args, &record, runs)
+}
+
+/// Records one unit calibration's outcome and its runs in `--registry`, if given.
+fn record_unit(args: &Args, record: &UnitCalibrationRecord, runs: &[Run]) -> Result<()> {
+    if let Some(db) = &args.registry {
+        let names: Vec<String> = runs.iter().map(Run::name).collect();
+        Registry::open(db)?.record_unit_calibration(record, &names)?;
+    }
+    Ok(())
 }

@@ -15,15 +15,13 @@
 //! shortest run. The size is bounded: at most `MAX_CANDIDATES` (the rest are skipped and
 //! reported as such); about 20 per column.
 
-use crate::diagnose::candidates::metadata::{MetaColumn, MetaKind};
+use crate::diagnose::candidates::metadata::{MetaColumn, MetaKind, MAX_LEVELS};
 use crate::diagnose::candidates::transforms::{BaseInput, Candidate, Source, Transform};
 use crate::diagnose::input::Campaign;
 use crate::stats::mean_or_zero;
 
 /// Cap on the library's size (the rest are reported as skipped).
 pub const MAX_CANDIDATES: usize = 400;
-/// Columns with at most this many distinct values also get level indicators.
-pub const MAX_LEVELS: usize = 5;
 /// Knot counts of the natural splines (Harrell's quantile placements).
 pub const SPLINE_KNOTS: [&[f64]; 2] = [
     &[0.05, 0.35, 0.65, 0.95],

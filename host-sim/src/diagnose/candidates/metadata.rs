@@ -20,9 +20,12 @@
 //! `ambient_c` and `latitude_deg` are left out: `between_runs` and the azimuth already
 //! use them.
 
-use crate::diagnose::candidates::generic::MAX_LEVELS;
 use crate::io::runs::Run;
 use crate::io::utc::parse_iso8601;
+
+/// Columns and metadata fields with at most this many distinct values also get level
+/// indicators (categories).
+pub const MAX_LEVELS: usize = 5;
 
 /// How a metadata key's values were read.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

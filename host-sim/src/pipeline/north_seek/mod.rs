@@ -21,11 +21,13 @@
 //! Files: `config` (what is asked), `seeks` (one power-on's seeks), `monte_carlo` (the
 //! starts over threads, the bench heading calibration), `summary` (statistics, report,
 //! tables); `own_model` (the device's own chamber model), `schedule` (when each seek
-//! runs), `targets` (the targets line).
+//! runs), `targets` (the targets line), `unit_recipe` (a unit's model from a type and a few
+//! of its own runs), `recipe_compare` (the demo's recipes side by side).
 
 mod config;
 mod monte_carlo;
 pub mod own_model;
+pub mod recipe_compare;
 pub mod schedule;
 mod seeks;
 mod summary;

@@ -73,6 +73,15 @@ impl UnitRecipe {
                 self.unit_runs
             ));
         }
+        // Without a type the unit's runs are trained as any model is: grouped validation
+        // over whole runs, `TrainConfig`'s folds.
+        let own_folds = crate::train::TrainConfig::default().folds;
+        if self.type_units == 0 && self.unit_runs < own_folds {
+            return Err(anyhow!(
+                "--unit-runs {}: --type-units 0 trains the unit on its own runs alone, and grouped validation needs at least {own_folds}",
+                self.unit_runs
+            ));
+        }
         if !(2..=48).contains(&self.type_unit_runs) {
             return Err(anyhow!(
                 "--type-unit-runs {}: must be within 2..=48 (a type unit's error is measured by leaving one run out)",
@@ -120,40 +129,41 @@ fn unit_runs(
         .collect())
 }
 
-/// Makes the seeking unit's model by `recipe` (see the module notes); `plan` is the
-/// own-model recipe's plan (the seek's ambient, dwell, criterion and seek timing).
-pub fn recipe_model(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<RecipeModel> {
+/// The recipe's fleet: the paper's gyro as the type, the default unit spread, drawn from
+/// the recipe's seed.
+fn recipe_fleet(recipe: &UnitRecipe) -> FleetType {
+    FleetType::paper(TypeSpread::default_spread(), "default", recipe.seed)
+}
+
+/// The seeking unit's parameters (what the Monte Carlo seeks with).
+pub fn seeking_unit_params(recipe: &UnitRecipe) -> Result<GyroParams> {
+    recipe_fleet(recipe)
+        .unit(SEEKING_UNIT)
+        .map_err(|e| anyhow!("{e}"))
+}
+
+/// Chamber hours of `runs` cold starts (soaks not counted).
+pub fn chamber_h(runs: usize) -> f64 {
+    runs as f64 * PAPER_MINUTES / 60.0
+}
+
+/// A type learnt from the recipe's type units (U2..U(N+1)), and how it was learnt.
+pub struct RecipeType {
+    pub type_model: TypeModel,
+    pub type_runs: usize,
+    pub summary: String,
+}
+
+/// Learns the recipe's type (`recipe.type_units` >= 3; see the module notes); `plan` is
+/// the own-model recipe's plan.
+pub fn learn_recipe_type(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<RecipeType> {
     recipe.check()?;
-    let fleet = FleetType::paper(TypeSpread::default_spread(), "default", recipe.seed);
-    let unit_params = fleet.unit(SEEKING_UNIT).map_err(|e| anyhow!("{e}"))?;
-    let own = unit_runs(
-        &fleet,
-        SEEKING_UNIT,
-        &recipe.unit_ambients_c,
-        recipe.unit_runs,
-        recipe.seed,
-    )?;
-    let hours = |runs: usize| runs as f64 * PAPER_MINUTES / 60.0;
     if recipe.type_units == 0 {
-        let trained = own_model_from_runs(&fleet.params, own, plan)?;
-        let summary = format!(
-            "type-free recipe: unit {} trained on its own {} runs ({:.1} chamber h)\n{}",
-            unit_id(SEEKING_UNIT),
-            recipe.unit_runs,
-            hours(recipe.unit_runs),
-            trained.summary()
-        );
-        return Ok(RecipeModel {
-            model: trained.trained.model,
-            unit_params,
-            type_model: None,
-            calibration: None,
-            type_runs: 0,
-            type_chamber_h: 0.0,
-            unit_chamber_h: hours(recipe.unit_runs),
-            summary,
-        });
+        return Err(anyhow!(
+            "--type-units 0: the type-free recipe learns no type"
+        ));
     }
+    let fleet = recipe_fleet(recipe);
     let per_unit = recipe.type_unit_runs;
     let mut pooled = Vec::with_capacity(recipe.type_units * per_unit);
     for u in 1..=recipe.type_units {
@@ -186,6 +196,82 @@ pub fn recipe_model(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<RecipeMo
         .into_iter()
         .find(|o| o.trained.model == ty.model)
         .ok_or_else(|| anyhow!("the type's shared model is none of the rounds'"))?;
+    let summary = format!(
+        "type: {} units x {per_unit} runs ({:.1} chamber h); shared model ({} centres, inputs {}):\n{}{}{}",
+        recipe.type_units,
+        chamber_h(type_runs),
+        shared.trained.report.n_centers,
+        shared.trained.report.inputs.join(", "),
+        shared.selection.summary(),
+        shared.summary(),
+        ty.summary(),
+    );
+    Ok(RecipeType {
+        type_model: ty,
+        type_runs,
+        summary,
+    })
+}
+
+/// Makes the seeking unit's model by `recipe` (see the module notes); `plan` is the
+/// own-model recipe's plan (the seek's ambient, dwell, criterion and seek timing).
+pub fn recipe_model(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<RecipeModel> {
+    recipe.check()?;
+    match recipe.type_units {
+        0 => type_free_model(recipe, plan),
+        _ => unit_model(recipe, learn_recipe_type(recipe, plan)?, plan),
+    }
+}
+
+/// The type-free recipe: the seeking unit's own runs alone, by the own-model recipe.
+pub fn type_free_model(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<RecipeModel> {
+    recipe.check()?;
+    let fleet = recipe_fleet(recipe);
+    let unit_params = seeking_unit_params(recipe)?;
+    let own = unit_runs(
+        &fleet,
+        SEEKING_UNIT,
+        &recipe.unit_ambients_c,
+        recipe.unit_runs,
+        recipe.seed,
+    )?;
+    let trained = own_model_from_runs(&fleet.params, own, plan)?;
+    let summary = format!(
+        "type-free recipe: unit {} trained on its own {} runs ({:.1} chamber h)\n{}",
+        unit_id(SEEKING_UNIT),
+        recipe.unit_runs,
+        chamber_h(recipe.unit_runs),
+        trained.summary()
+    );
+    Ok(RecipeModel {
+        model: trained.trained.model,
+        unit_params,
+        type_model: None,
+        calibration: None,
+        type_runs: 0,
+        type_chamber_h: 0.0,
+        unit_chamber_h: chamber_h(recipe.unit_runs),
+        summary,
+    })
+}
+
+/// The seeking unit calibrated from its own runs with `learnt` (the recipe's type, just
+/// learnt or kept from an earlier run with the same recipe) as the prior.
+pub fn unit_model(
+    recipe: &UnitRecipe,
+    learnt: RecipeType,
+    plan: &OwnModelPlan,
+) -> Result<RecipeModel> {
+    recipe.check()?;
+    let fleet = recipe_fleet(recipe);
+    let unit_params = seeking_unit_params(recipe)?;
+    let own = unit_runs(
+        &fleet,
+        SEEKING_UNIT,
+        &recipe.unit_ambients_c,
+        recipe.unit_runs,
+        recipe.seed,
+    )?;
     let unit_plan = UnitPlan {
         seek: SeekGeometry {
             dwell_s: plan.dwell_s,
@@ -193,26 +279,17 @@ pub fn recipe_model(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<RecipeMo
         },
         terms: None,
     };
+    let ty = learnt.type_model;
     let cal = calibrate_unit(&ty, &own, &unit_id(SEEKING_UNIT), &unit_plan)?;
-    let summary = format!(
-        "type: {} units x {per_unit} runs ({:.1} chamber h); shared model ({} centres, inputs {}):\n{}{}{}{}",
-        recipe.type_units,
-        hours(type_runs),
-        shared.trained.report.n_centers,
-        shared.trained.report.inputs.join(", "),
-        shared.selection.summary(),
-        shared.summary(),
-        ty.summary(),
-        cal.summary()
-    );
+    let summary = format!("{}{}", learnt.summary, cal.summary());
     Ok(RecipeModel {
         model: cal.model.clone(),
         unit_params,
         type_model: Some(ty),
         calibration: Some(cal),
-        type_runs,
-        type_chamber_h: hours(type_runs),
-        unit_chamber_h: hours(recipe.unit_runs),
+        type_runs: learnt.type_runs,
+        type_chamber_h: chamber_h(learnt.type_runs),
+        unit_chamber_h: chamber_h(recipe.unit_runs),
         summary,
     })
 }

@@ -52,7 +52,8 @@ impl Misfit {
     }
 
     /// One line per term outside (`unit U3: Shupe coefficient 4.1 sigma outside the type
-    /// (critical 3.2)`), then one naming the terms without test power.
+    /// (critical 3.2)`), then one naming the terms without test power (not those found
+    /// outside: their test was strong enough for this unit).
     pub fn lines(&self) -> Vec<String> {
         let mut v: Vec<String> = self
             .terms
@@ -71,7 +72,8 @@ impl Misfit {
         let blind: Vec<&str> = self
             .terms
             .iter()
-            .filter(|t| !t.has_power)
+            // a term found outside had power enough for this unit
+            .filter(|t| !t.has_power && !t.outside)
             .map(|t| t.name.as_str())
             .collect();
         if !blind.is_empty() {
@@ -182,6 +184,31 @@ mod tests {
             6,
         );
         assert!(!inside.outside(), "{:?}", inside.lines());
+    }
+
+    #[test]
+    fn a_term_found_outside_is_not_also_said_to_lack_power() {
+        let (mean, spread) = ([0.0, 1.0], [0.1, 0.1]);
+        // 3 type units: the critical value exceeds the 5-spread power bound, yet a unit
+        // 30 spreads out is found; it is not listed as having no test power.
+        let out = test_unit(
+            "U6",
+            &names(),
+            &[0.0, 4.0],
+            &[0.01, 0.01],
+            &mean,
+            &spread,
+            3,
+            3,
+        );
+        assert!(
+            out.terms[1].outside && !out.terms[1].has_power,
+            "{:?}",
+            out.terms[1]
+        );
+        let lines = out.lines().join("\n");
+        assert!(lines.contains("Shupe coefficient"), "{lines}");
+        assert!(!lines.contains("no test power for Shupe"), "{lines}");
     }
 
     #[test]
