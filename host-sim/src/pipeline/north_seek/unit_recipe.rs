@@ -223,8 +223,8 @@ pub fn recipe_model(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<RecipeMo
     }
 }
 
-/// The type-free recipe: the seeking unit's own runs alone, by the own-model recipe.
-pub fn type_free_model(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<RecipeModel> {
+/// The recipe checked, its fleet, the seeking unit's parameters and its own runs.
+fn seeking_unit_runs(recipe: &UnitRecipe) -> Result<(FleetType, GyroParams, Vec<Run>)> {
     recipe.check()?;
     let fleet = recipe_fleet(recipe);
     let unit_params = seeking_unit_params(recipe)?;
@@ -235,6 +235,12 @@ pub fn type_free_model(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<Recip
         recipe.unit_runs,
         recipe.seed,
     )?;
+    Ok((fleet, unit_params, own))
+}
+
+/// The type-free recipe: the seeking unit's own runs alone, by the own-model recipe.
+pub fn type_free_model(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<RecipeModel> {
+    let (fleet, unit_params, own) = seeking_unit_runs(recipe)?;
     let trained = own_model_from_runs(&fleet.params, own, plan)?;
     let summary = format!(
         "type-free recipe: unit {} trained on its own {} runs ({:.1} chamber h)\n{}",
@@ -262,16 +268,7 @@ pub fn unit_model(
     learnt: RecipeType,
     plan: &OwnModelPlan,
 ) -> Result<RecipeModel> {
-    recipe.check()?;
-    let fleet = recipe_fleet(recipe);
-    let unit_params = seeking_unit_params(recipe)?;
-    let own = unit_runs(
-        &fleet,
-        SEEKING_UNIT,
-        &recipe.unit_ambients_c,
-        recipe.unit_runs,
-        recipe.seed,
-    )?;
+    let (_, unit_params, own) = seeking_unit_runs(recipe)?;
     let unit_plan = UnitPlan {
         seek: SeekGeometry {
             dwell_s: plan.dwell_s,
