@@ -12,7 +12,9 @@
 //! column's own scatter about a local straight line (7 rows), 1.4826 x its median absolute
 //! value over the campaign (MAD), times sqrt 2 for a difference; a change is an event
 //! when it exceeds `EVENT_SIGMAS` of those, and consecutive flagged rows are one event (a
-//! step inside a 10 s window is split over two rows). The scatter, not the MAD of the
+//! step inside a 10 s window is split over two rows). A change across a gap of the stamps is
+//! no step: a wandering column moves while nothing is logged, and the gap has its own clock
+//! (measured: a decoy random walk's clock was the gaps' clock under another name). The scatter, not the MAD of the
 //! differences, because a quantised thermometer's differences are mostly 0 and their MAD
 //! would make every one-quantum tick an event (measured: 22 "events" of 0.056-0.063 degC
 //! on the simulator's 66-run campaign, none with the scatter). A column whose events fall
@@ -58,10 +60,11 @@ impl EventRule {
         match self {
             Self::Steps { threshold } => {
                 let e = detrended_differences(t, x);
+                let longest = GAP_SPACINGS * median_spacing(t);
                 let mut out = Vec::new();
                 let mut previous = false;
                 for (i, v) in e.iter().enumerate() {
-                    let flagged = v.abs() > threshold;
+                    let flagged = v.abs() > threshold && t[i + 1] - t[i] <= longest;
                     if flagged && !previous {
                         // row i + 1 differs from row i: the change fell between them
                         out.push(0.5 * (t[i] + t[i + 1]));
@@ -312,6 +315,12 @@ mod tests {
         assert!(
             step_rule(&c, |s| &s.extras[1]).is_err(),
             "one-quantum ticks are noise"
+        );
+        let gapped: Vec<f64> = c.runs[1].t_s.iter().map(|t| 0.01 * t).collect();
+        let across = EventRule::Steps { threshold: 0.5 };
+        assert!(
+            across.times(&c.runs[1].t_s, &gapped).is_empty(),
+            "a change across a gap is no step"
         );
         let gaps = gap_rule(&c).expect("a gap is an event");
         assert_eq!(gaps.times(&c.runs[1].t_s, &c.runs[1].t_s), vec![1195.0]);
