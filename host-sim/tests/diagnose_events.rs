@@ -54,3 +54,57 @@ fn steps_and_gaps_without_a_response_name_nothing() {
         r.engine == "none"
     });
 }
+
+/// The report says per operator family how many candidates it gave and what the test's
+/// power is for it (issue 38 item 4): on the null twin nothing is named, so the planted-shape
+/// check runs, and the event-clock family is among the families it checks.
+#[test]
+fn the_null_twin_reports_candidates_and_power_per_operator_family() {
+    let (runs, _) = crate::common::novel::campaign(
+        Family::Event,
+        Variant::Null,
+        crate::diagnose_novel::CI_SEED,
+        crate::diagnose_novel::SHAPE,
+    );
+    let d = fog_sim::diagnose::diagnose(&runs).expect("diagnose runs");
+    let families = &d.report.campaign.operator_families;
+    for f in families {
+        println!(
+            "{}: {} candidates, {} cut, {} skipped, planted {} named {}: {} {:?}",
+            f.family,
+            f.candidates,
+            f.cut_by_cap,
+            f.skipped,
+            f.shapes_planted,
+            f.shapes_named,
+            f.power,
+            f.why_cut
+        );
+    }
+    let total: usize = families.iter().map(|f| f.candidates).sum();
+    assert_eq!(
+        total, d.report.campaign.library_size,
+        "every candidate in one family"
+    );
+    let clock = families
+        .iter()
+        .find(|f| f.family == "event clock")
+        .expect("the event-clock family is reported");
+    assert!(
+        clock.candidates > 0,
+        "steps of supply_v and gaps give clocks"
+    );
+    assert_eq!(
+        clock.shapes_planted, 1,
+        "its shape is planted: {}",
+        clock.power
+    );
+    assert!(
+        clock.power.contains("planted shapes named") || clock.power.starts_with("no test power"),
+        "{}",
+        clock.power
+    );
+    let text = fog_sim::diagnose::report::text::render_text(&d.report);
+    assert!(text.contains("within-run candidates per operator family: value"));
+    assert!(text.contains("    event clock: "));
+}

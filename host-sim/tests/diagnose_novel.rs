@@ -15,7 +15,7 @@ use novel::{campaign, Family, Shape, Variant, VARIANTS};
 use serde_json::Value;
 
 /// Campaign shape of every case: 12 runs x 40 min, each planted cause at 1 sigma.
-const SHAPE: Shape = Shape {
+pub(crate) const SHAPE: Shape = Shape {
     runs: 12,
     minutes: 40.0,
     sigmas: 1.0,
