@@ -15,17 +15,17 @@ use novel::{campaign, Family, Shape, Variant, VARIANTS};
 use serde_json::Value;
 
 /// Campaign shape of every case: 12 runs x 40 min, each planted cause at 1 sigma.
-const SHAPE: Shape = Shape {
+pub(crate) const SHAPE: Shape = Shape {
     runs: 12,
     minutes: 40.0,
     sigmas: 1.0,
 };
 
 /// The CI seed: one, since `diagnose` itself takes ~1-3 s a case and there are 18 cases.
-const CI_SEED: u64 = seeds::SEEDS[0];
+pub(crate) const CI_SEED: u64 = seeds::SEEDS[0];
 
 /// `DIAG_SEEDS` when set, else the CI seed.
-fn case_seeds() -> Vec<u64> {
+pub(crate) fn case_seeds() -> Vec<u64> {
     if std::env::var("DIAG_SEEDS").is_ok() {
         seeds::seeds()
     } else {
@@ -138,12 +138,14 @@ fn verdict(truth: &[&str], named: &[String]) -> &'static str {
     }
 }
 
-struct Row {
-    variant: Variant,
-    seed: u64,
-    engine: &'static str,
-    peer: &'static str,
-    line: String,
+/// One case's table row: the verdicts of `diagnose` and the peer, and what `diagnose` named.
+pub(crate) struct Row {
+    pub(crate) variant: Variant,
+    pub(crate) seed: u64,
+    pub(crate) engine: &'static str,
+    pub(crate) peer: &'static str,
+    pub(crate) named: Vec<String>,
+    pub(crate) line: String,
 }
 
 fn run_family(family: Family) -> Vec<Row> {
@@ -153,33 +155,50 @@ fn run_family(family: Family) -> Vec<Row> {
         .collect();
     cases
         .into_iter()
-        .map(|(variant, seed)| {
-            let (runs, truth) = campaign(family, variant, seed, SHAPE);
-            let e = engine(&runs);
-            let p = peer::peer(&runs);
-            let peer_named: Vec<String> = p.named.iter().map(|n| format!("{} p{:.3}", n.label, n.p_value)).collect();
-            let peer_labels: Vec<String> = p.named.iter().map(|n| n.label.clone()).collect();
-            let (ev, pv) = (verdict(&truth.columns, &e.named), verdict(&truth.columns, &peer_labels));
-            let line = format!(
-                "| {family:?} | {variant:?} | {seed} | {} | {} {ev} | {:+.1} | {} | {} {pv} | {:+.1} ({} of {}) |",
-                truth.law,
-                if e.named.is_empty() { "-".to_owned() } else { e.named.join(", ") },
-                e.gain_pct,
-                e.p_value.map_or("-".to_owned(), |p| format!("{p:.4}")),
-                if peer_named.is_empty() { "-".to_owned() } else { peer_named.join(", ") },
-                p.cv_gain_pct,
-                p.selected,
-                p.library_size,
-            );
-            println!("{line}");
-            Row { variant, seed, engine: ev, peer: pv, line }
-        })
+        .map(|(variant, seed)| run_case(family, variant, seed))
         .collect()
+}
+
+/// One case: the campaign of `family` / `variant` / `seed`, diagnosed and given to the peer.
+pub(crate) fn run_case(family: Family, variant: Variant, seed: u64) -> Row {
+    let (runs, truth) = campaign(family, variant, seed, SHAPE);
+    let e = engine(&runs);
+    let p = peer::peer(&runs);
+    let peer_named: Vec<String> = p
+        .named
+        .iter()
+        .map(|n| format!("{} p{:.3}", n.label, n.p_value))
+        .collect();
+    let peer_labels: Vec<String> = p.named.iter().map(|n| n.label.clone()).collect();
+    let (ev, pv) = (
+        verdict(&truth.columns, &e.named),
+        verdict(&truth.columns, &peer_labels),
+    );
+    let line = format!(
+        "| {family:?} | {variant:?} | {seed} | {} | {} {ev} | {:+.1} | {} | {} {pv} | {:+.1} ({} of {}) |",
+        truth.law,
+        if e.named.is_empty() { "-".to_owned() } else { e.named.join(", ") },
+        e.gain_pct,
+        e.p_value.map_or("-".to_owned(), |p| format!("{p:.4}")),
+        if peer_named.is_empty() { "-".to_owned() } else { peer_named.join(", ") },
+        p.cv_gain_pct,
+        p.selected,
+        p.library_size,
+    );
+    println!("{line}");
+    Row {
+        variant,
+        seed,
+        engine: ev,
+        peer: pv,
+        named: e.named,
+        line,
+    }
 }
 
 /// Asserts `holds` on the CI seed's row of `variant` (other seeds are printed only; the
 /// 6-seed table in docs/record/diagnose.md says how often each claim holds there).
-fn assert_ci(rows: &[Row], variant: Variant, what: &str, holds: impl Fn(&Row) -> bool) {
+pub(crate) fn assert_ci(rows: &[Row], variant: Variant, what: &str, holds: impl Fn(&Row) -> bool) {
     let bad: Vec<&str> = rows
         .iter()
         .filter(|r| r.seed == CI_SEED && r.variant == variant && !holds(r))

@@ -26,6 +26,7 @@ mod diagnose_between;
 mod diagnose_cli_json;
 mod diagnose_competing;
 mod diagnose_derivatives;
+mod diagnose_events;
 mod diagnose_memory;
 mod diagnose_novel;
 mod diagnose_planted;

@@ -64,9 +64,10 @@ pub fn diagnose_with(
     let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
     let latitude = assemble::latitude_of(&campaign);
     let meta = candidates::metadata::metadata(runs);
-    let (library, cap_note) = candidates::library_of(&campaign, &meta, st.temp_rate_half_s);
+    let (built, cap_note) = candidates::library_of(&campaign, &meta, st.temp_rate_half_s);
+    let library = &built.candidates;
     let (choice, mut screening, base_rule, between_run, groups) =
-        between_runs::screen_both(&campaign, &meta, &folds, &st, choice, &library, latitude)?;
+        between_runs::screen_both(&campaign, &meta, &folds, &st, choice, library, latitude)?;
     let base = &choice.chosen;
     screening.skipped.extend(cap_note);
     let named = screening.steps.first();
@@ -89,10 +90,7 @@ pub fn diagnose_with(
         assemble::named_causes(&folds, &st, base, &screening, &between_run, latitude);
     let smallest_attainable_p = validation::signflip::smallest_p(folds.unit_rows.len());
     let silent = cause.is_none() && between_run.named.is_none();
-    let rerun = selection::power::Rerun {
-        library: &library,
-        groups,
-    };
+    let rerun = selection::power::Rerun { library, groups };
     let power_check =
         selection::power::check(silent, &campaign, &folds, &mut st, base, &screening, rerun)?;
     memprobe::stage("power::check");
@@ -111,9 +109,9 @@ pub fn diagnose_with(
             &campaign,
             &folds,
             &screening,
-            library.len(),
+            &built,
             smallest_attainable_p,
-            power_check,
+            (silent, power_check),
         ),
         base: assemble::base_summary(&choice, base_rule, &st, &campaign),
         residual_structure: report::residuals::structure(&campaign, &folds, &st, &base.cv.residual),

@@ -1,7 +1,8 @@
 //! Campaigns that plant effects `diagnose` was NOT written around (issue 18): a product of
 //! two columns, a categorical column, a smooth nonlinear function of a column,
-//! rate-independent memory (backlash), a between-run effect of a metadata key, and two
-//! causes at once. Each family has an effect, a twin with a different physical law and a
+//! rate-independent memory (backlash), a between-run effect of a metadata key, two
+//! causes at once, and a transient after each event (issue 38 item 1: a step of the
+//! supply, or a gap of the time stamps, each followed by a decay). Each family has an effect, a twin with a different physical law and a
 //! null twin (same campaign, nothing planted). Nothing is shared with the project's
 //! simulator or the other generators: its own warm-up law (first-order self-heating on a
 //! chamber that cycles through a lag), cold / warm / hot restarts, turn-on offsets, 0.0625
@@ -32,15 +33,17 @@ pub enum Family {
     Memory,
     Metadata,
     Stacked,
+    Event,
 }
 
-pub const FAMILIES: [Family; 6] = [
+pub const FAMILIES: [Family; 7] = [
     Family::Product,
     Family::Categorical,
     Family::Smooth,
     Family::Memory,
     Family::Metadata,
     Family::Stacked,
+    Family::Event,
 ];
 
 /// The effect, its twin (another physical law on the same columns) or the null twin.
@@ -74,7 +77,7 @@ impl Family {
     pub fn row_s(self) -> f64 {
         match self {
             Family::Product | Family::Smooth | Family::Stacked => 1.0,
-            Family::Categorical | Family::Memory | Family::Metadata => 10.0,
+            Family::Categorical | Family::Memory | Family::Metadata | Family::Event => 10.0,
         }
     }
 
@@ -99,6 +102,10 @@ impl Family {
             (Family::Stacked, Variant::Twin) => {
                 ("backlash of T + mount offset", vec!["temp_c", "mount"])
             }
+            (Family::Event, Variant::Effect) => {
+                ("exp decay after each supply_v step", vec!["supply_v"])
+            }
+            (Family::Event, Variant::Twin) => ("exp decay after each gap of t_s", vec!["t_s"]),
         };
         Truth { law, columns }
     }
@@ -116,6 +123,10 @@ struct Series {
     wander: Vec<f64>,
     mount_b: bool,
     ambient_c: f64,
+    /// Rows the logger wrote (false in the gaps of `Family::Event`).
+    kept: Vec<bool>,
+    /// Where the stamps resume after each gap, s.
+    gap_ends_s: Vec<f64>,
 }
 
 /// A first-order lag of `x` sampled every `dt` s.
@@ -225,7 +236,43 @@ fn draw_run(
         wander,
         mount_b,
         ambient_c,
+        kept: vec![true; n],
+        gap_ends_s: vec![],
     }
+}
+
+/// Cuts 3 gaps of 40-120 s into a run (none in its first 5 minutes), as a logger that
+/// drops out for a while writes it.
+fn cut_gaps(rng: &mut ChaCha8Rng, s: &mut Series, dt: f64) {
+    let n = s.t_s.len();
+    let first = (300.0 / dt) as usize;
+    for _ in 0..3 {
+        let len = (rng.random_range(40.0..120.0) / dt).round().max(1.0) as usize;
+        if first + len + 2 >= n {
+            return;
+        }
+        let start = rng.random_range(first..n - len - 1);
+        s.kept[start..start + len]
+            .iter_mut()
+            .for_each(|k| *k = false);
+    }
+    s.gap_ends_s = (1..n)
+        .filter(|&k| s.kept[k] && !s.kept[k - 1])
+        .map(|k| s.t_s[k] - 0.5 * dt)
+        .collect();
+}
+
+/// The sum of `exp(-(t - t_k) / tau_s)` over the events `t_k <= t`.
+fn transients(t: &[f64], events: &[f64], tau_s: f64) -> Vec<f64> {
+    t.iter()
+        .map(|ti| {
+            events
+                .iter()
+                .filter(|e| **e <= *ti)
+                .map(|e| (-(ti - e) / tau_s).exp())
+                .sum()
+        })
+        .collect()
 }
 
 /// Solves a 3x3 system by Cramer's rule (None if singular).
@@ -314,6 +361,8 @@ enum Cause {
     Lagged,
     MountOffset,
     MountSlope,
+    StepTransient,
+    GapTransient,
 }
 
 fn causes(f: Family, v: Variant) -> Vec<Cause> {
@@ -331,6 +380,8 @@ fn causes(f: Family, v: Variant) -> Vec<Cause> {
         (Family::Metadata, Variant::Twin) => vec![Cause::MountSlope],
         (Family::Stacked, Variant::Effect) => vec![Cause::CabinetTanh, Cause::ModeBias],
         (Family::Stacked, Variant::Twin) => vec![Cause::Backlash, Cause::MountOffset],
+        (Family::Event, Variant::Effect) => vec![Cause::StepTransient],
+        (Family::Event, Variant::Twin) => vec![Cause::GapTransient],
     }
 }
 
@@ -340,6 +391,8 @@ struct Law {
     cabinet_mid_c: f64,
     mode_bias: [f64; 3],
     dt: f64,
+    /// Time constant of the transients after events, s.
+    transient_tau_s: f64,
 }
 
 fn shape_of(c: Cause, s: &Series, law: &Law) -> Vec<f64> {
@@ -382,12 +435,63 @@ fn shape_of(c: Cause, s: &Series, law: &Law) -> Vec<f64> {
             .iter()
             .map(|t| if s.mount_b { t - law.temp_mid_c } else { 0.0 })
             .collect(),
+        Cause::StepTransient => {
+            // a change of the supply between rows k - 1 and k happened during row k
+            let steps: Vec<f64> = (1..n)
+                .filter(|&k| s.supply_v[k] != s.supply_v[k - 1])
+                .map(|k| s.t_s[k] - 0.5 * law.dt)
+                .collect();
+            transients(&s.t_s, &steps, law.transient_tau_s)
+        }
+        Cause::GapTransient => transients(&s.t_s, &s.gap_ends_s, law.transient_tau_s),
     }
 }
 
 fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
+}
+
+/// What the logger writes of run `i`: the sensed columns (thermometer, cabinet and supply
+/// quantised with their noise), `rate` as measured, the metadata; the rows in the
+/// logger's gaps (`Family::Event` only) are never written.
+fn logged_run(rng: &mut ChaCha8Rng, i: usize, s: &Series, rate: Vec<f64>) -> Run {
+    let g = Normal::new(0.0, 1.0).unwrap();
+    let sensed = |v: &[f64], sd: f64, q: f64, rng: &mut ChaCha8Rng| -> Vec<f64> {
+        v.iter()
+            .map(|x| ((x + sd * g.sample(rng)) / q).round() * q)
+            .collect()
+    };
+    let temp = sensed(&s.temp_c, 0.01, 0.0625, rng);
+    let cabinet = sensed(&s.cabinet_c, 0.05, 0.01, rng);
+    let supply = sensed(&s.supply_v, 0.01, 0.001, rng);
+    let cols = vec![
+        ("t_s".to_owned(), s.t_s.clone()),
+        ("rate_dph".to_owned(), rate),
+        ("temp_c".to_owned(), temp),
+        ("cabinet_c".to_owned(), cabinet),
+        ("supply_v".to_owned(), supply),
+        ("mode".to_owned(), s.mode.clone()),
+        ("fan_on".to_owned(), s.fan.clone()),
+        ("decoy_wander".to_owned(), s.wander.clone()),
+    ];
+    // the logger's gaps (`Family::Event` only): rows never written
+    let cols = cols
+        .into_iter()
+        .map(|(name, v)| {
+            let kept = v.into_iter().zip(&s.kept).filter(|(_, k)| **k);
+            (name, kept.map(|(x, _)| x).collect())
+        })
+        .collect();
+    let meta = vec![
+        ("gyro".to_owned(), "novel".to_owned()),
+        ("ambient_c".to_owned(), format!("{:.2}", s.ambient_c)),
+        (
+            "mount".to_owned(),
+            if s.mount_b { "B" } else { "A" }.to_owned(),
+        ),
+    ];
+    Run::new(format!("novel_{i:02}.csv"), meta, cols).expect("generator builds valid runs")
 }
 
 /// Builds a campaign of `family` / `variant`; the effect, twin and null of one seed share
@@ -410,7 +514,7 @@ pub fn campaign(family: Family, variant: Variant, seed: u64, shape: Shape) -> (V
     for i in (1..mounts.len()).rev() {
         mounts.swap(i, rng.random_range(0..=i));
     }
-    let series: Vec<Series> = (0..shape.runs)
+    let mut series: Vec<Series> = (0..shape.runs)
         .map(|i| {
             let amb = ambients[i % ambients.len()] + 0.5 * g.sample(&mut rng);
             draw_run(&mut rng, i, n, dt, amb, mounts[i])
@@ -433,7 +537,17 @@ pub fn campaign(family: Family, variant: Variant, seed: u64, shape: Shape) -> (V
         ),
         mode_bias: bias,
         dt,
+        transient_tau_s: if family == Family::Event {
+            rng.random_range(150.0..400.0)
+        } else {
+            0.0
+        },
     };
+    if family == Family::Event {
+        for s in &mut series {
+            cut_gaps(&mut rng, s, dt);
+        }
+    }
     let mut planted = vec![vec![0.0; n]; shape.runs];
     for c in causes(family, variant) {
         let mut e: Vec<Vec<f64>> = series.iter().map(|s| shape_of(c, s, &law)).collect();
@@ -463,33 +577,7 @@ pub fn campaign(family: Family, variant: Variant, seed: u64, shape: Shape) -> (V
                         + row_sigma * g.sample(&mut rng)
                 })
                 .collect();
-            let sensed = |v: &[f64], sd: f64, q: f64, rng: &mut ChaCha8Rng| -> Vec<f64> {
-                v.iter()
-                    .map(|x| ((x + sd * g.sample(rng)) / q).round() * q)
-                    .collect()
-            };
-            let temp = sensed(&s.temp_c, 0.01, 0.0625, &mut rng);
-            let cabinet = sensed(&s.cabinet_c, 0.05, 0.01, &mut rng);
-            let supply = sensed(&s.supply_v, 0.01, 0.001, &mut rng);
-            let cols = vec![
-                ("t_s".to_owned(), s.t_s.clone()),
-                ("rate_dph".to_owned(), rate),
-                ("temp_c".to_owned(), temp),
-                ("cabinet_c".to_owned(), cabinet),
-                ("supply_v".to_owned(), supply),
-                ("mode".to_owned(), s.mode.clone()),
-                ("fan_on".to_owned(), s.fan.clone()),
-                ("decoy_wander".to_owned(), s.wander.clone()),
-            ];
-            let meta = vec![
-                ("gyro".to_owned(), "novel".to_owned()),
-                ("ambient_c".to_owned(), format!("{:.2}", s.ambient_c)),
-                (
-                    "mount".to_owned(),
-                    if s.mount_b { "B" } else { "A" }.to_owned(),
-                ),
-            ];
-            Run::new(format!("novel_{i:02}.csv"), meta, cols).expect("generator builds valid runs")
+            logged_run(&mut rng, i, s, rate)
         })
         .collect();
     (runs, family.truth(variant))

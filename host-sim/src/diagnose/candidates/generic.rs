@@ -9,12 +9,17 @@
 //! time scales. Metadata keys that vary between runs enter as run-constant columns
 //! (`metadata`: numbers, times as days, versions by rank, categories; their products with
 //! the base's inputs are within-run candidates; their values and levels are run-level
-//! candidates, `between_runs`).
+//! candidates, `between_runs`). Last, event clocks (`events`): a decay after each step of
+//! every column (the temperature too) and after each gap of the time stamps; they come
+//! last so that the cap, when it bites, cuts them before the older families (the report
+//! says so per family).
 //!
 //! Memory time scales are the record's: from twice the row spacing, doubling, to half the
 //! shortest run. The size is bounded: at most `MAX_CANDIDATES` (the rest are skipped and
 //! reported as such); about 20 per column.
 
+use crate::diagnose::candidates::events;
+use crate::diagnose::candidates::families::{FamilyNote, OperatorFamily};
 use crate::diagnose::candidates::metadata::{MetaColumn, MetaKind, MAX_LEVELS};
 use crate::diagnose::candidates::transforms::{BaseInput, Candidate, Source, Transform};
 use crate::diagnose::input::Campaign;
@@ -106,13 +111,20 @@ fn knots_at(sorted: &[f64], qs: &[f64]) -> Option<Vec<f64>> {
     k.windows(2).all(|w| w[1] > w[0]).then_some(k)
 }
 
+/// The built library: its candidates, in a fixed order, and what was left out.
+#[derive(Clone, Debug)]
+pub struct Built {
+    pub candidates: Vec<Candidate>,
+    /// The families of the candidates the cap left out, in library order.
+    pub cut_by_cap: Vec<OperatorFamily>,
+    /// Columns a family offers nothing for, and why.
+    pub notes: Vec<FamilyNote>,
+}
+
 /// The whole library: within-run candidates of every column and of the run-constant
-/// metadata (products only), in a fixed order; and how many were left out by the cap.
-pub fn enumerate(
-    c: &Campaign,
-    meta: &[MetaColumn],
-    base_rate_half_s: f64,
-) -> (Vec<Candidate>, usize) {
+/// metadata (products only), then the event clocks, in a fixed order; what the cap left
+/// out and why a column has no event clock.
+pub fn enumerate(c: &Campaign, meta: &[MetaColumn], base_rate_half_s: f64) -> Built {
     let temps: Vec<f64> = c
         .runs
         .iter()
@@ -135,6 +147,7 @@ pub fn enumerate(
         centres: (0.0, temp_mean),
         base_rate_half_s,
         run_values: vec![],
+        event: None,
     };
     let taus = memory_taus_s(c);
     let mut out = Vec::new();
@@ -155,9 +168,59 @@ pub fn enumerate(
         out.extend(column_candidates(c, i, name, &taus, &blank));
     }
     out.extend(metadata_products(meta, &blank));
-    let left_out = out.len().saturating_sub(MAX_CANDIDATES);
+    let mut notes = Vec::new();
+    out.extend(event_clocks(c, &taus, &blank, &mut notes));
+    let cut_by_cap = out
+        .iter()
+        .skip(MAX_CANDIDATES)
+        .map(OperatorFamily::of)
+        .collect();
     out.truncate(MAX_CANDIDATES);
-    (out, left_out)
+    Built {
+        candidates: out,
+        cut_by_cap,
+        notes,
+    }
+}
+
+/// A decay on every memory time scale after the events of the temperature, of every extra
+/// column and of the time stamps' gaps; a column without usable events gets a note.
+fn event_clocks(
+    c: &Campaign,
+    taus: &[f64],
+    blank: &Blank,
+    notes: &mut Vec<FamilyNote>,
+) -> Vec<Candidate> {
+    let mut rules: Vec<(String, Source, Result<events::EventRule, String>)> = vec![
+        ("t_s".into(), Source::Time, events::gap_rule(c)),
+        (
+            "temp_c".into(),
+            Source::Temp,
+            events::step_rule(c, |s| &s.temp_c),
+        ),
+    ];
+    for (i, name) in c.extra_names.iter().enumerate() {
+        rules.push((
+            name.clone(),
+            Source::Extra(i),
+            events::step_rule(c, |s| &s.extras[i]),
+        ));
+    }
+    let mut out = Vec::new();
+    for (name, src, rule) in rules {
+        match rule {
+            Ok(rule) => out.extend(taus.iter().map(|&tau| Candidate {
+                tau_s: Some(tau),
+                event: Some(rule),
+                ..blank(&name, src, Transform::Event)
+            })),
+            Err(why) => notes.push(FamilyNote {
+                family: OperatorFamily::EventClock,
+                note: format!("{name}: {why}"),
+            }),
+        }
+    }
+    out
 }
 
 /// Builds a candidate of `column` under `transform` with every other field at its default.

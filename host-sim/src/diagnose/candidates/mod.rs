@@ -1,9 +1,12 @@
 //! Stage 3, the candidate library: every feature a column or metadata key can offer
 //! (values, smooth functions, derivatives, memory, levels, products with the base's
 //! inputs; `generic`), metadata of every type as run-constant columns (`metadata`) and
-//! what the device can compute of it causally.
+//! what the device can compute of it causally; event clocks (`events`) and the operator
+//! families the report counts and checks per family (`families`).
 
 pub mod causal;
+pub mod events;
+pub mod families;
 pub mod generic;
 pub mod metadata;
 pub mod transforms;
@@ -17,8 +20,9 @@ pub fn library_of(
     campaign: &Campaign,
     meta: &[metadata::MetaColumn],
     rate_half_s: f64,
-) -> (Vec<transforms::Candidate>, Option<(String, String)>) {
-    let (library, left_out) = generic::enumerate(campaign, meta, rate_half_s);
+) -> (generic::Built, Option<(String, String)>) {
+    let library = generic::enumerate(campaign, meta, rate_half_s);
+    let left_out = library.cut_by_cap.len();
     memprobe::stage("library");
     let note = (left_out > 0).then(|| {
         (

@@ -9,7 +9,10 @@
 //! Splines are natural (restricted) cubic splines with knots at the column's campaign
 //! quantiles; levels are indicators of all but the most common value; a product
 //! multiplies the (centred) feature by one of the base's inputs (T - mean T, dT/dt).
+//! An event clock decays after each change of its column larger than the column's noise
+//! (or each gap of the time stamps; `events`).
 
+use crate::diagnose::candidates::events::{clock_decay, EventRule};
 use crate::diagnose::input::derivatives;
 use crate::diagnose::input::Series;
 use serde::Serialize;
@@ -26,6 +29,8 @@ pub enum Transform {
     Decay,
     Lag,
     Spline,
+    /// A decay on the clock since the column's last event (`Candidate::event`).
+    Event,
 }
 
 impl Transform {
@@ -40,6 +45,7 @@ impl Transform {
             Self::Decay => "decay",
             Self::Lag => "lag",
             Self::Spline => "spline",
+            Self::Event => "event",
         }
     }
 
@@ -114,6 +120,8 @@ pub struct Candidate {
     pub base_rate_half_s: f64,
     /// Per-run values of a `Source::Meta` column.
     pub run_values: Vec<f64>,
+    /// What starts the clock of an `Event` candidate.
+    pub event: Option<EventRule>,
 }
 
 impl Candidate {
@@ -121,6 +129,12 @@ impl Candidate {
     pub fn label(&self) -> String {
         let own = match self.transform {
             Transform::Spline => format!("{}:spline(knots={})", self.column, self.knots.len()),
+            Transform::Event => format!(
+                "{}:exp decay {:.0} s after {}",
+                self.column,
+                self.tau_s.unwrap_or(0.0),
+                self.event.map_or("events", EventRule::name)
+            ),
             _ => fog_core::compensation::label::feature_label(
                 &self.column,
                 self.transform.name(),
@@ -208,6 +222,10 @@ impl Candidate {
             Transform::Spline => std::iter::once(x.to_vec())
                 .chain(natural_spline(x, &self.knots))
                 .collect(),
+            Transform::Event => {
+                let events = self.event.map(|e| e.times(&s.t_s, x)).unwrap_or_default();
+                vec![clock_decay(&s.t_s, &events, tau)]
+            }
         }
     }
 }

@@ -266,18 +266,27 @@ pub fn campaign_summary(
     campaign: &Campaign,
     folds: &Folds,
     screening: &Screening,
-    library_size: usize,
+    built: &crate::diagnose::candidates::generic::Built,
     smallest_attainable_p: f64,
-    power_check: Option<PowerCheck>,
+    (silent, power_check): (bool, Option<PowerCheck>),
 ) -> CampaignSummary {
+    let operator_families =
+        crate::diagnose::report::families::rows(&crate::diagnose::report::families::Inputs {
+            built,
+            screening,
+            smallest_attainable_p,
+            silent,
+            power_check: power_check.as_ref(),
+        });
     CampaignSummary {
         runs: campaign.runs.len(),
         points: campaign.points(),
         validation: folds.describe(),
         excluded_columns: campaign.exclusions.clone(),
         skipped_candidates: screening.skipped.iter().map(to_exclusion).collect(),
-        library_size,
+        library_size: built.candidates.len(),
         smallest_attainable_p,
         power_check,
+        operator_families,
     }
 }

@@ -6,6 +6,7 @@ pub mod assemble;
 pub mod azimuth;
 pub mod competing;
 pub mod diagnosis;
+pub mod families;
 pub mod olscheck;
 pub mod outliers;
 pub mod plots;
@@ -136,6 +137,9 @@ pub struct CampaignSummary {
     /// When nothing is named: whether a planted 1-sigma effect would have been
     /// (`power`).
     pub power_check: Option<crate::diagnose::selection::power::PowerCheck>,
+    /// The within-run library per operator family: candidates, what was cut and why,
+    /// and the test's power for the family (`families`).
+    pub operator_families: Vec<families::FamilyRow>,
 }
 
 /// The whole diagnosis.

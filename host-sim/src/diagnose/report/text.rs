@@ -313,10 +313,43 @@ fn write_causal(s: &mut String, c: &crate::diagnose::candidates::causal::CausalC
     );
 }
 
+/// The within-run library per operator family: counts, cuts with their reasons, and the
+/// test's power for each family (a "no test power for family F" line where it has none).
+fn write_operator_families(s: &mut String, rows: &[crate::diagnose::report::families::FamilyRow]) {
+    let counts: Vec<String> = rows
+        .iter()
+        .map(|f| {
+            let cut = if f.cut_by_cap > 0 {
+                format!(" (+{} cut by the cap)", f.cut_by_cap)
+            } else {
+                String::new()
+            };
+            format!("{} {}{cut}", f.family, f.candidates)
+        })
+        .collect();
+    let _ = writeln!(
+        s,
+        "  within-run candidates per operator family: {}",
+        counts.join(", ")
+    );
+    for f in rows {
+        if f.candidates == 0 && f.cut_by_cap == 0 && f.why_cut.is_empty() {
+            continue;
+        }
+        let why = if f.why_cut.is_empty() {
+            String::new()
+        } else {
+            format!("; cut: {}", f.why_cut.join("; "))
+        };
+        let _ = writeln!(s, "    {}: {}{why}", f.family, f.power);
+    }
+}
+
 /// Section 3: ranked within-run candidates, then the between-run ones.
 fn write_candidates(s: &mut String, r: &Report) {
     let _ = writeln!(s, "\n3. Candidate causes, first step (ranked by held-out rms; p = family-wise sign-flip max-T over the library and whole validation units, x sequences)");
     write_derivative_widths(s, &r.derivative_widths);
+    write_operator_families(s, &r.campaign.operator_families);
     for row in r.candidates.iter().take(8) {
         let _ = writeln!(
             s,
@@ -346,7 +379,7 @@ fn write_candidates(s: &mut String, r: &Report) {
         .collect();
     let _ = writeln!(
         s,
-        "  run-level candidates per family: {}",
+        "  run-level candidates per family: {} (power not checked per run-level family: the planted-shape check plants within-run shapes)",
         families.join(", ")
     );
     for row in b.rows.iter().take(4) {

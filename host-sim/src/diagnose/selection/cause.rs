@@ -64,7 +64,10 @@ impl Cause {
     pub fn is_plain(&self) -> bool {
         self.times.is_none()
             && !self.metadata
-            && !matches!(self.transform, Transform::Spline | Transform::Levels)
+            && !matches!(
+                self.transform,
+                Transform::Spline | Transform::Levels | Transform::Event
+            )
     }
 
     /// The cause in words (physics reading of the column and transform); `coef` are the
@@ -117,6 +120,14 @@ impl Cause {
                 "the drift level depends on the value of `{col}` (a bias per level: {} levels apart from the commonest)",
                 self.knots.len()
             ),
+            ("t_s", Transform::Event) => format!(
+                "after each gap of the time stamps the drift shows a transient exp(-t_since/{tau:.0} s) \
+                 ({k:.4} deg/h at the gap's end): e.g. a restart or drop-out of the gyro or its logger"
+            ),
+            (col, Transform::Event) => format!(
+                "after each change of `{col}` larger than its noise (a step or switch) the drift shows a transient \
+                 exp(-t_since/{tau:.0} s) ({k:.4} deg/h at the change), whatever the change's sign or size"
+            ),
             (col, Transform::Spline) => format!(
                 "drift follows a smooth nonlinear function of `{col}` (natural cubic spline, {} knots)",
                 self.knots.len()
@@ -144,6 +155,7 @@ mod tests {
             centres: (0.0, 0.0),
             base_rate_half_s: 20.0,
             run_values: vec![],
+            event: None,
         };
         let cause = Cause::from(&cand);
         assert_eq!(cause.label(), cand.label());

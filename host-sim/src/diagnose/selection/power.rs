@@ -20,6 +20,7 @@
 
 use crate::diagnose::baseline::choice::{self, BaseFit};
 use crate::diagnose::baseline::models::Stacked;
+use crate::diagnose::candidates::families::OperatorFamily;
 use crate::diagnose::candidates::transforms::Candidate;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
@@ -35,6 +36,8 @@ pub const PLANTED_SIGMAS: f64 = 1.0;
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ShapeCheck {
     pub planted: String,
+    /// Its operator family (`candidates::families`).
+    pub family: &'static str,
     /// Whether the selection's first step named it (its column, in the same product).
     pub named: bool,
     pub gain_pct: f64,
@@ -112,6 +115,7 @@ pub fn check(
         planted_rms = within_rms(&folds.run_rows, &planted);
         checked.push(ShapeCheck {
             planted: cand.label(),
+            family: OperatorFamily::of(&cand).name(),
             named,
             gain_pct: found.map_or(0.0, |s| s.gain_pct),
             p_value: found.map_or(1.0, |s| s.p_value),
