@@ -56,11 +56,17 @@ pub fn read_model_file(path: &Path) -> Result<(Vec<u8>, RbfModel), ModelFileErro
     Ok((bytes, model))
 }
 
-/// CRC-32 of a model's encoding (what the device reports as its model's CRC).
-pub fn model_crc32(model: &RbfModel) -> anyhow::Result<u32> {
+/// A model's encoding (fog-core's postcard bytes, what a model file holds and an upload
+/// sends).
+pub fn encode_model(model: &RbfModel) -> anyhow::Result<Vec<u8>> {
     let mut buf = [0u8; MAX_ENCODED_LEN];
     let n = model
         .encode(&mut buf)
         .map_err(|e| anyhow::anyhow!("encoding the model: {e}"))?;
-    Ok(fog_core::model::crc::crc32(&buf[..n]))
+    Ok(buf[..n].to_vec())
+}
+
+/// CRC-32 of a model's encoding (what the device reports as its model's CRC).
+pub fn model_crc32(model: &RbfModel) -> anyhow::Result<u32> {
+    Ok(fog_core::model::crc::crc32(&encode_model(model)?))
 }

@@ -6,10 +6,11 @@
 use std::path::Path;
 
 use anyhow::{anyhow, bail, Result};
-use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
+use fog_core::model::format::RbfModel;
 
 use super::args::Args;
 use super::finish::{field_refined, stage};
+use crate::io::model::encode_model;
 use crate::io::runs::Run;
 use crate::io::StagedFiles;
 use crate::registry::{Registry, UnitCalibrationRecord};
@@ -32,15 +33,9 @@ fn for_gyro(model: &RbfModel, gyro_id: &str) -> Result<RbfModel> {
 
 /// The model's encoding for the device `gyro_id`, and its CRC-32.
 fn encoded(model: &RbfModel, gyro_id: &str) -> Result<(Vec<u8>, u32)> {
-    let m = for_gyro(model, gyro_id)?;
-    let mut buf = [0u8; MAX_ENCODED_LEN];
-    let len = m
-        .encode(&mut buf)
-        .map_err(|e| anyhow!("encoding the model: {e}"))?;
-    Ok((
-        buf[..len].to_vec(),
-        fog_core::model::crc::crc32(&buf[..len]),
-    ))
+    let bytes = encode_model(&for_gyro(model, gyro_id)?)?;
+    let crc = fog_core::model::crc::crc32(&bytes);
+    Ok((bytes, crc))
 }
 
 /// `--type-out`: learns the type, writes it, the shared model (`--out`) and `--json` (the

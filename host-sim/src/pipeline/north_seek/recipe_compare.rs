@@ -23,12 +23,11 @@ use super::unit_recipe::{
     RecipeType, UnitRecipe, RECIPE_AMBIENTS_C,
 };
 use super::{build_report, run_monte_carlo, MonteCarloConfig};
-use crate::io::model::read_model;
+use crate::io::model::{encode_model, read_model};
 use crate::output::reports::Table;
 use crate::train::seek_score::{Criterion, SeekGeometry};
 use crate::train::type_unit::TypeModel;
 use crate::train::InputChoice;
-use fog_core::model::format::MAX_ENCODED_LEN;
 
 /// Units the demo's type is learnt from, and cold starts of each (2 per recipe ambient).
 pub const DEMO_TYPE_UNITS: usize = 10;
@@ -128,12 +127,7 @@ pub fn compare_recipes(cfg: &MonteCarloConfig, keep_dir: &Path) -> Result<Recipe
         },
         Err(_) => {
             let made = type_free_model(&chamber, &plan)?;
-            let mut buf = [0u8; MAX_ENCODED_LEN];
-            let len = made
-                .model
-                .encode(&mut buf)
-                .map_err(|e| anyhow!("encoding the 96-run model: {e}"))?;
-            keep(&model_path, MODEL_PREFIX, &buf[..len])?;
+            keep(&model_path, MODEL_PREFIX, &encode_model(&made.model)?)?;
             made
         }
     };

@@ -53,10 +53,6 @@ pub fn model_file_name(specs: &[FeatureSpec]) -> String {
 
 /// Writes a model in fog-core's encoding (what `fogsim upload` sends), atomically.
 pub fn write_model_file(path: &Path, model: &fog_core::model::format::RbfModel) -> Result<()> {
-    let mut buf = [0u8; fog_core::model::format::MAX_ENCODED_LEN];
-    let len = model
-        .encode(&mut buf)
-        .map_err(|e| anyhow!("encoding the trained model: {e}"))?;
-    crate::io::write_atomic(path, &buf[..len])
+    crate::io::write_atomic(path, &crate::io::model::encode_model(model)?)
         .map_err(|e| anyhow!("writing {}: {e}", path.display()))
 }

@@ -154,53 +154,44 @@ mod tests {
         vec!["offset".into(), "Shupe coefficient".into()]
     }
 
+    /// `test_unit` of a unit's two terms against a type of mean (0, 1) and spread 0.1 each.
+    fn against_type(
+        unit: &str,
+        own: [f64; 2],
+        se: [f64; 2],
+        type_units: usize,
+        runs: usize,
+    ) -> Misfit {
+        test_unit(
+            unit,
+            &names(),
+            &own,
+            &se,
+            &[0.0, 1.0],
+            &[0.1, 0.1],
+            type_units,
+            runs,
+        )
+    }
+
     #[test]
     fn a_unit_far_outside_is_named_and_one_inside_is_not() {
-        let (mean, spread) = ([0.0, 1.0], [0.1, 0.1]);
-        let out = test_unit(
-            "U3",
-            &names(),
-            &[0.02, 1.9],
-            &[0.05, 0.05],
-            &mean,
-            &spread,
-            10,
-            6,
-        );
+        let out = against_type("U3", [0.02, 1.9], [0.05, 0.05], 10, 6);
         assert!(out.outside());
         let lines = out.lines().join("\n");
         assert!(
             lines.contains("unit U3: Shupe coefficient 8.0 sigma outside the type"),
             "{lines}"
         );
-        let inside = test_unit(
-            "U4",
-            &names(),
-            &[0.02, 1.15],
-            &[0.05, 0.05],
-            &mean,
-            &spread,
-            10,
-            6,
-        );
+        let inside = against_type("U4", [0.02, 1.15], [0.05, 0.05], 10, 6);
         assert!(!inside.outside(), "{:?}", inside.lines());
     }
 
     #[test]
     fn a_term_found_outside_is_not_also_said_to_lack_power() {
-        let (mean, spread) = ([0.0, 1.0], [0.1, 0.1]);
         // 3 type units: the critical value exceeds the 5-spread power bound, yet a unit
         // 30 spreads out is found; it is not listed as having no test power.
-        let out = test_unit(
-            "U6",
-            &names(),
-            &[0.0, 4.0],
-            &[0.01, 0.01],
-            &mean,
-            &spread,
-            3,
-            3,
-        );
+        let out = against_type("U6", [0.0, 4.0], [0.01, 0.01], 3, 3);
         assert!(
             out.terms[1].outside && !out.terms[1].has_power,
             "{:?}",
@@ -213,44 +204,16 @@ mod tests {
 
     #[test]
     fn a_term_the_runs_cannot_see_has_no_test_power() {
-        let (mean, spread) = ([0.0, 1.0], [0.1, 0.1]);
         // an se of 10 spreads: even a unit 5 spreads out would not be flagged
-        let out = test_unit(
-            "U5",
-            &names(),
-            &[0.0, 3.0],
-            &[0.01, 1.0],
-            &mean,
-            &spread,
-            10,
-            6,
-        );
+        let out = against_type("U5", [0.0, 3.0], [0.01, 1.0], 10, 6);
         assert!(!out.terms[1].has_power && out.terms[0].has_power);
         assert!(out
             .lines()
             .iter()
             .any(|l| l.contains("no test power for Shupe coefficient")));
         // few runs: the critical value grows (Student's t), so noise is not a misfit
-        let few = test_unit(
-            "U6",
-            &names(),
-            &[0.0, 1.0],
-            &[0.1, 0.1],
-            &mean,
-            &spread,
-            10,
-            2,
-        );
-        let many = test_unit(
-            "U6",
-            &names(),
-            &[0.0, 1.0],
-            &[0.1, 0.1],
-            &mean,
-            &spread,
-            10,
-            30,
-        );
+        let few = against_type("U6", [0.0, 1.0], [0.1, 0.1], 10, 2);
+        let many = against_type("U6", [0.0, 1.0], [0.1, 0.1], 10, 30);
         assert!(few.terms[0].critical > many.terms[0].critical);
     }
 }
