@@ -15,21 +15,34 @@ pub const PERM_SEED: u64 = 0xBE7_3EE2;
 
 /// Least squares o = a + b . f over `rows` (small ridge for stability).
 pub fn fit(o: &[f64], f: &[Vec<f64>], rows: &[usize]) -> Option<Vec<f64>> {
+    fit_over(o, f, rows.iter().copied())
+}
+
+/// [`fit`] over the rows an iterator gives (leave-one-out: no list of rows a run).
+fn fit_over(o: &[f64], f: &[Vec<f64>], rows: impl Iterator<Item = usize>) -> Option<Vec<f64>> {
     let q = 1 + f.first().map_or(0, Vec::len);
     let mut a = vec![0.0; q * q];
     let mut b = vec![0.0; q];
-    // The row [1, f[r]...] read in place (no allocation a row: this runs for every
-    // permutation of every candidate).
-    for &r in rows {
-        let x = |i: usize| if i == 0 { 1.0 } else { f[r][i - 1] };
+    let mut x = vec![1.0; q];
+    // The row [1, f[r]...] copied into one buffer (this runs for every permutation of
+    // every candidate); the lower triangle summed and mirrored (the same products).
+    for r in rows {
+        for (xi, fi) in x[1..].iter_mut().zip(&f[r]) {
+            *xi = *fi;
+        }
         for i in 0..q {
-            b[i] += x(i) * o[r];
-            for j in 0..q {
-                a[i * q + j] += x(i) * x(j);
-            }
+            b[i] += x[i] * o[r];
+            let xi = x[i];
+            a[i * q..=i * q + i]
+                .iter_mut()
+                .zip(&x[..=i])
+                .for_each(|(s, xj)| *s += xi * xj);
         }
     }
     for i in 0..q {
+        for j in 0..i {
+            a[j * q + i] = a[i * q + j];
+        }
         a[i * q + i] += 1e-9 * (1.0 + a[i * q + i]);
     }
     solve_spd(&mut a, &mut b, q).ok()?;
@@ -59,9 +72,9 @@ pub fn loo_gains(o: &[f64], lens: &[usize], f: &[Vec<f64>]) -> Option<(Vec<f64>,
     let mut gains = Vec::with_capacity(n);
     let (mut ss0, mut ss1) = (0.0, 0.0);
     for r in 0..n {
-        let rows: Vec<usize> = (0..n).filter(|&i| i != r).collect();
-        let m = rows.iter().map(|&i| o[i]).sum::<f64>() / rows.len() as f64;
-        let coef = fit(o, f, &rows)?;
+        let others = || (0..n).filter(move |&i| i != r);
+        let m = others().map(|i| o[i]).sum::<f64>() / (n - 1) as f64;
+        let coef = fit_over(o, f, others())?;
         let e0 = o[r] - m;
         let e1 = o[r] - predict(&coef, &f[r]);
         ss0 += e0 * e0;

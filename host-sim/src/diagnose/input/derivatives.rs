@@ -60,16 +60,26 @@ fn fit_window(t: &[f64], x: &[f64], t0: f64, degree: usize) -> Option<LocalFit> 
     if scale <= 0.0 || t.len() < p {
         return None;
     }
-    let mut a = Matrix4::<f64>::zeros();
-    let mut b = Vector4::<f64>::zeros();
+    // The upper triangle summed in plain arrays, then mirrored (a product and its mirror
+    // are the same number, so this is the full sum's every bit at half the work).
+    let mut upper = [[0.0f64; 4]; 4];
+    let mut rhs = [0.0f64; 4];
     for (&ti, &xi) in t.iter().zip(x) {
         let u = (ti - t0) / scale;
         let pw = [1.0, u, u * u, u * u * u];
         for r in 0..p {
-            b[r] += pw[r] * xi;
-            for c in 0..p {
-                a[(r, c)] += pw[r] * pw[c];
+            rhs[r] += pw[r] * xi;
+            for c in r..p {
+                upper[r][c] += pw[r] * pw[c];
             }
+        }
+    }
+    let mut a = Matrix4::<f64>::zeros();
+    let b = Vector4::from(rhs);
+    for r in 0..p {
+        for c in r..p {
+            a[(r, c)] = upper[r][c];
+            a[(c, r)] = upper[r][c];
         }
     }
     // unused dimensions: identity rows, so they solve to 0 and leave the rest unchanged

@@ -8,6 +8,7 @@ use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::linalg::solve_spd;
 use crate::diagnose::validation::design::{Columns, Design};
 use crate::diagnose::validation::folds::{Folds, Offsets};
+use crate::diagnose::validation::row_cache::held_or_on_demand;
 use std::sync::Arc;
 
 /// A design prepared for validation: the design's rows (computed on demand, never held
@@ -89,6 +90,7 @@ impl Prepared {
     /// Prepares a design given by its rows: the per-unit means and Grams are accumulated
     /// row by row (the same sums, in the same order, as over materialised columns).
     pub fn from_design(folds: &Folds, design: Arc<dyn Design>, y: &[f64], ridge: f64) -> Self {
+        let design = held_or_on_demand(design, y.len());
         let unit_means = if folds.offsets == Offsets::PerUnit {
             let mut raw = vec![0.0; design.width()];
             folds
@@ -160,11 +162,15 @@ impl Prepared {
         let mut a = vec![0.0; p];
         for row in rows {
             self.adjusted_row(unit, row, &mut a);
-            for i in 0..p {
-                for j in 0..=i {
-                    g[i * p + j] += a[i] * a[j];
-                }
-                c[i] += a[i] * self.y[row];
+            let yr = self.y[row];
+            // Lower triangle, one row of it at a time (slices: no index checks, so the
+            // compiler vectorises; each sum still adds the rows in order).
+            for (i, &ai) in a.iter().enumerate() {
+                g[i * p..=i * p + i]
+                    .iter_mut()
+                    .zip(&a[..=i])
+                    .for_each(|(s, aj)| *s += ai * aj);
+                c[i] += ai * yr;
             }
         }
         for i in 0..p {

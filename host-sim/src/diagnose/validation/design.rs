@@ -9,6 +9,10 @@ pub trait Design: std::fmt::Debug {
     fn width(&self) -> usize;
     /// Writes row `i` (raw: no run offsets removed) into `out` (`width()` long).
     fn row(&self, i: usize, out: &mut [f64]);
+    /// Whether the rows are already in memory (holding them again would gain nothing).
+    fn is_held(&self) -> bool {
+        false
+    }
 }
 
 /// A design held as columns (a few: polynomials in T, the simulator's law).
@@ -22,6 +26,10 @@ impl Design for Columns {
 
     fn row(&self, i: usize, out: &mut [f64]) {
         self.0.as_slice().row(i, out);
+    }
+
+    fn is_held(&self) -> bool {
+        true
     }
 }
 
