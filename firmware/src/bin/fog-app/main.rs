@@ -1,6 +1,6 @@
 //! The north-finder firmware for the MPS2-AN386 board (Cortex-M4F; QEMU in CI).
 //!
-//! Wiring (a real board changes only this file and `target/`):
+//! Wiring (a real board changes only this folder and `target/`):
 //! - UART0 (0x4000_4000, QEMU's first `-serial`): the host port (RS-422 on the product),
 //!   carrying `fog_core::link::messages::HostFrame`s: model uploads, handled by
 //!   `fog_firmware::upload::UploadServer`, and north-finder commands (StartSeek,
@@ -30,33 +30,46 @@
 //! results and faults -> defmt log. The watchdog is fed only when the gyro ring was
 //! drained and lost nothing in this pass. Any fatal error records its reason in no-init
 //! RAM and resets; the next boot logs it and reports it in `DeviceStatus`.
+//!
+//! This file holds the wiring and the main loop; beside it, one job a file: `config` (rates,
+//! baud rates, periods, the build-time key), `options` (the QEMU scenarios' arguments),
+//! `boot` (what the boot found, logged), `console` (per-window and per-seek log lines),
+//! `host` (the host port: upload server, link replies, status) and `field_records` (the
+//! seek records' flash ring).
 #![no_std]
 #![no_main]
 
-#[path = "target/flash.rs"]
+mod boot;
+mod config;
+mod console;
+mod field_records;
+mod host;
+mod options;
+
+#[path = "../target/flash.rs"]
 mod flash;
 #[cfg(feature = "log-semihosting")]
-#[path = "target/flash_file.rs"]
+#[path = "../target/flash_file.rs"]
 mod flash_file;
-#[path = "target/millis.rs"]
+#[path = "../target/millis.rs"]
 mod millis;
-#[path = "target/panic_reset.rs"]
+#[path = "../target/panic_reset.rs"]
 mod panic_reset;
-#[path = "target/resets.rs"]
+#[path = "../target/resets.rs"]
 mod resets;
-#[path = "target/safe_loop.rs"]
+#[path = "../target/safe_loop.rs"]
 mod safe_loop;
 #[cfg(feature = "log-semihosting")]
-#[path = "target/semi.rs"]
+#[path = "../target/semi.rs"]
 mod semi;
 #[cfg(feature = "log-semihosting")]
-#[path = "target/stack.rs"]
+#[path = "../target/stack.rs"]
 mod stack;
-#[path = "target/uart.rs"]
+#[path = "../target/uart.rs"]
 mod uart;
-#[path = "target/upload_boot.rs"]
+#[path = "../target/upload_boot.rs"]
 mod upload_boot;
-#[path = "target/watchdog.rs"]
+#[path = "../target/watchdog.rs"]
 mod watchdog;
 
 #[cfg(feature = "log-rtt")]
@@ -68,14 +81,11 @@ use cortex_m_rt::entry;
 use embedded_hal_nb::serial::{Read as _, Write as _};
 use fog_core::compensation::compensator::Compensator;
 use fog_core::hal::Gyro;
-use fog_core::link::messages::{Command, DeviceMessage, FaultState, Refusal, ResetReason};
-use fog_core::link::upload::ResetRecord;
+use fog_core::link::messages::{Command, DeviceMessage, Refusal, ResetReason};
 use fog_core::seeking::bit::BitLimits;
-use fog_core::seeking::field_record::FieldRecord;
-use fog_core::seeking::tilt::Tilt;
-use fog_firmware::app::{App, AppConfig, BoardStatus, SeekOutcome};
+use fog_firmware::app::{App, AppConfig, SeekOutcome};
 use fog_firmware::bit_monitor::{BitCounters, BitMonitor};
-use fog_firmware::boot_args::{BootArgs, Inject};
+use fog_firmware::boot_args::Inject;
 use fog_firmware::clock::Clock;
 use fog_firmware::drivers::base_inclinometer::BaseInclinometer;
 use fog_firmware::drivers::fog_serial::FogSerialGyro;
@@ -84,41 +94,27 @@ use fog_firmware::drivers::inclinometer::{
 };
 use fog_firmware::drivers::serial_inclinometer::SerialInclinometer;
 use fog_firmware::drivers::turntable::{SerialTurntable, TurntableConfig};
-use fog_firmware::fault_record::{CleanRun, FaultRecord};
-use fog_firmware::field_log::FieldLog;
+use fog_firmware::fault_record::CleanRun;
 use fog_firmware::health::{GyroWatch, StuckEvent, DEFAULT_STUCK_RUN};
-use fog_firmware::link_out::{queue_whole, LinkFrame};
+use fog_firmware::link_out::queue_whole;
 use fog_firmware::upload::UploadBuffers;
 use resets::BootFault;
 
+use boot::{announce_boot, announce_heading_correction, report_boot_stack, report_slots};
+use config::{
+    GYRO_BAUD, GYRO_ID, GYRO_SILENCE_S, HOST_BAUD, HOST_BYTES_PER_PASS, INCL_BAUD, STATUS_PERIOD_S,
+    TABLE_BAUD, TILT_NOISE_SEED, TILT_PERIOD_S, VERIFY_KEY, WATCHDOG_TIMEOUT_MS,
+};
+use console::{report, seek_line, window_line};
+use field_records::{append_field_record, open_field_log};
+use host::{
+    answer_link, board_status, clear_faults, keep_server, send_link, start_upload_server,
+    swap_model, TxQueue,
+};
+use options::{inject_fault_at_boot, test_options};
+
 #[cfg(not(any(feature = "log-semihosting", feature = "log-rtt")))]
 compile_error!("fog-app needs a defmt logger: feature log-semihosting (QEMU) or log-rtt");
-
-/// Gyro output rate, Hz.
-const GYRO_RATE_HZ: u32 = 2000;
-/// Host link and turntable baud rates; the gyro link runs at 460,800 baud.
-const HOST_BAUD: u32 = 115_200;
-const GYRO_BAUD: u32 = 460_800;
-const TABLE_BAUD: u32 = 115_200;
-const INCL_BAUD: u32 = 115_200;
-/// Watchdog deadline between feeds, ms.
-const WATCHDOG_TIMEOUT_MS: u32 = 500;
-/// Host bytes handled per main-loop pass (the gyro ring is drained in between).
-const HOST_BYTES_PER_PASS: usize = 64;
-/// Reply bytes waiting for the host UART.
-const TX_QUEUE_LEN: usize = 512;
-/// No gyro sample for this long marks the gyro silent (a fault in the window), s.
-const GYRO_SILENCE_S: f64 = 0.1;
-/// Status period on the host port and BIT evaluation period, s (clock time).
-const STATUS_PERIOD_S: f64 = 1.0;
-/// Inclinometer reading period, s of sample time.
-const TILT_PERIOD_S: f64 = 1.0;
-/// Seed of the simulated inclinometer's noise.
-const TILT_NOISE_SEED: u64 = 0x5C13_3000;
-
-/// The model-verifying public key and the gyro id, chosen at build time (build.rs).
-const VERIFY_KEY: [u8; 32] = *include_bytes!(concat!(env!("OUT_DIR"), "/verify_key.bin"));
-const GYRO_ID: &str = include_str!(concat!(env!("OUT_DIR"), "/gyro_id.txt"));
 
 #[entry]
 fn main() -> ! {
@@ -403,369 +399,4 @@ fn main() -> ! {
             let _ = tx_queue.pop_front();
         }
     }
-}
-
-/// Logs the heading correction the active model brought (format v3 models carry it; the
-/// App applies it on every model change). Under QEMU also as plain text, where the seek
-/// scenario checks that an uploaded harmonic is in use.
-fn announce_heading_correction<T, C>(app: &App<T, C>)
-where
-    T: fog_core::hal::Turntable,
-    T::Error: Copy,
-    C: core::borrow::BorrowMut<Compensator>,
-{
-    let n_headings = app.heading_correction().map_or(0, |h| h.n_headings);
-    defmt::info!("heading correction: {} headings (0: none)", n_headings);
-    #[cfg(feature = "log-semihosting")]
-    semihosting::eprintln!("FOG-HEADING-CAL n_headings={}", n_headings);
-}
-
-/// Opens the field-record ring on its region (`None`: the region is unusable; seeks
-/// run on, records are not kept, `GetFieldRecords` is refused). Under QEMU the boot scan
-/// is also a plain `FOG-FIELD-LOG` line.
-fn open_field_log(flash: flash::AppFlash) -> Option<FieldLog<flash::AppFlash>> {
-    let capacity = embedded_storage::nor_flash::ReadNorFlash::capacity(&flash) as u32;
-    match FieldLog::open(flash, 0, capacity) {
-        Ok(log) => {
-            let s = log.scan();
-            defmt::info!("field log: {}", s);
-            #[cfg(feature = "log-semihosting")]
-            semihosting::eprintln!(
-                "FOG-FIELD-LOG valid={} corrupt={} oldest={} newest={}",
-                s.valid,
-                s.corrupt,
-                s.oldest_sequence.unwrap_or(0),
-                s.newest_sequence.unwrap_or(0)
-            );
-            Some(log)
-        }
-        Err(e) => {
-            defmt::error!("field log unusable: {}", e);
-            #[cfg(feature = "log-semihosting")]
-            semihosting::eprintln!("FOG-FIELD-LOG unusable: {}", e);
-            None
-        }
-    }
-}
-
-/// Appends a finished seek's record (a failure is logged; the seek result stands).
-fn append_field_record(log: Option<&mut FieldLog<flash::AppFlash>>, record: FieldRecord) {
-    let Some(log) = log else { return };
-    match log.append(record) {
-        Ok(r) => {
-            defmt::info!("field record {}: {} deg/h", r.sequence, r.residual_bias_dph);
-            #[cfg(feature = "log-semihosting")]
-            semihosting::eprintln!(
-                "FOG-FIELD-RECORD sequence={} residual_udph={}",
-                r.sequence,
-                // Integer micro-deg/h: no float formatting code in the image.
-                (r.residual_bias_dph * 1.0e6) as i64
-            );
-        }
-        Err(e) => {
-            defmt::error!("field record not kept: {}", e);
-            #[cfg(feature = "log-semihosting")]
-            semihosting::eprintln!("FOG-FIELD-RECORD failed: {}", e);
-        }
-    }
-}
-
-/// The board's part of a status message: the gyro's time and temperature, the model
-/// in flash, why the last reset happened.
-fn board_status<S: embedded_hal_nb::serial::Read<u8>, C: Clock>(
-    watch: &GyroWatch,
-    gyro: &FogSerialGyro<S, C>,
-    server: &Server,
-    reset_reason: ResetReason,
-    faults: FaultState,
-) -> BoardStatus {
-    BoardStatus {
-        t_s: watch.last_t_s(),
-        temp_c: gyro.latest_temp().map_or(f32::NAN, |t| t.temp_c),
-        model_crc32: server.active_info().map(|i| i.model_crc32),
-        reset_reason,
-        faults,
-    }
-}
-
-/// A clean run or a good upload: the record's faults in a row are forgotten (the
-/// status shows it at once).
-fn clear_faults(faults: &mut FaultState, why: &str) {
-    if faults.faults_in_a_row == 0 {
-        return;
-    }
-    resets::clear_faults();
-    faults.faults_in_a_row = 0;
-    defmt::info!("faults in a row cleared: {}", why);
-    #[cfg(feature = "log-semihosting")]
-    semihosting::eprintln!("FOG-FAULTS cleared by {}", why);
-}
-
-/// A time-driven link message (status, result): queued whole if the TX queue has room,
-/// otherwise dropped (the next status follows within a second).
-fn send_link(tx: &mut TxQueue, msg: DeviceMessage) {
-    if let Some(f) = LinkFrame::encode(msg) {
-        let _ = queue_whole(tx, f.bytes());
-    }
-}
-
-/// An answer to a host command: sent only if the bytes the host sent pay for it (the
-/// reply budget of issue 11 covers both protocols on the port).
-fn answer_link(server: &mut Server, tx: &mut TxQueue, msg: DeviceMessage) {
-    let Some(f) = LinkFrame::encode(msg) else {
-        return;
-    };
-    if server.spend_reply_credit(f.bytes().len()) && !queue_whole(tx, f.bytes()) {
-        server.note_reply_dropped();
-    }
-}
-
-/// A finished seek as one plain-text line on the semihosting console (QEMU tests).
-fn seek_line(r: &fog_core::link::messages::SeekReport) {
-    #[cfg(feature = "log-semihosting")]
-    semihosting::eprintln!(
-        "FOG-SEEK sequence={} azimuth_mdeg={} sigma_mdeg={} positions={}",
-        r.sequence,
-        // Integer millidegrees: no float formatting code in the image.
-        (r.azimuth_deg * 1000.0) as i64,
-        (r.sigma_deg * 1000.0) as i64,
-        r.positions
-    );
-    #[cfg(not(feature = "log-semihosting"))]
-    let _ = r;
-}
-
-type TxQueue = heapless::Deque<u8, TX_QUEUE_LEN>;
-
-/// A committed model: load it and hand it to the compensator.
-fn swap_model<T, C>(server: &mut Server, app: &mut App<T, C>)
-where
-    T: fog_core::hal::Turntable,
-    T::Error: Copy,
-    C: core::borrow::BorrowMut<Compensator>,
-{
-    match server.load_active_model_in_place() {
-        Ok(model) => match app.set_model_from(model) {
-            Ok(()) => {
-                defmt::info!("new model in use");
-                announce_heading_correction(app);
-            }
-            Err(e) => defmt::error!("new model refused: {}", e),
-        },
-        Err(e) => defmt::error!("new model not loaded: {}", e),
-    }
-}
-
-/// The boot line: why the previous run ended. Under QEMU also as plain text on the
-/// semihosting console, where the fault tests count boots.
-fn announce_boot(record: &FaultRecord) {
-    let reset = record.reset;
-    defmt::info!(
-        "fog-app: boot {} after {} (detail {}), {} faults in a row",
-        reset.boots,
-        reset.cause,
-        reset.detail,
-        record.faults_in_a_row
-    );
-    #[cfg(feature = "log-semihosting")]
-    semihosting::eprintln!(
-        "FOG-BOOT {} reset={:?} faults_in_a_row={} detail={}",
-        reset.boots,
-        reset.cause,
-        record.faults_in_a_row,
-        reset.detail
-    );
-}
-
-/// The boot check of both model slots (why a stored model is or is not used). Under
-/// QEMU also as a plain `FOG-SLOT` line per slot on the semihosting console.
-fn report_slots(report: [fog_firmware::upload::SlotVerdict; 2]) {
-    for (name, verdict) in ["A", "B"].into_iter().zip(report) {
-        if verdict.refused() {
-            defmt::warn!("model slot {}: {}", name, verdict);
-        } else {
-            defmt::info!("model slot {}: {}", name, verdict);
-        }
-        #[cfg(feature = "log-semihosting")]
-        semihosting::eprintln!("FOG-SLOT {} {}", name, verdict);
-    }
-}
-
-/// The boot's painted stack peak (store scan, signature re-check, model decode,
-/// configuration), under QEMU as a plain `FOG-STACK` line that `qemu_persist.rs` bounds
-/// (docs/explain/stack.md). Hardware builds do not paint.
-fn report_boot_stack() {
-    #[cfg(feature = "log-semihosting")]
-    semihosting::eprintln!(
-        "FOG-STACK boot_peak_bytes={} of={}",
-        stack::high_water_bytes(),
-        stack::size_bytes()
-    );
-}
-
-/// A closed window as one plain-text line on the semihosting console (QEMU tests).
-fn window_line(
-    w: &fog_core::compensation::compensator::WindowResult,
-    frames_lost: u32,
-    bytes_dropped: u32,
-) {
-    #[cfg(feature = "log-semihosting")]
-    semihosting::eprintln!(
-        "FOG-WINDOW t_end_ms={} status={:?} valid={} n_samples={} frames_lost={} gyro_bytes_dropped={}",
-        // Integer ms: no f64 formatting code in the image.
-        (w.t_end_s * 1000.0) as u64,
-        w.status,
-        w.status.is_valid(),
-        w.n_samples,
-        frames_lost,
-        bytes_dropped
-    );
-    #[cfg(not(feature = "log-semihosting"))]
-    let _ = (w, frames_lost, bytes_dropped);
-}
-
-/// What the QEMU scenarios ask for through semihosting arguments
-/// (`fog_firmware::boot_args`; every one is listed in docs/guide/firmware.md): faults to
-/// inject (first boot only), the gyro rate (QEMU's serial backend cannot deliver the
-/// 24 kB/s of a 2 kHz gyro in real time), the seek dwell, the simulated tilt and the
-/// power-cut point of the flash image. An argument the firmware does not know, or a
-/// value it cannot read, is refused with its name and QEMU exits with status 2.
-/// Hardware builds have no semihosting and use the defaults.
-#[derive(Clone, Copy)]
-struct TestOptions {
-    inject: Inject,
-    gyro_rate_hz: u32,
-    /// `tilt-mdeg=PITCH:ROLL`: a simulated inclinometer at this base tilt instead of the
-    /// UART3 link.
-    tilt: Option<Tilt>,
-    /// `seek-dwell-s=N`: dwell per main position (QEMU runs a short seek).
-    seek_dwell_s: Option<u32>,
-}
-
-impl TestOptions {
-    fn injects(&self, fault: BootFault) -> bool {
-        self.inject == Inject::Boot(fault)
-    }
-}
-
-fn test_options(reset: &ResetRecord) -> TestOptions {
-    let args = boot_args();
-    let mut o = TestOptions {
-        inject: args.inject,
-        gyro_rate_hz: args.gyro_rate_hz.unwrap_or(GYRO_RATE_HZ),
-        tilt: args.tilt_mdeg.map(|(p, r)| Tilt {
-            pitch_deg: p as f32 / 1000.0,
-            roll_deg: r as f32 / 1000.0,
-        }),
-        seek_dwell_s: args.seek_dwell_s,
-    };
-    #[cfg(feature = "log-semihosting")]
-    if let Some(n) = args.flash_cut_at {
-        flash_file::cut_at(n);
-    }
-    #[cfg(feature = "log-semihosting")]
-    if let Some(n) = args.flash_tear_at {
-        flash_file::tear_at(n);
-    }
-    if reset.boots != 1 {
-        o.inject = Inject::None;
-    }
-    o
-}
-
-/// The program arguments, or a refusal naming the bad one (QEMU exits with status 2).
-#[cfg(feature = "log-semihosting")]
-fn boot_args() -> BootArgs {
-    let refuse = |what: &dyn core::fmt::Display| -> ! {
-        defmt::error!("firmware arguments refused");
-        semihosting::eprintln!("FOG-ARGS refused: {}", what);
-        semihosting::process::exit(2)
-    };
-    let args = semi::Args::get().unwrap_or_else(|e| refuse(&e));
-    let texts = (0..args.len()).map(|i| args.str(i).unwrap_or("<not UTF-8>"));
-    match fog_firmware::boot_args::parse(texts) {
-        Ok(a) => a,
-        Err(e) => refuse(&e),
-    }
-}
-
-#[cfg(not(feature = "log-semihosting"))]
-fn boot_args() -> BootArgs {
-    BootArgs::DEFAULT
-}
-
-fn inject_fault_at_boot(o: TestOptions) {
-    match o.inject {
-        Inject::Panic => core::panic!("injected panic"),
-        Inject::Hang => loop {
-            cortex_m::asm::nop();
-        },
-        // An undefined instruction; UsageFault is not enabled, so it escalates to
-        // HardFault (`resets.rs`), which records the faulting address.
-        Inject::HardFault => cortex_m::asm::udf(),
-        Inject::None | Inject::PanicAfterCommit | Inject::Boot(_) => {}
-    }
-}
-
-fn report<E: defmt::Format>(step: fog_firmware::app::Step<E>) {
-    if let Some(w) = step.window {
-        if w.status.is_valid() {
-            defmt::info!(
-                "t={} s compensated {} deg/h (drift {}, T {} C)",
-                w.t_end_s,
-                w.compensated_dph,
-                w.drift_dph,
-                w.temp_c
-            );
-        } else {
-            defmt::warn!("t={} s window invalid: {}", w.t_end_s, w.status);
-        }
-    }
-    if let Some(why) = step.restarted {
-        defmt::warn!("north seek restarted: {}", why);
-        #[cfg(feature = "log-semihosting")]
-        semihosting::eprintln!("FOG-SEEK-RESTART reason={:?}", why);
-    }
-    match step.seek {
-        Some(SeekOutcome::Done(r, _)) => defmt::info!(
-            "north seek: azimuth {} deg +- {} deg ({} s)",
-            r.azimuth_deg,
-            r.sigma_deg,
-            r.duration_s
-        ),
-        Some(SeekOutcome::Failed(f)) => defmt::error!(
-            "north seek aborted at t={} s: {} (turntable: {})",
-            f.t_s,
-            f.error,
-            f.table_error
-        ),
-        None => {}
-    }
-}
-
-type Server = upload_boot::StaticServer<flash::AppFlash>;
-
-/// The upload server, in a static (`upload_boot.rs` builds it).
-fn start_upload_server(
-    flash: flash::AppFlash,
-    reset: ResetRecord,
-    options: TestOptions,
-    bufs: &'static mut UploadBuffers,
-) -> &'static mut Server {
-    if options.injects(BootFault::StoreGeometry) {
-        // Where the store's open fails (`upload_boot.rs`).
-        resets::fatal_boot(BootFault::StoreGeometry)
-    }
-    let server = upload_boot::new_upload_server(flash, VERIFY_KEY, GYRO_ID, reset, bufs);
-    keep_server(server, options)
-}
-
-/// Moves the server into its static (once).
-fn keep_server(server: Server, options: TestOptions) -> &'static mut Server {
-    let Some(server) =
-        cortex_m::singleton!(: Server = server).filter(|_| !options.injects(BootFault::Singleton))
-    else {
-        resets::fatal_boot(BootFault::Singleton)
-    };
-    server
 }
