@@ -76,14 +76,8 @@ fn main() -> Result<()> {
         let keep: Vec<usize> = (0..full.len()).filter(|&i| full.t_s[i] >= from_s).collect();
         let ds = full.subset(&keep);
         let cv = cross_validate(&ds, &cfg, cfg.folds).map_err(|e| anyhow!("{e}"))?;
-        let per_run = seek_azimuth_first_pairs_per_run(
-            &cv.residuals_dph,
-            &ds.groups,
-            &ds.t_s,
-            seek.dwell_s,
-            seek.latitude_deg,
-            1,
-        );
+        let per_run =
+            seek_azimuth_first_pairs_per_run(&cv.residuals_dph, &ds.groups, &ds.t_s, seek, 1);
         eprintln!(
             "{name}: width {:.2}, degree {}, held-out seek {:.5} deg",
             cv.best.width, cv.best.degree, cv.best.heldout_seek_deg

@@ -34,6 +34,7 @@ mod diagnose_raw_rows;
 mod diagnose_self_consistency;
 mod diagnose_simterm;
 mod diagnose_single_record;
+mod docs_commands;
 mod field_aging_independent;
 mod import_logger;
 mod import_pan;

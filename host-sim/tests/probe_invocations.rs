@@ -101,6 +101,7 @@ const NAME_FLAGS: &[&str] = &[
     "--incl-port",
     "--laws",
     "--sequence",
+    "--seek-sequence",
     "--misfit",
 ];
 /// Flags with a number (or a list of numbers) for value.

@@ -57,7 +57,7 @@ fn heldout_scores(hidden: Hidden, seed: u64, criterion: Criterion) -> (f64, f64)
     let seek = Criterion::seek_default().seek_geometry();
     (
         rms(&res),
-        seek_azimuth_rms_deg(&res, &hd.groups, &hd.t_s, seek.dwell_s, seek.latitude_deg),
+        seek_azimuth_rms_deg(&res, &hd.groups, &hd.t_s, seek),
     )
 }
 

@@ -165,10 +165,7 @@ fn a_seek_criterion_whose_seek_fits_in_no_run_is_refused_not_scored_as_zero() {
     let ds = campaign(&AMBIENTS, 3, 0.01, 13, shupe_like);
     let run_s = ds.t_s[ds.indices_where(|g| g == 0).last().copied().unwrap()] - ds.t_s[0];
     let seek = |dwell_s: f64| TrainConfig {
-        criterion: Criterion::Seek(SeekGeometry {
-            dwell_s,
-            latitude_deg: 34.0,
-        }),
+        criterion: Criterion::Seek(SeekGeometry::forward(dwell_s, 34.0)),
         ..TrainConfig::default()
     };
     // Two positions of a third of the run each fit; two of the whole run do not.

@@ -4,6 +4,7 @@
 
 use std::path::PathBuf;
 
+use crate::train::seek_score::Criterion;
 use anyhow::{bail, Result};
 use fog_core::model::format::RbfModel;
 use fog_core::seeking::northfinder::SeekMode;
@@ -89,7 +90,9 @@ pub struct Args {
     #[arg(long)]
     pub json: Option<PathBuf>,
     /// Held-out score that chooses the default model (as `train --criterion`; its seek
-    /// dwell and latitude are this Monte Carlo's).
+    /// dwell, latitude and sequence are this Monte Carlo's). `seek-forward`: the seek score
+    /// of a forward two-position seek even when `--sequence symmetric` (how a symmetric
+    /// seek's model was scored before 2026-12-02; for comparison).
     #[arg(long, default_value = crate::train::seek_score::DEFAULT_CRITERION_NAME)]
     pub criterion: String,
     /// The default model's inputs (as `train --inputs`): `auto` (chosen by validation, then
@@ -333,16 +336,25 @@ fn recipe_of(args: &Args) -> Option<UnitRecipe> {
     })
 }
 
+/// `--criterion` for this Monte Carlo's seeks. The model is scored on the seeks it will
+/// serve: a time-symmetric two-position seek sees its drift error's curvature, not its
+/// slope (`SeekGeometry::symmetric`); `seek-forward` scores forward seeks whatever the
+/// sequence.
+fn criterion_of(args: &Args, cfg: &MonteCarloConfig) -> Result<Criterion> {
+    let (name, symmetric) = match args.criterion.as_str() {
+        "seek-forward" => ("seek", false),
+        name => (name, cfg.mode == SeekMode::TwoPositionSymmetric),
+    };
+    Ok(Criterion::parse(name, cfg.dwell_s as f64, cfg.latitude_deg)
+        .map_err(|e| anyhow::anyhow!("--criterion {e}"))?
+        .with_symmetric_seeks(symmetric))
+}
+
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<()> {
     let cfg = config_from_args(&args)?;
     // Checked even when `--model` leaves it unused: a bad flag is never ignored.
-    let criterion = crate::train::seek_score::Criterion::parse(
-        &args.criterion,
-        cfg.dwell_s as f64,
-        cfg.latitude_deg,
-    )
-    .map_err(|e| anyhow::anyhow!("--criterion {e}"))?;
+    let criterion = criterion_of(&args, &cfg)?;
     let (training_runs, warm_restarts) = training_campaign(&args)?;
     if let Some(r) = recipe_of(&args) {
         r.check()?;

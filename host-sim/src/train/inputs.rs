@@ -244,17 +244,11 @@ impl InputCriterion for GroupedCvSeek {
             ..cfg.clone()
         };
         let cv = cross_validate(ds, cfg, cfg.folds)?;
-        let per_unit = seek_azimuth_per_run(
-            &cv.residuals_dph,
-            &ds.groups,
-            &ds.t_s,
-            seek.dwell_s,
-            seek.latitude_deg,
-        )
-        .iter()
-        .filter(|r| r.pairs > 0)
-        .map(|r| r.sum_sq_deg2 / r.pairs as f64)
-        .collect();
+        let per_unit = seek_azimuth_per_run(&cv.residuals_dph, &ds.groups, &ds.t_s, seek)
+            .iter()
+            .filter(|r| r.pairs > 0)
+            .map(|r| r.sum_sq_deg2 / r.pairs as f64)
+            .collect();
         Ok(SetScore {
             value: cv.best.heldout_seek_deg,
             per_unit,

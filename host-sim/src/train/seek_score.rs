@@ -33,15 +33,27 @@ pub const DEFAULT_CRITERION_NAME: &str = "seek";
 pub struct SeekGeometry {
     pub dwell_s: f64,
     pub latitude_deg: f64,
+    /// The time-symmetric sequence (0, 180, 180, 0 deg: `--sequence symmetric`): a seek
+    /// is four dwells and its error is the mean of the two 0 deg dwells' drift error minus
+    /// the mean of the two 180 deg dwells', so a drift error linear in time cancels and
+    /// only its curvature is scored. False: the forward seek (0, 180 deg).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub symmetric: bool,
 }
 
 impl SeekGeometry {
+    /// The forward two-position seek (0, 180 deg) with `dwell_s` per position.
+    pub fn forward(dwell_s: f64, latitude_deg: f64) -> Self {
+        SeekGeometry {
+            dwell_s,
+            latitude_deg,
+            symmetric: false,
+        }
+    }
+
     /// `north-seek`'s dwell at the simulator's site latitude.
     pub fn default_site() -> Self {
-        SeekGeometry {
-            dwell_s: DEFAULT_SEEK_DWELL_S,
-            latitude_deg: crate::sim::DEFAULT_LATITUDE_DEG,
-        }
+        Self::forward(DEFAULT_SEEK_DWELL_S, crate::sim::DEFAULT_LATITUDE_DEG)
     }
 
     /// Azimuth error, deg, of a two-position seek whose drift error differs by
@@ -87,6 +99,15 @@ impl Criterion {
         .unwrap_or(Criterion::Rms10s)
     }
 
+    /// The same criterion scoring time-symmetric seeks when `symmetric` (the 10 s rms is
+    /// unchanged).
+    pub fn with_symmetric_seeks(self, symmetric: bool) -> Self {
+        match self {
+            Criterion::Rms10s => Criterion::Rms10s,
+            Criterion::Seek(g) => Criterion::Seek(SeekGeometry { symmetric, ..g }),
+        }
+    }
+
     /// Short name for reports.
     pub fn name(&self) -> &'static str {
         match self {
@@ -99,10 +120,7 @@ impl Criterion {
     pub fn parse(name: &str, dwell_s: f64, latitude_deg: f64) -> Result<Self, String> {
         let c = match name {
             "rms10s" => Criterion::Rms10s,
-            "seek" => Criterion::Seek(SeekGeometry {
-                dwell_s,
-                latitude_deg,
-            }),
+            "seek" => Criterion::Seek(SeekGeometry::forward(dwell_s, latitude_deg)),
             _ => return Err(format!("`{name}`: use `seek` or `rms10s`")),
         };
         if !c.is_valid() {
@@ -120,6 +138,7 @@ impl Criterion {
             Criterion::Seek(SeekGeometry {
                 dwell_s,
                 latitude_deg,
+                ..
             }) => dwell_s.is_finite() && dwell_s > 0.0 && latitude_deg.abs() < 85.0,
         }
     }
@@ -129,14 +148,8 @@ impl Criterion {
 /// `res` (deg/h) of rows with run ids `groups` and times `t_s` (rows of a run in time
 /// order). Blocks with less than half of their rows present are skipped (with their
 /// pair). 0 when no pair exists (runs shorter than two dwells).
-pub fn seek_azimuth_rms_deg(
-    res: &[f64],
-    groups: &[u32],
-    t_s: &[f64],
-    dwell_s: f64,
-    latitude_deg: f64,
-) -> f64 {
-    let per_run = seek_azimuth_per_run(res, groups, t_s, dwell_s, latitude_deg);
+pub fn seek_azimuth_rms_deg(res: &[f64], groups: &[u32], t_s: &[f64], seek: SeekGeometry) -> f64 {
+    let per_run = seek_azimuth_per_run(res, groups, t_s, seek);
     let (ss, n) = per_run.iter().fold((0.0, 0usize), |(ss, n), r| {
         (ss + r.sum_sq_deg2, n + r.pairs)
     });
@@ -166,10 +179,9 @@ pub fn seek_azimuth_per_run(
     res: &[f64],
     groups: &[u32],
     t_s: &[f64],
-    dwell_s: f64,
-    latitude_deg: f64,
+    seek: SeekGeometry,
 ) -> Vec<RunSeekError> {
-    seek_azimuth_first_pairs_per_run(res, groups, t_s, dwell_s, latitude_deg, usize::MAX)
+    seek_azimuth_first_pairs_per_run(res, groups, t_s, seek, usize::MAX)
 }
 
 /// As `seek_azimuth_per_run`, but each run's first `max_pairs` pairs from power-on only
@@ -178,14 +190,9 @@ pub fn seek_azimuth_first_pairs_per_run(
     res: &[f64],
     groups: &[u32],
     t_s: &[f64],
-    dwell_s: f64,
-    latitude_deg: f64,
+    geometry: SeekGeometry,
     max_pairs: usize,
 ) -> Vec<RunSeekError> {
-    let geometry = SeekGeometry {
-        dwell_s,
-        latitude_deg,
-    };
     let mut out = Vec::new();
     let mut i = 0;
     while i < res.len() {
@@ -199,7 +206,7 @@ pub fn seek_azimuth_first_pairs_per_run(
             pairs: 0,
             span_s: t_s[end - 1] - t_s[i],
         };
-        for e in pair_errors_dph(&res[i..end], &t_s[i..end], dwell_s)
+        for e in seek_errors_dph(&res[i..end], &t_s[i..end], geometry)
             .into_iter()
             .take(max_pairs)
         {
@@ -213,7 +220,8 @@ pub fn seek_azimuth_first_pairs_per_run(
 }
 
 /// Differences of the block means (2k minus 2k+1) of one run, deg/h.
-fn pair_errors_dph(res: &[f64], t_s: &[f64], dwell_s: f64) -> Vec<f64> {
+fn seek_errors_dph(res: &[f64], t_s: &[f64], seek: SeekGeometry) -> Vec<f64> {
+    let dwell_s = seek.dwell_s;
     let Some(&t0) = t_s.first() else {
         return Vec::new();
     };
@@ -234,6 +242,15 @@ fn pair_errors_dph(res: &[f64], t_s: &[f64], dwell_s: f64) -> Vec<f64> {
         }
     }
     let mean = |b: usize| (count[b] as f64 >= 0.5 * expected).then(|| sum[b] / count[b] as f64);
+    if seek.symmetric {
+        // Dwells 4k..4k+3 at 0, 180, 180, 0 deg.
+        return (0..n_blocks / 4)
+            .filter_map(|k| {
+                let b = 4 * k;
+                Some((mean(b)? + mean(b + 3)?) / 2.0 - (mean(b + 1)? + mean(b + 2)?) / 2.0)
+            })
+            .collect();
+    }
     (0..n_blocks / 2)
         .filter_map(|k| Some(mean(2 * k)? - mean(2 * k + 1)?))
         .collect()
@@ -255,7 +272,10 @@ mod tests {
         let lat = 39.9;
         // Constant residual: cancels in every difference.
         let (r, g, t) = run(|_| 0.3, 44.0);
-        assert_eq!(seek_azimuth_rms_deg(&r, &g, &t, 110.0, lat), 0.0);
+        assert_eq!(
+            seek_azimuth_rms_deg(&r, &g, &t, SeekGeometry::forward(110.0, lat)),
+            0.0
+        );
         // Alternating +-0.05 deg/h every 10 s: cancels over a 120 s dwell (12 rows).
         let (r, g, t) = run(
             |x| {
@@ -267,12 +287,12 @@ mod tests {
             },
             44.0,
         );
-        let fast = seek_azimuth_rms_deg(&r, &g, &t, 120.0, lat);
+        let fast = seek_azimuth_rms_deg(&r, &g, &t, SeekGeometry::forward(120.0, lat));
         assert!(fast < 1e-12, "{fast}");
         // A ramp of 0.001 deg/h per minute: every pair differs by the ramp over one dwell.
         let slope = 0.001 / 60.0;
         let (r, g, t) = run(|x| slope * x, 44.0);
-        let slow = seek_azimuth_rms_deg(&r, &g, &t, 120.0, lat);
+        let slow = seek_azimuth_rms_deg(&r, &g, &t, SeekGeometry::forward(120.0, lat));
         let expect = (slope * 120.0 / (2.0 * earth_rate_horizontal_dph(lat))).to_degrees();
         assert!((slow - expect).abs() < 1e-9, "{slow} vs {expect}");
         // The 10 s rms says the opposite: the alternating error is ~4x the ramp's spread.
@@ -287,15 +307,42 @@ mod tests {
         // A step of 0.01 deg/h at 60 s: only the first pair (blocks 0-110, 110-220 s)
         // differs; the 11 later pairs are clean.
         let (r, g, t) = run(|x| if x < 60.0 { 0.01 } else { 0.0 }, 44.0);
-        let all = seek_azimuth_per_run(&r, &g, &t, 110.0, lat);
-        let first = seek_azimuth_first_pairs_per_run(&r, &g, &t, 110.0, lat, 3);
+        let all = seek_azimuth_per_run(&r, &g, &t, SeekGeometry::forward(110.0, lat));
+        let first =
+            seek_azimuth_first_pairs_per_run(&r, &g, &t, SeekGeometry::forward(110.0, lat), 3);
         assert_eq!((all[0].pairs, first[0].pairs), (12, 3));
         assert_eq!(all[0].sum_sq_deg2, first[0].sum_sq_deg2);
         let ms = |e: &RunSeekError| e.sum_sq_deg2 / e.pairs as f64;
         assert!((ms(&first[0]) / ms(&all[0]) - 4.0).abs() < 1e-9);
         // A run shorter than the limit keeps all its pairs.
         let (r, g, t) = run(|x| 1e-4 * x, 8.0);
-        let short = seek_azimuth_first_pairs_per_run(&r, &g, &t, 110.0, lat, 3);
+        let short =
+            seek_azimuth_first_pairs_per_run(&r, &g, &t, SeekGeometry::forward(110.0, lat), 3);
         assert_eq!(short[0].pairs, 2);
+    }
+
+    /// The time-symmetric seek scores a drift error's curvature, not its slope: a ramp
+    /// cancels, a parabola does not, and the forward seek scores both.
+    #[test]
+    fn the_symmetric_seek_cancels_a_ramp_and_scores_a_curvature() {
+        let lat = 39.9;
+        let (sym, fwd) = (
+            SeekGeometry {
+                symmetric: true,
+                ..SeekGeometry::forward(50.0, lat)
+            },
+            SeekGeometry::forward(50.0, lat),
+        );
+        let slope = 0.001 / 60.0;
+        let (r, g, t) = run(|x| slope * x, 44.0);
+        let ramp = seek_azimuth_rms_deg(&r, &g, &t, sym);
+        assert!(ramp < 1e-12, "{ramp}");
+        assert!(seek_azimuth_rms_deg(&r, &g, &t, fwd) > 1e-4);
+        let (r, g, t) = run(|x| 1e-8 * x * x, 44.0);
+        let curve = seek_azimuth_rms_deg(&r, &g, &t, sym);
+        assert!(curve > 1e-5, "{curve}");
+        // Four dwells a seek: half as many as the forward seek's pairs.
+        let n = |seek| seek_azimuth_per_run(&r, &g, &t, seek)[0].pairs;
+        assert_eq!((n(fwd), n(sym)), (26, 13));
     }
 }

@@ -19,10 +19,7 @@ pub fn plan(ambient_c: f64) -> OwnModelPlan {
         latitude_deg: LATITUDE_DEG,
         dwell_s: DWELL_S,
         seed: 1,
-        criterion: Criterion::Seek(SeekGeometry {
-            dwell_s: DWELL_S,
-            latitude_deg: LATITUDE_DEG,
-        }),
+        criterion: Criterion::Seek(SeekGeometry::forward(DWELL_S, LATITUDE_DEG)),
         inputs: fog_sim::train::InputChoice::Auto,
         seek_timing: None,
     }
@@ -38,5 +35,10 @@ pub fn seek_rms_deg(model: &RbfModel, runs: &[Run], specs: &[FeatureSpec]) -> f6
         .zip(&pred)
         .map(|(y, p)| y - p)
         .collect();
-    seek_azimuth_rms_deg(&res, &ds.groups, &ds.t_s, DWELL_S, LATITUDE_DEG)
+    seek_azimuth_rms_deg(
+        &res,
+        &ds.groups,
+        &ds.t_s,
+        SeekGeometry::forward(DWELL_S, LATITUDE_DEG),
+    )
 }

@@ -1,5 +1,6 @@
 //! `fogsim train`'s options and the training configuration they ask for.
 
+use crate::cmd::north_seek::Sequence;
 use crate::train::{InputChoice, Method, TrainConfig, WidthSearch};
 use std::path::PathBuf;
 
@@ -86,6 +87,11 @@ pub struct Args {
     /// score), deg.
     #[arg(long = "seek-latitude-deg", default_value_t = crate::sim::DEFAULT_LATITUDE_DEG, allow_negative_numbers = true)]
     pub seek_latitude: f64,
+    /// Sequence of the seeks the `seek` criterion and `--seek-refit` score (as
+    /// `north-seek --sequence`): `forward` (0, 180 deg) or `symmetric` (0, 180, 180, 0:
+    /// a drift error linear in time cancels, its curvature is scored).
+    #[arg(long = "seek-sequence", value_enum, default_value_t = Sequence::Forward)]
+    pub seek_sequence: Sequence,
     /// Refit the final model's output layer to the seeks of the north finder's own
     /// sequence at `--seek-dwell-s` and `--seek-latitude-deg` (the simulated device's
     /// timing, measured), with the weight of a seek pair chosen over folds of runs
@@ -160,6 +166,15 @@ fn parse_method(s: &str) -> Result<Method, String> {
 }
 
 impl Args {
+    /// The seeks the trainer scores: `--seek-dwell-s`, `--seek-latitude-deg`,
+    /// `--seek-sequence`.
+    pub fn seek_geometry(&self) -> crate::train::seek_score::SeekGeometry {
+        crate::train::seek_score::SeekGeometry {
+            symmetric: self.seek_sequence == Sequence::Symmetric,
+            ..crate::train::seek_score::SeekGeometry::forward(self.seek_dwell, self.seek_latitude)
+        }
+    }
+
     /// The training configuration these options ask for.
     pub fn config(&self) -> anyhow::Result<TrainConfig> {
         // Each seek parameter named by its flag (checked also under `rms10s`, which does
@@ -181,7 +196,8 @@ impl Args {
             self.seek_dwell,
             self.seek_latitude,
         )
-        .map_err(|e| anyhow::anyhow!("--criterion {e}"))?;
+        .map_err(|e| anyhow::anyhow!("--criterion {e}"))?
+        .with_symmetric_seeks(self.seek_sequence == Sequence::Symmetric);
         Ok(TrainConfig {
             criterion,
             method: self.method,

@@ -23,10 +23,7 @@ pub(super) fn field_refined(
         (None, _) => Vec::new(),
     };
     // The azimuth score's seeks are the ones the trainer's seek criterion scores.
-    let seek = crate::train::seek_score::SeekGeometry {
-        dwell_s: args.seek_dwell,
-        latitude_deg: args.seek_latitude,
-    };
+    let seek = args.seek_geometry();
     let refined = crate::train::field_correction::refine_with_dir(
         model,
         dir,

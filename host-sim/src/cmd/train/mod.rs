@@ -14,6 +14,7 @@ pub use args::Args;
 use finish::{field_refined, stage};
 
 use super::{check_distinct_outputs, check_output_file};
+use crate::cmd::north_seek::Sequence;
 use crate::io::runs::run_files;
 use crate::io::{read_runs_binned, OutputGuard, OutputLock, StagedFiles};
 use crate::train::cold_start::{self, envelope_for};
@@ -241,6 +242,10 @@ fn refit_to_device_seeks(
     let seek = crate::pipeline::north_seek::MonteCarloConfig {
         dwell_s: args.seek_dwell as f32,
         latitude_deg: args.seek_latitude,
+        mode: match args.seek_sequence {
+            Sequence::Forward => fog_core::seeking::northfinder::SeekMode::TwoPosition,
+            Sequence::Symmetric => fog_core::seeking::northfinder::SeekMode::TwoPositionSymmetric,
+        },
         ..crate::pipeline::north_seek::MonteCarloConfig::paper(1)
     };
     seek.validate().context("--seek-refit")?;
@@ -253,10 +258,7 @@ fn refit_to_device_seeks(
         .iter()
         .map(|r| r.temp_c().first().copied().unwrap_or(f64::NAN))
         .collect();
-    let geometry = crate::train::seek_score::SeekGeometry {
-        dwell_s: args.seek_dwell,
-        latitude_deg: args.seek_latitude,
-    };
+    let geometry = args.seek_geometry();
     refit_for_seeks(model, ds, &start_c, &schedule, geometry).context("--seek-refit")
 }
 

@@ -15,7 +15,6 @@ use crate::io::runs::Run;
 use crate::io::StagedFiles;
 use crate::registry::{Registry, UnitCalibrationRecord};
 use crate::train::cold_start::envelope_for;
-use crate::train::seek_score::SeekGeometry;
 use crate::train::type_unit::type_model::learn_type;
 use crate::train::type_unit::{calibrate_unit, unit_id_of, MisfitPolicy, TypeModel, UnitPlan};
 use crate::train::{choose_inputs_default, train_model, InputSet, TrainConfig};
@@ -112,10 +111,7 @@ pub(super) fn calibrate(
     let ty = TypeModel::read(type_path)?;
     let unit = unit_id_of(runs, &args.gyro_id)?;
     let plan = UnitPlan {
-        seek: SeekGeometry {
-            dwell_s: args.seek_dwell,
-            latitude_deg: args.seek_latitude,
-        },
+        seek: args.seek_geometry(),
         terms: args.unit_terms,
     };
     let cal = calibrate_unit(&ty, runs, &unit, &plan)?;

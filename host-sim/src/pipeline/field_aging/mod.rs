@@ -257,10 +257,10 @@ pub fn run_aging_on(
         .collect();
     let eval_cfg = &eval_cfgs[0];
     // The refinement's azimuth score scores the seeks this measurement runs.
-    let seek = crate::train::seek_score::SeekGeometry {
-        dwell_s: f64::from(eval_cfg.dwell_s),
-        latitude_deg: plan.latitude_deg,
-    };
+    let seek = crate::train::seek_score::SeekGeometry::forward(
+        f64::from(eval_cfg.dwell_s),
+        plan.latitude_deg,
+    );
     let chamber = subject.chamber(plan)?;
     progress(&format!(
         "chamber model: {} runs at {:?} degC, {} centres",

@@ -116,6 +116,18 @@ pub struct OwnModelPlan {
     pub seek_timing: Option<MonteCarloConfig>,
 }
 
+impl OwnModelPlan {
+    /// The seeks the model is scored and refitted for: the forward seek of the plan's
+    /// dwell and latitude, or the time-symmetric one when the criterion scores those.
+    pub fn seek_geometry(&self) -> SeekGeometry {
+        let symmetric = matches!(self.criterion, Criterion::Seek(g) if g.symmetric);
+        SeekGeometry {
+            symmetric,
+            ..SeekGeometry::forward(self.dwell_s, self.latitude_deg)
+        }
+    }
+}
+
 /// The trained own model and how its run count was chosen.
 pub struct OwnModel {
     pub trained: TrainOutcome,
@@ -325,11 +337,7 @@ fn refit_to_seeks(
         .iter()
         .map(|r| r.temp_c().first().copied().unwrap_or(f64::NAN))
         .collect();
-    let geometry = SeekGeometry {
-        dwell_s: plan.dwell_s,
-        latitude_deg: plan.latitude_deg,
-    };
-    refit_for_seeks(model, &ds, &start_c, schedule, geometry)
+    refit_for_seeks(model, &ds, &start_c, schedule, plan.seek_geometry())
         .map_err(|e| anyhow!("seek refit: {e}"))
 }
 
@@ -433,8 +441,7 @@ pub fn learned_seek_error_deg(
         let pa = predict_batch(&a.model, ds.rows()).map_err(|e| anyhow!("half-split: {e}"))?;
         let pb = predict_batch(&b.model, ds.rows()).map_err(|e| anyhow!("half-split: {e}"))?;
         let diff: Vec<f64> = pa.iter().zip(&pb).map(|(x, y)| x - y).collect();
-        sum +=
-            0.5 * seek_azimuth_rms_deg(&diff, &ds.groups, &ds.t_s, plan.dwell_s, plan.latitude_deg);
+        sum += 0.5 * seek_azimuth_rms_deg(&diff, &ds.groups, &ds.t_s, plan.seek_geometry());
     }
     Ok(sum / SPLITS as f64)
 }

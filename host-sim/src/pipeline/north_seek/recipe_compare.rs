@@ -85,10 +85,7 @@ pub fn compare_recipes(cfg: &MonteCarloConfig, keep_dir: &Path) -> Result<Recipe
         latitude_deg: cfg.latitude_deg,
         dwell_s: cfg.dwell_s as f64,
         seed: cfg.seed,
-        criterion: Criterion::Seek(SeekGeometry {
-            dwell_s: cfg.dwell_s as f64,
-            latitude_deg: cfg.latitude_deg,
-        }),
+        criterion: Criterion::Seek(SeekGeometry::forward(cfg.dwell_s as f64, cfg.latitude_deg)),
         inputs: InputChoice::Auto,
         seek_timing: Some(MonteCarloConfig {
             restart_above_ambient_c: 0.0,

@@ -18,7 +18,6 @@ use crate::io::runs::Run;
 use crate::pipeline::campaign::{CampaignSpec, PAPER_MINUTES};
 use crate::pipeline::fleet::{fleet_runs, unit_id, FleetType};
 use crate::sim::{GyroParams, TypeSpread};
-use crate::train::seek_score::SeekGeometry;
 use crate::train::type_unit::type_model::learn_type;
 use crate::train::type_unit::{calibrate_unit, TypeModel, UnitCalibration, UnitPlan};
 
@@ -270,10 +269,7 @@ pub fn unit_model(
 ) -> Result<RecipeModel> {
     let (_, unit_params, own) = seeking_unit_runs(recipe)?;
     let unit_plan = UnitPlan {
-        seek: SeekGeometry {
-            dwell_s: plan.dwell_s,
-            latitude_deg: plan.latitude_deg,
-        },
+        seek: plan.seek_geometry(),
         terms: None,
     };
     let ty = learnt.type_model;

@@ -304,10 +304,7 @@ mod tests {
     fn the_azimuth_score_is_taken_at_the_seeks_of_the_site() {
         let o = obs(40, 0.0005, 0.02, 3);
         let here = SeekGeometry::default_site();
-        let north = SeekGeometry {
-            dwell_s: 2.0 * here.dwell_s,
-            latitude_deg: 60.0,
-        };
+        let north = SeekGeometry::forward(2.0 * here.dwell_s, 60.0);
         let (a, b) = (held_out(&o, &[], 0.0, here), held_out(&o, &[], 0.0, north));
         assert!(a.az_rms_deg > 0.0, "{a:?}");
         assert_eq!(a.rms_dph, b.rms_dph, "the half-sum does not depend on it");

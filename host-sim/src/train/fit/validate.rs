@@ -273,7 +273,7 @@ impl WidthScore {
 /// every model would score 0 and the choice would be arbitrary.
 fn check_seek_fits(ds: &Dataset, seek: SeekGeometry) -> Result<()> {
     let zeros = vec![0.0; ds.len()];
-    let runs = seek_azimuth_per_run(&zeros, &ds.groups, &ds.t_s, seek.dwell_s, seek.latitude_deg);
+    let runs = seek_azimuth_per_run(&zeros, &ds.groups, &ds.t_s, seek);
     if runs.iter().any(|r| r.pairs > 0) {
         return Ok(());
     }
@@ -286,7 +286,7 @@ fn check_seek_fits(ds: &Dataset, seek: SeekGeometry) -> Result<()> {
 /// Held-out seek score at the criterion's dwell and latitude (the defaults under `Rms10s`).
 fn seek_score_of(cfg: &TrainConfig, res: &[f64], ds: &Dataset) -> f64 {
     let seek = cfg.criterion.seek_geometry();
-    seek_azimuth_rms_deg(res, &ds.groups, &ds.t_s, seek.dwell_s, seek.latitude_deg)
+    seek_azimuth_rms_deg(res, &ds.groups, &ds.t_s, seek)
 }
 
 /// Std around the overall mean.

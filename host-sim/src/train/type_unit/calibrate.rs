@@ -269,14 +269,8 @@ fn held_out(
         let range = rows.rows_of(r);
         let res = rows.corrected(range.clone(), &coef);
         let groups = vec![0u32; res.len()];
-        let run = seek_azimuth_first_pairs_per_run(
-            &res,
-            &groups,
-            &rows.t_s[range],
-            seek.dwell_s,
-            seek.latitude_deg,
-            SCORED_PAIRS,
-        );
+        let run =
+            seek_azimuth_first_pairs_per_run(&res, &groups, &rows.t_s[range], seek, SCORED_PAIRS);
         let (s, n) = run
             .iter()
             .fold((0.0, 0), |(s, n), x| (s + x.sum_sq_deg2, n + x.pairs));
