@@ -6,9 +6,10 @@
 //! misfit (the drift error changing over minutes) becomes azimuth bias. The seek score
 //! takes each held-out run's residual (target - prediction), averages it over consecutive
 //! dwell-length blocks from power-on, differences the blocks pairwise (blocks 2k and
-//! 2k+1: back-to-back seeks) and converts to azimuth error at the site latitude with
-//! |sin psi| = 1 (the best-conditioned azimuth; others scale by 1 / |sin psi|). The
-//! score is the rms of those azimuth errors over all held-out runs, deg.
+//! 2k+1: back-to-back seeks; for the time-symmetric sequence four blocks a seek, 0, 180,
+//! 180, 0 deg, so a drift error linear in time cancels) and converts to azimuth error at
+//! the site latitude with |sin psi| = 1 (the best-conditioned azimuth; others scale by
+//! 1 / |sin psi|). The score is the rms of those azimuth errors over all held-out runs, deg.
 //!
 //! `Criterion` picks which score chooses the model's shape (width and polynomial degree;
 //! the number of centres on each fold's path stays chosen by held-out residual energy).
@@ -219,7 +220,9 @@ pub fn seek_azimuth_first_pairs_per_run(
     out
 }
 
-/// Differences of the block means (2k minus 2k+1) of one run, deg/h.
+/// One run's seek errors, deg/h: the differences of the dwell-block means (2k minus 2k+1)
+/// of forward seeks, or for symmetric seeks the mean of blocks 4k and 4k+3 minus the mean
+/// of blocks 4k+1 and 4k+2.
 fn seek_errors_dph(res: &[f64], t_s: &[f64], seek: SeekGeometry) -> Vec<f64> {
     let dwell_s = seek.dwell_s;
     let Some(&t0) = t_s.first() else {
