@@ -302,7 +302,8 @@ fn worst_ratio(cal: &UnitCalibration) -> f64 {
 /// thread): with 4 units of 2 runs (the type from 3) the odd unit was missed at 1 seed of
 /// 12 (0.94), with 8 units of 1 run per ambient at 5 of 12. Only the last unit is tested:
 /// over every unit of the `Type` fleet in turn (18 seeds x 6 units) 5 of 108 normal units
-/// were flagged (up to 1.43), against the misfit test's nominal family-wise rate of 1 %.
+/// were flagged (up to 1.43), against the misfit test's nominal family-wise rate of 1 %;
+/// 4 of 108 since the type mean's own error is in the z (the slow-suite test below).
 #[test]
 fn an_independent_odd_unit_is_outside_its_type_and_a_normal_unit_is_within_it() {
     let t0 = Instant::now();
@@ -696,4 +697,58 @@ fn check_refused(dir: &Path, args: &[&str], needle: &str) {
         .filter(|p| p.file_name().unwrap().to_string_lossy().starts_with("out."))
         .collect();
     assert!(left.is_empty(), "{args:?} left {left:?}");
+}
+
+/// The misfit test's false alarms on normal units (the independent `Type` fleet, every unit
+/// in turn against the type of the others, `MISFIT_SEEDS` seeds, 18 by default: 108 units)
+/// stay within the family-wise level: at most the 99 % binomial quantile of 1 % of them
+/// (4 of 108). Measured: 5 of 108 (largest |z| / critical 1.56) when the z ignored the type
+/// mean's own error, 4 of 108 (1.34) with it: at the bound, not inside it with a margin.
+/// What is left is likely the unit's jackknife standard error from 6 runs (not measured).
+#[test]
+#[ignore = "slow suite: 108 unit calibrations (cargo test -- --include-ignored)"]
+fn qualification_normal_units_are_flagged_at_the_misfit_tests_level() {
+    let seeds: u64 = std::env::var("MISFIT_SEEDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(18);
+    let mut flagged = Vec::new();
+    let mut tested = 0usize;
+    for seed in 1..=seeds {
+        for unit in 1..=UNITS {
+            let (_, cal) = calibrated(FleetLaw::Type, seed, unit);
+            tested += 1;
+            let r = worst_ratio(&cal);
+            if cal.misfit.outside() {
+                flagged.push(format!("seed {seed} U{unit}: {r:.2}"));
+            }
+        }
+    }
+    let allowed = binomial_upper(
+        tested,
+        fog_sim::train::type_unit::misfit::FAMILY_ALPHA,
+        0.99,
+    );
+    println!(
+        "{} of {tested} normal units flagged (allowed {allowed}): {flagged:?}",
+        flagged.len()
+    );
+    assert!(
+        flagged.len() <= allowed,
+        "{} of {tested} flagged (allowed {allowed}): {flagged:?}",
+        flagged.len()
+    );
+}
+
+/// Smallest k with P(Binomial(n, p) <= k) >= q.
+fn binomial_upper(n: usize, p: f64, q: f64) -> usize {
+    let mut cdf = 0.0;
+    for k in 0..=n {
+        let ln_choose: f64 = (1..=k).map(|i| ((n - k + i) as f64 / i as f64).ln()).sum();
+        cdf += (ln_choose + k as f64 * p.ln() + (n - k) as f64 * (1.0 - p).ln()).exp();
+        if cdf >= q {
+            return k;
+        }
+    }
+    n
 }

@@ -193,6 +193,7 @@ pub fn calibrate_unit(
         &se,
         &mean,
         &spread,
+        &ty.file.terms.iter().map(|t| t.scatter).collect::<Vec<_>>(),
         ty.file.units.len(),
         rows.runs,
     );

@@ -2,9 +2,11 @@
 //! unit's runs, no prior) against the type's value, in units of the type's spread and the
 //! estimate's own error together,
 //!
-//!   z = (own - type mean) / sqrt(spread^2 + se^2)     (se: jackknife over the unit's runs)
+//!   z = (own - type mean) / sqrt(spread^2 + se^2 + scatter^2 / units)
 //!
-//! tested family-wise over the terms (Bonferroni at `FAMILY_ALPHA`) against Student's t
+//! (se: jackknife over the unit's runs; scatter^2 / units: the type mean's own error, the
+//! units' estimates scattered about it, as in a prediction interval for a new unit), tested
+//! family-wise over the terms (Bonferroni at `FAMILY_ALPHA`) against Student's t
 //! with the Welch-Satterthwaite degrees of freedom of the two variances (the spread from
 //! the type's units - 1, the se from the unit's runs - 1): with few runs the se is itself
 //! uncertain and a normal quantile would call noise a misfit. A term whose test could not
@@ -30,7 +32,7 @@ pub struct TermTest {
     /// The type's mean and spread, model units.
     pub type_mean: f64,
     pub type_spread: f64,
-    /// (own - mean) / sqrt(spread^2 + se^2).
+    /// (own - mean) / sqrt(spread^2 + se^2 + the type mean's error^2).
     pub z: f64,
     /// Critical |z| at the family-wise rate.
     pub critical: f64,
@@ -103,6 +105,7 @@ pub fn test_unit(
     se: &[f64],
     type_mean: &[f64],
     type_spread: &[f64],
+    type_scatter: &[f64],
     type_units: usize,
     unit_runs: usize,
 ) -> Misfit {
@@ -112,7 +115,10 @@ pub fn test_unit(
     let dof_unit = (unit_runs as f64 - 1.0).max(1.0);
     let terms = (0..own.len())
         .map(|k| {
-            let s2 = type_spread[k] * type_spread[k];
+            // The type's side: the spread of units about the mean, and the mean's own error
+            // (its units' scatter over their count), both known to the type's units - 1.
+            let mean_var = type_scatter[k] * type_scatter[k] / (type_units.max(1) as f64);
+            let s2 = type_spread[k] * type_spread[k] + mean_var;
             let e2 = if se[k].is_finite() {
                 se[k] * se[k]
             } else {
@@ -169,6 +175,7 @@ mod tests {
             &se,
             &[0.0, 1.0],
             &[0.1, 0.1],
+            &[0.1, 0.1],
             type_units,
             runs,
         )
@@ -180,7 +187,7 @@ mod tests {
         assert!(out.outside());
         let lines = out.lines().join("\n");
         assert!(
-            lines.contains("unit U3: Shupe coefficient 8.0 sigma outside the type"),
+            lines.contains("unit U3: Shupe coefficient 7.7 sigma outside the type"),
             "{lines}"
         );
         let inside = against_type("U4", [0.02, 1.15], [0.05, 0.05], 10, 6);
