@@ -19,13 +19,18 @@ pub const HELD_ROWS_BUDGET_BYTES: usize = 2 << 20;
 
 static HELD_BYTES: AtomicUsize = AtomicUsize::new(0);
 
-/// Bytes of held rows alive now (for tests).
-pub fn held_bytes() -> usize {
-    HELD_BYTES.load(Ordering::Relaxed)
-}
-
 /// `design`'s `rows` rows, held if the budget allows, else `design` itself.
 pub fn held_or_on_demand(design: Arc<dyn Design>, rows: usize) -> Arc<dyn Design> {
+    held_within(design, rows, &HELD_BYTES, HELD_ROWS_BUDGET_BYTES)
+}
+
+/// [`held_or_on_demand`] against the count `held` and its `budget` (tests give their own).
+fn held_within(
+    design: Arc<dyn Design>,
+    rows: usize,
+    held: &'static AtomicUsize,
+    budget: usize,
+) -> Arc<dyn Design> {
     if design.is_held() {
         return design;
     }
@@ -33,9 +38,8 @@ pub fn held_or_on_demand(design: Arc<dyn Design>, rows: usize) -> Arc<dyn Design
     let Some(bytes) = rows.checked_mul(p).and_then(|v| v.checked_mul(8)) else {
         return design;
     };
-    let reserved = HELD_BYTES.fetch_update(Ordering::Relaxed, Ordering::Relaxed, |held| {
-        held.checked_add(bytes)
-            .filter(|&total| total <= HELD_ROWS_BUDGET_BYTES)
+    let reserved = held.fetch_update(Ordering::Relaxed, Ordering::Relaxed, |now| {
+        now.checked_add(bytes).filter(|&total| total <= budget)
     });
     if reserved.is_err() {
         return design;
@@ -46,15 +50,21 @@ pub fn held_or_on_demand(design: Arc<dyn Design>, rows: usize) -> Arc<dyn Design
             design.row(i, row);
         }
     }
-    Arc::new(HeldRows { values, p, bytes })
+    Arc::new(HeldRows {
+        values,
+        p,
+        bytes,
+        held,
+    })
 }
 
-/// Rows computed once and kept, row-major.
+/// Rows computed once and kept, row-major; their bytes are returned to `held` on drop.
 #[derive(Debug)]
 struct HeldRows {
     values: Vec<f64>,
     p: usize,
     bytes: usize,
+    held: &'static AtomicUsize,
 }
 
 impl Design for HeldRows {
@@ -73,7 +83,7 @@ impl Design for HeldRows {
 
 impl Drop for HeldRows {
     fn drop(&mut self) {
-        HELD_BYTES.fetch_sub(self.bytes, Ordering::Relaxed);
+        self.held.fetch_sub(self.bytes, Ordering::Relaxed);
     }
 }
 
@@ -99,9 +109,10 @@ mod tests {
 
     #[test]
     fn held_rows_are_the_designs_rows_and_the_budget_is_returned() {
+        static HELD: AtomicUsize = AtomicUsize::new(0);
         let n = 1000;
         let design: Arc<dyn Design> = Arc::new(Computed(n));
-        let held = held_or_on_demand(design.clone(), n);
+        let held = held_within(design.clone(), n, &HELD, 1 << 20);
         assert!(held.is_held());
         let (mut a, mut b) = ([0.0; 3], [0.0; 3]);
         for i in [0, 1, 499, 999] {
@@ -109,16 +120,22 @@ mod tests {
             held.row(i, &mut b);
             assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "row {i}");
         }
-        // Other tests of this binary hold rows too: only the ordering is checked.
-        assert!(held_bytes() >= n * 3 * 8);
+        assert_eq!(HELD.load(Ordering::Relaxed), n * 3 * 8);
         drop(held);
+        assert_eq!(HELD.load(Ordering::Relaxed), 0);
     }
 
     #[test]
     fn a_design_over_the_budget_is_computed_on_demand() {
-        let n = HELD_ROWS_BUDGET_BYTES / 24 + 1;
+        static HELD: AtomicUsize = AtomicUsize::new(0);
+        let n = 1000;
         let design: Arc<dyn Design> = Arc::new(Computed(n));
-        assert!(!held_or_on_demand(design, n).is_held());
+        let first = held_within(design.clone(), n, &HELD, 30_000);
+        assert!(first.is_held());
+        // the second would pass the budget while the first is alive
+        assert!(!held_within(design.clone(), n, &HELD, 30_000).is_held());
+        drop(first);
+        assert!(held_within(design, n, &HELD, 30_000).is_held());
         let columns: Arc<dyn Design> = Arc::new(Columns(vec![vec![1.0; 4]]));
         assert!(Arc::ptr_eq(
             &held_or_on_demand(columns.clone(), 4),
