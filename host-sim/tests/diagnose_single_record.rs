@@ -141,19 +141,7 @@ fn tallies(sigmas: f64, seeds: &[u64], rules: &[BufferRule]) -> Tally {
 /// Largest count of false names consistent with the family-wise level over `records`
 /// independent records: the 99 % quantile of Binomial(records, ALPHA).
 fn allowed_false_names(records: usize) -> usize {
-    let alpha = fog_sim::diagnose::selection::scored::ALPHA;
-    let mut cdf = 0.0;
-    for k in 0..=records {
-        let ln_choose: f64 = (1..=k)
-            .map(|i| ((records - k + i) as f64 / i as f64).ln())
-            .sum();
-        cdf +=
-            (ln_choose + k as f64 * alpha.ln() + (records - k) as f64 * (1.0 - alpha).ln()).exp();
-        if cdf >= 0.99 {
-            return k;
-        }
-    }
-    records
+    crate::common::level::binomial_upper(records, fog_sim::diagnose::selection::scored::ALPHA, 0.99)
 }
 
 /// The buffered rule's false names (`wrong[1]`) must stay within the level.

@@ -724,7 +724,7 @@ fn qualification_normal_units_are_flagged_at_the_misfit_tests_level() {
             }
         }
     }
-    let allowed = binomial_upper(
+    let allowed = crate::common::level::binomial_upper(
         tested,
         fog_sim::train::type_unit::misfit::FAMILY_ALPHA,
         0.99,
@@ -738,19 +738,6 @@ fn qualification_normal_units_are_flagged_at_the_misfit_tests_level() {
         "{} of {tested} flagged (allowed {allowed}): {flagged:?}",
         flagged.len()
     );
-}
-
-/// Smallest k with P(Binomial(n, p) <= k) >= q.
-fn binomial_upper(n: usize, p: f64, q: f64) -> usize {
-    let mut cdf = 0.0;
-    for k in 0..=n {
-        let ln_choose: f64 = (1..=k).map(|i| ((n - k + i) as f64 / i as f64).ln()).sum();
-        cdf += (ln_choose + k as f64 * p.ln() + (n - k) as f64 * (1.0 - p).ln()).exp();
-        if cdf >= q {
-            return k;
-        }
-    }
-    n
 }
 
 // ---- self-check on the simulator's own fleet ----
@@ -850,13 +837,6 @@ fn spread_of(terms: &[(String, f64)], name: &str) -> f64 {
         .expect(name)
 }
 
-/// Sample standard deviation.
-fn sample_sd(v: &[f64]) -> f64 {
-    let n = v.len() as f64;
-    let m = v.iter().sum::<f64>() / n;
-    (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
-}
-
 /// Self-check: a type learnt (as a user learns it, `fogsim train --type-out`) from the
 /// simulator's own fleet whose units differ only in their Shupe coefficient (10 %) reads
 /// that spread in its Shupe term, against the drawn coefficients of the same 10 units; its
@@ -883,7 +863,10 @@ fn the_type_reads_the_simulators_own_unit_spread() {
         "drift.bias_dph_per_c",
     );
     let (none, _) = cli_type_of_simulated_fleet("none", "none", "drift.shupe_dph_per_cps");
-    let (sd_k, sd_c) = (sample_sd(&drawn_k), sample_sd(&drawn_c));
+    let (sd_k, sd_c) = (
+        crate::common::fleet_judge::std_dev(&drawn_k),
+        crate::common::fleet_judge::std_dev(&drawn_c),
+    );
     let ratios = [
         spread_of(&shupe, "Shupe coefficient") / sd_k,
         spread_of(&tempco, "temperature coefficient") / sd_c,

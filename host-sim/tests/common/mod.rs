@@ -5,6 +5,7 @@ pub mod field_gyro;
 pub mod fleet_independent;
 pub mod fleet_judge;
 pub mod independent;
+pub mod level;
 pub mod novel;
 pub mod peer;
 pub mod planted;
