@@ -8,6 +8,7 @@ pub mod independent;
 pub mod level;
 pub mod novel;
 pub mod peer;
+pub mod peer_library;
 pub mod planted;
 pub mod seeds;
 pub mod seek_judge;
