@@ -1,14 +1,19 @@
 //! Effects `diagnose` was not written around (issue 18): for every family of
 //! `common/novel.rs` (its effect, a twin of another physical law, the null twin) and every
 //! seed, `fog_sim::diagnose` (through its public entry point and the JSON of its report, so
-//! that a restructured engine still runs here) and the generic peer of `common/peer.rs`
-//! are run side by side; one table row per case. The assertions hold what both achieve on
-//! the CI seeds (see docs/record/diagnose.md, "Effects the library was not written around"); the
+//! that a restructured engine still runs here) and two generic peers on the same library
+//! and naming test (`common/peer_library.rs`) are run side by side: the lasso peer of
+//! `common/peer.rs` and the best-subset peer of `common/peer_subset.rs` (issue 38 item 5).
+//! One table row per case: diagnose, then the lasso peer, then the best-subset peer. The
+//! assertions hold what each achieves on the CI seeds (see docs/record/diagnose.md,
+//! "Effects the library was not written around" and the 2026-12-02 best-subset section); the
 //! rest is printed. Full table: `DIAG_SEEDS=11,22,33,44,55,66 cargo test -p fog-sim --test
-//! diagnose_novel -- --nocapture --test-threads=2`.
+//! integration diagnose_novel:: -- --nocapture --test-threads=2`.
 
 use crate::common::novel;
 use crate::common::peer;
+use crate::common::peer_library;
+use crate::common::peer_subset;
 use crate::common::seeds;
 
 use novel::{campaign, Family, Shape, Variant, VARIANTS};
@@ -138,12 +143,16 @@ fn verdict(truth: &[&str], named: &[String]) -> &'static str {
     }
 }
 
-/// One case's table row: the verdicts of `diagnose` and the peer, and what `diagnose` named.
+/// One case's table row: the verdicts of `diagnose` and the two peers, and what `diagnose`
+/// named.
 pub(crate) struct Row {
     pub(crate) variant: Variant,
     pub(crate) seed: u64,
     pub(crate) engine: &'static str,
+    /// The lasso peer's verdict.
     pub(crate) peer: &'static str,
+    /// The best-subset peer's verdict.
+    pub(crate) subset: &'static str,
     pub(crate) named: Vec<String>,
     pub(crate) line: String,
 }
@@ -159,31 +168,48 @@ fn run_family(family: Family) -> Vec<Row> {
         .collect()
 }
 
-/// One case: the campaign of `family` / `variant` / `seed`, diagnosed and given to the peer.
-pub(crate) fn run_case(family: Family, variant: Variant, seed: u64) -> Row {
-    let (runs, truth) = campaign(family, variant, seed, SHAPE);
-    let e = engine(&runs);
-    let p = peer::peer(&runs);
-    let peer_named: Vec<String> = p
+/// A table cell of names: comma separated, or "-".
+fn or_dash(names: &[String]) -> String {
+    if names.is_empty() {
+        "-".to_owned()
+    } else {
+        names.join(", ")
+    }
+}
+
+/// A peer's verdict and its table cells: named terms with p and the verdict, then the CV
+/// gain % and selected-of-library.
+fn peer_cells(truth: &[&str], p: &peer_library::PeerReport) -> (&'static str, String) {
+    let labels: Vec<String> = p.named.iter().map(|n| n.label.clone()).collect();
+    let v = verdict(truth, &labels);
+    let named: Vec<String> = p
         .named
         .iter()
         .map(|n| format!("{} p{:.3}", n.label, n.p_value))
         .collect();
-    let peer_labels: Vec<String> = p.named.iter().map(|n| n.label.clone()).collect();
-    let (ev, pv) = (
-        verdict(&truth.columns, &e.named),
-        verdict(&truth.columns, &peer_labels),
-    );
-    let line = format!(
-        "| {family:?} | {variant:?} | {seed} | {} | {} {ev} | {:+.1} | {} | {} {pv} | {:+.1} ({} of {}) |",
-        truth.law,
-        if e.named.is_empty() { "-".to_owned() } else { e.named.join(", ") },
-        e.gain_pct,
-        e.p_value.map_or("-".to_owned(), |p| format!("{p:.4}")),
-        if peer_named.is_empty() { "-".to_owned() } else { peer_named.join(", ") },
+    let cells = format!(
+        "{} {v} | {:+.1} ({} of {})",
+        or_dash(&named),
         p.cv_gain_pct,
         p.selected,
         p.library_size,
+    );
+    (v, cells)
+}
+
+/// One case: the campaign of `family` / `variant` / `seed`, diagnosed and given to both peers.
+pub(crate) fn run_case(family: Family, variant: Variant, seed: u64) -> Row {
+    let (runs, truth) = campaign(family, variant, seed, SHAPE);
+    let e = engine(&runs);
+    let (pv, lasso) = peer_cells(&truth.columns, &peer::peer(&runs));
+    let (sv, subset) = peer_cells(&truth.columns, &peer_subset::peer(&runs));
+    let ev = verdict(&truth.columns, &e.named);
+    let line = format!(
+        "| {family:?} | {variant:?} | {seed} | {} | {} {ev} | {:+.1} | {} | {lasso} | {subset} |",
+        truth.law,
+        or_dash(&e.named),
+        e.gain_pct,
+        e.p_value.map_or("-".to_owned(), |p| format!("{p:.4}")),
     );
     println!("{line}");
     Row {
@@ -191,6 +217,7 @@ pub(crate) fn run_case(family: Family, variant: Variant, seed: u64) -> Row {
         seed,
         engine: ev,
         peer: pv,
+        subset: sv,
         named: e.named,
         line,
     }
@@ -207,10 +234,10 @@ pub(crate) fn assert_ci(rows: &[Row], variant: Variant, what: &str, holds: impl 
     assert!(bad.is_empty(), "{what}: {bad:#?}");
 }
 
-/// Neither names anything on the null twin.
+/// None of the three names anything on the null twin.
 fn nulls_name_nothing(rows: &[Row]) {
     assert_ci(rows, Variant::Null, "null twin: nothing named", |r| {
-        r.engine == "none" && r.peer == "none"
+        r.engine == "none" && r.peer == "none" && r.subset == "none"
     });
 }
 
@@ -221,6 +248,12 @@ fn product_of_two_columns() {
     assert_ci(&rows, Variant::Effect, "peer names supply_v x dT/dt", |r| {
         r.peer == "right"
     });
+    assert_ci(
+        &rows,
+        Variant::Twin,
+        "best-subset peer names supply_v x T",
+        |r| r.subset == "right",
+    );
 }
 
 #[test]

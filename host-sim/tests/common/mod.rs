@@ -8,6 +8,8 @@ pub mod independent;
 pub mod level;
 pub mod novel;
 pub mod peer;
+pub mod peer_library;
+pub mod peer_subset;
 pub mod planted;
 pub mod seeds;
 pub mod seek_judge;
