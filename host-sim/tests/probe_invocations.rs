@@ -102,6 +102,7 @@ const NAME_FLAGS: &[&str] = &[
     "--laws",
     "--sequence",
     "--seek-sequence",
+    "--type-shape",
     "--misfit",
 ];
 /// Flags with a number (or a list of numbers) for value.

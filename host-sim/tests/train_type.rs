@@ -201,6 +201,59 @@ fn the_cli_learns_a_type_from_three_units_and_calibrates_a_fourth_with_reports_a
 }
 
 #[test]
+fn the_law_shape_learns_a_type_whose_unit_calibration_is_an_ordinary_model() {
+    let dir = app_support::scratch_dir("type-law");
+    sim_fleet(&dir, 4, "-40,20,60", 1);
+    let type_runs = unit_files(&dir, &[1, 2, 3]);
+    let unit_runs = unit_files(&dir, &[4]);
+    let learnt = fogsim_ok(
+        &dir,
+        &train_args(
+            &type_runs,
+            &[
+                "--type-out",
+                "type.json",
+                "--type-shape",
+                "law",
+                "--out",
+                "shared.model",
+            ],
+        ),
+    );
+    fogsim_ok(
+        &dir,
+        &train_args(&unit_runs, &["--type", "type.json", "--out", "u4.model"]),
+    );
+    // the shared model: T and the rise since power-on, then two power-on clocks of the
+    // grid (fast before slow), their products with T among the unit terms
+    let ty = TypeModel::read(&dir.join("type.json")).unwrap();
+    let labels: Vec<String> = ty
+        .model
+        .inputs
+        .iter()
+        .map(fog_sim::train::feature_name)
+        .collect();
+    assert_eq!(labels[..2], ["temp_c:value", "temp_c:rise"], "{labels:?}");
+    let taus: Vec<f32> = ty.model.inputs[2..].iter().map(|s| s.tau_s).collect();
+    assert!(taus.len() == 2 && taus[0] < taus[1], "{labels:?}");
+    assert!(
+        ty.file
+            .terms
+            .iter()
+            .any(|t| t.term.starts_with("linear_by_t:")),
+        "{learnt}"
+    );
+    assert_eq!(read_model(&dir.join("shared.model")).unwrap(), ty.model);
+    let unit = read_model(&dir.join("u4.model")).unwrap();
+    assert_eq!(unit.inputs, ty.model.inputs);
+    assert!(
+        unit.cold_start.is_some(),
+        "a clocked model checks cold starts"
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
 fn the_same_commands_write_the_same_type_and_unit_model_bytes() {
     let t0 = Instant::now();
     let dir = app_support::scratch_dir("type-bytes");

@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 
 use crate::train::seek_score::Criterion;
+use crate::train::type_unit::TypeShape;
 use anyhow::{bail, Result};
 use fog_core::model::format::RbfModel;
 use fog_core::seeking::northfinder::SeekMode;
@@ -137,6 +138,11 @@ pub struct Args {
     /// [default: 6]. Needs `--type-units`.
     #[arg(long = "type-unit-runs")]
     pub type_unit_runs: Option<usize>,
+    /// The form of the type's shared model: `network` (the trainer's, inputs chosen by
+    /// validation) or `law` (the warm-up law of a two-node thermal model as a network's
+    /// base; docs/record/fleet.md) [default: network]. Needs `--type-units`.
+    #[arg(long = "type-shape", value_enum)]
+    pub type_shape: Option<TypeShape>,
 }
 
 /// Every how many chamber power-ons one is a warm restart (`--training-restarts-above-c`).
@@ -191,6 +197,7 @@ fn training_campaign(args: &Args) -> Result<(usize, Option<WarmRestarts>)> {
         ("--unit-runs", args.unit_runs.is_some()),
         ("--unit-ambients-c", args.unit_ambients_c.is_some()),
         ("--type-unit-runs", args.type_unit_runs.is_some()),
+        ("--type-shape", args.type_shape.is_some()),
     ];
     if let (None, Some((flag, _))) = (args.type_units, shapes_recipe.iter().find(|(_, g)| *g)) {
         bail!("{flag}: needs --type-units N (the unit recipe it shapes)");
@@ -333,6 +340,7 @@ fn recipe_of(args: &Args) -> Option<UnitRecipe> {
             .clone()
             .unwrap_or_else(|| RECIPE_AMBIENTS_C.to_vec()),
         seed: args.seed,
+        type_shape: args.type_shape.unwrap_or_default(),
     })
 }
 

@@ -1,6 +1,7 @@
 //! `fogsim train`'s options and the training configuration they ask for.
 
 use crate::cmd::north_seek::Sequence;
+use crate::train::type_unit::TypeShape;
 use crate::train::{InputChoice, Method, TrainConfig, WidthSearch};
 use std::path::PathBuf;
 
@@ -130,6 +131,12 @@ pub struct Args {
     /// (`fog_sim::train::type_unit`).
     #[arg(long = "type-out", conflicts_with_all = ["type_model", "field", "seek_refit"])]
     pub type_out: Option<PathBuf>,
+    /// With `--type-out`: the form of the type's shared model, `network` (the trainer's,
+    /// with the options above) or `law` (the warm-up law of a two-node thermal model, two
+    /// power-on clocks chosen by leaving units out, as the base of a network on T and the
+    /// rise since power-on; for a type learnt over several ambients, docs/record/fleet.md).
+    #[arg(long = "type-shape", value_enum, default_value_t = TypeShape::Network, requires = "type_out")]
+    pub type_shape: TypeShape,
     /// Calibrate one unit from its own runs with this type (from `--type-out`) as the
     /// prior: the unit terms and the prior's weight are chosen by leave-one-run-out, and
     /// the unit is first tested against its type (`--misfit`). Writes an ordinary model.

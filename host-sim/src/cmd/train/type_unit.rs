@@ -15,8 +15,11 @@ use crate::io::runs::Run;
 use crate::io::StagedFiles;
 use crate::registry::{Registry, UnitCalibrationRecord};
 use crate::train::cold_start::envelope_for;
+use crate::train::type_unit::law::fit_law_network;
 use crate::train::type_unit::type_model::learn_type;
-use crate::train::type_unit::{calibrate_unit, unit_id_of, MisfitPolicy, TypeModel, UnitPlan};
+use crate::train::type_unit::{
+    calibrate_unit, unit_id_of, MisfitPolicy, TypeModel, TypeShape, UnitPlan,
+};
 use crate::train::{choose_inputs_default, train_model, InputSet, TrainConfig};
 
 /// `model` for the device `gyro_id` (written into its metadata).
@@ -47,6 +50,9 @@ pub(super) fn learn(
     runs: &[Run],
 ) -> Result<()> {
     let mut train = |runs: Vec<Run>| -> Result<RbfModel> {
+        if args.type_shape == TypeShape::Law {
+            return Ok(fit_law_network(&runs, cfg.criterion, &cfg.gyro_id)?.model);
+        }
         let (_, ds) = choose_inputs_default(&runs, candidates, cfg)?;
         let mut model = train_model(&ds, cfg)?.model;
         model.cold_start = envelope_for(&runs, &model.inputs)?;

@@ -79,6 +79,7 @@ pub fn compare_recipes(cfg: &MonteCarloConfig, keep_dir: &Path) -> Result<Recipe
         unit_runs: DEMO_UNIT_RUNS,
         unit_ambients_c: RECIPE_AMBIENTS_C.to_vec(),
         seed: cfg.seed,
+        type_shape: Default::default(),
     };
     let plan = OwnModelPlan {
         ambient_c: cfg.ambient_c,
@@ -271,6 +272,7 @@ mod tests {
             unit_runs: DEMO_UNIT_RUNS,
             unit_ambients_c: RECIPE_AMBIENTS_C.to_vec(),
             seed: 1,
+            type_shape: Default::default(),
         }
     }
 
@@ -312,6 +314,7 @@ mod tests {
     fn the_key_changes_with_the_recipe() {
         let other = UnitRecipe {
             seed: 2,
+            type_shape: Default::default(),
             ..recipe()
         };
         assert_eq!(cache_key(&recipe()).unwrap(), cache_key(&recipe()).unwrap());

@@ -18,8 +18,9 @@ use crate::io::runs::Run;
 use crate::pipeline::campaign::{CampaignSpec, PAPER_MINUTES};
 use crate::pipeline::fleet::{fleet_runs, unit_id, FleetType};
 use crate::sim::{GyroParams, TypeSpread};
+use crate::train::type_unit::law::fit_law_network;
 use crate::train::type_unit::type_model::learn_type;
-use crate::train::type_unit::{calibrate_unit, TypeModel, UnitCalibration, UnitPlan};
+use crate::train::type_unit::{calibrate_unit, TypeModel, TypeShape, UnitCalibration, UnitPlan};
 
 /// Ambients of the type's and the unit's chamber runs by default, degC.
 pub const RECIPE_AMBIENTS_C: [f64; 3] = [-40.0, 20.0, 60.0];
@@ -42,6 +43,8 @@ pub struct UnitRecipe {
     pub unit_ambients_c: Vec<f64>,
     /// The fleet's seed (units and runs).
     pub seed: u64,
+    /// The form of the type's shared model.
+    pub type_shape: TypeShape,
 }
 
 /// The seeking unit's model and where it came from.
@@ -146,6 +149,21 @@ pub fn chamber_h(runs: usize) -> f64 {
     runs as f64 * PAPER_MINUTES / 60.0
 }
 
+/// One backfitting round's shared model, with how it was made.
+enum RoundModel {
+    Network(Box<super::own_model::OwnModel>),
+    Law(Box<crate::train::type_unit::law::LawNetwork>),
+}
+
+impl RoundModel {
+    fn model(&self) -> &RbfModel {
+        match self {
+            Self::Network(own) => &own.trained.model,
+            Self::Law(law) => &law.model,
+        }
+    }
+}
+
 /// A type learnt from the recipe's type units (U2..U(N+1)), and how it was learnt.
 pub struct RecipeType {
     pub type_model: TypeModel,
@@ -185,24 +203,48 @@ pub fn learn_recipe_type(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<Rec
         ..plan.clone()
     };
     let ty = learn_type(&pooled, None, &mut |runs| {
-        let own = own_model_from_runs(&fleet.params, runs, &shared_plan)?;
-        let model = own.trained.model.clone();
-        rounds.push(own);
+        let model = match recipe.type_shape {
+            TypeShape::Network => {
+                let own = own_model_from_runs(&fleet.params, runs, &shared_plan)?;
+                let model = own.trained.model.clone();
+                rounds.push(RoundModel::Network(Box::new(own)));
+                model
+            }
+            TypeShape::Law => {
+                let law = fit_law_network(&runs, plan.criterion, "sim")?;
+                let model = law.model.clone();
+                rounds.push(RoundModel::Law(Box::new(law)));
+                model
+            }
+        };
         Ok(model)
     })?;
     drop(pooled);
     let shared = rounds
         .into_iter()
-        .find(|o| o.trained.model == ty.model)
+        .find(|r| r.model() == &ty.model)
         .ok_or_else(|| anyhow!("the type's shared model is none of the rounds'"))?;
+    let shared_text = match shared {
+        RoundModel::Network(own) => format!(
+            "shared model ({} centres, inputs {}):\n{}{}",
+            own.trained.report.n_centers,
+            own.trained.report.inputs.join(", "),
+            own.selection.summary(),
+            own.summary(),
+        ),
+        RoundModel::Law(law) => format!(
+            "shared model: the warm-up law (clocks of {:.0} s and {:.0} s, held-out first-seek error {:.4} deg) as the base of a network of {} centres\n",
+            law.taus_s[0],
+            law.taus_s[1],
+            law.law_heldout_deg,
+            law.model.centers.len(),
+        ),
+    };
     let summary = format!(
-        "type: {} units x {per_unit} runs ({:.1} chamber h); shared model ({} centres, inputs {}):\n{}{}{}",
+        "type: {} units x {per_unit} runs ({:.1} chamber h); {}{}",
         recipe.type_units,
         chamber_h(type_runs),
-        shared.trained.report.n_centers,
-        shared.trained.report.inputs.join(", "),
-        shared.selection.summary(),
-        shared.summary(),
+        shared_text,
         ty.summary(),
     );
     Ok(RecipeType {

@@ -10,10 +10,21 @@
 //! the unit pays parameters only for what its runs show it differs in.
 
 pub mod calibrate;
+pub mod law;
 pub mod misfit;
 pub mod solve;
 pub mod terms;
 pub mod type_model;
+
+/// The form of a type's shared model (`--type-shape`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+pub enum TypeShape {
+    /// The trainer's network, its inputs chosen by validation (`train`'s defaults).
+    #[default]
+    Network,
+    /// The warm-up law of a two-node thermal model as the base of a network (`law`).
+    Law,
+}
 
 pub use calibrate::{calibrate_unit, unit_id_of, MisfitPolicy, UnitCalibration, UnitPlan};
 pub use type_model::{fit_type, runs_by_unit, TypeModel};

@@ -33,12 +33,21 @@ pub enum UnitTerm {
     Gain,
     /// A linear term in the model's normalised input j, deg/h per normalised unit.
     Linear(usize),
+    /// A term in t xn_j (t: normalised T): how the unit's input-j coefficient changes with
+    /// temperature, e.g. its own Shupe coefficient's cold gain. Offered only on a type model
+    /// whose shared model has such terms (`linear_by_t`).
+    LinearByT(usize),
 }
 
 /// Every unit term a model can carry: the offset, the gain, then one linear term per input.
 pub fn unit_terms(model: &RbfModel) -> Vec<UnitTerm> {
     let mut t = vec![UnitTerm::Offset, UnitTerm::Gain];
     t.extend((0..model.inputs.len()).map(UnitTerm::Linear));
+    t.extend(
+        (0..model.linear_by_t.len().min(model.inputs.len()))
+            .filter(|&j| model.linear_by_t[j] != 0.0)
+            .map(UnitTerm::LinearByT),
+    );
     t
 }
 
@@ -58,6 +67,10 @@ pub fn term_name(model: &RbfModel, term: UnitTerm) -> String {
             Some(FeatureKind::TempLagC) => "lagged-temperature coefficient".into(),
             _ => format!("input {j} coefficient"),
         },
+        UnitTerm::LinearByT(j) => format!(
+            "{} x T",
+            term_name(model, UnitTerm::Linear(j)).replace(" coefficient", "")
+        ),
     }
 }
 
@@ -81,6 +94,10 @@ pub fn raw_coefficient(model: &RbfModel, term: UnitTerm, coef: f64) -> (f64, &'s
             };
             (coef / scale, unit)
         }
+        UnitTerm::LinearByT(j) => {
+            let scale = |k: usize| model.input_scale.get(k).map_or(1.0, |s| f64::from(*s));
+            (coef / (scale(j) * scale(0)), "deg/h per unit per degC")
+        }
     }
 }
 
@@ -94,7 +111,8 @@ pub fn design(model: &RbfModel, terms: &[UnitTerm], ds: &Dataset) -> Result<Desi
         columns.push(match t {
             UnitTerm::Offset => vec![1.0; ds.len()],
             UnitTerm::Gain => pred.iter().map(|p| p - bias).collect(),
-            UnitTerm::Linear(j) => predict_batch(&only_linear(model, j), ds.rows())?,
+            UnitTerm::Linear(j) => predict_batch(&only_linear(model, j, false), ds.rows())?,
+            UnitTerm::LinearByT(j) => predict_batch(&only_linear(model, j, true), ds.rows())?,
         });
     }
     Ok(Design { pred, columns })
@@ -108,15 +126,22 @@ pub struct Design {
     pub columns: Vec<Vec<f64>>,
 }
 
-/// `model` with every term zero but a linear coefficient of 1 on input j.
-fn only_linear(model: &RbfModel, j: usize) -> RbfModel {
+/// `model` with every term zero but a coefficient of 1 on input j's linear term (or, with
+/// `by_t`, on its `linear_by_t` term).
+fn only_linear(model: &RbfModel, j: usize, by_t: bool) -> RbfModel {
     let mut m = model.clone();
     m.bias_dph = 0.0;
     m.weights.iter_mut().for_each(|w| *w = 0.0);
     m.poly.iter_mut().for_each(|p| *p = 0.0);
     m.linear_by_t.iter_mut().for_each(|p| *p = 0.0);
-    for (k, l) in m.linear.iter_mut().enumerate() {
-        *l = if k == j { 1.0 } else { 0.0 };
+    m.linear.iter_mut().for_each(|p| *p = 0.0);
+    let target = if by_t {
+        &mut m.linear_by_t
+    } else {
+        &mut m.linear
+    };
+    if let Some(l) = target.get_mut(j) {
+        *l = 1.0;
     }
     m
 }
@@ -142,6 +167,10 @@ pub fn fold(model: &RbfModel, terms: &[UnitTerm], coef: &[f64]) -> Result<RbfMod
             UnitTerm::Linear(j) => match out.linear.get_mut(j) {
                 Some(l) => *l = (f64::from(*l) + c) as f32,
                 None => bail!("unit term on input {j}: the model has no such input"),
+            },
+            UnitTerm::LinearByT(j) => match out.linear_by_t.get_mut(j) {
+                Some(l) => *l = (f64::from(*l) + c) as f32,
+                None => bail!("unit term on T x input {j}: the model has no such term"),
             },
         }
     }
@@ -220,6 +249,28 @@ mod tests {
         let only_offset = fold(&m, &terms, &[0.05, 0.0, 0.0, 0.0]).unwrap();
         assert_eq!(only_offset.linear, m.linear);
         assert!((only_offset.bias_dph - 0.35).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_temperature_coupled_term_is_offered_and_folds_exactly_where_the_type_has_one() {
+        let mut m = model();
+        assert!(!unit_terms(&m).contains(&UnitTerm::LinearByT(1)));
+        m.linear_by_t.push(0.0).unwrap();
+        m.linear_by_t.push(0.03).unwrap();
+        let terms = unit_terms(&m);
+        assert_eq!(terms.last(), Some(&UnitTerm::LinearByT(1)));
+        assert_eq!(term_name(&m, UnitTerm::LinearByT(1)), "Shupe x T");
+        let ds = dataset(&m);
+        let coef = [0.0, 0.1, 0.0, 0.0, 0.02];
+        let d = design(&m, &terms, &ds).unwrap();
+        let after = predict_batch(&fold(&m, &terms, &coef).unwrap(), ds.rows()).unwrap();
+        for (i, a) in after.iter().enumerate() {
+            let want = d.pred[i] + 0.1 * d.columns[1][i] + 0.02 * d.columns[4][i];
+            assert!(
+                (a - want).abs() < 2e-6 * (1.0 + want.abs()),
+                "row {i}: {a} vs {want}"
+            );
+        }
     }
 
     #[test]

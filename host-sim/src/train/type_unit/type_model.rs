@@ -309,6 +309,7 @@ pub fn fit_type(
                 UnitTerm::Offset => "offset".into(),
                 UnitTerm::Gain => "gain".into(),
                 UnitTerm::Linear(j) => format!("linear:{j}"),
+                UnitTerm::LinearByT(j) => format!("linear_by_t:{j}"),
             },
             name: term_name(model, t),
             mean,
