@@ -5,8 +5,8 @@
 //! run; the planted cause at 1 noise sigma after removing what the paper's base absorbs):
 //! the effect (a decay after every step of `supply_v`, whatever the step's sign), its
 //! different-law twin (a decay after every gap of the time stamps) and the null twin
-//! (the same steps and gaps, no response). `diagnose` and the generic peer are run side
-//! by side as in `diagnose_novel`; one case a test so each stays short. Other seeds:
+//! (the same steps and gaps, no response). `diagnose` and the two generic peers (the lasso
+//! and the best subset) are run side by side as in `diagnose_novel`; one case a test so each stays short. Other seeds:
 //! `DIAG_SEEDS=11,22,33,44,55,66 cargo test -p fog-sim --test integration diagnose_events
 //! -- --nocapture`.
 
