@@ -84,6 +84,13 @@ fn unit_files(dir: &Path, units: &[usize]) -> Vec<String> {
         .collect()
 }
 
+/// A fleet of 4 units, one cold start each at -40, 20 and +60 degC: the runs of units 1-3
+/// (a type's) and of unit 4 (a unit to calibrate).
+fn three_units_and_a_fourth(dir: &Path) -> (Vec<String>, Vec<String>) {
+    sim_fleet(dir, 4, "-40,20,60", 1);
+    (unit_files(dir, &[1, 2, 3]), unit_files(dir, &[4]))
+}
+
 /// `fogsim train RUNS EXTRA...` as arguments.
 fn train_args<'a>(runs: &'a [String], extra: &[&'a str]) -> Vec<&'a str> {
     let mut a = vec!["train"];
@@ -96,9 +103,7 @@ fn train_args<'a>(runs: &'a [String], extra: &[&'a str]) -> Vec<&'a str> {
 fn the_cli_learns_a_type_from_three_units_and_calibrates_a_fourth_with_reports_and_registry() {
     let t0 = Instant::now();
     let dir = app_support::scratch_dir("type-cli");
-    sim_fleet(&dir, 4, "-40,20,60", 1);
-    let type_runs = unit_files(&dir, &[1, 2, 3]);
-    let unit_runs = unit_files(&dir, &[4]);
+    let (type_runs, unit_runs) = three_units_and_a_fourth(&dir);
     assert_eq!((type_runs.len(), unit_runs.len()), (9, 3));
     let learnt = fogsim_ok(
         &dir,
@@ -203,9 +208,7 @@ fn the_cli_learns_a_type_from_three_units_and_calibrates_a_fourth_with_reports_a
 #[test]
 fn the_law_shape_learns_a_type_whose_unit_calibration_is_an_ordinary_model() {
     let dir = app_support::scratch_dir("type-law");
-    sim_fleet(&dir, 4, "-40,20,60", 1);
-    let type_runs = unit_files(&dir, &[1, 2, 3]);
-    let unit_runs = unit_files(&dir, &[4]);
+    let (type_runs, unit_runs) = three_units_and_a_fourth(&dir);
     let learnt = fogsim_ok(
         &dir,
         &train_args(
