@@ -219,6 +219,12 @@ fn scenario_with(
             model.input_scale[j] = 0.5;
         }
     }
+    replay_both(evaluator, &model, tag);
+}
+
+/// Records a cold start with `model` in the loop, replays it on the host and under QEMU,
+/// and checks both against the recording to the last bit (and the firmware's stack).
+fn replay_both(evaluator: Evaluator, model: &RbfModel, tag: &str) {
     let mut buf = [0u8; MAX_ENCODED_LEN];
     let n = model.encode(&mut buf).expect("model encodes");
     let model = RbfModel::decode(&buf[..n]).expect("model decodes");
@@ -386,6 +392,57 @@ fn firmware_replay_matches_host_bit_for_bit_flat_start_accel() {
 #[test]
 fn firmware_replay_matches_host_bit_for_bit_rise() {
     scenario(Evaluator::F32, 3, FeatureKind::TempRiseC, "f32-rise");
+}
+
+/// A model of the type shape `law` (`fogsim train --type-out --type-shape law`): T and the
+/// rise under the Gaussians, two power-on clocks as linear-only inputs, linear terms, their
+/// products with T (`linear_by_t`) and a T^2 term, on the fixed-point evaluator.
+#[test]
+fn firmware_replay_matches_host_bit_for_bit_law_shape() {
+    if !qemu_ready("qemu_replay") {
+        return;
+    }
+    let mut model = warmup_model(3, 4, 0.05, 35);
+    let clock = |tau_s: f32| FeatureSpec {
+        kind: FeatureKind::PowerOnDecay,
+        tau_s,
+    };
+    let specs = [
+        FeatureSpec::plain(FeatureKind::TempC),
+        FeatureSpec::plain(FeatureKind::TempRiseC),
+        clock(130.0),
+        clock(300.0),
+    ];
+    // (offset, scale, min, max) of the rise and the clocks (the clocks over their range)
+    let ranges = [
+        (5.0, 5.0, -5.0, 100.0),
+        (0.5, 0.5, 0.0, 1.0),
+        (0.5, 0.5, 0.0, 1.0),
+    ];
+    for (j, spec) in specs.iter().enumerate() {
+        model.inputs[j] = *spec;
+        if let Some(&(offset, scale, lo, hi)) = j.checked_sub(1).and_then(|k| ranges.get(k)) {
+            model.input_offset[j] = offset;
+            model.input_scale[j] = scale;
+            model.input_min[j] = lo;
+            model.input_max[j] = hi;
+        }
+    }
+    model.n_rbf_inputs = 2;
+    for c in model.centers.iter_mut() {
+        c[2..].iter_mut().for_each(|v| *v = 0.0);
+    }
+    model.linear.copy_from_slice(&[0.01, 0.02, 0.05, -0.03]);
+    model
+        .linear_by_t
+        .extend_from_slice(&[0.0, 0.0, 0.02, -0.01])
+        .expect("4 T-coupled terms fit");
+    model
+        .poly
+        .extend_from_slice(&[0.0, 0.004])
+        .expect("2 polynomial terms fit");
+    model.validate().expect("a valid law-shaped model");
+    replay_both(Evaluator::Fixed, &model, "fixed-law-shape");
 }
 
 /// The time since power-on (`FeatureKind::PowerOnDecay`, exp(-t / tau), the clock input of
