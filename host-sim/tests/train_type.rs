@@ -848,6 +848,10 @@ fn cli_type_of_simulated_fleet(
     args.extend([
         "--type-out".into(),
         ty.display().to_string(),
+        // the network shape, whose unit terms name the Shupe and temperature coefficients
+        // the check reads (the law shape's are clock amplitudes)
+        "--type-shape".into(),
+        "network".into(),
         "--out".into(),
         dir.join("type.fogm").display().to_string(),
     ]);

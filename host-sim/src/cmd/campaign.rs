@@ -141,18 +141,23 @@ impl Args {
         if !(1..=MAX_UNITS).contains(&units) {
             bail!("--units {units}: must be within 1..={MAX_UNITS}");
         }
-        let (spread, label) = match self.unit_spread.as_deref() {
-            None => (TypeSpread::default_spread(), "default".to_string()),
-            Some(p) if p.as_os_str() == "default" => {
-                (TypeSpread::default_spread(), "default".to_string())
-            }
-            Some(p) if p.as_os_str() == "none" => (TypeSpread::none(), "none".to_string()),
-            Some(p) => (read_spread_file(p)?, spread_file_label(p)),
-        };
+        let (spread, label) = spread_of(self.unit_spread.as_deref())?;
         let mut fleet = FleetType::paper(spread, &label, self.type_seed.unwrap_or(1));
         fleet.params = fleet.params.with_heading_bias(self.heading_bias_dph);
         Ok(Some((fleet, units)))
     }
+}
+
+/// `--unit-spread`'s spread and its label (`default`, `none` or `file NAME`).
+pub(crate) fn spread_of(arg: Option<&Path>) -> anyhow::Result<(TypeSpread, String)> {
+    Ok(match arg {
+        None => (TypeSpread::default_spread(), "default".to_string()),
+        Some(p) if p.as_os_str() == "default" => {
+            (TypeSpread::default_spread(), "default".to_string())
+        }
+        Some(p) if p.as_os_str() == "none" => (TypeSpread::none(), "none".to_string()),
+        Some(p) => (read_spread_file(p)?, spread_file_label(p)),
+    })
 }
 
 /// A spread file (`--unit-spread FILE`), read whole within its size limit.

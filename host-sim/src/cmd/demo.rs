@@ -14,9 +14,10 @@ use crate::io::OutputGuard;
 use crate::output::reports::write_json;
 use crate::pipeline::campaign_steps::CampaignSpec;
 use crate::pipeline::north_seek::recipe_compare::{compare_recipes, recipe_table};
-use crate::pipeline::north_seek::MonteCarloConfig;
+use crate::pipeline::north_seek::{default_dwell_s, MonteCarloConfig};
 use crate::pipeline::reproduce::{reproduce, summary};
 use crate::sim::GyroParams;
+use fog_core::seeking::northfinder::SeekMode;
 
 /// Options of `fogsim demo`.
 #[derive(clap::Args, Debug)]
@@ -63,9 +64,13 @@ pub fn run(args: Args) -> Result<()> {
         .map(|m| m.model_file.as_str())
         .collect();
     let recipes = compare_recipes(
+        // the recommended seek with a few-run unit calibration: time-symmetric
+        // (docs/guide/fleet.md)
         &MonteCarloConfig {
             starts: args.starts,
             ambient_c: 20.0,
+            mode: SeekMode::TwoPositionSymmetric,
+            dwell_s: default_dwell_s(SeekMode::TwoPositionSymmetric),
             ..MonteCarloConfig::paper(args.seed)
         },
         &args.out,

@@ -4,6 +4,7 @@
 
 use std::path::PathBuf;
 
+use super::campaign::spread_of;
 use crate::train::seek_score::Criterion;
 use crate::train::type_unit::TypeShape;
 use anyhow::{bail, Result};
@@ -140,9 +141,14 @@ pub struct Args {
     pub type_unit_runs: Option<usize>,
     /// The form of the type's shared model: `network` (the trainer's, inputs chosen by
     /// validation) or `law` (the warm-up law of a two-node thermal model as a network's
-    /// base; docs/record/fleet.md) [default: network]. Needs `--type-units`.
+    /// base; docs/record/fleet.md) [default: law]. Needs `--type-units`.
     #[arg(long = "type-shape", value_enum)]
     pub type_shape: Option<TypeShape>,
+    /// How the simulated fleet's units differ (as `campaign --unit-spread`): `default`
+    /// (docs/explain/simulator.md, "Fleets"), `none` or a spread file of `parameter:
+    /// spread` lines (docs/reference/formats.md) [default: default]. Needs `--type-units`.
+    #[arg(long = "unit-spread")]
+    pub unit_spread: Option<PathBuf>,
 }
 
 /// Every how many chamber power-ons one is a warm restart (`--training-restarts-above-c`).
@@ -198,6 +204,7 @@ fn training_campaign(args: &Args) -> Result<(usize, Option<WarmRestarts>)> {
         ("--unit-ambients-c", args.unit_ambients_c.is_some()),
         ("--type-unit-runs", args.type_unit_runs.is_some()),
         ("--type-shape", args.type_shape.is_some()),
+        ("--unit-spread", args.unit_spread.is_some()),
     ];
     if let (None, Some((flag, _))) = (args.type_units, shapes_recipe.iter().find(|(_, g)| *g)) {
         bail!("{flag}: needs --type-units N (the unit recipe it shapes)");
@@ -329,9 +336,12 @@ fn recipe_unit_model(
 }
 
 /// `--type-units` and its companions as a recipe (None without `--type-units`).
-fn recipe_of(args: &Args) -> Option<UnitRecipe> {
-    Some(UnitRecipe {
-        type_units: args.type_units?,
+fn recipe_of(args: &Args) -> Result<Option<UnitRecipe>> {
+    let Some(type_units) = args.type_units else {
+        return Ok(None);
+    };
+    Ok(Some(UnitRecipe {
+        type_units,
         type_unit_runs: args.type_unit_runs.unwrap_or(6),
         type_ambients_c: RECIPE_AMBIENTS_C.to_vec(),
         unit_runs: args.unit_runs.unwrap_or(6),
@@ -341,7 +351,8 @@ fn recipe_of(args: &Args) -> Option<UnitRecipe> {
             .unwrap_or_else(|| RECIPE_AMBIENTS_C.to_vec()),
         seed: args.seed,
         type_shape: args.type_shape.unwrap_or_default(),
-    })
+        unit_spread: spread_of(args.unit_spread.as_deref())?,
+    }))
 }
 
 /// `--criterion` for this Monte Carlo's seeks. The model is scored on the seeks it will
@@ -364,7 +375,8 @@ pub fn run(args: Args) -> Result<()> {
     // Checked even when `--model` leaves it unused: a bad flag is never ignored.
     let criterion = criterion_of(&args, &cfg)?;
     let (training_runs, warm_restarts) = training_campaign(&args)?;
-    if let Some(r) = recipe_of(&args) {
+    let recipe = recipe_of(&args)?;
+    if let Some(r) = &recipe {
         r.check()?;
     }
     let guard = match &args.model {
@@ -397,8 +409,8 @@ pub fn run(args: Args) -> Result<()> {
                     ..cfg.clone()
                 }),
             };
-            match recipe_of(&args) {
-                Some(recipe) => recipe_unit_model(&recipe, &plan, &args, &mut params)?,
+            match &recipe {
+                Some(recipe) => recipe_unit_model(recipe, &plan, &args, &mut params)?,
                 None => train_default_model(
                     &params,
                     &plan,

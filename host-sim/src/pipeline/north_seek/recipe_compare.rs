@@ -19,8 +19,8 @@ use serde::Serialize;
 use super::own_model::OwnModelPlan;
 use super::targets::{seek_targets, SeekTargets};
 use super::unit_recipe::{
-    chamber_h, learn_recipe_type, seeking_unit_params, type_free_model, unit_model, RecipeModel,
-    RecipeType, UnitRecipe, RECIPE_AMBIENTS_C,
+    chamber_h, default_unit_spread, learn_recipe_type, seeking_unit_params, type_free_model,
+    unit_model, RecipeModel, RecipeType, UnitRecipe, RECIPE_AMBIENTS_C,
 };
 use super::{build_report, run_monte_carlo, MonteCarloConfig};
 use crate::io::model::{encode_model, read_model};
@@ -28,6 +28,7 @@ use crate::output::reports::Table;
 use crate::train::seek_score::{Criterion, SeekGeometry};
 use crate::train::type_unit::TypeModel;
 use crate::train::InputChoice;
+use fog_core::seeking::northfinder::SeekMode;
 
 /// Units the demo's type is learnt from, and cold starts of each (2 per recipe ambient).
 pub const DEMO_TYPE_UNITS: usize = 10;
@@ -80,13 +81,17 @@ pub fn compare_recipes(cfg: &MonteCarloConfig, keep_dir: &Path) -> Result<Recipe
         unit_ambients_c: RECIPE_AMBIENTS_C.to_vec(),
         seed: cfg.seed,
         type_shape: Default::default(),
+        unit_spread: default_unit_spread(),
     };
     let plan = OwnModelPlan {
         ambient_c: cfg.ambient_c,
         latitude_deg: cfg.latitude_deg,
         dwell_s: cfg.dwell_s as f64,
         seed: cfg.seed,
-        criterion: Criterion::Seek(SeekGeometry::forward(cfg.dwell_s as f64, cfg.latitude_deg)),
+        criterion: Criterion::Seek(SeekGeometry {
+            symmetric: cfg.mode == SeekMode::TwoPositionSymmetric,
+            ..SeekGeometry::forward(cfg.dwell_s as f64, cfg.latitude_deg)
+        }),
         inputs: InputChoice::Auto,
         seek_timing: Some(MonteCarloConfig {
             restart_above_ambient_c: 0.0,
@@ -250,13 +255,16 @@ pub fn recipe_table(c: &RecipeComparison) -> String {
         ]);
     }
     format!(
-        "production recipe: unit U1 of a simulated fleet, {} cold starts x {} seeks at {} degC ({}type {}):\n{}",
+        "production recipe: unit U1 of a simulated fleet, {} cold starts x {} seeks at {} degC ({}type {}):\n{}\
+         ({} starts: a |mean|/std is known to about +-{:.2}, so a verdict near a target is not decided here; 1,000-start figures over ten fleets: docs/record/fleet.md)\n",
         c.starts,
         c.seeks_per_start,
         c.ambient_c,
         if c.type_reused { "kept " } else { "" },
         c.type_file,
-        t.render()
+        t.render(),
+        c.starts,
+        1.0 / (c.starts.max(1) as f64).sqrt(),
     )
 }
 
@@ -273,6 +281,7 @@ mod tests {
             unit_ambients_c: RECIPE_AMBIENTS_C.to_vec(),
             seed: 1,
             type_shape: Default::default(),
+            unit_spread: default_unit_spread(),
         }
     }
 
@@ -315,6 +324,7 @@ mod tests {
         let other = UnitRecipe {
             seed: 2,
             type_shape: Default::default(),
+            unit_spread: default_unit_spread(),
             ..recipe()
         };
         assert_eq!(cache_key(&recipe()).unwrap(), cache_key(&recipe()).unwrap());

@@ -45,6 +45,8 @@ pub struct UnitRecipe {
     pub seed: u64,
     /// The form of the type's shared model.
     pub type_shape: TypeShape,
+    /// How the fleet's units differ, and its label (`default`, `none`, `file NAME`).
+    pub unit_spread: (TypeSpread, String),
 }
 
 /// The seeking unit's model and where it came from.
@@ -131,10 +133,16 @@ fn unit_runs(
         .collect())
 }
 
-/// The recipe's fleet: the paper's gyro as the type, the default unit spread, drawn from
+/// The recipe's fleet: the paper's gyro as the type, the recipe's unit spread, drawn from
 /// the recipe's seed.
 fn recipe_fleet(recipe: &UnitRecipe) -> FleetType {
-    FleetType::paper(TypeSpread::default_spread(), "default", recipe.seed)
+    let (spread, label) = &recipe.unit_spread;
+    FleetType::paper(spread.clone(), label, recipe.seed)
+}
+
+/// The default unit spread (docs/explain/simulator.md, "Fleets") with its label.
+pub fn default_unit_spread() -> (TypeSpread, String) {
+    (TypeSpread::default_spread(), "default".into())
 }
 
 /// The seeking unit's parameters (what the Monte Carlo seeks with).

@@ -24,8 +24,8 @@
 //! first seeks' bias with them, from fleet to fleet (docs/record/fleet.md): on one fleet
 //! it kept one Gaussian and left seek 1 at -40 degC biased by 1.7 of its std. The law
 //! alone has no such choices but no ambient effect (6 of 15 cells, as the network); the
-//! law as the network's base met 8 of 15 and halved the worst bias (docs/record/fleet.md,
-//! 2026-12-02). The estimated derivatives are not its inputs: a 60 s rate fit and a 180 s
+//! law as the network's base was better in 21 of 30 cells over ten fleets (11 met against
+//! 8, the worst bias 1.5 std against 5.4; docs/record/fleet.md, 2026-12-02): the default. The estimated derivatives are not its inputs: a 60 s rate fit and a 180 s
 //! second-derivative fit lag and are noisy in exactly the first minutes the first seek
 //! needs (tried: 2-3x the floor at -40 degC).
 

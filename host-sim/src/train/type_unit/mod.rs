@@ -20,9 +20,10 @@ pub mod type_model;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
 pub enum TypeShape {
     /// The trainer's network, its inputs chosen by validation (`train`'s defaults).
-    #[default]
     Network,
-    /// The warm-up law of a two-node thermal model as the base of a network (`law`).
+    /// The warm-up law of a two-node thermal model as the base of a network (`law`): the
+    /// default, from the Monte Carlo over ten simulated fleets (docs/record/fleet.md).
+    #[default]
     Law,
 }
 
