@@ -134,7 +134,7 @@ pub struct Args {
     /// With `--type-out`: the form of the type's shared model, `network` (the trainer's,
     /// with the options above) or `law` (the warm-up law of a two-node thermal model, two
     /// power-on clocks chosen by leaving units out, as the base of a network on T and the
-    /// rise since power-on; the default: better over ten simulated fleets, docs/record/fleet.md).
+    /// rise since power-on; better over ten simulated fleets, docs/record/fleet.md).
     #[arg(long = "type-shape", value_enum, default_value_t = TypeShape::Law, requires = "type_out")]
     pub type_shape: TypeShape,
     /// Calibrate one unit from its own runs with this type (from `--type-out`) as the
