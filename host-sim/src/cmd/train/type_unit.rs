@@ -51,7 +51,11 @@ pub(super) fn learn(
 ) -> Result<()> {
     let mut train = |runs: Vec<Run>| -> Result<RbfModel> {
         if args.type_shape == TypeShape::Law {
-            return Ok(fit_law_network(&runs, cfg.criterion, &cfg.gyro_id)?.model);
+            let law = fit_law_network(&runs, cfg.criterion, &cfg.gyro_id)?;
+            if let Some(e) = law.grid_edge() {
+                eprintln!("fogsim train: warning: {e}");
+            }
+            return Ok(law.model);
         }
         let (_, ds) = choose_inputs_default(&runs, candidates, cfg)?;
         let mut model = train_model(&ds, cfg)?.model;

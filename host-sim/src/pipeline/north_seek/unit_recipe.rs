@@ -241,11 +241,12 @@ pub fn learn_recipe_type(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<Rec
             own.summary(),
         ),
         RoundModel::Law(law) => format!(
-            "shared model: the warm-up law (clocks of {:.0} s and {:.0} s, held-out first-seek error {:.4} deg) as the base of a network of {} centres\n",
+            "shared model: the warm-up law (clocks of {:.0} s and {:.0} s, held-out first-seek error {:.4} deg) as the base of a network of {} centres\n{}",
             law.taus_s[0],
             law.taus_s[1],
             law.law_heldout_deg,
             law.model.centers.len(),
+            law.grid_edge().map_or(String::new(), |e| format!("  {e}\n")),
         ),
     };
     let summary = format!(
