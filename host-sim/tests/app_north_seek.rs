@@ -1,7 +1,8 @@
 //! `fogsim north-seek` on a short Monte Carlo: the JSON has the fields, the seeks
 //! fit the paper's 4 min 56 s, and after a cold start the compensated first seek is
 //! clearly better than the uncompensated one. Also: the Monte Carlo is deterministic and
-//! does not depend on the thread count.
+//! does not depend on the thread count; a bad `--unit-spread` file of the unit recipe is
+//! refused with one line.
 
 use crate::app_support;
 
@@ -187,4 +188,34 @@ fn tilt_and_heading_arms_are_in_the_json_and_out_of_range_tilt_is_refused() {
     let out = fogsim(&dir, &["north-seek", "--starts", "1", "--tilt-deg", "31"]);
     assert!(!out.status.success());
     assert!(stderr(&out).contains("--tilt-deg 31"), "{}", stderr(&out));
+}
+
+#[test]
+fn a_bad_unit_spread_file_is_refused_with_one_line_and_nothing_written() {
+    let dir = scratch_dir("north-seek-spread");
+    std::fs::write(
+        dir.join("spread.txt"),
+        "drift.shupe_dph_per_cps: ten percent\n",
+    )
+    .unwrap();
+    let out = fogsim(
+        &dir,
+        &[
+            "north-seek",
+            "--type-units",
+            "3",
+            "--unit-spread",
+            "spread.txt",
+            "--starts",
+            "1",
+            "--json",
+            "out.json",
+        ],
+    );
+    let err = stderr(&out);
+    assert!(!out.status.success());
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("--unit-spread spread.txt"), "{err}");
+    assert!(!dir.join("out.json").exists());
+    std::fs::remove_dir_all(dir).unwrap();
 }

@@ -337,3 +337,39 @@ pub fn unit_model(
         summary,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn recipe(unit_spread: (TypeSpread, String)) -> UnitRecipe {
+        UnitRecipe {
+            type_units: 3,
+            type_unit_runs: 2,
+            type_ambients_c: RECIPE_AMBIENTS_C.to_vec(),
+            unit_runs: 2,
+            unit_ambients_c: RECIPE_AMBIENTS_C.to_vec(),
+            seed: 4,
+            type_shape: TypeShape::Law,
+            unit_spread,
+        }
+    }
+
+    #[test]
+    fn the_recipes_unit_spread_draws_the_seeking_unit() {
+        let paper = GyroParams::paper_default();
+        // no spread: the seeking unit is the type; the default spread: it is not
+        let none = seeking_unit_params(&recipe((TypeSpread::none(), "none".into()))).unwrap();
+        assert_eq!(none.drift.shupe_dph_per_cps, paper.drift.shupe_dph_per_cps);
+        assert_eq!(none.thermal.power_w, paper.thermal.power_w);
+        let drawn = seeking_unit_params(&recipe(default_unit_spread())).unwrap();
+        assert_ne!(drawn.drift.shupe_dph_per_cps, paper.drift.shupe_dph_per_cps);
+        // one parameter's spread moves that parameter only
+        let shupe = TypeSpread::none()
+            .with("drift.shupe_dph_per_cps", 0.1)
+            .unwrap();
+        let one = seeking_unit_params(&recipe((shupe, "file shupe".into()))).unwrap();
+        assert_ne!(one.drift.shupe_dph_per_cps, paper.drift.shupe_dph_per_cps);
+        assert_eq!(one.thermal.power_w, paper.thermal.power_w);
+    }
+}
