@@ -49,11 +49,13 @@ pub(super) fn learn(
     type_path: &Path,
     runs: &[Run],
 ) -> Result<()> {
+    // what the law's clock choices said of their grid, once each whatever the rounds
+    let mut edges: Vec<String> = Vec::new();
     let mut train = |runs: Vec<Run>| -> Result<RbfModel> {
         if args.type_shape == TypeShape::Law {
             let law = fit_law_network(&runs, cfg.criterion, &cfg.gyro_id)?;
-            if let Some(e) = law.grid_edge() {
-                eprintln!("fogsim train: warning: {e}");
+            if let Some(e) = law.grid_edge().filter(|e| !edges.contains(e)) {
+                edges.push(e);
             }
             return Ok(law.model);
         }
@@ -63,6 +65,9 @@ pub(super) fn learn(
         Ok(model)
     };
     let ty = learn_type(runs, None, &mut train)?;
+    for e in &edges {
+        eprintln!("fogsim train: warning: {e}");
+    }
     let (model_bytes, crc) = encoded(&ty.model, &cfg.gyro_id)?;
     let type_bytes = ty.to_bytes()?;
     let mut staged = StagedFiles::default();

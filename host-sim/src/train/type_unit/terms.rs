@@ -63,7 +63,10 @@ pub fn term_name(model: &RbfModel, term: UnitTerm) -> String {
                 "gradient (d2T/dt2) coefficient".into()
             }
             Some(FeatureKind::TempRiseC) => "rise coefficient".into(),
-            Some(FeatureKind::PowerOnDecay) => "warm-up clock amplitude".into(),
+            // a type of the law shape has two clocks: named by their time constants
+            Some(FeatureKind::PowerOnDecay) => {
+                format!("warm-up clock amplitude ({:.0} s)", model.inputs[j].tau_s)
+            }
             Some(FeatureKind::TempLagC) => "lagged-temperature coefficient".into(),
             _ => format!("input {j} coefficient"),
         },
