@@ -182,6 +182,30 @@ impl Args {
         }
     }
 
+    /// The network-shape options given away from their defaults: the law type
+    /// (`--type-shape law`) chooses its own shape and reads none of them, so `--type-out`
+    /// refuses them by name rather than ignore them.
+    pub fn network_shape_flags(&self) -> Vec<&'static str> {
+        let d = TrainConfig::default();
+        let given = [
+            ("--max-centers", self.max_centers != d.max_centers),
+            ("--rho", self.rho != d.rho),
+            ("--target-dph", self.target_dph.is_some()),
+            ("--poly-degrees", self.poly_degrees != d.poly_degrees),
+            ("--max-candidates", self.max_candidates != d.max_candidates),
+            ("--method", self.method != d.method),
+            ("--widths", self.widths != d.width_candidates),
+            ("--width-search", self.width_search != d.width_search),
+            ("--folds", self.folds != d.folds),
+            ("--collinearity-tol", self.collinearity_tol != d.collinearity_tol),
+            ("--linear-inputs", self.linear_inputs),
+            ("--linear-by-t", self.linear_by_t),
+            ("--inputs", !matches!(self.inputs, InputChoice::Auto)),
+            ("--export-design", self.export_design.is_some()),
+        ];
+        given.iter().filter(|(_, g)| *g).map(|(f, _)| *f).collect()
+    }
+
     /// The training configuration these options ask for.
     pub fn config(&self) -> anyhow::Result<TrainConfig> {
         // Each seek parameter named by its flag (checked also under `rms10s`, which does

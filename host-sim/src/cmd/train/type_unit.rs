@@ -49,6 +49,14 @@ pub(super) fn learn(
     type_path: &Path,
     runs: &[Run],
 ) -> Result<()> {
+    let ignored = args.network_shape_flags();
+    if args.type_shape == TypeShape::Law && !ignored.is_empty() {
+        bail!(
+            "{}: a network's shape options; the law type (--type-shape law, the default) \
+             chooses its own shape: drop them or use --type-shape network",
+            ignored.join(", ")
+        );
+    }
     // what the law's clock choices said of their grid, once each whatever the rounds
     let mut edges: Vec<String> = Vec::new();
     let mut train = |runs: Vec<Run>| -> Result<RbfModel> {
