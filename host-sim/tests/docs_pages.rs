@@ -1,19 +1,39 @@
 //! Every docs page with a fenced `sh` block, run as written (issue 39 item 2), one test
 //! per page, each in its own scratch directory, by the page runner of `docs_support` (its
-//! //! says how `fogsim`, `cargo fw-run`, `&`, the ports and `../shared/` are run).
+//! module doc says how `fogsim`, `cargo fw-run`, `&`, the ports and `../shared/` are run).
 //! docs/workflow.md is `workflow.rs`; the pages' other fenced blocks are synopses with
 //! placeholders (`RUNS...`, `[--opt]`, `/dev/ttyUSB0`), name-checked by `docs_commands.rs`.
 //!
 //! Checked: every command succeeds, the page keeps its steps, and what they make is there
 //! (the fleet's unit model, diagnose's JSON naming a base, the trainer's model and report,
-//! the field records pulled and counted). A page that stops working fails here.
+//! the uploaded model in the device's status, the field records pulled and counted). A
+//! page that stops working fails here, and a page given an `sh` block without a test here
+//! fails `every_page_with_an_sh_block_is_run_here`.
 //!
 //! The fast suite runs the cheapest pages (diagnose 1.3 s, upload under QEMU 0.4 s); the
-//! trainer, simulator and fleet pages (1.8-2.4 s each) and the field page (QEMU, two seeks,
+//! trainer, simulator and fleet pages (about 2 s each) and the field page (QEMU, two seeks,
 //! about 37 s) are in the slow suite (docs/record/suite.md). The QEMU pages skip loudly
 //! without QEMU unless FOG_REQUIRE_QEMU=1.
 
-use crate::docs_support::{Page, Walk};
+use crate::docs_support::{pages_with_sh, Page, Walk};
+
+const DIAGNOSE: &str = "docs/explain/diagnose.md";
+const SIMULATOR: &str = "docs/explain/simulator.md";
+const TRAINER: &str = "docs/explain/trainer.md";
+const FIELD: &str = "docs/guide/field.md";
+const FLEET: &str = "docs/guide/fleet.md";
+const UPLOAD: &str = "docs/guide/upload.md";
+
+/// The pages this file runs, one test each.
+const PAGES: [&str; 6] = [DIAGNOSE, SIMULATOR, TRAINER, FIELD, FLEET, UPLOAD];
+
+#[test]
+fn every_page_with_an_sh_block_is_run_here() {
+    let mut expected: Vec<String> = PAGES.iter().map(|p| p.to_string()).collect();
+    expected.push("docs/workflow.md".into()); // workflow.rs
+    expected.sort();
+    assert_eq!(pages_with_sh(), expected);
+}
 
 /// Runs `path` after checking it keeps `steps`; asserts each of `files` was made.
 fn run_page(path: &str, steps: &[&str], files: &[&str]) -> Option<Walk> {
@@ -34,7 +54,7 @@ fn run_page(path: &str, steps: &[&str], files: &[&str]) -> Option<Walk> {
 #[ignore = "slow suite: docs pages run as written"]
 fn the_fleet_guide_runs_as_written() {
     let Some(walk) = run_page(
-        "docs/guide/fleet.md",
+        FLEET,
         &[
             "fogsim campaign --out fleet --units",
             "fogsim train",
@@ -52,7 +72,7 @@ fn the_fleet_guide_runs_as_written() {
 #[test]
 fn the_diagnose_page_runs_as_written() {
     let Some(walk) = run_page(
-        "docs/explain/diagnose.md",
+        DIAGNOSE,
         &["fogsim campaign", "fogsim diagnose", "fogsim import"],
         &["camp.json", "pan/x.json"],
     ) else {
@@ -70,7 +90,7 @@ fn the_diagnose_page_runs_as_written() {
 #[ignore = "slow suite: docs pages run as written"]
 fn the_simulator_page_runs_as_written() {
     let steps = ["fogsim campaign", "fogsim train train"];
-    if let Some(walk) = run_page("docs/explain/simulator.md", &steps, &["model.bin"]) {
+    if let Some(walk) = run_page(SIMULATOR, &steps, &["model.bin"]) {
         walk.finish();
     }
 }
@@ -79,7 +99,7 @@ fn the_simulator_page_runs_as_written() {
 #[ignore = "slow suite: docs pages run as written"]
 fn the_trainer_page_runs_as_written() {
     let made = ["model.bin", "train.json"];
-    if let Some(walk) = run_page("docs/explain/trainer.md", &["fogsim train train"], &made) {
+    if let Some(walk) = run_page(TRAINER, &["fogsim train train"], &made) {
         walk.finish();
     }
 }
@@ -88,7 +108,7 @@ fn the_trainer_page_runs_as_written() {
 #[ignore = "slow suite: docs pages run as written"]
 fn the_field_guide_runs_as_written_under_qemu() {
     let Some(walk) = run_page(
-        "docs/guide/field.md",
+        FIELD,
         &[
             "cargo fw-run",
             "fogsim rig",
@@ -119,7 +139,7 @@ fn the_field_guide_runs_as_written_under_qemu() {
 #[test]
 fn the_upload_guide_runs_as_written_under_qemu() {
     let Some(walk) = run_page(
-        "docs/guide/upload.md",
+        UPLOAD,
         &[
             "fogsim train runs --out model.fogm --gyro-id QEMU-FOG-1",
             "cargo fw-run &",

@@ -53,6 +53,24 @@ pub fn page_commands(page: &str) -> Vec<String> {
     out
 }
 
+/// README.md and the pages under docs/ with an `sh` block, from the repository root, sorted.
+pub fn pages_with_sh() -> Vec<String> {
+    let root = workspace_root();
+    let mut out = Vec::new();
+    let mut todo = vec![root.join("README.md"), root.join("docs")];
+    while let Some(p) = todo.pop() {
+        if p.is_dir() {
+            todo.extend(std::fs::read_dir(&p).unwrap().map(|e| e.unwrap().path()));
+        } else if p.extension().is_some_and(|x| x == "md")
+            && !page_commands(&std::fs::read_to_string(&p).unwrap()).is_empty()
+        {
+            out.push(p.strip_prefix(&root).unwrap().display().to_string());
+        }
+    }
+    out.sort();
+    out
+}
+
 /// One page of the docs: its path from the repository root and its `sh` commands.
 pub struct Page {
     pub path: String,
