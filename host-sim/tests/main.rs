@@ -5,6 +5,7 @@
 
 mod app_support;
 mod common;
+mod docs_support;
 mod train_support;
 
 mod allan_noise_terms;
@@ -35,6 +36,7 @@ mod diagnose_self_consistency;
 mod diagnose_simterm;
 mod diagnose_single_record;
 mod docs_commands;
+mod docs_pages;
 mod field_aging_independent;
 mod import_logger;
 mod import_pan;
