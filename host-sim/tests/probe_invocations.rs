@@ -160,6 +160,7 @@ const NUMBER_FLAGS: &[&str] = &[
     "--timeout-s",
     "--training-restarts-above-c",
     "--training-runs",
+    "--type-ambients-c",
     "--type-unit-runs",
     "--type-seed",
     "--type-units",

@@ -135,10 +135,19 @@ pub struct Args {
         allow_negative_numbers = true
     )]
     pub unit_ambients_c: Option<Vec<f64>>,
-    /// Cold starts of each type unit (2..=48), spread over -40, 20 and +60 degC in turn
+    /// Cold starts of each type unit (2..=48), spread over `--type-ambients-c` in turn
     /// [default: 6]. Needs `--type-units`.
     #[arg(long = "type-unit-runs")]
     pub type_unit_runs: Option<usize>,
+    /// Ambients of the type units' cold starts, degC [default: -40,20,60]; one ambient
+    /// (with `--unit-ambients-c` the same) is a calibration for that ambient band alone.
+    /// Needs `--type-units`.
+    #[arg(
+        long = "type-ambients-c",
+        value_delimiter = ',',
+        allow_negative_numbers = true
+    )]
+    pub type_ambients_c: Option<Vec<f64>>,
     /// The form of the type's shared model: `network` (the trainer's, inputs chosen by
     /// validation) or `law` (the warm-up law of a two-node thermal model as a network's
     /// base; docs/record/fleet.md) [default: law]. Needs `--type-units`.
@@ -203,6 +212,7 @@ fn training_campaign(args: &Args) -> Result<(usize, Option<WarmRestarts>)> {
         ("--unit-runs", args.unit_runs.is_some()),
         ("--unit-ambients-c", args.unit_ambients_c.is_some()),
         ("--type-unit-runs", args.type_unit_runs.is_some()),
+        ("--type-ambients-c", args.type_ambients_c.is_some()),
         ("--type-shape", args.type_shape.is_some()),
         ("--unit-spread", args.unit_spread.is_some()),
     ];
@@ -320,19 +330,32 @@ fn recipe_unit_model(
     }
     let source = match recipe.type_units {
         0 => format!(
-            "unit U1 of a simulated fleet (seed {}), trained on its own {} runs ({:.1} chamber h)",
-            recipe.seed, recipe.unit_runs, made.unit_chamber_h
+            "unit U1 of a simulated fleet (seed {}), trained on its own {} runs at {} degC ({:.1} chamber h)",
+            recipe.seed,
+            recipe.unit_runs,
+            ambients(&recipe.unit_ambients_c),
+            made.unit_chamber_h
         ),
         n => format!(
-            "unit U1 of a simulated fleet (seed {}): type from {n} units x {} runs ({:.1} chamber h), unit calibration from {} runs ({:.1} chamber h)",
+            "unit U1 of a simulated fleet (seed {}): type from {n} units x {} runs at {} degC ({:.1} chamber h), unit calibration from {} runs at {} degC ({:.1} chamber h)",
             recipe.seed,
             made.type_runs / n,
+            ambients(&recipe.type_ambients_c),
             made.type_chamber_h,
             recipe.unit_runs,
+            ambients(&recipe.unit_ambients_c),
             made.unit_chamber_h
         ),
     };
     Ok((made.model, source))
+}
+
+/// A list of ambients as the flags take it: `-40,20,60`.
+fn ambients(list: &[f64]) -> String {
+    list.iter()
+        .map(|a| a.to_string())
+        .collect::<Vec<_>>()
+        .join(",")
 }
 
 /// `--type-units` and its companions as a recipe (None without `--type-units`).
@@ -343,7 +366,10 @@ fn recipe_of(args: &Args) -> Result<Option<UnitRecipe>> {
     Ok(Some(UnitRecipe {
         type_units,
         type_unit_runs: args.type_unit_runs.unwrap_or(6),
-        type_ambients_c: RECIPE_AMBIENTS_C.to_vec(),
+        type_ambients_c: args
+            .type_ambients_c
+            .clone()
+            .unwrap_or_else(|| RECIPE_AMBIENTS_C.to_vec()),
         unit_runs: args.unit_runs.unwrap_or(6),
         unit_ambients_c: args
             .unit_ambients_c
@@ -467,4 +493,45 @@ pub fn run(args: Args) -> Result<()> {
         write_json(p, &product)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    /// `north-seek`'s options as the command line gives them.
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: Args,
+    }
+
+    fn args(line: &[&str]) -> Args {
+        Cli::try_parse_from(std::iter::once("north-seek").chain(line.iter().copied()))
+            .unwrap()
+            .args
+    }
+
+    #[test]
+    fn the_type_and_unit_ambients_reach_the_recipe_and_need_a_type() {
+        let band = args(&[
+            "--type-units",
+            "3",
+            "--type-ambients-c=-40",
+            "--unit-ambients-c=-40,20",
+        ]);
+        let r = recipe_of(&band).unwrap().unwrap();
+        assert_eq!(
+            (r.type_ambients_c, r.unit_ambients_c),
+            (vec![-40.0], vec![-40.0, 20.0])
+        );
+        let default = recipe_of(&args(&["--type-units", "3"])).unwrap().unwrap();
+        assert_eq!(default.type_ambients_c, RECIPE_AMBIENTS_C.to_vec());
+        let alone = training_campaign(&args(&["--type-ambients-c=-40"])).unwrap_err();
+        assert_eq!(
+            alone.to_string(),
+            "--type-ambients-c: needs --type-units N (the unit recipe it shapes)"
+        );
+    }
 }

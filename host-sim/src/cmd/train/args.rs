@@ -197,7 +197,10 @@ impl Args {
             ("--widths", self.widths != d.width_candidates),
             ("--width-search", self.width_search != d.width_search),
             ("--folds", self.folds != d.folds),
-            ("--collinearity-tol", self.collinearity_tol != d.collinearity_tol),
+            (
+                "--collinearity-tol",
+                self.collinearity_tol != d.collinearity_tol,
+            ),
             ("--linear-inputs", self.linear_inputs),
             ("--linear-by-t", self.linear_by_t),
             ("--inputs", !matches!(self.inputs, InputChoice::Auto)),
