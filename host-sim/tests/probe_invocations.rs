@@ -165,6 +165,7 @@ const NUMBER_FLAGS: &[&str] = &[
     "--type-seed",
     "--type-units",
     "--unit-ambients-c",
+    "--unit-fit",
     "--unit-runs",
     "--unit-terms",
     "--units",

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use super::campaign::spread_of;
 use crate::train::seek_score::Criterion;
+use crate::train::type_unit::solve::Fit;
 use crate::train::type_unit::TypeShape;
 use anyhow::{bail, Result};
 use fog_core::model::format::RbfModel;
@@ -153,6 +154,11 @@ pub struct Args {
     /// base; docs/record/fleet.md) [default: law]. Needs `--type-units`.
     #[arg(long = "type-shape", value_enum)]
     pub type_shape: Option<TypeShape>,
+    /// How the type reads its units and calibrates the seeking unit: `within-runs` (each
+    /// cold start's own constant taken out) or `pooled` (the runs as measured, with an
+    /// offset; docs/record/fleet.md) [default: within-runs]. Needs `--type-units`.
+    #[arg(long = "unit-fit", value_enum)]
+    pub unit_fit: Option<Fit>,
     /// How the simulated fleet's units differ (as `campaign --unit-spread`): `default`
     /// (docs/explain/simulator.md, "Fleets"), `none` or a spread file of `parameter:
     /// spread` lines (docs/reference/formats.md) [default: default]. Needs `--type-units`.
@@ -214,6 +220,7 @@ fn training_campaign(args: &Args) -> Result<(usize, Option<WarmRestarts>)> {
         ("--type-unit-runs", args.type_unit_runs.is_some()),
         ("--type-ambients-c", args.type_ambients_c.is_some()),
         ("--type-shape", args.type_shape.is_some()),
+        ("--unit-fit", args.unit_fit.is_some()),
         ("--unit-spread", args.unit_spread.is_some()),
     ];
     if let (None, Some((flag, _))) = (args.type_units, shapes_recipe.iter().find(|(_, g)| *g)) {
@@ -377,6 +384,7 @@ fn recipe_of(args: &Args) -> Result<Option<UnitRecipe>> {
             .unwrap_or_else(|| RECIPE_AMBIENTS_C.to_vec()),
         seed: args.seed,
         type_shape: args.type_shape.unwrap_or_default(),
+        unit_fit: args.unit_fit.unwrap_or_default(),
         unit_spread: spread_of(args.unit_spread.as_deref())?,
     }))
 }

@@ -1,6 +1,7 @@
 //! `fogsim train`'s options and the training configuration they ask for.
 
 use crate::cmd::north_seek::Sequence;
+use crate::train::type_unit::solve::Fit;
 use crate::train::type_unit::TypeShape;
 use crate::train::{InputChoice, Method, TrainConfig, WidthSearch};
 use std::path::PathBuf;
@@ -126,7 +127,7 @@ pub struct Args {
     /// Learn a gyro type from these runs and write it here (JSON): the runs are several
     /// units' cold starts, each naming its unit in `unit_id` metadata (and its type in
     /// `type_id`: one type only). The shared drift model (also written to `--out`) and
-    /// the unit terms (offset, warm-up gain, a linear term per input) are fitted in turn;
+    /// the unit terms (warm-up gain, a linear term per input) are fitted in turn;
     /// the terms' mean and unit-to-unit spread are the prior of `--type`
     /// (`fog_sim::train::type_unit`).
     #[arg(long = "type-out", conflicts_with_all = ["type_model", "field", "seek_refit"])]
@@ -137,6 +138,13 @@ pub struct Args {
     /// rise since power-on; better over ten simulated fleets, docs/record/fleet.md).
     #[arg(long = "type-shape", value_enum, default_value_t = TypeShape::Law, requires = "type_out")]
     pub type_shape: TypeShape,
+    /// With `--type-out`: how the units are read, and every unit calibrated against the
+    /// type will be: `within-runs` (each cold start's own constant, which a seek cancels,
+    /// taken out; no offset term; better over 20 simulated fleets, docs/record/fleet.md) or
+    /// `pooled` (the runs as measured, with an offset: the physical unit-to-unit spread,
+    /// e.g. of the temperature coefficient, which shows between runs).
+    #[arg(long = "unit-fit", value_enum, default_value_t = Fit::WithinRuns, requires = "type_out")]
+    pub unit_fit: Fit,
     /// Calibrate one unit from its own runs with this type (from `--type-out`) as the
     /// prior: the unit terms and the prior's weight are chosen by leave-one-run-out, and
     /// the unit is first tested against its type (`--misfit`). Writes an ordinary model.

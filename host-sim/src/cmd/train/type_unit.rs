@@ -72,7 +72,7 @@ pub(super) fn learn(
         model.cold_start = envelope_for(&runs, &model.inputs)?;
         Ok(model)
     };
-    let ty = learn_type(runs, None, &mut train)?;
+    let ty = learn_type(runs, None, args.unit_fit, &mut train)?;
     for e in &edges {
         eprintln!("fogsim train: warning: {e}");
     }

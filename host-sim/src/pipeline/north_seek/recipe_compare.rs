@@ -81,6 +81,7 @@ pub fn compare_recipes(cfg: &MonteCarloConfig, keep_dir: &Path) -> Result<Recipe
         unit_ambients_c: RECIPE_AMBIENTS_C.to_vec(),
         seed: cfg.seed,
         type_shape: Default::default(),
+        unit_fit: Default::default(),
         unit_spread: default_unit_spread(),
     };
     let plan = OwnModelPlan {
@@ -281,6 +282,7 @@ mod tests {
             unit_ambients_c: RECIPE_AMBIENTS_C.to_vec(),
             seed: 1,
             type_shape: Default::default(),
+            unit_fit: Default::default(),
             unit_spread: default_unit_spread(),
         }
     }
@@ -324,6 +326,7 @@ mod tests {
         let other = UnitRecipe {
             seed: 2,
             type_shape: Default::default(),
+            unit_fit: Default::default(),
             unit_spread: default_unit_spread(),
             ..recipe()
         };

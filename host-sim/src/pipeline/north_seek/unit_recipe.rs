@@ -19,6 +19,7 @@ use crate::pipeline::campaign::{CampaignSpec, PAPER_MINUTES};
 use crate::pipeline::fleet::{fleet_runs, unit_id, FleetType};
 use crate::sim::{GyroParams, TypeSpread};
 use crate::train::type_unit::law::fit_law_network;
+use crate::train::type_unit::solve::Fit;
 use crate::train::type_unit::type_model::learn_type;
 use crate::train::type_unit::{calibrate_unit, TypeModel, TypeShape, UnitCalibration, UnitPlan};
 
@@ -45,6 +46,8 @@ pub struct UnitRecipe {
     pub seed: u64,
     /// The form of the type's shared model.
     pub type_shape: TypeShape,
+    /// How the type reads its units and the unit is calibrated.
+    pub unit_fit: Fit,
     /// How the fleet's units differ, and its label (`default`, `none`, `file NAME`).
     pub unit_spread: (TypeSpread, String),
 }
@@ -210,7 +213,7 @@ pub fn learn_recipe_type(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<Rec
         seek_timing: None,
         ..plan.clone()
     };
-    let ty = learn_type(&pooled, None, &mut |runs| {
+    let ty = learn_type(&pooled, None, recipe.unit_fit, &mut |runs| {
         let model = match recipe.type_shape {
             TypeShape::Network => {
                 let own = own_model_from_runs(&fleet.params, runs, &shared_plan)?;
@@ -351,6 +354,7 @@ mod tests {
             unit_ambients_c: RECIPE_AMBIENTS_C.to_vec(),
             seed: 4,
             type_shape: TypeShape::Law,
+            unit_fit: Fit::WithinRuns,
             unit_spread,
         }
     }

@@ -5,7 +5,9 @@
 //! unit terms (in the type's order: the terms the fleet shows units differ in most
 //! first), fitted by least squares on the unit's runs with a Gaussian prior at the type's
 //! mean and spread of weight W (in runs: W = 1 counts the prior like one more run; W = 0
-//! is the unit's own least squares). The terms not fitted stay at the type's mean.
+//! is the unit's own least squares). The terms not fitted stay at the type's mean. The fit
+//! is the type's (`unit_fit`, by default within runs: each cold start's own constant,
+//! which the seeks cancel, taken out; `solve::Fit`).
 //!
 //! m and W are chosen together by leaving one of the unit's runs out at a time: every
 //! candidate is fitted on the other runs and scored on the held-out run by the seek score
@@ -16,8 +18,8 @@
 //! 4.6x the floor); then the fewest terms whose held-out mean square is within one
 //! standard error (over the held-out runs) of the best are kept. m = 0 is the type alone.
 //!
-//! Before anything is fitted, the unit's own estimates are tested against the type
-//! (`misfit`): a unit outside its type is said, term by term, and by default refused;
+//! Before anything is fitted, the unit's own estimates (made as the type's units' were)
+//! are tested against the type (`misfit`): a unit outside its type is said, term by term, and by default refused;
 //! it is never silently pulled to the type (`MisfitPolicy`).
 
 use anyhow::{anyhow, bail, Result};
@@ -179,12 +181,13 @@ pub fn calibrate_unit(
     let terms = ty.terms();
     let names: Vec<String> = ty.file.terms.iter().map(|t| t.name.clone()).collect();
     let ds = dataset_from_runs(runs, &model.inputs).map_err(|e| anyhow!("unit {unit_id}: {e}"))?;
-    let rows = UnitRows::new(model, &terms, &ds)?;
     let (mean, spread) = (ty.mean(), ty.spread());
     let prior = Prior {
         mean: &mean,
         spread: &spread,
     };
+    // the unit read as the type read its units
+    let rows = UnitRows::new(model, &terms, &ds, ty.file.unit_fit)?;
     let (own, se) = own_estimate(&rows)?;
     let misfit = test_unit(
         unit_id,

@@ -3,6 +3,18 @@
 //! others held at the type's mean and a Gaussian prior of chosen weight, and the
 //! jackknife over runs that gives every estimate its standard error.
 //!
+//! Two ways to fit (`Fit`), chosen once per type (`train --type-out --unit-fit`) and kept
+//! in its file, so the type's units and every unit calibrated against it are read alike.
+//! `WithinRuns` (the default): every cold start has its own constant (the turn-on bias,
+//! and the level its bias instability starts at), which a two- or four-position seek
+//! cancels and no unit term carries; fitted across a unit's few runs, that constant is
+//! scatter in every term not flat within a run (a slow clock, T). So each run's mean is
+//! taken out of its residual and of every column, the terms are fitted to the shape of the
+//! drift the seeks see, and there is no offset term. `Pooled` fits the runs as measured,
+//! with an offset: it reads what shows between runs at different ambients (a unit's own
+//! temperature coefficient), the physical unit-to-unit spread, not the seeks' calibration.
+//! Measured on the simulator's fleets: docs/record/fleet.md, "Unit terms within runs".
+//!
 //! Why the jackknife: 10 s rows of one run are not independent (the warm-up, the bias
 //! instability and the turn-on bias are shared by a run's rows), so the rows' own least
 //! squares errors would be far too small; leaving one whole run out at a time measures the
@@ -14,6 +26,29 @@ use nalgebra::{DMatrix, DVector};
 use super::terms::{design, UnitTerm};
 use crate::train::Dataset;
 use fog_core::model::format::RbfModel;
+
+/// How a type's units and a unit's rows are fitted (module notes; `--unit-fit`, a type's
+/// `unit_fit`).
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum Fit {
+    /// Over all the unit's runs as measured (every type before 2026-12-03).
+    Pooled,
+    /// To each run's deviation from its own mean: the default, from the Monte Carlo over
+    /// 20 simulated fleets (docs/record/fleet.md).
+    #[default]
+    WithinRuns,
+}
 
 /// One unit's rows against a type model.
 #[derive(Clone, Debug)]
@@ -31,14 +66,15 @@ pub struct UnitRows {
 }
 
 impl UnitRows {
-    pub fn new(model: &RbfModel, terms: &[UnitTerm], ds: &Dataset) -> Result<Self> {
+    pub fn new(model: &RbfModel, terms: &[UnitTerm], ds: &Dataset, fit: Fit) -> Result<Self> {
         let d = design(model, terms, ds)?;
-        let residual: Vec<f64> = ds
+        let mut residual: Vec<f64> = ds
             .targets_dph
             .iter()
             .zip(&d.pred)
             .map(|(y, p)| y - p)
             .collect();
+        // the rows' scale: the type's residual as measured (before any run's mean goes)
         let residual_ms =
             residual.iter().map(|r| r * r).sum::<f64>() / residual.len().max(1) as f64;
         let mut run = Vec::with_capacity(ds.len());
@@ -49,14 +85,31 @@ impl UnitRows {
             }
             run.push(ids.len() - 1);
         }
+        let mut columns = d.columns;
+        let mut start = 0;
+        while fit == Fit::WithinRuns && start < run.len() {
+            let end = run.partition_point(|&r| r <= run[start]);
+            for v in std::iter::once(&mut residual).chain(columns.iter_mut()) {
+                let rows = &mut v[start..end];
+                let mean = rows.iter().sum::<f64>() / rows.len() as f64;
+                rows.iter_mut().for_each(|x| *x -= mean);
+            }
+            start = end;
+        }
         Ok(Self {
             residual,
-            columns: d.columns,
+            columns,
             run,
             t_s: ds.t_s.clone(),
             runs: ids.len(),
             residual_ms: residual_ms.max(f64::MIN_POSITIVE),
         })
+    }
+
+    /// Whether term k's column is zero on every row (the offset, fitted within runs):
+    /// nothing in these rows can estimate it.
+    pub fn unseen(&self, k: usize) -> bool {
+        self.columns[k].iter().all(|v| v.abs() <= UNSEEN_ABS)
     }
 
     /// Rows of run `r` (consecutive).
@@ -82,6 +135,9 @@ impl UnitRows {
     }
 }
 
+/// A column this small on every row is not seen (a mean taken out leaves ~1e-16).
+const UNSEEN_ABS: f64 = 1e-12;
+
 /// The prior on the unit terms: the type's mean and its unit-to-unit spread per term.
 #[derive(Clone, Copy, Debug)]
 pub struct Prior<'a> {
@@ -106,6 +162,9 @@ pub fn solve(
         Some(pr) => pr.mean.to_vec(),
         None => vec![0.0; p],
     };
+    // a term the rows cannot see stays where it is
+    let kept: Vec<usize> = kept.iter().copied().filter(|&k| !rows.unseen(k)).collect();
+    let kept = &kept[..];
     if kept.is_empty() {
         return Some(coef);
     }
@@ -164,7 +223,7 @@ pub fn solve(
 }
 
 /// A unit's own estimate of every term (least squares, no prior) and its jackknife
-/// standard error over runs (needs 2 runs).
+/// standard error over runs (needs 2 runs; infinite for a term the rows cannot see).
 pub fn own_estimate(rows: &UnitRows) -> Result<(Vec<f64>, Vec<f64>)> {
     let p = rows.columns.len();
     let all: Vec<usize> = (0..p).collect();
@@ -183,10 +242,80 @@ pub fn own_estimate(rows: &UnitRows) -> Result<(Vec<f64>, Vec<f64>)> {
     }
     let se = (0..p)
         .map(|k| {
+            if rows.unseen(k) {
+                return f64::INFINITY;
+            }
             let mean = leave.iter().map(|c| c[k]).sum::<f64>() / n as f64;
             let ss: f64 = leave.iter().map(|c| (c[k] - mean).powi(2)).sum();
             ((n as f64 - 1.0) / n as f64 * ss).sqrt()
         })
         .collect();
     Ok((full, se))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::train::type_unit::terms::{tests::model, unit_terms};
+    use fog_core::model::format::FeatureSpec;
+
+    /// Four runs of one unit against `model()` with a T^2 term: a warm-up in dT/dt of a
+    /// run-dependent size, the unit's own correction `delta` on term k, and a large constant
+    /// of each run's own (turn-on biases of -0.8 .. 1.1 deg/h, 10x the corrections); no
+    /// noise. Fitted `fit`.
+    fn unit_rows(k: usize, delta: f64, fit: Fit) -> UnitRows {
+        let mut m = model();
+        // a T^2 term makes the gain's column more than a sum of the linear terms' columns
+        m.poly.push(0.003).unwrap();
+        let terms = unit_terms(&m, Fit::Pooled);
+        let t: Vec<f64> = (0..50).map(|i| 10.0 * i as f64).collect();
+        let specs: Vec<FeatureSpec> = m.inputs.iter().copied().collect();
+        let names = vec!["t".to_string(), "rate".to_string()];
+        let mut ds = Dataset::with_specs(specs.clone(), names.clone()).unwrap();
+        for (r, turn_on_dph) in [0.5, -0.8, 0.3, 1.1].into_iter().enumerate() {
+            let warm = 1.0 + 0.3 * r as f64;
+            let rows: Vec<Vec<f64>> = (0..50)
+                .map(|i| {
+                    let rate = 0.012 * warm * (-(i as f64) / 9.0).exp();
+                    vec![-30.0 + 1.7 * i as f64, rate]
+                })
+                .collect();
+            let mut one = Dataset::with_specs(specs.clone(), names.clone()).unwrap();
+            one.push_group("r", &rows, &[0.0; 50], &t).unwrap();
+            let d = design(&m, &terms, &one).unwrap();
+            let y: Vec<f64> = (0..50)
+                .map(|i| d.pred[i] + delta * d.columns[k][i] + turn_on_dph)
+                .collect();
+            ds.push_group(&format!("r{r}"), &rows, &y, &t).unwrap();
+        }
+        UnitRows::new(&m, &terms, &ds, fit).unwrap()
+    }
+
+    #[test]
+    fn within_runs_each_runs_constant_does_not_leak_into_the_unit_terms() {
+        // terms: offset, gain, T, dT/dt. The unit's own Shupe coefficient (term 3), its twin
+        // the warm-up gain (term 1), and the null: each reads what was planted, whatever
+        // the runs' constants; the offset is not seen (infinite se) and stays put
+        for (k, delta) in [(3, 0.04), (1, -0.08), (3, 0.0)] {
+            let rows = unit_rows(k, delta, Fit::WithinRuns);
+            let (own, se) = own_estimate(&rows).unwrap();
+            assert!(rows.unseen(0) && own[0] == 0.0 && se[0].is_infinite());
+            for j in 1..own.len() {
+                let want = if j == k { delta } else { 0.0 };
+                assert!(
+                    (own[j] - want).abs() < 1e-6 && se[j] < 1e-6,
+                    "term {k} planted {delta}: term {j} reads {} +- {}",
+                    own[j],
+                    se[j]
+                );
+            }
+        }
+        // pooled, the same runs' constants scatter into the terms (the offset takes only
+        // their mean): the reason the unit step fits within runs
+        let (own, se) = own_estimate(&unit_rows(3, 0.04, Fit::Pooled)).unwrap();
+        assert!(
+            (own[3] - 0.04).abs() > 1e-3 && se[3] > 1e-3,
+            "{own:?} {se:?}"
+        );
+    }
 }

@@ -22,6 +22,7 @@
 use anyhow::{bail, Result};
 use fog_core::model::format::{FeatureKind, RbfModel};
 
+use super::solve::Fit;
 use crate::train::{predict_batch, Dataset};
 
 /// One unit term of a type model.
@@ -39,9 +40,13 @@ pub enum UnitTerm {
     LinearByT(usize),
 }
 
-/// Every unit term a model can carry: the offset, the gain, then one linear term per input.
-pub fn unit_terms(model: &RbfModel) -> Vec<UnitTerm> {
-    let mut t = vec![UnitTerm::Offset, UnitTerm::Gain];
+/// Every unit term a model can carry when fitted `fit`: the offset (pooled only: within
+/// runs each run's constant is taken out), the gain, then one linear term per input.
+pub fn unit_terms(model: &RbfModel, fit: Fit) -> Vec<UnitTerm> {
+    let mut t = match fit {
+        Fit::Pooled => vec![UnitTerm::Offset, UnitTerm::Gain],
+        Fit::WithinRuns => vec![UnitTerm::Gain],
+    };
     t.extend((0..model.inputs.len()).map(UnitTerm::Linear));
     t.extend(
         (0..model.linear_by_t.len().min(model.inputs.len()))
@@ -191,12 +196,12 @@ pub fn fold(model: &RbfModel, terms: &[UnitTerm], coef: &[f64]) -> Result<RbfMod
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use fog_core::model::format::FeatureSpec;
 
     /// T and dT/dt with linear terms and a T polynomial, no Gaussians.
-    fn model() -> RbfModel {
+    pub(in crate::train::type_unit) fn model() -> RbfModel {
         let mut m = RbfModel::empty();
         m.n_rbf_inputs = 0;
         for (k, off, scale, lin) in [
@@ -230,7 +235,7 @@ mod tests {
     fn folded_terms_predict_what_the_design_says() {
         let m = model();
         let ds = dataset(&m);
-        let terms = unit_terms(&m);
+        let terms = unit_terms(&m, Fit::Pooled);
         assert_eq!(terms.len(), 4);
         let coef = [0.011, -0.07, 0.004, -0.02];
         let d = design(&m, &terms, &ds).unwrap();
@@ -257,10 +262,10 @@ mod tests {
     #[test]
     fn a_temperature_coupled_term_is_offered_and_folds_exactly_where_the_type_has_one() {
         let mut m = model();
-        assert!(!unit_terms(&m).contains(&UnitTerm::LinearByT(1)));
+        assert!(!unit_terms(&m, Fit::Pooled).contains(&UnitTerm::LinearByT(1)));
         m.linear_by_t.push(0.0).unwrap();
         m.linear_by_t.push(0.03).unwrap();
-        let terms = unit_terms(&m);
+        let terms = unit_terms(&m, Fit::Pooled);
         assert_eq!(terms.last(), Some(&UnitTerm::LinearByT(1)));
         assert_eq!(term_name(&m, UnitTerm::LinearByT(1)), "Shupe x T");
         let ds = dataset(&m);
@@ -279,7 +284,7 @@ mod tests {
     #[test]
     fn a_term_that_makes_the_model_not_finite_is_refused() {
         let m = model();
-        let terms = unit_terms(&m);
+        let terms = unit_terms(&m, Fit::Pooled);
         assert!(fold(&m, &terms, &[0.0, 0.0, f64::INFINITY, 0.0]).is_err());
     }
 }

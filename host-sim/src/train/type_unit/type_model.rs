@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use super::solve::{own_estimate, UnitRows};
+use super::solve::{own_estimate, Fit, UnitRows};
 use super::terms::{raw_coefficient, term_name, unit_terms, UnitTerm};
 use crate::io::runs::Run;
 use crate::train::dataset_from_runs;
@@ -86,6 +86,14 @@ pub struct TypeFile {
     pub rounds_rms_dph: Vec<f64>,
     /// The shared model, fog-core encoding, hex.
     pub model_hex: String,
+    /// How the units were fitted, and every unit calibrated against this type is
+    /// (`within_runs` or `pooled`; absent in types before 2026-12-03: `pooled`).
+    #[serde(default = "pooled")]
+    pub unit_fit: Fit,
+}
+
+fn pooled() -> Fit {
+    Fit::Pooled
 }
 
 /// A type model in memory: the file's fields with the model decoded.
@@ -97,7 +105,7 @@ pub struct TypeModel {
 
 impl TypeModel {
     pub fn terms(&self) -> Vec<UnitTerm> {
-        unit_terms(&self.model)
+        unit_terms(&self.model, self.file.unit_fit)
     }
     pub fn mean(&self) -> Vec<f64> {
         self.file.terms.iter().map(|t| t.mean).collect()
@@ -113,10 +121,14 @@ impl TypeModel {
     pub fn summary(&self) -> String {
         let f = &self.file;
         let mut s = format!(
-            "type {}: {} units, {} runs; unit terms, best resolved first (value and unit-to-unit spread, raw units):\n",
+            "type {}: {} units, {} runs, read {}; unit terms, best resolved first (value and unit-to-unit spread, raw units):\n",
             f.type_id,
             f.units.len(),
-            self.runs()
+            self.runs(),
+            match f.unit_fit {
+                Fit::WithinRuns => "within runs",
+                Fit::Pooled => "pooled over runs",
+            }
         );
         if !f.rounds_rms_dph.is_empty() {
             let r: Vec<String> = f.rounds_rms_dph.iter().map(|v| format!("{v:.4}")).collect();
@@ -152,7 +164,7 @@ impl TypeModel {
         }
         let bytes = from_hex(&file.model_hex)?;
         let model = RbfModel::decode(&bytes).map_err(|e| anyhow!("its model: {e}"))?;
-        let p = unit_terms(&model).len();
+        let p = unit_terms(&model, file.unit_fit).len();
         if file.terms.len() != p {
             bail!("{} terms for a model with {p} unit terms", file.terms.len());
         }
@@ -265,10 +277,11 @@ pub fn fit_type(
     model: &RbfModel,
     runs: &[Run],
     type_id_override: Option<&str>,
+    fit: Fit,
 ) -> Result<TypeModel> {
     let (type_id, units) = check_type_runs(runs)?;
     let type_id = type_id_override.map_or(type_id, str::to_string);
-    let terms = unit_terms(model);
+    let terms = unit_terms(model, fit);
     let p = terms.len();
     let mut fitted = Vec::with_capacity(units.len());
     let (mut ss, mut rows_n) = (0.0, 0usize);
@@ -276,7 +289,7 @@ pub fn fit_type(
         let unit_runs: Vec<Run> = idx.iter().map(|&i| runs[i].clone()).collect();
         let ds =
             dataset_from_runs(&unit_runs, &model.inputs).map_err(|e| anyhow!("unit {u}: {e}"))?;
-        let rows = UnitRows::new(model, &terms, &ds)?;
+        let rows = UnitRows::new(model, &terms, &ds, fit)?;
         let (estimate, se) = own_estimate(&rows).map_err(|e| anyhow!("unit {u}: {e}"))?;
         let res = rows.corrected(0..rows.residual.len(), &estimate);
         ss += res.iter().map(|r| r * r).sum::<f64>();
@@ -340,6 +353,7 @@ pub fn fit_type(
         unit_residual_rms_dph: (ss / rows_n.max(1) as f64).sqrt(),
         rounds_rms_dph: Vec::new(),
         model_hex: to_hex(&buf[..len]),
+        unit_fit: fit,
     })
 }
 
@@ -359,15 +373,16 @@ pub const ROUND_GAIN: f64 = 0.01;
 pub fn learn_type(
     runs: &[Run],
     type_id: Option<&str>,
+    fit: Fit,
     train: &mut dyn FnMut(Vec<Run>) -> Result<RbfModel>,
 ) -> Result<TypeModel> {
     check_type_runs(runs)?;
     let shared = train(runs.to_vec())?;
-    let mut ty = fit_type(&shared, runs, type_id)?;
+    let mut ty = fit_type(&shared, runs, type_id, fit)?;
     let mut history = vec![ty.file.unit_residual_rms_dph];
     for _ in 1..MAX_ROUNDS {
         let shared = train(corrected_runs(&ty, runs)?)?;
-        let next = fit_type(&shared, runs, type_id)?;
+        let next = fit_type(&shared, runs, type_id, fit)?;
         let rms = next.file.unit_residual_rms_dph;
         history.push(rms);
         if rms >= (1.0 - ROUND_GAIN) * ty.file.unit_residual_rms_dph {
@@ -455,4 +470,75 @@ fn from_hex(s: &str) -> Result<Vec<u8>> {
                 .map_err(|_| anyhow!("its model is not hex (at character {i})"))
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fog_core::model::format::{FeatureKind, FeatureSpec};
+
+    /// The JSON of a type read pooled (before `unit_fit` existed: no such key) of a model on
+    /// T and dT/dt: terms offset, gain, linear:0, linear:1; 3 units.
+    fn pooled_type_json() -> serde_json::Value {
+        let mut m = RbfModel::empty();
+        m.n_rbf_inputs = 0;
+        for k in [FeatureKind::TempC, FeatureKind::TempRateCps] {
+            m.inputs.push(FeatureSpec::plain(k)).unwrap();
+            m.input_offset.push(0.0).unwrap();
+            m.input_scale.push(1.0).unwrap();
+            m.input_min.push(-40.0).unwrap();
+            m.input_max.push(80.0).unwrap();
+            m.linear.push(0.01).unwrap();
+        }
+        let mut buf = [0u8; MAX_ENCODED_LEN];
+        let len = m.encode(&mut buf).unwrap();
+        let terms = unit_terms(&m, Fit::Pooled);
+        let file = TypeFile {
+            format: TYPE_FORMAT.into(),
+            type_id: "t".into(),
+            units: (0..3)
+                .map(|u| TypeUnit {
+                    unit_id: format!("U{u}"),
+                    runs: 2,
+                    estimate: vec![0.0; terms.len()],
+                    se: vec![0.01; terms.len()],
+                })
+                .collect(),
+            terms: terms
+                .iter()
+                .map(|&t| TypeTerm {
+                    term: format!("{t:?}"),
+                    name: term_name(&m, t),
+                    mean: 0.0,
+                    spread: 0.1,
+                    scatter: 0.1,
+                    noise: 0.01,
+                    raw_mean: 0.0,
+                    raw_spread: 0.1,
+                    raw_unit: String::new(),
+                })
+                .collect(),
+            order: (0..terms.len()).collect(),
+            unit_residual_rms_dph: 0.01,
+            rounds_rms_dph: Vec::new(),
+            model_hex: to_hex(&buf[..len]),
+            unit_fit: Fit::Pooled,
+        };
+        let mut v = serde_json::to_value(&file).unwrap();
+        v.as_object_mut().unwrap().remove("unit_fit");
+        v
+    }
+
+    #[test]
+    fn a_type_file_without_unit_fit_reads_pooled_and_a_mismatch_is_refused() {
+        let old: TypeFile = serde_json::from_value(pooled_type_json()).unwrap();
+        let ty = TypeModel::from_file(old).unwrap();
+        assert_eq!(ty.file.unit_fit, Fit::Pooled);
+        assert_eq!(ty.terms()[0], UnitTerm::Offset);
+        // the same terms said to be read within runs: one term too many (no offset there)
+        let mut v = pooled_type_json();
+        v["unit_fit"] = "within_runs".into();
+        let err = TypeModel::from_file(serde_json::from_value(v).unwrap()).unwrap_err();
+        assert_eq!(err.to_string(), "4 terms for a model with 3 unit terms");
+    }
 }
