@@ -2,8 +2,9 @@
 //!
 //! It is learnt once per design from the cold starts of several units (`fogsim train
 //! FLEET_RUNS --type-out TYPE.json`): the shared drift model is trained on every unit's
-//! runs together, and then each unit's own unit terms (`terms`: offset, warm-up gain, a
-//! linear term per input) are fitted to its runs against that shared model. Their mean over
+//! runs together, and then each unit's own unit terms (`terms`: warm-up gain, a
+//! linear term per input; an offset too when read `Pooled`) are fitted to its runs against
+//! that shared model, within each run by default (`solve::Fit`). Their mean over
 //! the units is the type's value of each term and their scatter over the units, less what
 //! the units' own estimation noise (jackknife over their runs) explains, is the type's
 //! unit-to-unit spread: the prior of every later unit calibration.
