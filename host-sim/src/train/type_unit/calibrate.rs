@@ -19,8 +19,8 @@
 //! standard error (over the held-out runs) of the best are kept. m = 0 is the type alone.
 //!
 //! Before anything is fitted, the unit's own estimates (made as the type's units' were)
-//! are tested against the type (`misfit`): a unit outside its type is said, term by term, and by default refused;
-//! it is never silently pulled to the type (`MisfitPolicy`).
+//! are tested against the type (`misfit`): a unit outside its type is said, term by term,
+//! and by default refused; it is never silently pulled to the type (`MisfitPolicy`).
 
 use anyhow::{anyhow, bail, Result};
 use serde::Serialize;

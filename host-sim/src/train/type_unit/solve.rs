@@ -63,6 +63,9 @@ pub struct UnitRows {
     pub runs: usize,
     /// Mean square of the type's residual: the rows' scale in the prior's weighting.
     pub residual_ms: f64,
+    /// Per term: its column is zero on every row (the offset, fitted within runs), so
+    /// nothing in these rows can estimate it.
+    unseen: Vec<bool>,
 }
 
 impl UnitRows {
@@ -96,7 +99,12 @@ impl UnitRows {
             }
             start = end;
         }
+        let unseen = columns
+            .iter()
+            .map(|c| c.iter().all(|v| v.abs() <= UNSEEN_ABS))
+            .collect();
         Ok(Self {
+            unseen,
             residual,
             columns,
             run,
@@ -109,7 +117,7 @@ impl UnitRows {
     /// Whether term k's column is zero on every row (the offset, fitted within runs):
     /// nothing in these rows can estimate it.
     pub fn unseen(&self, k: usize) -> bool {
-        self.columns[k].iter().all(|v| v.abs() <= UNSEEN_ABS)
+        self.unseen[k]
     }
 
     /// Rows of run `r` (consecutive).
