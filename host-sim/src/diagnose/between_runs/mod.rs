@@ -35,7 +35,7 @@ use crate::diagnose::input::Campaign;
 use crate::diagnose::memprobe;
 use crate::diagnose::selection::parsimony::{choose_and_screen, BaseRule};
 use crate::diagnose::selection::scored::ALPHA;
-use crate::diagnose::selection::screen::{Screening, MAX_STEPS, MIN_GAIN_PCT};
+use crate::diagnose::selection::screen::{Screening, MAX_STEPS};
 use crate::diagnose::validation::folds::Folds;
 use crate::diagnose::validation::signflip::{max_t_pvalues, FLIP_SEED};
 use crate::stats::rms;
@@ -44,6 +44,11 @@ use serde::Serialize;
 use heading::{heading_effect, HeadingEffect};
 use loo::{fit, loo_errors, loo_gains, permutation_p};
 use run_features::{enumerate, family_counts, run_offsets, Family, FamilyCount, RunCandidate};
+
+/// Smallest gain on the turn-on repeatability worth naming, %. The run-level test reads
+/// leave-one-run-out gains alone, so it keeps the size the within-run test had before
+/// it read scores too (`screen::MIN_GAIN_PCT`).
+pub const MIN_RUN_GAIN_PCT: f64 = 0.2;
 
 /// One scored run-level candidate, for the report.
 #[derive(Clone, Debug, Serialize)]
@@ -245,7 +250,7 @@ pub fn finish(p: Prepared, groups: f64, latitude_deg: f64) -> BetweenRun {
         }
         for (r, fp) in rows.iter_mut().zip(max_t_pvalues(&gains, FLIP_SEED)) {
             r.p_value = (fp * groups).min(1.0);
-            r.significant = r.p_value < ALPHA && r.gain_pct > MIN_GAIN_PCT;
+            r.significant = r.p_value < ALPHA && r.gain_pct > MIN_RUN_GAIN_PCT;
         }
         let best = rows
             .iter()

@@ -17,7 +17,8 @@ pub struct Scored {
     pub heldout_rms_dph: f64,
     /// Held-out gain over the model of the previous step, %.
     pub gain_pct: f64,
-    /// Family-wise p (max-T over the library, x groups).
+    /// Family-wise p (held-out gain and score, each max-T over the library, joined by
+    /// min-p; x groups).
     pub p_value: f64,
     pub significant: bool,
     /// Share of validation units whose held-out error dropped.

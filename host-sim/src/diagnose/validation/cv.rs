@@ -9,6 +9,7 @@ use crate::diagnose::linalg::solve_spd;
 use crate::diagnose::validation::design::{Columns, Design};
 use crate::diagnose::validation::folds::{Folds, Offsets};
 use crate::diagnose::validation::row_cache::held_or_on_demand;
+use crate::diagnose::validation::score::{whitened_unit_scores, UnitScores};
 use std::sync::Arc;
 
 /// A design prepared for validation: the design's rows (computed on demand, never held
@@ -233,14 +234,48 @@ impl Prepared {
         folds: &Folds,
         extra: &[Vec<f64>],
         ridges: &[f64],
+        residual: Option<&mut Vec<f64>>,
+    ) -> Vec<Result<CvResult, DiagnoseError>> {
+        let aug = self.augmented(folds, extra);
+        self.held_out_on(folds, &aug, ridges, residual)
+    }
+
+    /// Held-out validation of this design plus `extra` columns (raw, full length), and
+    /// the per-unit whitened scores of the last `tested` of them given the design and the
+    /// others (`score`; None when they add nothing new), from one pass over the rows.
+    pub fn validate_scored(
+        &self,
+        folds: &Folds,
+        extra: &[Vec<f64>],
+        tested: usize,
+    ) -> Result<(CvResult, Option<UnitScores>), DiagnoseError> {
+        let aug = self.augmented(folds, extra);
+        let q = self.width() + aug.2.len();
+        let scores = whitened_unit_scores(&aug.0, &aug.1, q, tested, self.ridge);
+        let cv = self
+            .held_out_on(folds, &aug, &[self.ridge], None)
+            .into_iter()
+            .next()
+            .unwrap_or(Err(DiagnoseError::Singular {
+                what: "held-out fit",
+            }))?;
+        Ok((cv, scores))
+    }
+
+    /// [`Prepared::held_out`] on the augmented systems `aug`.
+    fn held_out_on(
+        &self,
+        folds: &Folds,
+        aug: &Augmented,
+        ridges: &[f64],
         mut residual: Option<&mut Vec<f64>>,
     ) -> Vec<Result<CvResult, DiagnoseError>> {
-        let (grams, xty, ex) = self.augmented(folds, extra);
-        let buffered = (folds.buffer_points > 0).then(|| self.augmented_excluded(folds, &ex));
-        let (excl_g, excl_c) = buffered.as_ref().map_or((&grams, &xty), |(g, c)| (g, c));
+        let (grams, xty, ex) = aug;
+        let buffered = (folds.buffer_points > 0).then(|| self.augmented_excluded(folds, ex));
+        let (excl_g, excl_c) = buffered.as_ref().map_or((grams, xty), |(g, c)| (g, c));
         let q = self.width() + ex.len();
-        let total_g = sum_all(&grams);
-        let total_c = sum_all(&xty);
+        let total_g = sum_all(grams);
+        let total_c = sum_all(xty);
         let diag_scale: Vec<f64> = (0..q).map(|i| total_g[i * q + i]).collect();
         let mut unit_sse = vec![Vec::with_capacity(folds.unit_rows.len()); ridges.len()];
         let mut singular = vec![false; ridges.len()];
@@ -261,7 +296,7 @@ impl Prepared {
                 .collect();
             let mut sse = vec![0.0; ridges.len()];
             for row in r.clone() {
-                self.full_row(u, row, &ex, &mut a);
+                self.full_row(u, row, ex, &mut a);
                 for (k, w) in weights.iter().enumerate() {
                     let Some(w) = w else { continue };
                     let e = self.y[row] - dot(&a, w);

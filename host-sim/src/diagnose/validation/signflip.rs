@@ -5,8 +5,19 @@
 //! term costs held-out error), so flipping the signs of whole-unit gains gives the null
 //! distribution. The max over all candidates of each flipped total (Westfall-Young
 //! single-step max-T) makes the p-values hold for the whole family of candidates.
+//!
+//! The naming test reads two statistics of each candidate under the same flips
+//! ([`max_t_pvalues_with_scores`]): the held-out gain and the in-sample score (`score`),
+//! each maximised over the whole family, the two maxima joined by their smaller tail
+//! share (Westfall-Young min-p over the two): a candidate is judged by whichever of its
+//! two statistics is more extreme against its own family's maximum, and the multiplicity
+//! of reading two is paid for in the same flips, not by Bonferroni. Measured (issue 38):
+//! held-out drops of a product term are strongly negative in runs where the term is
+//! small (refitting moves the base there), which widens its own flipped totals; the
+//! score, linear in the term, is not (docs/record/diagnose.md, 2026-12-03).
 
 use crate::diagnose::validation::cv::CvResult;
+use crate::diagnose::validation::score::UnitScores;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -42,6 +53,61 @@ pub fn max_t_pvalues(gains: &[Vec<f64>], seed: u64) -> Vec<f64> {
     let Some(units) = gains.first().map(Vec::len) else {
         return vec![];
     };
+    let pats = patterns(units, seed);
+    let null = NullMaxima::new(gain_maxima(gains, &pats));
+    gains
+        .iter()
+        .map(|g| null.share_at_least(g.iter().sum()))
+        .collect()
+}
+
+/// Family-wise adjusted p-values from two statistics per candidate under the same sign
+/// patterns: its per-unit gains (flipped totals, as [`max_t_pvalues`]) and its per-unit
+/// whitened score vectors (`scores[k][u]`, from `score::whitened_unit_scores`; flipped,
+/// the squared length of their sum: the in-sample drop in squared error the term would
+/// bring, in the gains' units). Each statistic's maximum over all candidates is taken
+/// per pattern; a pattern's tail share is the smaller of its two maxima's shares, and a
+/// candidate's p is the share of patterns whose tail share is at or below the smaller of
+/// its own two (min-p over the two maxima). A candidate with no score (empty vectors)
+/// is read by its gain alone.
+pub fn max_t_pvalues_with_scores(gains: &[Vec<f64>], scores: &[UnitScores], seed: u64) -> Vec<f64> {
+    let Some(units) = gains.first().map(Vec::len) else {
+        return vec![];
+    };
+    let pats = patterns(units, seed);
+    let gain_null = NullMaxima::new(gain_maxima(gains, &pats));
+    let score_null = NullMaxima::new(score_maxima(scores, &pats));
+    let mut joint: Vec<f64> = gain_null
+        .per_pattern
+        .iter()
+        .zip(&score_null.per_pattern)
+        .map(|(&g, &s)| {
+            gain_null
+                .share_at_least(g)
+                .min(score_null.share_at_least(s))
+        })
+        .collect();
+    joint.sort_by(f64::total_cmp);
+    let n = joint.len() as f64;
+    gains
+        .iter()
+        .enumerate()
+        .map(|(k, g)| {
+            let by_gain = gain_null.share_at_least(g.iter().sum());
+            let by_score = scores
+                .get(k)
+                .map_or(1.0, |w| score_null.share_at_least(flipped_score(w, 0)));
+            let own = by_gain.min(by_score);
+            joint.partition_point(|&q| q <= own * (1.0 + 1e-12)) as f64 / n
+        })
+        .collect()
+}
+
+/// Each pattern's largest flipped gain total over all candidates. The totals are summed
+/// for all candidates at once, unit by unit (the gains held unit-major, so the sums
+/// vectorise); every total still adds its units in order.
+fn gain_maxima(gains: &[Vec<f64>], pats: &[u64]) -> Vec<f64> {
+    let units = gains.first().map_or(0, Vec::len);
     let candidates = gains.len();
     let mut by_unit = vec![0.0; units * candidates];
     for (k, g) in gains.iter().enumerate() {
@@ -49,40 +115,84 @@ pub fn max_t_pvalues(gains: &[Vec<f64>], seed: u64) -> Vec<f64> {
             by_unit[u * candidates + k] = v;
         }
     }
-    let pats = patterns(units, seed);
     let mut totals = vec![0.0; candidates];
-    let mut null_max: Vec<f64> = pats
-        .iter()
+    pats.iter()
         .map(|&m| {
             totals.fill(0.0);
             for (u, gu) in by_unit.chunks_exact(candidates).enumerate() {
-                let sign = if u < 64 && (m >> u) & 1 == 1 {
-                    -1.0
-                } else {
-                    1.0
-                };
+                let sign = if flipped(m, u) { -1.0 } else { 1.0 };
                 totals.iter_mut().zip(gu).for_each(|(t, g)| *t += sign * g);
             }
             totals.iter().copied().fold(f64::NEG_INFINITY, f64::max)
         })
-        .collect();
-    let n = null_max.len() as f64;
-    // Sorted, a count of maxima at or above a total is one binary search (NaN maxima
-    // never count, as in a comparison).
-    null_max.retain(|m| !m.is_nan());
-    null_max.sort_by(f64::total_cmp);
-    gains
-        .iter()
-        .map(|g| {
-            let obs: f64 = g.iter().sum();
-            let at_least = obs - 1e-12 * obs.abs();
-            if at_least.is_nan() {
-                return 0.0; // no maximum reaches NaN
-            }
-            let below = null_max.partition_point(|&m| m < at_least);
-            (null_max.len() - below) as f64 / n
+        .collect()
+}
+
+/// Each pattern's largest flipped score statistic over all candidates.
+fn score_maxima(scores: &[UnitScores], pats: &[u64]) -> Vec<f64> {
+    pats.iter()
+        .map(|&m| {
+            scores
+                .iter()
+                .map(|w| flipped_score(w, m))
+                .fold(0.0, f64::max)
         })
         .collect()
+}
+
+/// Squared length of the sum over units of the whitened score vectors `w`, unit u's
+/// sign flipped when bit u of `mask` is set (0 when the vectors are empty).
+fn flipped_score(w: &[Vec<f64>], mask: u64) -> f64 {
+    let width = w.first().map_or(0, Vec::len);
+    (0..width)
+        .map(|j| {
+            let s: f64 = w
+                .iter()
+                .enumerate()
+                .map(|(u, wu)| if flipped(mask, u) { -wu[j] } else { wu[j] })
+                .sum();
+            s * s
+        })
+        .sum()
+}
+
+fn flipped(mask: u64, unit: usize) -> bool {
+    unit < 64 && (mask >> unit) & 1 == 1
+}
+
+/// One statistic's maxima over the family, one per sign pattern, and their tail shares.
+struct NullMaxima {
+    /// In pattern order.
+    per_pattern: Vec<f64>,
+    /// Sorted, NaN left out (a NaN maximum never counts, as in a comparison).
+    sorted: Vec<f64>,
+    patterns: f64,
+}
+
+impl NullMaxima {
+    fn new(per_pattern: Vec<f64>) -> Self {
+        let mut sorted: Vec<f64> = per_pattern
+            .iter()
+            .copied()
+            .filter(|m| !m.is_nan())
+            .collect();
+        sorted.sort_by(f64::total_cmp);
+        Self {
+            patterns: per_pattern.len() as f64,
+            per_pattern,
+            sorted,
+        }
+    }
+
+    /// Share of patterns whose maximum reaches `obs` (one binary search; 0 for NaN).
+    fn share_at_least(&self, obs: f64) -> f64 {
+        let at_least = obs - 1e-12 * obs.abs();
+        if at_least.is_nan() {
+            return 0.0; // no maximum reaches NaN
+        }
+        let below = self.sorted.partition_point(|&m| m < at_least);
+        (self.sorted.len() - below) as f64 / self.patterns
+    }
 }
 
 /// Smallest p-value attainable with `units` validation units.
@@ -120,5 +230,47 @@ mod tests {
         let p = max_t_pvalues(&[strong, mixed], 1);
         assert!(p[0] < 0.002, "{p:?}");
         assert!(p[1] > 0.2, "{p:?}");
+    }
+
+    /// Whitened scores of one column per unit.
+    fn one_column(v: &[f64]) -> Vec<Vec<f64>> {
+        v.iter().map(|x| vec![*x]).collect()
+    }
+
+    #[test]
+    fn a_consistent_score_is_significant_where_noisy_gains_are_not() {
+        // The term's held-out gains are swamped by two units' losses; its scores agree.
+        let gains = vec![
+            vec![1.0, -2.5, 0.9, -2.0, 1.1, 1.0, 0.8, 1.3, 1.0, 0.9],
+            vec![0.1, -0.1, 0.2, -0.2, 0.1, -0.1, 0.1, 0.0, -0.1, 0.1],
+        ];
+        let scores = vec![
+            one_column(&[1.0, 0.1, 0.9, 0.2, 1.1, 1.0, 0.8, 1.3, 1.0, 0.9]),
+            one_column(&[0.3, -0.2, 0.1, -0.3, 0.2, -0.1, 0.3, -0.2, 0.1, -0.1]),
+        ];
+        let by_gain = max_t_pvalues(&gains, 1);
+        let both = max_t_pvalues_with_scores(&gains, &scores, 1);
+        assert!(by_gain[0] > 0.05, "{by_gain:?}");
+        assert!(both[0] < 0.01, "{both:?}");
+        assert!(both[1] > 0.2, "{both:?}");
+    }
+
+    #[test]
+    fn reading_two_statistics_costs_at_most_their_count_and_empty_scores_read_the_gains() {
+        let gains = vec![
+            vec![1.0, 1.2, 0.9, 1.1, -0.3, 0.8, 1.3, 1.0, 0.9, 1.1],
+            vec![1.0, -1.2, 0.9, -1.1, 1.0, -0.8, 1.3, -1.0, 0.9, -1.1],
+        ];
+        let scores = vec![
+            one_column(&[0.2, -0.1, 0.3, 0.1, -0.2, 0.1, 0.2, -0.3, 0.1, 0.2]),
+            one_column(&[1.0, -1.0, 1.0, -1.0, 1.0, -1.0, 1.0, -1.0, 1.0, -1.0]),
+        ];
+        let by_gain = max_t_pvalues(&gains, 1);
+        let both = max_t_pvalues_with_scores(&gains, &scores, 1);
+        for (g, b) in by_gain.iter().zip(&both) {
+            assert!(*b <= 2.0 * g + 1e-12, "{by_gain:?} {both:?}");
+        }
+        let none = vec![vec![]; 2];
+        assert_eq!(max_t_pvalues_with_scores(&gains, &none, 1), by_gain);
     }
 }
