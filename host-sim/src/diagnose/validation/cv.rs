@@ -525,7 +525,8 @@ fn counted_sum(v: &[Vec<f64>], counts: &[f64]) -> Vec<f64> {
     out
 }
 
-fn sum_all(v: &[Vec<f64>]) -> Vec<f64> {
+/// Element-wise sum of per-unit vectors (Grams or X'y) over the units.
+pub(crate) fn sum_all(v: &[Vec<f64>]) -> Vec<f64> {
     let mut out = vec![0.0; v.first().map_or(0, Vec::len)];
     for x in v {
         out.iter_mut().zip(x).for_each(|(o, a)| *o += a);

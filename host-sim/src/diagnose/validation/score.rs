@@ -13,6 +13,7 @@
 //! are on one scale: the score over the square root of the orthogonal part's energy.
 
 use crate::diagnose::linalg::solve_spd;
+use crate::diagnose::validation::cv::sum_all;
 
 /// One term's whitened score vector per unit (`units x k`).
 pub type UnitScores = Vec<Vec<f64>>;
@@ -33,8 +34,15 @@ pub fn whitened_unit_scores(
         return None;
     }
     let p = q - k;
-    let total_g = sum(grams, q * q);
-    let total_c = sum(xty, q);
+    let shapes_fit = !grams.is_empty()
+        && grams.len() == xty.len()
+        && grams.iter().all(|g| g.len() == q * q)
+        && xty.iter().all(|c| c.len() == q);
+    if !shapes_fit {
+        return None;
+    }
+    let total_g = sum_all(grams);
+    let total_c = sum_all(xty);
     let at = |g: &[f64], i: usize, j: usize| g[i * q + j];
     // The model's normal equations (ridged as the held-out fits are).
     let mut a: Vec<f64> = (0..p * p).map(|ij| at(&total_g, ij / p, ij % p)).collect();
@@ -83,14 +91,6 @@ pub fn whitened_unit_scores(
         })
         .collect();
     per_unit
-}
-
-fn sum(v: &[Vec<f64>], len: usize) -> Vec<f64> {
-    let mut out = vec![0.0; len];
-    for x in v {
-        out.iter_mut().zip(x).for_each(|(o, a)| *o += a);
-    }
-    out
 }
 
 #[cfg(test)]
