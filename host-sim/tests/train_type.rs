@@ -14,7 +14,7 @@ use fog_sim::io::model::read_model;
 use fog_sim::io::runs::{write_run, Run};
 use fog_sim::registry::Registry;
 use fog_sim::train::seek_score::SeekGeometry;
-use fog_sim::train::type_unit::solve::Fit;
+use fog_sim::train::type_unit::terms::Fit;
 use fog_sim::train::type_unit::type_model::learn_type;
 use fog_sim::train::type_unit::{calibrate_unit, TypeModel, UnitCalibration, UnitPlan};
 use fog_sim::train::{dataset_from_runs, default_specs, train_model, TrainConfig};

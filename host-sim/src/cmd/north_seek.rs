@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use super::campaign::spread_of;
 use crate::train::seek_score::Criterion;
-use crate::train::type_unit::solve::Fit;
+use crate::train::type_unit::terms::Fit;
 use crate::train::type_unit::TypeShape;
 use anyhow::{bail, Result};
 use fog_core::model::format::RbfModel;

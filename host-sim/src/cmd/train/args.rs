@@ -1,7 +1,7 @@
 //! `fogsim train`'s options and the training configuration they ask for.
 
 use crate::cmd::north_seek::Sequence;
-use crate::train::type_unit::solve::Fit;
+use crate::train::type_unit::terms::Fit;
 use crate::train::type_unit::TypeShape;
 use crate::train::{InputChoice, Method, TrainConfig, WidthSearch};
 use std::path::PathBuf;

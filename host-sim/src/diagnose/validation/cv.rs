@@ -10,6 +10,7 @@ use crate::diagnose::validation::design::{Columns, Design};
 use crate::diagnose::validation::folds::{Folds, Offsets};
 use crate::diagnose::validation::row_cache::held_or_on_demand;
 use crate::diagnose::validation::score::{whitened_unit_scores, UnitScores};
+use crate::diagnose::validation::unit_sums::{counted_sum, sum_all};
 use std::sync::Arc;
 
 /// A design prepared for validation: the design's rows (computed on demand, never held
@@ -511,27 +512,6 @@ fn add_ridge(a: &mut [f64], diag_scale: &[f64], q: usize, ridge: f64) {
     for i in 0..q {
         a[i * q + i] += ridge * diag_scale[i] + 1e-12 * mean_diag + 1e-300;
     }
-}
-
-fn counted_sum(v: &[Vec<f64>], counts: &[f64]) -> Vec<f64> {
-    let mut out = vec![0.0; v.first().map_or(0, Vec::len)];
-    for (x, &c) in v.iter().zip(counts) {
-        if c == 1.0 {
-            out.iter_mut().zip(x).for_each(|(o, a)| *o += a);
-        } else if c != 0.0 {
-            out.iter_mut().zip(x).for_each(|(o, a)| *o += c * a);
-        }
-    }
-    out
-}
-
-/// Element-wise sum of per-unit vectors (Grams or X'y) over the units.
-pub(crate) fn sum_all(v: &[Vec<f64>]) -> Vec<f64> {
-    let mut out = vec![0.0; v.first().map_or(0, Vec::len)];
-    for x in v {
-        out.iter_mut().zip(x).for_each(|(o, a)| *o += a);
-    }
-    out
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@
 //! are on one scale: the score over the square root of the orthogonal part's energy.
 
 use crate::diagnose::linalg::solve_spd;
-use crate::diagnose::validation::cv::sum_all;
+use crate::diagnose::validation::unit_sums::sum_all;
 
 /// One term's whitened score vector per unit (`units x k`).
 pub type UnitScores = Vec<Vec<f64>>;

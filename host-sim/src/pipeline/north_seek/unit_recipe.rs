@@ -19,7 +19,7 @@ use crate::pipeline::campaign::{CampaignSpec, PAPER_MINUTES};
 use crate::pipeline::fleet::{fleet_runs, unit_id, FleetType};
 use crate::sim::{GyroParams, TypeSpread};
 use crate::train::type_unit::law::fit_law_network;
-use crate::train::type_unit::solve::Fit;
+use crate::train::type_unit::terms::Fit;
 use crate::train::type_unit::type_model::learn_type;
 use crate::train::type_unit::{calibrate_unit, TypeModel, TypeShape, UnitCalibration, UnitPlan};
 

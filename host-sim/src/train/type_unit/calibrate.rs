@@ -7,7 +7,7 @@
 //! mean and spread of weight W (in runs: W = 1 counts the prior like one more run; W = 0
 //! is the unit's own least squares). The terms not fitted stay at the type's mean. The fit
 //! is the type's (`unit_fit`, by default within runs: each cold start's own constant,
-//! which the seeks cancel, taken out; `solve::Fit`).
+//! which the seeks cancel, taken out; `terms::Fit`).
 //!
 //! m and W are chosen together by leaving one of the unit's runs out at a time: every
 //! candidate is fitted on the other runs and scored on the held-out run by the seek score

@@ -3,7 +3,7 @@
 //! others held at the type's mean and a Gaussian prior of chosen weight, and the
 //! jackknife over runs that gives every estimate its standard error.
 //!
-//! Two ways to fit (`Fit`), chosen once per type (`train --type-out --unit-fit`) and kept
+//! Two ways to fit (`terms::Fit`), chosen once per type (`train --type-out --unit-fit`) and kept
 //! in its file, so the type's units and every unit calibrated against it are read alike.
 //! `WithinRuns` (the default): every cold start has its own constant (the turn-on bias,
 //! and the level its bias instability starts at), which a two- or four-position seek
@@ -23,32 +23,9 @@
 use anyhow::{anyhow, Result};
 use nalgebra::{DMatrix, DVector};
 
-use super::terms::{design, UnitTerm};
+use super::terms::{design, Fit, UnitTerm};
 use crate::train::Dataset;
 use fog_core::model::format::RbfModel;
-
-/// How a type's units and a unit's rows are fitted (module notes; `--unit-fit`, a type's
-/// `unit_fit`).
-#[derive(
-    Clone,
-    Copy,
-    Debug,
-    Default,
-    PartialEq,
-    Eq,
-    serde::Serialize,
-    serde::Deserialize,
-    clap::ValueEnum,
-)]
-#[serde(rename_all = "snake_case")]
-pub enum Fit {
-    /// Over all the unit's runs as measured (every type before 2026-12-03).
-    Pooled,
-    /// To each run's deviation from its own mean: the default, from the Monte Carlo over
-    /// 20 simulated fleets (docs/record/fleet.md).
-    #[default]
-    WithinRuns,
-}
 
 /// One unit's rows against a type model.
 #[derive(Clone, Debug)]

@@ -22,8 +22,30 @@
 use anyhow::{bail, Result};
 use fog_core::model::format::{FeatureKind, RbfModel};
 
-use super::solve::Fit;
 use crate::train::{predict_batch, Dataset};
+
+/// How a type's units and a unit's rows are fitted (`solve`'s module notes; `--unit-fit`, a type's
+/// `unit_fit`).
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum Fit {
+    /// Over all the unit's runs as measured (every type before 2026-12-03).
+    Pooled,
+    /// To each run's deviation from its own mean: the default, from the Monte Carlo over
+    /// 20 simulated fleets (docs/record/fleet.md).
+    #[default]
+    WithinRuns,
+}
 
 /// One unit term of a type model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

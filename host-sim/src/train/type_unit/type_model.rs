@@ -4,7 +4,7 @@
 //! FLEET_RUNS --type-out TYPE.json`): the shared drift model is trained on every unit's
 //! runs together, and then each unit's own unit terms (`terms`: warm-up gain, a
 //! linear term per input; an offset too when read `Pooled`) are fitted to its runs against
-//! that shared model, within each run by default (`solve::Fit`). Their mean over
+//! that shared model, within each run by default (`terms::Fit`). Their mean over
 //! the units is the type's value of each term and their scatter over the units, less what
 //! the units' own estimation noise (jackknife over their runs) explains, is the type's
 //! unit-to-unit spread: the prior of every later unit calibration.
@@ -23,7 +23,8 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use super::solve::{own_estimate, Fit, UnitRows};
+use super::solve::{own_estimate, UnitRows};
+use super::terms::Fit;
 use super::terms::{raw_coefficient, term_name, unit_terms, UnitTerm};
 use crate::io::runs::Run;
 use crate::train::dataset_from_runs;
