@@ -13,6 +13,7 @@ mod allan_vs_allantools;
 mod app_allan;
 mod app_bad_input;
 mod app_compensate;
+mod app_demo;
 mod app_flag_units;
 mod app_heading_cal;
 mod app_north_seek;
