@@ -22,6 +22,7 @@ mod field_log_power_cut;
 mod fw_budgets;
 mod fw_fault_record;
 mod health_stuck;
+mod layout_imports;
 mod probe_models;
 mod protocol_fuzz;
 mod qemu_faults;
