@@ -163,7 +163,6 @@ fn words(path: &str) -> Vec<String> {
 /// The file an import path leads to: the longest module prefix that is a file.
 fn resolve(
     from: &[String],
-    from_is_mod: bool,
     path: &[String],
     files: &BTreeMap<Vec<String>, PathBuf>,
 ) -> Option<Vec<String>> {
@@ -176,8 +175,8 @@ fn resolve(
             rest = &rest[1..];
         }
         Some("super") | Some("self") => {
-            // `self` in a.rs is module a; `super` is its parent (a mod.rs is its folder).
-            let _ = from_is_mod;
+            // `self` in a.rs is module a, `super` its parent (a mod.rs is its folder's
+            // module, so the same rule holds for it).
             while let Some(w) = rest.first() {
                 match w.as_str() {
                     "super" => {
@@ -208,7 +207,7 @@ fn graph(src: &Path) -> BTreeMap<Vec<String>, BTreeSet<Vec<String>>> {
         let code = code_of(&std::fs::read_to_string(path).unwrap());
         let mut to = BTreeSet::new();
         for (p, public) in import_paths(&code) {
-            let Some(target) = resolve(module, is_mod, &p, &files) else {
+            let Some(target) = resolve(module, &p, &files) else {
                 continue;
             };
             let facade = public && is_mod && target.starts_with(module);
