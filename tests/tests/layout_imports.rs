@@ -3,7 +3,7 @@
 //! import from a folder to one above it in its map. A circle between two files came back
 //! once in a review mend (2026-12-03); this is the guard.
 //!
-//! An import is every `crate::`, `super::` and `self::` path outside `#[cfg(test)]` code
+//! An import is every `crate::`, `super::` and `self::` path outside `#[cfg(test)]` items
 //! (tests may reach anywhere), resolved to the longest module path that is a file. A
 //! `pub use` in a `mod.rs` of its own folder's files is the folder's face, not a
 //! dependency of the folder on its files, and is left out, as are `mod` declarations.
@@ -48,20 +48,49 @@ fn modules(src: &Path) -> BTreeMap<Vec<String>, PathBuf> {
         .collect()
 }
 
-/// The source without its `#[cfg(test)]` items (from the attribute to the end of the
-/// file: this project keeps its tests last) and without comments.
+/// The source without comments and without its `#[cfg(test)]` items (the attribute and the
+/// item after it: a `mod x;` line, or everything up to the brace that closes the item).
 fn code_of(text: &str) -> String {
-    let text = match text.find("#[cfg(test)]") {
-        Some(i) => &text[..i],
-        None => text,
-    };
-    text.lines()
+    let code: String = text
+        .lines()
         .map(|l| match l.find("//") {
             Some(i) => &l[..i],
             None => l,
         })
         .collect::<Vec<_>>()
-        .join("\n")
+        .join("\n");
+    let mut out = String::with_capacity(code.len());
+    let mut rest = code.as_str();
+    while let Some(i) = rest.find("#[cfg(test)]") {
+        out.push_str(&rest[..i]);
+        let item = &rest[i + "#[cfg(test)]".len()..];
+        let (semi, open) = (item.find(';'), item.find('{'));
+        let end = match (semi, open) {
+            (Some(s), o) if o.is_none_or(|o| s < o) => s + 1,
+            (_, Some(o)) => {
+                let mut depth = 0usize;
+                let mut close = item.len();
+                for (k, ch) in item[o..].char_indices() {
+                    match ch {
+                        '{' => depth += 1,
+                        '}' => {
+                            depth -= 1;
+                            if depth == 0 {
+                                close = o + k + 1;
+                                break;
+                            }
+                        }
+                        _ => {}
+                    }
+                }
+                close
+            }
+            _ => item.len(),
+        };
+        rest = &item[end..];
+    }
+    out.push_str(rest);
+    out
 }
 
 /// Expands a use tree (`a::{b, c::{d, e}}`) into its paths.
@@ -374,7 +403,7 @@ fn the_reader_sees_a_planted_circle_and_an_import_up() {
     .unwrap();
     std::fs::write(
         dir.join("low/b.rs"),
-        "pub struct B;\nfn f() { let _ = crate::low::a::A; let _ = crate::high::h::H; }\n",
+        "pub struct B;\n#[cfg(test)]\nfn only_in_tests() { let _ = crate::high::H; }\nfn f() { let _ = crate::low::a::A; let _ = crate::high::h::H; }\n",
     )
     .unwrap();
     std::fs::write(dir.join("high/mod.rs"), "pub mod h;\n").unwrap();
