@@ -91,7 +91,7 @@ fn windows_features_and_drift_match_the_trainers_view() {
     let temp: Vec<f32> = out.results.iter().map(|r| r.temp_c).collect();
     let mut fv = vec![
         FeatureVector {
-            values: [0.0; 4],
+            values: [0.0; fog_core::model::format::MAX_INPUTS],
             len: 0,
             ready: false
         };

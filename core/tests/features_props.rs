@@ -182,7 +182,7 @@ fn series_helper_equals_the_device_extractor() {
     let heading: Vec<f32> = t.iter().map(|t| (t / 10.0 % 360.0) as f32).collect();
     let mut out = vec![
         FeatureVector {
-            values: [0.0; 4],
+            values: [0.0; fog_core::model::format::MAX_INPUTS],
             len: 0,
             ready: false
         };

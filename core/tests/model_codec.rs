@@ -333,7 +333,7 @@ fn random_bytes_never_panic() {
 }
 
 /// An older format version's bytes: version 1 ends the body after `meta`, 2 after `poly`,
-/// 3 after `heading`, 4 after `linear_by_t` (postcard writes a struct as its fields back to back, so the body is
+/// 3 after `heading`, 4 after `linear_by_t`, 5 and 6 after `cold_start` (postcard writes a struct as its fields back to back, so the body is
 /// the older fields' bytes in order).
 fn encode_version(m: &RbfModel, version: u16) -> Vec<u8> {
     let loose = LooseModel::from(m);
@@ -351,6 +351,9 @@ fn encode_version(m: &RbfModel, version: u16) -> Vec<u8> {
     }
     if version >= 4 {
         body.extend(postcard::to_allocvec(&loose.linear_by_t).unwrap());
+    }
+    if version >= 5 {
+        body.extend(postcard::to_allocvec(&loose.cold_start).unwrap());
     }
     wrap(&body, version)
 }
@@ -669,4 +672,72 @@ fn the_cold_start_envelope_round_trips_and_old_versions_decode_without_it() {
             ..
         })
     ));
+}
+
+/// `m` with the warm-up law's two linear-only inputs appended (a clock and its stretch).
+fn with_law_clock(mut m: RbfModel) -> RbfModel {
+    for kind in [FeatureKind::PowerOnDecay, FeatureKind::PowerOnDecayStretch] {
+        m.inputs
+            .push(fog_core::model::format::FeatureSpec { kind, tau_s: 300.0 })
+            .unwrap();
+        m.input_offset.push(0.5).unwrap();
+        m.input_scale.push(0.5).unwrap();
+        m.input_min.push(0.0).unwrap();
+        m.input_max.push(1.0).unwrap();
+        m.linear.push(-0.1).unwrap();
+    }
+    m
+}
+
+#[test]
+fn six_inputs_fit_the_limit_and_version_5_bytes_decode_as_before() {
+    // the largest model version 6 allows: 64 centres on 4 Gaussian inputs, two more
+    // linear-only inputs, every optional field
+    let mut m = with_law_clock(warmup_model(MAX_CENTERS, 4, 2.0, 11));
+    m.meta.gyro_id.clear();
+    m.meta.gyro_id.push_str("0123456789ABCDEF").unwrap();
+    m.poly.extend_from_slice(&[0.3, -0.05, 0.01]).unwrap();
+    m.heading = Some(harmonic());
+    m.linear_by_t
+        .extend_from_slice(&[0.0, 0.02, -0.01, 0.005, 0.001, -0.002])
+        .unwrap();
+    m.cold_start = Some(envelope(MAX_COLD_START_POINTS));
+    let bytes = encode(&m);
+    println!("64 centres x 6 inputs + every field: {} bytes", bytes.len());
+    assert!(bytes.len() <= MAX_ENCODED_LEN, "{} bytes", bytes.len());
+    assert_eq!(RbfModel::decode(&bytes), Ok(m.clone()));
+    // version 6 keeps version 5's layout: the same body under either version number, so
+    // every version-5 file decodes to what it meant
+    for model in [&m, &warmup_model(35, 2, 2.0, 5)] {
+        assert_eq!(encode_version(model, 6), encode(model));
+        assert_eq!(
+            RbfModel::decode(&encode_version(model, 5)),
+            Ok(model.clone())
+        );
+    }
+    // a centre is four wide: a fifth input in the Gaussians is refused, as is a seventh input
+    let mut five = with_law_clock(warmup_model(8, 4, 2.0, 1));
+    five.n_rbf_inputs = 5;
+    assert!(matches!(
+        RbfModel::decode(&encode_loose(&LooseModel::from(&five), MODEL_VERSION)),
+        Err(ModelError::BadRbfInputCount {
+            n_rbf_inputs: 5,
+            n_inputs: 6
+        })
+    ));
+    let mut seven = LooseModel::from(&with_law_clock(warmup_model(8, 4, 2.0, 1)));
+    seven.inputs.push(seven.inputs[5]);
+    for v in [
+        &mut seven.input_offset,
+        &mut seven.input_scale,
+        &mut seven.input_min,
+        &mut seven.input_max,
+        &mut seven.linear,
+    ] {
+        v.push(v[5]);
+    }
+    assert_eq!(
+        RbfModel::decode(&encode_loose(&seven, MODEL_VERSION)),
+        Err(ModelError::TooManyInputs { count: 7 })
+    );
 }

@@ -72,7 +72,7 @@ pub(crate) fn window(t_end_s: f64, rate_dph: f64, status: WindowStatus) -> Windo
         mean_rate_dph: rate_dph as f32,
         temp_c: 20.0,
         temp_rate_cps: 0.0,
-        inputs: [0.0; 4],
+        inputs: [0.0; fog_core::model::format::MAX_INPUTS],
         n_inputs: 0,
         drift_dph: 0.0,
         compensated_dph: rate_dph as f32,

@@ -394,32 +394,39 @@ fn firmware_replay_matches_host_bit_for_bit_rise() {
     scenario(Evaluator::F32, 3, FeatureKind::TempRiseC, "f32-rise");
 }
 
-/// A model of the type shape `law` (`fogsim train --type-out --type-shape law`): T and the
-/// rise under the Gaussians, two power-on clocks as linear-only inputs, linear terms, their
-/// products with T (`linear_by_t`) and a T^2 term, on the fixed-point evaluator.
-#[test]
-fn firmware_replay_matches_host_bit_for_bit_law_shape() {
-    if !qemu_ready("qemu_replay") {
-        return;
-    }
+/// A model of the type shape `law` (`fogsim train --type-out --type-shape law`, model
+/// format version 6): T and the rise under the Gaussians, two power-on clocks and their
+/// stretches as linear-only inputs (six inputs), linear terms, their products with T
+/// (`linear_by_t`) and a T^2 term, on the fixed-point evaluator and on the f32 one.
+fn law_shape_model() -> RbfModel {
     let mut model = warmup_model(3, 4, 0.05, 35);
-    let clock = |tau_s: f32| FeatureSpec {
-        kind: FeatureKind::PowerOnDecay,
-        tau_s,
-    };
+    let clock = |kind: FeatureKind, tau_s: f32| FeatureSpec { kind, tau_s };
     let specs = [
         FeatureSpec::plain(FeatureKind::TempC),
         FeatureSpec::plain(FeatureKind::TempRiseC),
-        clock(130.0),
-        clock(300.0),
+        clock(FeatureKind::PowerOnDecay, 130.0),
+        clock(FeatureKind::PowerOnDecay, 300.0),
+        clock(FeatureKind::PowerOnDecayStretch, 130.0),
+        clock(FeatureKind::PowerOnDecayStretch, 300.0),
     ];
-    // (offset, scale, min, max) of the rise and the clocks (the clocks over their range)
+    // (offset, scale, min, max) of the rise, the clocks and the stretches over their
+    // ranges ((t / tau) exp(-t / tau) peaks at 1/e)
     let ranges = [
         (5.0, 5.0, -5.0, 100.0),
         (0.5, 0.5, 0.0, 1.0),
         (0.5, 0.5, 0.0, 1.0),
+        (0.18, 0.18, 0.0, 0.37),
+        (0.18, 0.18, 0.0, 0.37),
     ];
     for (j, spec) in specs.iter().enumerate() {
+        if j == model.inputs.len() {
+            model.inputs.push(*spec).expect("six inputs fit");
+            model.input_offset.push(0.0).expect("six inputs fit");
+            model.input_scale.push(1.0).expect("six inputs fit");
+            model.input_min.push(0.0).expect("six inputs fit");
+            model.input_max.push(0.0).expect("six inputs fit");
+            model.linear.push(0.0).expect("six inputs fit");
+        }
         model.inputs[j] = *spec;
         if let Some(&(offset, scale, lo, hi)) = j.checked_sub(1).and_then(|k| ranges.get(k)) {
             model.input_offset[j] = offset;
@@ -432,17 +439,35 @@ fn firmware_replay_matches_host_bit_for_bit_law_shape() {
     for c in model.centers.iter_mut() {
         c[2..].iter_mut().for_each(|v| *v = 0.0);
     }
-    model.linear.copy_from_slice(&[0.01, 0.02, 0.05, -0.03]);
+    model
+        .linear
+        .copy_from_slice(&[0.01, 0.02, 0.05, -0.03, 0.04, -0.02]);
     model
         .linear_by_t
-        .extend_from_slice(&[0.0, 0.0, 0.02, -0.01])
-        .expect("4 T-coupled terms fit");
+        .extend_from_slice(&[0.0, 0.0, 0.02, -0.01, 0.01, 0.005])
+        .expect("6 T-coupled terms fit");
     model
         .poly
         .extend_from_slice(&[0.0, 0.004])
         .expect("2 polynomial terms fit");
     model.validate().expect("a valid law-shaped model");
-    replay_both(Evaluator::Fixed, &model, "fixed-law-shape");
+    model
+}
+
+#[test]
+fn firmware_replay_matches_host_bit_for_bit_law_shape() {
+    if !qemu_ready("qemu_replay") {
+        return;
+    }
+    replay_both(Evaluator::Fixed, &law_shape_model(), "fixed-law-shape");
+}
+
+#[test]
+fn firmware_replay_matches_host_bit_for_bit_law_shape_f32() {
+    if !qemu_ready("qemu_replay") {
+        return;
+    }
+    replay_both(Evaluator::F32, &law_shape_model(), "f32-law-shape");
 }
 
 /// The time since power-on (`FeatureKind::PowerOnDecay`, exp(-t / tau), the clock input of

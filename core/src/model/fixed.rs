@@ -22,7 +22,7 @@
 //! `fixed_worst_error_*` tests: `cargo test -p fog-core --test rbf_accuracy fixed_worst -- --nocapture`).
 
 use crate::model::error::ModelError;
-use crate::model::format::{RbfModel, MAX_CENTERS, MAX_INPUTS, MAX_POLY_DEGREE};
+use crate::model::format::{RbfModel, MAX_CENTERS, MAX_INPUTS, MAX_POLY_DEGREE, MAX_RBF_INPUTS};
 use crate::model::rbf::RbfError;
 
 /// Fraction bits of normalised inputs and centres.
@@ -108,7 +108,7 @@ pub struct FixedModel {
     in_gain_q: [i64; MAX_INPUTS],
     /// Right shift that brings (x - offset) * gain to Q.28.
     in_shift: [u8; MAX_INPUTS],
-    centers_q: [[i64; MAX_INPUTS]; MAX_CENTERS],
+    centers_q: [[i64; MAX_RBF_INPUTS]; MAX_CENTERS],
     gain_q: [i32; MAX_CENTERS],
     weights_q: [i32; MAX_CENTERS],
     linear_q: [i32; MAX_INPUTS],
@@ -152,7 +152,7 @@ impl FixedModel {
             in_offset_q: [0; MAX_INPUTS],
             in_gain_q: [0; MAX_INPUTS],
             in_shift: [0; MAX_INPUTS],
-            centers_q: [[0; MAX_INPUTS]; MAX_CENTERS],
+            centers_q: [[0; MAX_RBF_INPUTS]; MAX_CENTERS],
             gain_q: [0; MAX_CENTERS],
             weights_q: [0; MAX_CENTERS],
             linear_q: [0; MAX_INPUTS],
@@ -187,7 +187,7 @@ impl FixedModel {
         fm.in_offset_q = [0; MAX_INPUTS];
         fm.in_gain_q = [0; MAX_INPUTS];
         fm.in_shift = [0; MAX_INPUTS];
-        fm.centers_q = [[0; MAX_INPUTS]; MAX_CENTERS];
+        fm.centers_q = [[0; MAX_RBF_INPUTS]; MAX_CENTERS];
         fm.gain_q = [0; MAX_CENTERS];
         fm.weights_q = [0; MAX_CENTERS];
         fm.linear_q = [0; MAX_INPUTS];
@@ -220,7 +220,11 @@ impl FixedModel {
             fm.in_shift[j] = shift as u8;
         }
         for (i, c) in model.centers.iter().enumerate() {
-            for (q, &v) in fm.centers_q[i].iter_mut().zip(c.iter()).take(n) {
+            for (q, &v) in fm.centers_q[i]
+                .iter_mut()
+                .zip(c.iter())
+                .take(model.n_rbf_inputs as usize)
+            {
                 if v.abs() >= 100.0 {
                     return Err(FixedError::CenterOutOfRange { center: i as u8 });
                 }
@@ -318,8 +322,8 @@ impl FixedModel {
             let g = self.gain_q[i] as i64; // < 127 * 2^24 < 2^31
             let c = &self.centers_q[i];
             let mut u: i64 = 0;
-            for j in 0..nr {
-                let d = xn[j] - c[j]; // Q.28, |d| < 220 * 2^28
+            for (&x, &cj) in xn.iter().zip(c.iter()).take(nr) {
+                let d = x - cj; // Q.28, |d| < 220 * 2^28
                 let z = if d.unsigned_abs() < 1 << 32 {
                     (d * g) >> GAIN_FRAC
                 } else {

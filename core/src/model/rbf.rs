@@ -11,7 +11,7 @@
 
 pub use crate::model::exp_neg::exp_neg_f32;
 use crate::model::exp_neg::{twice_exp_neg_half, GAUSS_MAX_V};
-use crate::model::format::{RbfModel, MAX_INPUTS, XN_CLAMP};
+use crate::model::format::{RbfModel, MAX_INPUTS, MAX_RBF_INPUTS, XN_CLAMP};
 
 /// Why an RBF evaluation was refused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -64,7 +64,7 @@ pub(crate) fn check_inputs<T: Copy>(
         || model.linear.len() != n
         || model.widths.len() != m
         || model.weights.len() != m
-        || model.n_rbf_inputs as usize > n
+        || model.n_rbf_inputs as usize > n.min(MAX_RBF_INPUTS)
     {
         return Err(RbfError::InvalidModel);
     }
@@ -139,7 +139,7 @@ fn sq(d: f32) -> f32 {
 /// (exact scalings by 2: the result has the bits of the plain sum); a centre whose v
 /// is beyond the f32 underflow threshold costs a compare and a branch.
 #[inline(always)]
-fn add_gaussians(model: &RbfModel, acc: f32, d2: impl Fn(&[f32; MAX_INPUTS]) -> f32) -> f32 {
+fn add_gaussians(model: &RbfModel, acc: f32, d2: impl Fn(&[f32; MAX_RBF_INPUTS]) -> f32) -> f32 {
     let mut twice_acc = 2.0 * acc;
     for ((c, &s), &w) in model
         .centers
@@ -165,8 +165,9 @@ pub fn predict_f32(model: &RbfModel, x_raw: &[f32]) -> Result<f32, RbfError> {
         acc += l * x;
     }
     // Summed in input order as a loop over the inputs would, so the result does not
-    // depend on which arm runs; `check_inputs` bounds n_rbf_inputs by the input count.
-    let [x0, x1, x2, x3] = xn;
+    // depend on which arm runs; `check_inputs` bounds n_rbf_inputs by the input count and
+    // by `MAX_RBF_INPUTS` (4): the last arm is the four-input one.
+    let [x0, x1, x2, x3, ..] = xn;
     Ok(match model.n_rbf_inputs {
         0 => add_gaussians(model, acc, |_| 0.0),
         1 => add_gaussians(model, acc, |c| sq(x0 - c[0])),
@@ -211,8 +212,8 @@ pub fn predict_f64(model: &RbfModel, x_raw: &[f64]) -> Result<f64, RbfError> {
         .zip(model.weights.iter())
     {
         let mut d2 = 0.0f64;
-        for j in 0..nr {
-            let d = xn[j] - c[j] as f64;
+        for (&x, &cj) in xn.iter().zip(c.iter()).take(nr) {
+            let d = x - cj as f64;
             d2 += d * d;
         }
         let s = s as f64;

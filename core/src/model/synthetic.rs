@@ -4,7 +4,7 @@
 //! pseudo-random. No RNG crate: a SplitMix64 sequence keeps it `no_std` and seedable.
 
 use crate::model::format::{
-    FeatureKind, FeatureSpec, RbfModel, TrainingMeta, MAX_CENTERS, MAX_INPUTS,
+    FeatureKind, FeatureSpec, RbfModel, TrainingMeta, MAX_CENTERS, MAX_RBF_INPUTS,
 };
 
 /// Ambient temperatures of the synthetic campaign, degC.
@@ -47,8 +47,11 @@ impl SplitMix64 {
     }
 }
 
+/// Inputs of the synthetic warm-up: T, dT/dt, d2T/dt2, lagged T.
+pub const WARMUP_INPUTS: usize = 4;
+
 /// Raw inputs (T, dT/dt, d2T/dt2, lagged T) of the synthetic warm-up at `ambient_c`, `t_s`.
-pub fn warmup_inputs(ambient_c: f64, t_s: f64) -> [f64; MAX_INPUTS] {
+pub fn warmup_inputs(ambient_c: f64, t_s: f64) -> [f64; WARMUP_INPUTS] {
     let e = libm::exp(-t_s / WARMUP_TAU_S);
     let temp = ambient_c + WARMUP_DELTA_C * (1.0 - e);
     let rate = WARMUP_DELTA_C / WARMUP_TAU_S * e;
@@ -61,7 +64,7 @@ pub fn warmup_inputs(ambient_c: f64, t_s: f64) -> [f64; MAX_INPUTS] {
 }
 
 /// A point on a random warm-up trajectory of the synthetic campaign.
-pub fn random_warmup_point(rng: &mut SplitMix64) -> [f64; MAX_INPUTS] {
+pub fn random_warmup_point(rng: &mut SplitMix64) -> [f64; WARMUP_INPUTS] {
     let k = (rng.next_u64() % AMBIENTS_C.len() as u64) as usize;
     warmup_inputs(AMBIENTS_C[k], rng.range(0.0, RECORD_S))
 }
@@ -76,7 +79,7 @@ pub fn warmup_model(
     seed: u64,
 ) -> RbfModel {
     let n_centers = n_centers.min(MAX_CENTERS);
-    let n_inputs = n_inputs.clamp(1, MAX_INPUTS);
+    let n_inputs = n_inputs.clamp(1, WARMUP_INPUTS.min(MAX_RBF_INPUTS));
     let kinds = [
         FeatureSpec::plain(FeatureKind::TempC),
         FeatureSpec::plain(FeatureKind::TempRateCps),
@@ -87,12 +90,12 @@ pub fn warmup_model(
         },
     ];
     // Ranges over the whole campaign (start and end of each record bound every input).
-    let mut lo = [f64::INFINITY; MAX_INPUTS];
-    let mut hi = [f64::NEG_INFINITY; MAX_INPUTS];
+    let mut lo = [f64::INFINITY; WARMUP_INPUTS];
+    let mut hi = [f64::NEG_INFINITY; WARMUP_INPUTS];
     for &a in AMBIENTS_C.iter() {
         for k in 0..=270 {
             let x = warmup_inputs(a, k as f64 * 10.0);
-            for j in 0..MAX_INPUTS {
+            for j in 0..WARMUP_INPUTS {
                 lo[j] = lo[j].min(x[j]);
                 hi[j] = hi[j].max(x[j]);
             }
@@ -121,7 +124,7 @@ pub fn warmup_model(
     }
     for _ in 0..n_centers {
         let x = random_warmup_point(&mut rng);
-        let mut c = [0.0f32; MAX_INPUTS];
+        let mut c = [0.0f32; MAX_RBF_INPUTS];
         for j in 0..n_inputs {
             c[j] = ((x[j] - 0.5 * (lo[j] + hi[j])) / (0.5 * (hi[j] - lo[j]))) as f32;
         }

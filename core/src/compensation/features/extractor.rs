@@ -2,7 +2,7 @@
 //! feeds its window means and the trainer's helper that runs it over a whole series.
 
 use super::error::{positive_time_constant, FeatureError};
-use super::lag::{power_on_decay, FirstOrderLag};
+use super::lag::{power_on_decay, power_on_decay_stretch, FirstOrderLag};
 use super::rate::TempRateEstimator;
 use crate::model::format::{FeatureKind, FeatureSpec, MAX_AUX, MAX_INPUTS};
 use heapless::Vec;
@@ -74,7 +74,7 @@ fn check_spec(spec: &FeatureSpec) -> Result<(), FeatureError> {
         | FeatureKind::TempAccelCps2
         | FeatureKind::TempAccelFlatStartCps2
         | FeatureKind::AuxRate(_) => positive_time_constant(span_for(spec))?,
-        FeatureKind::TempLagC | FeatureKind::PowerOnDecay => {
+        FeatureKind::TempLagC | FeatureKind::PowerOnDecay | FeatureKind::PowerOnDecayStretch => {
             positive_time_constant(spec.tau_s as f64)?
         }
         _ => {}
@@ -224,6 +224,9 @@ impl FeatureExtractor {
                     Some(temp - *first.get_or_insert(temp))
                 }
                 (FeatureKind::PowerOnDecay, _) => Some(power_on_decay(t_s, spec.tau_s as f64)),
+                (FeatureKind::PowerOnDecayStretch, _) => {
+                    Some(power_on_decay_stretch(t_s, spec.tau_s as f64))
+                }
                 (FeatureKind::AuxValue(_), _) => aux_v,
                 (FeatureKind::AuxRate(_), FeatureState::Rate(e)) => {
                     e.push(t_s, aux_v.unwrap_or(0.0)).map(|r| r.rate_per_s)

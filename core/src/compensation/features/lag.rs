@@ -43,3 +43,32 @@ impl FirstOrderLag {
 pub fn power_on_decay(t_s: f64, tau_s: f64) -> f64 {
     libm::exp(-t_s / tau_s)
 }
+
+/// (t / tau) exp(-t / tau): tau d/dtau of `power_on_decay`, the first-order change of the
+/// decay when its time constant stretches by a fraction (`FeatureKind::PowerOnDecayStretch`).
+pub fn power_on_decay_stretch(t_s: f64, tau_s: f64) -> f64 {
+    t_s / tau_s * libm::exp(-t_s / tau_s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_stretch_is_the_decays_change_with_its_time_constant() {
+        // tau d/dtau exp(-t / tau), by a central difference, at and around the time
+        // constant; zero at power-on and long after, largest (1/e) at t = tau
+        let tau = 300.0;
+        for t in [0.0, 30.0, 300.0, 900.0, 5000.0] {
+            let h = 1e-4 * tau;
+            let numeric =
+                tau * (power_on_decay(t, tau + h) - power_on_decay(t, tau - h)) / (2.0 * h);
+            let got = power_on_decay_stretch(t, tau);
+            assert!(
+                (got - numeric).abs() < 1e-9,
+                "t {t}: {got} against {numeric}"
+            );
+        }
+        assert!((power_on_decay_stretch(tau, tau) - libm::exp(-1.0)).abs() < 1e-15);
+    }
+}

@@ -37,6 +37,6 @@ pub use extractor::{
     features_for_series, span_for, FeatureExtractor, FeatureVector, DEFAULT_ACCEL_SPAN_S,
     DEFAULT_RATE_SPAN_S, EXTRACTOR_RATE_POINTS,
 };
-pub use lag::{power_on_decay, FirstOrderLag};
+pub use lag::{power_on_decay, power_on_decay_stretch, FirstOrderLag};
 pub use rate::{RateEstimate, TempRateEstimator};
 pub use window::{WindowAverager, WindowMean};

@@ -36,6 +36,13 @@ pub enum FeatureKind {
     /// first minutes' d2T/dt2 can only tell through its noise. Appended last: existing
     /// model files keep their meaning.
     TempRiseC,
+    /// (t / tau_s) exp(-t / tau_s), t = time since power-on: how `PowerOnDecay` changes when
+    /// its time constant stretches (tau d/dtau of exp(-t / tau)), so a model linear in it
+    /// carries a warm-up whose time constant differs by a few per cent from tau_s, e.g.
+    /// with the ambient through a temperature-dependent conductance, which no fixed
+    /// clock can (docs/record/fleet.md). Appended last: existing model files keep their
+    /// meaning.
+    PowerOnDecayStretch,
 }
 
 /// One model input: its kind and, for lags and decays, a time constant (s; 0 otherwise).
@@ -73,7 +80,10 @@ impl FeatureKind {
 
     /// True for kinds whose `tau_s` must be > 0 (lags and decays).
     pub const fn needs_time_constant(self) -> bool {
-        matches!(self, FeatureKind::TempLagC | FeatureKind::PowerOnDecay)
+        matches!(
+            self,
+            FeatureKind::TempLagC | FeatureKind::PowerOnDecay | FeatureKind::PowerOnDecayStretch
+        )
     }
 
     /// True for kinds that take the power-on to be a cold start from a soak: the clock
@@ -84,6 +94,7 @@ impl FeatureKind {
         matches!(
             self,
             FeatureKind::PowerOnDecay
+                | FeatureKind::PowerOnDecayStretch
                 | FeatureKind::TempRiseC
                 | FeatureKind::TempLagC
                 | FeatureKind::TempAccelFlatStartCps2

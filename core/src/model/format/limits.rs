@@ -5,13 +5,17 @@ use crate::model::error::ModelError;
 
 /// Most RBF centres a model may hold.
 pub const MAX_CENTERS: usize = 64;
-/// Most model inputs.
-pub const MAX_INPUTS: usize = 4;
+/// Most model inputs (format version 6; 4 before).
+pub const MAX_INPUTS: usize = 6;
+/// Most inputs that enter the Gaussians' distance (`n_rbf_inputs`): the width of a stored
+/// centre, 4 in every format version, so that the inputs after them (linear-only: a
+/// warm-up law's clocks) cost no centre storage.
+pub const MAX_RBF_INPUTS: usize = 4;
 /// Magic at the start of every encoded model: "FOGM".
 pub const MODEL_MAGIC: u32 = 0x4D47_4F46;
-/// Current format version (5: the cold-start envelope after the temperature-coupled
-/// linear terms).
-pub const MODEL_VERSION: u16 = 5;
+/// Current format version (6: up to `MAX_INPUTS` = 6 inputs and the warm-up clock's
+/// stretch `FeatureKind::PowerOnDecayStretch`, the wire layout of version 5).
+pub const MODEL_VERSION: u16 = 6;
 /// Oldest format version still decoded (1: no polynomial base).
 pub const MODEL_VERSION_OLDEST: u16 = 1;
 /// Highest power of the polynomial base in the first input.
@@ -36,7 +40,7 @@ pub const WIDTH_RANGE: (f32, f32) = (1.0e-3, 100.0);
 pub const MAX_HEADING_HARMONIC_DPH: f32 = 10.0;
 /// Largest 1-sigma of a stored heading harmonic coefficient, deg/h.
 pub const MAX_HEADING_SIGMA_DPH: f32 = 10.0;
-/// Largest encoded model, bytes (a 64-centre, 4-input model must fit).
+/// Largest encoded model, bytes (a 64-centre, 6-input model must fit).
 pub const MAX_ENCODED_LEN: usize = 2048;
 
 /// Most auxiliary (extra sensor) channels a model may refer to.
@@ -78,7 +82,7 @@ impl core::fmt::Display for ModelError {
             }
             ModelError::BadRbfInputCount { n_rbf_inputs, n_inputs } => write!(
                 f,
-                "model: n_rbf_inputs = {n_rbf_inputs} is invalid for {n_inputs} inputs"
+                "model: n_rbf_inputs = {n_rbf_inputs} is invalid for {n_inputs} inputs (at most {MAX_RBF_INPUTS} enter the Gaussians)"
             ),
             ModelError::LengthMismatch { field, expected, found } => write!(
                 f,

@@ -21,7 +21,10 @@
 //! `heading`: linear terms whose coefficients change with temperature (a Shupe coefficient
 //! k_S(T) = k_0 + k_1 T makes the drift k_0 dT/dt + k_1 T dT/dt; v1-v3 decode with none), 5
 //! appends `cold_start` after `linear_by_t`: the optional envelope of the training cold
-//! starts' temperature rise (`model::cold_start`; v1-v4 decode with none). Validation bounds every parameter's magnitude so that any model that decodes
+//! starts' temperature rise (`model::cold_start`; v1-v4 decode with none), 6 keeps 5's layout
+//! and allows up to six inputs (four of them at most in the Gaussians, so a centre stays
+//! four wide) and the warm-up clock's stretch as an input kind: a v6 file a v5 build
+//! refuses by its version, not as malformed. Validation bounds every parameter's magnitude so that any model that decodes
 //! gives a finite drift below `MAX_OUTPUT_DPH` at any finite input.
 //!
 //! One file a job, importing one way: `limits` (the format's constants and bounds, with the
@@ -40,6 +43,6 @@ pub use inputs::{FeatureKind, FeatureSpec, PAPER_INPUTS};
 pub use limits::{
     INPUT_SCALE_RANGE, MAX_ABS_CENTER, MAX_ABS_RAW_INPUT, MAX_AUX, MAX_CENTERS, MAX_ENCODED_LEN,
     MAX_HEADING_HARMONIC_DPH, MAX_HEADING_SIGMA_DPH, MAX_INPUTS, MAX_OUTPUT_DPH, MAX_POLY_DEGREE,
-    MODEL_MAGIC, MODEL_VERSION, MODEL_VERSION_OLDEST, WIDTH_RANGE, XN_CLAMP,
+    MAX_RBF_INPUTS, MODEL_MAGIC, MODEL_VERSION, MODEL_VERSION_OLDEST, WIDTH_RANGE, XN_CLAMP,
 };
 pub use model::{RbfModel, TrainingMeta};

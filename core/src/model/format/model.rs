@@ -2,7 +2,7 @@
 //! operations on it: an empty placeholder, an in-place copy, sizes and output bounds.
 
 use super::inputs::FeatureSpec;
-use super::limits::{MAX_CENTERS, MAX_INPUTS, MAX_POLY_DEGREE, XN_CLAMP};
+use super::limits::{MAX_CENTERS, MAX_INPUTS, MAX_POLY_DEGREE, MAX_RBF_INPUTS, XN_CLAMP};
 use crate::model::cold_start::ColdStartEnvelope;
 use crate::model::heading::HeadingHarmonic;
 use heapless::{String, Vec};
@@ -31,8 +31,8 @@ pub struct RbfModel {
     pub input_max: Vec<f32, MAX_INPUTS>,
     /// Linear terms on the normalised inputs, deg/h per unit (zeros for a pure RBF).
     pub linear: Vec<f32, MAX_INPUTS>,
-    /// Centres in normalised input space; each has `inputs.len()` used entries.
-    pub centers: Vec<[f32; MAX_INPUTS], MAX_CENTERS>,
+    /// Centres in normalised input space; each has `n_rbf_inputs` used entries.
+    pub centers: Vec<[f32; MAX_RBF_INPUTS], MAX_CENTERS>,
     /// Gaussian widths (sigma) in normalised space, > 0.
     pub widths: Vec<f32, MAX_CENTERS>,
     /// Output weights, deg/h.

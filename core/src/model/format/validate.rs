@@ -3,7 +3,7 @@
 
 use super::limits::{
     INPUT_SCALE_RANGE, MAX_ABS_CENTER, MAX_ABS_RAW_INPUT, MAX_AUX, MAX_HEADING_HARMONIC_DPH,
-    MAX_HEADING_SIGMA_DPH, MAX_OUTPUT_DPH, MAX_POLY_DEGREE, WIDTH_RANGE,
+    MAX_HEADING_SIGMA_DPH, MAX_OUTPUT_DPH, MAX_POLY_DEGREE, MAX_RBF_INPUTS, WIDTH_RANGE,
 };
 use super::model::RbfModel;
 use crate::model::error::{check_finite, check_len, ModelError, ModelField};
@@ -17,7 +17,7 @@ impl RbfModel {
             return Err(ModelError::NoInputs);
         }
         let nr = self.n_rbf_inputs as usize;
-        if nr > n || (nr == 0 && !self.centers.is_empty()) {
+        if nr > n || nr > MAX_RBF_INPUTS || (nr == 0 && !self.centers.is_empty()) {
             return Err(ModelError::BadRbfInputCount {
                 n_rbf_inputs: self.n_rbf_inputs,
                 n_inputs: n as u8,
@@ -159,11 +159,11 @@ impl RbfModel {
         {
             return out(ModelField::InputScale, i);
         }
-        let n = self.inputs.len();
+        let nr = self.n_rbf_inputs as usize;
         if let Some(i) = self
             .centers
             .iter()
-            .position(|c| c[..n].iter().any(|v| v.abs() > MAX_ABS_CENTER))
+            .position(|c| c.iter().take(nr).any(|v| v.abs() > MAX_ABS_CENTER))
         {
             return out(ModelField::Centers, i);
         }

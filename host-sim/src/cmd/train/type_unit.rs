@@ -134,7 +134,6 @@ pub(super) fn calibrate(
     let ty = TypeModel::read(type_path)?;
     let unit = unit_id_of(runs, &args.gyro_id)?;
     let plan = UnitPlan {
-        seek: args.seek_geometry(),
         terms: args.unit_terms,
     };
     let cal = calibrate_unit(&ty, runs, &unit, &plan)?;

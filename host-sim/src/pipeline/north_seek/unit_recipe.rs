@@ -272,7 +272,7 @@ pub fn recipe_model(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<RecipeMo
     recipe.check()?;
     match recipe.type_units {
         0 => type_free_model(recipe, plan),
-        _ => unit_model(recipe, learn_recipe_type(recipe, plan)?, plan),
+        _ => unit_model(recipe, learn_recipe_type(recipe, plan)?),
     }
 }
 
@@ -316,16 +316,9 @@ pub fn type_free_model(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<Recip
 
 /// The seeking unit calibrated from its own runs with `learnt` (the recipe's type, just
 /// learnt or kept from an earlier run with the same recipe) as the prior.
-pub fn unit_model(
-    recipe: &UnitRecipe,
-    learnt: RecipeType,
-    plan: &OwnModelPlan,
-) -> Result<RecipeModel> {
+pub fn unit_model(recipe: &UnitRecipe, learnt: RecipeType) -> Result<RecipeModel> {
     let (_, unit_params, own) = seeking_unit_runs(recipe)?;
-    let unit_plan = UnitPlan {
-        seek: plan.seek_geometry(),
-        terms: None,
-    };
+    let unit_plan = UnitPlan { terms: None };
     let ty = learnt.type_model;
     let cal = calibrate_unit(&ty, &own, &unit_id(SEEKING_UNIT), &unit_plan)?;
     let summary = format!("{}{}", learnt.summary, cal.summary());

@@ -28,6 +28,9 @@ pub fn feature_name(spec: &FeatureSpec) -> String {
         FeatureKind::PowerOnDecay => {
             feature_label("t_s", "decay", Some(f64::from(spec.tau_s))).to_string()
         }
+        FeatureKind::PowerOnDecayStretch => {
+            feature_label("t_s", "decay_stretch", Some(f64::from(spec.tau_s))).to_string()
+        }
         FeatureKind::AuxValue(n) => format!("aux{n}:value"),
         FeatureKind::AuxRate(n) => format!("aux{n}:rate"),
         FeatureKind::AuxCos(n) => format!("aux{n}:cos"),

@@ -5,7 +5,7 @@
 
 use crate::train::data::normalize::Normalizer;
 use crate::train::error::{Result, TrainError};
-use fog_core::model::format::{FeatureSpec, RbfModel, TrainingMeta, MAX_INPUTS};
+use fog_core::model::format::{FeatureSpec, RbfModel, TrainingMeta, MAX_RBF_INPUTS};
 
 /// What a forced (always-present) regressor is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -110,10 +110,11 @@ pub fn assemble(parts: &ModelParts<'_>) -> Result<RbfModel> {
         }
     }
     for (&k, &w) in parts.centers.iter().zip(&parts.theta[nf..]) {
-        let mut c = [0.0f32; MAX_INPUTS];
-        c[..d].copy_from_slice(&parts.points[k * d..(k + 1) * d]);
-        // Linear-only coordinates play no part in the distance; keep them at 0.
-        c[parts.n_rbf_inputs..].iter_mut().for_each(|v| *v = 0.0);
+        // Only the RBF inputs' coordinates are stored: linear-only ones play no part in
+        // the distance (config validation holds their count to `MAX_RBF_INPUTS`).
+        let mut c = [0.0f32; MAX_RBF_INPUTS];
+        let nr = parts.n_rbf_inputs.min(MAX_RBF_INPUTS);
+        c[..nr].copy_from_slice(&parts.points[k * d..k * d + nr]);
         model.centers.push(c).map_err(|_| capacity("centres"))?;
         model
             .widths

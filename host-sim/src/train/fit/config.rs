@@ -1,7 +1,7 @@
 //! Training options (`TrainConfig`) with the defaults `fogsim train` uses, and their checks.
 
 use crate::train::error::{Result, TrainError};
-use fog_core::model::format::MAX_CENTERS;
+use fog_core::model::format::{MAX_CENTERS, MAX_RBF_INPUTS};
 use serde::Serialize;
 
 /// Which forward-selection algorithm picks the centres.
@@ -154,6 +154,16 @@ impl TrainConfig {
                 format!(
                     "{} of {n_inputs} inputs: at least one RBF input is needed",
                     self.linear_only_inputs
+                ),
+            );
+        }
+        let n_rbf = n_inputs - self.linear_only_inputs;
+        if n_rbf > MAX_RBF_INPUTS {
+            return bad(
+                "linear-inputs",
+                format!(
+                    "{n_rbf} of {n_inputs} inputs in the Gaussians: at most {MAX_RBF_INPUTS} (make the last {} linear-only)",
+                    n_inputs - MAX_RBF_INPUTS
                 ),
             );
         }

@@ -10,13 +10,23 @@
 //! which the seeks cancel, taken out; `terms::Fit`).
 //!
 //! m and W are chosen together by leaving one of the unit's runs out at a time: every
-//! candidate is fitted on the other runs and scored on the held-out run by the seek score
-//! the trainer uses (`seek_score`: the azimuth error of back-to-back two-position seeks
-//! on the residual) over the first `SCORED_PAIRS` seeks from power-on, the seeks a cold
-//! start's targets judge (a score over a whole 45 min run is mostly settled seeks, and
-//! could not see a misfit of the first seek at -40 degC that the Monte Carlo measured at
-//! 4.6x the floor); then the fewest terms whose held-out mean square is within one
-//! standard error (over the held-out runs) of the best are kept. m = 0 is the type alone.
+//! candidate is fitted on the other runs and scored on the held-out run's drift residual
+//! over the first `SCORED_WINDOW_S` from power-on (the time of the six seeks a cold
+//! start's targets judge), less its own mean (a seek cancels a constant); then the fewest
+//! terms whose held-out mean square is within one standard error (over the held-out runs)
+//! of the best are kept. m = 0 is the type alone.
+//!
+//! Why the drift rows and not the seeks' azimuths: a score over a whole 45 min run is
+//! mostly settled seeks, and could not see a misfit of the first seek at -40 degC that
+//! the Monte Carlo measured at 4.6x the floor; the first six seeks' azimuths see it, but
+//! from a handful of runs too noisily to choose by: a bias of 0.5 of a seek's std raises
+//! one seek's mean square by a quarter, while a 6-run mean of seek 1 has a standard error
+//! of 0.41 std. Scored so, the unit step kept the type alone for units whose Shupe
+//! coefficient or dissipation differed from the type's, and their first seek stayed biased
+//! (fleets 58, 68, 78 at -40 degC: 0.95 / 0.33 / 0.51 std). The rows see the same misfit
+//! as about 170 residual rows a run instead of six azimuths (0.25 / 0.28 / 0.11 std), and
+//! over 240 cells of fleets never seen while it was built the rows score with the
+//! six-input law met 160 targets against 138 (docs/record/fleet.md).
 //!
 //! Before anything is fitted, the unit's own estimates (made as the type's units' were)
 //! are tested against the type (`misfit`): a unit outside its type is said, term by term,
@@ -31,13 +41,14 @@ use super::terms::fold;
 use super::type_model::TypeModel;
 use crate::io::runs::Run;
 use crate::train::dataset_from_runs;
-use crate::train::seek_score::{seek_azimuth_first_pairs_per_run, SeekGeometry};
 use fog_core::model::format::RbfModel;
 
 /// Fewest runs of a unit: one is held out, one fits.
 pub const MIN_UNIT_RUNS: usize = 2;
-/// Seeks from power-on the held-out score counts: the six of the north-seek targets.
-pub const SCORED_PAIRS: usize = 6;
+/// Time from power-on the held-out score covers, s: the six seeks of the north-seek targets
+/// at about 280 s each (the forward and symmetric two-position seeks of `north-seek`,
+/// measured 269 s and 279 s).
+pub const SCORED_WINDOW_S: f64 = 1_700.0;
 /// Prior weights tried, in runs (0: the unit's own least squares).
 pub const PRIOR_WEIGHTS: [f64; 10] = [0.0, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0, 1000.0];
 
@@ -53,7 +64,6 @@ pub enum MisfitPolicy {
 /// How the unit is calibrated.
 #[derive(Clone, Copy, Debug)]
 pub struct UnitPlan {
-    pub seek: SeekGeometry,
     /// Fix the number of unit terms (None: chosen by leave-one-run-out).
     pub terms: Option<usize>,
 }
@@ -63,9 +73,10 @@ pub struct UnitPlan {
 pub struct UnitCandidate {
     pub terms: usize,
     pub prior_weight: f64,
-    /// Held-out seek azimuth rms, deg (the first `SCORED_PAIRS` pairs of every held-out run).
-    pub heldout_seek_deg: f64,
-    /// Per held-out run: mean square of its seek azimuth errors, deg^2.
+    /// Held-out rms of the drift residual over every held-out run's first
+    /// `SCORED_WINDOW_S`, each run's own mean taken out, deg/h.
+    pub heldout_drift_dph: f64,
+    /// Per held-out run: its mean square, (deg/h)^2.
     #[serde(skip)]
     pub per_run: Vec<f64>,
 }
@@ -82,9 +93,10 @@ pub struct UnitCalibration {
     pub prior_weight: f64,
     /// Every term's coefficient (fitted or the type's mean), model units.
     pub coefficients: Vec<f64>,
-    /// Held-out seek rms of the type alone and of the chosen calibration, deg.
-    pub type_alone_seek_deg: f64,
-    pub chosen_seek_deg: f64,
+    /// Held-out drift rms (`UnitCandidate::heldout_drift_dph`) of the type alone and of
+    /// the chosen calibration, deg/h.
+    pub type_alone_drift_dph: f64,
+    pub chosen_drift_dph: f64,
     pub candidates: Vec<UnitCandidate>,
     pub misfit: Misfit,
     #[serde(skip)]
@@ -104,8 +116,8 @@ impl UnitCalibration {
             self.term_names[..self.terms].join(", ")
         };
         s += &format!(
-            "unit {} calibrated on {} runs against type {}: unit terms fitted: {fitted}; prior weight {} runs; held-out seek rms {:.4} deg ({:.4} with the type alone), chosen by leave-one-run-out\n",
-            self.unit_id, self.runs, self.type_id, self.prior_weight, self.chosen_seek_deg, self.type_alone_seek_deg
+            "unit {} calibrated on {} runs against type {}: unit terms fitted: {fitted}; prior weight {} runs; held-out drift rms {:.4} deg/h over the first {:.0} s ({:.4} with the type alone), chosen by leave-one-run-out\n",
+            self.unit_id, self.runs, self.type_id, self.prior_weight, self.chosen_drift_dph, SCORED_WINDOW_S, self.type_alone_drift_dph
         );
         s
     }
@@ -215,7 +227,7 @@ pub fn calibrate_unit(
             &PRIOR_WEIGHTS
         };
         for &w in weights {
-            if let Some(c) = held_out(&rows, &kept, prior, w, plan.seek) {
+            if let Some(c) = held_out(&rows, &kept, prior, w) {
                 candidates.push(UnitCandidate {
                     terms: m,
                     prior_weight: w,
@@ -227,7 +239,7 @@ pub fn calibrate_unit(
     let type_alone = candidates
         .iter()
         .find(|c| c.terms == 0)
-        .map_or(f64::NAN, |c| c.heldout_seek_deg);
+        .map_or(f64::NAN, |c| c.heldout_drift_dph);
     let chosen = choose(&candidates).ok_or_else(|| {
         anyhow!("unit {unit_id}: no unit calibration could be scored on held-out runs")
     })?;
@@ -246,8 +258,8 @@ pub fn calibrate_unit(
         term_names: ordered,
         prior_weight: chosen.prior_weight,
         coefficients: coef,
-        type_alone_seek_deg: type_alone,
-        chosen_seek_deg: chosen.heldout_seek_deg,
+        type_alone_drift_dph: type_alone,
+        chosen_drift_dph: chosen.heldout_drift_dph,
         candidates,
         misfit,
         model: folded,
@@ -255,15 +267,9 @@ pub fn calibrate_unit(
 }
 
 /// Leave-one-run-out score of fitting `kept` with prior weight `w` (infinite: the prior's mean).
-fn held_out(
-    rows: &UnitRows,
-    kept: &[usize],
-    prior: Prior,
-    w: f64,
-    seek: SeekGeometry,
-) -> Option<UnitCandidate> {
+fn held_out(rows: &UnitRows, kept: &[usize], prior: Prior, w: f64) -> Option<UnitCandidate> {
     let mut per_run = Vec::with_capacity(rows.runs);
-    let (mut ss, mut pairs) = (0.0, 0usize);
+    let (mut ss, mut rows_scored) = (0.0, 0usize);
     for r in 0..rows.runs {
         let coef = if w.is_infinite() {
             prior.mean.to_vec()
@@ -272,27 +278,30 @@ fn held_out(
         };
         let range = rows.rows_of(r);
         let res = rows.corrected(range.clone(), &coef);
-        let groups = vec![0u32; res.len()];
-        let run =
-            seek_azimuth_first_pairs_per_run(&res, &groups, &rows.t_s[range], seek, SCORED_PAIRS);
-        let (s, n) = run
+        let early: Vec<f64> = res
             .iter()
-            .fold((0.0, 0), |(s, n), x| (s + x.sum_sq_deg2, n + x.pairs));
+            .zip(&rows.t_s[range])
+            .filter(|(_, &t)| t <= SCORED_WINDOW_S)
+            .map(|(v, _)| *v)
+            .collect();
+        let n = early.len();
+        let mean = early.iter().sum::<f64>() / n.max(1) as f64;
+        let s: f64 = early.iter().map(|v| (v - mean).powi(2)).sum();
         if n > 0 {
             per_run.push(s / n as f64);
         } else {
             per_run.push(f64::NAN);
         }
         ss += s;
-        pairs += n;
+        rows_scored += n;
     }
-    if pairs == 0 {
+    if rows_scored == 0 {
         return None;
     }
     Some(UnitCandidate {
         terms: kept.len(),
         prior_weight: w,
-        heldout_seek_deg: (ss / pairs as f64).sqrt(),
+        heldout_drift_dph: (ss / rows_scored as f64).sqrt(),
         per_run,
     })
 }
@@ -302,7 +311,7 @@ fn held_out(
 fn choose(cands: &[UnitCandidate]) -> Option<UnitCandidate> {
     let best = cands
         .iter()
-        .min_by(|a, b| a.heldout_seek_deg.total_cmp(&b.heldout_seek_deg))?;
+        .min_by(|a, b| a.heldout_drift_dph.total_cmp(&b.heldout_drift_dph))?;
     let mut counts: Vec<usize> = cands.iter().map(|c| c.terms).collect();
     counts.sort_unstable();
     counts.dedup();
@@ -310,7 +319,7 @@ fn choose(cands: &[UnitCandidate]) -> Option<UnitCandidate> {
         let Some(c) = cands
             .iter()
             .filter(|c| c.terms == m)
-            .min_by(|a, b| a.heldout_seek_deg.total_cmp(&b.heldout_seek_deg))
+            .min_by(|a, b| a.heldout_drift_dph.total_cmp(&b.heldout_drift_dph))
         else {
             continue;
         };

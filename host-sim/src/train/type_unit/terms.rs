@@ -94,6 +94,9 @@ pub fn term_name(model: &RbfModel, term: UnitTerm) -> String {
             Some(FeatureKind::PowerOnDecay) => {
                 format!("warm-up clock amplitude ({:.0} s)", model.inputs[j].tau_s)
             }
+            Some(FeatureKind::PowerOnDecayStretch) => {
+                format!("warm-up clock stretch ({:.0} s)", model.inputs[j].tau_s)
+            }
             Some(FeatureKind::TempLagC) => "lagged-temperature coefficient".into(),
             _ => format!("input {j} coefficient"),
         },
