@@ -218,24 +218,7 @@ pub fn calibrate_unit(
         Some(m) => vec![m],
         None => (0..=most).collect(),
     };
-    let mut candidates = Vec::new();
-    for &m in &counts {
-        let kept: Vec<usize> = ty.file.order[..m].to_vec();
-        let weights: &[f64] = if m == 0 {
-            &[f64::INFINITY]
-        } else {
-            &PRIOR_WEIGHTS
-        };
-        for &w in weights {
-            if let Some(c) = held_out(&rows, &kept, prior, w) {
-                candidates.push(UnitCandidate {
-                    terms: m,
-                    prior_weight: w,
-                    ..c
-                });
-            }
-        }
-    }
+    let candidates = scan(&rows, &ty.file.order, &counts, prior);
     let type_alone = candidates
         .iter()
         .find(|c| c.terms == 0)
@@ -264,6 +247,30 @@ pub fn calibrate_unit(
         misfit,
         model: folded,
     })
+}
+
+/// Every candidate: the first m terms of `order` for each m of `counts`, at every prior
+/// weight (the type alone, m = 0, at the prior's mean), each scored by `held_out`.
+fn scan(rows: &UnitRows, order: &[usize], counts: &[usize], prior: Prior) -> Vec<UnitCandidate> {
+    let mut candidates = Vec::new();
+    for &m in counts {
+        let kept = &order[..m];
+        let weights: &[f64] = if m == 0 {
+            &[f64::INFINITY]
+        } else {
+            &PRIOR_WEIGHTS
+        };
+        for &w in weights {
+            if let Some(c) = held_out(rows, kept, prior, w) {
+                candidates.push(UnitCandidate {
+                    terms: m,
+                    prior_weight: w,
+                    ..c
+                });
+            }
+        }
+    }
+    candidates
 }
 
 /// Leave-one-run-out score of fitting `kept` with prior weight `w` (infinite: the prior's mean).
@@ -341,4 +348,77 @@ fn choose(cands: &[UnitCandidate]) -> Option<UnitCandidate> {
         }
     }
     Some(best.clone())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Six runs of 45 min in 10 s rows, read within runs (each run's mean taken out of the
+    /// residual and of the column, as `UnitRows::new` does): residual = `effect` x the
+    /// warm-up column (the one unit term, exp(-t / 300 s)) + each run's own constant
+    /// (turn-on biases of -0.6 .. 0.9 deg/h) + a deterministic 0.002 deg/h ripple + `late` x
+    /// (t - 1,700 s) / 1,000 s after the scored window.
+    fn rows(effect: f64, late: f64) -> UnitRows {
+        let (mut residual, mut column, mut run, mut t_s) = (vec![], vec![], vec![], vec![]);
+        let less_mean = |v: &mut [f64]| {
+            let m = v.iter().sum::<f64>() / v.len() as f64;
+            v.iter_mut().for_each(|x| *x -= m);
+        };
+        for (r, turn_on) in [0.5, -0.6, 0.9, 0.1, -0.3, 0.2].into_iter().enumerate() {
+            let t: Vec<f64> = (0..270).map(|i| 10.0 * i as f64).collect();
+            let mut c: Vec<f64> = t.iter().map(|t| (-t / 300.0).exp()).collect();
+            let mut y: Vec<f64> = t
+                .iter()
+                .zip(&c)
+                .enumerate()
+                .map(|(i, (t, c))| {
+                    let ripple = 0.002 * (0.37 * i as f64 + r as f64).sin();
+                    let after = late * ((t - SCORED_WINDOW_S) / 1000.0).max(0.0);
+                    effect * c + turn_on + ripple + after
+                })
+                .collect();
+            less_mean(&mut c);
+            less_mean(&mut y);
+            residual.extend(y);
+            column.extend(c);
+            run.extend([r; 270]);
+            t_s.extend(t);
+        }
+        UnitRows::from_parts(residual, vec![column], run, t_s)
+    }
+
+    fn chosen(rows: &UnitRows) -> (UnitCandidate, f64) {
+        let prior = Prior {
+            mean: &[0.0],
+            spread: &[0.01],
+        };
+        let cands = scan(rows, &[0], &[0, 1], prior);
+        let alone = cands
+            .iter()
+            .find(|c| c.terms == 0)
+            .unwrap()
+            .heldout_drift_dph;
+        (choose(&cands).unwrap(), alone)
+    }
+
+    #[test]
+    fn the_score_sees_the_first_seeks_drift_not_the_runs_constants_nor_later_rows() {
+        // effect: the unit's own warm-up amplitude, 10x the ripple: fitted, and the score
+        // falls to the ripple's rms (0.0014 deg/h), from 0.0051 with the type alone
+        let ripple_dph = 0.002 / 2f64.sqrt();
+        let (c, alone) = chosen(&rows(0.02, 0.0));
+        assert_eq!(c.terms, 1, "{c:?}");
+        assert!((c.heldout_drift_dph - ripple_dph).abs() < 1e-4, "{c:?}");
+        assert!(alone > 3.0 * ripple_dph, "{alone}");
+        // twin: a drift after the six seeks' time, which moves the run's mean and so every
+        // scored row by a constant (a seek cancels it), is not scored: the type alone, its
+        // score the ripple's with or without the late drift
+        let (c, alone) = chosen(&rows(0.0, 0.05));
+        assert_eq!(c.terms, 0, "{c:?}");
+        assert!((alone - ripple_dph).abs() < 1e-4, "{alone}");
+        assert!((alone - chosen(&rows(0.0, 0.0)).1).abs() < 1e-12);
+        // null: nothing to fit, the type alone
+        assert_eq!(chosen(&rows(0.0, 0.0)).0.terms, 0);
+    }
 }

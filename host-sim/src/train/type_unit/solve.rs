@@ -97,6 +97,32 @@ impl UnitRows {
         self.unseen[k]
     }
 
+    /// Rows from their parts (tests): the residual, each term's column, each row's run
+    /// (0..runs, consecutive) and time.
+    #[cfg(test)]
+    pub(crate) fn from_parts(
+        residual: Vec<f64>,
+        columns: Vec<Vec<f64>>,
+        run: Vec<usize>,
+        t_s: Vec<f64>,
+    ) -> Self {
+        let residual_ms =
+            residual.iter().map(|r| r * r).sum::<f64>() / residual.len().max(1) as f64;
+        let unseen = columns
+            .iter()
+            .map(|c| c.iter().all(|v| v.abs() < UNSEEN_ABS))
+            .collect();
+        UnitRows {
+            runs: run.last().map_or(0, |r| r + 1),
+            residual,
+            columns,
+            run,
+            t_s,
+            residual_ms,
+            unseen,
+        }
+    }
+
     /// Rows of run `r` (consecutive).
     pub fn rows_of(&self, r: usize) -> std::ops::Range<usize> {
         let start = self.run.partition_point(|&x| x < r);
