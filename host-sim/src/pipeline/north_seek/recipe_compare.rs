@@ -257,7 +257,7 @@ pub fn recipe_table(c: &RecipeComparison) -> String {
     }
     format!(
         "production recipe: unit U1 of a simulated fleet, {} cold starts x {} seeks at {} degC ({}type {}):\n{}\
-         ({} starts: a |mean|/std is known to about +-{:.2}, so a verdict near a target is not decided here; 1,000-start figures over twenty fleets: docs/record/fleet.md)\n",
+         ({} starts: a |mean|/std is known to about +-{:.2}, so a verdict near a target is not decided here; 1,000-start figures over eighty fleets: docs/record/fleet.md)\n",
         c.starts,
         c.seeks_per_start,
         c.ambient_c,
