@@ -179,10 +179,7 @@ impl Walk {
 
     /// The page's line as `sh` runs it: ports moved, `cargo fw-run` as its runner script.
     fn shell_line(&self, line: &str) -> String {
-        let mut line = line.to_string();
-        for (doc, free) in &self.ports {
-            line = line.replace(&format!("127.0.0.1:{doc}"), &format!("127.0.0.1:{free}"));
-        }
+        let line = move_ports(line, &self.ports);
         if let Some(rest) = line.strip_prefix("cargo fw-run") {
             let args = rest.trim_start().strip_prefix("--").unwrap_or(rest);
             let script = workspace_root().join("scripts/fw-qemu.sh");
@@ -302,4 +299,39 @@ impl Walk {
 fn tail(log: &Path) -> String {
     let bytes = std::fs::read(log).unwrap_or_default();
     String::from_utf8_lossy(&bytes[bytes.len().saturating_sub(4000)..]).into_owned()
+}
+
+/// `line` with every `127.0.0.1:PORT` whose whole port number is one of `ports`' first
+/// elements moved to its second, in one pass: a moved port is never read again (one
+/// substitution after another turned 4445 -> 44479 into 44253 + "9" when 4447's free port
+/// was 44253).
+fn move_ports(line: &str, ports: &[(&str, String)]) -> String {
+    const HOST: &str = "127.0.0.1:";
+    let mut out = String::with_capacity(line.len());
+    let mut rest = line;
+    while let Some(at) = rest.find(HOST) {
+        let (before, after) = rest.split_at(at + HOST.len());
+        out.push_str(before);
+        let digits = after.len() - after.trim_start_matches(|c: char| c.is_ascii_digit()).len();
+        let (port, tail) = after.split_at(digits);
+        match ports.iter().find(|(doc, _)| *doc == port) {
+            Some((_, free)) => out.push_str(free),
+            None => out.push_str(port),
+        }
+        rest = tail;
+    }
+    out.push_str(rest);
+    out
+}
+
+#[test]
+fn a_moved_port_is_not_moved_again() {
+    let ports = [("4445", "44479".to_string()), ("4447", "44253".to_string())];
+    assert_eq!(
+        move_ports(
+            "--gyro-port tcp:127.0.0.1:4445 --incl tcp:127.0.0.1:4447 x:127.0.0.1:44451",
+            &ports
+        ),
+        "--gyro-port tcp:127.0.0.1:44479 --incl tcp:127.0.0.1:44253 x:127.0.0.1:44451"
+    );
 }
