@@ -74,9 +74,7 @@ fn check_spec(spec: &FeatureSpec) -> Result<(), FeatureError> {
         | FeatureKind::TempAccelCps2
         | FeatureKind::TempAccelFlatStartCps2
         | FeatureKind::AuxRate(_) => positive_time_constant(span_for(spec))?,
-        FeatureKind::TempLagC | FeatureKind::PowerOnDecay | FeatureKind::PowerOnDecayStretch => {
-            positive_time_constant(spec.tau_s as f64)?
-        }
+        kind if kind.needs_time_constant() => positive_time_constant(spec.tau_s as f64)?,
         _ => {}
     }
     if let Some(ch) = spec.kind.aux_channel() {

@@ -209,8 +209,9 @@ pub fn choose_clocks(runs: &[Run], seek: SeekGeometry) -> Result<([f64; 2], f64)
     let mut best: Option<([f64; 2], f64)> = None;
     for &fast in &FAST_TAUS_S {
         for &slow in SLOW_TAUS_S.iter().filter(|&&s| s >= MIN_CLOCK_RATIO * fast) {
-            let ds =
-                dataset_from_runs(runs, &law_inputs([fast, slow])).map_err(|e| anyhow!("{e}"))?;
+            // T and the two clocks: the stretches are not in the choice (`LAW_TERMS`)
+            let ds = dataset_from_runs(runs, &law_inputs([fast, slow])[..3])
+                .map_err(|e| anyhow!("{e}"))?;
             let norm = Normalizer::fit(&ds).map_err(|e| anyhow!("{e}"))?;
             let fold_of_row = |i: usize| folds_of_run[ds.groups[i] as usize];
             let (mut ss, mut n) = (0.0, 0);
