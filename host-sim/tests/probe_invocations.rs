@@ -148,6 +148,7 @@ const NUMBER_FLAGS: &[&str] = &[
     "--seed",
     "--seek-dwell-s",
     "--seek-latitude-deg",
+    "--seek-period-s",
     "--seeks",
     "--sigma-dph",
     "--speed",

@@ -351,7 +351,7 @@ fn calibrated(law: FleetLaw, seed: u64, unit: usize) -> (TypeModel, UnitCalibrat
         &mut train_shared,
     )
     .unwrap();
-    let plan = UnitPlan { terms: None };
+    let plan = UnitPlan::chosen();
     let cal = calibrate_unit(&ty, &own, &id, &plan).unwrap();
     (ty, cal)
 }

@@ -160,6 +160,11 @@ pub struct Args {
     /// leave-one-run-out, at most one per run].
     #[arg(long = "unit-terms")]
     pub unit_terms: Option<usize>,
+    /// With `--type`: time from one of the device's seeks to the next, s: the unit terms
+    /// are chosen on the held-out drift in the first six seeks' windows [default: 280,
+    /// `north-seek`'s seeks].
+    #[arg(long = "seek-period-s")]
+    pub seek_period_s: Option<f64>,
 }
 
 fn parse_width_search(s: &str) -> Result<WidthSearch, String> {
@@ -226,6 +231,14 @@ impl Args {
                 "--seek-dwell-s {}: must be a positive number of seconds",
                 self.seek_dwell
             );
+        }
+        if let Some(p) = self.seek_period_s {
+            use crate::train::type_unit::calibrate::{MAX_SEEK_PERIOD_S, MIN_SEEK_PERIOD_S};
+            if !(p.is_finite() && (MIN_SEEK_PERIOD_S..=MAX_SEEK_PERIOD_S).contains(&p)) {
+                anyhow::bail!(
+                    "--seek-period-s {p}: must be within {MIN_SEEK_PERIOD_S}..={MAX_SEEK_PERIOD_S} s"
+                );
+            }
         }
         if self.seek_latitude.is_nan() || self.seek_latitude.abs() >= 85.0 {
             anyhow::bail!(

@@ -15,6 +15,7 @@ use crate::io::runs::Run;
 use crate::io::StagedFiles;
 use crate::registry::{Registry, UnitCalibrationRecord};
 use crate::train::cold_start::envelope_for;
+use crate::train::type_unit::calibrate::DEFAULT_SEEK_PERIOD_S;
 use crate::train::type_unit::law::fit_law_network;
 use crate::train::type_unit::type_model::learn_type;
 use crate::train::type_unit::{
@@ -135,6 +136,7 @@ pub(super) fn calibrate(
     let unit = unit_id_of(runs, &args.gyro_id)?;
     let plan = UnitPlan {
         terms: args.unit_terms,
+        seek_period_s: args.seek_period_s.unwrap_or(DEFAULT_SEEK_PERIOD_S),
     };
     let cal = calibrate_unit(&ty, runs, &unit, &plan)?;
     print!("{}", cal.summary());

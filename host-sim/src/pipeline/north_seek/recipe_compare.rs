@@ -109,7 +109,7 @@ pub fn compare_recipes(cfg: &MonteCarloConfig, keep_dir: &Path) -> Result<Recipe
             (t, false)
         }
     };
-    let with_type = unit_model(&recipe, learnt)?;
+    let with_type = unit_model(&recipe, learnt, &plan)?;
     let free = type_free_model(&recipe, &plan)?;
     let chamber = UnitRecipe {
         type_units: 0,

@@ -14,10 +14,13 @@ use anyhow::{anyhow, Result};
 use fog_core::model::format::RbfModel;
 
 use super::own_model::{own_model_from_runs, OwnModelPlan};
+use super::schedule::seek_schedule;
+use super::MonteCarloConfig;
 use crate::io::runs::Run;
 use crate::pipeline::campaign::{CampaignSpec, PAPER_MINUTES};
 use crate::pipeline::fleet::{fleet_runs, unit_id, FleetType};
 use crate::sim::{GyroParams, TypeSpread};
+use crate::train::type_unit::calibrate::DEFAULT_SEEK_PERIOD_S;
 use crate::train::type_unit::law::fit_law_network;
 use crate::train::type_unit::terms::Fit;
 use crate::train::type_unit::type_model::learn_type;
@@ -272,7 +275,7 @@ pub fn recipe_model(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<RecipeMo
     recipe.check()?;
     match recipe.type_units {
         0 => type_free_model(recipe, plan),
-        _ => unit_model(recipe, learn_recipe_type(recipe, plan)?),
+        _ => unit_model(recipe, learn_recipe_type(recipe, plan)?, plan),
     }
 }
 
@@ -289,6 +292,22 @@ fn seeking_unit_runs(recipe: &UnitRecipe) -> Result<(FleetType, GyroParams, Vec<
         recipe.seed,
     )?;
     Ok((fleet, unit_params, own))
+}
+
+/// Time from one of `plan`'s seeks to the next, s: measured on the seek schedule of its
+/// seek timing (the finder's own state machine on the unit), else the calibration's
+/// default (`DEFAULT_SEEK_PERIOD_S`).
+fn seek_period_s(unit_params: &GyroParams, plan: &OwnModelPlan) -> Result<f64> {
+    Ok(match &plan.seek_timing {
+        Some(seeks) => {
+            let at_ambient = MonteCarloConfig {
+                ambient_c: plan.ambient_c,
+                ..seeks.clone()
+            };
+            seek_schedule(unit_params, &at_ambient, None)?.period_s
+        }
+        None => DEFAULT_SEEK_PERIOD_S,
+    })
 }
 
 /// The type-free recipe: the seeking unit's own runs alone, by the own-model recipe.
@@ -315,10 +334,18 @@ pub fn type_free_model(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<Recip
 }
 
 /// The seeking unit calibrated from its own runs with `learnt` (the recipe's type, just
-/// learnt or kept from an earlier run with the same recipe) as the prior.
-pub fn unit_model(recipe: &UnitRecipe, learnt: RecipeType) -> Result<RecipeModel> {
+/// learnt or kept from an earlier run with the same recipe) as the prior, its held-out
+/// score cut by the period of `plan`'s seeks.
+pub fn unit_model(
+    recipe: &UnitRecipe,
+    learnt: RecipeType,
+    plan: &OwnModelPlan,
+) -> Result<RecipeModel> {
     let (_, unit_params, own) = seeking_unit_runs(recipe)?;
-    let unit_plan = UnitPlan { terms: None };
+    let unit_plan = UnitPlan {
+        terms: None,
+        seek_period_s: seek_period_s(&unit_params, plan)?,
+    };
     let ty = learnt.type_model;
     let cal = calibrate_unit(&ty, &own, &unit_id(SEEKING_UNIT), &unit_plan)?;
     let summary = format!("{}{}", learnt.summary, cal.summary());

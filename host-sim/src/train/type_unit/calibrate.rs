@@ -11,24 +11,24 @@
 //!
 //! m and W are chosen together by leaving one of the unit's runs out at a time: every
 //! candidate is fitted on the other runs and scored on the held-out run's drift residual
-//! over the first `SCORED_WINDOW_S` from power-on (the time of the six seeks a cold
-//! start's targets judge), less its own mean (a seek cancels a constant); then the fewest
-//! terms whose held-out mean square is within one standard error (over the held-out runs)
-//! of the best are kept. m = 0 is the type alone.
+//! in the windows of the first `SCORED_SEEKS` seeks after power-on (one seek period each,
+//! `UnitPlan::seek_period_s`), each window less its own straight line: what a
+//! time-symmetric seek cancels (a constant and a drift linear over the seek), so what is
+//! left is what turns into azimuth error. A run's score is the mean of its windows' mean
+//! squares; then the fewest terms whose held-out score is within one standard error (over
+//! the held-out runs) of the best are kept. m = 0 is the type alone.
 //!
 //! Why the drift rows and not the seeks' azimuths: a score over a whole 45 min run is
 //! mostly settled seeks, and could not see a misfit of the first seek at -40 degC that
 //! the Monte Carlo measured at 4.6x the floor; the first six seeks' azimuths see it, but
 //! from a handful of runs too noisily to choose by: a bias of 0.5 of a seek's std raises
 //! one seek's mean square by a quarter, while a 6-run mean of seek 1 has a standard error
-//! of 0.41 std. Scored so, the unit step kept the type alone for units whose Shupe
-//! coefficient or dissipation differed from the type's, and their first seek stayed biased
-//! (fleets 58, 68, 78 at -40 degC, only the Shupe group spread: 0.95 / 0.33 / 0.51 std).
-//! The rows see the same misfit as about 170 residual rows a run instead of six azimuths
-//! (0.25 / 0.28 / 0.11 std with the law's clocks chosen with their stretches, 0.06 / 0.51 /
-//! 0.51 as they are chosen now); over 80 simulated fleets x 3 ambients the six-input law
-//! with this score met every target in 147 cells of 240, against 138 before
-//! (docs/record/fleet.md).
+//! of 0.41 std. The rows see the same misfit as about 170 residual rows a run instead of
+//! six azimuths. Why each window less its line, not the whole span less its mean: the
+//! span's mean leaves the warm-up's slope within each seek in the score, which the
+//! symmetric seek cancels, so the score chose terms for a slope the seek never sees and
+//! missed the curvature it does (docs/record/fleet.md: over 120 simulated fleets x 3
+//! ambients the windows met every target in more cells than the span).
 //!
 //! Before anything is fitted, the unit's own estimates (made as the type's units' were)
 //! are tested against the type (`misfit`): a unit outside its type is said, term by term,
@@ -47,10 +47,19 @@ use fog_core::model::format::RbfModel;
 
 /// Fewest runs of a unit: one is held out, one fits.
 pub const MIN_UNIT_RUNS: usize = 2;
-/// Time from power-on the held-out score covers, s: the six seeks of the north-seek targets
-/// at about 280 s each (the forward and symmetric two-position seeks of `north-seek`,
-/// measured 269 s and 279 s).
-pub const SCORED_WINDOW_S: f64 = 1_700.0;
+/// Seeks after power-on the held-out score covers: the six the north-seek targets judge
+/// one by one (`pipeline::north_seek::targets`; a 45 min run holds about nine).
+pub const SCORED_SEEKS: usize = 6;
+/// Time of one seek, s, when the caller does not know its own (`fogsim train --type`
+/// without `--seek-period-s`): `north-seek`'s default seeks, measured 269 s (forward) and
+/// 279 s (time-symmetric).
+pub const DEFAULT_SEEK_PERIOD_S: f64 = 280.0;
+/// Range of `UnitPlan::seek_period_s`, s: at least three 10 s rows a window, and the
+/// first `SCORED_SEEKS` within a 45 min run.
+pub const MIN_SEEK_PERIOD_S: f64 = 30.0;
+pub const MAX_SEEK_PERIOD_S: f64 = 450.0;
+/// Fewest rows in a seek's window for it to be scored (a line takes two).
+const MIN_WINDOW_ROWS: usize = 3;
 /// Prior weights tried, in runs (0: the unit's own least squares).
 pub const PRIOR_WEIGHTS: [f64; 10] = [0.0, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0, 1000.0];
 
@@ -68,6 +77,18 @@ pub enum MisfitPolicy {
 pub struct UnitPlan {
     /// Fix the number of unit terms (None: chosen by leave-one-run-out).
     pub terms: Option<usize>,
+    /// Time from one seek's start to the next's, s: the windows the held-out score reads.
+    pub seek_period_s: f64,
+}
+
+impl UnitPlan {
+    /// The number of terms chosen, for seeks of `DEFAULT_SEEK_PERIOD_S`.
+    pub fn chosen() -> Self {
+        UnitPlan {
+            terms: None,
+            seek_period_s: DEFAULT_SEEK_PERIOD_S,
+        }
+    }
 }
 
 /// One candidate's held-out score.
@@ -75,10 +96,10 @@ pub struct UnitPlan {
 pub struct UnitCandidate {
     pub terms: usize,
     pub prior_weight: f64,
-    /// Held-out rms of the drift residual over every held-out run's first
-    /// `SCORED_WINDOW_S`, each run's own mean taken out, deg/h.
+    /// Held-out rms of the drift residual in the first `SCORED_SEEKS` seeks' windows,
+    /// each window less its own straight line, every held-out run weighed alike, deg/h.
     pub heldout_drift_dph: f64,
-    /// Per held-out run: its mean square, (deg/h)^2.
+    /// Per held-out run: the mean of its windows' mean squares, (deg/h)^2.
     #[serde(skip)]
     pub per_run: Vec<f64>,
 }
@@ -99,6 +120,8 @@ pub struct UnitCalibration {
     /// the chosen calibration, deg/h.
     pub type_alone_drift_dph: f64,
     pub chosen_drift_dph: f64,
+    /// The seek period the score's windows were cut by, s (`UnitPlan::seek_period_s`).
+    pub seek_period_s: f64,
     pub candidates: Vec<UnitCandidate>,
     pub misfit: Misfit,
     #[serde(skip)]
@@ -118,8 +141,8 @@ impl UnitCalibration {
             self.term_names[..self.terms].join(", ")
         };
         s += &format!(
-            "unit {} calibrated on {} runs against type {}: unit terms fitted: {fitted}; prior weight {} runs; held-out drift rms {:.4} deg/h over the first {:.0} s ({:.4} with the type alone), chosen by leave-one-run-out\n",
-            self.unit_id, self.runs, self.type_id, self.prior_weight, self.chosen_drift_dph, SCORED_WINDOW_S, self.type_alone_drift_dph
+            "unit {} calibrated on {} runs against type {}: unit terms fitted: {fitted}; prior weight {} runs; held-out drift rms {:.4} deg/h in the first {SCORED_SEEKS} seeks of {:.0} s, each less its line ({:.4} with the type alone), chosen by leave-one-run-out\n",
+            self.unit_id, self.runs, self.type_id, self.prior_weight, self.chosen_drift_dph, self.seek_period_s, self.type_alone_drift_dph
         );
         s
     }
@@ -168,6 +191,14 @@ pub fn check_unit_runs(ty: &TypeModel, runs: &[Run], unit_id: &str, plan: &UnitP
         bail!(
             "unit {unit_id}: {} run(s); a unit calibration needs at least {MIN_UNIT_RUNS} (one is held out to choose the prior's weight)",
             runs.len()
+        );
+    }
+    if !(plan.seek_period_s.is_finite()
+        && (MIN_SEEK_PERIOD_S..=MAX_SEEK_PERIOD_S).contains(&plan.seek_period_s))
+    {
+        bail!(
+            "--seek-period-s {}: a seek's period must be within {MIN_SEEK_PERIOD_S}..={MAX_SEEK_PERIOD_S} s",
+            plan.seek_period_s
         );
     }
     let p = ty.file.terms.len();
@@ -220,7 +251,7 @@ pub fn calibrate_unit(
         Some(m) => vec![m],
         None => (0..=most).collect(),
     };
-    let candidates = scan(&rows, &ty.file.order, &counts, prior);
+    let candidates = scan(&rows, &ty.file.order, &counts, prior, plan.seek_period_s);
     let type_alone = candidates
         .iter()
         .find(|c| c.terms == 0)
@@ -245,6 +276,7 @@ pub fn calibrate_unit(
         coefficients: coef,
         type_alone_drift_dph: type_alone,
         chosen_drift_dph: chosen.heldout_drift_dph,
+        seek_period_s: plan.seek_period_s,
         candidates,
         misfit,
         model: folded,
@@ -252,8 +284,15 @@ pub fn calibrate_unit(
 }
 
 /// Every candidate: the first m terms of `order` for each m of `counts`, at every prior
-/// weight (the type alone, m = 0, at the prior's mean), each scored by `held_out`.
-fn scan(rows: &UnitRows, order: &[usize], counts: &[usize], prior: Prior) -> Vec<UnitCandidate> {
+/// weight (the type alone, m = 0, at the prior's mean), each scored by `held_out` on seeks
+/// of `seek_period_s`.
+fn scan(
+    rows: &UnitRows,
+    order: &[usize],
+    counts: &[usize],
+    prior: Prior,
+    seek_period_s: f64,
+) -> Vec<UnitCandidate> {
     let mut candidates = Vec::new();
     for &m in counts {
         let kept = &order[..m];
@@ -263,7 +302,7 @@ fn scan(rows: &UnitRows, order: &[usize], counts: &[usize], prior: Prior) -> Vec
             &PRIOR_WEIGHTS
         };
         for &w in weights {
-            if let Some(c) = held_out(rows, kept, prior, w) {
+            if let Some(c) = held_out(rows, kept, prior, w, seek_period_s) {
                 candidates.push(UnitCandidate {
                     terms: m,
                     prior_weight: w,
@@ -275,10 +314,16 @@ fn scan(rows: &UnitRows, order: &[usize], counts: &[usize], prior: Prior) -> Vec
     candidates
 }
 
-/// Leave-one-run-out score of fitting `kept` with prior weight `w` (infinite: the prior's mean).
-fn held_out(rows: &UnitRows, kept: &[usize], prior: Prior, w: f64) -> Option<UnitCandidate> {
+/// Leave-one-run-out score of fitting `kept` with prior weight `w` (infinite: the prior's
+/// mean), on seeks of `seek_period_s`.
+fn held_out(
+    rows: &UnitRows,
+    kept: &[usize],
+    prior: Prior,
+    w: f64,
+    seek_period_s: f64,
+) -> Option<UnitCandidate> {
     let mut per_run = Vec::with_capacity(rows.runs);
-    let (mut ss, mut rows_scored) = (0.0, 0usize);
     for r in 0..rows.runs {
         let coef = if w.is_infinite() {
             prior.mean.to_vec()
@@ -287,32 +332,64 @@ fn held_out(rows: &UnitRows, kept: &[usize], prior: Prior, w: f64) -> Option<Uni
         };
         let range = rows.rows_of(r);
         let res = rows.corrected(range.clone(), &coef);
-        let early: Vec<f64> = res
-            .iter()
-            .zip(&rows.t_s[range])
-            .filter(|(_, &t)| t <= SCORED_WINDOW_S)
-            .map(|(v, _)| *v)
-            .collect();
-        let n = early.len();
-        let mean = early.iter().sum::<f64>() / n.max(1) as f64;
-        let s: f64 = early.iter().map(|v| (v - mean).powi(2)).sum();
-        if n > 0 {
-            per_run.push(s / n as f64);
-        } else {
-            per_run.push(f64::NAN);
-        }
-        ss += s;
-        rows_scored += n;
+        per_run.push(seek_windows_mean_square(
+            &res,
+            &rows.t_s[range],
+            seek_period_s,
+        ));
     }
-    if rows_scored == 0 {
+    let scored: Vec<f64> = per_run.iter().copied().filter(|v| v.is_finite()).collect();
+    if scored.is_empty() {
         return None;
     }
     Some(UnitCandidate {
         terms: kept.len(),
         prior_weight: w,
-        heldout_drift_dph: (ss / rows_scored as f64).sqrt(),
+        heldout_drift_dph: (scored.iter().sum::<f64>() / scored.len() as f64).sqrt(),
         per_run,
     })
+}
+
+/// Mean over the first `SCORED_SEEKS` seek windows (`(k p, (k + 1) p]` from power-on) of
+/// the mean square of `res` less the window's own least-squares line in time; NaN when no
+/// window has `MIN_WINDOW_ROWS` rows.
+fn seek_windows_mean_square(res: &[f64], t_s: &[f64], period_s: f64) -> f64 {
+    let (mut sum, mut windows) = (0.0, 0usize);
+    for k in 0..SCORED_SEEKS {
+        // the first seek starts at power-on and takes every row before its end
+        let lo = if k == 0 {
+            f64::NEG_INFINITY
+        } else {
+            k as f64 * period_s
+        };
+        let hi = (k + 1) as f64 * period_s;
+        let window: Vec<(f64, f64)> = t_s
+            .iter()
+            .zip(res)
+            .filter(|(&t, _)| t > lo && t <= hi)
+            .map(|(&t, &v)| (t, v))
+            .collect();
+        if window.len() < MIN_WINDOW_ROWS {
+            continue;
+        }
+        let n = window.len() as f64;
+        let t_mean = window.iter().map(|p| p.0).sum::<f64>() / n;
+        let v_mean = window.iter().map(|p| p.1).sum::<f64>() / n;
+        let sxx: f64 = window.iter().map(|p| (p.0 - t_mean).powi(2)).sum();
+        let sxy: f64 = window.iter().map(|p| (p.0 - t_mean) * (p.1 - v_mean)).sum();
+        let slope = if sxx > 0.0 { sxy / sxx } else { 0.0 };
+        let ss: f64 = window
+            .iter()
+            .map(|p| (p.1 - v_mean - slope * (p.0 - t_mean)).powi(2))
+            .sum();
+        sum += ss / n;
+        windows += 1;
+    }
+    if windows == 0 {
+        f64::NAN
+    } else {
+        sum / windows as f64
+    }
 }
 
 /// The best candidate per term count, then the fewest terms within one standard error
@@ -358,10 +435,10 @@ mod tests {
 
     /// Six runs of 45 min in 10 s rows, read within runs (each run's mean taken out of the
     /// residual and of the column, as `UnitRows::new` does): residual = `effect` x the
-    /// warm-up column (the one unit term, exp(-t / 300 s)) + each run's own constant
-    /// (turn-on biases of -0.6 .. 0.9 deg/h) + a deterministic 0.002 deg/h ripple + `late` x
-    /// (t - 1,700 s) / 1,000 s after the scored window.
-    fn rows(effect: f64, late: f64) -> UnitRows {
+    /// warm-up column (the one unit term, exp(-t / 120 s)) + each run's own constant
+    /// (turn-on biases of -0.6 .. 0.9 deg/h) + a deterministic 0.002 deg/h ripple +
+    /// `ramp` x t / 1,000 s + `late` x (t - 1,700 s) / 1,000 s after the scored seeks.
+    fn rows(effect: f64, ramp: f64, late: f64) -> UnitRows {
         let (mut residual, mut column, mut run, mut t_s) = (vec![], vec![], vec![], vec![]);
         let less_mean = |v: &mut [f64]| {
             let m = v.iter().sum::<f64>() / v.len() as f64;
@@ -369,15 +446,15 @@ mod tests {
         };
         for (r, turn_on) in [0.5, -0.6, 0.9, 0.1, -0.3, 0.2].into_iter().enumerate() {
             let t: Vec<f64> = (0..270).map(|i| 10.0 * i as f64).collect();
-            let mut c: Vec<f64> = t.iter().map(|t| (-t / 300.0).exp()).collect();
+            let mut c: Vec<f64> = t.iter().map(|t| (-t / 120.0).exp()).collect();
             let mut y: Vec<f64> = t
                 .iter()
                 .zip(&c)
                 .enumerate()
                 .map(|(i, (t, c))| {
                     let ripple = 0.002 * (0.37 * i as f64 + r as f64).sin();
-                    let after = late * ((t - SCORED_WINDOW_S) / 1000.0).max(0.0);
-                    effect * c + turn_on + ripple + after
+                    let after = late * ((t - 1_700.0) / 1000.0).max(0.0);
+                    effect * c + turn_on + ripple + ramp * t / 1000.0 + after
                 })
                 .collect();
             less_mean(&mut c);
@@ -390,12 +467,13 @@ mod tests {
         UnitRows::from_parts(residual, vec![column], run, t_s)
     }
 
+    /// The chosen candidate and the type alone's score, seeks of the default period.
     fn chosen(rows: &UnitRows) -> (UnitCandidate, f64) {
         let prior = Prior {
             mean: &[0.0],
             spread: &[0.01],
         };
-        let cands = scan(rows, &[0], &[0, 1], prior);
+        let cands = scan(rows, &[0], &[0, 1], prior, DEFAULT_SEEK_PERIOD_S);
         let alone = cands
             .iter()
             .find(|c| c.terms == 0)
@@ -405,22 +483,54 @@ mod tests {
     }
 
     #[test]
-    fn the_score_sees_the_first_seeks_drift_not_the_runs_constants_nor_later_rows() {
-        // effect: the unit's own warm-up amplitude, 10x the ripple: fitted, and the score
-        // falls to the ripple's rms (0.0014 deg/h), from 0.0051 with the type alone
-        let ripple_dph = 0.002 / 2f64.sqrt();
-        let (c, alone) = chosen(&rows(0.02, 0.0));
+    fn the_score_sees_the_curvature_a_seek_keeps_not_the_constants_and_slopes_it_cancels() {
+        // null: nothing to fit, the type alone; its score is the ripple's left in the
+        // windows (a line per window takes a little of it: under 0.002 / sqrt 2)
+        let (c, ripple_dph) = chosen(&rows(0.0, 0.0, 0.0));
+        assert_eq!(c.terms, 0, "{c:?}");
+        assert!(
+            ripple_dph > 0.001 && ripple_dph < 0.002 / 2f64.sqrt(),
+            "{ripple_dph}"
+        );
+        // effect: the unit's own warm-up amplitude, 100x the ripple, curved within the
+        // first seeks: fitted, and the score falls to the ripple's
+        let (c, alone) = chosen(&rows(0.2, 0.0, 0.0));
         assert_eq!(c.terms, 1, "{c:?}");
         assert!((c.heldout_drift_dph - ripple_dph).abs() < 1e-4, "{c:?}");
         assert!(alone > 3.0 * ripple_dph, "{alone}");
-        // twin: a drift after the six seeks' time, which moves the run's mean and so every
-        // scored row by a constant (a seek cancels it), is not scored: the type alone, its
-        // score the ripple's with or without the late drift
-        let (c, alone) = chosen(&rows(0.0, 0.05));
+        // twin: a drift a time-symmetric seek cancels (a ramp over the whole run, 0.1 deg/h
+        // per 1,000 s) and one after the scored seeks are not
+        // scored: the type alone, with the null's score to rounding
+        let (c, alone) = chosen(&rows(0.0, 0.1, 0.05));
         assert_eq!(c.terms, 0, "{c:?}");
-        assert!((alone - ripple_dph).abs() < 1e-4, "{alone}");
-        assert!((alone - chosen(&rows(0.0, 0.0)).1).abs() < 1e-12);
-        // null: nothing to fit, the type alone
-        assert_eq!(chosen(&rows(0.0, 0.0)).0.terms, 0);
+        assert!((alone - ripple_dph).abs() < 1e-12, "{alone} {ripple_dph}");
+        // a seek period that cuts the run elsewhere still sees the effect
+        let prior = Prior {
+            mean: &[0.0],
+            spread: &[0.01],
+        };
+        let cands = scan(&rows(0.2, 0.0, 0.0), &[0], &[0, 1], prior, 150.0);
+        assert_eq!(choose(&cands).unwrap().terms, 1);
+    }
+
+    #[test]
+    fn a_window_less_its_line_scores_only_what_is_left_of_a_line() {
+        let t: Vec<f64> = (0..200).map(|i| 10.0 * i as f64).collect();
+        // a line (any slope and offset): nothing left in any window
+        let line: Vec<f64> = t.iter().map(|t| 0.3 - 0.002 * t).collect();
+        assert!(seek_windows_mean_square(&line, &t, 280.0) < 1e-20);
+        // a different line in each window, too (a seek cancels each its own)
+        let broken: Vec<f64> = t.iter().map(|t| (t / 280.0).ceil() * 0.01 * t).collect();
+        assert!(seek_windows_mean_square(&broken, &t, 280.0) < 1e-20);
+        // a parabola leaves its curvature: over a window of width w, the residual of
+        // a t^2 less its line has mean square a^2 w^4 / 180 (continuous limit)
+        let a = 1e-6;
+        let parabola: Vec<f64> = t.iter().map(|t| a * t * t).collect();
+        let w = 280.0f64;
+        let expect = a * a * w.powi(4) / 180.0;
+        let got = seek_windows_mean_square(&parabola, &t, w);
+        assert!((got / expect - 1.0).abs() < 0.15, "{got} {expect}");
+        // no window with three rows: NaN, not zero
+        assert!(seek_windows_mean_square(&[1.0, 2.0], &[5.0, 900.0], 280.0).is_nan());
     }
 }
