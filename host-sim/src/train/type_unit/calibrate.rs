@@ -141,8 +141,9 @@ impl UnitCalibration {
             self.term_names[..self.terms].join(", ")
         };
         s += &format!(
-            "unit {} calibrated on {} runs against type {}: unit terms fitted: {fitted}; prior weight {} runs; held-out drift rms {:.4} deg/h in the first {SCORED_SEEKS} seeks of {:.0} s, each less its line ({:.4} with the type alone), chosen by leave-one-run-out\n",
-            self.unit_id, self.runs, self.type_id, self.prior_weight, self.chosen_drift_dph, self.seek_period_s, self.type_alone_drift_dph
+            "unit {} calibrated on {} runs against type {}: unit terms fitted: {fitted}; prior weight {} runs; held-out drift rms {:.4} deg/h in the first {SCORED_SEEKS} seeks of {:.0} s, each less its line ({:.4} with the type alone, {:+.1} %), chosen by leave-one-run-out\n",
+            self.unit_id, self.runs, self.type_id, self.prior_weight, self.chosen_drift_dph, self.seek_period_s, self.type_alone_drift_dph,
+            100.0 * (self.type_alone_drift_dph / self.chosen_drift_dph - 1.0)
         );
         s
     }
