@@ -10,13 +10,18 @@
 //! (`metadata`: numbers, times as days, versions by rank, categories; their products with
 //! the base's inputs are within-run candidates; their values and levels are run-level
 //! candidates, `between_runs`). Last, event clocks (`events`): a decay after each step of
-//! every column (the temperature too) and after each gap of the time stamps; they come
-//! last so that the cap, when it bites, cuts them before the older families (the report
-//! says so per family).
+//! every column (the temperature too) and after each gap of the time stamps. Last of all,
+//! products of the values of any two extra columns (issue 38 item 2, `pairs`): all
+//! k(k-1)/2 are scored once against the base (the sum over runs of each one's squared
+//! per-run score, which whole-run sign flips leave unchanged, so the naming test keeps its
+//! level) and only the `pairs::PAIR_BUDGET` (4) strongest enter; the rest are named in the
+//! family's note. The newest families come last so that the cap, when it bites, cuts them
+//! before the older families (the report says so per family).
 //!
 //! Memory time scales are the record's: from twice the row spacing, doubling, to half the
 //! shortest run. The size is bounded: at most `MAX_CANDIDATES` (the rest are skipped and
-//! reported as such); about 20 per column.
+//! reported as such); about 20 per column, and at most `pairs::PAIR_BUDGET` products of
+//! two columns whatever their number.
 
 use crate::diagnose::candidates::events;
 use crate::diagnose::candidates::families::{FamilyNote, OperatorFamily};

@@ -14,22 +14,24 @@ pub mod pairs;
 pub mod transforms;
 
 use crate::diagnose::baseline::choice::BaseFit;
+use crate::diagnose::baseline::models::Stacked;
 use crate::diagnose::input::Campaign;
 use crate::diagnose::memprobe;
 use crate::diagnose::validation::folds::Folds;
 
 /// The generic library and, if the cap left candidates out, a note saying so (the
 /// candidate's label and the reason, as the selection lists skipped candidates).
-/// The pairwise products are screened against `base` on `folds` (`pairs`).
+/// Products with dT/dt use the base's window (`st`); the pairwise products are screened
+/// against `base` on `folds` (`pairs`).
 pub fn library_of(
     campaign: &Campaign,
     meta: &[metadata::MetaColumn],
-    rate_half_s: f64,
+    st: &Stacked,
     folds: &Folds,
     base: &BaseFit,
 ) -> (generic::Built, Option<(String, String)>) {
     let keep_pairs = |p| pairs::screened(campaign, folds, base, p);
-    let library = generic::enumerate(campaign, meta, rate_half_s, &keep_pairs);
+    let library = generic::enumerate(campaign, meta, st.temp_rate_half_s, &keep_pairs);
     let left_out = library.cut_by_cap.len();
     memprobe::stage("library");
     let note = (left_out > 0).then(|| {

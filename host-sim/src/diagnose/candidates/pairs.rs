@@ -185,7 +185,7 @@ mod tests {
     fn a_planted_product_is_kept_an_unrelated_one_is_screened_out_and_counted() {
         let c = campaign();
         let (folds, st, choice) = layout_and_base(&c, BufferRule::default()).unwrap();
-        let (built, _) = library_of(&c, &[], st.temp_rate_half_s, &folds, &choice.chosen);
+        let (built, _) = library_of(&c, &[], &st, &folds, &choice.chosen);
         let kept: Vec<String> = built
             .candidates
             .iter()
