@@ -302,6 +302,14 @@ fn two_causes_at_once() {
 fn product_of_two_columns_neither_the_temperature() {
     let rows = run_family(Family::Pairwise);
     nulls_name_nothing(&rows);
+    // issue 38 item 2: only a product of the two columns names both (6 of 6 seeds; the
+    // twin 5 of 6, not seed 11; the peers 1 of 6 and 0 of 6)
+    assert_ci(
+        &rows,
+        Variant::Effect,
+        "diagnose names supply_v x cabinet_c",
+        |r| r.engine == "right" && r.named.iter().any(|n| n == "cabinet_c:value*supply_v"),
+    );
 }
 
 /// Writes the pairwise family's campaigns (effect, twin, null; CI seed, `SHAPE`, 1 Hz rows)
