@@ -297,3 +297,36 @@ fn two_causes_at_once() {
     let rows = run_family(Family::Stacked);
     nulls_name_nothing(&rows);
 }
+
+#[test]
+fn product_of_two_columns_neither_the_temperature() {
+    let rows = run_family(Family::Pairwise);
+    nulls_name_nothing(&rows);
+    // issue 38 item 2: only a product of the two columns names both (6 of 6 seeds; the
+    // twin 5 of 6, not seed 11; the peers 1 of 6 and 0 of 6)
+    assert_ci(
+        &rows,
+        Variant::Effect,
+        "diagnose names supply_v x cabinet_c",
+        |r| r.engine == "right" && r.named.iter().any(|n| n == "cabinet_c:value*supply_v"),
+    );
+}
+
+/// Writes the pairwise family's campaigns (effect, twin, null; CI seed, `SHAPE`, 1 Hz rows)
+/// as fog-runs files into `$NOVEL_OUT/{effect,twin,null}`, for timing `fogsim diagnose`
+/// on them (docs/record/diagnose.md, 2026-12-03, issue 38 item 2): `NOVEL_OUT=/tmp/p38
+/// cargo test -p fog-sim --test integration -- --ignored write_pairwise_campaign`.
+#[test]
+#[ignore = "writes files; for timing the command line"]
+fn write_pairwise_campaign() {
+    let out = std::path::PathBuf::from(std::env::var("NOVEL_OUT").expect("NOVEL_OUT is set"));
+    for variant in VARIANTS {
+        let dir = out.join(format!("{variant:?}").to_lowercase());
+        std::fs::create_dir_all(&dir).expect("output directory");
+        let (runs, _) = campaign(Family::Pairwise, variant, CI_SEED, SHAPE);
+        for (i, run) in runs.iter().enumerate() {
+            fog_sim::io::runs::write_run(dir.join(format!("pairwise_{i:02}.csv")), run)
+                .expect("run written");
+        }
+    }
+}

@@ -64,7 +64,7 @@ pub fn diagnose_with(
     let run_names: Vec<String> = campaign.runs.iter().map(|s| s.name.clone()).collect();
     let latitude = assemble::latitude_of(&campaign);
     let meta = candidates::metadata::metadata(runs);
-    let (built, cap_note) = candidates::library_of(&campaign, &meta, st.temp_rate_half_s);
+    let (built, cap_note) = candidates::library_of(&campaign, &meta, &st, &folds, &choice.chosen);
     let library = &built.candidates;
     let (choice, mut screening, base_rule, between_run, groups) =
         between_runs::screen_both(&campaign, &meta, &folds, &st, choice, library, latitude)?;

@@ -2,7 +2,9 @@
 //! two columns, a categorical column, a smooth nonlinear function of a column,
 //! rate-independent memory (backlash), a between-run effect of a metadata key, two
 //! causes at once, and a transient after each event (issue 38 item 1: a step of the
-//! supply, or a gap of the time stamps, each followed by a decay). Each family has an effect, a twin with a different physical law and a
+//! supply, or a gap of the time stamps, each followed by a decay), and a product of two
+//! columns neither of which is the temperature (issue 38 item 2: the supply's coefficient
+//! set by the cabinet's temperature). Each family has an effect, a twin with a different physical law and a
 //! null twin (same campaign, nothing planted). Nothing is shared with the project's
 //! simulator or the other generators: its own warm-up law (first-order self-heating on a
 //! chamber that cycles through a lag), cold / warm / hot restarts, turn-on offsets, 0.0625
@@ -34,9 +36,10 @@ pub enum Family {
     Metadata,
     Stacked,
     Event,
+    Pairwise,
 }
 
-pub const FAMILIES: [Family; 7] = [
+pub const FAMILIES: [Family; 8] = [
     Family::Product,
     Family::Categorical,
     Family::Smooth,
@@ -44,6 +47,7 @@ pub const FAMILIES: [Family; 7] = [
     Family::Metadata,
     Family::Stacked,
     Family::Event,
+    Family::Pairwise,
 ];
 
 /// The effect, its twin (another physical law on the same columns) or the null twin.
@@ -76,7 +80,7 @@ impl Family {
     /// Row period of this family's campaigns, s (half at 1 Hz, half 10 s means).
     pub fn row_s(self) -> f64 {
         match self {
-            Family::Product | Family::Smooth | Family::Stacked => 1.0,
+            Family::Product | Family::Smooth | Family::Stacked | Family::Pairwise => 1.0,
             Family::Categorical | Family::Memory | Family::Metadata | Family::Event => 10.0,
         }
     }
@@ -106,6 +110,14 @@ impl Family {
                 ("exp decay after each supply_v step", vec!["supply_v"])
             }
             (Family::Event, Variant::Twin) => ("exp decay after each gap of t_s", vec!["t_s"]),
+            (Family::Pairwise, Variant::Effect) => (
+                "(supply_v-24) x (cabinet-c0)",
+                vec!["supply_v", "cabinet_c"],
+            ),
+            (Family::Pairwise, Variant::Twin) => (
+                "(supply_v-24) x (cabinet through a 600 s lag - c0)",
+                vec!["supply_v", "cabinet_c"],
+            ),
         };
         Truth { law, columns }
     }
@@ -363,6 +375,8 @@ enum Cause {
     MountSlope,
     StepTransient,
     GapTransient,
+    SupplyCabinet,
+    SupplyCabinetLagged,
 }
 
 fn causes(f: Family, v: Variant) -> Vec<Cause> {
@@ -382,6 +396,8 @@ fn causes(f: Family, v: Variant) -> Vec<Cause> {
         (Family::Stacked, Variant::Twin) => vec![Cause::Backlash, Cause::MountOffset],
         (Family::Event, Variant::Effect) => vec![Cause::StepTransient],
         (Family::Event, Variant::Twin) => vec![Cause::GapTransient],
+        (Family::Pairwise, Variant::Effect) => vec![Cause::SupplyCabinet],
+        (Family::Pairwise, Variant::Twin) => vec![Cause::SupplyCabinetLagged],
     }
 }
 
@@ -444,7 +460,19 @@ fn shape_of(c: Cause, s: &Series, law: &Law) -> Vec<f64> {
             transients(&s.t_s, &steps, law.transient_tau_s)
         }
         Cause::GapTransient => transients(&s.t_s, &s.gap_ends_s, law.transient_tau_s),
+        Cause::SupplyCabinet => supply_times(s, &s.cabinet_c, law),
+        // the part whose coefficient it is sits in the cabinet, behind its own thermal lag
+        Cause::SupplyCabinetLagged => supply_times(s, &lag(&s.cabinet_c, law.dt, 600.0), law),
     }
+}
+
+/// `(supply_v - 24) x (cabinet - c0)` for a cabinet temperature `cabinet_c`.
+fn supply_times(s: &Series, cabinet_c: &[f64], law: &Law) -> Vec<f64> {
+    s.supply_v
+        .iter()
+        .zip(cabinet_c)
+        .map(|(v, c)| (v - 24.0) * (c - law.cabinet_mid_c))
+        .collect()
 }
 
 fn median(v: &mut [f64]) -> f64 {

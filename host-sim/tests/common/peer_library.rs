@@ -7,9 +7,11 @@
 //!
 //! Rows are averaged to 10 s means; the library is built from every column and metadata
 //! key (value, hinges at the quartiles, d/dt and d2/dt2 over a fixed +/-3 row window,
-//! first-order lags of 60 / 300 / 1500 s, products with temp_c and dT/dt, sin/cos of
-//! `_deg` columns, level indicators of columns with <= 5 values, run means of every column,
-//! every metadata value); the base is 1, T, T^2, dT/dt (one absolute intercept, no free run
+//! first-order lags of 60 / 300 / 1500 s, products with temp_c and dT/dt, products of the
+//! values of every two columns other than t_s and temp_c (issue 38 item 2: `diagnose`
+//! screens these down to a few; a peer is offered them all and selects as it selects the
+//! rest), sin/cos of `_deg` columns, level indicators of columns with <= 5 values, run means
+//! of every column, every metadata value); the base is 1, T, T^2, dT/dt (one absolute intercept, no free run
 //! offsets). Naming: each selected term enters forward (strongest first, given the base and
 //! the terms already named) while a sign-flip max test over whole runs, the max taken over
 //! the whole library (family-wise at each step; within-run and run-level columns as two
@@ -195,6 +197,31 @@ fn column_features(
     f
 }
 
+/// Products of the values of every two columns but time and temperature (the base's), each
+/// less its run mean as the products with temp_c centre the column; `values[i]` is column
+/// `names[i]` in one run.
+fn pair_products(names: &[String], values: &[Vec<f64>]) -> Vec<(String, Vec<f64>)> {
+    let centred: Vec<(&String, Vec<f64>)> = names
+        .iter()
+        .zip(values)
+        .filter(|(n, _)| *n != "t_s" && *n != "temp_c")
+        .map(|(n, x)| {
+            let m = mean(x);
+            (n, x.iter().map(|v| v - m).collect())
+        })
+        .collect();
+    let mut out = Vec::new();
+    for (i, (a, x)) in centred.iter().enumerate() {
+        for (b, y) in &centred[i + 1..] {
+            out.push((
+                format!("{a}:value*{b}"),
+                x.iter().zip(y).map(|(p, q)| p * q).collect(),
+            ));
+        }
+    }
+    out
+}
+
 /// Run-level features of run `ri`'s metadata: numeric values as they are, other values as
 /// level indicators (all but the first level in sorted order).
 fn meta_features(runs: &[Run], ri: usize, n: usize) -> Vec<(String, Vec<f64>)> {
@@ -315,6 +342,8 @@ pub fn table(runs: &[Run]) -> Table {
             }
             feats.push((format!("{name}:run_mean"), vec![mean(&x); n]));
         }
+        let values: Vec<Vec<f64>> = (0..names.len()).map(|i| value(r, i)).collect();
+        feats.extend(pair_products(&names, &values));
         feats.extend(meta_features(runs, ri, n));
         for (b, v) in base.iter_mut().zip([
             vec![1.0; n],

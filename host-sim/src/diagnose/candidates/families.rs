@@ -2,7 +2,8 @@
 //! candidate, so the report can say per family how many candidates it contributed, how
 //! many the cap or the record cut and why, and what the test's power is for it. A family
 //! is what a user would ask about ("are lags tried? could a step response be found?"),
-//! coarser than a transform: rate and accel are one family, products are one family.
+//! coarser than a transform: rate and accel are one family, products are one family
+//! (with T or dT/dt; products of two extra columns are another, `pairs`).
 
 use crate::diagnose::candidates::transforms::{Candidate, Source, Transform};
 
@@ -19,10 +20,11 @@ pub enum OperatorFamily {
     Product,
     MetadataProduct,
     EventClock,
+    PairProduct,
 }
 
 /// Every family, in the report's order.
-pub const ALL: [OperatorFamily; 10] = [
+pub const ALL: [OperatorFamily; 11] = [
     OperatorFamily::Value,
     OperatorFamily::Smooth,
     OperatorFamily::Derivative,
@@ -33,6 +35,7 @@ pub const ALL: [OperatorFamily; 10] = [
     OperatorFamily::Product,
     OperatorFamily::MetadataProduct,
     OperatorFamily::EventClock,
+    OperatorFamily::PairProduct,
 ];
 
 impl OperatorFamily {
@@ -49,11 +52,15 @@ impl OperatorFamily {
             Self::Product => "product with T or dT/dt",
             Self::MetadataProduct => "metadata product with T or dT/dt",
             Self::EventClock => "event clock",
+            Self::PairProduct => "pairwise products",
         }
     }
 
     /// The family of a candidate.
     pub fn of(c: &Candidate) -> Self {
+        if c.partner.is_some() {
+            return Self::PairProduct;
+        }
         if c.times.is_some() {
             return if c.source == Source::Meta {
                 Self::MetadataProduct

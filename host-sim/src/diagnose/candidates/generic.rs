@@ -10,17 +10,23 @@
 //! (`metadata`: numbers, times as days, versions by rank, categories; their products with
 //! the base's inputs are within-run candidates; their values and levels are run-level
 //! candidates, `between_runs`). Last, event clocks (`events`): a decay after each step of
-//! every column (the temperature too) and after each gap of the time stamps; they come
-//! last so that the cap, when it bites, cuts them before the older families (the report
-//! says so per family).
+//! every column (the temperature too) and after each gap of the time stamps. Last of all,
+//! products of the values of any two extra columns (issue 38 item 2, `pairs`): all
+//! k(k-1)/2 are scored once against the base (the sum over runs of each one's squared
+//! per-run score, which whole-run sign flips leave unchanged, so the naming test keeps its
+//! level) and only the `pairs::PAIR_BUDGET` (4) strongest enter; the rest are named in the
+//! family's note. The newest families come last so that the cap, when it bites, cuts them
+//! before the older families (the report says so per family).
 //!
 //! Memory time scales are the record's: from twice the row spacing, doubling, to half the
 //! shortest run. The size is bounded: at most `MAX_CANDIDATES` (the rest are skipped and
-//! reported as such); about 20 per column.
+//! reported as such); about 20 per column, and at most `pairs::PAIR_BUDGET` products of
+//! two columns whatever their number.
 
 use crate::diagnose::candidates::events;
 use crate::diagnose::candidates::families::{FamilyNote, OperatorFamily};
 use crate::diagnose::candidates::metadata::{MetaColumn, MetaKind, MAX_LEVELS};
+use crate::diagnose::candidates::pairs;
 use crate::diagnose::candidates::transforms::{BaseInput, Candidate, Source, Transform};
 use crate::diagnose::input::Campaign;
 use crate::stats::mean_or_zero;
@@ -124,7 +130,14 @@ pub struct Built {
 /// The whole library: within-run candidates of every column and of the run-constant
 /// metadata (products only), then the event clocks, in a fixed order; what the cap left
 /// out and why a column has no event clock.
-pub fn enumerate(c: &Campaign, meta: &[MetaColumn], base_rate_half_s: f64) -> Built {
+/// The pairwise products go through `keep_pairs` (the screen, `pairs::screened`) and
+/// come last.
+pub fn enumerate(
+    c: &Campaign,
+    meta: &[MetaColumn],
+    base_rate_half_s: f64,
+    keep_pairs: &KeepPairs,
+) -> Built {
     let temps: Vec<f64> = c
         .runs
         .iter()
@@ -144,6 +157,7 @@ pub fn enumerate(c: &Campaign, meta: &[MetaColumn], base_rate_half_s: f64) -> Bu
         knots: vec![],
         levels: vec![],
         times: None,
+        partner: None,
         centres: (0.0, temp_mean),
         base_rate_half_s,
         run_values: vec![],
@@ -170,6 +184,9 @@ pub fn enumerate(c: &Campaign, meta: &[MetaColumn], base_rate_half_s: f64) -> Bu
     out.extend(metadata_products(meta, &blank));
     let mut notes = Vec::new();
     out.extend(event_clocks(c, &taus, &blank, &mut notes));
+    let (pairs, pair_note) = keep_pairs(pairs::all_pairs(c, &|i| centred_value(c, i, &blank)));
+    out.extend(pairs);
+    notes.extend(pair_note);
     let cut_by_cap = out
         .iter()
         .skip(MAX_CANDIDATES)
@@ -226,6 +243,24 @@ fn event_clocks(
 /// Builds a candidate of `column` under `transform` with every other field at its default.
 type Blank<'a> = dyn Fn(&str, Source, Transform) -> Candidate + 'a;
 
+/// The screen of the pairwise products: the products kept and a note on the rest.
+pub type KeepPairs<'a> = dyn Fn(Vec<Candidate>) -> (Vec<Candidate>, Option<FamilyNote>) + 'a;
+
+/// The value of extra column `i` with its campaign mean as the centre of its products.
+fn centred_value(c: &Campaign, i: usize, blank: &Blank) -> Candidate {
+    let name = &c.extra_names[i];
+    let pooled: Vec<f64> = c
+        .runs
+        .iter()
+        .flat_map(|s| s.extras[i].iter().copied())
+        .collect();
+    let own = blank(name, Source::Extra(i), Transform::Value);
+    Candidate {
+        centres: (mean_or_zero(&pooled), own.centres.1),
+        ..own
+    }
+}
+
 /// Every within-run candidate of extra column `i` (`name`).
 fn column_candidates(
     c: &Campaign,
@@ -234,7 +269,6 @@ fn column_candidates(
     taus: &[f64],
     blank: &Blank,
 ) -> Vec<Candidate> {
-    let temp_mean = blank(name, Source::Temp, Transform::Value).centres.1;
     let mut out = Vec::new();
     let src = Source::Extra(i);
     let pooled: Vec<f64> = c
@@ -242,7 +276,6 @@ fn column_candidates(
         .iter()
         .flat_map(|s| s.extras[i].iter().copied())
         .collect();
-    let centre = mean_or_zero(&pooled);
     for tr in [Transform::Value, Transform::Rate, Transform::Accel] {
         out.push(blank(name, src, tr));
     }
@@ -256,10 +289,7 @@ fn column_candidates(
             levels: l.clone(),
             ..blank(name, src, Transform::Levels)
         },
-        None => Candidate {
-            centres: (centre, temp_mean),
-            ..blank(name, src, Transform::Value)
-        },
+        None => centred_value(c, i, blank),
     };
     if levels.is_some() {
         out.push(own.clone());

@@ -8,13 +8,14 @@
 //! need not be causal. Lags are exact first-order low-passes started at the first value.
 //! Splines are natural (restricted) cubic splines with knots at the column's campaign
 //! quantiles; levels are indicators of all but the most common value; a product
-//! multiplies the (centred) feature by one of the base's inputs (T - mean T, dT/dt).
+//! multiplies the (centred) feature by one of the base's inputs (T - mean T, dT/dt), a
+//! pairwise product by another extra column less its campaign mean (`pairs`).
 //! An event clock decays after each change of its column larger than the column's noise
 //! (or each gap of the time stamps; `events`).
 
 use crate::diagnose::candidates::events::{clock_decay, EventRule};
 use crate::diagnose::input::derivatives;
-use crate::diagnose::input::Series;
+use crate::diagnose::input::{Campaign, Series};
 use serde::Serialize;
 
 /// How a column is turned into a feature.
@@ -86,6 +87,16 @@ impl BaseInput {
     }
 }
 
+/// Another extra column a feature is multiplied by (a pairwise product, `pairs`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Partner {
+    /// Its index among the extra columns (`Source::Extra`).
+    pub index: usize,
+    pub column: String,
+    /// Its campaign mean, subtracted before the product.
+    pub centre: f64,
+}
+
 impl Source {
     /// This signal in one run (`None` for metadata, which has no series).
     pub fn of(self, s: &Series) -> Option<&[f64]> {
@@ -113,6 +124,8 @@ pub struct Candidate {
     pub levels: Vec<f64>,
     /// The base input the feature is multiplied by, if any.
     pub times: Option<BaseInput>,
+    /// The other extra column the feature is multiplied by, if any (never with `times`).
+    pub partner: Option<Partner>,
     /// Centre subtracted from the feature before a product (its campaign mean), and
     /// the campaign mean of T for `BaseInput::Temp`.
     pub centres: (f64, f64),
@@ -147,9 +160,10 @@ impl Candidate {
         } else {
             own
         };
-        match self.times {
-            Some(b) => format!("{own}*{}", b.name()),
-            None => own,
+        match (self.times, &self.partner) {
+            (Some(b), _) => format!("{own}*{}", b.name()),
+            (None, Some(p)) => format!("{own}*{}", p.column),
+            (None, None) => own,
         }
     }
 
@@ -162,20 +176,24 @@ impl Candidate {
             Transform::Value if self.column.ends_with("_deg") => Transform::Harmonic.complexity(),
             t => t.complexity(),
         };
-        own + if self.times.is_some() { 16 } else { 0 }
+        own + if self.is_product() { 16 } else { 0 }
+    }
+
+    /// Whether the feature is multiplied by a base input or by another column.
+    pub fn is_product(&self) -> bool {
+        self.times.is_some() || self.partner.is_some()
     }
 
     /// The feature's columns for run `run` (`s`, its series).
     pub fn compute(&self, run: usize, s: &Series) -> Vec<Vec<f64>> {
         let own = self.own_columns(run, s);
-        let Some(b) = self.times else {
-            return own;
-        };
-        let partner: Vec<f64> = match b {
-            BaseInput::Temp => s.temp_c.iter().map(|t| t - self.centres.1).collect(),
-            BaseInput::TempRate => {
+        let partner: Vec<f64> = match (self.times, &self.partner) {
+            (Some(BaseInput::Temp), _) => s.temp_c.iter().map(|t| t - self.centres.1).collect(),
+            (Some(BaseInput::TempRate), _) => {
                 derivatives::centred(&s.t_s, &s.temp_c, 1, self.base_rate_half_s)
             }
+            (None, Some(p)) => s.extras[p.index].iter().map(|v| v - p.centre).collect(),
+            (None, None) => return own,
         };
         let centre = if self.transform == Transform::Levels {
             0.0
@@ -228,6 +246,20 @@ impl Candidate {
             }
         }
     }
+}
+
+/// The candidate's columns for every run, stacked run after run.
+pub fn stacked_columns(campaign: &Campaign, cand: &Candidate) -> Vec<Vec<f64>> {
+    let per_run: Vec<Vec<Vec<f64>>> = campaign
+        .runs
+        .iter()
+        .enumerate()
+        .map(|(r, s)| cand.compute(r, s))
+        .collect();
+    let m = per_run.first().map_or(0, Vec::len);
+    (0..m)
+        .map(|j| per_run.iter().flat_map(|r| r[j].iter().copied()).collect())
+        .collect()
 }
 
 /// Membership of `x` in `level` among the sorted `levels`: 1 on the level, falling

@@ -18,6 +18,9 @@ pub struct Cause {
     /// The base input the feature is multiplied by, if any.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub times: Option<BaseInput>,
+    /// The other extra column the feature is multiplied by, if any (pairwise products).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub with: Option<String>,
     /// Whether the column is a metadata key (constant within each run).
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub metadata: bool,
@@ -33,6 +36,7 @@ impl From<&Candidate> for Cause {
             tau_s: c.tau_s,
             knots: c.knots.clone(),
             times: c.times,
+            with: c.partner.as_ref().map(|p| p.column.clone()),
             metadata: c.source == Source::Meta,
             label: c.label(),
         }
@@ -48,6 +52,7 @@ impl Cause {
             tau_s,
             knots: vec![],
             times: None,
+            with: None,
             metadata: false,
             label: fog_core::compensation::label::feature_label(column, transform.name(), tau_s)
                 .to_string(),
@@ -63,6 +68,7 @@ impl Cause {
     /// mapping, the device features and the OLS cross-check can express).
     pub fn is_plain(&self) -> bool {
         self.times.is_none()
+            && self.with.is_none()
             && !self.metadata
             && !matches!(
                 self.transform,
@@ -79,6 +85,13 @@ impl Cause {
                 self.label.split('*').next().unwrap_or(&self.column),
                 b.name(),
                 if b == BaseInput::Temp { "temperature" } else { "temperature-rate" },
+                self.column
+            );
+        }
+        if let Some(other) = &self.with {
+            return format!(
+                "drift follows the product of `{}` and `{other}` (each less its mean): the sensitivity to one \
+                 depends on the other",
                 self.column
             );
         }
@@ -152,6 +165,7 @@ mod tests {
             knots: vec![],
             levels: vec![],
             times: None,
+            partner: None,
             centres: (0.0, 0.0),
             base_rate_half_s: 20.0,
             run_values: vec![],

@@ -110,7 +110,9 @@ pub fn check(
         )?;
         let found = again.scored.iter().find(|s| s.cand.label() == cand.label());
         let named = again.steps.first().is_some_and(|s| {
-            s.scored.cand.column == cand.column && s.scored.cand.times == cand.times
+            s.scored.cand.column == cand.column
+                && s.scored.cand.times == cand.times
+                && s.scored.cand.partner == cand.partner
         });
         planted_rms = within_rms(&folds.run_rows, &planted);
         checked.push(ShapeCheck {
@@ -144,9 +146,14 @@ pub const TRIED: usize = 5;
 /// lack of test power.
 const MIN_UNEXPLAINED: f64 = 0.5;
 
-/// A candidate's shape: its transform and the base input it multiplies.
+/// A candidate's shape: its transform and the base input (or, for a pairwise product,
+/// any other column) it multiplies.
 fn shape_of(c: &Candidate) -> Shape {
-    (c.transform.name(), c.times.map(|b| b.name()))
+    let times = c.times.map(|b| b.name());
+    (
+        c.transform.name(),
+        times.or(c.partner.as_ref().map(|_| "another column")),
+    )
 }
 
 /// A candidate's shape, as the power check plants it.

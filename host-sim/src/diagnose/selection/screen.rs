@@ -30,6 +30,7 @@
 //! passes or after `MAX_STEPS`.
 
 use crate::diagnose::baseline::choice::BaseFit;
+pub use crate::diagnose::candidates::transforms::stacked_columns;
 use crate::diagnose::candidates::transforms::Candidate;
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
@@ -221,10 +222,14 @@ pub fn screen(
     })
 }
 
-/// Same column, transform family and product: a second one adds nothing new (a spline
-/// of 4 knots after one of 6, a lag of another tau).
+/// Same column, transform family and product (with the same base input or the same
+/// other column): a second one adds nothing new (a spline of 4 knots after one of 6, a
+/// lag of another tau).
 fn same_form(a: &Candidate, b: &Candidate) -> bool {
-    a.column == b.column && a.transform == b.transform && a.times == b.times
+    a.column == b.column
+        && a.transform == b.transform
+        && a.times == b.times
+        && a.partner.as_ref().map(|p| p.index) == b.partner.as_ref().map(|p| p.index)
 }
 
 /// Candidates whose columns are finite and, with run offsets free, vary within runs;
@@ -253,20 +258,6 @@ fn usable(
         }
     }
     (keep, skipped)
-}
-
-/// The candidate's columns for every run, stacked run after run.
-pub fn stacked_columns(campaign: &Campaign, cand: &Candidate) -> Vec<Vec<f64>> {
-    let per_run: Vec<Vec<Vec<f64>>> = campaign
-        .runs
-        .iter()
-        .enumerate()
-        .map(|(r, s)| cand.compute(r, s))
-        .collect();
-    let m = per_run.first().map_or(0, Vec::len);
-    (0..m)
-        .map(|j| per_run.iter().flat_map(|r| r[j].iter().copied()).collect())
-        .collect()
 }
 
 /// The best significant candidate (sorted), or a simpler transform of the same column

@@ -251,8 +251,7 @@ impl Prepared {
         tested: usize,
     ) -> Result<(CvResult, Option<UnitScores>), DiagnoseError> {
         let aug = self.augmented(folds, extra);
-        let q = self.width() + aug.2.len();
-        let scores = whitened_unit_scores(&aug.0, &aug.1, q, tested, self.ridge);
+        let scores = self.scores_on(&aug, tested);
         let cv = self
             .held_out_on(folds, &aug, &[self.ridge], None)
             .into_iter()
@@ -261,6 +260,19 @@ impl Prepared {
                 what: "held-out fit",
             }))?;
         Ok((cv, scores))
+    }
+
+    /// The per-unit whitened scores of all of `extra` (raw, full length) given this
+    /// design (`score`), without a held-out fit: one pass over the rows (the cheap
+    /// screen of the pairwise products, `candidates::pairs`).
+    pub fn unit_scores(&self, folds: &Folds, extra: &[Vec<f64>]) -> Option<UnitScores> {
+        self.scores_on(&self.augmented(folds, extra), extra.len())
+    }
+
+    /// Scores of the last `tested` columns of the augmented systems `aug`.
+    fn scores_on(&self, aug: &Augmented, tested: usize) -> Option<UnitScores> {
+        let q = self.width() + aug.2.len();
+        whitened_unit_scores(&aug.0, &aug.1, q, tested, self.ridge)
     }
 
     /// [`Prepared::held_out`] on the augmented systems `aug`.
