@@ -89,7 +89,7 @@ pub struct Args {
     /// score), deg.
     #[arg(long = "seek-latitude-deg", default_value_t = crate::sim::DEFAULT_LATITUDE_DEG, allow_negative_numbers = true)]
     pub seek_latitude: f64,
-    /// Sequence of the seeks the `seek` criterion and `--seek-refit` score (as
+    /// Sequence of the seeks the `seek` criterion, `--seek-refit` and `--type` score (as
     /// `north-seek --sequence`): `forward` (0, 180 deg) or `symmetric` (0, 180, 180, 0:
     /// a drift error linear in time cancels, its curvature is scored).
     #[arg(long = "seek-sequence", value_enum, default_value_t = Sequence::Forward)]
@@ -161,8 +161,8 @@ pub struct Args {
     #[arg(long = "unit-terms")]
     pub unit_terms: Option<usize>,
     /// With `--type`: time from one of the device's seeks to the next, s: the unit terms
-    /// are chosen on the held-out drift in the first six seeks' windows [default: 280,
-    /// `north-seek`'s seeks].
+    /// are chosen on the held-out drift in the first six seeks' windows, each less what
+    /// a seek of `--seek-sequence` cancels [default: 280, `north-seek`'s seeks].
     #[arg(long = "seek-period-s")]
     pub seek_period_s: Option<f64>,
 }

@@ -137,6 +137,7 @@ pub(super) fn calibrate(
     let plan = UnitPlan {
         terms: args.unit_terms,
         seek_period_s: args.seek_period_s.unwrap_or(DEFAULT_SEEK_PERIOD_S),
+        symmetric_seeks: args.seek_geometry().symmetric,
     };
     let cal = calibrate_unit(&ty, runs, &unit, &plan)?;
     print!("{}", cal.summary());

@@ -335,7 +335,7 @@ pub fn type_free_model(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<Recip
 
 /// The seeking unit calibrated from its own runs with `learnt` (the recipe's type, just
 /// learnt or kept from an earlier run with the same recipe) as the prior, its held-out
-/// score cut by the period of `plan`'s seeks.
+/// score read as `plan`'s seeks see the drift (their period and sequence).
 pub fn unit_model(
     recipe: &UnitRecipe,
     learnt: RecipeType,
@@ -345,6 +345,10 @@ pub fn unit_model(
     let unit_plan = UnitPlan {
         terms: None,
         seek_period_s: seek_period_s(&unit_params, plan)?,
+        symmetric_seeks: match &plan.seek_timing {
+            Some(seeks) => seeks.mode.is_symmetric(),
+            None => plan.criterion.seek_geometry().symmetric,
+        },
     };
     let ty = learnt.type_model;
     let cal = calibrate_unit(&ty, &own, &unit_id(SEEKING_UNIT), &unit_plan)?;

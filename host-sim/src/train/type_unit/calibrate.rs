@@ -12,8 +12,9 @@
 //! m and W are chosen together by leaving one of the unit's runs out at a time: every
 //! candidate is fitted on the other runs and scored on the held-out run's drift residual
 //! in the windows of the first `SCORED_SEEKS` seeks after power-on (one seek period each,
-//! `UnitPlan::seek_period_s`), each window less its own straight line: what a
-//! time-symmetric seek cancels (a constant and a drift linear over the seek), so what is
+//! `UnitPlan::seek_period_s`), each window less what the device's seek cancels
+//! (`UnitPlan::symmetric_seeks`): for a time-symmetric seek its own straight line (a
+//! constant and a drift linear over the seek), for a forward seek its mean; so what is
 //! left is what turns into azimuth error. A run's score is the mean of its windows' mean
 //! squares; then the fewest terms whose held-out score is within one standard error (over
 //! the held-out runs) of the best are kept. m = 0 is the type alone.
@@ -24,11 +25,10 @@
 //! from a handful of runs too noisily to choose by: a bias of 0.5 of a seek's std raises
 //! one seek's mean square by a quarter, while a 6-run mean of seek 1 has a standard error
 //! of 0.41 std. The rows see the same misfit as about 170 residual rows a run instead of
-//! six azimuths. Why each window less its line, not the whole span less its mean: the
-//! span's mean leaves the warm-up's slope within each seek in the score, which the
-//! symmetric seek cancels, so the score chose terms for a slope the seek never sees and
-//! missed the curvature it does (docs/record/fleet.md: over 120 simulated fleets x 3
-//! ambients the windows met every target in more cells than the span).
+//! six azimuths. Why each window less its line for a symmetric seek, not the whole span
+//! less its mean: the span's mean leaves the warm-up's slope within each seek in the
+//! score, which the symmetric seek cancels, so the score chose terms for a slope the seek
+//! never sees (docs/record/fleet.md, "The unit step scored per seek window").
 //!
 //! Before anything is fitted, the unit's own estimates (made as the type's units' were)
 //! are tested against the type (`misfit`): a unit outside its type is said, term by term,
@@ -79,14 +79,19 @@ pub struct UnitPlan {
     pub terms: Option<usize>,
     /// Time from one seek's start to the next's, s: the windows the held-out score reads.
     pub seek_period_s: f64,
+    /// The device's seeks are time-symmetric (each window less its line; else less its
+    /// mean, what a forward seek cancels).
+    pub symmetric_seeks: bool,
 }
 
 impl UnitPlan {
-    /// The number of terms chosen, for seeks of `DEFAULT_SEEK_PERIOD_S`.
+    /// The number of terms chosen, for forward seeks of `DEFAULT_SEEK_PERIOD_S` (the
+    /// finder's default sequence).
     pub fn chosen() -> Self {
         UnitPlan {
             terms: None,
             seek_period_s: DEFAULT_SEEK_PERIOD_S,
+            symmetric_seeks: false,
         }
     }
 }
@@ -97,7 +102,7 @@ pub struct UnitCandidate {
     pub terms: usize,
     pub prior_weight: f64,
     /// Held-out rms of the drift residual in the first `SCORED_SEEKS` seeks' windows,
-    /// each window less its own straight line, every held-out run weighed alike, deg/h.
+    /// each window less what the seek cancels, every held-out run weighed alike, deg/h.
     pub heldout_drift_dph: f64,
     /// Per held-out run: the mean of its windows' mean squares, (deg/h)^2.
     #[serde(skip)]
@@ -120,8 +125,10 @@ pub struct UnitCalibration {
     /// the chosen calibration, deg/h.
     pub type_alone_drift_dph: f64,
     pub chosen_drift_dph: f64,
-    /// The seek period the score's windows were cut by, s (`UnitPlan::seek_period_s`).
+    /// The seek period the score's windows were cut by, s (`UnitPlan::seek_period_s`),
+    /// and whether each window's line was taken out or only its mean.
     pub seek_period_s: f64,
+    pub symmetric_seeks: bool,
     pub candidates: Vec<UnitCandidate>,
     pub misfit: Misfit,
     #[serde(skip)]
@@ -141,8 +148,12 @@ impl UnitCalibration {
             self.term_names[..self.terms].join(", ")
         };
         s += &format!(
-            "unit {} calibrated on {} runs against type {}: unit terms fitted: {fitted}; prior weight {} runs; held-out drift rms {:.4} deg/h in the first {SCORED_SEEKS} seeks of {:.0} s, each less its line ({:.4} with the type alone, {:+.1} %), chosen by leave-one-run-out\n",
-            self.unit_id, self.runs, self.type_id, self.prior_weight, self.chosen_drift_dph, self.seek_period_s, self.type_alone_drift_dph,
+            "unit {} calibrated on {} runs against type {}: unit terms fitted: {fitted}; prior weight {} runs; held-out drift rms {:.4} deg/h in the first {SCORED_SEEKS} {} seeks of {:.0} s, each less its {} ({:.4} with the type alone, {:+.1} %), chosen by leave-one-run-out\n",
+            self.unit_id, self.runs, self.type_id, self.prior_weight, self.chosen_drift_dph,
+            if self.symmetric_seeks { "time-symmetric" } else { "forward" },
+            self.seek_period_s,
+            if self.symmetric_seeks { "line" } else { "mean" },
+            self.type_alone_drift_dph,
             100.0 * (self.type_alone_drift_dph / self.chosen_drift_dph - 1.0)
         );
         s
@@ -252,7 +263,7 @@ pub fn calibrate_unit(
         Some(m) => vec![m],
         None => (0..=most).collect(),
     };
-    let candidates = scan(&rows, &ty.file.order, &counts, prior, plan.seek_period_s);
+    let candidates = scan(&rows, &ty.file.order, &counts, prior, plan);
     let type_alone = candidates
         .iter()
         .find(|c| c.terms == 0)
@@ -278,6 +289,7 @@ pub fn calibrate_unit(
         type_alone_drift_dph: type_alone,
         chosen_drift_dph: chosen.heldout_drift_dph,
         seek_period_s: plan.seek_period_s,
+        symmetric_seeks: plan.symmetric_seeks,
         candidates,
         misfit,
         model: folded,
@@ -285,14 +297,14 @@ pub fn calibrate_unit(
 }
 
 /// Every candidate: the first m terms of `order` for each m of `counts`, at every prior
-/// weight (the type alone, m = 0, at the prior's mean), each scored by `held_out` on seeks
-/// of `seek_period_s`.
+/// weight (the type alone, m = 0, at the prior's mean), each scored by `held_out` on the
+/// plan's seeks.
 fn scan(
     rows: &UnitRows,
     order: &[usize],
     counts: &[usize],
     prior: Prior,
-    seek_period_s: f64,
+    plan: &UnitPlan,
 ) -> Vec<UnitCandidate> {
     let mut candidates = Vec::new();
     for &m in counts {
@@ -303,7 +315,7 @@ fn scan(
             &PRIOR_WEIGHTS
         };
         for &w in weights {
-            if let Some(c) = held_out(rows, kept, prior, w, seek_period_s) {
+            if let Some(c) = held_out(rows, kept, prior, w, plan) {
                 candidates.push(UnitCandidate {
                     terms: m,
                     prior_weight: w,
@@ -316,13 +328,13 @@ fn scan(
 }
 
 /// Leave-one-run-out score of fitting `kept` with prior weight `w` (infinite: the prior's
-/// mean), on seeks of `seek_period_s`.
+/// mean), on the plan's seeks.
 fn held_out(
     rows: &UnitRows,
     kept: &[usize],
     prior: Prior,
     w: f64,
-    seek_period_s: f64,
+    plan: &UnitPlan,
 ) -> Option<UnitCandidate> {
     let mut per_run = Vec::with_capacity(rows.runs);
     for r in 0..rows.runs {
@@ -336,7 +348,8 @@ fn held_out(
         per_run.push(seek_windows_mean_square(
             &res,
             &rows.t_s[range],
-            seek_period_s,
+            plan.seek_period_s,
+            plan.symmetric_seeks,
         ));
     }
     let scored: Vec<f64> = per_run.iter().copied().filter(|v| v.is_finite()).collect();
@@ -352,9 +365,10 @@ fn held_out(
 }
 
 /// Mean over the first `SCORED_SEEKS` seek windows (`(k p, (k + 1) p]` from power-on) of
-/// the mean square of `res` less the window's own least-squares line in time; NaN when no
-/// window has `MIN_WINDOW_ROWS` rows.
-fn seek_windows_mean_square(res: &[f64], t_s: &[f64], period_s: f64) -> f64 {
+/// the mean square of `res` less the window's own least-squares line in time (`less_line`,
+/// a time-symmetric seek) or its mean (a forward seek); NaN when no window has
+/// `MIN_WINDOW_ROWS` rows.
+fn seek_windows_mean_square(res: &[f64], t_s: &[f64], period_s: f64, less_line: bool) -> f64 {
     let (mut sum, mut windows) = (0.0, 0usize);
     for k in 0..SCORED_SEEKS {
         // the first seek starts at power-on and takes every row before its end
@@ -378,7 +392,11 @@ fn seek_windows_mean_square(res: &[f64], t_s: &[f64], period_s: f64) -> f64 {
         let v_mean = window.iter().map(|p| p.1).sum::<f64>() / n;
         let sxx: f64 = window.iter().map(|p| (p.0 - t_mean).powi(2)).sum();
         let sxy: f64 = window.iter().map(|p| (p.0 - t_mean) * (p.1 - v_mean)).sum();
-        let slope = if sxx > 0.0 { sxy / sxx } else { 0.0 };
+        let slope = if less_line && sxx > 0.0 {
+            sxy / sxx
+        } else {
+            0.0
+        };
         let ss: f64 = window
             .iter()
             .map(|p| (p.1 - v_mean - slope * (p.0 - t_mean)).powi(2))
@@ -468,13 +486,24 @@ mod tests {
         UnitRows::from_parts(residual, vec![column], run, t_s)
     }
 
-    /// The chosen candidate and the type alone's score, seeks of the default period.
+    const SYMMETRIC: UnitPlan = UnitPlan {
+        terms: None,
+        seek_period_s: DEFAULT_SEEK_PERIOD_S,
+        symmetric_seeks: true,
+    };
+
+    /// The chosen candidate and the type alone's score, time-symmetric seeks of the
+    /// default period.
     fn chosen(rows: &UnitRows) -> (UnitCandidate, f64) {
+        chosen_for(rows, &SYMMETRIC)
+    }
+
+    fn chosen_for(rows: &UnitRows, plan: &UnitPlan) -> (UnitCandidate, f64) {
         let prior = Prior {
             mean: &[0.0],
             spread: &[0.01],
         };
-        let cands = scan(rows, &[0], &[0, 1], prior, DEFAULT_SEEK_PERIOD_S);
+        let cands = scan(rows, &[0], &[0, 1], prior, plan);
         let alone = cands
             .iter()
             .find(|c| c.terms == 0)
@@ -506,12 +535,22 @@ mod tests {
         assert_eq!(c.terms, 0, "{c:?}");
         assert!((alone - ripple_dph).abs() < 1e-12, "{alone} {ripple_dph}");
         // a seek period that cuts the run elsewhere still sees the effect
-        let prior = Prior {
-            mean: &[0.0],
-            spread: &[0.01],
+        let short = UnitPlan {
+            seek_period_s: 150.0,
+            ..SYMMETRIC
         };
-        let cands = scan(&rows(0.2, 0.0, 0.0), &[0], &[0, 1], prior, 150.0);
-        assert_eq!(choose(&cands).unwrap().terms, 1);
+        assert_eq!(chosen_for(&rows(0.2, 0.0, 0.0), &short).0.terms, 1);
+        // forward seeks cancel only a constant: the ramp is in their score, 0.1 deg/h per
+        // 1,000 s over a 280 s window (rms 0.1 x 0.28 / sqrt 12 = 0.0081 deg/h)
+        let forward = UnitPlan::chosen();
+        let (_, alone) = chosen_for(&rows(0.0, 0.1, 0.05), &forward);
+        let (_, flat) = chosen_for(&rows(0.0, 0.0, 0.0), &forward);
+        assert!((flat - ripple_dph).abs() < 2e-4, "{flat} {ripple_dph}");
+        let ramp_dph = 0.1 * 0.28 / 12f64.sqrt();
+        assert!(
+            ((alone * alone - flat * flat).sqrt() / ramp_dph - 1.0).abs() < 0.1,
+            "{alone}"
+        );
     }
 
     #[test]
@@ -519,19 +558,23 @@ mod tests {
         let t: Vec<f64> = (0..200).map(|i| 10.0 * i as f64).collect();
         // a line (any slope and offset): nothing left in any window
         let line: Vec<f64> = t.iter().map(|t| 0.3 - 0.002 * t).collect();
-        assert!(seek_windows_mean_square(&line, &t, 280.0) < 1e-20);
+        assert!(seek_windows_mean_square(&line, &t, 280.0, true) < 1e-20);
         // a different line in each window, too (a seek cancels each its own)
         let broken: Vec<f64> = t.iter().map(|t| (t / 280.0).ceil() * 0.01 * t).collect();
-        assert!(seek_windows_mean_square(&broken, &t, 280.0) < 1e-20);
+        assert!(seek_windows_mean_square(&broken, &t, 280.0, true) < 1e-20);
         // a parabola leaves its curvature: over a window of width w, the residual of
         // a t^2 less its line has mean square a^2 w^4 / 180 (continuous limit)
         let a = 1e-6;
         let parabola: Vec<f64> = t.iter().map(|t| a * t * t).collect();
         let w = 280.0f64;
         let expect = a * a * w.powi(4) / 180.0;
-        let got = seek_windows_mean_square(&parabola, &t, w);
+        let got = seek_windows_mean_square(&parabola, &t, w, true);
         assert!((got / expect - 1.0).abs() < 0.15, "{got} {expect}");
         // no window with three rows: NaN, not zero
-        assert!(seek_windows_mean_square(&[1.0, 2.0], &[5.0, 900.0], 280.0).is_nan());
+        assert!(seek_windows_mean_square(&[1.0, 2.0], &[5.0, 900.0], 280.0, true).is_nan());
+        // less its mean only (a forward seek), a line leaves its slope: (0.002 w)^2 / 12
+        let slope_ms = (0.002f64 * 280.0).powi(2) / 12.0;
+        let got = seek_windows_mean_square(&line, &t, 280.0, false);
+        assert!((got / slope_ms - 1.0).abs() < 0.1, "{got} {slope_ms}");
     }
 }
