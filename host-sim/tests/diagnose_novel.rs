@@ -313,20 +313,28 @@ fn product_of_two_columns_neither_the_temperature() {
 }
 
 /// Writes the pairwise family's campaigns (effect, twin, null; CI seed, `SHAPE`, 1 Hz rows)
-/// as fog-runs files into `$NOVEL_OUT/{effect,twin,null}`, for timing `fogsim diagnose`
-/// on them (docs/record/diagnose.md, 2026-12-03, issue 38 item 2): `NOVEL_OUT=/tmp/p38
-/// cargo test -p fog-sim --test integration -- --ignored write_pairwise_campaign`.
+/// as fog-runs files into `$NOVEL_OUT/{effect,twin,null}` (a scratch directory without it),
+/// for timing `fogsim diagnose` on them (docs/record/diagnose.md, 2026-12-03, issue 38 item
+/// 2): `NOVEL_OUT=/tmp/p38 cargo test -p fog-sim --test integration -- --ignored
+/// write_pairwise_campaign`. Each file is read back whole: what is timed is what was planted.
 #[test]
-#[ignore = "writes files; for timing the command line"]
+#[ignore = "slow suite: writes the pairwise family's campaigns for timing the command line"]
 fn write_pairwise_campaign() {
-    let out = std::path::PathBuf::from(std::env::var("NOVEL_OUT").expect("NOVEL_OUT is set"));
+    let out = match std::env::var("NOVEL_OUT") {
+        Ok(dir) => std::path::PathBuf::from(dir),
+        Err(_) => crate::app_support::scratch_dir("novel-pairwise"),
+    };
     for variant in VARIANTS {
         let dir = out.join(format!("{variant:?}").to_lowercase());
         std::fs::create_dir_all(&dir).expect("output directory");
         let (runs, _) = campaign(Family::Pairwise, variant, CI_SEED, SHAPE);
+        assert_eq!(runs.len(), SHAPE.runs, "{variant:?}");
         for (i, run) in runs.iter().enumerate() {
-            fog_sim::io::runs::write_run(dir.join(format!("pairwise_{i:02}.csv")), run)
-                .expect("run written");
+            let path = dir.join(format!("pairwise_{i:02}.csv"));
+            fog_sim::io::runs::write_run(&path, run).expect("run written");
+            let back = fog_sim::io::runs::read_run(&path).expect("run read back");
+            assert_eq!(back.columns, run.columns, "{}", path.display());
+            assert_eq!(back.data[0].len(), run.data[0].len(), "{}", path.display());
         }
     }
 }
