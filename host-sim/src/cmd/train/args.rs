@@ -233,12 +233,7 @@ impl Args {
             );
         }
         if let Some(p) = self.seek_period_s {
-            use crate::train::type_unit::calibrate::{MAX_SEEK_PERIOD_S, MIN_SEEK_PERIOD_S};
-            if !(p.is_finite() && (MIN_SEEK_PERIOD_S..=MAX_SEEK_PERIOD_S).contains(&p)) {
-                anyhow::bail!(
-                    "--seek-period-s {p}: must be within {MIN_SEEK_PERIOD_S}..={MAX_SEEK_PERIOD_S} s"
-                );
-            }
+            crate::train::type_unit::calibrate::check_seek_period(p)?;
         }
         if self.seek_latitude.is_nan() || self.seek_latitude.abs() >= 85.0 {
             anyhow::bail!(

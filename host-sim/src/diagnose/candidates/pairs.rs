@@ -41,18 +41,18 @@ pub const PAIR_BUDGET: usize = 4;
 /// column `i` (centred on `centre_i`) times column `j` less its mean. `value(i)` is the
 /// centred value candidate of extra column `i` (with its campaign mean in `centres.0`).
 pub fn all_pairs(c: &Campaign, value: &dyn Fn(usize) -> Candidate) -> Vec<Candidate> {
-    let k = c.extra_names.len();
+    let values: Vec<Candidate> = (0..c.extra_names.len()).map(value).collect();
+    let k = values.len();
     let mut out = Vec::with_capacity(k * k.saturating_sub(1) / 2);
-    for i in 0..k {
-        for j in i + 1..k {
-            let other = value(j);
+    for (i, own) in values.iter().enumerate() {
+        for (j, other) in values.iter().enumerate().skip(i + 1) {
             out.push(Candidate {
                 partner: Some(Partner {
                     index: j,
-                    column: other.column,
+                    column: other.column.clone(),
                     centre: other.centres.0,
                 }),
-                ..value(i)
+                ..own.clone()
             });
         }
     }

@@ -21,7 +21,7 @@
 use crate::diagnose::baseline::choice::{self, BaseFit};
 use crate::diagnose::baseline::models::Stacked;
 use crate::diagnose::candidates::families::OperatorFamily;
-use crate::diagnose::candidates::transforms::Candidate;
+use crate::diagnose::candidates::transforms::{stacked_columns, Candidate};
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
 use crate::diagnose::selection::scored::ALPHA;
@@ -188,7 +188,7 @@ fn plantable(
         .filter(|s| shape_of(&s.cand) == shape)
         .take(TRIED)
     {
-        let cols = screen::stacked_columns(campaign, &scored.cand);
+        let cols = stacked_columns(campaign, &scored.cand);
         let drift = std::mem::replace(&mut st.y, unit_sum(runs, &cols));
         drop(cols);
         let fit = choice::fit(folds, st, &base.spec);

@@ -30,8 +30,7 @@
 //! passes or after `MAX_STEPS`.
 
 use crate::diagnose::baseline::choice::BaseFit;
-pub use crate::diagnose::candidates::transforms::stacked_columns;
-use crate::diagnose::candidates::transforms::Candidate;
+use crate::diagnose::candidates::transforms::{stacked_columns, Candidate};
 use crate::diagnose::error::DiagnoseError;
 use crate::diagnose::input::Campaign;
 use crate::diagnose::validation::cv::CvResult;

@@ -58,6 +58,18 @@ pub const DEFAULT_SEEK_PERIOD_S: f64 = 280.0;
 /// first `SCORED_SEEKS` within a 45 min run.
 pub const MIN_SEEK_PERIOD_S: f64 = 30.0;
 pub const MAX_SEEK_PERIOD_S: f64 = 450.0;
+/// Checks a seek period (`--seek-period-s`) against its range.
+pub fn check_seek_period(seek_period_s: f64) -> Result<()> {
+    if !(seek_period_s.is_finite()
+        && (MIN_SEEK_PERIOD_S..=MAX_SEEK_PERIOD_S).contains(&seek_period_s))
+    {
+        bail!(
+            "--seek-period-s {seek_period_s}: a seek's period must be within {MIN_SEEK_PERIOD_S}..={MAX_SEEK_PERIOD_S} s"
+        );
+    }
+    Ok(())
+}
+
 /// Fewest rows in a seek's window for it to be scored (a line takes two).
 const MIN_WINDOW_ROWS: usize = 3;
 /// Prior weights tried, in runs (0: the unit's own least squares).
@@ -205,14 +217,7 @@ pub fn check_unit_runs(ty: &TypeModel, runs: &[Run], unit_id: &str, plan: &UnitP
             runs.len()
         );
     }
-    if !(plan.seek_period_s.is_finite()
-        && (MIN_SEEK_PERIOD_S..=MAX_SEEK_PERIOD_S).contains(&plan.seek_period_s))
-    {
-        bail!(
-            "--seek-period-s {}: a seek's period must be within {MIN_SEEK_PERIOD_S}..={MAX_SEEK_PERIOD_S} s",
-            plan.seek_period_s
-        );
-    }
+    check_seek_period(plan.seek_period_s)?;
     let p = ty.file.terms.len();
     if let Some(m) = plan.terms {
         if m > p {
