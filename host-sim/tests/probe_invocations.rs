@@ -167,6 +167,7 @@ const NUMBER_FLAGS: &[&str] = &[
     "--type-units",
     "--unit-ambients-c",
     "--unit-fit",
+    "--unit-prior-weight",
     "--unit-runs",
     "--unit-terms",
     "--units",

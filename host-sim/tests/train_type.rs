@@ -652,6 +652,11 @@ fn bad_type_learning_inputs_fail_with_one_line_and_write_nothing() {
         ),
         (
             "U4",
+            "--out out.model --unit-prior-weight 1",
+            "--unit-prior-weight: needs --type TYPE",
+        ),
+        (
+            "U4",
             "--out out.model --registry out.sqlite",
             "--registry: needs --field, --type-out or --type",
         ),
@@ -699,6 +704,11 @@ fn bad_unit_calibration_inputs_fail_with_one_line_and_write_nothing() {
             "U4",
             "--type type.json --out out.model --unit-terms TERMS+1",
             "--unit-terms TERMS+1: the type has TERMS unit terms",
+        ),
+        (
+            "U4",
+            "--type type.json --out out.model --unit-prior-weight -1",
+            "--unit-prior-weight -1: a weight in runs, finite and >= 0",
         ),
         (
             "U4'",

@@ -164,6 +164,14 @@ pub struct Args {
     /// spread` lines (docs/reference/formats.md) [default: default]. Needs `--type-units`.
     #[arg(long = "unit-spread")]
     pub unit_spread: Option<PathBuf>,
+    /// Fit this many unit terms, in the type's order (as `train --unit-terms`) [default:
+    /// chosen by leave-one-run-out]. Needs `--type-units` of 3 or more.
+    #[arg(long = "unit-terms")]
+    pub unit_terms: Option<usize>,
+    /// The type's pull on the unit, in runs (as `train --unit-prior-weight`) [default:
+    /// chosen with the terms]. Needs `--type-units` of 3 or more.
+    #[arg(long = "unit-prior-weight", allow_negative_numbers = true)]
+    pub unit_prior_weight: Option<f64>,
 }
 
 /// Every how many chamber power-ons one is a warm restart (`--training-restarts-above-c`).
@@ -222,6 +230,8 @@ fn training_campaign(args: &Args) -> Result<(usize, Option<WarmRestarts>)> {
         ("--type-shape", args.type_shape.is_some()),
         ("--unit-fit", args.unit_fit.is_some()),
         ("--unit-spread", args.unit_spread.is_some()),
+        ("--unit-terms", args.unit_terms.is_some()),
+        ("--unit-prior-weight", args.unit_prior_weight.is_some()),
     ];
     if let (None, Some((flag, _))) = (args.type_units, shapes_recipe.iter().find(|(_, g)| *g)) {
         bail!("{flag}: needs --type-units N (the unit recipe it shapes)");
@@ -386,6 +396,8 @@ fn recipe_of(args: &Args) -> Result<Option<UnitRecipe>> {
         type_shape: args.type_shape.unwrap_or_default(),
         unit_fit: args.unit_fit.unwrap_or_default(),
         unit_spread: spread_of(args.unit_spread.as_deref())?,
+        unit_terms: args.unit_terms,
+        unit_prior_weight: args.unit_prior_weight,
     }))
 }
 
@@ -536,6 +548,25 @@ mod tests {
         );
         let default = recipe_of(&args(&["--type-units", "3"])).unwrap().unwrap();
         assert_eq!(default.type_ambients_c, RECIPE_AMBIENTS_C.to_vec());
+        let fixed = recipe_of(&args(&[
+            "--type-units",
+            "3",
+            "--unit-terms",
+            "2",
+            "--unit-prior-weight",
+            "0.3",
+        ]))
+        .unwrap()
+        .unwrap();
+        assert_eq!(
+            (fixed.unit_terms, fixed.unit_prior_weight),
+            (Some(2), Some(0.3))
+        );
+        let no_type = training_campaign(&args(&["--unit-prior-weight", "1"])).unwrap_err();
+        assert_eq!(
+            no_type.to_string(),
+            "--unit-prior-weight: needs --type-units N (the unit recipe it shapes)"
+        );
         let alone = training_campaign(&args(&["--type-ambients-c=-40"])).unwrap_err();
         assert_eq!(
             alone.to_string(),

@@ -160,6 +160,11 @@ pub struct Args {
     /// leave-one-run-out, at most one per run].
     #[arg(long = "unit-terms")]
     pub unit_terms: Option<usize>,
+    /// With `--type`: the type's pull on the unit, in runs (0: the unit's own least
+    /// squares; 1: the prior counts as one more run) [default: chosen with the terms by
+    /// leave-one-run-out, from 0, 0.03, 0.1, ... 1000].
+    #[arg(long = "unit-prior-weight", allow_negative_numbers = true)]
+    pub unit_prior_weight: Option<f64>,
     /// With `--type`: time from one of the device's seeks to the next, s: the unit terms
     /// are chosen on the held-out drift in the first six seeks' windows, each less what
     /// a seek of `--seek-sequence` cancels [default: 280, `north-seek`'s seeks].
@@ -234,6 +239,9 @@ impl Args {
         }
         if let Some(p) = self.seek_period_s {
             crate::train::type_unit::calibrate::check_seek_period(p)?;
+        }
+        if let Some(w) = self.unit_prior_weight {
+            crate::train::type_unit::calibrate::check_prior_weight(w)?;
         }
         if self.seek_latitude.is_nan() || self.seek_latitude.abs() >= 85.0 {
             anyhow::bail!(

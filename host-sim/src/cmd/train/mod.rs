@@ -97,6 +97,7 @@ fn inputs(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
     for (flag, given) in [
         ("--misfit", args.misfit.is_some()),
         ("--unit-terms", args.unit_terms.is_some()),
+        ("--unit-prior-weight", args.unit_prior_weight.is_some()),
         ("--seek-period-s", args.seek_period_s.is_some()),
     ] {
         if given && args.type_model.is_none() {

@@ -136,6 +136,7 @@ pub(super) fn calibrate(
     let unit = unit_id_of(runs, &args.gyro_id)?;
     let plan = UnitPlan {
         terms: args.unit_terms,
+        prior_weight: args.unit_prior_weight,
         seek_period_s: args.seek_period_s.unwrap_or(DEFAULT_SEEK_PERIOD_S),
         symmetric_seeks: args.seek_geometry().symmetric,
     };

@@ -83,6 +83,8 @@ pub fn compare_recipes(cfg: &MonteCarloConfig, keep_dir: &Path) -> Result<Recipe
         type_shape: Default::default(),
         unit_fit: Default::default(),
         unit_spread: default_unit_spread(),
+        unit_terms: None,
+        unit_prior_weight: None,
     };
     let plan = OwnModelPlan {
         ambient_c: cfg.ambient_c,
@@ -284,6 +286,8 @@ mod tests {
             type_shape: Default::default(),
             unit_fit: Default::default(),
             unit_spread: default_unit_spread(),
+            unit_terms: None,
+            unit_prior_weight: None,
         }
     }
 

@@ -53,6 +53,10 @@ pub struct UnitRecipe {
     pub unit_fit: Fit,
     /// How the fleet's units differ, and its label (`default`, `none`, `file NAME`).
     pub unit_spread: (TypeSpread, String),
+    /// The unit step's terms and prior weight when fixed (`--unit-terms`,
+    /// `--unit-prior-weight`; None: chosen by leave-one-run-out).
+    pub unit_terms: Option<usize>,
+    pub unit_prior_weight: Option<f64>,
 }
 
 /// The seeking unit's model and where it came from.
@@ -86,6 +90,21 @@ impl UnitRecipe {
         // Without a type the unit's runs are trained as any model is: grouped validation
         // over whole runs, `TrainConfig`'s folds.
         let own_folds = crate::train::TrainConfig::default().folds;
+        if self.type_units == 0 {
+            for (flag, given) in [
+                ("--unit-terms", self.unit_terms.is_some()),
+                ("--unit-prior-weight", self.unit_prior_weight.is_some()),
+            ] {
+                if given {
+                    return Err(anyhow!(
+                        "{flag}: --type-units 0 calibrates no unit against a type"
+                    ));
+                }
+            }
+        }
+        if let Some(w) = self.unit_prior_weight {
+            crate::train::type_unit::calibrate::check_prior_weight(w)?;
+        }
         if self.type_units == 0 && self.unit_runs < own_folds {
             return Err(anyhow!(
                 "--unit-runs {}: --type-units 0 trains the unit on its own runs alone, and grouped validation needs at least {own_folds}",
@@ -343,7 +362,8 @@ pub fn unit_model(
 ) -> Result<RecipeModel> {
     let (_, unit_params, own) = seeking_unit_runs(recipe)?;
     let unit_plan = UnitPlan {
-        terms: None,
+        terms: recipe.unit_terms,
+        prior_weight: recipe.unit_prior_weight,
         seek_period_s: seek_period_s(&unit_params, plan)?,
         symmetric_seeks: match &plan.seek_timing {
             Some(seeks) => seeks.mode.is_symmetric(),
@@ -380,6 +400,8 @@ mod tests {
             type_shape: TypeShape::Law,
             unit_fit: Fit::WithinRuns,
             unit_spread,
+            unit_terms: None,
+            unit_prior_weight: None,
         }
     }
 

@@ -70,6 +70,14 @@ pub fn check_seek_period(seek_period_s: f64) -> Result<()> {
     Ok(())
 }
 
+/// Checks a fixed prior weight (`--unit-prior-weight`), in runs.
+pub fn check_prior_weight(w: f64) -> Result<()> {
+    if !(w.is_finite() && w >= 0.0) {
+        bail!("--unit-prior-weight {w}: a weight in runs, finite and >= 0");
+    }
+    Ok(())
+}
+
 /// Fewest rows in a seek's window for it to be scored (a line takes two).
 const MIN_WINDOW_ROWS: usize = 3;
 /// Prior weights tried, in runs (0: the unit's own least squares).
@@ -89,6 +97,8 @@ pub enum MisfitPolicy {
 pub struct UnitPlan {
     /// Fix the number of unit terms (None: chosen by leave-one-run-out).
     pub terms: Option<usize>,
+    /// Fix the prior's weight, in runs (None: chosen with the terms from `PRIOR_WEIGHTS`).
+    pub prior_weight: Option<f64>,
     /// Time from one seek's start to the next's, s: the windows the held-out score reads.
     pub seek_period_s: f64,
     /// The device's seeks are time-symmetric (each window less its line; else less its
@@ -102,6 +112,7 @@ impl UnitPlan {
     pub fn chosen() -> Self {
         UnitPlan {
             terms: None,
+            prior_weight: None,
             seek_period_s: DEFAULT_SEEK_PERIOD_S,
             symmetric_seeks: false,
         }
@@ -141,6 +152,8 @@ pub struct UnitCalibration {
     /// and whether each window's line was taken out or only its mean.
     pub seek_period_s: f64,
     pub symmetric_seeks: bool,
+    /// How terms and weight were chosen (`leave-one-run-out`, or what was fixed).
+    pub chosen_by: String,
     pub candidates: Vec<UnitCandidate>,
     pub misfit: Misfit,
     #[serde(skip)]
@@ -160,13 +173,14 @@ impl UnitCalibration {
             self.term_names[..self.terms].join(", ")
         };
         s += &format!(
-            "unit {} calibrated on {} runs against type {}: unit terms fitted: {fitted}; prior weight {} runs; held-out drift rms {:.4} deg/h in the first {SCORED_SEEKS} {} seeks of {:.0} s, each less its {} ({:.4} with the type alone, {:+.1} %), chosen by leave-one-run-out\n",
+            "unit {} calibrated on {} runs against type {}: unit terms fitted: {fitted}; prior weight {} runs; held-out drift rms {:.4} deg/h in the first {SCORED_SEEKS} {} seeks of {:.0} s, each less its {} ({:.4} with the type alone, {:+.1} %), chosen by {}\n",
             self.unit_id, self.runs, self.type_id, self.prior_weight, self.chosen_drift_dph,
             if self.symmetric_seeks { "time-symmetric" } else { "forward" },
             self.seek_period_s,
             if self.symmetric_seeks { "line" } else { "mean" },
             self.type_alone_drift_dph,
-            100.0 * (self.type_alone_drift_dph / self.chosen_drift_dph - 1.0)
+            100.0 * (self.type_alone_drift_dph / self.chosen_drift_dph - 1.0),
+            self.chosen_by
         );
         s
     }
@@ -218,6 +232,9 @@ pub fn check_unit_runs(ty: &TypeModel, runs: &[Run], unit_id: &str, plan: &UnitP
         );
     }
     check_seek_period(plan.seek_period_s)?;
+    if let Some(w) = plan.prior_weight {
+        check_prior_weight(w)?;
+    }
     let p = ty.file.terms.len();
     if let Some(m) = plan.terms {
         if m > p {
@@ -268,7 +285,10 @@ pub fn calibrate_unit(
         Some(m) => vec![m],
         None => (0..=most).collect(),
     };
-    let candidates = scan(&rows, &ty.file.order, &counts, prior, plan);
+    let weights = plan
+        .prior_weight
+        .map_or(PRIOR_WEIGHTS.to_vec(), |w| vec![w]);
+    let candidates = scan(&rows, &ty.file.order, &counts, &weights, prior, plan);
     let type_alone = candidates
         .iter()
         .find(|c| c.terms == 0)
@@ -295,6 +315,13 @@ pub fn calibrate_unit(
         chosen_drift_dph: chosen.heldout_drift_dph,
         seek_period_s: plan.seek_period_s,
         symmetric_seeks: plan.symmetric_seeks,
+        chosen_by: match (plan.terms, plan.prior_weight) {
+            (None, None) => "leave-one-run-out",
+            (Some(_), None) => "leave-one-run-out of the prior weight (--unit-terms fixed)",
+            (None, Some(_)) => "leave-one-run-out of the terms (--unit-prior-weight fixed)",
+            (Some(_), Some(_)) => "--unit-terms and --unit-prior-weight (fixed)",
+        }
+        .into(),
         candidates,
         misfit,
         model: folded,
@@ -302,23 +329,20 @@ pub fn calibrate_unit(
 }
 
 /// Every candidate: the first m terms of `order` for each m of `counts`, at every prior
-/// weight (the type alone, m = 0, at the prior's mean), each scored by `held_out` on the
-/// plan's seeks.
+/// weight of `weights` (the type alone, m = 0, at the prior's mean), each scored by
+/// `held_out` on the plan's seeks.
 fn scan(
     rows: &UnitRows,
     order: &[usize],
     counts: &[usize],
+    weights: &[f64],
     prior: Prior,
     plan: &UnitPlan,
 ) -> Vec<UnitCandidate> {
     let mut candidates = Vec::new();
     for &m in counts {
         let kept = &order[..m];
-        let weights: &[f64] = if m == 0 {
-            &[f64::INFINITY]
-        } else {
-            &PRIOR_WEIGHTS
-        };
+        let weights: &[f64] = if m == 0 { &[f64::INFINITY] } else { weights };
         for &w in weights {
             if let Some(c) = held_out(rows, kept, prior, w, plan) {
                 candidates.push(UnitCandidate {
@@ -508,7 +532,7 @@ mod tests {
             mean: &[0.0],
             spread: &[0.01],
         };
-        let cands = scan(rows, &[0], &[0, 1], prior, plan);
+        let cands = scan(rows, &[0], &[0, 1], &PRIOR_WEIGHTS, prior, plan);
         let alone = cands
             .iter()
             .find(|c| c.terms == 0)
