@@ -517,6 +517,7 @@ mod tests {
 
     const SYMMETRIC: UnitPlan = UnitPlan {
         terms: None,
+        prior_weight: None,
         seek_period_s: DEFAULT_SEEK_PERIOD_S,
         symmetric_seeks: true,
     };
