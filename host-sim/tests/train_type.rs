@@ -426,6 +426,56 @@ fn an_independent_odd_unit_is_outside_its_type_and_a_normal_unit_is_within_it() 
     println!("{:.1} s", t0.elapsed().as_secs_f64());
 }
 
+/// A fixed choice (`--unit-terms`, `--unit-prior-weight`) is what is fitted, and is still
+/// scored beside the type alone, so the summary can compare the two.
+#[test]
+fn a_fixed_unit_step_fits_what_it_is_told_and_reports_the_type_alone_beside_it() {
+    let f = fleet(
+        FleetLaw::Type,
+        UNITS,
+        &AMBIENTS_C,
+        RUNS_PER_AMBIENT,
+        MINUTES,
+        1,
+    );
+    let id = format!("U{UNITS}");
+    let (own, others): (Vec<Run>, Vec<Run>) = f
+        .runs
+        .into_iter()
+        .partition(|r| r.meta_value("unit_id") == Some(id.as_str()));
+    let ty = learn_type(
+        &others,
+        Some("independent"),
+        Fit::default(),
+        &mut train_shared,
+    )
+    .unwrap();
+    let plan = UnitPlan {
+        terms: Some(2),
+        prior_weight: Some(0.3),
+        ..UnitPlan::chosen()
+    };
+    let cal = calibrate_unit(&ty, &own, &id, &plan).unwrap();
+    let summary = cal.summary();
+    println!("{summary}");
+    assert_eq!((cal.terms, cal.prior_weight), (2, 0.3));
+    assert!(cal.type_alone_drift_dph.is_finite(), "{summary}");
+    assert!(
+        summary.contains("chosen by --unit-terms and --unit-prior-weight (fixed)"),
+        "{summary}"
+    );
+    // the weight fixed alone: every count tried at that weight
+    let weight_only = UnitPlan {
+        terms: None,
+        ..plan
+    };
+    let cal = calibrate_unit(&ty, &own, &id, &weight_only).unwrap();
+    assert!(cal
+        .candidates
+        .iter()
+        .all(|c| c.terms == 0 || c.prior_weight == 0.3));
+}
+
 /// Measured (seeds 1..=18, every unit in turn): the null twin's largest |z| / critical was
 /// at most 0.71 (|z| at most 3.6); seed 1 here: at most 0.34.
 #[test]

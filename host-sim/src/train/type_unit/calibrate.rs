@@ -281,8 +281,10 @@ pub fn calibrate_unit(
     );
     // At most one term per run: more cannot be told apart by leaving runs out.
     let most = plan.terms.unwrap_or(terms.len().min(rows.runs));
+    // a fixed count is scored beside the type alone, which the summary compares it with
     let counts: Vec<usize> = match plan.terms {
-        Some(m) => vec![m],
+        Some(0) => vec![0],
+        Some(m) => vec![0, m],
         None => (0..=most).collect(),
     };
     let weights = plan
@@ -293,7 +295,12 @@ pub fn calibrate_unit(
         .iter()
         .find(|c| c.terms == 0)
         .map_or(f64::NAN, |c| c.heldout_drift_dph);
-    let chosen = choose(&candidates).ok_or_else(|| {
+    let allowed: Vec<UnitCandidate> = candidates
+        .iter()
+        .filter(|c| plan.terms.is_none_or(|m| c.terms == m))
+        .cloned()
+        .collect();
+    let chosen = choose(&allowed).ok_or_else(|| {
         anyhow!("unit {unit_id}: no unit calibration could be scored on held-out runs")
     })?;
     let kept: Vec<usize> = ty.file.order[..chosen.terms].to_vec();
