@@ -335,9 +335,9 @@ fn train_shared(runs: Vec<Run>) -> anyhow::Result<RbfModel> {
     Ok(train_model(&ds, &cfg)?.model)
 }
 
-/// Unit `unit` (1-based) of the independent fleet `law` (seed `seed`) calibrated against a
-/// type learnt from every other unit.
-fn calibrated(law: FleetLaw, seed: u64, unit: usize) -> (TypeModel, UnitCalibration) {
+/// Unit `unit` (1-based) of the independent fleet `law` (seed `seed`): the type learnt from
+/// every other unit, the unit's runs and its id.
+fn type_and_unit(law: FleetLaw, seed: u64, unit: usize) -> (TypeModel, Vec<Run>, String) {
     let f = fleet(law, UNITS, &AMBIENTS_C, RUNS_PER_AMBIENT, MINUTES, seed);
     let id = format!("U{unit}");
     let (own, others): (Vec<Run>, Vec<Run>) = f
@@ -351,8 +351,13 @@ fn calibrated(law: FleetLaw, seed: u64, unit: usize) -> (TypeModel, UnitCalibrat
         &mut train_shared,
     )
     .unwrap();
-    let plan = UnitPlan::chosen();
-    let cal = calibrate_unit(&ty, &own, &id, &plan).unwrap();
+    (ty, own, id)
+}
+
+/// That unit calibrated against that type, its choice made by leave-one-run-out.
+fn calibrated(law: FleetLaw, seed: u64, unit: usize) -> (TypeModel, UnitCalibration) {
+    let (ty, own, id) = type_and_unit(law, seed, unit);
+    let cal = calibrate_unit(&ty, &own, &id, &UnitPlan::chosen()).unwrap();
     (ty, cal)
 }
 
@@ -430,26 +435,7 @@ fn an_independent_odd_unit_is_outside_its_type_and_a_normal_unit_is_within_it() 
 /// scored beside the type alone, so the summary can compare the two.
 #[test]
 fn a_fixed_unit_step_fits_what_it_is_told_and_reports_the_type_alone_beside_it() {
-    let f = fleet(
-        FleetLaw::Type,
-        UNITS,
-        &AMBIENTS_C,
-        RUNS_PER_AMBIENT,
-        MINUTES,
-        1,
-    );
-    let id = format!("U{UNITS}");
-    let (own, others): (Vec<Run>, Vec<Run>) = f
-        .runs
-        .into_iter()
-        .partition(|r| r.meta_value("unit_id") == Some(id.as_str()));
-    let ty = learn_type(
-        &others,
-        Some("independent"),
-        Fit::default(),
-        &mut train_shared,
-    )
-    .unwrap();
+    let (ty, own, id) = type_and_unit(FleetLaw::Type, 1, UNITS);
     let plan = UnitPlan {
         terms: Some(2),
         prior_weight: Some(0.3),
