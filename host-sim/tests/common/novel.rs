@@ -4,7 +4,9 @@
 //! causes at once, and a transient after each event (issue 38 item 1: a step of the
 //! supply, or a gap of the time stamps, each followed by a decay), and a product of two
 //! columns neither of which is the temperature (issue 38 item 2: the supply's coefficient
-//! set by the cabinet's temperature). Each family has an effect, a twin with a different physical law and a
+//! set by the cabinet's temperature), and a narrow feature of one column (issue 38 item 1:
+//! a peak a quarter of a degree wide in the cabinet's temperature; twin, a band of half a
+//! degree where the bias jumps, as a mode hop does). Each family has an effect, a twin with a different physical law and a
 //! null twin (same campaign, nothing planted). Nothing is shared with the project's
 //! simulator or the other generators: its own warm-up law (first-order self-heating on a
 //! chamber that cycles through a lag), cold / warm / hot restarts, turn-on offsets, 0.0625
@@ -37,9 +39,10 @@ pub enum Family {
     Stacked,
     Event,
     Pairwise,
+    Peak,
 }
 
-pub const FAMILIES: [Family; 8] = [
+pub const FAMILIES: [Family; 9] = [
     Family::Product,
     Family::Categorical,
     Family::Smooth,
@@ -48,6 +51,7 @@ pub const FAMILIES: [Family; 8] = [
     Family::Stacked,
     Family::Event,
     Family::Pairwise,
+    Family::Peak,
 ];
 
 /// The effect, its twin (another physical law on the same columns) or the null twin.
@@ -80,7 +84,11 @@ impl Family {
     /// Row period of this family's campaigns, s (half at 1 Hz, half 10 s means).
     pub fn row_s(self) -> f64 {
         match self {
-            Family::Product | Family::Smooth | Family::Stacked | Family::Pairwise => 1.0,
+            Family::Product
+            | Family::Smooth
+            | Family::Stacked
+            | Family::Pairwise
+            | Family::Peak => 1.0,
             Family::Categorical | Family::Memory | Family::Metadata | Family::Event => 10.0,
         }
     }
@@ -117,6 +125,14 @@ impl Family {
             (Family::Pairwise, Variant::Twin) => (
                 "(supply_v-24) x (cabinet through a 600 s lag - c0)",
                 vec!["supply_v", "cabinet_c"],
+            ),
+            (Family::Peak, Variant::Effect) => (
+                "narrow peak exp(-((cabinet-c40)/0.25 degC)^2)",
+                vec!["cabinet_c"],
+            ),
+            (Family::Peak, Variant::Twin) => (
+                "mode-hop band: bias up while |cabinet-c40| < 0.25 degC",
+                vec!["cabinet_c"],
             ),
         };
         Truth { law, columns }
@@ -377,6 +393,8 @@ enum Cause {
     GapTransient,
     SupplyCabinet,
     SupplyCabinetLagged,
+    CabinetPeak,
+    CabinetBand,
 }
 
 fn causes(f: Family, v: Variant) -> Vec<Cause> {
@@ -398,6 +416,8 @@ fn causes(f: Family, v: Variant) -> Vec<Cause> {
         (Family::Event, Variant::Twin) => vec![Cause::GapTransient],
         (Family::Pairwise, Variant::Effect) => vec![Cause::SupplyCabinet],
         (Family::Pairwise, Variant::Twin) => vec![Cause::SupplyCabinetLagged],
+        (Family::Peak, Variant::Effect) => vec![Cause::CabinetPeak],
+        (Family::Peak, Variant::Twin) => vec![Cause::CabinetBand],
     }
 }
 
@@ -405,6 +425,8 @@ fn causes(f: Family, v: Variant) -> Vec<Cause> {
 struct Law {
     temp_mid_c: f64,
     cabinet_mid_c: f64,
+    /// The cabinet's 40th percentile over the campaign (where its range is well covered).
+    cabinet_p40_c: f64,
     mode_bias: [f64; 3],
     dt: f64,
     /// Time constant of the transients after events, s.
@@ -463,6 +485,16 @@ fn shape_of(c: Cause, s: &Series, law: &Law) -> Vec<f64> {
         Cause::SupplyCabinet => supply_times(s, &s.cabinet_c, law),
         // the part whose coefficient it is sits in the cabinet, behind its own thermal lag
         Cause::SupplyCabinetLagged => supply_times(s, &lag(&s.cabinet_c, law.dt, 600.0), law),
+        Cause::CabinetPeak => s
+            .cabinet_c
+            .iter()
+            .map(|c| (-((c - law.cabinet_p40_c) / 0.25).powi(2)).exp())
+            .collect(),
+        Cause::CabinetBand => s
+            .cabinet_c
+            .iter()
+            .map(|c| f64::from(u8::from((c - law.cabinet_p40_c).abs() < 0.25)))
+            .collect(),
     }
 }
 
@@ -476,8 +508,13 @@ fn supply_times(s: &Series, cabinet_c: &[f64], law: &Law) -> Vec<f64> {
 }
 
 fn median(v: &mut [f64]) -> f64 {
+    quantile(v, 0.5)
+}
+
+/// The `q` quantile of `v` (sorts it; the nearest row below).
+fn quantile(v: &mut [f64], q: f64) -> f64 {
     v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
+    v[(q * v.len() as f64) as usize]
 }
 
 /// What the logger writes of run `i`: the sensed columns (thermometer, cabinet and supply
@@ -550,6 +587,7 @@ pub fn campaign(family: Family, variant: Variant, seed: u64, shape: Shape) -> (V
         .collect();
     let mut bias = [0.0, rng.random_range(0.5..1.0), -rng.random_range(0.5..1.0)];
     bias.swap(0, rng.random_range(0..3));
+    let mut pooled_cabinet: Vec<f64> = series.iter().flat_map(|s| s.cabinet_c.clone()).collect();
     let law = Law {
         temp_mid_c: median(
             &mut series
@@ -557,12 +595,8 @@ pub fn campaign(family: Family, variant: Variant, seed: u64, shape: Shape) -> (V
                 .flat_map(|s| s.temp_c.clone())
                 .collect::<Vec<_>>(),
         ),
-        cabinet_mid_c: median(
-            &mut series
-                .iter()
-                .flat_map(|s| s.cabinet_c.clone())
-                .collect::<Vec<_>>(),
-        ),
+        cabinet_mid_c: median(&mut pooled_cabinet),
+        cabinet_p40_c: quantile(&mut pooled_cabinet, 0.4),
         mode_bias: bias,
         dt,
         transient_tau_s: if family == Family::Event {

@@ -6,7 +6,7 @@
 //! selection's, not the library's or the test's.
 //!
 //! Rows are averaged to 10 s means; the library is built from every column and metadata
-//! key (value, hinges at the quartiles, d/dt and d2/dt2 over a fixed +/-3 row window,
+//! key (value, hinges at the deciles, d/dt and d2/dt2 over a fixed +/-3 row window,
 //! first-order lags of 60 / 300 / 1500 s, products with temp_c and dT/dt, products of the
 //! values of every two columns other than t_s and temp_c (issue 38 item 2: `diagnose`
 //! screens these down to a few; a peer is offered them all and selects as it selects the
@@ -134,10 +134,13 @@ fn levels(runs: &[Run], name: &str) -> Option<Vec<f64>> {
     (seen.len() >= 2).then_some(seen)
 }
 
-fn quartiles(v: &[f64]) -> [f64; 3] {
+/// The nine deciles of `v` (hinges there give a peer a feature a tenth of a column's
+/// range wide, as `diagnose`'s splines of 10 knots; its 16-40 knots are not offered to
+/// the peers, whose best-subset search grows as the fourth power of the library).
+fn deciles(v: &[f64]) -> [f64; 9] {
     let mut s = v.to_vec();
     s.sort_by(f64::total_cmp);
-    [0.25, 0.5, 0.75].map(|q| s[((s.len() - 1) as f64 * q) as usize])
+    std::array::from_fn(|j| s[((s.len() - 1) as f64 * (j + 1) as f64 / 10.0) as usize])
 }
 
 /// Within-run features of one column, stacked over runs.
@@ -245,9 +248,9 @@ fn meta_features(runs: &[Run], ri: usize, n: usize) -> Vec<(String, Vec<f64>)> {
     feats
 }
 
-/// max(0, x - q) at the quartiles q of `x` (a linear spline basis beside the value).
+/// max(0, x - q) at the deciles q of `x` (a linear spline basis beside the value).
 fn hinges(name: &str, x: &[f64]) -> Vec<(String, Vec<f64>)> {
-    quartiles(x)
+    deciles(x)
         .into_iter()
         .map(|q| {
             (
@@ -363,7 +366,7 @@ pub fn table(runs: &[Run]) -> Table {
         }
         run_rows.push(start..y.len());
     }
-    // hinges at the campaign's quartiles of every many-valued column
+    // hinges at the campaign's deciles of every many-valued column
     for (i, name) in names.iter().enumerate().filter(|(i, _)| few[*i].is_none()) {
         let x: Vec<f64> = per_run.iter().flat_map(|r| value(r, i)).collect();
         lib.extend(hinges(name, &x));

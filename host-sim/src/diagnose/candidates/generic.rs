@@ -1,7 +1,10 @@
 //! The generic candidate library (issue 18 item 2): built from the record's own columns
 //! and metadata, never from a list of expected effects. For every extra column: its value,
-//! a natural cubic spline of it (4 and 6 knots at campaign quantiles; which one, if any,
-//! is chosen on held-out data by the selection), d/dt and d2/dt2 (windows validated per
+//! natural cubic splines of it (4, 6, 10, 16, 25 and 40 knots at equally spaced campaign
+//! quantiles, so they are densest where the column's range is best covered; a count is
+//! offered only where every interval between its knots holds rows of at least
+//! `MIN_UNITS_BETWEEN_KNOTS` validation units, so the held-out test can check a feature
+//! there; which count, if any, is chosen on held-out data by the selection), d/dt and d2/dt2 (windows validated per
 //! column), its memory (first-order lags), levels when it has few distinct values, a
 //! sinusoid for angles (`*_deg`), and products of its value (or levels) with the base's
 //! inputs (T - mean T, dT/dt). For the temperature: d2/dt2 and memory (its value and
@@ -30,14 +33,20 @@ use crate::diagnose::candidates::pairs;
 use crate::diagnose::candidates::transforms::{BaseInput, Candidate, Source, Transform};
 use crate::diagnose::input::Campaign;
 use crate::stats::mean_or_zero;
+use std::ops::Range;
 
 /// Cap on the library's size (the rest are reported as skipped).
 pub const MAX_CANDIDATES: usize = 400;
-/// Knot counts of the natural splines (Harrell's quantile placements).
-pub const SPLINE_KNOTS: [&[f64]; 2] = [
-    &[0.05, 0.35, 0.65, 0.95],
-    &[0.05, 0.23, 0.41, 0.59, 0.77, 0.95],
-];
+/// Knot counts of the natural splines, sparsest first: from Harrell's 4 and 6 (a smooth
+/// law over the whole range) to 40 (a feature a fortieth of the covered range wide), each
+/// about 1.6 times the last.
+pub const SPLINE_KNOT_COUNTS: [usize; 6] = [4, 6, 10, 16, 25, 40];
+/// The outer knots' quantiles (Harrell's placement; the inner ones equally spaced).
+pub const OUTER_KNOT_QUANTILES: (f64, f64) = (0.05, 0.95);
+/// Fewest validation units (runs, or time blocks of a single record) whose rows must fall
+/// between every two neighbouring knots for a knot count to be offered: a narrow feature
+/// seen in one or two units cannot be told from those units' own drift by a held-out test.
+pub const MIN_UNITS_BETWEEN_KNOTS: usize = 3;
 /// Longest memory time scale, as a fraction of the shortest run.
 pub const LONGEST_TAU_FRACTION: f64 = 0.5;
 
@@ -111,10 +120,40 @@ fn quantile(sorted: &[f64], q: f64) -> f64 {
     sorted[lo] + (pos - lo as f64) * (sorted[hi] - sorted[lo])
 }
 
-/// Knots at `qs` of the pooled values, when they are distinct.
-fn knots_at(sorted: &[f64], qs: &[f64]) -> Option<Vec<f64>> {
-    let k: Vec<f64> = qs.iter().map(|q| quantile(sorted, *q)).collect();
+/// `count` knots at equally spaced quantiles of the pooled values (`OUTER_KNOT_QUANTILES`
+/// at the ends), when they are distinct.
+fn knots_at(sorted: &[f64], count: usize) -> Option<Vec<f64>> {
+    let (lo, hi) = OUTER_KNOT_QUANTILES;
+    let step = (hi - lo) / (count.max(2) - 1) as f64;
+    let k: Vec<f64> = (0..count)
+        .map(|j| quantile(sorted, lo + step * j as f64))
+        .collect();
     k.windows(2).all(|w| w[1] > w[0]).then_some(k)
+}
+
+/// How many of the intervals between neighbouring `knots` hold rows of fewer than
+/// `MIN_UNITS_BETWEEN_KNOTS` of the validation units (`unit_rows` of the stacked column
+/// `x`; all of them when there are fewer units).
+fn thin_intervals(x: &[f64], unit_rows: &[Range<usize>], knots: &[f64]) -> usize {
+    let need = MIN_UNITS_BETWEEN_KNOTS.min(unit_rows.len());
+    let intervals = knots.len().saturating_sub(1);
+    let mut seen = vec![0usize; intervals];
+    for rows in unit_rows {
+        let mut here = vec![false; intervals];
+        for v in x.get(rows.clone()).unwrap_or(&[]) {
+            // interval j holds knots[j] <= v < knots[j + 1] (the last one includes its end)
+            let j = knots.partition_point(|k| k <= v);
+            if (1..=intervals).contains(&j) {
+                here[j - 1] = true;
+            } else if j > intervals && *v == knots[intervals] {
+                here[intervals - 1] = true;
+            }
+        }
+        seen.iter_mut()
+            .zip(here)
+            .for_each(|(s, h)| *s += usize::from(h));
+    }
+    seen.iter().filter(|s| **s < need).count()
 }
 
 /// The built library: its candidates, in a fixed order, and what was left out.
@@ -131,11 +170,13 @@ pub struct Built {
 /// metadata (products only), then the event clocks, in a fixed order; what the cap left
 /// out and why a column has no event clock.
 /// The pairwise products go through `keep_pairs` (the screen, `pairs::screened`) and
-/// come last.
+/// come last. `unit_rows` are the validation units' rows of the stacked campaign (which
+/// spline knot counts the record covers).
 pub fn enumerate(
     c: &Campaign,
     meta: &[MetaColumn],
     base_rate_half_s: f64,
+    unit_rows: &[Range<usize>],
     keep_pairs: &KeepPairs,
 ) -> Built {
     let temps: Vec<f64> = c
@@ -178,11 +219,13 @@ pub fn enumerate(
             ..blank("temp_c", Source::Temp, Transform::Lag)
         });
     }
+    let mut notes = Vec::new();
     for (i, name) in c.extra_names.iter().enumerate() {
-        out.extend(column_candidates(c, i, name, &taus, &blank));
+        out.extend(column_candidates(
+            c, i, name, &taus, unit_rows, &blank, &mut notes,
+        ));
     }
     out.extend(metadata_products(meta, &blank));
-    let mut notes = Vec::new();
     out.extend(event_clocks(c, &taus, &blank, &mut notes));
     let (pairs, pair_note) = keep_pairs(pairs::all_pairs(c, &|i| centred_value(c, i, &blank)));
     out.extend(pairs);
@@ -261,13 +304,16 @@ fn centred_value(c: &Campaign, i: usize, blank: &Blank) -> Candidate {
     }
 }
 
-/// Every within-run candidate of extra column `i` (`name`).
+/// Every within-run candidate of extra column `i` (`name`); a note for the spline knot
+/// counts the record does not cover.
 fn column_candidates(
     c: &Campaign,
     i: usize,
     name: &str,
     taus: &[f64],
+    unit_rows: &[Range<usize>],
     blank: &Blank,
+    notes: &mut Vec<FamilyNote>,
 ) -> Vec<Candidate> {
     let mut out = Vec::new();
     let src = Source::Extra(i);
@@ -296,13 +342,27 @@ fn column_candidates(
     } else {
         let mut sorted = pooled.clone();
         sorted.sort_by(f64::total_cmp);
-        for qs in SPLINE_KNOTS {
-            if let Some(knots) = knots_at(&sorted, qs) {
-                out.push(Candidate {
-                    knots,
-                    ..blank(name, src, Transform::Spline)
+        for count in SPLINE_KNOT_COUNTS {
+            let Some(knots) = knots_at(&sorted, count) else {
+                continue;
+            };
+            let thin = thin_intervals(&pooled, unit_rows, &knots);
+            if thin > 0 {
+                notes.push(FamilyNote {
+                    family: OperatorFamily::Smooth,
+                    note: format!(
+                        "{name}: {count} knots not offered ({thin} of {} intervals between \
+                         them seen in fewer than {} validation units)",
+                        count - 1,
+                        MIN_UNITS_BETWEEN_KNOTS.min(unit_rows.len())
+                    ),
                 });
+                break;
             }
+            out.push(Candidate {
+                knots,
+                ..blank(name, src, Transform::Spline)
+            });
         }
     }
     for &tau in taus {
@@ -380,10 +440,32 @@ mod tests {
     #[test]
     fn knots_need_distinct_quantiles() {
         let v: Vec<f64> = (0..101).map(f64::from).collect();
-        assert_eq!(
-            knots_at(&v, SPLINE_KNOTS[0]).unwrap(),
-            vec![5.0, 35.0, 65.0, 95.0]
-        );
-        assert!(knots_at(&[1.0; 50], SPLINE_KNOTS[0]).is_none());
+        let k = knots_at(&v, 4).unwrap();
+        for (k, want) in k.iter().zip([5.0, 35.0, 65.0, 95.0]) {
+            assert!((k - want).abs() < 1e-9, "{k} against {want}");
+        }
+        assert_eq!(knots_at(&v, 16).unwrap().len(), 16);
+        assert!(knots_at(&[1.0; 50], 4).is_none());
+    }
+
+    #[test]
+    fn a_knot_count_needs_every_interval_seen_in_enough_units() {
+        // three units over 0..=9, a fourth only over 0..=4: every interval of 4 knots
+        // is seen by three units or more
+        let mut x: Vec<f64> = Vec::new();
+        let mut rows = Vec::new();
+        for hi in [9, 9, 9, 4] {
+            let start = x.len();
+            x.extend((0..=hi).map(f64::from));
+            rows.push(start..x.len());
+        }
+        assert_eq!(thin_intervals(&x, &rows, &[0.5, 3.5, 6.5, 9.0]), 0);
+        // one unit alone covers 10..=12: the interval reaching there is thin
+        let start = x.len();
+        x.extend([10.0, 11.0, 12.0]);
+        rows.push(start..x.len());
+        assert_eq!(thin_intervals(&x, &rows, &[0.5, 3.5, 9.5, 12.0]), 1);
+        // a single unit (one record's validation) needs only itself
+        assert_eq!(thin_intervals(&x, &rows[4..], &[10.0, 11.0, 12.0]), 0);
     }
 }

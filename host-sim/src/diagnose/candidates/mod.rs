@@ -31,7 +31,13 @@ pub fn library_of(
     base: &BaseFit,
 ) -> (generic::Built, Option<(String, String)>) {
     let keep_pairs = |p| pairs::screened(campaign, folds, base, p);
-    let library = generic::enumerate(campaign, meta, st.temp_rate_half_s, &keep_pairs);
+    let library = generic::enumerate(
+        campaign,
+        meta,
+        st.temp_rate_half_s,
+        &folds.unit_rows,
+        &keep_pairs,
+    );
     let left_out = library.cut_by_cap.len();
     memprobe::stage("library");
     let note = (left_out > 0).then(|| {

@@ -169,14 +169,21 @@ impl Candidate {
 
     /// Parsimony rank within a column (see `Transform::complexity`), except that for an
     /// angle (`*_deg`) the harmonic is the natural form: its raw value wraps at 360 deg
-    /// and is only equivalent when few headings occur (e.g. two, 180 deg apart).
-    pub fn complexity(&self) -> u8 {
+    /// and is only equivalent when few headings occur (e.g. two, 180 deg apart). Within a
+    /// transform, fewer spline knots rank simpler (a smooth law is named with the fewest
+    /// knots that are not significantly worse held out; a narrow feature keeps its many).
+    pub fn complexity(&self) -> (u8, usize) {
         let own = match self.transform {
             Transform::Harmonic if self.column.ends_with("_deg") => 0,
             Transform::Value if self.column.ends_with("_deg") => Transform::Harmonic.complexity(),
             t => t.complexity(),
         };
-        own + if self.is_product() { 16 } else { 0 }
+        let knots = if self.transform == Transform::Spline {
+            self.knots.len()
+        } else {
+            0
+        };
+        (own + if self.is_product() { 16 } else { 0 }, knots)
     }
 
     /// Whether the feature is multiplied by a base input or by another column.
@@ -329,6 +336,32 @@ mod tests {
         let y = first_order_lag(&t, &x, 100.0);
         // the step is held from t[0] to t[1]; ten 10 s steps later it has risen 1 - e^-1
         assert!((y[10] - (1.0 - (-1.0f64).exp())).abs() < 1e-12);
+    }
+
+    #[test]
+    fn fewer_knots_rank_simpler_and_a_spline_after_the_value() {
+        let spline = |knots: usize| Candidate {
+            column: "c".into(),
+            source: Source::Extra(0),
+            transform: Transform::Spline,
+            tau_s: None,
+            half_s: None,
+            knots: (0..knots).map(|k| k as f64).collect(),
+            levels: vec![],
+            times: None,
+            partner: None,
+            centres: (0.0, 0.0),
+            base_rate_half_s: 1.0,
+            run_values: vec![],
+            event: None,
+        };
+        let value = Candidate {
+            transform: Transform::Value,
+            knots: vec![],
+            ..spline(0)
+        };
+        assert!(spline(6).complexity() < spline(40).complexity());
+        assert!(value.complexity() < spline(4).complexity());
     }
 
     #[test]

@@ -15,6 +15,18 @@
 //! held-out drops of a product term are strongly negative in runs where the term is
 //! small (refitting moves the base there), which widens its own flipped totals; the
 //! score, linear in the term, is not (docs/record/diagnose.md, 2026-12-03).
+//!
+//! The score statistic of a term of k columns is about s^2 chi-square with k degrees of
+//! freedom under the null, so a raw maximum over the family would be set by its widest
+//! terms (a spline of 40 knots, 38 columns) and hide every one-column term. Each
+//! candidate's statistic is put on one scale before the maximum ([`ScoreScale`]): divided
+//! by a scale s^2 common to the whole family (the median over candidates of the flips'
+//! mean statistic per column, which is the sum over units of the squared score length
+//! and does not depend on the signs), then the Wilson-Hilferty cube root for its k, which
+//! makes a chi-square of any degrees of freedom nearly standard normal. The scale is the
+//! family's, not the candidate's own: a candidate's own flips would bound its statistic
+//! (a real effect's own energy would enter its scale). Any transform that does not
+//! depend on the signs keeps the test's level; this one keeps its power for every width.
 
 use crate::diagnose::validation::cv::CvResult;
 use crate::diagnose::validation::score::UnitScores;
@@ -76,7 +88,8 @@ pub fn max_t_pvalues_with_scores(gains: &[Vec<f64>], scores: &[UnitScores], seed
     };
     let pats = patterns(units, seed);
     let gain_null = NullMaxima::new(gain_maxima(gains, &pats));
-    let score_null = NullMaxima::new(score_maxima(scores, &pats));
+    let scales = ScoreScale::of_family(scores);
+    let score_null = NullMaxima::new(score_maxima(scores, &scales, &pats));
     let mut joint: Vec<f64> = gain_null
         .per_pattern
         .iter()
@@ -94,9 +107,9 @@ pub fn max_t_pvalues_with_scores(gains: &[Vec<f64>], scores: &[UnitScores], seed
         .enumerate()
         .map(|(k, g)| {
             let by_gain = gain_null.share_at_least(g.iter().sum());
-            let by_score = scores
-                .get(k)
-                .map_or(1.0, |w| score_null.share_at_least(flipped_score(w, 0)));
+            let by_score = scores.get(k).zip(scales.get(k)).map_or(1.0, |(w, scale)| {
+                score_null.share_at_least(scale.standardised(flipped_score(w, 0)))
+            });
             let own = by_gain.min(by_score);
             joint.partition_point(|&q| q <= own * (1.0 + 1e-12)) as f64 / n
         })
@@ -128,16 +141,59 @@ fn gain_maxima(gains: &[Vec<f64>], pats: &[u64]) -> Vec<f64> {
         .collect()
 }
 
-/// Each pattern's largest flipped score statistic over all candidates.
-fn score_maxima(scores: &[UnitScores], pats: &[u64]) -> Vec<f64> {
+/// Each pattern's largest standardised flipped score statistic over all candidates.
+fn score_maxima(scores: &[UnitScores], scales: &[ScoreScale], pats: &[u64]) -> Vec<f64> {
     pats.iter()
         .map(|&m| {
             scores
                 .iter()
-                .map(|w| flipped_score(w, m))
-                .fold(0.0, f64::max)
+                .zip(scales)
+                .map(|(w, scale)| scale.standardised(flipped_score(w, m)))
+                .fold(f64::NEG_INFINITY, f64::max)
         })
         .collect()
+}
+
+/// The common scale of the score statistics (`s^2`) and one candidate's width `k`: the
+/// statistic on the scale is the Wilson-Hilferty normal deviate of `stat / s^2` as a
+/// chi-square with k degrees of freedom.
+#[derive(Clone, Copy, Debug)]
+struct ScoreScale {
+    scale: f64,
+    columns: usize,
+}
+
+impl ScoreScale {
+    /// One scale per candidate, `s^2` shared (see the module's note).
+    fn of_family(scores: &[UnitScores]) -> Vec<Self> {
+        let width = |w: &UnitScores| w.first().map_or(0, Vec::len);
+        let mut per_column: Vec<f64> = scores
+            .iter()
+            .filter(|w| width(w) > 0)
+            .map(|w| w.iter().flatten().map(|v| v * v).sum::<f64>() / width(w) as f64)
+            .filter(|v| v.is_finite() && *v > 0.0)
+            .collect();
+        per_column.sort_by(f64::total_cmp);
+        let scale = per_column.get(per_column.len() / 2).copied().unwrap_or(0.0);
+        scores
+            .iter()
+            .map(|w| Self {
+                scale,
+                columns: width(w),
+            })
+            .collect()
+    }
+
+    /// The statistic on the common scale; minus infinity for an empty score or no scale,
+    /// so it never sets a maximum.
+    fn standardised(self, stat: f64) -> f64 {
+        if self.columns == 0 || self.scale <= 0.0 {
+            return f64::NEG_INFINITY;
+        }
+        let k = self.columns as f64;
+        let v = 2.0 / (9.0 * k);
+        ((stat / self.scale / k).cbrt() - (1.0 - v)) / v.sqrt()
+    }
 }
 
 /// Squared length of the sum over units of the whitened score vectors `w`, unit u's
@@ -272,5 +328,24 @@ mod tests {
         }
         let none = vec![vec![]; 2];
         assert_eq!(max_t_pvalues_with_scores(&gains, &none, 1), by_gain);
+    }
+
+    #[test]
+    fn a_wide_null_term_does_not_hide_a_one_column_effect() {
+        // Unit u's whitened score of a one-column effect: consistent in sign. A null term
+        // of 38 columns: random signs, each column of the same size, so its squared length
+        // (about 38 per unit squared) dwarfs the effect's on the raw scale.
+        let units = 12;
+        let effect: Vec<Vec<f64>> = (0..units)
+            .map(|u| vec![1.0 + 0.1 * (u % 3) as f64])
+            .collect();
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let wide: Vec<Vec<f64>> = (0..units)
+            .map(|_| (0..38).map(|_| rng.random_range(-1.5..1.5)).collect())
+            .collect();
+        let gains = vec![vec![0.0; units]; 2];
+        let p = max_t_pvalues_with_scores(&gains, &[effect, wide], 1);
+        assert!(p[0] < 0.01, "{p:?}");
+        assert!(p[1] > 0.1, "{p:?}");
     }
 }
