@@ -7,7 +7,8 @@
 //!
 //! Rows are averaged to 10 s means; the library is built from every column and metadata
 //! key (value, hinges at the deciles, d/dt and d2/dt2 over a fixed +/-3 row window,
-//! first-order lags of 60 / 300 / 1500 s, products with temp_c and dT/dt, products of the
+//! first-order lags of 60 / 300 / 1500 s, stop operators (the column less its play, issue 38
+//! item 6) at 2.5 / 5 / 10 % of its median within-run range, products with temp_c and dT/dt, products of the
 //! values of every two columns other than t_s and temp_c (issue 38 item 2: `diagnose`
 //! screens these down to a few; a peer is offered them all and selects as it selects the
 //! rest), sin/cos of `_deg` columns, level indicators of columns with <= 5 values, run means
@@ -17,6 +18,7 @@
 //! the whole library (family-wise at each step; within-run and run-level columns as two
 //! families, Bonferroni), gives p < ALPHA; the first term that fails ends the naming.
 
+use fog_sim::diagnose::candidates::hysteresis::stop;
 use fog_sim::io::runs::Run;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -29,6 +31,8 @@ const BIN_S: f64 = 10.0;
 const DERIV_HALF_ROWS: usize = 3;
 const LAGS_S: [f64; 3] = [60.0, 300.0, 1500.0];
 const MAX_LEVELS: usize = 5;
+/// Half-widths of the stop operators, as shares of a column's median within-run range.
+const STOP_SHARES: [f64; 3] = [0.025, 0.05, 0.1];
 
 /// A named term.
 #[derive(Clone, Debug)]
@@ -248,6 +252,31 @@ fn meta_features(runs: &[Run], ri: usize, n: usize) -> Vec<(String, Vec<f64>)> {
     feats
 }
 
+/// Rate-independent memory: the stop operator (the column less its play) of one column,
+/// per run (`xs`) and stacked, at `STOP_SHARES` of its median within-run range.
+fn stops(name: &str, xs: &[Vec<f64>]) -> Vec<(String, Vec<f64>)> {
+    let mut ranges: Vec<f64> = xs
+        .iter()
+        .map(|x| {
+            let hi = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let lo = x.iter().copied().fold(f64::INFINITY, f64::min);
+            hi - lo
+        })
+        .collect();
+    ranges.sort_by(f64::total_cmp);
+    let range = ranges.get(ranges.len() / 2).copied().unwrap_or(0.0);
+    STOP_SHARES
+        .iter()
+        .map(|share| {
+            let h = share * range;
+            (
+                format!("{name}:stop{h:.3}"),
+                xs.iter().flat_map(|x| stop(x, h)).collect(),
+            )
+        })
+        .collect()
+}
+
 /// max(0, x - q) at the deciles q of `x` (a linear spline basis beside the value).
 fn hinges(name: &str, x: &[f64]) -> Vec<(String, Vec<f64>)> {
     deciles(x)
@@ -370,6 +399,14 @@ pub fn table(runs: &[Run]) -> Table {
     for (i, name) in names.iter().enumerate().filter(|(i, _)| few[*i].is_none()) {
         let x: Vec<f64> = per_run.iter().flat_map(|r| value(r, i)).collect();
         lib.extend(hinges(name, &x));
+    }
+    for (i, name) in names
+        .iter()
+        .enumerate()
+        .filter(|(i, n)| few[*i].is_none() && n.as_str() != "t_s")
+    {
+        let xs: Vec<Vec<f64>> = per_run.iter().map(|r| value(r, i)).collect();
+        lib.extend(stops(name, &xs));
     }
     lib.retain(|(_, v)| varies(v));
     Table {

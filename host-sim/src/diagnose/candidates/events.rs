@@ -170,17 +170,26 @@ fn local_line_residuals(t: &[f64], x: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// The step rule of a column (`x` gives it per run), or why it has no clock.
-pub fn step_rule(c: &Campaign, x: impl Fn(&Series) -> &[f64]) -> Result<EventRule, String> {
+/// The column's robust noise sigma (`x` gives it per run): its scatter about a local
+/// line, 1.4826 x the median absolute value over the campaign (NaN without rows).
+pub fn noise_sigma(c: &Campaign, x: impl Fn(&Series) -> &[f64]) -> f64 {
     let pooled: Vec<f64> = c
         .runs
         .iter()
         .flat_map(|s| local_line_residuals(&s.t_s, x(s)))
         .collect();
-    if pooled.len() < 2 {
+    if pooled.is_empty() {
+        return f64::NAN;
+    }
+    robust_sigma(pooled)
+}
+
+/// The step rule of a column (`x` gives it per run), or why it has no clock.
+pub fn step_rule(c: &Campaign, x: impl Fn(&Series) -> &[f64]) -> Result<EventRule, String> {
+    if c.runs.iter().map(|s| x(s).len()).sum::<usize>() < 2 {
         return Err("too few rows".into());
     }
-    let threshold = EVENT_SIGMAS * std::f64::consts::SQRT_2 * robust_sigma(pooled);
+    let threshold = EVENT_SIGMAS * std::f64::consts::SQRT_2 * noise_sigma(c, &x);
     if !threshold.is_finite() {
         return Err("noise not finite".into());
     }

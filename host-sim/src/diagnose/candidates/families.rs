@@ -14,6 +14,7 @@ pub enum OperatorFamily {
     Smooth,
     Derivative,
     Memory,
+    Hysteresis,
     PowerOnDecay,
     Harmonic,
     Levels,
@@ -24,11 +25,12 @@ pub enum OperatorFamily {
 }
 
 /// Every family, in the report's order.
-pub const ALL: [OperatorFamily; 11] = [
+pub const ALL: [OperatorFamily; 12] = [
     OperatorFamily::Value,
     OperatorFamily::Smooth,
     OperatorFamily::Derivative,
     OperatorFamily::Memory,
+    OperatorFamily::Hysteresis,
     OperatorFamily::PowerOnDecay,
     OperatorFamily::Harmonic,
     OperatorFamily::Levels,
@@ -46,6 +48,7 @@ impl OperatorFamily {
             Self::Smooth => "smooth (spline)",
             Self::Derivative => "derivative",
             Self::Memory => "memory (lag)",
+            Self::Hysteresis => "hysteresis (play)",
             Self::PowerOnDecay => "power-on decay",
             Self::Harmonic => "angle harmonic",
             Self::Levels => "levels",
@@ -73,6 +76,7 @@ impl OperatorFamily {
             Transform::Spline => Self::Smooth,
             Transform::Rate | Transform::Accel => Self::Derivative,
             Transform::Lag => Self::Memory,
+            Transform::Hysteresis => Self::Hysteresis,
             Transform::Decay => Self::PowerOnDecay,
             Transform::Harmonic => Self::Harmonic,
             Transform::Levels => Self::Levels,

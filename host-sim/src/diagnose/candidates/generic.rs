@@ -28,6 +28,7 @@
 
 use crate::diagnose::candidates::events;
 use crate::diagnose::candidates::families::{FamilyNote, OperatorFamily};
+use crate::diagnose::candidates::hysteresis;
 use crate::diagnose::candidates::metadata::{MetaColumn, MetaKind, MAX_LEVELS};
 use crate::diagnose::candidates::pairs;
 use crate::diagnose::candidates::transforms::{BaseInput, Candidate, Source, Transform};
@@ -203,6 +204,7 @@ pub fn enumerate(
         base_rate_half_s,
         run_values: vec![],
         event: None,
+        width: None,
     };
     let taus = memory_taus_s(c);
     let mut out = Vec::new();
@@ -220,6 +222,7 @@ pub fn enumerate(
         });
     }
     let mut notes = Vec::new();
+    out.extend(hysteresis_of(c, "temp_c", Source::Temp, &blank, &mut notes));
     for (i, name) in c.extra_names.iter().enumerate() {
         out.extend(column_candidates(
             c, i, name, &taus, unit_rows, &blank, &mut notes,
@@ -371,6 +374,9 @@ fn column_candidates(
             ..blank(name, src, Transform::Lag)
         });
     }
+    if levels.is_none() {
+        out.extend(hysteresis_of(c, name, src, blank, notes));
+    }
     for b in [BaseInput::Temp, BaseInput::TempRate] {
         out.push(Candidate {
             times: Some(b),
@@ -378,6 +384,33 @@ fn column_candidates(
         });
     }
     out
+}
+
+/// The stop operator of a many-valued column on every play width its record supports
+/// (`hysteresis`); a note when it supports none.
+fn hysteresis_of(
+    c: &Campaign,
+    name: &str,
+    src: Source,
+    blank: &Blank,
+    notes: &mut Vec<FamilyNote>,
+) -> Vec<Candidate> {
+    match hysteresis::widths(c, |s| src.of(s).unwrap_or(&[])) {
+        Ok(w) => w
+            .into_iter()
+            .map(|h| Candidate {
+                width: Some(h),
+                ..blank(name, src, Transform::Hysteresis)
+            })
+            .collect(),
+        Err(why) => {
+            notes.push(FamilyNote {
+                family: OperatorFamily::Hysteresis,
+                note: format!("{name}: {why}"),
+            });
+            vec![]
+        }
+    }
 }
 
 /// Products of every run-constant metadata column (its value, or its levels) with the

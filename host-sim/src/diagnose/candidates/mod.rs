@@ -2,13 +2,15 @@
 //! (values, smooth functions, derivatives, memory, levels, products with the base's
 //! inputs; `generic`), metadata of every type as run-constant columns (`metadata`) and
 //! what the device can compute of it causally; event clocks (`events`), products of two
-//! extra columns screened against the base (`pairs`) and the operator families the report
-//! counts and checks per family (`families`).
+//! extra columns screened against the base (`pairs`), rate-independent memory
+//! (`hysteresis`) and the operator families the report counts and checks per family
+//! (`families`).
 
 pub mod causal;
 pub mod events;
 pub mod families;
 pub mod generic;
+pub mod hysteresis;
 pub mod metadata;
 pub mod pairs;
 pub mod transforms;

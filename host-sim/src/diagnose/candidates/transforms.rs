@@ -14,6 +14,7 @@
 //! (or each gap of the time stamps; `events`).
 
 use crate::diagnose::candidates::events::{clock_decay, EventRule};
+use crate::diagnose::candidates::hysteresis;
 use crate::diagnose::input::derivatives;
 use crate::diagnose::input::{Campaign, Series};
 use serde::Serialize;
@@ -29,6 +30,8 @@ pub enum Transform {
     Levels,
     Decay,
     Lag,
+    /// The column less its play (`hysteresis`): rate-independent memory.
+    Hysteresis,
     Spline,
     /// A decay on the clock since the column's last event (`Candidate::event`).
     Event,
@@ -45,6 +48,7 @@ impl Transform {
             Self::Levels => "levels",
             Self::Decay => "decay",
             Self::Lag => "lag",
+            Self::Hysteresis => "hysteresis",
             Self::Spline => "spline",
             Self::Event => "event",
         }
@@ -135,6 +139,8 @@ pub struct Candidate {
     pub run_values: Vec<f64>,
     /// What starts the clock of an `Event` candidate.
     pub event: Option<EventRule>,
+    /// Half-width of a `Hysteresis` candidate's play, in the column's units.
+    pub width: Option<f64>,
 }
 
 impl Candidate {
@@ -142,6 +148,11 @@ impl Candidate {
     pub fn label(&self) -> String {
         let own = match self.transform {
             Transform::Spline => format!("{}:spline(knots={})", self.column, self.knots.len()),
+            Transform::Hysteresis => format!(
+                "{}:hysteresis(width={:.3})",
+                self.column,
+                self.width.unwrap_or(0.0)
+            ),
             Transform::Event => format!(
                 "{}:exp decay {:.0} s after {}",
                 self.column,
@@ -230,6 +241,7 @@ impl Candidate {
             Transform::Rate => vec![derivatives::centred(&s.t_s, x, 1, half_s)],
             Transform::Accel => vec![derivatives::centred(&s.t_s, x, 2, half_s)],
             Transform::Lag => vec![first_order_lag(&s.t_s, x, tau)],
+            Transform::Hysteresis => vec![hysteresis::stop(x, self.width.unwrap_or(0.0))],
             Transform::Decay => vec![s.t_s.iter().map(|t| (-t / tau).exp()).collect()],
             Transform::Harmonic => vec![
                 x.iter().map(|d| d.to_radians().cos()).collect(),
@@ -354,6 +366,7 @@ mod tests {
             base_rate_half_s: 1.0,
             run_values: vec![],
             event: None,
+            width: None,
         };
         let value = Candidate {
             transform: Transform::Value,

@@ -12,6 +12,9 @@ pub struct Cause {
     pub column: String,
     pub transform: Transform,
     pub tau_s: Option<f64>,
+    /// Half-width of a hysteresis play, in the column's units.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub width: Option<f64>,
     /// Spline knots or indicated levels (empty otherwise).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub knots: Vec<f64>,
@@ -34,6 +37,7 @@ impl From<&Candidate> for Cause {
             column: c.column.clone(),
             transform: c.transform,
             tau_s: c.tau_s,
+            width: c.width,
             knots: c.knots.clone(),
             times: c.times,
             with: c.partner.as_ref().map(|p| p.column.clone()),
@@ -50,6 +54,7 @@ impl Cause {
             column: column.into(),
             transform,
             tau_s,
+            width: None,
             knots: vec![],
             times: None,
             with: None,
@@ -72,7 +77,7 @@ impl Cause {
             && !self.metadata
             && !matches!(
                 self.transform,
-                Transform::Spline | Transform::Levels | Transform::Event
+                Transform::Spline | Transform::Levels | Transform::Event | Transform::Hysteresis
             )
     }
 
@@ -141,6 +146,11 @@ impl Cause {
                 "after each change of `{col}` larger than its noise (a step or switch) the drift shows a transient \
                  exp(-t_since/{tau:.0} s) ({k:.4} deg/h at the change), whatever the change's sign or size"
             ),
+            (col, Transform::Hysteresis) => format!(
+                "drift follows where `{col}` has been, not how fast: its excursion beyond a play of +/-{:.3} \
+                 ({k:.4e} deg/h per unit), rate-independent memory such as a winding's or a mount's hysteresis",
+                self.width.unwrap_or(0.0)
+            ),
             (col, Transform::Spline) => format!(
                 "drift follows a smooth nonlinear function of `{col}` (natural cubic spline, {} knots)",
                 self.knots.len()
@@ -170,6 +180,7 @@ mod tests {
             base_rate_half_s: 20.0,
             run_values: vec![],
             event: None,
+            width: None,
         };
         let cause = Cause::from(&cand);
         assert_eq!(cause.label(), cand.label());

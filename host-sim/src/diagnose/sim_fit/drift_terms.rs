@@ -47,7 +47,7 @@ fn sim_transform(t: Transform, tau_s: Option<f64>) -> Option<AuxTransform> {
         Transform::Rate => Some(AuxTransform::Rate),
         Transform::Accel => Some(AuxTransform::Accel),
         Transform::Lag => tau_s.map(|tau_s| AuxTransform::Lag { tau_s }),
-        Transform::Levels | Transform::Spline | Transform::Event => None,
+        Transform::Levels | Transform::Spline | Transform::Event | Transform::Hysteresis => None,
     }
 }
 
