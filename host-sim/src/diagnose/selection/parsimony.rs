@@ -165,21 +165,94 @@ pub fn choose_and_screen(
         rule.weighed.push(w);
         if within {
             rule.reason = format!(
-                "{} is the simplest base within one standard error of {lowest} (the lowest), alone ({:+.5} +/- {:.5} deg/h) and with the causes named on each ({whole_excess:+.5} +/- {whole_se:.5} deg/h)",
-                s.spec.name, base_excess, base_se
+                "{} is the simplest base within one standard error of {lowest} (the lowest), alone ({:+.5} +/- {:.5} deg/h) and with the causes named on each ({whole_excess:+.5} +/- {whole_se:.5} deg/h){}",
+                s.spec.name,
+                base_excess,
+                base_se,
+                as_simple_and_as_good(&choice.scores, &s.spec, lowest_rms, lowest_se)
             );
             return Ok((candidate, sc, rule));
         }
     }
     rule.reason = format!(
-        "{lowest} has the lowest held-out rms; no simpler base is within one standard error of it, alone and with the causes named on each"
+        "{lowest} has the lowest held-out rms; no simpler base is within one standard error of it, alone and with the causes named on each{}",
+        as_simple_and_as_good(&choice.scores, &choice.chosen.spec, lowest_rms, lowest_se)
     );
     Ok((choice, lowest_screen, rule))
+}
+
+/// The bases with as many terms as `chosen` whose held-out rms is also within one standard
+/// error of the lowest, as a clause for the rule's reason (empty when there are none): the
+/// record cannot tell them from the chosen one, and a reader who expects one of them (a
+/// quadratic in T where the chosen base has T and dT/dt) should see that it fits as well.
+fn as_simple_and_as_good(
+    scores: &[BaseScore],
+    chosen: &crate::diagnose::baseline::choice::BaseSpec,
+    lowest_rms: f64,
+    lowest_se: f64,
+) -> String {
+    let equals: Vec<String> = scores
+        .iter()
+        .filter(|b| {
+            b.spec.name != chosen.name
+                && complexity(&b.spec) == complexity(chosen)
+                && b.heldout_rms_dph - lowest_rms <= lowest_se
+        })
+        .map(|b| format!("{} ({:.5} deg/h)", b.spec.name, b.heldout_rms_dph))
+        .collect();
+    if equals.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; as many terms and also within one standard error: {} (the record cannot tell them from {}; the choice between them is by held-out rms alone)",
+            equals.join(", "),
+            chosen.name
+        )
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn base(name: &str, degree: Option<u8>, rate: bool, rms: f64) -> BaseScore {
+        BaseScore {
+            spec: crate::diagnose::baseline::choice::BaseSpec {
+                name: name.into(),
+                poly_degree_t: degree,
+                uses_rate: rate,
+                rbf: false,
+            },
+            heldout_rms_dph: rms,
+            heldout_se_dph: 1.0,
+            levels: vec![],
+            parameters: 0,
+            paired_p_vs_best: None,
+            unit_sse: vec![],
+        }
+    }
+
+    /// A quadratic in T as good as T with dT/dt (the PAN record's x axis) is said, with as
+    /// many terms; a simpler or a worse base is not.
+    #[test]
+    fn a_base_with_as_many_terms_and_as_good_is_named_beside_the_chosen_one() {
+        let scores = vec![
+            base("poly_t1", Some(1), false, 31.8),
+            base("poly_t1_rate", Some(1), true, 23.7),
+            base("poly_t2", Some(2), false, 24.8),
+            base("poly_t2_rate", Some(2), true, 24.0),
+        ];
+        let said = as_simple_and_as_good(&scores, &scores[1].spec, 23.7, 4.0);
+        assert!(said.contains("poly_t2 (24.80000 deg/h)"), "{said}");
+        assert!(
+            !said.contains("poly_t1 ") && !said.contains("poly_t2_rate"),
+            "{said}"
+        );
+        assert_eq!(
+            as_simple_and_as_good(&scores, &scores[1].spec, 23.7, 0.5),
+            ""
+        );
+    }
 
     /// The paired standard error sees a difference that is the same in every unit (so
     /// real however small), which the spread of the scores themselves hides; and a
