@@ -1,22 +1,23 @@
 //! Campaigns that plant effects `diagnose` was NOT written around (issue 18): a product of
 //! two columns, a categorical column, a smooth nonlinear function of a column,
-//! rate-independent memory (backlash), a between-run effect of a metadata key, two
-//! causes at once, and a transient after each event (issue 38 item 1: a step of the
-//! supply, or a gap of the time stamps, each followed by a decay), and a product of two
-//! columns neither of which is the temperature (issue 38 item 2: the supply's coefficient
-//! set by the cabinet's temperature), and a narrow feature of one column (issue 38 item 1:
-//! a peak a quarter of a degree wide in the cabinet's temperature; twin, a band of half a
-//! degree where the bias jumps, as a mode hop does). Each family has an effect, a twin with a different physical law and a
-//! null twin (same campaign, nothing planted). Nothing is shared with the project's
-//! simulator or the other generators: its own warm-up law (first-order self-heating on a
-//! chamber that cycles through a lag), cold / warm / hot restarts, turn-on offsets, 0.0625
-//! degC thermometer, supply load steps, a three-level mode flag, decoys (a wandering
-//! column and a two-level fan flag), a `# mount: A|B` metadata key, rows at 1 Hz or 10 s.
+//! rate-independent memory (backlash), a between-run effect of a metadata key, two causes
+//! at once, and a transient after each event (issue 38 item 1: a step of the supply, or a
+//! gap of the time stamps, each followed by a decay), and a product of two columns neither
+//! of which is the temperature (issue 38 item 2: the supply's coefficient set by the
+//! cabinet's temperature), and a narrow feature of one column (issue 38 item 1: a peak a
+//! quarter of a degree wide in the cabinet's temperature; twin, a band of half a degree
+//! where the bias jumps, as a mode hop does). Each family has an effect, a twin with a
+//! different physical law and a null twin (same campaign, nothing planted). Nothing is
+//! shared with the project's simulator or the other generators: its own warm-up law
+//! (first-order self-heating on a chamber that cycles through a lag), cold / warm / hot
+//! restarts, turn-on offsets, 0.0625 degC thermometer, supply load steps, a three-level
+//! mode flag, decoys (a wandering column and a two-level fan flag), a `# mount: A|B`
+//! metadata key, rows at 1 Hz or 10 s.
 //!
-//! Size: each planted cause, after removing what the paper's base can absorb (run
-//! offsets, T, T^2, dT/dt: least squares within runs), has an rms over the campaign of
-//! `sigmas` white-noise sigmas of 10 s means ([`NOISE_10S_DPH`]); a purely between-run
-//! cause (mount offset) has that rms over runs.
+//! Size: each planted cause, after removing what the paper's base can absorb (run offsets,
+//! T, T^2, dT/dt: least squares within runs), has an rms over the campaign of `sigmas`
+//! white-noise sigmas of 10 s means ([`NOISE_10S_DPH`]); a purely between-run cause (mount
+//! offset) has that rms over runs.
 
 use fog_sim::io::runs::Run;
 use rand::{Rng, SeedableRng};

@@ -5,18 +5,19 @@
 //! pick the terms the naming test is offered, and a difference in their verdicts is the
 //! selection's, not the library's or the test's.
 //!
-//! Rows are averaged to 10 s means; the library is built from every column and metadata
-//! key (value, hinges at the deciles, d/dt and d2/dt2 over a fixed +/-3 row window,
-//! first-order lags of 60 / 300 / 1500 s, stop operators (the column less its play, issue 38
-//! item 6) at 2.5 / 5 / 10 % of its median within-run range, products with temp_c and dT/dt, products of the
-//! values of every two columns other than t_s and temp_c (issue 38 item 2: `diagnose`
-//! screens these down to a few; a peer is offered them all and selects as it selects the
-//! rest), sin/cos of `_deg` columns, level indicators of columns with <= 5 values, run means
-//! of every column, every metadata value); the base is 1, T, T^2, dT/dt (one absolute intercept, no free run
-//! offsets). Naming: each selected term enters forward (strongest first, given the base and
-//! the terms already named) while a sign-flip max test over whole runs, the max taken over
-//! the whole library (family-wise at each step; within-run and run-level columns as two
-//! families, Bonferroni), gives p < ALPHA; the first term that fails ends the naming.
+//! Rows are averaged to 10 s means; the library is built from every column and metadata key
+//! (value, hinges at the deciles, d/dt and d2/dt2 over a fixed +/-3 row window, first-order
+//! lags of 60 / 300 / 1500 s, stop operators (the column less its play, issue 38 item 6) at
+//! 2.5 / 5 / 10 % of its median within-run range, products with temp_c and dT/dt, products
+//! of the values of every two columns other than t_s and temp_c (issue 38 item 2:
+//! `diagnose` screens these down to a few; a peer is offered them all and selects as it
+//! selects the rest), sin/cos of `_deg` columns, level indicators of columns with <= 5
+//! values, run means of every column, every metadata value); the base is 1, T, T^2, dT/dt
+//! (one absolute intercept, no free run offsets). Naming: each selected term enters forward
+//! (strongest first, given the base and the terms already named) while a sign-flip max test
+//! over whole runs, the max taken over the whole library (family-wise at each step;
+//! within-run and run-level columns as two families, Bonferroni), gives p < ALPHA; the
+//! first term that fails ends the naming.
 
 use fog_sim::diagnose::candidates::hysteresis::stop;
 use fog_sim::io::runs::Run;

@@ -1,21 +1,22 @@
-//! The generic candidate library (issue 18 item 2): built from the record's own columns
-//! and metadata, never from a list of expected effects. For every extra column: its value,
+//! The generic candidate library (issue 18 item 2): built from the record's own columns and
+//! metadata, never from a list of expected effects. For every extra column: its value,
 //! natural cubic splines of it (4, 6, 10, 16, 25 and 40 knots at equally spaced campaign
 //! quantiles, so they are densest where the column's range is best covered; a count is
 //! offered only where every interval between its knots holds rows of at least
 //! `MIN_UNITS_BETWEEN_KNOTS` validation units, so the held-out test can check a feature
-//! there; which count, if any, is chosen on held-out data by the selection), d/dt and d2/dt2 (windows validated per
-//! column), its memory (first-order lags), levels when it has few distinct values, a
-//! sinusoid for angles (`*_deg`), and products of its value (or levels) with the base's
-//! inputs (T - mean T, dT/dt). For the temperature: d2/dt2 and memory (its value and
-//! dT/dt are the base's inputs). For time since the start: a power-on decay on the same
-//! time scales. Metadata keys that vary between runs enter as run-constant columns
-//! (`metadata`: numbers, times as days, versions by rank, categories; their products with
-//! the base's inputs are within-run candidates; their values and levels are run-level
-//! candidates, `between_runs`). Last, event clocks (`events`): a decay after each step of
-//! every column (the temperature too) and after each gap of the time stamps. Last of all,
-//! products of the values of any two extra columns (issue 38 item 2, `pairs`): all
-//! k(k-1)/2 are scored once against the base (the sum over runs of each one's squared
+//! there; which count, if any, is chosen on held-out data by the selection), d/dt and
+//! d2/dt2 (windows validated per column), its memory (first-order lags), its hysteresis
+//! (stop operators on a ladder of play widths, `hysteresis`) when it has many values,
+//! levels when it has few, a sinusoid for angles (`*_deg`), and products of its value (or
+//! levels) with the base's inputs (T - mean T, dT/dt). For the temperature: d2/dt2, memory
+//! and hysteresis (its value and dT/dt are the base's inputs). For time since the start: a
+//! power-on decay on the same time scales. Metadata keys that vary between runs enter as
+//! run-constant columns (`metadata`: numbers, times as days, versions by rank, categories;
+//! their products with the base's inputs are within-run candidates; their values and levels
+//! are run-level candidates, `between_runs`). Last, event clocks (`events`): a decay after
+//! each step of every column (the temperature too) and after each gap of the time stamps.
+//! Last of all, products of the values of any two extra columns (issue 38 item 2, `pairs`):
+//! all k(k-1)/2 are scored once against the base (the sum over runs of each one's squared
 //! per-run score, which whole-run sign flips leave unchanged, so the naming test keeps its
 //! level) and only the `pairs::PAIR_BUDGET` (4) strongest enter; the rest are named in the
 //! family's note. The newest families come last so that the cap, when it bites, cuts them
@@ -23,8 +24,8 @@
 //!
 //! Memory time scales are the record's: from twice the row spacing, doubling, to half the
 //! shortest run. The size is bounded: at most `MAX_CANDIDATES` (the rest are skipped and
-//! reported as such); about 20 per column, and at most `pairs::PAIR_BUDGET` products of
-//! two columns whatever their number.
+//! reported as such); 20 to 30 per column, and at most `pairs::PAIR_BUDGET` products of two
+//! columns whatever their number.
 
 use crate::diagnose::candidates::events;
 use crate::diagnose::candidates::families::{FamilyNote, OperatorFamily};

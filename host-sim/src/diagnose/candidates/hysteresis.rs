@@ -32,8 +32,8 @@ pub fn stop(x: &[f64], h: f64) -> Vec<f64> {
         .collect()
 }
 
-/// The half-widths the record supports for the column `x` gives per run (empty when the
-/// column is flat or its noise spans its range), or why none.
+/// The half-widths the record supports for the column `x` gives per run, narrowest first;
+/// `Err` with the reason when none does (a flat column, or noise spanning its range).
 pub fn widths(c: &Campaign, x: impl Fn(&Series) -> &[f64]) -> Result<Vec<f64>, String> {
     let noise = events::noise_sigma(c, &x);
     let mut ranges: Vec<f64> = c

@@ -147,8 +147,9 @@ impl Cause {
                  exp(-t_since/{tau:.0} s) ({k:.4} deg/h at the change), whatever the change's sign or size"
             ),
             (col, Transform::Hysteresis) => format!(
-                "drift follows where `{col}` has been, not how fast: its excursion beyond a play of +/-{:.3} \
-                 ({k:.4e} deg/h per unit), rate-independent memory such as a winding's or a mount's hysteresis",
+                "drift follows where `{col}` has been, not how fast: its position within a play of +/-{:.3}, \
+                 saturating at the edges and turning over at each reversal ({k:.4e} deg/h per unit), \
+                 rate-independent memory such as a winding's or a mount's hysteresis",
                 self.width.unwrap_or(0.0)
             ),
             (col, Transform::Spline) => format!(
