@@ -1,7 +1,8 @@
 //! The FOG physics simulator (seeded, deterministic): two-node thermal model after
 //! power-on, temperature sensor, drift physics (temperature bias, Shupe rate term,
 //! gradient-rate term, turn-on bias, pluggable extra terms), IEEE Std 952 noise, an
-//! indexing turntable, and the units of one gyro type (`unit_spread`, `fleet`). See
+//! indexing turntable, the units of one gyro type (`unit_spread`, `fleet`), and its random
+//! parts one at a time switched off (`quiet`). See
 //! `docs/explain/simulator.md` for the calibration to the paper and the fleet's spreads.
 
 mod checks;
@@ -11,6 +12,7 @@ pub mod gyro;
 pub mod instrument;
 pub mod noise;
 pub mod params;
+pub mod quiet;
 pub mod run;
 pub mod spec;
 pub mod terms;
@@ -27,6 +29,7 @@ pub use params::{
     DriftParams, GyroParams, NoiseParams, RunVariation, SensorParams, SensorPlacement,
     ThermalParams,
 };
+pub use quiet::RandomPart;
 pub use run::{rig, simulate_run, MEAN_WINDOW_S};
 pub use spec::{RunSpec, StartState, DEFAULT_LATITUDE_DEG};
 pub use terms::{AuxSource, AuxTransform, DriftTerm};
