@@ -19,6 +19,17 @@ fn fogsim(args: &[&str]) {
     app_support::fogsim_ok(args);
 }
 
+/// `fogsim diagnose CAMP --json JSON`, and the report it wrote.
+fn diagnose_json(camp: &Path, json: &Path) -> serde_json::Value {
+    fogsim(&[
+        "diagnose",
+        camp.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap()
+}
+
 /// One campaign and its verdict line; true when it passes.
 fn case(dir: &Path, seed: u64, ambient: &str, runs: &str) -> (bool, String) {
     let camp = dir.join(format!("c{seed}_{}", ambient.replace(',', "_")));
@@ -36,14 +47,7 @@ fn case(dir: &Path, seed: u64, ambient: &str, runs: &str) -> (bool, String) {
         "--raw-rate-hz",
         "1",
     ]);
-    fogsim(&[
-        "diagnose",
-        camp.to_str().unwrap(),
-        "--json",
-        json.to_str().unwrap(),
-    ]);
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let v = diagnose_json(&camp, &json);
     let within = v["named_cause"].clone();
     let between = v["between_run"]["named"].clone();
     let mut ok = within.is_null() && between.is_null();
@@ -106,14 +110,7 @@ fn a_noise_free_campaign_gives_the_simulators_physics_to_two_percent() {
     spec.ambients_c = vec![-10.0, 25.0, 55.0];
     spec.runs_per_ambient = 3;
     write_campaign(&camp, &simulate_campaign(&quiet, &spec).unwrap()).unwrap();
-    fogsim(&[
-        "diagnose",
-        camp.to_str().unwrap(),
-        "--json",
-        json.to_str().unwrap(),
-    ]);
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let v = diagnose_json(&camp, &json);
     let _ = std::fs::remove_dir_all(&dir);
     let mut lines = Vec::new();
     for r in v["uncertainty"]["ratios"].as_array().unwrap() {
