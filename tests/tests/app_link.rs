@@ -270,6 +270,40 @@ fn a_symmetric_seek_over_the_link_cancels_a_linear_drift() {
     );
 }
 
+/// The Thue-Morse order over the link (`positions` 0xC2): a drift with a curvature in time
+/// gives the truth, where the time-symmetric seek (0x82) keeps the curvature's error.
+#[test]
+fn a_thue_morse_seek_over_the_link_cancels_a_quadratic_drift() {
+    let (lat, truth) = (39.9, 108.4);
+    let seek = |positions: u8| {
+        let mut a = app();
+        let r = drive(
+            &mut a,
+            Tilt::LEVEL,
+            |t, h| {
+                earth_rate_on_axis_dph(lat, truth, Tilt::LEVEL, h) + 0.2 + 1e-3 * t
+                    - 2e-6 * (t - 1_200.0).powi(2)
+            },
+            |a, i, t_s| {
+                if i == 105 {
+                    let c = Command::StartSeek { positions };
+                    assert_eq!(a.command(c, t_s), Some(DeviceMessage::Accepted));
+                }
+            },
+            &mut Vec::new(),
+        );
+        (r.positions, r.azimuth_deg - truth)
+    };
+    let (code, tm_err) = seek(0xC2);
+    assert_eq!(code, 0xC2);
+    let (code, sym_err) = seek(0x82);
+    assert_eq!(code, 0x82);
+    assert!(
+        tm_err.abs() < 1e-3 && sym_err.abs() > 10.0 * tm_err.abs().max(1e-4),
+        "Thue-Morse {tm_err}, symmetric {sym_err}"
+    );
+}
+
 fn good(now_s: f64) -> BitCounters {
     BitCounters {
         now_s,

@@ -18,6 +18,14 @@
 //! the same number of valid windows. The heading at the turning point of a symmetric
 //! sequence is visited once for twice the dwell (`Dwell::Double`): the same mean time,
 //! and no turn onto the heading the table is already at.
+//!
+//! Why the Thue-Morse order (`TwoPositionThueMorse`: 0, 180, 180, 0, 180, 0, 0, 180 deg,
+//! a repeated heading one double dwell, the ambiguity dwell in the middle): what the
+//! time-symmetric seek leaves is the curvature d2, and after a model it is most of the
+//! first seek's bias (docs/record/fleet.md). The signs + - - + - + + - have equal sums of
+//! t^0, t^1 and t^2 over both headings, and the turns fall mirrored about the middle, so
+//! the parabola cancels too; the price is six turns instead of four, 80 s per heading
+//! instead of 100 s in about the same seek time.
 
 /// The seek modes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -33,6 +41,10 @@ pub enum SeekMode {
     /// The four positions there and back: h0, +90, +180, +270 (twice the dwell), +180, +90,
     /// h0: a drift linear in time cancels.
     FourPositionSymmetric,
+    /// The two positions in Thue-Morse order, 0, 180, 180, 0, 180, 0, 0, 180 (the repeated
+    /// headings one double dwell; the ambiguity dwell in the middle): signs + - - + - + + -,
+    /// so a constant, a slope and a parabola in time cancel, with the turns' windows.
+    TwoPositionThueMorse,
 }
 
 /// How long one step of a sequence measures.
@@ -89,6 +101,16 @@ const FOUR_SYMMETRIC: [Step; 7] = [
     step(0, Dwell::Main),
 ];
 
+const TWO_THUE_MORSE: [Step; 7] = [
+    step(0, Dwell::Main),
+    step(1, Dwell::Double),
+    step(0, Dwell::Main),
+    step(2, Dwell::Ambiguity),
+    step(1, Dwell::Main),
+    step(0, Dwell::Double),
+    step(1, Dwell::Main),
+];
+
 /// The high bit of the link's `positions` byte that marks a time-symmetric sequence.
 pub const SYMMETRIC_CODE_BIT: u8 = 0x80;
 
@@ -100,6 +122,7 @@ impl SeekMode {
             SeekMode::TwoPositionSymmetric => &TWO_SYMMETRIC,
             SeekMode::FourPosition => &FOUR,
             SeekMode::FourPositionSymmetric => &FOUR_SYMMETRIC,
+            SeekMode::TwoPositionThueMorse => &TWO_THUE_MORSE,
         }
     }
 
@@ -115,7 +138,9 @@ impl SeekMode {
     /// The mode with the same positions in one pass: the geometry the solution uses.
     pub const fn forward(self) -> SeekMode {
         match self {
-            SeekMode::TwoPosition | SeekMode::TwoPositionSymmetric => SeekMode::TwoPosition,
+            SeekMode::TwoPosition
+            | SeekMode::TwoPositionSymmetric
+            | SeekMode::TwoPositionThueMorse => SeekMode::TwoPosition,
             SeekMode::FourPosition | SeekMode::FourPositionSymmetric => SeekMode::FourPosition,
         }
     }
@@ -124,7 +149,9 @@ impl SeekMode {
     pub const fn is_symmetric(self) -> bool {
         matches!(
             self,
-            SeekMode::TwoPositionSymmetric | SeekMode::FourPositionSymmetric
+            SeekMode::TwoPositionSymmetric
+                | SeekMode::FourPositionSymmetric
+                | SeekMode::TwoPositionThueMorse
         )
     }
 
@@ -139,7 +166,9 @@ impl SeekMode {
     /// Measuring time at each main position, in units of `dwell_s` (2 for the symmetric
     /// sequences: two visits, or one double dwell).
     pub const fn main_dwells_per_position(self) -> u8 {
-        if self.is_symmetric() {
+        if matches!(self, SeekMode::TwoPositionThueMorse) {
+            4
+        } else if self.is_symmetric() {
             2
         } else {
             1
@@ -147,7 +176,7 @@ impl SeekMode {
     }
 
     /// The mode as the link's `positions` byte: 2 or 4, with `SYMMETRIC_CODE_BIT` set for
-    /// a symmetric sequence (0x82, 0x84). 2 and 4 keep their meaning, so old bytes decode
+    /// a symmetric sequence (0x82, 0x84) and 0x40 too for the Thue-Morse order (0xC2). 2 and 4 keep their meaning, so old bytes decode
     /// the same; a device without the symmetric sequences refuses 0x82/0x84.
     pub const fn code(self) -> u8 {
         let sym = if self.is_symmetric() {
@@ -155,7 +184,12 @@ impl SeekMode {
         } else {
             0
         };
-        self.main_positions() | sym
+        let thue_morse = if matches!(self, SeekMode::TwoPositionThueMorse) {
+            0x40
+        } else {
+            0
+        };
+        self.main_positions() | sym | thue_morse
     }
 
     /// The mode of a `positions` byte (`code`), `None` for any other byte.
@@ -165,6 +199,7 @@ impl SeekMode {
             4 => Some(SeekMode::FourPosition),
             0x82 => Some(SeekMode::TwoPositionSymmetric),
             0x84 => Some(SeekMode::FourPositionSymmetric),
+            0xC2 => Some(SeekMode::TwoPositionThueMorse),
             _ => None,
         }
     }
@@ -174,11 +209,12 @@ impl SeekMode {
 mod tests {
     use super::*;
 
-    const ALL: [SeekMode; 4] = [
+    const ALL: [SeekMode; 5] = [
         SeekMode::TwoPosition,
         SeekMode::FourPosition,
         SeekMode::TwoPositionSymmetric,
         SeekMode::FourPositionSymmetric,
+        SeekMode::TwoPositionThueMorse,
     ];
 
     #[test]
@@ -190,6 +226,56 @@ mod tests {
         assert_eq!(SeekMode::FourPosition.code(), 4);
         assert_eq!(SeekMode::from_code(3), None);
         assert_eq!(SeekMode::from_code(0x80), None);
+        assert_eq!(SeekMode::from_code(0xC4), None);
+    }
+
+    /// The Thue-Morse order: whatever the dwell (in 10 s windows) and the turns' cost (one
+    /// or two windows for a half turn, one for a quarter), the windows at 0 and at 180 deg
+    /// have the same count, mean time and mean squared time, so a drift d0 + d1 t + d2 t^2
+    /// cancels in their difference; the cubic does not.
+    #[test]
+    fn the_thue_morse_order_cancels_a_parabola_with_its_turns() {
+        let s = SeekMode::TwoPositionThueMorse.steps();
+        assert!(s.len() <= MAX_STEPS);
+        for dwell in 1..6usize {
+            for half_turn in 1..3usize {
+                // each window's heading (None: turning), in time order
+                let mut windows: Vec<Option<u8>> = Vec::new();
+                for (k, st) in s.iter().enumerate() {
+                    if k > 0 && s[k - 1].position != st.position {
+                        let half = (s[k - 1].position + st.position) == 1;
+                        windows
+                            .extend(core::iter::repeat_n(None, if half { half_turn } else { 1 }));
+                    }
+                    let n = match st.dwell {
+                        Dwell::Main => dwell,
+                        Dwell::Double => 2 * dwell,
+                        Dwell::Ambiguity => 1,
+                    };
+                    windows.extend(core::iter::repeat_n(Some(st.position), n));
+                }
+                let moment = |p: u8, d: i32| -> (usize, f64) {
+                    let t: Vec<f64> = (0..windows.len())
+                        .filter(|&i| windows[i] == Some(p))
+                        .map(|i| i as f64 - windows.len() as f64 / 2.0)
+                        .collect();
+                    (
+                        t.len(),
+                        t.iter().map(|t| t.powi(d)).sum::<f64>() / t.len() as f64,
+                    )
+                };
+                for d in 0..3 {
+                    let (n0, m0) = moment(0, d);
+                    let (n1, m1) = moment(1, d);
+                    assert_eq!(n0, n1);
+                    assert!(
+                        (m0 - m1).abs() < 1e-9,
+                        "dwell {dwell} turn {half_turn} d {d}"
+                    );
+                }
+                assert!((moment(0, 3).1 - moment(1, 3).1).abs() > 1.0);
+            }
+        }
     }
 
     /// Each position's mean time (dwell-weighted step index, turns taken as one step)

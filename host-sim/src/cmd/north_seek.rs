@@ -43,7 +43,9 @@ pub struct Args {
     pub positions: u8,
     /// Order of the positions: `forward` (one pass, the paper's) or `symmetric` (there and
     /// back, symmetric in time: 0, 180, 90, 180, 0 or 0, 90, 180, 270, 180, 90, 0 deg, so a
-    /// drift linear in time cancels; each position is visited twice for `--dwell-s`).
+    /// drift linear in time cancels; each position is visited twice for `--dwell-s`) or
+    /// `thue-morse` (2 positions: 0, 180, 180, 0, 180, 0, 0, 180 deg, so a parabola cancels
+    /// too; each position measured four times `--dwell-s`, default 20 s).
     #[arg(long, value_enum, default_value_t = Sequence::Forward)]
     pub sequence: Sequence,
     /// Site latitude, deg (north positive).
@@ -185,6 +187,9 @@ pub const MAX_TRAINING_RUNS: usize = 2 * CAMPAIGN_RUNS;
 pub enum Sequence {
     Forward,
     Symmetric,
+    /// Two positions in Thue-Morse order (0, 180, 180, 0, 180, 0, 0, 180): a parabola
+    /// in time cancels too.
+    ThueMorse,
 }
 
 /// Turns the options into a Monte Carlo configuration, rejecting impossible values.
@@ -194,6 +199,10 @@ pub fn config_from_args(a: &Args) -> Result<MonteCarloConfig> {
         (4, Sequence::Forward) => SeekMode::FourPosition,
         (2, Sequence::Symmetric) => SeekMode::TwoPositionSymmetric,
         (4, Sequence::Symmetric) => SeekMode::FourPositionSymmetric,
+        (2, Sequence::ThueMorse) => SeekMode::TwoPositionThueMorse,
+        (p, Sequence::ThueMorse) => {
+            bail!("--positions {p}: the Thue-Morse order is for 2 positions")
+        }
         (p, _) => bail!("--positions {p}: must be 2 or 4"),
     };
     if !(a.ambient.is_finite() && (-60.0..=100.0).contains(&a.ambient)) {
@@ -408,7 +417,7 @@ fn recipe_of(args: &Args) -> Result<Option<UnitRecipe>> {
 fn criterion_of(args: &Args, cfg: &MonteCarloConfig) -> Result<Criterion> {
     let (name, symmetric) = match args.criterion.as_str() {
         "seek-forward" => ("seek", false),
-        name => (name, cfg.mode == SeekMode::TwoPositionSymmetric),
+        name => (name, cfg.mode.is_symmetric()),
     };
     Ok(Criterion::parse(name, cfg.dwell_s as f64, cfg.latitude_deg)
         .map_err(|e| anyhow::anyhow!("--criterion {e}"))?

@@ -60,7 +60,9 @@ impl NorthFinder {
         // c = P0 X + Q0 Y + V0 from the two opposite main dwells, q = P90 X + Q90 Y + V90
         // from the quadrature dwell(s); the bias cancels in both.
         let (k_c, k_q, c, q, var_c, var_q, bias) = match self.cfg.mode.forward() {
-            SeekMode::TwoPosition | SeekMode::TwoPositionSymmetric => {
+            SeekMode::TwoPosition
+            | SeekMode::TwoPositionSymmetric
+            | SeekMode::TwoPositionThueMorse => {
                 let bias = 0.5 * (m[0] + m[1]);
                 let var_c = (v[0] + v[1]) / 4.0;
                 (
@@ -89,7 +91,9 @@ impl NorthFinder {
             SeekMode::FourPosition | SeekMode::FourPositionSymmetric => {
                 (direct.azimuth_rad, direct.sigma_rad)
             }
-            SeekMode::TwoPosition | SeekMode::TwoPositionSymmetric => {
+            SeekMode::TwoPosition
+            | SeekMode::TwoPositionSymmetric
+            | SeekMode::TwoPositionThueMorse => {
                 // c - V0 = Omega_H R0 cos(A - d0): acos of the two long dwells, the sign (and,
                 // near A - d0 = 0/180 deg, where acos is ill-conditioned, the whole angle) from
                 // the quadrature dwell.

@@ -90,8 +90,9 @@ pub struct Args {
     #[arg(long = "seek-latitude-deg", default_value_t = crate::sim::DEFAULT_LATITUDE_DEG, allow_negative_numbers = true)]
     pub seek_latitude: f64,
     /// Sequence of the seeks the `seek` criterion, `--seek-refit` and `--type` score (as
-    /// `north-seek --sequence`): `forward` (0, 180 deg) or `symmetric` (0, 180, 180, 0:
-    /// a drift error linear in time cancels, its curvature is scored).
+    /// `north-seek --sequence`): `forward` (0, 180 deg), `symmetric` (0, 180, 180, 0: a
+    /// drift error linear in time cancels, its curvature is scored) or `thue-morse` (scored
+    /// as `symmetric`).
     #[arg(long = "seek-sequence", value_enum, default_value_t = Sequence::Forward)]
     pub seek_sequence: Sequence,
     /// Refit the final model's output layer to the seeks of the north finder's own
@@ -195,7 +196,7 @@ impl Args {
     /// `--seek-sequence`.
     pub fn seek_geometry(&self) -> crate::train::seek_score::SeekGeometry {
         crate::train::seek_score::SeekGeometry {
-            symmetric: self.seek_sequence == Sequence::Symmetric,
+            symmetric: self.seek_sequence != Sequence::Forward,
             ..crate::train::seek_score::SeekGeometry::forward(self.seek_dwell, self.seek_latitude)
         }
     }
@@ -255,7 +256,7 @@ impl Args {
             self.seek_latitude,
         )
         .map_err(|e| anyhow::anyhow!("--criterion {e}"))?
-        .with_symmetric_seeks(self.seek_sequence == Sequence::Symmetric);
+        .with_symmetric_seeks(self.seek_sequence != Sequence::Forward);
         Ok(TrainConfig {
             criterion,
             method: self.method,

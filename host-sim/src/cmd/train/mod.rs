@@ -247,6 +247,7 @@ fn refit_to_device_seeks(
         mode: match args.seek_sequence {
             Sequence::Forward => fog_core::seeking::northfinder::SeekMode::TwoPosition,
             Sequence::Symmetric => fog_core::seeking::northfinder::SeekMode::TwoPositionSymmetric,
+            Sequence::ThueMorse => fog_core::seeking::northfinder::SeekMode::TwoPositionThueMorse,
         },
         ..crate::pipeline::north_seek::MonteCarloConfig::paper(1)
     };

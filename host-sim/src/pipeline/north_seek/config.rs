@@ -167,13 +167,16 @@ impl MonteCarloConfig {
 /// = 280 s (measured 279 s against 269 s): 100 s per position instead of 110 s, and 10 s
 /// longer, as 40 s dwells would be 30 s shorter. Four positions: 4 x 60 s + 4 windows =
 /// 280 s; symmetric, 8 x 20 s + 7 windows = 230 s, 40 s per position (30 s dwells take
-/// 310 s, beyond the paper's 296 s).
+/// 310 s, beyond the paper's 296 s). Two positions in Thue-Morse order: 8 x 20 s + 10 s + 11
+/// windows (four half turns of two, two quarter turns and the first command of one) =
+/// 280 s (measured 288 s, at most 290 s), 80 s per position.
 pub fn default_dwell_s(mode: SeekMode) -> f32 {
     match mode {
         SeekMode::TwoPosition => 110.0,
         SeekMode::FourPosition => 60.0,
         SeekMode::TwoPositionSymmetric => 50.0,
         SeekMode::FourPositionSymmetric => 20.0,
+        SeekMode::TwoPositionThueMorse => 20.0,
     }
 }
 

@@ -28,7 +28,6 @@ use crate::output::reports::Table;
 use crate::train::seek_score::{Criterion, SeekGeometry};
 use crate::train::type_unit::TypeModel;
 use crate::train::InputChoice;
-use fog_core::seeking::northfinder::SeekMode;
 
 /// Units the demo's type is learnt from, and cold starts of each (2 per recipe ambient).
 pub const DEMO_TYPE_UNITS: usize = 10;
@@ -92,7 +91,7 @@ pub fn compare_recipes(cfg: &MonteCarloConfig, keep_dir: &Path) -> Result<Recipe
         dwell_s: cfg.dwell_s as f64,
         seed: cfg.seed,
         criterion: Criterion::Seek(SeekGeometry {
-            symmetric: cfg.mode == SeekMode::TwoPositionSymmetric,
+            symmetric: cfg.mode.is_symmetric(),
             ..SeekGeometry::forward(cfg.dwell_s as f64, cfg.latitude_deg)
         }),
         inputs: InputChoice::Auto,

@@ -33,6 +33,7 @@ fn opposite_positions(mode: SeekMode) -> &'static [(usize, usize)] {
         SeekMode::FourPosition => &[(0, 2), (1, 3)],
         SeekMode::TwoPositionSymmetric => &[(0, 1), (3, 4)],
         SeekMode::FourPositionSymmetric => &[(0, 2), (1, 3), (3, 5), (4, 6)],
+        SeekMode::TwoPositionThueMorse => &[(0, 1), (2, 1), (5, 4), (5, 6)],
     }
 }
 

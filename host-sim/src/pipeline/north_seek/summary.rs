@@ -34,7 +34,7 @@ pub fn noise_floor_deg(
     let omega_h = earth_rate_horizontal_dph(latitude_deg);
     let tau_h = dwell_s / 3600.0;
     let rad = match mode.forward() {
-        SeekMode::TwoPosition | SeekMode::TwoPositionSymmetric => {
+        SeekMode::TwoPosition | SeekMode::TwoPositionSymmetric | SeekMode::TwoPositionThueMorse => {
             arw_dpsh / ((2.0 * tau_h).sqrt() * omega_h * psi_deg.to_radians().sin().abs())
         }
         SeekMode::FourPosition | SeekMode::FourPositionSymmetric => {
