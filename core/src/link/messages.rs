@@ -62,8 +62,9 @@ impl From<ResetCause> for ResetReason {
 pub enum Command {
     /// Start a seek with 2 or 4 positions; answered with `Accepted` or `Refused`.
     /// `positions` is `SeekMode::code`: 2 or 4, or 0x82 / 0x84 for the time-symmetric
-    /// sequences (added without a version change: 2 and 4 keep their bytes and meaning, a
-    /// device that predates them refuses 0x82 / 0x84 with `BadPositions`).
+    /// sequences, 0xC2 for the Thue-Morse order (added without a version change: 2 and 4
+    /// keep their bytes and meaning, a device that predates them refuses them with
+    /// `BadPositions`).
     StartSeek { positions: u8 },
     /// Site latitude, deg; refused while seeking or outside |lat| < 85.
     SetLatitude { latitude_deg: f32 },
