@@ -236,32 +236,37 @@ fn a_four_position_seek_at_the_wrong_latitude_is_flagged() {
     );
 }
 
+/// One seek over the link (`StartSeek { positions }`, sent at the 105th sample) on a level
+/// gyro at 39.9 deg latitude and 108.4 deg true azimuth whose rate reads the Earth's plus
+/// `drift_dph(t)`: the mode the report names and its azimuth error, deg.
+fn seek_over_link(positions: u8, drift_dph: impl Fn(f64) -> f64) -> (u8, f64) {
+    let (lat, truth) = (39.9, 108.4);
+    let mut a = app();
+    let r = drive(
+        &mut a,
+        Tilt::LEVEL,
+        |t, h| earth_rate_on_axis_dph(lat, truth, Tilt::LEVEL, h) + drift_dph(t),
+        |a, i, t_s| {
+            if i == 105 {
+                let c = Command::StartSeek { positions };
+                assert_eq!(a.command(c, t_s), Some(DeviceMessage::Accepted));
+            }
+        },
+        &mut Vec::new(),
+    );
+    (r.positions, r.azimuth_deg - truth)
+}
+
 /// A time-symmetric seek over the link (`positions` 0x82, `SeekMode::code`): a gyro whose
 /// bias drifts linearly in time gives the truth and the report names the sequence; the
 /// forward seek on the same gyro errs (the twin), and a byte that is no mode is refused.
 #[test]
 fn a_symmetric_seek_over_the_link_cancels_a_linear_drift() {
-    let (lat, truth) = (39.9, 108.4);
-    let seek = |positions: u8| {
-        let mut a = app();
-        let r = drive(
-            &mut a,
-            Tilt::LEVEL,
-            |t, h| earth_rate_on_axis_dph(lat, truth, Tilt::LEVEL, h) + 0.2 + 1e-3 * t,
-            |a, i, t_s| {
-                if i == 105 {
-                    let c = Command::StartSeek { positions };
-                    assert_eq!(a.command(c, t_s), Some(DeviceMessage::Accepted));
-                }
-            },
-            &mut Vec::new(),
-        );
-        (r.positions, r.azimuth_deg - truth)
-    };
-    let (code, err) = seek(0x82);
+    let linear = |t: f64| 0.2 + 1e-3 * t;
+    let (code, err) = seek_over_link(0x82, linear);
     assert_eq!(code, 0x82);
     assert!(err.abs() < 1e-3, "{err}");
-    let (code, err) = seek(2);
+    let (code, err) = seek_over_link(2, linear);
     assert_eq!(code, 2);
     assert!(err.abs() > 0.02, "{err}");
     assert_eq!(
@@ -274,29 +279,10 @@ fn a_symmetric_seek_over_the_link_cancels_a_linear_drift() {
 /// gives the truth, where the time-symmetric seek (0x82) keeps the curvature's error.
 #[test]
 fn a_thue_morse_seek_over_the_link_cancels_a_quadratic_drift() {
-    let (lat, truth) = (39.9, 108.4);
-    let seek = |positions: u8| {
-        let mut a = app();
-        let r = drive(
-            &mut a,
-            Tilt::LEVEL,
-            |t, h| {
-                earth_rate_on_axis_dph(lat, truth, Tilt::LEVEL, h) + 0.2 + 1e-3 * t
-                    - 2e-6 * (t - 1_200.0).powi(2)
-            },
-            |a, i, t_s| {
-                if i == 105 {
-                    let c = Command::StartSeek { positions };
-                    assert_eq!(a.command(c, t_s), Some(DeviceMessage::Accepted));
-                }
-            },
-            &mut Vec::new(),
-        );
-        (r.positions, r.azimuth_deg - truth)
-    };
-    let (code, tm_err) = seek(0xC2);
+    let curved = |t: f64| 0.2 + 1e-3 * t - 2e-6 * (t - 1_200.0).powi(2);
+    let (code, tm_err) = seek_over_link(0xC2, curved);
     assert_eq!(code, 0xC2);
-    let (code, sym_err) = seek(0x82);
+    let (code, sym_err) = seek_over_link(0x82, curved);
     assert_eq!(code, 0x82);
     assert!(
         tm_err.abs() < 1e-3 && sym_err.abs() > 10.0 * tm_err.abs().max(1e-4),
