@@ -113,6 +113,8 @@ const TWO_THUE_MORSE: [Step; 7] = [
 
 /// The high bit of the link's `positions` byte that marks a time-symmetric sequence.
 pub const SYMMETRIC_CODE_BIT: u8 = 0x80;
+/// The bit below it that marks the Thue-Morse order (with `SYMMETRIC_CODE_BIT`: 0xC2).
+pub const THUE_MORSE_CODE_BIT: u8 = 0x40;
 
 impl SeekMode {
     /// The dwells in time order.
@@ -164,7 +166,7 @@ impl SeekMode {
     }
 
     /// Measuring time at each main position, in units of `dwell_s` (2 for the symmetric
-    /// sequences: two visits, or one double dwell).
+    /// sequences: two visits, or one double dwell; 4 for the Thue-Morse order).
     pub const fn main_dwells_per_position(self) -> u8 {
         if matches!(self, SeekMode::TwoPositionThueMorse) {
             4
@@ -176,8 +178,9 @@ impl SeekMode {
     }
 
     /// The mode as the link's `positions` byte: 2 or 4, with `SYMMETRIC_CODE_BIT` set for
-    /// a symmetric sequence (0x82, 0x84) and 0x40 too for the Thue-Morse order (0xC2). 2 and 4 keep their meaning, so old bytes decode
-    /// the same; a device without the symmetric sequences refuses 0x82/0x84.
+    /// a symmetric sequence (0x82, 0x84) and `THUE_MORSE_CODE_BIT` too for the Thue-Morse
+    /// order (0xC2). 2 and 4 keep their meaning, so old bytes decode the same; a device
+    /// without these sequences refuses their bytes.
     pub const fn code(self) -> u8 {
         let sym = if self.is_symmetric() {
             SYMMETRIC_CODE_BIT
@@ -185,7 +188,7 @@ impl SeekMode {
             0
         };
         let thue_morse = if matches!(self, SeekMode::TwoPositionThueMorse) {
-            0x40
+            THUE_MORSE_CODE_BIT
         } else {
             0
         };

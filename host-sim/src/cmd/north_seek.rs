@@ -417,7 +417,10 @@ fn recipe_of(args: &Args) -> Result<Option<UnitRecipe>> {
 fn criterion_of(args: &Args, cfg: &MonteCarloConfig) -> Result<Criterion> {
     let (name, symmetric) = match args.criterion.as_str() {
         "seek-forward" => ("seek", false),
-        name => (name, cfg.mode.is_symmetric()),
+        name => (
+            name,
+            crate::pipeline::north_seek::scored_as_symmetric(cfg.mode),
+        ),
     };
     Ok(Criterion::parse(name, cfg.dwell_s as f64, cfg.latitude_deg)
         .map_err(|e| anyhow::anyhow!("--criterion {e}"))?

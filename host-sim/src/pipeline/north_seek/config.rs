@@ -180,6 +180,17 @@ pub fn default_dwell_s(mode: SeekMode) -> f32 {
     }
 }
 
+/// Whether a mode's seeks are scored as the time-symmetric two-position seek's (the seek
+/// score's `SeekGeometry::symmetric`: its drift error's curvature, not its slope): the two
+/// positions there and back or in Thue-Morse order. The four-position sequences are
+/// scored as forward seeks.
+pub fn scored_as_symmetric(mode: SeekMode) -> bool {
+    matches!(
+        mode,
+        SeekMode::TwoPositionSymmetric | SeekMode::TwoPositionThueMorse
+    )
+}
+
 /// Both cores by default, as the machine the demo targets has two.
 pub fn default_threads() -> usize {
     crate::fanout::thread_count(None).min(8)

@@ -91,7 +91,7 @@ pub fn compare_recipes(cfg: &MonteCarloConfig, keep_dir: &Path) -> Result<Recipe
         dwell_s: cfg.dwell_s as f64,
         seed: cfg.seed,
         criterion: Criterion::Seek(SeekGeometry {
-            symmetric: cfg.mode.is_symmetric(),
+            symmetric: super::config::scored_as_symmetric(cfg.mode),
             ..SeekGeometry::forward(cfg.dwell_s as f64, cfg.latitude_deg)
         }),
         inputs: InputChoice::Auto,
