@@ -46,6 +46,7 @@ mod own_model_derivative_free;
 mod own_model_linear_terms;
 mod probe_invocations;
 mod registry_concurrency;
+mod seek_independent;
 mod sim_base_motion;
 mod sim_calibration;
 mod sim_campaign;

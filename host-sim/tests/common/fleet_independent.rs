@@ -43,6 +43,10 @@ pub enum FleetLaw {
     OddUnit,
     /// The null twin: every unit is the type (the same draws are made and not used).
     Identical,
+    /// Single-effect twins (the same draws; only these parameters of each unit kept):
+    /// the Shupe coefficient alone, or the thermal ones alone (time constant and rise).
+    OnlyShupe,
+    OnlyThermal,
 }
 
 /// One unit's physics.
@@ -102,6 +106,15 @@ pub fn fleet(
         let mut truth = match law {
             FleetLaw::Identical => UnitTruth::TYPE,
             FleetLaw::Type | FleetLaw::OddUnit => drawn,
+            FleetLaw::OnlyShupe => UnitTruth {
+                shupe_dph_per_cps: drawn.shupe_dph_per_cps,
+                ..UnitTruth::TYPE
+            },
+            FleetLaw::OnlyThermal => UnitTruth {
+                tau_s: drawn.tau_s,
+                rise_c: drawn.rise_c,
+                ..UnitTruth::TYPE
+            },
         };
         if law == FleetLaw::OddUnit && u + 1 == units {
             truth.shupe_dph_per_cps = -truth.shupe_dph_per_cps;
@@ -122,8 +135,9 @@ pub fn fleet(
     }
 }
 
-/// One cold start of unit `truth` at ambient `amb`: 1 s physics, 10 s means.
-fn cold_start(truth: &UnitTruth, amb: f64, minutes: usize, rng: &mut ChaCha8Rng) -> Run {
+/// One cold start of unit `truth` at ambient `amb`: 1 s physics, 10 s means (`rng` is
+/// the caller's stream: more cold starts of a unit than its fleet gave it).
+pub fn cold_start(truth: &UnitTruth, amb: f64, minutes: usize, rng: &mut ChaCha8Rng) -> Run {
     let g = Normal::new(0.0, 1.0).unwrap();
     let rise = truth.rise_c * (1.0 + 0.01 * (20.0 - amb));
     let offset = TURN_ON_DPH * g.sample(rng);

@@ -1,0 +1,513 @@
+//! The seek sequences and the type + unit recipe on the independent fleet
+//! (`common::fleet_independent`: a stretched-exponential warm-up, a drift in T and the
+//! true dT/dt, a uniform unit-to-unit law; nothing shared with the simulator), judged by
+//! issue 37's targets on held-out cold starts of a unit the type never saw.
+//!
+//! The type is learnt from 10 units of 6 cold starts (2 at each of -40, 20, +60 degC) as
+//! `north-seek --type-units` learns it, in either shape (`--type-shape law`, the default,
+//! or `network`), scored with the sequence's seek geometry; the 11th unit is calibrated
+//! from its own 6 (`calibrate_unit`: its terms and prior chosen by leave-one-run-out in the
+//! sequence's seek windows; `INDEP_UNIT_RUNS` for more); the type-free recipe is `fogsim
+//! train`'s default trainer on those runs alone. Each held-out cold start of the 11th unit
+//! (its own physics, fresh noise and turn-on offset) is read as each seek reads its drift:
+//! the residual (drift less the model) averaged over the device's own position spans
+//! (`pipeline::north_seek::schedule`: the simulator's turntable and firmware timing at the
+//! sequence's default dwell), the opposite positions differenced, turned into azimuth
+//! error at the site latitude. The floor is the generator's white noise through the same
+//! rows. Per ambient and seek: the rms over the floor and |mean| / std over the held-out
+//! starts, `north-seek`'s targets.
+//!
+//! Twins (`FleetLaw`): identical units (null), an odd unit (a Shupe term of the other sign:
+//! refused by the misfit test, not scored), and single-effect fleets whose units differ
+//! only in the Shupe coefficient or only in the thermal time constant and rise.
+//!
+//! The CI size (`INDEP_SEEK_STARTS`, default 200 held-out starts per ambient; seed 1; the
+//! type fleet and its null twin) guards the judge (white noise at its floor) and the recipe
+//! where the type carries the unit; the measurement over seeds and twins is run with
+//! `INDEP_SEEK_STARTS=1000 INDEP_SEEK_SEEDS=1,2,3,4,5 INDEP_SEEK_FLEETS=type,identical,shupe,thermal`
+//! (docs/record/fleet.md, "The type and unit recipe on the independent fleet").
+
+use crate::common::fleet_independent::{cold_start, fleet, FleetLaw, NOISE_10S_DPH};
+
+use fog_core::model::format::RbfModel;
+use fog_core::seeking::northfinder::SeekMode;
+use fog_sim::io::runs::Run;
+use fog_sim::pipeline::north_seek::schedule::seek_schedule;
+use fog_sim::pipeline::north_seek::{default_dwell_s, scored_as_symmetric, MonteCarloConfig};
+use fog_sim::sim::GyroParams;
+use fog_sim::train::seek_refit::SeekSchedule;
+use fog_sim::train::seek_score::{Criterion, SeekGeometry};
+use fog_sim::train::type_unit::law::fit_law_network;
+use fog_sim::train::type_unit::terms::Fit;
+use fog_sim::train::type_unit::type_model::learn_type;
+use fog_sim::train::type_unit::{calibrate_unit, UnitPlan};
+use fog_sim::train::{dataset_from_runs, default_specs, predict_batch, train_model, TrainConfig};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use std::time::Instant;
+
+const TYPE_UNITS: usize = 10;
+const AMBIENTS_C: [f64; 3] = [-40.0, 20.0, 60.0];
+const MINUTES: usize = 45;
+const SEEKS: usize = 6;
+const SEQUENCES: [SeekMode; 3] = [
+    SeekMode::TwoPosition,
+    SeekMode::TwoPositionSymmetric,
+    SeekMode::TwoPositionThueMorse,
+];
+
+/// Held-out cold starts per ambient.
+fn heldout_starts() -> usize {
+    std::env::var("INDEP_SEEK_STARTS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(200)
+}
+
+fn sequence_name(mode: SeekMode) -> &'static str {
+    match mode {
+        SeekMode::TwoPosition => "forward",
+        SeekMode::TwoPositionSymmetric => "time-symmetric",
+        SeekMode::TwoPositionThueMorse => "Thue-Morse",
+        _ => "other",
+    }
+}
+
+/// The device's seeks of `mode` at its default dwell: their position spans.
+fn schedule(mode: SeekMode) -> SeekSchedule {
+    let cfg = MonteCarloConfig {
+        mode,
+        dwell_s: default_dwell_s(mode),
+        starts: 1,
+        threads: 1,
+        ..MonteCarloConfig::paper(1)
+    };
+    seek_schedule(&GyroParams::paper_default(), &cfg, None).unwrap()
+}
+
+/// Each seek's weights on a run's rows (10 s means ending at `t_s`): +1/(pairs x rows)
+/// on the first position's rows, -1/(pairs x rows) on the second's, so that the weighted
+/// sum of the residual is the seek's drift difference, deg/h.
+fn seek_weights(sched: &SeekSchedule, t_s: &[f64]) -> Vec<Vec<(usize, f64)>> {
+    sched
+        .seeks
+        .iter()
+        .take(SEEKS)
+        .map(|pairs| {
+            let mut w = vec![0.0; t_s.len()];
+            let rows = |(a, b): (f64, f64)| -> Vec<usize> {
+                (0..t_s.len())
+                    .filter(|&i| t_s[i] - 5.0 >= a && t_s[i] - 5.0 < b)
+                    .collect()
+            };
+            let p = pairs.len() as f64;
+            for pair in pairs {
+                for (span, sign) in [(pair.first_s, 1.0), (pair.second_s, -1.0)] {
+                    let r = rows(span);
+                    assert!(!r.is_empty(), "a position span holds no row: {span:?}");
+                    for &i in &r {
+                        w[i] += sign / (p * r.len() as f64);
+                    }
+                }
+            }
+            w.into_iter()
+                .enumerate()
+                .filter(|&(_, v)| v != 0.0)
+                .collect()
+        })
+        .collect()
+}
+
+/// Each seek's azimuth error, deg, of the residual `res` (deg/h, rows ending at `t_s`),
+/// and each seek's white-noise floor (the generator's 10 s noise through the same rows).
+fn seek_errors_deg(
+    sched: &SeekSchedule,
+    t_s: &[f64],
+    res: &[f64],
+    geometry: SeekGeometry,
+) -> (Vec<f64>, Vec<f64>) {
+    seek_weights(sched, t_s)
+        .iter()
+        .map(|w| {
+            let e: f64 = w.iter().map(|&(i, v)| v * res[i]).sum();
+            let ss: f64 = w.iter().map(|(_, v)| v * v).sum();
+            (
+                geometry.azimuth_deg(e),
+                geometry.azimuth_deg(NOISE_10S_DPH * ss.sqrt()),
+            )
+        })
+        .unzip()
+}
+
+/// A recipe's model for one sequence, with how it reads the held-out starts.
+struct Judged {
+    recipe: &'static str,
+    mode: SeekMode,
+    model: RbfModel,
+    sched: SeekSchedule,
+    /// Azimuth errors, deg: [ambient][seek] over held-out starts.
+    errors_deg: Vec<Vec<Vec<f64>>>,
+    floor_deg: Vec<f64>,
+}
+
+impl Judged {
+    fn new(recipe: &'static str, mode: SeekMode, model: RbfModel, sched: SeekSchedule) -> Self {
+        Judged {
+            recipe,
+            mode,
+            model,
+            sched,
+            errors_deg: vec![vec![Vec::new(); SEEKS]; AMBIENTS_C.len()],
+            floor_deg: Vec::new(),
+        }
+    }
+
+    fn read(&mut self, ambient: usize, run: &Run, geometry: SeekGeometry) {
+        let ds = dataset_from_runs(std::slice::from_ref(run), &self.model.inputs).unwrap();
+        let pred = predict_batch(&self.model, ds.rows()).unwrap();
+        let res: Vec<f64> = ds
+            .targets_dph
+            .iter()
+            .zip(&pred)
+            .map(|(y, p)| y - p)
+            .collect();
+        let (errors, floors) = seek_errors_deg(&self.sched, &ds.t_s, &res, geometry);
+        if self.floor_deg.is_empty() {
+            self.floor_deg = floors;
+        }
+        for (k, e) in errors.into_iter().enumerate() {
+            self.errors_deg[ambient][k].push(e);
+        }
+    }
+
+    /// Per ambient: all seeks' rms over the floor, the worst of seeks 1-3 over its floor,
+    /// the worst |mean| / std over the six seeks (with its seek).
+    fn figures(&self) -> Vec<(f64, f64, f64, usize)> {
+        self.errors_deg
+            .iter()
+            .map(|seeks| {
+                let mut all = (0.0, 0.0);
+                let mut worst13: f64 = 0.0;
+                let mut bias = (0.0, 0);
+                for (k, e) in seeks.iter().enumerate() {
+                    let n = e.len() as f64;
+                    let mean = e.iter().sum::<f64>() / n;
+                    let ms = e.iter().map(|x| x * x).sum::<f64>() / n;
+                    let std = (ms - mean * mean).max(0.0).sqrt();
+                    all.0 += ms;
+                    all.1 += self.floor_deg[k].powi(2);
+                    if k < 3 {
+                        worst13 = worst13.max(ms.sqrt() / self.floor_deg[k]);
+                    }
+                    if mean.abs() / std > bias.0 {
+                        bias = (mean.abs() / std, k + 1);
+                    }
+                }
+                ((all.0 / all.1).sqrt(), worst13, bias.0, bias.1)
+            })
+            .collect()
+    }
+}
+
+fn met((all, worst13, bias, _): (f64, f64, f64, usize)) -> bool {
+    all <= 1.1 && worst13 <= 1.15 && bias <= 0.3
+}
+
+/// The type-free recipe: `fogsim train`'s default trainer on the unit's runs alone, scored
+/// with the sequence's seek geometry.
+fn train_alone(runs: &[Run], criterion: Criterion) -> RbfModel {
+    let ds = dataset_from_runs(runs, &default_specs()).unwrap();
+    let cfg = TrainConfig {
+        criterion,
+        ..TrainConfig::default()
+    };
+    train_model(&ds, &cfg).unwrap().model
+}
+
+/// The type's shared model: `north-seek --type-shape`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Shape {
+    /// The warm-up law (the default): two clocks, their stretches and products with T.
+    Law,
+    /// A network of the paper's inputs (T, dT/dt) with linear terms, as `train --type-out`
+    /// with its default inputs.
+    Network,
+}
+
+impl Shape {
+    fn train(self, runs: &[Run], criterion: Criterion) -> anyhow::Result<RbfModel> {
+        match self {
+            Shape::Law => Ok(fit_law_network(runs, criterion, "independent")?.model),
+            Shape::Network => {
+                let ds = dataset_from_runs(runs, &default_specs())?;
+                let cfg = TrainConfig {
+                    criterion,
+                    linear_on_rbf_inputs: true,
+                    ..TrainConfig::default()
+                };
+                Ok(train_model(&ds, &cfg)?.model)
+            }
+        }
+    }
+}
+
+/// The fleet `law`: the type from units 1-10, unit 11 calibrated from its own 6 runs and,
+/// for each sequence, read on `starts` held-out cold starts per ambient; and whether the
+/// misfit test refused unit 11 (then only the type-free rows are read).
+fn measure(law: FleetLaw, shape: Shape, seed: u64, starts: usize) -> (Vec<Judged>, bool) {
+    let f = fleet(law, TYPE_UNITS + 1, &AMBIENTS_C, 2, MINUTES, seed);
+    let unit_id = format!("U{}", TYPE_UNITS + 1);
+    let truth = f.units[TYPE_UNITS];
+    let (mut own, type_runs): (Vec<Run>, Vec<Run>) = f
+        .runs
+        .into_iter()
+        .partition(|r| r.meta_value("unit_id") == Some(unit_id.as_str()));
+    // more cold starts of the unit (`INDEP_UNIT_RUNS`, spread evenly over the ambients)
+    let mut extra = ChaCha8Rng::seed_from_u64(seed ^ 0x0417_0000);
+    for k in own.len()..unit_runs() {
+        let amb = AMBIENTS_C[k % AMBIENTS_C.len()];
+        let mut run = cold_start(&truth, amb, MINUTES, &mut extra);
+        run.path = format!("extra_u011_a{amb}_r{k}.csv").into();
+        run.meta.push(("unit_id".into(), unit_id.clone()));
+        own.push(run);
+    }
+    let lat = fog_sim::sim::DEFAULT_LATITUDE_DEG;
+    let mut judged = Vec::new();
+    let mut refused = false;
+    for mode in SEQUENCES {
+        let dwell_s = default_dwell_s(mode) as f64;
+        let criterion = Criterion::parse("seek", dwell_s, lat)
+            .unwrap()
+            .with_symmetric_seeks(scored_as_symmetric(mode));
+        let ty = learn_type(
+            &type_runs,
+            Some("independent"),
+            Fit::default(),
+            &mut |runs| shape.train(&runs, criterion),
+        )
+        .unwrap();
+        let sched = schedule(mode);
+        let plan = UnitPlan {
+            seek_period_s: sched.period_s,
+            symmetric_seeks: scored_as_symmetric(mode),
+            ..UnitPlan::chosen()
+        };
+        let cal = calibrate_unit(&ty, &own, &unit_id, &plan).unwrap();
+        let own_model = train_alone(&own, criterion);
+        if cal.misfit.outside() {
+            // refused, as `train --type` refuses it by default (`--misfit own`: the unit's
+            // runs alone, the type-free rows)
+            println!(
+                "{law:?} seed {seed}, {shape:?} type, {}: {}",
+                sequence_name(mode),
+                cal.misfit.lines().join("; ")
+            );
+            refused = true;
+            judged.push(Judged::new("unit runs alone", mode, own_model, sched));
+            continue;
+        }
+        println!(
+            "{law:?} seed {seed}, {shape:?} type, {}: {} unit terms, prior weight {}; type terms: {}",
+            sequence_name(mode),
+            cal.terms,
+            cal.prior_weight,
+            ty.file.terms.iter().map(|t| t.name.as_str()).collect::<Vec<_>>().join(", ")
+        );
+        judged.push(Judged::new(
+            "type + unit runs",
+            mode,
+            cal.model,
+            sched.clone(),
+        ));
+        judged.push(Judged::new("unit runs alone", mode, own_model, sched));
+    }
+    let geometry = SeekGeometry::forward(0.0, lat);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5EE4_0000);
+    for (a, &amb) in AMBIENTS_C.iter().enumerate() {
+        for _ in 0..starts {
+            let run = cold_start(&truth, amb, MINUTES, &mut rng);
+            for j in judged.iter_mut() {
+                j.read(a, &run, geometry);
+            }
+        }
+    }
+    (judged, refused)
+}
+
+fn print_table(law: FleetLaw, shape: Shape, judged: &[Judged], starts: usize) {
+    println!(
+        "{law:?} fleet, {shape:?} type: {starts} held-out cold starts per ambient (-40 | 20 | +60 degC): \
+         all seeks / worst of 1-3 x floor / worst |mean|/std (seek)"
+    );
+    for j in judged {
+        let cells: Vec<String> = j
+            .figures()
+            .into_iter()
+            .map(|f| {
+                format!(
+                    "{:.3} / {:.3} / {:.2} (seek {}) {}",
+                    f.0,
+                    f.1,
+                    f.2,
+                    f.3,
+                    if met(f) { "met" } else { "missed" }
+                )
+            })
+            .collect();
+        println!(
+            "  {:15} {:18} floor {:.4} deg | {}",
+            sequence_name(j.mode),
+            j.recipe,
+            j.floor_deg[0],
+            cells.join(" | ")
+        );
+    }
+}
+
+/// The unit's calibration runs (`INDEP_UNIT_RUNS`; default 6, two at each ambient).
+fn unit_runs() -> usize {
+    std::env::var("INDEP_UNIT_RUNS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(6)
+}
+
+/// The fleets measured (`INDEP_SEEK_FLEETS=type,identical,shupe,thermal`; default the
+/// type fleet and its null twin).
+fn fleets() -> Vec<FleetLaw> {
+    let names = std::env::var("INDEP_SEEK_FLEETS").unwrap_or_else(|_| "type,identical".into());
+    names
+        .split(',')
+        .map(|n| match n.trim() {
+            "type" => FleetLaw::Type,
+            "identical" => FleetLaw::Identical,
+            "shupe" => FleetLaw::OnlyShupe,
+            "thermal" => FleetLaw::OnlyThermal,
+            other => panic!("INDEP_SEEK_FLEETS: unknown fleet {other}"),
+        })
+        .collect()
+}
+
+/// The seeds of the measurement (`INDEP_SEEK_SEEDS=1,2,3`; default 1).
+fn seeds() -> Vec<u64> {
+    std::env::var("INDEP_SEEK_SEEDS")
+        .ok()
+        .map(|v| v.split(',').map(|x| x.trim().parse().unwrap()).collect())
+        .unwrap_or_else(|| vec![1])
+}
+
+/// The cells `recipe` with `mode` meets, of the three ambients.
+fn cells_met(judged: &[Judged], recipe: &str, mode: SeekMode) -> usize {
+    let j = judged
+        .iter()
+        .find(|j| j.recipe == recipe && j.mode == mode)
+        .unwrap();
+    j.figures().into_iter().filter(|&f| met(f)).count()
+}
+
+/// The judge's self-check: a residual of the generator's white noise alone (what a model
+/// equal to the unit's drift leaves, its turn-on offset included) reads at its floor with
+/// no bias, for every sequence; a constant (the turn-on offset) cancels.
+#[test]
+fn the_judge_reads_white_noise_at_its_floor_and_cancels_a_constant() {
+    use rand_distr::{Distribution, Normal};
+    let geometry = SeekGeometry::forward(0.0, fog_sim::sim::DEFAULT_LATITUDE_DEG);
+    let t_s: Vec<f64> = (1..=MINUTES * 6).map(|k| 10.0 * k as f64).collect();
+    let noise = Normal::new(0.0, NOISE_10S_DPH).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    for mode in SEQUENCES {
+        let sched = schedule(mode);
+        let (constant, _) = seek_errors_deg(&sched, &t_s, &vec![0.3; t_s.len()], geometry);
+        assert!(constant.iter().all(|e| e.abs() < 1e-12), "{constant:?}");
+        let mut sums = [(0.0, 0.0); SEEKS];
+        let mut floors = Vec::new();
+        let n = 2000;
+        for _ in 0..n {
+            let res: Vec<f64> = t_s.iter().map(|_| 0.3 + noise.sample(&mut rng)).collect();
+            let (e, f) = seek_errors_deg(&sched, &t_s, &res, geometry);
+            for (s, x) in sums.iter_mut().zip(e) {
+                s.0 += x;
+                s.1 += x * x;
+            }
+            floors = f;
+        }
+        for (k, (sum, ss)) in sums.iter().enumerate() {
+            let mean = sum / n as f64;
+            let rms = (ss / n as f64).sqrt();
+            // 2000 draws: the rms within 5 % (3.5 standard errors), the mean within 0.1 std
+            assert!(
+                (rms / floors[k] - 1.0).abs() < 0.05,
+                "{mode:?} seek {}: {rms} vs {}",
+                k + 1,
+                floors[k]
+            );
+            assert!(
+                mean.abs() < 0.1 * rms,
+                "{mode:?} seek {}: mean {mean}",
+                k + 1
+            );
+        }
+    }
+}
+
+/// Cells met per (fleet, shape, sequence, recipe) over the seeds run, and the refusals.
+#[derive(Default)]
+struct Tally {
+    rows: Vec<(String, usize, usize)>,
+}
+
+impl Tally {
+    fn add(&mut self, law: FleetLaw, shape: Shape, judged: &[Judged]) {
+        for j in judged {
+            let key = format!(
+                "{law:?} fleet, {shape:?} type, {}, {}",
+                sequence_name(j.mode),
+                j.recipe
+            );
+            let met = j.figures().into_iter().filter(|&f| met(f)).count();
+            match self.rows.iter_mut().find(|r| r.0 == key) {
+                Some(r) => {
+                    r.1 += met;
+                    r.2 += AMBIENTS_C.len();
+                }
+                None => self.rows.push((key, met, AMBIENTS_C.len())),
+            }
+        }
+    }
+}
+
+/// Measured at 200 starts, seed 1 (the CI size): with identical units the type + unit
+/// recipe meets every target at every ambient with the Thue-Morse seek (law type); the odd
+/// twin's unit is refused. Over seeds 1-5 at 1,000 starts (docs/record/fleet.md): with
+/// units that differ the recipe misses in most cells with every seek and either shape; the
+/// single-effect twins put the cause in the units' thermal differences, which the law
+/// shape's clocks do not carry on this law.
+#[test]
+fn the_type_and_unit_recipe_on_the_independent_fleet_and_its_twins() {
+    let t0 = Instant::now();
+    let starts = heldout_starts();
+    let mut tally = Tally::default();
+    for seed in seeds() {
+        for shape in [Shape::Law, Shape::Network] {
+            for law in fleets() {
+                let (judged, refused) = measure(law, shape, seed, starts);
+                print_table(law, shape, &judged, starts);
+                tally.add(law, shape, &judged);
+                if seed == 1 && shape == Shape::Law && law == FleetLaw::Identical {
+                    assert!(!refused, "the null twin's U11 refused");
+                    let met =
+                        cells_met(&judged, "type + unit runs", SeekMode::TwoPositionThueMorse);
+                    assert_eq!(met, 3, "the null twin's Thue-Morse cells met");
+                }
+            }
+        }
+        assert!(
+            measure(FleetLaw::OddUnit, Shape::Law, seed, 0).1,
+            "seed {seed}: the odd twin's unit passed its type's misfit test"
+        );
+    }
+    for (key, met, cells) in &tally.rows {
+        println!("{key}: {met} of {cells} cells met");
+    }
+    println!("{:.1} s", t0.elapsed().as_secs_f64());
+}
