@@ -28,6 +28,7 @@
 //! (docs/record/fleet.md, "The type and unit recipe on the independent fleet").
 
 use crate::common::fleet_independent::{cold_start, fleet, FleetLaw, NOISE_10S_DPH};
+use crate::common::seek_judge::residual_dph;
 
 use fog_core::model::format::RbfModel;
 use fog_core::seeking::northfinder::SeekMode;
@@ -41,7 +42,7 @@ use fog_sim::train::type_unit::law::fit_law_network;
 use fog_sim::train::type_unit::terms::Fit;
 use fog_sim::train::type_unit::type_model::learn_type;
 use fog_sim::train::type_unit::{calibrate_unit, UnitPlan};
-use fog_sim::train::{dataset_from_runs, default_specs, predict_batch, train_model, TrainConfig};
+use fog_sim::train::{dataset_from_runs, default_specs, train_model, TrainConfig};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::time::Instant;
@@ -163,14 +164,7 @@ impl Judged {
     }
 
     fn read(&mut self, ambient: usize, run: &Run, geometry: SeekGeometry) {
-        let ds = dataset_from_runs(std::slice::from_ref(run), &self.model.inputs).unwrap();
-        let pred = predict_batch(&self.model, ds.rows()).unwrap();
-        let res: Vec<f64> = ds
-            .targets_dph
-            .iter()
-            .zip(&pred)
-            .map(|(y, p)| y - p)
-            .collect();
+        let (ds, res) = residual_dph(&self.model, std::slice::from_ref(run), &self.model.inputs);
         let (errors, floors) = seek_errors_deg(&self.sched, &ds.t_s, &res, geometry);
         if self.floor_deg.is_empty() {
             self.floor_deg = floors;
