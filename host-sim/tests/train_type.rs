@@ -674,7 +674,7 @@ fn bad_type_learning_inputs_fail_with_one_line_and_write_nothing() {
         (
             "U1+U2+U3",
             "--type-out out.type.json --out out.model --max-centers 5 --rho 0.01",
-            "--max-centers, --rho: a network's shape options; the law type",
+            "--max-centers, --rho: a network's shape options; --type-shape law and auto",
         ),
         (
             "U4",

@@ -152,8 +152,9 @@ pub struct Args {
     )]
     pub type_ambients_c: Option<Vec<f64>>,
     /// The form of the type's shared model: `network` (the trainer's, inputs chosen by
-    /// validation) or `law` (the warm-up law of a two-node thermal model as a network's
-    /// base; docs/record/fleet.md) [default: law]. Needs `--type-units`.
+    /// validation, as `train --type-out` makes it), `law` (the warm-up law of a two-node
+    /// thermal model as a network's base; docs/record/fleet.md) or `auto` (chosen by the
+    /// first seeks of the type's units left out) [default: auto]. Needs `--type-units`.
     #[arg(long = "type-shape", value_enum)]
     pub type_shape: Option<TypeShape>,
     /// How the type reads its units and calibrates the seeking unit: `within-runs` (each

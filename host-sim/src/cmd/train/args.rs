@@ -134,10 +134,12 @@ pub struct Args {
     #[arg(long = "type-out", conflicts_with_all = ["type_model", "field", "seek_refit"])]
     pub type_out: Option<PathBuf>,
     /// With `--type-out`: the form of the type's shared model, `network` (the trainer's,
-    /// with the options above) or `law` (the warm-up law of a two-node thermal model, two
+    /// with the options above), `law` (the warm-up law of a two-node thermal model, two
     /// power-on clocks chosen by leaving units out, as the base of a network on T and the
-    /// rise since power-on; better over ten simulated fleets, docs/record/fleet.md).
-    #[arg(long = "type-shape", value_enum, default_value_t = TypeShape::Law, requires = "type_out")]
+    /// rise since power-on; better on the simulated fleets, docs/record/fleet.md) or `auto`
+    /// (each trained on the other units' runs and scored on the first seeks of the units
+    /// left out; the network only when better beyond the units' scatter).
+    #[arg(long = "type-shape", value_enum, default_value_t = TypeShape::Auto, requires = "type_out")]
     pub type_shape: TypeShape,
     /// With `--type-out`: how the units are read, and every unit calibrated against the
     /// type will be: `within-runs` (each cold start's own constant, which a seek cancels,

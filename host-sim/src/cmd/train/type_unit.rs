@@ -14,14 +14,13 @@ use crate::io::model::encode_model;
 use crate::io::runs::Run;
 use crate::io::StagedFiles;
 use crate::registry::{Registry, UnitCalibrationRecord};
-use crate::train::cold_start::envelope_for;
 use crate::train::type_unit::calibrate::DEFAULT_SEEK_PERIOD_S;
-use crate::train::type_unit::law::fit_law_network;
 use crate::train::type_unit::type_model::learn_type;
 use crate::train::type_unit::{
-    calibrate_unit, unit_id_of, MisfitPolicy, TypeModel, TypeShape, UnitPlan,
+    calibrate_unit, resolve_shape, train_shared, unit_id_of, MisfitPolicy, SharedModel, TypeModel,
+    TypeShape, UnitPlan,
 };
-use crate::train::{choose_inputs_default, train_model, InputSet, TrainConfig};
+use crate::train::{InputSet, TrainConfig};
 
 /// `model` for the device `gyro_id` (written into its metadata).
 fn for_gyro(model: &RbfModel, gyro_id: &str) -> Result<RbfModel> {
@@ -51,27 +50,27 @@ pub(super) fn learn(
     runs: &[Run],
 ) -> Result<()> {
     let ignored = args.network_shape_flags();
-    if args.type_shape == TypeShape::Law && !ignored.is_empty() {
+    if args.type_shape != TypeShape::Network && !ignored.is_empty() {
         bail!(
-            "{}: a network's shape options; the law type (--type-shape law, the default) \
-             chooses its own shape: drop them or use --type-shape network",
+            "{}: a network's shape options; --type-shape law and auto (the default) choose \
+             their own shape: drop them or use --type-shape network",
             ignored.join(", ")
         );
+    }
+    let (shape, choice) = resolve_shape(args.type_shape, runs, cfg, candidates)?;
+    if let Some(c) = &choice {
+        print!("{}", c.summary());
     }
     // what the law's clock choices said of their grid, once each whatever the rounds
     let mut edges: Vec<String> = Vec::new();
     let mut train = |runs: Vec<Run>| -> Result<RbfModel> {
-        if args.type_shape == TypeShape::Law {
-            let law = fit_law_network(&runs, cfg.criterion, &cfg.gyro_id)?;
+        let shared = train_shared(shape, &runs, cfg, candidates)?;
+        if let SharedModel::Law(law) = &shared {
             if let Some(e) = law.grid_edge().filter(|e| !edges.contains(e)) {
                 edges.push(e);
             }
-            return Ok(law.model);
         }
-        let (_, ds) = choose_inputs_default(&runs, candidates, cfg)?;
-        let mut model = train_model(&ds, cfg)?.model;
-        model.cold_start = envelope_for(&runs, &model.inputs)?;
-        Ok(model)
+        Ok(shared.model().clone())
     };
     let ty = learn_type(runs, None, args.unit_fit, &mut train)?;
     for e in &edges {

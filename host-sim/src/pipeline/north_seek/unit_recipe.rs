@@ -13,7 +13,7 @@
 use anyhow::{anyhow, Result};
 use fog_core::model::format::RbfModel;
 
-use super::own_model::{own_model_from_runs, OwnModelPlan};
+use super::own_model::{own_model_from_runs, train_config, OwnModelPlan};
 use super::schedule::seek_schedule;
 use super::MonteCarloConfig;
 use crate::io::runs::Run;
@@ -21,10 +21,12 @@ use crate::pipeline::campaign::{CampaignSpec, PAPER_MINUTES};
 use crate::pipeline::fleet::{fleet_runs, unit_id, FleetType};
 use crate::sim::{GyroParams, TypeSpread};
 use crate::train::type_unit::calibrate::DEFAULT_SEEK_PERIOD_S;
-use crate::train::type_unit::law::fit_law_network;
 use crate::train::type_unit::terms::Fit;
 use crate::train::type_unit::type_model::learn_type;
-use crate::train::type_unit::{calibrate_unit, TypeModel, TypeShape, UnitCalibration, UnitPlan};
+use crate::train::type_unit::{
+    calibrate_unit, resolve_shape, train_shared, SharedModel, TypeModel, TypeShape,
+    UnitCalibration, UnitPlan,
+};
 
 /// Ambients of the type's and the unit's chamber runs by default, degC.
 pub const RECIPE_AMBIENTS_C: [f64; 3] = [-40.0, 20.0, 60.0];
@@ -182,21 +184,6 @@ pub fn chamber_h(runs: usize) -> f64 {
     runs as f64 * PAPER_MINUTES / 60.0
 }
 
-/// One backfitting round's shared model, with how it was made.
-enum RoundModel {
-    Network(Box<super::own_model::OwnModel>),
-    Law(Box<crate::train::type_unit::law::LawNetwork>),
-}
-
-impl RoundModel {
-    fn model(&self) -> &RbfModel {
-        match self {
-            Self::Network(own) => &own.trained.model,
-            Self::Law(law) => &law.model,
-        }
-    }
-}
-
 /// A type learnt from the recipe's type units (U2..U(N+1)), and how it was learnt.
 pub struct RecipeType {
     pub type_model: TypeModel,
@@ -226,54 +213,31 @@ pub fn learn_recipe_type(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<Rec
         )?);
     }
     let type_runs = pooled.len();
-    // every round's shared model, to report the one the type kept
-    let mut rounds = Vec::new();
     // The shared model without the seek refit: its output layer is the unit terms' to fit
     // (a refit to pooled seeks trades the 10 s fit the backfitting needs for seek bias
-    // averaged over units, and chose the grid's largest weight).
-    let shared_plan = OwnModelPlan {
-        seek_timing: None,
-        ..plan.clone()
-    };
+    // averaged over units, and chose the grid's largest weight). The network is `train`'s,
+    // as `train --type-out` makes it.
+    let cfg = train_config(plan, false);
+    let candidates = plan.inputs.candidates();
+    let (shape, choice) = resolve_shape(recipe.type_shape, &pooled, &cfg, &candidates)?;
+    // every round's shared model, to report the one the type kept
+    let mut rounds: Vec<SharedModel> = Vec::new();
     let ty = learn_type(&pooled, None, recipe.unit_fit, &mut |runs| {
-        let model = match recipe.type_shape {
-            TypeShape::Network => {
-                let own = own_model_from_runs(&fleet.params, runs, &shared_plan)?;
-                let model = own.trained.model.clone();
-                rounds.push(RoundModel::Network(Box::new(own)));
-                model
-            }
-            TypeShape::Law => {
-                let law = fit_law_network(&runs, plan.criterion, "sim")?;
-                let model = law.model.clone();
-                rounds.push(RoundModel::Law(Box::new(law)));
-                model
-            }
-        };
+        let shared = train_shared(shape, &runs, &cfg, &candidates)?;
+        let model = shared.model().clone();
+        rounds.push(shared);
         Ok(model)
     })?;
     drop(pooled);
-    let shared = rounds
+    let shared_text = rounds
         .into_iter()
         .find(|r| r.model() == &ty.model)
-        .ok_or_else(|| anyhow!("the type's shared model is none of the rounds'"))?;
-    let shared_text = match shared {
-        RoundModel::Network(own) => format!(
-            "shared model ({} centres, inputs {}):\n{}{}",
-            own.trained.report.n_centers,
-            own.trained.report.inputs.join(", "),
-            own.selection.summary(),
-            own.summary(),
-        ),
-        RoundModel::Law(law) => format!(
-            "shared model: the warm-up law (clocks of {:.0} s and {:.0} s, held-out first-seek error {:.4} deg) as the base of a network of {} centres\n{}",
-            law.taus_s[0],
-            law.taus_s[1],
-            law.law_heldout_deg,
-            law.model.centers.len(),
-            law.grid_edge().map_or(String::new(), |e| format!("  {e}\n")),
-        ),
-    };
+        .ok_or_else(|| anyhow!("the type's shared model is none of the rounds'"))?
+        .describe();
+    let shared_text = format!(
+        "{}{shared_text}",
+        choice.map_or(String::new(), |c| c.summary())
+    );
     let summary = format!(
         "type: {} units x {per_unit} runs ({:.1} chamber h); {}{}",
         recipe.type_units,

@@ -34,14 +34,17 @@
 //! it kept one Gaussian and left seek 1 at -40 degC biased by 1.7 of its std. The law
 //! alone has no such choices but no ambient effect (6 of 15 cells, as the network); the
 //! law as the network's base was better in 21 of 30 cells over ten fleets (11 met against
-//! 8, the worst bias 1.5 std against 5.4; docs/record/fleet.md, 2026-12-02): the default. The estimated derivatives are not its inputs: a 60 s rate fit and a 180 s
-//! second-derivative fit lag and are noisy in exactly the first minutes the first seek
-//! needs (tried: 2-3x the floor at -40 degC).
+//! 8, the worst bias 1.5 std against 5.4; docs/record/fleet.md, 2026-12-02), and it is
+//! the shape `auto` keeps unless a network is better on units left out (`shape`). The
+//! estimated derivatives are not its inputs: a 60 s rate fit and a 180 s second-derivative
+//! fit lag and are noisy in exactly the first minutes the first seek needs (tried: 2-3x
+//! the floor at -40 degC).
 
 use anyhow::{anyhow, Result};
 use fog_core::model::format::{FeatureKind, FeatureSpec, RbfModel};
 use nalgebra::{DMatrix, DVector};
 
+use super::folds::run_folds;
 use crate::io::runs::Run;
 use crate::train::cold_start::envelope_for;
 use crate::train::fit::assemble::ForcedTerm;
@@ -176,25 +179,6 @@ fn seek_sse(
 /// targets judge one by one and where the warm-up's curvature is.
 pub const FIRST_SEEKS: usize = 3;
 
-/// The fold of each run: whole units (their `unit_id`) dealt to folds in order of first
-/// appearance, or whole runs when no run names its unit.
-fn run_folds(runs: &[Run], folds: usize) -> Vec<usize> {
-    let mut units: Vec<&str> = Vec::new();
-    runs.iter()
-        .enumerate()
-        .map(|(i, r)| match r.meta_value("unit_id").map(str::trim) {
-            Some(u) if !u.is_empty() => {
-                let k = units.iter().position(|x| *x == u).unwrap_or_else(|| {
-                    units.push(u);
-                    units.len() - 1
-                });
-                k % folds
-            }
-            _ => i % folds,
-        })
-        .collect()
-}
-
 /// The law's clock time constants, chosen from `FAST_TAUS_S` x `SLOW_TAUS_S` by the
 /// held-out azimuth error of the first `FIRST_SEEKS` seeks over `LAW_FOLDS` folds of whole
 /// units (the law fitted on the other folds), and that error, deg.
@@ -308,20 +292,20 @@ impl LawNetwork {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
-    /// Run `k` of unit `u`: T rises from `ambient_c` as `rise(t, ambient_c)` (the unit's
+    /// Run `k` of unit `u`: T rises from `ambient_c` as `rise(t, ambient_c, u)` (the unit's
     /// dissipation 3 % apart from the next one's), 1 Hz rows for 45 min, the drift
     /// `drift(t, T, dT/dt, ambient_c)` plus 0.003 deg/h of white noise.
     fn run(
         u: usize,
         k: u64,
         ambient_c: f64,
-        rise: &dyn Fn(f64, f64) -> f64,
+        rise: &dyn Fn(f64, f64, usize) -> f64,
         drift: &dyn Fn(f64, f64, f64, f64) -> f64,
     ) -> Run {
-        let rise = |t: f64| rise(t, ambient_c);
+        let rise = |t: f64| rise(t, ambient_c, u);
         let mut state = (u as u64 * 1000 + k + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15);
         let mut noise = move || {
             state = state
@@ -353,7 +337,10 @@ mod tests {
 
     /// Five units x 4 runs at -20, 20 and +50 degC in turn, the warm-up the same at every
     /// ambient.
-    fn fleet(rise: &dyn Fn(f64) -> f64, drift: &dyn Fn(f64, f64, f64) -> f64) -> Vec<Run> {
+    pub(in crate::train::type_unit) fn fleet(
+        rise: &dyn Fn(f64) -> f64,
+        drift: &dyn Fn(f64, f64, f64) -> f64,
+    ) -> Vec<Run> {
         fleet_at(&|t, _| rise(t), &|t, temp, rate, _| drift(t, temp, rate))
     }
 
@@ -362,8 +349,18 @@ mod tests {
         rise: &dyn Fn(f64, f64) -> f64,
         drift: &dyn Fn(f64, f64, f64, f64) -> f64,
     ) -> Vec<Run> {
+        fleet_of_units(5, &|t, ambient_c, _| rise(t, ambient_c), drift)
+    }
+
+    /// `units` units x 4 runs at -20, 20 and +50 degC in turn, the warm-up a function of
+    /// the unit too: `rise(t, ambient_c, unit)`.
+    pub(in crate::train::type_unit) fn fleet_of_units(
+        units: usize,
+        rise: &dyn Fn(f64, f64, usize) -> f64,
+        drift: &dyn Fn(f64, f64, f64, f64) -> f64,
+    ) -> Vec<Run> {
         let ambients = [-20.0, 20.0, 50.0];
-        (1..=5)
+        (1..=units)
             .flat_map(|u| (0..4u64).map(move |k| (u, k)))
             .map(|(u, k)| run(u, k, ambients[k as usize % 3], rise, drift))
             .collect()
@@ -449,12 +446,12 @@ mod tests {
         assert!((null_with / null_without - 1.0).abs() < 0.15, "{got:?}");
     }
 
-    fn two_node(t: f64) -> f64 {
+    pub(in crate::train::type_unit) fn two_node(t: f64) -> f64 {
         let t = t.max(0.0);
         2.0 * (1.0 - (-t / 60.0).exp()) + 6.0 * (1.0 - (-t / 400.0).exp())
     }
 
-    fn seek() -> SeekGeometry {
+    pub(in crate::train::type_unit) fn seek() -> SeekGeometry {
         SeekGeometry::forward(50.0, 39.9)
     }
 
@@ -495,7 +492,7 @@ mod tests {
         assert_eq!(inside.grid_edge(), None, "{:?}", inside.taus_s);
     }
 
-    fn law_of_two_node(t: f64, temp: f64, _: f64) -> f64 {
+    pub(in crate::train::type_unit) fn law_of_two_node(t: f64, temp: f64, _: f64) -> f64 {
         (0.2 + 0.002 * temp) * (-t / 60.0).exp() - 0.05 * (-t / 400.0).exp() + 0.001 * temp
     }
 

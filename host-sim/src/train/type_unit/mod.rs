@@ -10,22 +10,14 @@
 //! the unit pays parameters only for what its runs show it differs in.
 
 pub mod calibrate;
+pub mod folds;
 pub mod law;
 pub mod misfit;
+pub mod shape;
 pub mod solve;
 pub mod terms;
 pub mod type_model;
 
-/// The form of a type's shared model (`--type-shape`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
-pub enum TypeShape {
-    /// The trainer's network, its inputs chosen by validation (`train`'s defaults).
-    Network,
-    /// The warm-up law of a two-node thermal model as the base of a network (`law`): the
-    /// default, from the Monte Carlo over ten simulated fleets (docs/record/fleet.md).
-    #[default]
-    Law,
-}
-
 pub use calibrate::{calibrate_unit, unit_id_of, MisfitPolicy, UnitCalibration, UnitPlan};
+pub use shape::{resolve_shape, train_shared, ShapeChoice, SharedModel, SharedShape, TypeShape};
 pub use type_model::{fit_type, runs_by_unit, TypeModel};

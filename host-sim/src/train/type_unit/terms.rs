@@ -63,12 +63,17 @@ pub enum UnitTerm {
 }
 
 /// Every unit term a model can carry when fitted `fit`: the offset (pooled only: within
-/// runs each run's constant is taken out), the gain, then one linear term per input.
+/// runs each run's constant is taken out), the gain (only when the model predicts more
+/// than its bias: a gain on nothing is a term no unit can show), then one linear term per
+/// input.
 pub fn unit_terms(model: &RbfModel, fit: Fit) -> Vec<UnitTerm> {
     let mut t = match fit {
-        Fit::Pooled => vec![UnitTerm::Offset, UnitTerm::Gain],
-        Fit::WithinRuns => vec![UnitTerm::Gain],
+        Fit::Pooled => vec![UnitTerm::Offset],
+        Fit::WithinRuns => vec![],
     };
+    if predicts_beyond_bias(model) {
+        t.push(UnitTerm::Gain);
+    }
     t.extend((0..model.inputs.len()).map(UnitTerm::Linear));
     t.extend(
         (0..model.linear_by_t.len().min(model.inputs.len()))
@@ -76,6 +81,19 @@ pub fn unit_terms(model: &RbfModel, fit: Fit) -> Vec<UnitTerm> {
             .map(UnitTerm::LinearByT),
     );
     t
+}
+
+/// Whether `model`'s prediction less its bias can be other than zero: a weighted centre, a
+/// polynomial or linear coefficient, or a heading harmonic. (Validation may keep none of
+/// them: on some simulated fleets the trainer's network kept no centre, the units' own
+/// linear terms carrying their drift.)
+fn predicts_beyond_bias(model: &RbfModel) -> bool {
+    let any = |v: &[f32]| v.iter().any(|&x| x != 0.0);
+    any(&model.weights)
+        || any(&model.poly)
+        || any(&model.linear)
+        || any(&model.linear_by_t)
+        || model.heading.is_some()
 }
 
 /// The term's name in reports and files, in the physics' words where they fit.
@@ -254,6 +272,22 @@ pub(super) mod tests {
         let t: Vec<f64> = (0..50).map(|i| 10.0 * i as f64).collect();
         ds.push_group("r", &rows, &vec![0.0; 50], &t).unwrap();
         ds
+    }
+
+    #[test]
+    fn a_model_of_its_bias_alone_offers_no_gain() {
+        // validation may keep nothing but the bias (seen on simulated fleets with the
+        // trainer's network): the gain's column is zero, no unit can show it, and the type
+        // must not carry a term it cannot estimate
+        let mut m = model();
+        m.weights.iter_mut().for_each(|w| *w = 0.0);
+        m.poly.iter_mut().for_each(|p| *p = 0.0);
+        m.linear.iter_mut().for_each(|l| *l = 0.0);
+        m.linear_by_t.iter_mut().for_each(|l| *l = 0.0);
+        m.heading = None;
+        let terms = unit_terms(&m, Fit::WithinRuns);
+        assert_eq!(terms, [UnitTerm::Linear(0), UnitTerm::Linear(1)]);
+        assert!(unit_terms(&model(), Fit::WithinRuns).contains(&UnitTerm::Gain));
     }
 
     #[test]

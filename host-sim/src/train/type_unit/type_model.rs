@@ -479,9 +479,8 @@ mod tests {
     use super::*;
     use fog_core::model::format::{FeatureKind, FeatureSpec};
 
-    /// The JSON of a type read pooled (before `unit_fit` existed: no such key) of a model on
-    /// T and dT/dt: terms offset, gain, linear:0, linear:1; 3 units.
-    fn pooled_type_json() -> serde_json::Value {
+    /// A model on T and dT/dt of linear terms `linear` alone (no centres).
+    fn linear_model(linear: f32) -> RbfModel {
         let mut m = RbfModel::empty();
         m.n_rbf_inputs = 0;
         for k in [FeatureKind::TempC, FeatureKind::TempRateCps] {
@@ -490,8 +489,30 @@ mod tests {
             m.input_scale.push(1.0).unwrap();
             m.input_min.push(-40.0).unwrap();
             m.input_max.push(80.0).unwrap();
-            m.linear.push(0.01).unwrap();
+            m.linear.push(linear).unwrap();
         }
+        m
+    }
+
+    #[test]
+    fn a_shared_model_of_its_bias_alone_makes_a_type_of_the_units_linear_terms() {
+        // the trainer's network kept no centre on some simulated fleets (the units' own
+        // linear terms carry their drift): the type is learnt without a warm-up gain,
+        // which no unit could show, and reads back
+        let runs = super::super::law::tests::fleet(
+            &super::super::law::tests::two_node,
+            &|_, temp, rate| 0.001 * temp + 9.0 * rate,
+        );
+        let ty = fit_type(&linear_model(0.0), &runs, None, Fit::WithinRuns).unwrap();
+        let names: Vec<&str> = ty.file.terms.iter().map(|t| t.name.as_str()).collect();
+        assert_eq!(names, ["temperature coefficient", "Shupe coefficient"]);
+        TypeModel::from_file(ty.file.clone()).unwrap();
+    }
+
+    /// The JSON of a type read pooled (before `unit_fit` existed: no such key) of a model on
+    /// T and dT/dt: terms offset, gain, linear:0, linear:1; 3 units.
+    fn pooled_type_json() -> serde_json::Value {
+        let m = linear_model(0.01);
         let mut buf = [0u8; MAX_ENCODED_LEN];
         let len = m.encode(&mut buf).unwrap();
         let terms = unit_terms(&m, Fit::Pooled);

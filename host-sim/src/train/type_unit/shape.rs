@@ -1,0 +1,437 @@
+//! The form of a type's shared model: the warm-up law as a network's base (`law`) or the
+//! trainer's network (`network`), trained the same way by `train --type-out` and
+//! `north-seek --type-units`, and chosen from the fleet's own runs (`--type-shape auto`).
+//!
+//! Why a choice: the law carries a warm-up of two exponential modes with few parameters,
+//! and on the simulator's fleets it was the better base; on a fleet whose units warm up
+//! otherwise (the independent generator's, whose units differ in their thermal law) the
+//! free network carried the type better (docs/record/fleet.md). Which one a design needs
+//! is the data's to say: each shape is trained on the other units' runs and scored by
+//! the azimuth error of the first seeks of the units left out, as the type will meet a
+//! unit it has never seen. The network is taken only when its pooled error is lower than
+//! the law's beyond what the units left out could make of it (the log ratio over its
+//! jackknife standard error, each unit left out in turn, above `SHAPE_T_MIN`); otherwise,
+//! and when too few units leave no test power, the law: the physical base. (A paired test
+//! of each unit's log ratio was tried first: it kept the law on independent fleets whose
+//! pooled error the network cut by a third, carried by a few units far off the type;
+//! docs/record/fleet.md.)
+
+use anyhow::{anyhow, Result};
+use fog_core::model::format::RbfModel;
+
+use super::folds::unit_of_runs;
+use super::law::{fit_law_network, LawNetwork, LAW_FOLDS};
+use crate::io::runs::Run;
+use crate::train::cold_start::envelope_for;
+use crate::train::seek_score::seek_azimuth_first_pairs_per_run;
+use crate::train::{
+    choose_inputs_default, dataset_from_runs, predict_batch, train_model, InputSelection, InputSet,
+    TrainConfig,
+};
+
+/// The form of a type's shared model asked for (`--type-shape`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum TypeShape {
+    /// The trainer's network, its inputs chosen by validation (`train`'s defaults).
+    Network,
+    /// The warm-up law of a two-node thermal model as the base of a network (`law`).
+    Law,
+    /// Chosen from the fleet's runs by leaving whole units out (`choose_shape`).
+    #[default]
+    Auto,
+}
+
+/// A shared model's form, as trained.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SharedShape {
+    /// The trainer's network with the configuration given (`--linear-inputs` among it).
+    Network,
+    /// The trainer's network with linear terms in its inputs under the Gaussians (a drift
+    /// linear in an input, as the Shupe term is in dT/dt, is carried by one term whatever
+    /// the unit's warm-up, where Gaussians only approximate it).
+    NetworkLinear,
+    Law,
+}
+
+impl SharedShape {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Network => "network",
+            Self::NetworkLinear => "network with linear terms",
+            Self::Law => "law",
+        }
+    }
+}
+
+/// The shapes `auto` chooses among; the first is the one kept when no other is better
+/// beyond the units' scatter.
+pub const AUTO_SHAPES: [SharedShape; 3] = [
+    SharedShape::Law,
+    SharedShape::Network,
+    SharedShape::NetworkLinear,
+];
+
+/// A trained shared model and what its training chose.
+#[derive(Clone, Debug)]
+pub enum SharedModel {
+    Network {
+        model: RbfModel,
+        selection: Box<InputSelection>,
+        centres: usize,
+        inputs: Vec<String>,
+    },
+    Law(LawNetwork),
+}
+
+impl SharedModel {
+    pub fn model(&self) -> &RbfModel {
+        match self {
+            Self::Network { model, .. } => model,
+            Self::Law(law) => &law.model,
+        }
+    }
+
+    /// What it is, in a few lines.
+    pub fn describe(&self) -> String {
+        match self {
+            Self::Network {
+                selection,
+                centres,
+                inputs,
+                ..
+            } => format!(
+                "shared model: the network ({centres} centres, inputs {}):\n{}",
+                inputs.join(", "),
+                selection.summary(),
+            ),
+            Self::Law(law) => format!(
+                "shared model: the warm-up law (clocks of {:.0} s and {:.0} s, held-out first-seek error {:.4} deg) as the base of a network of {} centres\n{}",
+                law.taus_s[0],
+                law.taus_s[1],
+                law.law_heldout_deg,
+                law.model.centers.len(),
+                law.grid_edge().map_or(String::new(), |e| format!("  {e}\n")),
+            ),
+        }
+    }
+}
+
+/// Trains a shared model of `shape` on `runs`: the law with `cfg.criterion`, or the
+/// network as `train` would (inputs from `candidates` by validation, `cfg`'s shape).
+pub fn train_shared(
+    shape: SharedShape,
+    runs: &[Run],
+    cfg: &TrainConfig,
+    candidates: &[InputSet],
+) -> Result<SharedModel> {
+    match shape {
+        SharedShape::Law => Ok(SharedModel::Law(fit_law_network(
+            runs,
+            cfg.criterion,
+            &cfg.gyro_id,
+        )?)),
+        SharedShape::Network | SharedShape::NetworkLinear => {
+            let linear = TrainConfig {
+                linear_on_rbf_inputs: true,
+                ..cfg.clone()
+            };
+            let cfg = if shape == SharedShape::NetworkLinear {
+                &linear
+            } else {
+                cfg
+            };
+            let (selection, ds) = choose_inputs_default(runs, candidates, cfg)?;
+            let trained = train_model(&ds, cfg)?;
+            let mut model = trained.model;
+            model.cold_start = envelope_for(runs, &model.inputs)?;
+            Ok(SharedModel::Network {
+                model,
+                selection: Box::new(selection),
+                centres: trained.report.n_centers,
+                inputs: trained.report.inputs,
+            })
+        }
+    }
+}
+
+/// Seeks from power-on each held-out run is scored on: the first hour of a cold start at
+/// the default dwells, where the type's warm-up law and the seek targets' first seeks are.
+pub const SHAPE_SEEKS: usize = 6;
+/// The network is taken when its pooled held-out error is lower than the law's by more than
+/// this many standard errors of the log ratio (jackknife over the held-out units).
+pub const SHAPE_T_MIN: f64 = 2.0;
+/// Fewest units the choice is made on (fewer: the law, for want of test power).
+pub const SHAPE_MIN_UNITS: usize = 3;
+
+/// How the shape was chosen.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ShapeChoice {
+    pub chosen: SharedShape,
+    /// Each shape's held-out azimuth rms of the first `SHAPE_SEEKS` seeks, deg, in the
+    /// order of `AUTO_SHAPES`; empty when too few units were left to score.
+    pub scores_deg: Vec<(SharedShape, f64)>,
+    /// The network of the lower score, tested against the law.
+    pub challenger: SharedShape,
+    /// Held-out units, and those where the challenger's error was the lower.
+    pub units: usize,
+    pub challenger_better_units: usize,
+    /// The log of the law's pooled mean-square error over the challenger's, over its
+    /// jackknife standard error (each held-out unit left out in turn).
+    pub t_challenger_better: f64,
+    /// Each held-out unit's mean-square azimuth error under each shape (the order of
+    /// `AUTO_SHAPES`), deg^2: what the choice was made on.
+    pub per_unit_ms_deg2: Vec<Vec<f64>>,
+}
+
+impl ShapeChoice {
+    pub fn summary(&self) -> String {
+        if self.scores_deg.is_empty() {
+            return format!(
+                "shape: {} ({} units: no test power for a choice, at least {SHAPE_MIN_UNITS} needed)\n",
+                self.chosen.name(),
+                self.units
+            );
+        }
+        let scores: Vec<String> = self
+            .scores_deg
+            .iter()
+            .map(|(s, d)| format!("{} {d:.4} deg", s.name()))
+            .collect();
+        format!(
+            "shape: {} (held-out first {SHAPE_SEEKS} seeks of {} units left out: {}; the {} better on {} of {} units, t = {:.1}, taken above {SHAPE_T_MIN})\n",
+            self.chosen.name(),
+            self.units,
+            scores.join(", "),
+            self.challenger.name(),
+            self.challenger_better_units,
+            self.units,
+            self.t_challenger_better,
+        )
+    }
+}
+
+/// Chooses the shared model's shape for a type learnt from `runs` (several units'): each of
+/// `AUTO_SHAPES` trained by `train_shared` on the runs of the other units, in `LAW_FOLDS`
+/// folds of whole units, and scored on the held-out units' first `SHAPE_SEEKS` seeks (the
+/// seek of `cfg.criterion`); the network of the lower score is taken over the law when
+/// its pooled error is lower beyond the units' scatter (`jackknife_t` > `SHAPE_T_MIN`).
+pub fn choose_shape(
+    runs: &[Run],
+    cfg: &TrainConfig,
+    candidates: &[InputSet],
+) -> Result<ShapeChoice> {
+    let unit_of_run = unit_of_runs(runs);
+    let units = unit_of_run.iter().max().map_or(0, |m| m + 1);
+    if units < SHAPE_MIN_UNITS {
+        return Ok(ShapeChoice {
+            chosen: AUTO_SHAPES[0],
+            scores_deg: Vec::new(),
+            challenger: AUTO_SHAPES[1],
+            units,
+            challenger_better_units: 0,
+            t_challenger_better: 0.0,
+            per_unit_ms_deg2: Vec::new(),
+        });
+    }
+    let sse = heldout_sse(runs, &unit_of_run, units, cfg, candidates)?;
+    let rms = |k: usize| {
+        let (s, n) = sse
+            .iter()
+            .fold((0.0, 0), |(s, n), u| (s + u[k].0, n + u[k].1));
+        (s / n.max(1) as f64).sqrt()
+    };
+    let scores_deg: Vec<(SharedShape, f64)> = AUTO_SHAPES
+        .iter()
+        .enumerate()
+        .map(|(k, &s)| (s, rms(k)))
+        .collect();
+    let c = (1..AUTO_SHAPES.len())
+        .min_by(|&a, &b| scores_deg[a].1.total_cmp(&scores_deg[b].1))
+        .unwrap_or(1);
+    let ms = |u: &[(f64, usize)], k: usize| u[k].0 / u[k].1.max(1) as f64;
+    let scored: Vec<&UnitSse> = sse.iter().filter(|u| u[0].1 > 0 && u[c].1 > 0).collect();
+    let t = jackknife_t(&scored, c);
+    let d: Vec<f64> = scored
+        .iter()
+        .map(|u| ms(&u[..], 0) - ms(&u[..], c))
+        .collect();
+    let chosen = if d.len() >= SHAPE_MIN_UNITS && t > SHAPE_T_MIN {
+        AUTO_SHAPES[c]
+    } else {
+        AUTO_SHAPES[0]
+    };
+    Ok(ShapeChoice {
+        chosen,
+        scores_deg,
+        challenger: AUTO_SHAPES[c],
+        units: d.len(),
+        challenger_better_units: d.iter().filter(|&&x| x > 0.0).count(),
+        t_challenger_better: t,
+        per_unit_ms_deg2: sse
+            .iter()
+            .map(|u| (0..AUTO_SHAPES.len()).map(|k| ms(&u[..], k)).collect())
+            .collect(),
+    })
+}
+
+/// Squared azimuth errors and their count, per shape of `AUTO_SHAPES`, of one unit.
+type UnitSse = [(f64, usize); AUTO_SHAPES.len()];
+
+/// Each unit's held-out first-seek errors under each shape: the shapes trained on the runs
+/// of the other folds (`LAW_FOLDS` folds of whole units), read on the fold's runs.
+fn heldout_sse(
+    runs: &[Run],
+    unit_of_run: &[usize],
+    units: usize,
+    cfg: &TrainConfig,
+    candidates: &[InputSet],
+) -> Result<Vec<UnitSse>> {
+    let folds = LAW_FOLDS.min(units);
+    let geometry = cfg.criterion.seek_geometry();
+    // per unit and shape: squared azimuth errors and their count
+    let mut sse = vec![[(0.0, 0usize); AUTO_SHAPES.len()]; units];
+    for fold in 0..folds {
+        let held = |r: usize| unit_of_run[r] % folds == fold;
+        let train: Vec<Run> = (0..runs.len())
+            .filter(|&r| !held(r))
+            .map(|r| runs[r].clone())
+            .collect();
+        let test: Vec<usize> = (0..runs.len()).filter(|&r| held(r)).collect();
+        let test_runs: Vec<Run> = test.iter().map(|&r| runs[r].clone()).collect();
+        for (k, shape) in AUTO_SHAPES.into_iter().enumerate() {
+            let shared = train_shared(shape, &train, cfg, candidates).map_err(|e| {
+                anyhow!(
+                    "choosing the type's shape, {} on fold {fold}: {e}",
+                    shape.name()
+                )
+            })?;
+            let model = shared.model();
+            let ds = dataset_from_runs(&test_runs, &model.inputs).map_err(|e| anyhow!("{e}"))?;
+            let pred = predict_batch(model, ds.rows())?;
+            let res: Vec<f64> = ds
+                .targets_dph
+                .iter()
+                .zip(&pred)
+                .map(|(y, p)| y - p)
+                .collect();
+            for e in
+                seek_azimuth_first_pairs_per_run(&res, &ds.groups, &ds.t_s, geometry, SHAPE_SEEKS)
+            {
+                let u = unit_of_run[test[e.group as usize]];
+                sse[u][k].0 += e.sum_sq_deg2;
+                sse[u][k].1 += e.pairs;
+            }
+        }
+    }
+    Ok(sse)
+}
+
+/// The log of the law's pooled mean square (shape 0) over shape `c`'s on the `scored`
+/// units, over its jackknife standard error (each unit left out in turn): the pooled
+/// error is what the seeks see, and a few units far off the type may carry most of it.
+fn jackknife_t(scored: &[&UnitSse], c: usize) -> f64 {
+    let log_ratio = |skip: Option<usize>| {
+        let (mut l, mut ln, mut ch, mut cn) = (0.0, 0usize, 0.0, 0usize);
+        for (_, u) in scored.iter().enumerate().filter(|(i, _)| Some(*i) != skip) {
+            l += u[0].0;
+            ln += u[0].1;
+            ch += u[c].0;
+            cn += u[c].1;
+        }
+        ((l / ln.max(1) as f64) / (ch / cn.max(1) as f64)).ln()
+    };
+    let n = scored.len();
+    let full = log_ratio(None);
+    let leave: Vec<f64> = (0..n).map(|i| log_ratio(Some(i))).collect();
+    let mean = leave.iter().sum::<f64>() / n.max(1) as f64;
+    let se = ((n as f64 - 1.0) / n.max(1) as f64
+        * leave.iter().map(|x| (x - mean).powi(2)).sum::<f64>())
+    .sqrt();
+    if se > 0.0 && full.is_finite() {
+        full / se
+    } else {
+        0.0
+    }
+}
+
+/// The shape `asked` resolves to on `runs`: itself when fixed, else `choose_shape`'s
+/// choice (and the choice, to report).
+pub fn resolve_shape(
+    asked: TypeShape,
+    runs: &[Run],
+    cfg: &TrainConfig,
+    candidates: &[InputSet],
+) -> Result<(SharedShape, Option<ShapeChoice>)> {
+    match asked {
+        TypeShape::Law => Ok((SharedShape::Law, None)),
+        TypeShape::Network => Ok((SharedShape::Network, None)),
+        TypeShape::Auto => {
+            let choice = choose_shape(runs, cfg, candidates)?;
+            Ok((choice.chosen, Some(choice)))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::law::tests::{fleet, fleet_of_units, law_of_two_node, seek, two_node};
+    use super::*;
+    use crate::train::seek_score::Criterion;
+    use crate::train::InputSet;
+
+    fn cfg() -> TrainConfig {
+        TrainConfig {
+            gyro_id: "test".into(),
+            criterion: Criterion::Seek(seek()),
+            ..TrainConfig::default()
+        }
+    }
+
+    fn choose(runs: &[Run]) -> ShapeChoice {
+        choose_shape(runs, &cfg(), &[InputSet::TempRate]).unwrap()
+    }
+
+    #[test]
+    fn a_fleet_that_warms_up_by_the_law_keeps_the_law() {
+        // units 3 % apart in dissipation, the drift the law's own: the network gains
+        // nothing beyond the units' scatter
+        let got = choose(&fleet(&two_node, &law_of_two_node));
+        assert_eq!(got.chosen, SharedShape::Law, "{}", got.summary());
+    }
+
+    #[test]
+    fn units_whose_warm_up_is_no_law_of_modes_take_the_network() {
+        // the twin of another law: a coil heated from one face (diffusion: a stretched
+        // exponential, no exponential modes) whose time constant runs from 250 to 850 s
+        // over the units, and a Shupe drift in dT/dt: no pair of clocks carries every
+        // unit, and the network on T and dT/dt carries all of them
+        let rise = |t: f64, _: f64, u: usize| {
+            let tau_s = 250.0 + 100.0 * (u as f64 - 1.0);
+            7.0 * (1.0 - (-(t.max(0.0) / tau_s).sqrt()).exp())
+        };
+        let shupe = |_: f64, _: f64, rate: f64, _: f64| 9.0 * rate;
+        let got = choose(&fleet_of_units(7, &rise, &shupe));
+        assert_ne!(got.chosen, SharedShape::Law, "{}", got.summary());
+    }
+
+    #[test]
+    fn without_a_warm_up_drift_the_choice_stays_with_the_law() {
+        // the null twin: a drift of T alone, which both shapes carry
+        let got = choose(&fleet(&two_node, &|_, temp, _| 0.001 * temp));
+        assert_eq!(got.chosen, SharedShape::Law, "{}", got.summary());
+    }
+
+    #[test]
+    fn two_units_leave_no_test_power() {
+        let runs: Vec<Run> = fleet(&two_node, &law_of_two_node)
+            .into_iter()
+            .filter(|r| matches!(r.meta_value("unit_id"), Some("U1" | "U2")))
+            .collect();
+        let got = choose(&runs);
+        assert_eq!(got.chosen, SharedShape::Law);
+        assert!(got.scores_deg.is_empty());
+        assert!(got.summary().contains("no test power"), "{}", got.summary());
+    }
+}
