@@ -35,7 +35,7 @@ pub use fit::config::{Method, TrainConfig, WidthSearch};
 pub use fit::design::GaussianDesign;
 pub use fit::gram::gram_bytes;
 pub use fit::path::StopReason;
-pub use fit::predict::predict_batch;
+pub use fit::predict::{predict_batch, residuals_dph};
 pub use fit::shape::{fit_path, fit_shape, fit_width, Fit, PathFit, Shape};
 pub use fit::validate::{
     cross_validate, fold_of_rows, pooled_std, rms, std_within_groups, CvReport, WidthScore,
@@ -211,13 +211,7 @@ pub fn train_model(ds: &Dataset, cfg: &TrainConfig) -> Result<TrainOutcome> {
     fit.model.meta.heldout_rms_dph = cv.best.heldout_rms_dph as f32;
     let ranges = data::declared_range::declared_ranges(ds);
     data::declared_range::apply(&mut fit.model, &ranges);
-    let pred = predict_batch(&fit.model, ds.rows())?;
-    let resid: Vec<f64> = ds
-        .targets_dph
-        .iter()
-        .zip(&pred)
-        .map(|(y, p)| y - p)
-        .collect();
+    let resid = residuals_dph(&fit.model, ds)?;
     let report = TrainReport {
         method: cfg.method,
         criterion: cfg.criterion,

@@ -6,7 +6,7 @@ use fog_core::model::format::{FeatureSpec, RbfModel};
 use fog_sim::io::runs::Run;
 use fog_sim::pipeline::north_seek::own_model::OwnModelPlan;
 use fog_sim::train::seek_score::{seek_azimuth_rms_deg, Criterion, SeekGeometry};
-use fog_sim::train::{dataset_from_runs, predict_batch, Dataset};
+use fog_sim::train::{dataset_from_runs, residuals_dph, Dataset};
 
 pub const LATITUDE_DEG: f64 = 40.0;
 pub const DWELL_S: f64 = 110.0;
@@ -29,13 +29,7 @@ pub fn plan(ambient_c: f64) -> OwnModelPlan {
 /// rows it was read on.
 pub fn residual_dph(model: &RbfModel, runs: &[Run], specs: &[FeatureSpec]) -> (Dataset, Vec<f64>) {
     let ds = dataset_from_runs(runs, specs).unwrap();
-    let pred = predict_batch(model, ds.rows()).unwrap();
-    let res = ds
-        .targets_dph
-        .iter()
-        .zip(&pred)
-        .map(|(y, p)| y - p)
-        .collect();
+    let res = residuals_dph(model, &ds).unwrap();
     (ds, res)
 }
 

@@ -32,3 +32,14 @@ pub fn predict_batch<'r>(
         })
         .collect()
 }
+
+/// `model`'s residual on `ds`, deg/h: each row's drift less its prediction.
+pub fn residuals_dph(model: &RbfModel, ds: &crate::train::Dataset) -> Result<Vec<f64>> {
+    let pred = predict_batch(model, ds.rows())?;
+    Ok(ds
+        .targets_dph
+        .iter()
+        .zip(&pred)
+        .map(|(y, p)| y - p)
+        .collect())
+}

@@ -25,7 +25,7 @@ use crate::io::runs::Run;
 use crate::train::cold_start::envelope_for;
 use crate::train::seek_score::seek_azimuth_first_pairs_per_run;
 use crate::train::{
-    choose_inputs_default, dataset_from_runs, predict_batch, train_model, InputSelection, InputSet,
+    choose_inputs_default, dataset_from_runs, residuals_dph, train_model, InputSelection, InputSet,
     TrainConfig,
 };
 
@@ -309,13 +309,7 @@ fn heldout_sse(
             })?;
             let model = shared.model();
             let ds = dataset_from_runs(&test_runs, &model.inputs).map_err(|e| anyhow!("{e}"))?;
-            let pred = predict_batch(model, ds.rows())?;
-            let res: Vec<f64> = ds
-                .targets_dph
-                .iter()
-                .zip(&pred)
-                .map(|(y, p)| y - p)
-                .collect();
+            let res = residuals_dph(model, &ds)?;
             for e in
                 seek_azimuth_first_pairs_per_run(&res, &ds.groups, &ds.t_s, geometry, SHAPE_SEEKS)
             {
