@@ -156,9 +156,10 @@ pub fn train_shared(
     }
 }
 
-/// Seeks from power-on each held-out run is scored on: the first hour of a cold start at
-/// the default dwells, where the type's warm-up law and the seek targets' first seeks are.
-pub const SHAPE_SEEKS: usize = 6;
+/// Seeks from power-on each held-out run is scored on: the six the seek targets judge one
+/// by one, as the unit step's score (`calibrate::SCORED_SEEKS`; about the first half hour
+/// of a cold start at the default dwells, where the warm-up is).
+pub const SHAPE_SEEKS: usize = super::calibrate::SCORED_SEEKS;
 /// The network is taken when its pooled held-out error is lower than the law's by more than
 /// this many standard errors of the log ratio (jackknife over the held-out units).
 pub const SHAPE_T_MIN: f64 = 2.0;
