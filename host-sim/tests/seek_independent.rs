@@ -222,13 +222,13 @@ fn train_alone(runs: &[Run], criterion: Criterion) -> RbfModel {
 }
 
 /// The type of shape `shape` learnt from `runs` as `train --type-out` learns it (`train`'s
-/// inputs and configuration for the network; `auto` chosen once on all the runs), and
-/// the shape's choice when it was made.
+/// inputs and configuration for the network; `auto` chosen once on all the runs), the
+/// shape it took, and the choice when one was made.
 fn learn_independent_type(
     runs: &[Run],
     shape: TypeShape,
     criterion: Criterion,
-) -> (TypeModel, Option<ShapeChoice>) {
+) -> (TypeModel, SharedShape, Option<ShapeChoice>) {
     let cfg = TrainConfig {
         gyro_id: "independent".into(),
         criterion,
@@ -242,7 +242,7 @@ fn learn_independent_type(
             .clone())
     })
     .unwrap();
-    (ty, choice)
+    (ty, shared, choice)
 }
 
 /// Shapes measured (`INDEP_SHAPES`, default `law,auto`).
@@ -295,7 +295,7 @@ fn measure(law: FleetLaw, shape: TypeShape, seed: u64, starts: usize) -> Measure
         let criterion = Criterion::parse("seek", dwell_s, lat)
             .unwrap()
             .with_symmetric_seeks(scored_as_symmetric(mode));
-        let (ty, choice) = learn_independent_type(&type_runs, shape, criterion);
+        let (ty, took, choice) = learn_independent_type(&type_runs, shape, criterion);
         if let Some(c) = &choice {
             print!(
                 "{law:?} seed {seed}, {}: {}",
@@ -303,11 +303,7 @@ fn measure(law: FleetLaw, shape: TypeShape, seed: u64, starts: usize) -> Measure
                 c.summary()
             );
         }
-        let fixed = match shape {
-            TypeShape::Network => SharedShape::Network,
-            _ => SharedShape::Law,
-        };
-        shapes.push((mode, choice.map_or(fixed, |c| c.chosen)));
+        shapes.push((mode, took));
         let sched = schedule(mode);
         let plan = UnitPlan {
             seek_period_s: sched.period_s,

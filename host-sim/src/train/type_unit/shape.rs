@@ -181,9 +181,6 @@ pub struct ShapeChoice {
     /// The log of the law's pooled mean-square error over the challenger's, over its
     /// jackknife standard error (each held-out unit left out in turn).
     pub t_challenger_better: f64,
-    /// Each held-out unit's mean-square azimuth error under each shape (the order of
-    /// `AUTO_SHAPES`), deg^2: what the choice was made on.
-    pub per_unit_ms_deg2: Vec<Vec<f64>>,
 }
 
 impl ShapeChoice {
@@ -233,7 +230,6 @@ pub fn choose_shape(
             units,
             challenger_better_units: 0,
             t_challenger_better: 0.0,
-            per_unit_ms_deg2: Vec::new(),
         });
     }
     let sse = heldout_sse(runs, &unit_of_run, units, cfg, candidates)?;
@@ -270,10 +266,6 @@ pub fn choose_shape(
         units: d.len(),
         challenger_better_units: d.iter().filter(|&&x| x > 0.0).count(),
         t_challenger_better: t,
-        per_unit_ms_deg2: sse
-            .iter()
-            .map(|u| (0..AUTO_SHAPES.len()).map(|k| ms(&u[..], k)).collect())
-            .collect(),
     })
 }
 
