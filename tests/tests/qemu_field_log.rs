@@ -42,7 +42,7 @@ use fog_sim::device::upload::UploadClient;
 use fog_sim::sim::{GyroParams, StartState};
 use fog_tests::console::{start_with_console, wait_line, wait_line_where};
 use fog_tests::{firmware_elf, qemu_ready, scratch_dir, KillOnDrop, QemuOptions};
-use qemu_support::{link_command, polled};
+use qemu_support::{link_command, polled, wait_ready};
 use upload_support::*;
 
 const RATE_HZ: u32 = 20;
@@ -136,8 +136,9 @@ impl Run {
         }
     }
 
-    /// Starts a two-position seek (latitude first).
+    /// Starts a two-position seek (latitude first) once the device says it is ready.
     fn start_seek(&mut self) {
+        wait_ready(&mut self.host, WAIT);
         let lat = Command::SetLatitude {
             latitude_deg: LATITUDE_DEG as f32,
         };

@@ -98,6 +98,7 @@ fn qemu_gyro_stall_mid_seek_keeps_time_counts_losses_and_restarts_with_reason() 
         .upload(&bytes, 1, &sign_for_gyro(1, QEMU_GYRO, &bytes), |_, _| {})
         .expect("upload");
     wait_line_where(&console, "FOG-WINDOW", WAIT, |l| l.contains("status=Valid"));
+    wait_ready(&mut host, WAIT);
     assert_eq!(
         link_command(&mut host, Command::SetLatitude { latitude_deg: 40.0 }, WAIT),
         DeviceMessage::Accepted

@@ -128,6 +128,14 @@ pub fn wait_status(
     found.unwrap_or_else(|| panic!("no accepted link status within {within:?}; last {last:#?}"))
 }
 
+/// Waits (within `within`) for a link status that says a seek can start: the BIT
+/// is evaluated once a second, so the first gyro window can come before the first
+/// evaluation that saw the inclinometer (a race under load; found in CI).
+pub fn wait_ready(link: &mut TcpStream, within: Duration) -> fog_core::link::messages::Status {
+    use fog_core::seeking::quality::SeekState;
+    wait_status(link, within, |s| s.state == SeekState::Ready)
+}
+
 /// Sends one link command and waits for its answer (`Accepted` or `Refused`).
 pub fn link_command(
     link: &mut TcpStream,
