@@ -28,7 +28,9 @@
 //! `INDEP_SEEK_STARTS=1000 INDEP_SEEK_SEEDS=1,2,3,4,5 INDEP_SEEK_FLEETS=type,identical,shupe,thermal`
 //! (docs/record/fleet.md, "The type and unit recipe on the independent fleet").
 
-use crate::common::fleet_independent::{cold_start, fleet, FleetLaw, NOISE_10S_DPH};
+use crate::common::fleet_independent::{
+    cold_start, cold_start_rows, fleet, FleetLaw, NOISE_10S_DPH,
+};
 use crate::common::seek_judge::residual_dph;
 
 use fog_core::model::format::RbfModel;
@@ -430,6 +432,27 @@ fn cells_met(judged: &[Judged], recipe: &str, mode: SeekMode) -> usize {
 /// The judge's self-check: a residual of the generator's white noise alone (what a model
 /// equal to the unit's drift leaves, its turn-on offset included) reads at its floor with
 /// no bias, for every sequence; a constant (the turn-on offset) cancels.
+/// The judge reads the generator's 10 s means, as the device reads its windows; a logger
+/// writes 1 Hz rows, which `fogsim train` reads through `io::bin` into the same windows.
+/// Written as a 1 Hz file and read by `train`'s reader, a cold start is its 10 s means
+/// exactly, at every ambient, so the recipe's figures here hold for 1 Hz logs too.
+#[test]
+fn one_hz_rows_read_by_train_are_the_10_s_means_the_judge_reads() {
+    let dir = crate::app_support::scratch_dir("indep_1hz");
+    for (k, amb) in AMBIENTS_C.into_iter().enumerate() {
+        let truth = fleet(FleetLaw::Type, 1, &[amb], 1, 1, k as u64).units[0];
+        let means = cold_start(&truth, amb, MINUTES, &mut ChaCha8Rng::seed_from_u64(7));
+        let rows = cold_start_rows(&truth, amb, MINUTES, &mut ChaCha8Rng::seed_from_u64(7), 1);
+        assert_eq!(rows.len(), 10 * means.len());
+        let path = dir.join(format!("cold_start_{amb}.csv"));
+        fog_sim::io::runs::write_run(&path, &rows).unwrap();
+        let binned = fog_sim::io::read_binned(&path).unwrap();
+        for col in ["t_s", "rate_dph", "temp_c"] {
+            assert_eq!(binned.column(col), means.column(col), "{col} at {amb} degC");
+        }
+    }
+}
+
 #[test]
 fn the_judge_reads_white_noise_at_its_floor_and_cancels_a_constant() {
     use rand_distr::{Distribution, Normal};

@@ -1,6 +1,7 @@
 //! An independent fleet generator (nothing shared with the project's simulator,
 //! `sim::fleet` or the other generators here): N units of one gyro type, each with a few
-//! cold starts at given ambients, as 10 s means, each run tagged with its `unit_id`.
+//! cold starts at given ambients, as 10 s means (or 1 Hz rows: [`cold_start_rows`]), each
+//! run tagged with its `unit_id`.
 //!
 //! - Its own thermal law: the coil warms as a stretched exponential,
 //!   T = T_a + R (1 - exp(-sqrt(t / tau))) (a thick spool heated from one face:
@@ -138,6 +139,18 @@ pub fn fleet(
 /// One cold start of unit `truth` at ambient `amb`: 1 s physics, 10 s means (`rng` is
 /// the caller's stream: more cold starts of a unit than its fleet gave it).
 pub fn cold_start(truth: &UnitTruth, amb: f64, minutes: usize, rng: &mut ChaCha8Rng) -> Run {
+    cold_start_rows(truth, amb, minutes, rng, 10)
+}
+
+/// As [`cold_start`], with a row every `every_s` seconds (1: the logger's 1 Hz rows; 10:
+/// the device's 10 s means), each the mean of its seconds; the same draws either way.
+pub fn cold_start_rows(
+    truth: &UnitTruth,
+    amb: f64,
+    minutes: usize,
+    rng: &mut ChaCha8Rng,
+    every_s: usize,
+) -> Run {
     let g = Normal::new(0.0, 1.0).unwrap();
     let rise = truth.rise_c * (1.0 + 0.01 * (20.0 - amb));
     let offset = TURN_ON_DPH * g.sample(rng);
@@ -155,8 +168,9 @@ pub fn cold_start(truth: &UnitTruth, amb: f64, minutes: usize, rng: &mut ChaCha8
             + offset;
         rate_sum += drift + white_1s * g.sample(rng);
         temp_sum += ((temp + 0.02 * g.sample(rng)) / 0.0625).round() * 0.0625;
-        if k % 10 == 0 {
-            for (c, v) in cols.iter_mut().zip([t, rate_sum / 10.0, temp_sum / 10.0]) {
+        if k % every_s == 0 {
+            let n = every_s as f64;
+            for (c, v) in cols.iter_mut().zip([t, rate_sum / n, temp_sum / n]) {
                 c.push(v);
             }
             (rate_sum, temp_sum) = (0.0, 0.0);
