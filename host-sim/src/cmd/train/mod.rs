@@ -149,10 +149,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     check_run_count(&args, &cfg)?;
     let runs = read_runs_binned(&args.runs)?;
     let own_record = match &args.type_model {
-        Some(path) => match type_unit::calibrate(&args, path, &runs, cfg.folds.max(2))? {
-            type_unit::Calibrated::Done => return Ok(()),
-            type_unit::Calibrated::Own(record) => Some(record),
-        },
+        Some(path) => {
+            match type_unit::calibrate(&args, &cfg, &candidates, path, &runs, cfg.folds.max(2))? {
+                type_unit::Calibrated::Done => return Ok(()),
+                type_unit::Calibrated::Own(record) => Some(record),
+            }
+        }
         None => None,
     };
     if let Some(path) = &args.type_out {

@@ -17,10 +17,10 @@ use crate::registry::{Registry, UnitCalibrationRecord};
 use crate::train::type_unit::calibrate::DEFAULT_SEEK_PERIOD_S;
 use crate::train::type_unit::type_model::learn_type;
 use crate::train::type_unit::{
-    calibrate_unit, resolve_shape, train_shared, unit_id_of, MisfitPolicy, SharedModel, TypeModel,
-    TypeShape, UnitPlan,
+    calibrate_unit, choose_own, resolve_shape, train_shared, unit_id_of, MisfitPolicy, SharedModel,
+    TypeModel, TypeShape, UnitPlan,
 };
-use crate::train::{InputSet, TrainConfig};
+use crate::train::{choose_inputs_default, train_model, InputSet, TrainConfig};
 
 /// `model` for the device `gyro_id` (written into its metadata).
 fn for_gyro(model: &RbfModel, gyro_id: &str) -> Result<RbfModel> {
@@ -124,9 +124,15 @@ pub(super) enum Calibrated {
 }
 
 /// `--type`: calibrates the unit. `min_own_runs`: the run count the ordinary training
-/// needs, checked before anything is recorded when `--misfit own` falls back to it.
+/// needs, checked before anything is recorded when `--misfit own` falls back to it. The
+/// unit's own model (the ordinary training, `cfg` over `candidates`) is compared with the
+/// calibration first (`type_unit::own`; not when `--unit-terms` or `--unit-prior-weight`
+/// fix the calibration): where its own runs say more than its type, it leaves the type, as
+/// with `--misfit own`.
 pub(super) fn calibrate(
     args: &Args,
+    cfg: &TrainConfig,
+    candidates: &[InputSet],
     type_path: &Path,
     runs: &[Run],
     min_own_runs: usize,
@@ -143,6 +149,26 @@ pub(super) fn calibrate(
     print!("{}", cal.summary());
     let policy = args.misfit.unwrap_or(MisfitPolicy::Refuse);
     let misfit = cal.misfit.outside();
+    if !misfit && plan.terms.is_none() && plan.prior_weight.is_none() {
+        let own = choose_own(&cal, runs, &plan, min_own_runs, &mut |subset| {
+            let (_, ds) = choose_inputs_default(subset, candidates, cfg)?;
+            Ok(train_model(&ds, cfg)?.model)
+        })?;
+        print!("{}", own.summary());
+        if own.taken {
+            println!("unit {unit}: trained on its own runs alone");
+            return Ok(Calibrated::Own(UnitCalibrationRecord {
+                unit_id: unit.clone(),
+                type_id: ty.file.type_id.clone(),
+                runs: cal.runs,
+                terms: String::new(),
+                prior_weight: cal.prior_weight,
+                misfit: String::new(),
+                outcome: "own model (its runs say more than its type)".into(),
+                model_crc32: None,
+            }));
+        }
+    }
     // the device's model (its gyro id in it) is what field records were measured under
     let device_model = for_gyro(&cal.model, &args.gyro_id)?;
     let model = match misfit {

@@ -20,13 +20,15 @@ use crate::io::runs::Run;
 use crate::pipeline::campaign::{CampaignSpec, PAPER_MINUTES};
 use crate::pipeline::fleet::{fleet_runs, unit_id, FleetType};
 use crate::sim::{GyroParams, TypeSpread};
+use crate::train::cold_start::envelope_for;
 use crate::train::type_unit::calibrate::DEFAULT_SEEK_PERIOD_S;
 use crate::train::type_unit::terms::Fit;
 use crate::train::type_unit::type_model::learn_type;
 use crate::train::type_unit::{
-    calibrate_unit, resolve_shape, train_shared, SharedModel, TypeModel, TypeShape,
+    calibrate_unit, choose_own, resolve_shape, train_shared, SharedModel, TypeModel, TypeShape,
     UnitCalibration, UnitPlan,
 };
+use crate::train::{choose_inputs_default, train_model};
 
 /// Ambients of the type's and the unit's chamber runs by default, degC.
 pub const RECIPE_AMBIENTS_C: [f64; 3] = [-40.0, 20.0, 60.0];
@@ -336,9 +338,25 @@ pub fn unit_model(
     };
     let ty = learnt.type_model;
     let cal = calibrate_unit(&ty, &own, &unit_id(SEEKING_UNIT), &unit_plan)?;
-    let summary = format!("{}{}", learnt.summary, cal.summary());
+    let mut summary = format!("{}{}", learnt.summary, cal.summary());
+    // the unit's own model beside it, trained as `train` trains it (`train --type`)
+    let mut model = cal.model.clone();
+    if recipe.unit_terms.is_none() && recipe.unit_prior_weight.is_none() {
+        let cfg = train_config(plan, false);
+        let candidates = plan.inputs.candidates();
+        let mut train = |runs: &[Run]| -> Result<RbfModel> {
+            let (_, ds) = choose_inputs_default(runs, &candidates, &cfg)?;
+            Ok(train_model(&ds, &cfg)?.model)
+        };
+        let own_choice = choose_own(&cal, &own, &unit_plan, cfg.folds.max(2), &mut train)?;
+        summary += &own_choice.summary();
+        if own_choice.taken {
+            model = train(&own)?;
+            model.cold_start = envelope_for(&own, &model.inputs)?;
+        }
+    }
     Ok(RecipeModel {
-        model: cal.model.clone(),
+        model,
         unit_params,
         type_model: Some(ty),
         calibration: Some(cal),

@@ -404,7 +404,12 @@ fn held_out(
 /// the mean square of `res` less the window's own least-squares line in time (`less_line`,
 /// a time-symmetric seek) or its mean (a forward seek); NaN when no window has
 /// `MIN_WINDOW_ROWS` rows.
-fn seek_windows_mean_square(res: &[f64], t_s: &[f64], period_s: f64, less_line: bool) -> f64 {
+pub(super) fn seek_windows_mean_square(
+    res: &[f64],
+    t_s: &[f64],
+    period_s: f64,
+    less_line: bool,
+) -> f64 {
     let (mut sum, mut windows) = (0.0, 0usize);
     for k in 0..SCORED_SEEKS {
         // the first seek starts at power-on and takes every row before its end

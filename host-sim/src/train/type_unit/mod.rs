@@ -13,11 +13,13 @@ pub mod calibrate;
 pub mod folds;
 pub mod law;
 pub mod misfit;
+pub mod own;
 pub mod shape;
 pub mod solve;
 pub mod terms;
 pub mod type_model;
 
 pub use calibrate::{calibrate_unit, unit_id_of, MisfitPolicy, UnitCalibration, UnitPlan};
+pub use own::{choose_own, OwnChoice};
 pub use shape::{resolve_shape, train_shared, ShapeChoice, SharedModel, SharedShape, TypeShape};
 pub use type_model::{fit_type, runs_by_unit, TypeModel};
