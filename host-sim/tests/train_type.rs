@@ -3,8 +3,9 @@
 //! same commands give the same bytes); on an independent fleet (`common::fleet_independent`)
 //! a unit outside its type is flagged and one inside it is not, its null twin flags no
 //! unit, and the unit calibration does no worse on held-out seeks than the type alone; the
-//! CLI refuses an odd unit by default and trains it alone with `--misfit own`; bad input
-//! gets one line and writes nothing.
+//! CLI refuses an odd unit by default and trains it alone with `--misfit own`, and trains a
+//! unit alone when its own runs say more than its type; bad input gets one line and writes
+//! nothing.
 
 use crate::app_support;
 use crate::common::fleet_independent::{fleet, FleetLaw};
@@ -144,6 +145,11 @@ fn the_cli_learns_a_type_from_three_units_and_calibrates_a_fourth_with_reports_a
         ),
     );
     assert!(calibrated.contains("wrote unit U4's model"), "{calibrated}");
+    // three runs, three folds of the ordinary training: none can be left out to compare
+    assert!(
+        calibrated.contains("unit's own model: not compared (3 runs are too few"),
+        "{calibrated}"
+    );
 
     // the type: three units of three runs, its shared model the one written beside it
     let ty = TypeModel::read(&dir.join("type.json")).unwrap();
@@ -587,6 +593,80 @@ fn the_cli_refuses_an_odd_unit_by_default_and_trains_it_alone_with_misfit_own() 
         (None, None)
     );
     println!("{:.1} s", t0.elapsed().as_secs_f64());
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// `train --type` compares the unit's own model with its calibration: a unit of the
+/// independent fleet whose units differ in what the type's terms cannot carry, with 48 of
+/// its cold starts (16 at each of -40, 20, +60 degC), leaves its type (seek_independent's
+/// library figures: t 4.7-6.7 over seeds 1-3) and is trained on its own runs, recorded as
+/// such; the same unit with its 6 fleet runs keeps the calibration.
+#[test]
+fn the_cli_trains_a_unit_on_its_own_when_its_runs_say_more_than_its_type() {
+    use crate::common::fleet_independent::cold_start;
+    use rand::SeedableRng;
+    const AMBIENTS: [f64; 3] = [-40.0, 20.0, 60.0];
+    let dir = app_support::scratch_dir("type-own");
+    std::fs::create_dir_all(dir.join("indep")).unwrap();
+    let f = fleet(FleetLaw::Type, 11, &AMBIENTS, 2, 45, 1);
+    let truth = f.units[10];
+    let mut runs = f.runs;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x0417_0001);
+    for k in 6..48 {
+        let amb = AMBIENTS[k % 3];
+        let mut run = cold_start(&truth, amb, 45, &mut rng);
+        run.path = format!("fleet1_u011_extra_a{amb}_r{k}.csv").into();
+        run.meta.push(("unit_id".into(), "U11".into()));
+        runs.push(run);
+    }
+    for mut run in runs {
+        run.meta.push(("type_id".into(), "independent".into()));
+        write_run(dir.join("indep").join(run.name()), &run).unwrap();
+    }
+    let type_runs = indep_files(&dir, &(1..=10).collect::<Vec<_>>());
+    let unit48 = indep_files(&dir, &[11]);
+    assert_eq!(unit48.len(), 48);
+    let six: Vec<String> = unit48
+        .iter()
+        .filter(|f| !f.contains("extra"))
+        .cloned()
+        .collect();
+    assert_eq!(six.len(), 6);
+    let tm = ["--seek-sequence", "thue-morse"];
+    let mut a = vec!["--type-out", "type.json", "--out", "shared.model"];
+    a.extend(tm);
+    fogsim_ok(&dir, &train_args(&type_runs, &a));
+    let unit = |runs: &[String], out: &str| {
+        let mut a = vec!["--out", out, "--gyro-id", "U11"];
+        a.extend(tm);
+        let o = unit_runs_cmd(&dir, runs, &a);
+        assert!(o.status.success(), "{}", app_support::stderr(&o));
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    let many = unit(&unit48, "u11_48.model");
+    assert!(
+        many.contains("its own runs say more than its type: the unit's own model")
+            && many.contains("unit U11: trained on its own runs alone"),
+        "{many}"
+    );
+    let few = unit(&six, "u11_6.model");
+    assert!(
+        few.contains("over 6 runs (6 folds)")
+            && few.contains("the unit calibration\n")
+            && few.contains("wrote unit U11's model"),
+        "{few}"
+    );
+    let outcomes: Vec<String> = Registry::open(&dir.join("reg.sqlite"))
+        .unwrap()
+        .unit_calibrations("U11")
+        .unwrap()
+        .into_iter()
+        .map(|c| c.outcome)
+        .collect();
+    assert_eq!(
+        outcomes,
+        ["own model (its runs say more than its type)", "calibrated"]
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }
 
