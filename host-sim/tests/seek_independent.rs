@@ -29,7 +29,7 @@
 //! (docs/record/fleet.md, "The type and unit recipe on the independent fleet").
 
 use crate::common::fleet_independent::{
-    cold_start, cold_start_rows, fleet, FleetLaw, UnitTruth, NOISE_10S_DPH,
+    cold_start, cold_start_rows, extra_cold_starts, fleet, FleetLaw, UnitTruth, NOISE_10S_DPH,
 };
 use crate::common::seek_judge::residual_dph;
 
@@ -320,13 +320,15 @@ fn split(law: FleetLaw, seed: u64, unit_runs: usize) -> Split {
         .into_iter()
         .partition(|r| r.meta_value("unit_id") == Some(unit_id.as_str()));
     let mut extra = ChaCha8Rng::seed_from_u64(seed ^ 0x0417_0000);
-    for k in own.len()..unit_runs {
-        let amb = AMBIENTS_C[k % AMBIENTS_C.len()];
-        let mut run = cold_start(&truth, amb, MINUTES, &mut extra);
-        run.path = format!("extra_u011_a{amb}_r{k}.csv").into();
-        run.meta.push(("unit_id".into(), unit_id.clone()));
-        own.push(run);
-    }
+    own.extend(extra_cold_starts(
+        &truth,
+        &unit_id,
+        &AMBIENTS_C,
+        own.len()..unit_runs,
+        MINUTES,
+        "extra_u011_",
+        &mut extra,
+    ));
     Split {
         truth,
         unit_id,

@@ -603,7 +603,7 @@ fn the_cli_refuses_an_odd_unit_by_default_and_trains_it_alone_with_misfit_own() 
 /// such; the same unit with its 6 fleet runs keeps the calibration.
 #[test]
 fn the_cli_trains_a_unit_on_its_own_when_its_runs_say_more_than_its_type() {
-    use crate::common::fleet_independent::cold_start;
+    use crate::common::fleet_independent::extra_cold_starts;
     use rand::SeedableRng;
     const AMBIENTS: [f64; 3] = [-40.0, 20.0, 60.0];
     let dir = app_support::scratch_dir("type-own");
@@ -612,13 +612,15 @@ fn the_cli_trains_a_unit_on_its_own_when_its_runs_say_more_than_its_type() {
     let truth = f.units[10];
     let mut runs = f.runs;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x0417_0001);
-    for k in 6..48 {
-        let amb = AMBIENTS[k % 3];
-        let mut run = cold_start(&truth, amb, 45, &mut rng);
-        run.path = format!("fleet1_u011_extra_a{amb}_r{k}.csv").into();
-        run.meta.push(("unit_id".into(), "U11".into()));
-        runs.push(run);
-    }
+    runs.extend(extra_cold_starts(
+        &truth,
+        "U11",
+        &AMBIENTS,
+        6..48,
+        45,
+        "fleet1_u011_extra_",
+        &mut rng,
+    ));
     for mut run in runs {
         run.meta.push(("type_id".into(), "independent".into()));
         write_run(dir.join("indep").join(run.name()), &run).unwrap();

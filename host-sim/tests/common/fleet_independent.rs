@@ -136,6 +136,27 @@ pub fn fleet(
     }
 }
 
+/// More cold starts of one unit (`truth`, `unit_id`) than its fleet gave it: numbers `ks`,
+/// the k-th at `ambients_c[k % len]` (spread evenly), named `{prefix}a{amb}_r{k}.csv`.
+pub fn extra_cold_starts(
+    truth: &UnitTruth,
+    unit_id: &str,
+    ambients_c: &[f64],
+    ks: std::ops::Range<usize>,
+    minutes: usize,
+    prefix: &str,
+    rng: &mut ChaCha8Rng,
+) -> Vec<Run> {
+    ks.map(|k| {
+        let amb = ambients_c[k % ambients_c.len()];
+        let mut run = cold_start(truth, amb, minutes, rng);
+        run.path = format!("{prefix}a{amb}_r{k}.csv").into();
+        run.meta.push(("unit_id".into(), unit_id.into()));
+        run
+    })
+    .collect()
+}
+
 /// One cold start of unit `truth` at ambient `amb`: 1 s physics, 10 s means (`rng` is
 /// the caller's stream: more cold starts of a unit than its fleet gave it).
 pub fn cold_start(truth: &UnitTruth, amb: f64, minutes: usize, rng: &mut ChaCha8Rng) -> Run {

@@ -17,10 +17,10 @@ use crate::registry::{Registry, UnitCalibrationRecord};
 use crate::train::type_unit::calibrate::DEFAULT_SEEK_PERIOD_S;
 use crate::train::type_unit::type_model::learn_type;
 use crate::train::type_unit::{
-    calibrate_unit, choose_own, resolve_shape, train_shared, unit_id_of, MisfitPolicy, SharedModel,
-    TypeModel, TypeShape, UnitPlan,
+    calibrate_unit, choose_own, ordinary_model, resolve_shape, train_shared, unit_id_of,
+    MisfitPolicy, SharedModel, TypeModel, TypeShape, UnitPlan,
 };
-use crate::train::{choose_inputs_default, train_model, InputSet, TrainConfig};
+use crate::train::{InputSet, TrainConfig};
 
 /// `model` for the device `gyro_id` (written into its metadata).
 fn for_gyro(model: &RbfModel, gyro_id: &str) -> Result<RbfModel> {
@@ -151,8 +151,7 @@ pub(super) fn calibrate(
     let misfit = cal.misfit.outside();
     if !misfit && plan.terms.is_none() && plan.prior_weight.is_none() {
         let own = choose_own(&cal, runs, &plan, min_own_runs, &mut |subset| {
-            let (_, ds) = choose_inputs_default(subset, candidates, cfg)?;
-            Ok(train_model(&ds, cfg)?.model)
+            ordinary_model(subset, candidates, cfg)
         })?;
         print!("{}", own.summary());
         if own.taken {

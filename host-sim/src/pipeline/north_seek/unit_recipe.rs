@@ -25,10 +25,9 @@ use crate::train::type_unit::calibrate::DEFAULT_SEEK_PERIOD_S;
 use crate::train::type_unit::terms::Fit;
 use crate::train::type_unit::type_model::learn_type;
 use crate::train::type_unit::{
-    calibrate_unit, choose_own, resolve_shape, train_shared, SharedModel, TypeModel, TypeShape,
-    UnitCalibration, UnitPlan,
+    calibrate_unit, choose_own, ordinary_model, resolve_shape, train_shared, SharedModel,
+    TypeModel, TypeShape, UnitCalibration, UnitPlan,
 };
-use crate::train::{choose_inputs_default, train_model};
 
 /// Ambients of the type's and the unit's chamber runs by default, degC.
 pub const RECIPE_AMBIENTS_C: [f64; 3] = [-40.0, 20.0, 60.0];
@@ -344,10 +343,7 @@ pub fn unit_model(
     if recipe.unit_terms.is_none() && recipe.unit_prior_weight.is_none() {
         let cfg = train_config(plan, false);
         let candidates = plan.inputs.candidates();
-        let mut train = |runs: &[Run]| -> Result<RbfModel> {
-            let (_, ds) = choose_inputs_default(runs, &candidates, &cfg)?;
-            Ok(train_model(&ds, &cfg)?.model)
-        };
+        let mut train = |runs: &[Run]| ordinary_model(runs, &candidates, &cfg);
         let own_choice = choose_own(&cal, &own, &unit_plan, cfg.folds.max(2), &mut train)?;
         summary += &own_choice.summary();
         if own_choice.taken {

@@ -23,7 +23,10 @@ use serde::Serialize;
 use super::calibrate::{seek_windows_mean_square, UnitCalibration, UnitPlan};
 use crate::io::runs::Run;
 use crate::stats::student_t::upper_quantile;
-use crate::train::{dataset_from_runs, residuals_dph};
+use crate::stats::{mean, mean_or_zero, std_dev};
+use crate::train::{
+    choose_inputs_default, dataset_from_runs, residuals_dph, train_model, InputSet, TrainConfig,
+};
 
 /// Folds of the unit's runs the own model is trained without (at most; one run a fold
 /// below that): each fold is one training.
@@ -101,7 +104,8 @@ pub fn choose_own(
             chosen.per_run.len()
         );
     }
-    let rms = |v: &[f64]| (v.iter().sum::<f64>() / v.len().max(1) as f64).sqrt();
+    // per-run scores are mean squares: their rms is the root of their mean
+    let rms = |v: &[f64]| mean_or_zero(v).sqrt();
     let mut own = vec![f64::NAN; n];
     if powered {
         for k in 0..folds {
@@ -145,16 +149,21 @@ pub fn choose_own(
 
 /// Mean over its standard error; 0 with fewer than two values or no spread.
 fn paired_t(d: &[f64]) -> f64 {
-    let n = d.len() as f64;
-    if d.len() < 2 {
-        return 0.0;
-    }
-    let mean = d.iter().sum::<f64>() / n;
-    let var = d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    let se = (var / n).sqrt();
+    let se = std_dev(d) / (d.len() as f64).sqrt();
     if se > 0.0 {
-        mean / se
+        mean(d) / se
     } else {
         0.0
     }
+}
+
+/// The unit's own model as `train` trains it without a type: its input choice over
+/// `candidates`, then its network, with `cfg`.
+pub fn ordinary_model(
+    runs: &[Run],
+    candidates: &[InputSet],
+    cfg: &TrainConfig,
+) -> Result<RbfModel> {
+    let (_, ds) = choose_inputs_default(runs, candidates, cfg)?;
+    Ok(train_model(&ds, cfg)?.model)
 }
