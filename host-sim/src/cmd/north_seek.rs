@@ -497,7 +497,11 @@ pub fn run(args: Args) -> Result<()> {
     println!(
         "north-seek Monte Carlo: {} {starts} x {} seeks, {} positions{}, {} degC, latitude {} deg, true azimuth {} deg",
         report.starts, report.seeks_per_start, report.positions,
-        if report.symmetric { " (time-symmetric sequence)" } else { "" },
+        match (report.symmetric, report.thue_morse) {
+            (_, true) => " (time-symmetric, Thue-Morse order)",
+            (true, false) => " (time-symmetric sequence)",
+            _ => "",
+        },
         report.ambient_c, report.latitude_deg, report.true_azimuth_deg
     );
     print!("{}", seek_table(report));

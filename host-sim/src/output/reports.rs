@@ -131,6 +131,10 @@ pub struct NorthSeekReport {
     /// when true, so a forward seek's report keeps its bytes.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub symmetric: bool,
+    /// The time-symmetric positions in Thue-Morse order (`--sequence thue-morse`, with
+    /// `symmetric`); written only when true, so the other sequences keep their bytes.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub thue_morse: bool,
     pub latitude_deg: f64,
     pub ambient_c: f64,
     /// Gyro temperature above the ambient at power-on, degC (0: cold start from a soak).

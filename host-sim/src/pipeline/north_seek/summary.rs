@@ -182,6 +182,7 @@ pub fn build_report(
         seeks_per_start: cfg.seeks_per_start,
         positions: cfg.mode.main_positions(),
         symmetric: cfg.mode.is_symmetric(),
+        thue_morse: cfg.mode == SeekMode::TwoPositionThueMorse,
         latitude_deg: cfg.latitude_deg,
         ambient_c: cfg.ambient_c,
         restart_above_ambient_c: cfg.restart_above_ambient_c,
@@ -354,4 +355,31 @@ pub fn reliability_line(arm: &str, r: &SeekReliability) -> String {
             format!(" [{}]", reasons.join(", "))
         }
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The report names the sequence: `symmetric` for the time-symmetric ones, and
+    /// `thue_morse` too for the Thue-Morse order; a forward seek's report writes neither
+    /// (its bytes as before these sequences).
+    #[test]
+    fn the_report_names_the_thue_morse_order_and_only_it() {
+        for (mode, symmetric, thue_morse) in [
+            (SeekMode::TwoPosition, false, false),
+            (SeekMode::TwoPositionSymmetric, true, false),
+            (SeekMode::TwoPositionThueMorse, true, true),
+        ] {
+            let cfg = MonteCarloConfig {
+                mode,
+                ..MonteCarloConfig::paper(1)
+            };
+            let r = build_report(&GyroParams::paper_default(), &cfg, &[], "test");
+            assert_eq!((r.symmetric, r.thue_morse), (symmetric, thue_morse));
+            let json = serde_json::to_string(&r).unwrap();
+            assert_eq!(json.contains("\"symmetric\""), symmetric, "{mode:?}");
+            assert_eq!(json.contains("\"thue_morse\""), thue_morse, "{mode:?}");
+        }
+    }
 }
