@@ -519,9 +519,6 @@ fn cells_met(judged: &[Judged], recipe: &str, mode: SeekMode) -> usize {
     j.figures().into_iter().filter(|&f| met(f)).count()
 }
 
-/// The judge's self-check: a residual of the generator's white noise alone (what a model
-/// equal to the unit's drift leaves, its turn-on offset included) reads at its floor with
-/// no bias, for every sequence; a constant (the turn-on offset) cancels.
 /// The judge reads the generator's 10 s means, as the device reads its windows; a logger
 /// writes 1 Hz rows, which `fogsim train` reads through `io::bin` into the same windows.
 /// Written as a 1 Hz file and read by `train`'s reader, a cold start is its 10 s means
@@ -543,6 +540,9 @@ fn one_hz_rows_read_by_train_are_the_10_s_means_the_judge_reads() {
     }
 }
 
+/// The judge's self-check: a residual of the generator's white noise alone (what a model
+/// equal to the unit's drift leaves, its turn-on offset included) reads at its floor with
+/// no bias, for every sequence; a constant (the turn-on offset) cancels.
 #[test]
 fn the_judge_reads_white_noise_at_its_floor_and_cancels_a_constant() {
     use rand_distr::{Distribution, Normal};
