@@ -45,8 +45,8 @@ use fog_sim::train::seek_score::{Criterion, SeekGeometry};
 use fog_sim::train::type_unit::terms::Fit;
 use fog_sim::train::type_unit::type_model::learn_type;
 use fog_sim::train::type_unit::{
-    calibrate_unit, choose_own, resolve_shape, train_shared, OwnChoice, ShapeChoice, SharedShape,
-    TypeModel, TypeShape, UnitPlan,
+    calibrate_unit, choose_own, resolve_shape, train_shared, OwnChoice, ShapeChoice, ShapeScoring,
+    SharedShape, TypeModel, TypeShape, UnitPlan,
 };
 use fog_sim::train::{dataset_from_runs, default_specs, train_model, InputChoice, TrainConfig};
 use rand::SeedableRng;
@@ -231,6 +231,7 @@ fn learn_independent_type(
     runs: &[Run],
     shape: TypeShape,
     criterion: Criterion,
+    plan: UnitPlan,
 ) -> (TypeModel, SharedShape, Option<ShapeChoice>) {
     let cfg = TrainConfig {
         gyro_id: "independent".into(),
@@ -238,7 +239,13 @@ fn learn_independent_type(
         ..TrainConfig::default()
     };
     let candidates = InputChoice::Auto.candidates();
-    let (shared, choice) = resolve_shape(shape, runs, &cfg, &candidates).unwrap();
+    let scoring = ShapeScoring {
+        cfg: &cfg,
+        candidates: &candidates,
+        fit: Fit::default(),
+        plan,
+    };
+    let (shared, choice) = resolve_shape(shape, runs, &scoring).unwrap();
     let ty = learn_type(runs, Some("independent"), Fit::default(), &mut |runs| {
         Ok(train_shared(shared, &runs, &cfg, &candidates)?
             .model()
@@ -293,8 +300,8 @@ fn own_choice(law: FleetLaw, seed: u64, unit_runs: usize) -> OwnChoice {
     let mode = SeekMode::TwoPositionThueMorse;
     let sp = split(law, seed, unit_runs);
     let criterion = criterion_of(mode);
-    let (ty, _, _) = learn_independent_type(&sp.type_runs, TypeShape::Auto, criterion);
     let plan = plan_of(&schedule(mode), mode);
+    let (ty, _, _) = learn_independent_type(&sp.type_runs, TypeShape::Auto, criterion, plan);
     let cal = calibrate_unit(&ty, &sp.own, &sp.unit_id, &plan).unwrap();
     let min_train = TrainConfig::default().folds;
     choose_own(&cal, &sp.own, &plan, min_train, &mut |r| {
@@ -367,7 +374,9 @@ fn measure(law: FleetLaw, shape: TypeShape, seed: u64, starts: usize) -> Measure
     let mut shapes = Vec::new();
     for mode in SEQUENCES {
         let criterion = criterion_of(mode);
-        let (ty, took, choice) = learn_independent_type(&type_runs, shape, criterion);
+        let sched = schedule(mode);
+        let plan = plan_of(&sched, mode);
+        let (ty, took, choice) = learn_independent_type(&type_runs, shape, criterion, plan);
         if let Some(c) = &choice {
             print!(
                 "{law:?} seed {seed}, {}: {}",
@@ -376,8 +385,6 @@ fn measure(law: FleetLaw, shape: TypeShape, seed: u64, starts: usize) -> Measure
             );
         }
         shapes.push((mode, took));
-        let sched = schedule(mode);
-        let plan = plan_of(&sched, mode);
         let cal = calibrate_unit(&ty, &own, &unit_id, &plan).unwrap();
         let own_model = train_alone(&own, criterion);
         if cal.misfit.outside() {

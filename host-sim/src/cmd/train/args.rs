@@ -170,7 +170,8 @@ pub struct Args {
     pub unit_prior_weight: Option<f64>,
     /// With `--type`: time from one of the device's seeks to the next, s: the unit terms
     /// are chosen on the held-out drift in the first six seeks' windows, each less what
-    /// a seek of `--seek-sequence` cancels [default: 280, `north-seek`'s seeks].
+    /// a seek of `--seek-sequence` cancels; with `--type-out`, the same for the unit step
+    /// that scores the type's shape [default: 280, `north-seek`'s seeks].
     #[arg(long = "seek-period-s")]
     pub seek_period_s: Option<f64>,
 }

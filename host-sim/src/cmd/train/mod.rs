@@ -98,11 +98,15 @@ fn inputs(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
         ("--misfit", args.misfit.is_some()),
         ("--unit-terms", args.unit_terms.is_some()),
         ("--unit-prior-weight", args.unit_prior_weight.is_some()),
-        ("--seek-period-s", args.seek_period_s.is_some()),
     ] {
         if given && args.type_model.is_none() {
             anyhow::bail!("{flag}: needs --type TYPE (a unit calibration)");
         }
+    }
+    if args.seek_period_s.is_some() && args.type_model.is_none() && args.type_out.is_none() {
+        anyhow::bail!(
+            "--seek-period-s: needs --type TYPE (a unit calibration) or --type-out (the unit step that scores the type's shape)"
+        );
     }
     Ok(inputs)
 }

@@ -18,7 +18,7 @@ use crate::train::type_unit::calibrate::DEFAULT_SEEK_PERIOD_S;
 use crate::train::type_unit::type_model::learn_type;
 use crate::train::type_unit::{
     calibrate_unit, choose_own, ordinary_model, resolve_shape, train_shared, unit_id_of,
-    MisfitPolicy, SharedModel, TypeModel, TypeShape, UnitPlan,
+    MisfitPolicy, ShapeScoring, SharedModel, TypeModel, TypeShape, UnitPlan,
 };
 use crate::train::{InputSet, TrainConfig};
 
@@ -40,6 +40,17 @@ fn encoded(model: &RbfModel, gyro_id: &str) -> Result<(Vec<u8>, u32)> {
     Ok((bytes, crc))
 }
 
+/// The unit step's plan from the flags: `--unit-terms`, `--unit-prior-weight`,
+/// `--seek-period-s` and the seek sequence.
+fn unit_plan(args: &Args) -> UnitPlan {
+    UnitPlan {
+        terms: args.unit_terms,
+        prior_weight: args.unit_prior_weight,
+        seek_period_s: args.seek_period_s.unwrap_or(DEFAULT_SEEK_PERIOD_S),
+        symmetric_seeks: args.seek_geometry().symmetric,
+    }
+}
+
 /// `--type-out`: learns the type, writes it, the shared model (`--out`) and `--json` (the
 /// type file's content), and records it when `--registry` is given.
 pub(super) fn learn(
@@ -57,7 +68,14 @@ pub(super) fn learn(
             ignored.join(", ")
         );
     }
-    let (shape, choice) = resolve_shape(args.type_shape, runs, cfg, candidates)?;
+    // the shapes scored by what the unit step makes of units left out (`--seek-period-s`)
+    let scoring = ShapeScoring {
+        cfg,
+        candidates,
+        fit: args.unit_fit,
+        plan: unit_plan(args),
+    };
+    let (shape, choice) = resolve_shape(args.type_shape, runs, &scoring)?;
     if let Some(c) = &choice {
         print!("{}", c.summary());
     }
@@ -139,12 +157,7 @@ pub(super) fn calibrate(
 ) -> Result<Calibrated> {
     let ty = TypeModel::read(type_path)?;
     let unit = unit_id_of(runs, &args.gyro_id)?;
-    let plan = UnitPlan {
-        terms: args.unit_terms,
-        prior_weight: args.unit_prior_weight,
-        seek_period_s: args.seek_period_s.unwrap_or(DEFAULT_SEEK_PERIOD_S),
-        symmetric_seeks: args.seek_geometry().symmetric,
-    };
+    let plan = unit_plan(args);
     let cal = calibrate_unit(&ty, runs, &unit, &plan)?;
     print!("{}", cal.summary());
     let policy = args.misfit.unwrap_or(MisfitPolicy::Refuse);

@@ -25,8 +25,8 @@ use crate::train::type_unit::calibrate::DEFAULT_SEEK_PERIOD_S;
 use crate::train::type_unit::terms::Fit;
 use crate::train::type_unit::type_model::learn_type;
 use crate::train::type_unit::{
-    calibrate_unit, choose_own, ordinary_model, resolve_shape, train_shared, SharedModel,
-    TypeModel, TypeShape, UnitCalibration, UnitPlan,
+    calibrate_unit, choose_own, ordinary_model, resolve_shape, train_shared, ShapeScoring,
+    SharedModel, TypeModel, TypeShape, UnitCalibration, UnitPlan,
 };
 
 /// Ambients of the type's and the unit's chamber runs by default, degC.
@@ -220,7 +220,15 @@ pub fn learn_recipe_type(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<Rec
     // as `train --type-out` makes it.
     let cfg = train_config(plan, false);
     let candidates = plan.inputs.candidates();
-    let (shape, choice) = resolve_shape(recipe.type_shape, &pooled, &cfg, &candidates)?;
+    // the shapes scored by what the unit step makes of units left out, its seeks those
+    // of the type's own parameters (the seeking unit is not the type's to know)
+    let scoring = ShapeScoring {
+        cfg: &cfg,
+        candidates: &candidates,
+        fit: recipe.unit_fit,
+        plan: unit_step_plan(recipe, &fleet.params, plan)?,
+    };
+    let (shape, choice) = resolve_shape(recipe.type_shape, &pooled, &scoring)?;
     // every round's shared model, to report the one the type kept
     let mut rounds: Vec<SharedModel> = Vec::new();
     let ty = learn_type(&pooled, None, recipe.unit_fit, &mut |runs| {
@@ -294,6 +302,24 @@ fn seek_period_s(unit_params: &GyroParams, plan: &OwnModelPlan) -> Result<f64> {
     })
 }
 
+/// The unit step's plan: `recipe`'s terms and prior weight, the seeks of `plan` on a gyro
+/// of `params` (their period and sequence).
+fn unit_step_plan(
+    recipe: &UnitRecipe,
+    params: &GyroParams,
+    plan: &OwnModelPlan,
+) -> Result<UnitPlan> {
+    Ok(UnitPlan {
+        terms: recipe.unit_terms,
+        prior_weight: recipe.unit_prior_weight,
+        seek_period_s: seek_period_s(params, plan)?,
+        symmetric_seeks: match &plan.seek_timing {
+            Some(seeks) => seeks.mode.is_symmetric(),
+            None => plan.criterion.seek_geometry().symmetric,
+        },
+    })
+}
+
 /// The type-free recipe: the seeking unit's own runs alone, by the own-model recipe.
 pub fn type_free_model(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<RecipeModel> {
     let (fleet, unit_params, own) = seeking_unit_runs(recipe)?;
@@ -326,15 +352,7 @@ pub fn unit_model(
     plan: &OwnModelPlan,
 ) -> Result<RecipeModel> {
     let (_, unit_params, own) = seeking_unit_runs(recipe)?;
-    let unit_plan = UnitPlan {
-        terms: recipe.unit_terms,
-        prior_weight: recipe.unit_prior_weight,
-        seek_period_s: seek_period_s(&unit_params, plan)?,
-        symmetric_seeks: match &plan.seek_timing {
-            Some(seeks) => seeks.mode.is_symmetric(),
-            None => plan.criterion.seek_geometry().symmetric,
-        },
-    };
+    let unit_plan = unit_step_plan(recipe, &unit_params, plan)?;
     let ty = learnt.type_model;
     let cal = calibrate_unit(&ty, &own, &unit_id(SEEKING_UNIT), &unit_plan)?;
     let mut summary = format!("{}{}", learnt.summary, cal.summary());

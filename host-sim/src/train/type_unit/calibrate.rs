@@ -42,7 +42,7 @@ use super::solve::{own_estimate, solve, Prior, UnitRows};
 use super::terms::fold;
 use super::type_model::TypeModel;
 use crate::io::runs::Run;
-use crate::train::dataset_from_runs;
+use crate::train::{dataset_from_runs, Dataset};
 use fog_core::model::format::RbfModel;
 
 /// Fewest runs of a unit: one is held out, one fits.
@@ -279,30 +279,14 @@ pub fn calibrate_unit(
         ty.file.units.len(),
         rows.runs,
     );
-    // At most one term per run: more cannot be told apart by leaving runs out.
-    let most = plan.terms.unwrap_or(terms.len().min(rows.runs));
-    // a fixed count is scored beside the type alone, which the summary compares it with
-    let counts: Vec<usize> = match plan.terms {
-        Some(0) => vec![0],
-        Some(m) => vec![0, m],
-        None => (0..=most).collect(),
-    };
-    let weights = plan
-        .prior_weight
-        .map_or(PRIOR_WEIGHTS.to_vec(), |w| vec![w]);
-    let candidates = scan(&rows, &ty.file.order, &counts, &weights, prior, plan);
+    let (candidates, chosen) =
+        scan_and_choose(&rows, &ty.file.order, prior, plan).ok_or_else(|| {
+            anyhow!("unit {unit_id}: no unit calibration could be scored on held-out runs")
+        })?;
     let type_alone = candidates
         .iter()
         .find(|c| c.terms == 0)
         .map_or(f64::NAN, |c| c.heldout_drift_dph);
-    let allowed: Vec<UnitCandidate> = candidates
-        .iter()
-        .filter(|c| plan.terms.is_none_or(|m| c.terms == m))
-        .cloned()
-        .collect();
-    let chosen = choose(&allowed).ok_or_else(|| {
-        anyhow!("unit {unit_id}: no unit calibration could be scored on held-out runs")
-    })?;
     let kept: Vec<usize> = ty.file.order[..chosen.terms].to_vec();
     let coef =
         solve(&rows, &kept, Some(prior), chosen.prior_weight, |_| false).ok_or_else(|| {
@@ -333,6 +317,88 @@ pub fn calibrate_unit(
         misfit,
         model: folded,
     })
+}
+
+/// Every candidate `plan` allows (`scan`) and the one chosen among them (`choose`); None
+/// when none could be scored.
+fn scan_and_choose(
+    rows: &UnitRows,
+    order: &[usize],
+    prior: Prior,
+    plan: &UnitPlan,
+) -> Option<(Vec<UnitCandidate>, UnitCandidate)> {
+    // At most one term per run: more cannot be told apart by leaving runs out.
+    let most = plan.terms.unwrap_or(order.len().min(rows.runs));
+    // a fixed count is scored beside the type alone, which the summary compares it with
+    let counts: Vec<usize> = match plan.terms {
+        Some(0) => vec![0],
+        Some(m) => vec![0, m],
+        None => (0..=most).collect(),
+    };
+    let weights = plan
+        .prior_weight
+        .map_or(PRIOR_WEIGHTS.to_vec(), |w| vec![w]);
+    let candidates = scan(rows, order, &counts, &weights, prior, plan);
+    let allowed: Vec<UnitCandidate> = candidates
+        .iter()
+        .filter(|c| plan.terms.is_none_or(|m| c.terms == m))
+        .cloned()
+        .collect();
+    let chosen = choose(&allowed)?;
+    Some((candidates, chosen))
+}
+
+/// What a unit step leaves of a unit's drift on runs it did not see: `runs` (one unit's,
+/// at least `MIN_UNIT_RUNS`) read against `ty`, the terms and prior weight chosen as
+/// `calibrate_unit` chooses them (on all the runs), and each run's residual after the
+/// terms fitted on the others. The rows' dataset and that residual, row by row: how a
+/// type is scored by what its unit calibration makes of units it never saw
+/// (`shape::choose_shape`).
+pub fn unit_step_heldout_residual(
+    ty: &TypeModel,
+    runs: &[Run],
+    plan: &UnitPlan,
+) -> Result<(Dataset, Vec<f64>)> {
+    let model = &ty.model;
+    let ds = dataset_from_runs(runs, &model.inputs).map_err(|e| anyhow!("{e}"))?;
+    let rows = UnitRows::new(model, &ty.terms(), &ds, ty.file.unit_fit)?;
+    if rows.runs < MIN_UNIT_RUNS {
+        bail!(
+            "{} run(s): a unit step held out needs at least {MIN_UNIT_RUNS}",
+            rows.runs
+        );
+    }
+    let (mean, spread) = (ty.mean(), ty.spread());
+    let prior = Prior {
+        mean: &mean,
+        spread: &spread,
+    };
+    let (_, chosen) = scan_and_choose(&rows, &ty.file.order, prior, plan)
+        .ok_or_else(|| anyhow!("no unit step could be scored on held-out runs"))?;
+    let kept = &ty.file.order[..chosen.terms];
+    let mut residual = Vec::with_capacity(rows.residual.len());
+    for r in 0..rows.runs {
+        let coef = heldout_coefficients(&rows, kept, prior, chosen.prior_weight, r)
+            .ok_or_else(|| anyhow!("the unit terms cannot be solved without run {r}"))?;
+        residual.extend(rows.corrected(rows.rows_of(r), &coef));
+    }
+    Ok((ds, residual))
+}
+
+/// Every term's coefficient fitted on all runs but `r`: `kept` with prior weight `w`
+/// (infinite: the prior's mean).
+fn heldout_coefficients(
+    rows: &UnitRows,
+    kept: &[usize],
+    prior: Prior,
+    w: f64,
+    r: usize,
+) -> Option<Vec<f64>> {
+    if w.is_infinite() {
+        Some(prior.mean.to_vec())
+    } else {
+        solve(rows, kept, Some(prior), w, |x| x == r)
+    }
 }
 
 /// Every candidate: the first m terms of `order` for each m of `counts`, at every prior
@@ -374,11 +440,7 @@ fn held_out(
 ) -> Option<UnitCandidate> {
     let mut per_run = Vec::with_capacity(rows.runs);
     for r in 0..rows.runs {
-        let coef = if w.is_infinite() {
-            prior.mean.to_vec()
-        } else {
-            solve(rows, kept, Some(prior), w, |x| x == r)?
-        };
+        let coef = heldout_coefficients(rows, kept, prior, w, r)?;
         let range = rows.rows_of(r);
         let res = rows.corrected(range.clone(), &coef);
         per_run.push(seek_windows_mean_square(

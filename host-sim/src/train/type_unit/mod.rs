@@ -21,5 +21,7 @@ pub mod type_model;
 
 pub use calibrate::{calibrate_unit, unit_id_of, MisfitPolicy, UnitCalibration, UnitPlan};
 pub use own::{choose_own, ordinary_model, OwnChoice};
-pub use shape::{resolve_shape, train_shared, ShapeChoice, SharedModel, SharedShape, TypeShape};
+pub use shape::{
+    resolve_shape, train_shared, ShapeChoice, ShapeScoring, SharedModel, SharedShape, TypeShape,
+};
 pub use type_model::{fit_type, runs_by_unit, TypeModel};
