@@ -295,19 +295,29 @@ fn plan_of(sched: &SeekSchedule, mode: SeekMode) -> UnitPlan {
 }
 
 /// The unit's own model against its calibration for the fleet `law` (seed `seed`, the
-/// Thue-Morse seek, `unit_runs` of the unit), as `train --type` compares them.
-fn own_choice(law: FleetLaw, seed: u64, unit_runs: usize) -> OwnChoice {
+/// Thue-Morse seek), as `train --type` compares them, for each count of the unit's runs in
+/// `unit_runs` (the type's runs do not depend on it: the type is learnt once).
+fn own_choices(law: FleetLaw, seed: u64, unit_runs: &[usize]) -> Vec<OwnChoice> {
     let mode = SeekMode::TwoPositionThueMorse;
-    let sp = split(law, seed, unit_runs);
     let criterion = criterion_of(mode);
     let plan = plan_of(&schedule(mode), mode);
-    let (ty, _, _) = learn_independent_type(&sp.type_runs, TypeShape::Auto, criterion, plan);
-    let cal = calibrate_unit(&ty, &sp.own, &sp.unit_id, &plan).unwrap();
-    let min_train = TrainConfig::default().folds;
-    choose_own(&cal, &sp.own, &plan, min_train, &mut |r| {
-        Ok(train_alone(r, criterion))
-    })
-    .unwrap()
+    let mut ty = None;
+    let mut choices = Vec::new();
+    for &runs in unit_runs {
+        let sp = split(law, seed, runs);
+        let ty = ty.get_or_insert_with(|| {
+            learn_independent_type(&sp.type_runs, TypeShape::Auto, criterion, plan).0
+        });
+        let cal = calibrate_unit(ty, &sp.own, &sp.unit_id, &plan).unwrap();
+        let min_train = TrainConfig::default().folds;
+        choices.push(
+            choose_own(&cal, &sp.own, &plan, min_train, &mut |r| {
+                Ok(train_alone(r, criterion))
+            })
+            .unwrap(),
+        );
+    }
+    choices
 }
 
 /// The fleet `law`'s unit 11: its truth, id and `unit_runs` cold starts (2 per ambient
@@ -626,20 +636,20 @@ impl Tally {
 /// unit's runs alone, against 2 of 9: docs/record/fleet.md.)
 #[test]
 fn a_unit_leaves_its_type_when_its_own_runs_say_more_and_only_then() {
-    let show = |law: FleetLaw, runs: usize| {
-        let c = own_choice(law, 1, runs);
-        print!("{law:?}, {runs} unit runs: {}", c.summary());
-        c.taken
+    let show = |law: FleetLaw, runs: &[usize]| -> Vec<bool> {
+        let choices = own_choices(law, 1, runs);
+        for (c, n) in choices.iter().zip(runs) {
+            print!("{law:?}, {n} unit runs: {}", c.summary());
+        }
+        choices.iter().map(|c| c.taken).collect()
     };
+    let differ = show(FleetLaw::Type, &[24, 6]);
+    assert!(differ[0], "24 runs of a unit its type cannot carry");
     assert!(
-        show(FleetLaw::Type, 24),
-        "24 runs of a unit its type cannot carry"
-    );
-    assert!(
-        !show(FleetLaw::Identical, 24),
+        !show(FleetLaw::Identical, &[24])[0],
         "the null twin left its type"
     );
-    assert!(!show(FleetLaw::Type, 6), "6 runs left the type");
+    assert!(!differ[1], "6 runs left the type");
 }
 
 /// Measured at 200 starts, seed 1 (the CI size): with identical units the type + unit
