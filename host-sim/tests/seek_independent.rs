@@ -43,10 +43,9 @@ use fog_sim::sim::GyroParams;
 use fog_sim::train::seek_refit::SeekSchedule;
 use fog_sim::train::seek_score::{Criterion, SeekGeometry};
 use fog_sim::train::type_unit::terms::Fit;
-use fog_sim::train::type_unit::type_model::learn_type;
 use fog_sim::train::type_unit::{
-    calibrate_unit, choose_own, resolve_shape, train_shared, OwnChoice, ShapeChoice, ShapeScoring,
-    SharedShape, TypeModel, TypeShape, UnitPlan,
+    calibrate_unit, choose_own, resolve_shape, OwnChoice, ShapeChoice, ShapeScoring, SharedShape,
+    TypeModel, TypeShape, UnitPlan,
 };
 use fog_sim::train::{dataset_from_runs, default_specs, train_model, InputChoice, TrainConfig};
 use rand::SeedableRng;
@@ -246,12 +245,9 @@ fn learn_independent_type(
         plan,
     };
     let (shared, choice) = resolve_shape(shape, runs, &scoring).unwrap();
-    let ty = learn_type(runs, Some("independent"), Fit::default(), &mut |runs| {
-        Ok(train_shared(shared, &runs, &cfg, &candidates)?
-            .model()
-            .clone())
-    })
-    .unwrap();
+    let ty = scoring
+        .learn_type(shared, runs, Some("independent"))
+        .unwrap();
     (ty, shared, choice)
 }
 

@@ -12,8 +12,9 @@
 //! see: as the type will meet a unit it has never seen, after that unit's calibration.
 //! (Scored on the shared model alone, without the unit step, the choice took the network
 //! on simulator fleets whose law type met every target after the unit step, and the law
-//! on independent fleets the network carried: docs/record/fleet.md.) The network is taken only when its pooled error is lower than
-//! the law's beyond what the units left out could make of it (the log ratio over its
+//! on independent fleets the network carried: docs/record/fleet.md.) The network is taken
+//! only when its pooled error is lower than the law's beyond what the units left out could
+//! make of it (the log ratio over its
 //! jackknife standard error, each unit left out in turn, above `SHAPE_T_MIN`); otherwise,
 //! and when too few units leave no test power, the law: the physical base. (A paired test
 //! of each unit's log ratio was tried first: it kept the law on independent fleets whose
@@ -27,7 +28,7 @@ use super::calibrate::{unit_step_heldout_residual, UnitPlan};
 use super::folds::unit_of_runs;
 use super::law::{fit_law_network, LawNetwork, LAW_FOLDS};
 use super::terms::Fit;
-use super::type_model::{check_type_runs, learn_type, MIN_TYPE_UNITS};
+use super::type_model::{check_type_runs, learn_type, TypeModel, MIN_TYPE_UNITS};
 use crate::io::runs::Run;
 use crate::train::cold_start::envelope_for;
 use crate::train::seek_score::seek_azimuth_first_pairs_per_run;
@@ -171,6 +172,23 @@ pub struct ShapeScoring<'a> {
     pub plan: UnitPlan,
 }
 
+impl ShapeScoring<'_> {
+    /// The type of `shape` learnt from `runs` as `train --type-out` learns it
+    /// (`learn_type` around `train_shared`, the unit terms read with `fit`).
+    pub fn learn_type(
+        &self,
+        shape: SharedShape,
+        runs: &[Run],
+        type_id: Option<&str>,
+    ) -> Result<TypeModel> {
+        learn_type(runs, type_id, self.fit, &mut |runs| {
+            Ok(train_shared(shape, &runs, self.cfg, self.candidates)?
+                .model()
+                .clone())
+        })
+    }
+}
+
 /// Seeks from power-on each held-out run is scored on: the six the seek targets judge one
 /// by one, as the unit step's score (`calibrate::SCORED_SEEKS`; about the first half hour
 /// of a cold start at the default dwells, where the warm-up is).
@@ -203,7 +221,7 @@ impl ShapeChoice {
     pub fn summary(&self) -> String {
         if self.scores_deg.is_empty() {
             return format!(
-                "shape: {} ({} units: no test power for a choice, at least {SHAPE_MIN_UNITS} needed)\n",
+                "shape: {} ({} units: no test power for a choice; a type from at least {SHAPE_MIN_UNITS} units lets its units choose)\n",
                 self.chosen.name(),
                 self.units
             );
@@ -229,8 +247,9 @@ impl ShapeChoice {
 /// Chooses the shared model's shape for a type learnt from `runs` (several units'): each of
 /// `AUTO_SHAPES` learnt as a type on the runs of the other units, in `LAW_FOLDS` folds of
 /// whole units, and scored on the held-out units' first `SHAPE_SEEKS` seeks (the seek of
-/// `scoring.cfg.criterion`) after their unit step (`heldout_sse`); the network of the lower score is taken over the law when
-/// its pooled error is lower beyond the units' scatter (`jackknife_t` > `SHAPE_T_MIN`).
+/// `scoring.cfg.criterion`) after their unit step (`heldout_sse`); the network of the lower
+/// score is taken over the law when its pooled error is lower beyond the units' scatter
+/// (`jackknife_t` > `SHAPE_T_MIN`).
 pub fn choose_shape(runs: &[Run], scoring: &ShapeScoring) -> Result<ShapeChoice> {
     let unit_of_run = unit_of_runs(runs);
     let units = unit_of_run.iter().max().map_or(0, |m| m + 1);
@@ -310,6 +329,17 @@ fn heldout_sse(
             .filter(|&r| !held(r))
             .map(|r| runs[r].clone())
             .collect();
+        // the fold's units left out, each with its runs
+        let held_units: Vec<(usize, Vec<Run>)> = (0..units)
+            .filter(|u| u % folds == fold)
+            .map(|u| {
+                let unit_runs = (0..runs.len())
+                    .filter(|&r| unit_of_run[r] == u)
+                    .map(|r| runs[r].clone())
+                    .collect();
+                (u, unit_runs)
+            })
+            .collect();
         for (k, shape) in AUTO_SHAPES.into_iter().enumerate() {
             let context = |e: anyhow::Error| {
                 anyhow!(
@@ -317,19 +347,11 @@ fn heldout_sse(
                     shape.name()
                 )
             };
-            let ty = learn_type(&train, None, scoring.fit, &mut |runs| {
-                Ok(train_shared(shape, &runs, scoring.cfg, scoring.candidates)?
-                    .model()
-                    .clone())
-            })
-            .map_err(context)?;
-            for u in (0..units).filter(|u| u % folds == fold) {
-                let unit: Vec<Run> = (0..runs.len())
-                    .filter(|&r| unit_of_run[r] == u)
-                    .map(|r| runs[r].clone())
-                    .collect();
+            let ty = scoring.learn_type(shape, &train, None).map_err(context)?;
+            for (u, unit) in &held_units {
+                let u = *u;
                 let (ds, res) =
-                    unit_step_heldout_residual(&ty, &unit, &scoring.plan).map_err(context)?;
+                    unit_step_heldout_residual(&ty, unit, &scoring.plan).map_err(context)?;
                 for e in seek_azimuth_first_pairs_per_run(
                     &res,
                     &ds.groups,
