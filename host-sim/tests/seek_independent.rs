@@ -406,11 +406,12 @@ fn measure(law: FleetLaw, shape: TypeShape, seed: u64, starts: usize) -> Measure
             continue;
         }
         println!(
-            "{law:?} seed {seed}, {shape:?} type, {}: {} unit terms, prior weight {}; type terms: {}",
+            "{law:?} seed {seed}, {shape:?} type, {}: {} unit terms, prior weight {}; type terms: {}; {}",
             sequence_name(mode),
             cal.terms,
             cal.prior_weight,
-            ty.file.terms.iter().map(|t| t.name.as_str()).collect::<Vec<_>>().join(", ")
+            ty.file.terms.iter().map(|t| t.name.as_str()).collect::<Vec<_>>().join(", "),
+            cal.misfit.lines().join("; ")
         );
         // the unit's own model beside it, as `train --type` compares them
         let min_train = TrainConfig::default().folds;
@@ -499,7 +500,7 @@ fn type_unit_runs() -> usize {
         .unwrap_or(6)
 }
 
-/// The fleets measured (`INDEP_SEEK_FLEETS=type,identical,shupe,thermal`; default the
+/// The fleets measured (`INDEP_SEEK_FLEETS=type,identical,shupe,thermal,odd`; default the
 /// type fleet and its null twin).
 fn fleets() -> Vec<FleetLaw> {
     let names = std::env::var("INDEP_SEEK_FLEETS").unwrap_or_else(|_| "type,identical".into());
@@ -510,6 +511,7 @@ fn fleets() -> Vec<FleetLaw> {
             "identical" => FleetLaw::Identical,
             "shupe" => FleetLaw::OnlyShupe,
             "thermal" => FleetLaw::OnlyThermal,
+            "odd" => FleetLaw::OddUnit,
             other => panic!("INDEP_SEEK_FLEETS: unknown fleet {other}"),
         })
         .collect()

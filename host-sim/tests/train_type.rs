@@ -502,6 +502,44 @@ fn indep_files(dir: &Path, units: &[usize]) -> Vec<String> {
         .collect()
 }
 
+/// Learns `type.json` from `type_runs` (units 1-5 of the odd fleet in `dir`): none of its
+/// units is outside the type its other units make; and a type from units 2-6, which names
+/// the odd U6 so before its runs shape a type.
+fn learn_types_with_and_without_the_odd_unit(dir: &Path, type_runs: &[String]) {
+    let learnt = fogsim_ok(
+        dir,
+        &train_args(
+            type_runs,
+            &["--type-out", "type.json", "--out", "shared.model"],
+        ),
+    );
+    // its own units, each tested as a new unit against the type the others make: none out
+    assert!(
+        learnt.contains("against the type their other units make: none of 5 outside"),
+        "{learnt}"
+    );
+    // with the odd unit among them, it is named before its runs shape a type
+    let with_odd = fogsim_ok(
+        dir,
+        &train_args(
+            &indep_files(dir, &[2, 3, 4, 5, UNITS]),
+            &["--type-out", "type-odd.json", "--out", "shared-odd.model"],
+        ),
+    );
+    for l in learnt.lines().chain(with_odd.lines()) {
+        if l.starts_with("type units") || l.starts_with("shape:") {
+            println!("{l}");
+        }
+    }
+    assert!(
+        with_odd
+            .lines()
+            .any(|l| l
+                .starts_with("type units outside the type their other units make: 1 of 5: U6 (")),
+        "{with_odd}"
+    );
+}
+
 #[test]
 fn the_cli_refuses_an_odd_unit_by_default_and_trains_it_alone_with_misfit_own() {
     let t0 = Instant::now();
@@ -509,13 +547,7 @@ fn the_cli_refuses_an_odd_unit_by_default_and_trains_it_alone_with_misfit_own() 
     write_independent(&dir, FleetLaw::OddUnit, UNITS, RUNS_PER_AMBIENT);
     let type_runs = indep_files(&dir, &[1, 2, 3, 4, 5]);
     let odd_runs = indep_files(&dir, &[UNITS]);
-    fogsim_ok(
-        &dir,
-        &train_args(
-            &type_runs,
-            &["--type-out", "type.json", "--out", "shared.model"],
-        ),
-    );
+    learn_types_with_and_without_the_odd_unit(&dir, &type_runs);
     let unit = |extra: &[&str]| {
         let mut a = vec!["--out", "u6.model"];
         a.extend_from_slice(extra);

@@ -37,7 +37,7 @@
 use anyhow::{anyhow, bail, Result};
 use serde::Serialize;
 
-use super::misfit::{test_unit, Misfit};
+use super::misfit::{test_unit, Misfit, TypeSide};
 use super::solve::{own_estimate, solve, Prior, UnitRows};
 use super::terms::fold;
 use super::type_model::TypeModel;
@@ -267,18 +267,7 @@ pub fn calibrate_unit(
     };
     // the unit read as the type read its units
     let rows = UnitRows::new(model, &terms, &ds, ty.file.unit_fit)?;
-    let (own, se) = own_estimate(&rows)?;
-    let misfit = test_unit(
-        unit_id,
-        &names,
-        &own,
-        &se,
-        &mean,
-        &spread,
-        &ty.file.terms.iter().map(|t| t.scatter).collect::<Vec<_>>(),
-        ty.file.units.len(),
-        rows.runs,
-    );
+    let misfit = misfit_of(ty, &rows, unit_id)?;
     let (candidates, chosen) =
         scan_and_choose(&rows, &ty.file.order, prior, plan).ok_or_else(|| {
             anyhow!("unit {unit_id}: no unit calibration could be scored on held-out runs")
@@ -319,6 +308,22 @@ pub fn calibrate_unit(
     })
 }
 
+/// The misfit test of a unit's `rows` (read as the type read its units) against `ty`.
+fn misfit_of(ty: &TypeModel, rows: &UnitRows, unit_id: &str) -> Result<Misfit> {
+    let (own, se) = own_estimate(rows)?;
+    let f = &ty.file;
+    let names: Vec<String> = f.terms.iter().map(|t| t.name.clone()).collect();
+    let (mean, spread) = (ty.mean(), ty.spread());
+    let scatter: Vec<f64> = f.terms.iter().map(|t| t.scatter).collect();
+    let side = TypeSide {
+        mean: &mean,
+        spread: &spread,
+        scatter: &scatter,
+        units: f.units.len(),
+    };
+    Ok(test_unit(unit_id, &names, &own, &se, &side, rows.runs))
+}
+
 /// Every candidate `plan` allows (`scan`) and the one chosen among them (`choose`); None
 /// when none could be scored.
 fn scan_and_choose(
@@ -348,17 +353,28 @@ fn scan_and_choose(
     Some((candidates, chosen))
 }
 
+/// What the unit step makes of a unit the type never saw (`unit_step_held_out`).
+pub struct HeldOutUnit {
+    /// The unit's rows and each one's residual after the unit terms fitted on the
+    /// unit's other runs.
+    pub dataset: Dataset,
+    pub residual: Vec<f64>,
+    /// Its misfit test against the type.
+    pub misfit: Misfit,
+}
+
 /// What a unit step leaves of a unit's drift on runs it did not see: `runs` (one unit's,
 /// at least `MIN_UNIT_RUNS`) read against `ty`, the terms and prior weight chosen as
 /// `calibrate_unit` chooses them (on all the runs), and each run's residual after the
-/// terms fitted on the others. The rows' dataset and that residual, row by row: how a
-/// type is scored by what its unit calibration makes of units it never saw
+/// terms fitted on the others; and the unit's misfit test (as `unit_id`). How a type is
+/// judged by what its unit calibration makes of units it never saw
 /// (`shape::choose_shape`).
-pub fn unit_step_heldout_residual(
+pub fn unit_step_held_out(
     ty: &TypeModel,
     runs: &[Run],
+    unit_id: &str,
     plan: &UnitPlan,
-) -> Result<(Dataset, Vec<f64>)> {
+) -> Result<HeldOutUnit> {
     let model = &ty.model;
     let ds = dataset_from_runs(runs, &model.inputs).map_err(|e| anyhow!("{e}"))?;
     let rows = UnitRows::new(model, &ty.terms(), &ds, ty.file.unit_fit)?;
@@ -382,7 +398,12 @@ pub fn unit_step_heldout_residual(
             .ok_or_else(|| anyhow!("the unit terms cannot be solved without run {r}"))?;
         residual.extend(rows.corrected(rows.rows_of(r), &coef));
     }
-    Ok((ds, residual))
+    let misfit = misfit_of(ty, &rows, unit_id)?;
+    Ok(HeldOutUnit {
+        dataset: ds,
+        residual,
+        misfit,
+    })
 }
 
 /// Every term's coefficient fitted on all runs but `r`: `kept` with prior weight `w`

@@ -12,6 +12,10 @@
 //! uncertain and a normal quantile would call noise a misfit. A term whose test could not
 //! see even a unit `POWER_SIGMAS` spreads out (its se too large, e.g. T and dT/dt from
 //! runs at one ambient) has no test power, and is said to have none.
+//!
+//! A type's own units are tested the same way when the shape is chosen: each unit left out
+//! of a fold against the type its other units make (`shape::choose_shape`), so a type unit
+//! unlike the others is said before its runs shape the type.
 
 use serde::Serialize;
 
@@ -29,10 +33,12 @@ pub struct TermTest {
     /// The unit's own estimate and its jackknife standard error, model units.
     pub own: f64,
     pub se: f64,
-    /// The type's mean and spread, model units.
+    /// The type's mean and spread as learnt from its units, model units, and the mean's
+    /// own error (its units' scatter over the square root of their count).
     pub type_mean: f64,
     pub type_spread: f64,
-    /// (own - mean) / sqrt(spread^2 + se^2 + the type mean's error^2).
+    pub mean_se: f64,
+    /// (own - mean) / sqrt(spread^2 + se^2 + mean_se^2).
     pub z: f64,
     /// Critical |z| at the family-wise rate.
     pub critical: f64,
@@ -96,29 +102,37 @@ impl Misfit {
     }
 }
 
-/// Tests a unit's own estimates against the type (see the module notes).
-#[allow(clippy::too_many_arguments)]
+/// The type's side of the test: each term's mean, spread and units' scatter (model
+/// units), and the units it was learnt from.
+#[derive(Clone, Copy, Debug)]
+pub struct TypeSide<'a> {
+    pub mean: &'a [f64],
+    pub spread: &'a [f64],
+    pub scatter: &'a [f64],
+    pub units: usize,
+}
+
+/// Tests a unit's own estimates (`own`, jackknife `se` over its `unit_runs` runs) against
+/// the type (see the module notes).
 pub fn test_unit(
     unit_id: &str,
     names: &[String],
     own: &[f64],
     se: &[f64],
-    type_mean: &[f64],
-    type_spread: &[f64],
-    type_scatter: &[f64],
-    type_units: usize,
+    ty: &TypeSide,
     unit_runs: usize,
 ) -> Misfit {
     let p = own.len().max(1) as f64;
     let tail = FAMILY_ALPHA / (2.0 * p);
-    let dof_type = (type_units as f64 - 1.0).max(1.0);
+    let dof_type = (ty.units as f64 - 1.0).max(1.0);
     let dof_unit = (unit_runs as f64 - 1.0).max(1.0);
     let terms = (0..own.len())
         .map(|k| {
             // The type's side: the spread of units about the mean, and the mean's own error
             // (its units' scatter over their count), both known to the type's units - 1.
-            let mean_var = type_scatter[k] * type_scatter[k] / (type_units.max(1) as f64);
-            let s2 = type_spread[k] * type_spread[k] + mean_var;
+            let mean_se = ty.scatter[k] / (ty.units.max(1) as f64).sqrt();
+            let spread = ty.spread[k];
+            let s2 = spread * spread + mean_se * mean_se;
             let e2 = if se[k].is_finite() {
                 se[k] * se[k]
             } else {
@@ -131,14 +145,15 @@ pub fn test_unit(
             } else {
                 f64::INFINITY
             };
-            let z = (own[k] - type_mean[k]) / total;
-            let has_power = total.is_finite() && critical * total <= POWER_SIGMAS * type_spread[k];
+            let z = (own[k] - ty.mean[k]) / total;
+            let has_power = total.is_finite() && critical * total <= POWER_SIGMAS * spread;
             TermTest {
                 name: names[k].clone(),
                 own: own[k],
                 se: se[k],
-                type_mean: type_mean[k],
-                type_spread: type_spread[k],
+                type_mean: ty.mean[k],
+                type_spread: ty.spread[k],
+                mean_se,
                 z: if z.is_finite() { z } else { 0.0 },
                 critical,
                 has_power,
@@ -173,10 +188,12 @@ mod tests {
             &names(),
             &own,
             &se,
-            &[0.0, 1.0],
-            &[0.1, 0.1],
-            &[0.1, 0.1],
-            type_units,
+            &TypeSide {
+                mean: &[0.0, 1.0],
+                spread: &[0.1, 0.1],
+                scatter: &[0.1, 0.1],
+                units: type_units,
+            },
             runs,
         )
     }

@@ -24,9 +24,10 @@
 use anyhow::{anyhow, Result};
 use fog_core::model::format::RbfModel;
 
-use super::calibrate::{unit_step_heldout_residual, UnitPlan};
+use super::calibrate::{unit_step_held_out, UnitPlan};
 use super::folds::unit_of_runs;
 use super::law::{fit_law_network, LawNetwork, LAW_FOLDS};
+use super::misfit::Misfit;
 use super::terms::Fit;
 use super::type_model::{check_type_runs, learn_type, TypeModel, MIN_TYPE_UNITS};
 use crate::io::runs::Run;
@@ -215,6 +216,10 @@ pub struct ShapeChoice {
     /// The log of the law's pooled mean-square error over the challenger's, over its
     /// jackknife standard error (each held-out unit left out in turn).
     pub t_challenger_better: f64,
+    /// The type's own units the misfit test finds outside the chosen shape's type their
+    /// other units make (each left out of its fold as a new unit): `U6 (warm-up gain 8.2
+    /// sigma, critical 3.6)`.
+    pub units_outside: Vec<String>,
 }
 
 impl ShapeChoice {
@@ -231,8 +236,18 @@ impl ShapeChoice {
             .iter()
             .map(|(s, d)| format!("{} {d:.4} deg", s.name()))
             .collect();
+        let outside = if self.units_outside.is_empty() {
+            format!("type units tested as new units against the type their other units make: none of {} outside its type\n", self.units)
+        } else {
+            format!(
+                "type units outside the type their other units make: {} of {}: {}; a unit's runs shape the type it is tested against: learn the type without them, unless the design's units do differ so\n",
+                self.units_outside.len(),
+                self.units,
+                self.units_outside.join(", ")
+            )
+        };
         format!(
-            "shape: {} (held-out first {SHAPE_SEEKS} seeks of {} units left out: {}; the {} better on {} of {} units, t = {:.1}, taken above {SHAPE_T_MIN})\n",
+            "shape: {} (held-out first {SHAPE_SEEKS} seeks of {} units left out: {}; the {} better on {} of {} units, t = {:.1}, taken above {SHAPE_T_MIN})\n{outside}",
             self.chosen.name(),
             self.units,
             scores.join(", "),
@@ -242,6 +257,23 @@ impl ShapeChoice {
             self.t_challenger_better,
         )
     }
+}
+
+/// `U6 (warm-up gain 8.2 sigma, critical 3.6)`: a unit outside its type, by its term
+/// farthest out (|z| over its critical value).
+fn outside_line(m: &Misfit) -> Option<String> {
+    let worst = m
+        .terms
+        .iter()
+        .filter(|t| t.outside)
+        .max_by(|a, b| (a.z.abs() / a.critical).total_cmp(&(b.z.abs() / b.critical)))?;
+    Some(format!(
+        "{} ({} {:.1} sigma, critical {:.1})",
+        m.unit_id,
+        worst.name,
+        worst.z.abs(),
+        worst.critical
+    ))
 }
 
 /// Chooses the shared model's shape for a type learnt from `runs` (several units'): each of
@@ -261,11 +293,12 @@ pub fn choose_shape(runs: &[Run], scoring: &ShapeScoring) -> Result<ShapeChoice>
             units,
             challenger_better_units: 0,
             t_challenger_better: 0.0,
+            units_outside: Vec::new(),
         });
     }
     // every fold's type and every unit's step need what a type needs
     check_type_runs(runs)?;
-    let sse = heldout_sse(runs, &unit_of_run, units, scoring)?;
+    let (sse, mut outside) = heldout_sse(runs, &unit_of_run, units, scoring)?;
     let rms = |k: usize| {
         let (s, n) = sse
             .iter()
@@ -287,13 +320,14 @@ pub fn choose_shape(runs: &[Run], scoring: &ShapeScoring) -> Result<ShapeChoice>
         .iter()
         .map(|u| ms(&u[..], 0) - ms(&u[..], c))
         .collect();
-    let chosen = if d.len() >= SHAPE_MIN_UNITS && t > SHAPE_T_MIN {
-        AUTO_SHAPES[c]
+    let chosen_k = if d.len() >= SHAPE_MIN_UNITS && t > SHAPE_T_MIN {
+        c
     } else {
-        AUTO_SHAPES[0]
+        0
     };
     Ok(ShapeChoice {
-        chosen,
+        chosen: AUTO_SHAPES[chosen_k],
+        units_outside: std::mem::take(&mut outside[chosen_k]),
         scores_deg,
         challenger: AUTO_SHAPES[c],
         units: d.len(),
@@ -309,35 +343,41 @@ type UnitSse = [(f64, usize); AUTO_SHAPES.len()];
 /// learnt as `learn_type` learns it (the shape's shared model and the unit terms, `fit`)
 /// from the runs of the other folds (`LAW_FOLDS` folds of whole units); each held-out
 /// unit calibrated against it by the unit step (`plan`), every run scored after the unit
-/// terms fitted on the unit's other runs (`unit_step_heldout_residual`). So a shape is
+/// terms fitted on the unit's other runs (`unit_step_held_out`). So a shape is
 /// judged by what the seeks of a unit it never saw meet after that unit's own calibration,
 /// not by the shared model alone: a shape whose units differ in what the unit terms carry
-/// loses nothing by it.
+/// loses nothing by it. With them, per shape, the held-out units the misfit test finds
+/// outside the fold's type (`outside_line`).
 fn heldout_sse(
     runs: &[Run],
     unit_of_run: &[usize],
     units: usize,
     scoring: &ShapeScoring,
-) -> Result<Vec<UnitSse>> {
+) -> Result<(Vec<UnitSse>, [Vec<String>; AUTO_SHAPES.len()])> {
     let folds = LAW_FOLDS.min(units);
     let geometry = scoring.cfg.criterion.seek_geometry();
     // per unit and shape: squared azimuth errors and their count
     let mut sse = vec![[(0.0, 0usize); AUTO_SHAPES.len()]; units];
+    let mut outside: [Vec<String>; AUTO_SHAPES.len()] = Default::default();
     for fold in 0..folds {
         let held = |r: usize| unit_of_run[r] % folds == fold;
         let train: Vec<Run> = (0..runs.len())
             .filter(|&r| !held(r))
             .map(|r| runs[r].clone())
             .collect();
-        // the fold's units left out, each with its runs
-        let held_units: Vec<(usize, Vec<Run>)> = (0..units)
+        // the fold's units left out, each with its id and runs
+        let held_units: Vec<(usize, String, Vec<Run>)> = (0..units)
             .filter(|u| u % folds == fold)
             .map(|u| {
-                let unit_runs = (0..runs.len())
+                let unit_runs: Vec<Run> = (0..runs.len())
                     .filter(|&r| unit_of_run[r] == u)
                     .map(|r| runs[r].clone())
                     .collect();
-                (u, unit_runs)
+                let id = unit_runs
+                    .first()
+                    .and_then(|r| r.meta_value("unit_id"))
+                    .map_or_else(|| format!("unit {}", u + 1), |s| s.trim().to_string());
+                (u, id, unit_runs)
             })
             .collect();
         for (k, shape) in AUTO_SHAPES.into_iter().enumerate() {
@@ -348,12 +388,12 @@ fn heldout_sse(
                 )
             };
             let ty = scoring.learn_type(shape, &train, None).map_err(context)?;
-            for (u, unit) in &held_units {
+            for (u, id, unit) in &held_units {
                 let u = *u;
-                let (ds, res) =
-                    unit_step_heldout_residual(&ty, unit, &scoring.plan).map_err(context)?;
+                let held = unit_step_held_out(&ty, unit, id, &scoring.plan).map_err(context)?;
+                let ds = &held.dataset;
                 for e in seek_azimuth_first_pairs_per_run(
-                    &res,
+                    &held.residual,
                     &ds.groups,
                     &ds.t_s,
                     geometry,
@@ -362,10 +402,11 @@ fn heldout_sse(
                     sse[u][k].0 += e.sum_sq_deg2;
                     sse[u][k].1 += e.pairs;
                 }
+                outside[k].extend(outside_line(&held.misfit));
             }
         }
     }
-    Ok(sse)
+    Ok((sse, outside))
 }
 
 /// The log of the law's pooled mean square (shape 0) over shape `c`'s on the `scored`
