@@ -18,7 +18,9 @@ use crate::io::OutputGuard;
 use crate::output::reports::{progress_bar, write_json};
 use crate::pipeline::campaign::WarmRestarts;
 use crate::pipeline::north_seek::own_model::{train_own_model, OwnModelPlan, CAMPAIGN_RUNS};
-use crate::pipeline::north_seek::unit_recipe::{recipe_model, UnitRecipe, RECIPE_AMBIENTS_C};
+use crate::pipeline::north_seek::unit_recipe::{
+    recipe_model, UnitRecipe, DEFAULT_TYPE_UNIT_RUNS, RECIPE_AMBIENTS_C,
+};
 use crate::pipeline::north_seek::{
     build_product_report, default_dwell_s, default_threads, run_monte_carlo_with_calibration,
     seek_table, MonteCarloConfig, MAX_RESTART_ABOVE_AMBIENT_C,
@@ -139,7 +141,7 @@ pub struct Args {
     )]
     pub unit_ambients_c: Option<Vec<f64>>,
     /// Cold starts of each type unit (2..=48), spread over `--type-ambients-c` in turn
-    /// [default: 6]. Needs `--type-units`.
+    /// [default: 18]. Needs `--type-units`.
     #[arg(long = "type-unit-runs")]
     pub type_unit_runs: Option<usize>,
     /// Ambients of the type units' cold starts, degC [default: -40,20,60]; one ambient
@@ -392,7 +394,7 @@ fn recipe_of(args: &Args) -> Result<Option<UnitRecipe>> {
     };
     Ok(Some(UnitRecipe {
         type_units,
-        type_unit_runs: args.type_unit_runs.unwrap_or(6),
+        type_unit_runs: args.type_unit_runs.unwrap_or(DEFAULT_TYPE_UNIT_RUNS),
         type_ambients_c: args
             .type_ambients_c
             .clone()
@@ -565,6 +567,7 @@ mod tests {
         );
         let default = recipe_of(&args(&["--type-units", "3"])).unwrap().unwrap();
         assert_eq!(default.type_ambients_c, RECIPE_AMBIENTS_C.to_vec());
+        assert_eq!(default.type_unit_runs, DEFAULT_TYPE_UNIT_RUNS);
         let fixed = recipe_of(&args(&[
             "--type-units",
             "3",
