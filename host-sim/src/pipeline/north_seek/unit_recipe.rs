@@ -32,10 +32,11 @@ use crate::train::type_unit::{
 /// Ambients of the type's and the unit's chamber runs by default, degC.
 pub const RECIPE_AMBIENTS_C: [f64; 3] = [-40.0, 20.0, 60.0];
 /// Cold starts of each type unit by default: 6 a unit at each of the three ambients. With
-/// 18, a type of 10 units met 119 of 120 simulated cells (fleets 81-120 x -40/20/+60 degC,
-/// 6 unit runs, Thue-Morse, 1,000 starts) against 113 of 118 with 6, where two runs a unit
-/// and ambient chose the law's clocks by chance; on the independent fleet 5 of 15 against
-/// 4, no unit refused against one (docs/record/fleet.md). A type is learnt once per design.
+/// 18, a type of 10 units met 120 of 120 simulated cells (fleets 81-120 x -40/20/+60 degC,
+/// 6 unit runs, Thue-Morse, 1,000 starts; fleet 111 at -40 degC at 16,000) against 113 of
+/// 118 with 6, where two runs a unit and ambient chose the law's clocks by chance; on the
+/// independent fleet 5 of 15 against 4, no unit refused against one
+/// (docs/record/fleet.md). A type is learnt once per design.
 pub const DEFAULT_TYPE_UNIT_RUNS: usize = 18;
 /// Most type units (every unit's runs are held in memory).
 pub const MAX_TYPE_UNITS: usize = 60;
