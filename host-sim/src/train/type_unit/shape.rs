@@ -14,17 +14,16 @@
 //! on simulator fleets whose law type met every target after the unit step, and the law
 //! on independent fleets the network carried: docs/record/fleet.md.) The network is taken
 //! only when its pooled error is lower than the law's beyond what the units left out could
-//! make of it (the log ratio over its
-//! jackknife standard error, each unit left out in turn, above `SHAPE_T_MIN`); otherwise,
-//! and when too few units leave no test power, the law: the physical base. (A paired test
-//! of each unit's log ratio was tried first: it kept the law on independent fleets whose
-//! pooled error the network cut by a third, carried by a few units far off the type;
-//! docs/record/fleet.md.)
+//! make of it (the log ratio over its jackknife standard error, each unit left out in turn,
+//! above `SHAPE_T_MIN`); otherwise, and when too few units leave no test power, the law:
+//! the physical base. (A paired test of each unit's log ratio was tried first: it kept the
+//! law on independent fleets whose pooled error the network cut by a third, carried by a
+//! few units far off the type; docs/record/fleet.md.)
 
 use anyhow::{anyhow, Result};
 use fog_core::model::format::RbfModel;
 
-use super::calibrate::{unit_step_held_out, UnitPlan};
+use super::calibrate::{unit_id_of, unit_step_held_out, UnitPlan};
 use super::folds::unit_of_runs;
 use super::law::{fit_law_network, LawNetwork, LAW_FOLDS};
 use super::misfit::Misfit;
@@ -366,20 +365,17 @@ fn heldout_sse(
             .map(|r| runs[r].clone())
             .collect();
         // the fold's units left out, each with its id and runs
-        let held_units: Vec<(usize, String, Vec<Run>)> = (0..units)
+        let held_units = (0..units)
             .filter(|u| u % folds == fold)
             .map(|u| {
                 let unit_runs: Vec<Run> = (0..runs.len())
                     .filter(|&r| unit_of_run[r] == u)
                     .map(|r| runs[r].clone())
                     .collect();
-                let id = unit_runs
-                    .first()
-                    .and_then(|r| r.meta_value("unit_id"))
-                    .map_or_else(|| format!("unit {}", u + 1), |s| s.trim().to_string());
-                (u, id, unit_runs)
+                let id = unit_id_of(&unit_runs, &format!("unit {}", u + 1))?;
+                Ok((u, id, unit_runs))
             })
-            .collect();
+            .collect::<Result<Vec<(usize, String, Vec<Run>)>>>()?;
         for (k, shape) in AUTO_SHAPES.into_iter().enumerate() {
             let context = |e: anyhow::Error| {
                 anyhow!(
