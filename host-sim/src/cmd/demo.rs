@@ -64,13 +64,13 @@ pub fn run(args: Args) -> Result<()> {
         .map(|m| m.model_file.as_str())
         .collect();
     let recipes = compare_recipes(
-        // the recommended seek with a few-run unit calibration: time-symmetric
-        // (docs/guide/fleet.md)
+        // the recommended seek with a few-run unit calibration: Thue-Morse
+        // (docs/guide/fleet.md, "What the recipe meets")
         &MonteCarloConfig {
             starts: args.starts,
             ambient_c: 20.0,
-            mode: SeekMode::TwoPositionSymmetric,
-            dwell_s: default_dwell_s(SeekMode::TwoPositionSymmetric),
+            mode: SeekMode::TwoPositionThueMorse,
+            dwell_s: default_dwell_s(SeekMode::TwoPositionThueMorse),
             ..MonteCarloConfig::paper(args.seed)
         },
         &args.out,

@@ -17,7 +17,7 @@ use anyhow::{anyhow, Result};
 use serde::Serialize;
 
 use super::own_model::OwnModelPlan;
-use super::targets::{seek_targets, SeekTargets};
+use super::targets::{seek_targets, verdict_words, SeekTargets, DECIDED_SE};
 use super::unit_recipe::{
     chamber_h, default_unit_spread, learn_recipe_type, seeking_unit_params, type_free_model,
     unit_model, RecipeModel, RecipeType, UnitRecipe, RECIPE_AMBIENTS_C,
@@ -248,17 +248,17 @@ pub fn recipe_table(c: &RecipeComparison) -> String {
             fig(|t| t.all_over_floor),
             fig(|t| t.worst_first_over_floor),
             fig(|t| t.worst_mean_over_std),
-            match &r.targets {
-                Some(t) if t.met => "met",
-                Some(_) => "missed",
-                None => "no seeks",
-            }
-            .to_string(),
+            r.targets
+                .as_ref()
+                .map_or("no seeks", |t| {
+                    verdict_words(t, c.starts, c.seeks_per_start)
+                })
+                .to_string(),
         ]);
     }
     format!(
         "production recipe: unit U1 of a simulated fleet, {} cold starts x {} seeks at {} degC ({}type {}):\n{}\
-         ({} starts: a |mean|/std is known to about +-{:.2}, so a verdict near a target is not decided here; 1,000-start figures over eighty fleets: docs/record/fleet.md)\n",
+         ({} starts: a |mean|/std is known to about +-{:.2}; \"not decided\": a figure within {DECIDED_SE} standard errors of its target; 1,000-start figures over forty fleets: docs/guide/fleet.md)\n",
         c.starts,
         c.seeks_per_start,
         c.ambient_c,

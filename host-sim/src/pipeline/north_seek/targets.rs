@@ -125,19 +125,18 @@ pub fn decided_verdict(figures: &[(f64, f64, f64)]) -> Option<bool> {
     }
 }
 
-/// One line for the seek table: each figure (+- its standard error over `r.starts` cold
-/// starts: a std or rms of n values has about x / sqrt(2n), a mean over its std
-/// 1 / sqrt(n)) against its target, the verdict on the point values, and whether the
-/// Monte Carlo decided it (`decided_verdict`). The errors say how far to trust it: at the
-/// default 30 starts |mean| / std carries +-0.18, so a 0.3 target is not decided by one
-/// run; at 300 starts a seek 1.12x the floor is within 2 standard errors of 1.15x.
-pub fn seek_targets_line(r: &NorthSeekReport) -> String {
-    let Some(t) = seek_targets(r) else {
-        return String::new();
-    };
-    let n = r.starts.max(1) as f64;
-    let all_n = n * r.seeks_per_start.max(1) as f64;
-    let figures = [
+/// The three figures of `t` (all seeks, worst of the first seeks, worst |mean| / std),
+/// each as (value, standard error over `starts` cold starts of `seeks_per_start` seeks,
+/// target): a std or rms of n values has about x / sqrt(2n), a mean over its std
+/// 1 / sqrt(n).
+pub fn figures_with_se(
+    t: &SeekTargets,
+    starts: usize,
+    seeks_per_start: usize,
+) -> [(f64, f64, f64); 3] {
+    let n = starts.max(1) as f64;
+    let all_n = n * seeks_per_start.max(1) as f64;
+    [
         (
             t.all_over_floor,
             t.all_over_floor / (2.0 * all_n).sqrt(),
@@ -149,7 +148,35 @@ pub fn seek_targets_line(r: &NorthSeekReport) -> String {
             FIRST_SEEKS_OVER_FLOOR,
         ),
         (t.worst_mean_over_std, 1.0 / n.sqrt(), MEAN_OVER_STD),
-    ];
+    ]
+}
+
+/// The verdict in a table's words: `met` or `missed` where the Monte Carlo decided it
+/// (`decided_verdict`), else the verdict on the point values and `not decided` (at 30
+/// starts the worst of six |mean| / std reads about 0.3 with no bias at all: the mean of
+/// the largest of six half-normals is 1.65, over sqrt 30).
+pub fn verdict_words(t: &SeekTargets, starts: usize, seeks_per_start: usize) -> &'static str {
+    if t.seeks_without_result > 0 {
+        return "missed";
+    }
+    match decided_verdict(&figures_with_se(t, starts, seeks_per_start)) {
+        Some(true) => "met",
+        Some(false) => "missed",
+        None if t.met => "met, not decided",
+        None => "missed, not decided",
+    }
+}
+
+/// One line for the seek table: each figure (+- its standard error, `figures_with_se`)
+/// against its target, the verdict on the point values, and whether the
+/// Monte Carlo decided it (`decided_verdict`). The errors say how far to trust it: at the
+/// default 30 starts |mean| / std carries +-0.18, so a 0.3 target is not decided by one
+/// run; at 300 starts a seek 1.12x the floor is within 2 standard errors of 1.15x.
+pub fn seek_targets_line(r: &NorthSeekReport) -> String {
+    let Some(t) = seek_targets(r) else {
+        return String::new();
+    };
+    let figures = figures_with_se(&t, r.starts, r.seeks_per_start);
     let ok = |b: bool| if b { "met" } else { "MISSED" };
     let decided = match decided_verdict(&figures) {
         _ if t.seeks_without_result > 0 => format!(
@@ -234,6 +261,31 @@ mod tests {
         let bias = targets_of(FLOOR, &[FLOOR; 6], &mean, FLOOR).unwrap();
         assert_eq!(bias.worst_mean_seek, 5);
         assert!((bias.worst_mean_over_std - 0.35).abs() < 1e-12 && !bias.met);
+    }
+
+    #[test]
+    fn a_table_says_not_decided_where_the_starts_cannot_tell() {
+        let t = |mean_over_std: f64| SeekTargets {
+            all_over_floor: 1.02,
+            worst_first_over_floor: 1.05,
+            worst_first_seek: 1,
+            worst_mean_over_std: mean_over_std,
+            worst_mean_seek: 1,
+            seeks_without_result: 0,
+            met: mean_over_std <= MEAN_OVER_STD,
+        };
+        // the demo's 30 starts: |mean|/std +-0.18, so 0.35 and 0.20 are both open
+        assert_eq!(verdict_words(&t(0.35), 30, 6), "missed, not decided");
+        assert_eq!(verdict_words(&t(0.20), 30, 6), "met, not decided");
+        // 1,000 starts (+-0.032): 0.35 is still open, 0.40 and 0.20 are decided
+        assert_eq!(verdict_words(&t(0.35), 1000, 6), "missed, not decided");
+        assert_eq!(verdict_words(&t(0.40), 1000, 6), "missed");
+        assert_eq!(verdict_words(&t(0.20), 1000, 6), "met");
+        let none = SeekTargets {
+            seeks_without_result: 1,
+            ..t(0.0)
+        };
+        assert_eq!(verdict_words(&none, 1000, 6), "missed");
     }
 
     #[test]
