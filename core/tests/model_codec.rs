@@ -5,7 +5,8 @@ use fog_core::model::cold_start::{ColdStartEnvelope, MAX_COLD_START_POINTS};
 use fog_core::model::crc::crc32;
 use fog_core::model::error::{ModelError, ModelField};
 use fog_core::model::format::{
-    FeatureKind, RbfModel, MAX_CENTERS, MAX_ENCODED_LEN, MODEL_MAGIC, MODEL_VERSION,
+    FeatureKind, FeatureSpec, RbfModel, MAX_CENTERS, MAX_ENCODED_LEN, MODEL_MAGIC, MODEL_VERSION,
+    MODEL_VERSION_BASE,
 };
 use fog_core::model::heading::HeadingHarmonic;
 use fog_core::model::synthetic::warmup_model;
@@ -95,8 +96,35 @@ fn layout_is_postcard_of_the_wire_envelope() {
     let m = warmup_model(35, 2, 2.0, 3);
     assert_eq!(
         encode(&m),
-        encode_loose(&LooseModel::from(&m), MODEL_VERSION)
+        encode_loose(&LooseModel::from(&m), MODEL_VERSION_BASE)
     );
+}
+
+#[test]
+fn a_diffusion_clock_rate_is_written_as_version_7_and_refused_under_an_older_number() {
+    // the paper's inputs with dT/dt read in the diffusion clock: version 7, round trip
+    let mut m = warmup_model(35, 2, 2.0, 3);
+    assert_eq!(m.inputs[1].kind, FeatureKind::TempRateCps);
+    m.inputs[1] = FeatureSpec {
+        kind: FeatureKind::TempRateDiffusionCps,
+        tau_s: 400.0,
+    };
+    assert_eq!((m.format_version(), MODEL_VERSION), (7, 7));
+    let bytes = encode(&m);
+    assert_eq!(bytes[5] as u16, 7, "version byte of {:?}", &bytes[..8]);
+    assert_eq!(RbfModel::decode(&bytes), Ok(m.clone()));
+    // every other model keeps version 6 and its bytes
+    let plain = warmup_model(35, 2, 2.0, 3);
+    assert_eq!(plain.format_version(), MODEL_VERSION_BASE);
+    assert_eq!(encode(&plain)[5] as u16, 6);
+    // the same body under version 6 (no writer makes it): refused, not misread
+    assert_eq!(
+        RbfModel::decode(&encode_version(&m, 6)),
+        Err(ModelError::Malformed)
+    );
+    // its clock needs a time constant
+    m.inputs[1].tau_s = 0.0;
+    assert!(RbfModel::decode(&encode_version(&m, 7)).is_err());
 }
 
 #[test]

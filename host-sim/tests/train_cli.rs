@@ -138,7 +138,7 @@ fn train_writes_a_valid_model_and_rejects_bad_input_without_output() {
     let bytes = std::fs::read(&coupled_path).unwrap();
     assert_eq!(
         bytes[5] as u16,
-        fog_core::model::format::MODEL_VERSION,
+        fog_core::model::format::MODEL_VERSION_BASE,
         "format version byte: {:?}",
         &bytes[..8]
     );

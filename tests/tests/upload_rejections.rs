@@ -110,7 +110,7 @@ fn every_bad_upload_is_refused_with_its_typed_error_and_the_model_stays() {
     let mut v2 = bytes.clone();
     assert_eq!(
         u16::from(v2[5]),
-        fog_core::model::format::MODEL_VERSION,
+        fog_core::model::format::MODEL_VERSION_BASE,
         "version byte"
     );
     v2[5] = (fog_core::model::format::MODEL_VERSION + 1) as u8;

@@ -23,7 +23,7 @@ use crate::model::crc::crc32;
 use crate::model::error::{check_len, ModelError, ModelField};
 use crate::model::format::{
     BodyCounts, RbfModel, WireModel, MAX_CENTERS, MAX_ENCODED_LEN, MAX_INPUTS, MODEL_MAGIC,
-    MODEL_VERSION, MODEL_VERSION_OLDEST,
+    MODEL_VERSION, MODEL_VERSION_BASE, MODEL_VERSION_OLDEST,
 };
 
 impl RbfModel {
@@ -88,6 +88,11 @@ impl RbfModel {
         .map_err(|_| ModelError::Malformed)?;
         let left = de.finalize().map_err(|_| ModelError::Malformed)?;
         let model = &*self;
+        let needs = model.format_version();
+        if needs > MODEL_VERSION_BASE && version < needs {
+            // an input kind newer than the file's version: no writer makes it
+            return Err(ModelError::Malformed);
+        }
         if !left.is_empty() {
             return Err(ModelError::TrailingBytes {
                 count: left.len() as u16,

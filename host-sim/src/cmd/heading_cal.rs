@@ -155,7 +155,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     println!(
         "wrote {} ({len} bytes, model format v{}); sign and install it with `fogsim upload`",
         args.out.display(),
-        fog_core::model::format::MODEL_VERSION
+        model.format_version()
     );
     Ok(())
 }

@@ -56,6 +56,10 @@ pub struct FeatureExtractor {
 
 /// Span used for a rate or accel spec (its `tau_s`, or the default when 0).
 pub fn span_for(spec: &FeatureSpec) -> f64 {
+    // the diffusion-clock rate's `tau_s` is its clock's time constant, not a span
+    if spec.kind == FeatureKind::TempRateDiffusionCps {
+        return DEFAULT_RATE_SPAN_S;
+    }
     let default = match spec.kind {
         FeatureKind::TempAccelCps2 | FeatureKind::TempAccelFlatStartCps2 => DEFAULT_ACCEL_SPAN_S,
         _ => DEFAULT_RATE_SPAN_S,
@@ -100,6 +104,7 @@ fn reset_state(state: &mut FeatureState, spec: &FeatureSpec) -> Result<(), Featu
         // (same T, settled) sits, and a model over several ambients cannot tell them
         // apart (measured: global model, seek 1 at -40 degC 0.0203 -> 0.0276 deg rms).
         FeatureKind::TempRateCps
+        | FeatureKind::TempRateDiffusionCps
         | FeatureKind::TempAccelCps2
         | FeatureKind::TempAccelFlatStartCps2
         | FeatureKind::AuxRate(_) => {
@@ -213,6 +218,9 @@ impl FeatureExtractor {
                 (FeatureKind::TempRateCps, FeatureState::Rate(e)) => {
                     e.push(t_s, temp).map(|r| r.rate_per_s)
                 }
+                (FeatureKind::TempRateDiffusionCps, FeatureState::Rate(e)) => e
+                    .push(t_s, temp)
+                    .and_then(|_| e.diffusion_clock_rate(spec.tau_s as f64)),
                 (
                     FeatureKind::TempAccelCps2 | FeatureKind::TempAccelFlatStartCps2,
                     FeatureState::Rate(e),

@@ -187,6 +187,57 @@ impl<const N: usize> TempRateEstimator<N> {
         })
     }
 
+    /// The rate of a warm-up by diffusion, T = a + b g(t), g(t) = 1 - exp(-sqrt(t / tau_s)),
+    /// t the time since power-on (`FeatureKind::TempRateDiffusionCps`): the least-squares
+    /// slope of the points against g, each point placed at g's mean over its row's window
+    /// [t - w, t] (w the spacing of the last two points: the rows are window means), times
+    /// g's mean rate over the last window, (g(t) - g(t - w)) / w. So the estimate is the
+    /// window-mean dT/dt the drift sees, exact for such a warm-up from the second row on,
+    /// with a line's noise (two parameters); a slope against t lags a rate that falls as
+    /// 1/sqrt(t) and reads it up to 1.7 times high in the first minutes. None with fewer than
+    /// two points, a non-positive `tau_s` or spacing, or points that do not spread g.
+    pub fn diffusion_clock_rate(&self, tau_s: f64) -> Option<f64> {
+        let n = self.points.len();
+        if n < 2 || !(tau_s > 0.0 && tau_s.is_finite()) {
+            return None;
+        }
+        let (t_prev, _) = *self.points.get(n - 2)?;
+        let (t_last, _) = *self.points.back()?;
+        let w = t_last - t_prev;
+        if w.is_nan() || w <= 0.0 {
+            return None;
+        }
+        let g = |t: f64| 1.0 - libm::exp(-libm::sqrt(t.max(0.0) / tau_s));
+        // mean of g over [a, b]: with u = sqrt(t / tau), the integral of exp(-u) dt is
+        // -2 tau (u + 1) exp(-u)
+        let g_mean = |b: f64| {
+            let a = (b - w).max(0.0);
+            let (ua, ub) = (libm::sqrt(a / tau_s), libm::sqrt(b.max(0.0) / tau_s));
+            let width = b - a;
+            if width <= 0.0 {
+                return g(b);
+            }
+            1.0 - 2.0 * tau_s * ((ua + 1.0) * libm::exp(-ua) - (ub + 1.0) * libm::exp(-ub)) / width
+        };
+        let nf = n as f64;
+        let (mut sx, mut sy) = (0.0, 0.0);
+        for &(t, y) in self.points.iter() {
+            sx += g_mean(t);
+            sy += y;
+        }
+        let (xm, ym) = (sx / nf, sy / nf);
+        let (mut sxx, mut sxy) = (0.0, 0.0);
+        for &(t, y) in self.points.iter() {
+            let xc = g_mean(t) - xm;
+            sxx += xc * xc;
+            sxy += xc * (y - ym);
+        }
+        if sxx.is_nan() || sxx <= 0.0 {
+            return None;
+        }
+        Some(sxy / sxx * (g(t_last) - g(t_last - w)) / w)
+    }
+
     /// How many points the flat extension of `new_flat_start` adds for points spanning
     /// `t0_s..=t1_s` (the first reading repeated back at the first spacing while inside the
     /// span, at most `N` minus the points held), and that spacing, s. None once the first
@@ -215,6 +266,74 @@ impl<const N: usize> TempRateEstimator<N> {
 mod tests {
     use super::*;
     use crate::compensation::features::EXTRACTOR_RATE_POINTS;
+
+    /// Window means of T = a + R (1 - exp(-sqrt(t / tau))) over 10 s rows, exactly (the
+    /// closed-form mean of the law), and the exact window-mean rate of the last row.
+    fn diffusion_rows(tau_s: f64, rise_c: f64, rows: usize) -> (f64, [(f64, f64); 40]) {
+        let g_int = |t: f64| {
+            let u = libm::sqrt(t / tau_s);
+            t + 2.0 * tau_s * (u + 1.0) * libm::exp(-u)
+        };
+        let law = |t: f64| -5.0 + rise_c * (1.0 - libm::exp(-libm::sqrt(t / tau_s)));
+        let mut out = [(0.0, 0.0); 40];
+        for (k, row) in out.iter_mut().enumerate().take(rows) {
+            let (a, b) = (10.0 * k as f64, 10.0 * (k + 1) as f64);
+            *row = (b, -5.0 + rise_c * (g_int(b) - g_int(a)) / 10.0);
+        }
+        let t = 10.0 * rows as f64;
+        ((law(t) - law(t - 10.0)) / 10.0, out)
+    }
+
+    #[test]
+    fn the_diffusion_clock_rate_is_exact_on_its_law_and_a_slope_is_not() {
+        for rows in [2usize, 3, 6, 12, 30] {
+            let (want, pts) = diffusion_rows(400.0, 11.2, rows);
+            let mut clock = TempRateEstimator::<EXTRACTOR_RATE_POINTS>::new(60.0).unwrap();
+            let mut slope = TempRateEstimator::<EXTRACTOR_RATE_POINTS>::new(60.0).unwrap();
+            let mut got_slope = 0.0;
+            for &(t, y) in &pts[..rows] {
+                clock.push(t, y);
+                got_slope = slope
+                    .push(t, y)
+                    .unwrap_or(RateEstimate {
+                        rate_per_s: 0.0,
+                        accel_per_s2: None,
+                        n_points: 0,
+                        covered_s: 0.0,
+                        full: false,
+                    })
+                    .rate_per_s;
+            }
+            let got = clock.diffusion_clock_rate(400.0).unwrap();
+            assert!(
+                (got / want - 1.0).abs() < 1e-9,
+                "{rows} rows: {got} vs {want}"
+            );
+            if rows <= 12 {
+                // the slope against t lags the 1/sqrt(t) rate: 20 % high or more here
+                assert!(
+                    got_slope / want > 1.2,
+                    "{rows} rows: slope {got_slope} vs {want}"
+                );
+            }
+        }
+        // the twin: on a line in t (a warm-up whose rate is bounded) the clock is wrong
+        // and the slope exact, so which one a model uses is the data's choice
+        let mut clock = TempRateEstimator::<EXTRACTOR_RATE_POINTS>::new(60.0).unwrap();
+        for k in 1..=12 {
+            clock.push(10.0 * k as f64, 0.01 * 10.0 * k as f64);
+        }
+        let got = clock.diffusion_clock_rate(400.0).unwrap();
+        assert!((got / 0.01 - 1.0).abs() > 0.1, "clock on a line: {got}");
+        // the null twin: a flat series reads 0; one point, a bad tau: None
+        let mut flat = TempRateEstimator::<EXTRACTOR_RATE_POINTS>::new(60.0).unwrap();
+        assert_eq!(flat.push(10.0, 3.0).map(|r| r.n_points), None);
+        assert_eq!(flat.diffusion_clock_rate(400.0), None);
+        flat.push(20.0, 3.0);
+        assert_eq!(flat.diffusion_clock_rate(400.0), Some(0.0));
+        assert_eq!(flat.diffusion_clock_rate(0.0), None);
+        assert_eq!(flat.diffusion_clock_rate(f64::NAN), None);
+    }
 
     /// `restart` in place equals a new estimator, whatever the old one held: a flat-start
     /// estimator with points must forget its first reading and spacing (else the flat

@@ -28,6 +28,21 @@ pub(crate) struct WireModel<'a> {
 }
 
 impl RbfModel {
+    /// The format version this model is written as: 7 when an input is the diffusion-clock
+    /// rate (a version-6 reader refuses the file by its version, never by misreading it),
+    /// else `MODEL_VERSION_BASE`, so every other model keeps its bytes.
+    pub fn format_version(&self) -> u16 {
+        if self
+            .inputs
+            .iter()
+            .any(|s| s.kind == crate::model::format::FeatureKind::TempRateDiffusionCps)
+        {
+            MODEL_VERSION
+        } else {
+            super::limits::MODEL_VERSION_BASE
+        }
+    }
+
     /// Validate and encode into `buf`; returns the number of bytes written.
     ///
     /// Layout: postcard of `(magic: u32, version: u16, body: bytes, crc32: u32)` where body is
@@ -65,7 +80,7 @@ impl RbfModel {
         // body slice and drop the trailing zero length byte, then write the real length.
         let mut head = [0u8; HEADER_RESERVE + 8];
         let head_len = {
-            let fixed = postcard::to_slice(&(MODEL_MAGIC, MODEL_VERSION), &mut head)
+            let fixed = postcard::to_slice(&(MODEL_MAGIC, self.format_version()), &mut head)
                 .map_err(|_| ModelError::Malformed)?
                 .len();
             let len_varint = postcard::to_slice(&(body_len as u32), &mut head[fixed..])

@@ -43,6 +43,16 @@ pub enum FeatureKind {
     /// clock can (docs/record/fleet.md). Appended last: existing model files keep their
     /// meaning.
     PowerOnDecayStretch,
+    /// dT/dt, degC/s, read in the clock of a warm-up by diffusion, g(t) = 1 - exp(-sqrt(t /
+    /// tau_s)) (a thick coil heated from one face: T - T_a = R g(t), whose rate is unbounded
+    /// at power-on, 1/sqrt(t)): the 60 s least-squares slope of the temperature against g,
+    /// times g's mean rate over the last window (`TempRateEstimator::diffusion_clock_rate`).
+    /// Exact for such a warm-up at every row from the second, where a slope against t
+    /// reads up to 1.7 times the rate in the first minutes. `tau_s` is the type's, chosen
+    /// from its runs' temperatures (host `train::warmup_clock`). Appended last: existing
+    /// model files keep their meaning (a reader built before it refuses such a model at
+    /// decode).
+    TempRateDiffusionCps,
 }
 
 /// One model input: its kind and, for lags and decays, a time constant (s; 0 otherwise).
@@ -82,7 +92,10 @@ impl FeatureKind {
     pub const fn needs_time_constant(self) -> bool {
         matches!(
             self,
-            FeatureKind::TempLagC | FeatureKind::PowerOnDecay | FeatureKind::PowerOnDecayStretch
+            FeatureKind::TempLagC
+                | FeatureKind::PowerOnDecay
+                | FeatureKind::PowerOnDecayStretch
+                | FeatureKind::TempRateDiffusionCps
         )
     }
 
@@ -98,6 +111,7 @@ impl FeatureKind {
                 | FeatureKind::TempRiseC
                 | FeatureKind::TempLagC
                 | FeatureKind::TempAccelFlatStartCps2
+                | FeatureKind::TempRateDiffusionCps
         )
     }
 }

@@ -13,9 +13,14 @@ pub const MAX_INPUTS: usize = 6;
 pub const MAX_RBF_INPUTS: usize = 4;
 /// Magic at the start of every encoded model: "FOGM".
 pub const MODEL_MAGIC: u32 = 0x4D47_4F46;
-/// Current format version (6: up to `MAX_INPUTS` = 6 inputs and the warm-up clock's
-/// stretch `FeatureKind::PowerOnDecayStretch`, the wire layout of version 5).
-pub const MODEL_VERSION: u16 = 6;
+/// Newest format version read (7: the wire layout of version 5 with the diffusion-clock
+/// rate `FeatureKind::TempRateDiffusionCps`; 6: up to `MAX_INPUTS` = 6 inputs and the
+/// warm-up clock's stretch `FeatureKind::PowerOnDecayStretch`, the same layout). A model is
+/// written as the oldest version that holds it (`RbfModel::format_version`).
+pub const MODEL_VERSION: u16 = 7;
+/// The version a model without a version-7 input kind is written as: its bytes are those
+/// of every earlier release.
+pub const MODEL_VERSION_BASE: u16 = 6;
 /// Oldest format version still decoded (1: no polynomial base).
 pub const MODEL_VERSION_OLDEST: u16 = 1;
 /// Highest power of the polynomial base in the first input.

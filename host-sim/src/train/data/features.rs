@@ -19,6 +19,9 @@ pub fn feature_name(spec: &FeatureSpec) -> String {
     match spec.kind {
         FeatureKind::TempC => "temp_c:value".into(),
         FeatureKind::TempRateCps => "temp_c:rate".into(),
+        FeatureKind::TempRateDiffusionCps => {
+            feature_label("temp_c", "rate_diffusion", Some(f64::from(spec.tau_s))).to_string()
+        }
         FeatureKind::TempAccelCps2 => "temp_c:accel".into(),
         FeatureKind::TempAccelFlatStartCps2 => "temp_c:accel_flat_start".into(),
         FeatureKind::TempRiseC => "temp_c:rise".into(),

@@ -28,6 +28,7 @@ fn candidate_terms(model: &RbfModel) -> Vec<(usize, usize)> {
             let kind = match s.kind {
                 FeatureKind::TempC => 0,
                 FeatureKind::TempRateCps if s.tau_s == 0.0 => 1,
+                FeatureKind::TempRateDiffusionCps => 1,
                 _ => return None,
             };
             Some((j, kind))

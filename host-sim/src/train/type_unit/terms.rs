@@ -103,7 +103,9 @@ pub fn term_name(model: &RbfModel, term: UnitTerm) -> String {
         UnitTerm::Gain => "warm-up gain".into(),
         UnitTerm::Linear(j) => match model.inputs.get(j).map(|s| s.kind) {
             Some(FeatureKind::TempC) => "temperature coefficient".into(),
-            Some(FeatureKind::TempRateCps) => "Shupe coefficient".into(),
+            Some(FeatureKind::TempRateCps | FeatureKind::TempRateDiffusionCps) => {
+                "Shupe coefficient".into()
+            }
             Some(FeatureKind::TempAccelCps2 | FeatureKind::TempAccelFlatStartCps2) => {
                 "gradient (d2T/dt2) coefficient".into()
             }
@@ -137,7 +139,9 @@ pub fn raw_coefficient(model: &RbfModel, term: UnitTerm, coef: f64) -> (f64, &'s
                 Some(FeatureKind::TempC | FeatureKind::TempRiseC | FeatureKind::TempLagC) => {
                     "deg/h per degC"
                 }
-                Some(FeatureKind::TempRateCps) => "deg/h per degC/s",
+                Some(FeatureKind::TempRateCps | FeatureKind::TempRateDiffusionCps) => {
+                    "deg/h per degC/s"
+                }
                 Some(FeatureKind::TempAccelCps2 | FeatureKind::TempAccelFlatStartCps2) => {
                     "deg/h per degC/s^2"
                 }
