@@ -63,4 +63,5 @@ mod train_scale;
 mod train_seek_criterion;
 mod train_type;
 mod train_validation;
+mod train_warmup_clock;
 mod workflow;

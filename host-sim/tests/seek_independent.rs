@@ -47,7 +47,10 @@ use fog_sim::train::type_unit::{
     calibrate_unit, choose_own, resolve_shape, OwnChoice, ShapeChoice, ShapeScoring, SharedShape,
     TypeModel, TypeShape, UnitPlan,
 };
-use fog_sim::train::{dataset_from_runs, default_specs, train_model, InputChoice, TrainConfig};
+use fog_sim::train::warmup_clock::RateClock;
+use fog_sim::train::{
+    dataset_from_runs, default_specs, feature_name, train_model, InputChoice, TrainConfig,
+};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::time::Instant;
@@ -235,6 +238,7 @@ fn learn_independent_type(
     let cfg = TrainConfig {
         gyro_id: "independent".into(),
         criterion,
+        rate_clock: rate_clock(),
         ..TrainConfig::default()
     };
     let candidates = InputChoice::Auto.candidates();
@@ -249,6 +253,16 @@ fn learn_independent_type(
         .learn_type(shared, runs, Some("independent"))
         .unwrap();
     (ty, shared, choice)
+}
+
+/// How the type's network reads dT/dt (`INDEP_RATE_CLOCK=auto|slope`, default slope, as
+/// `train --rate-clock`).
+fn rate_clock() -> RateClock {
+    match std::env::var("INDEP_RATE_CLOCK").as_deref() {
+        Ok("auto") => RateClock::Auto,
+        Ok("slope") | Err(_) => RateClock::Slope,
+        Ok(other) => panic!("INDEP_RATE_CLOCK: unknown clock {other}"),
+    }
 }
 
 /// Shapes measured (`INDEP_SHAPES`, default `law,auto`).
@@ -413,8 +427,9 @@ fn measure(law: FleetLaw, shape: TypeShape, seed: u64, starts: usize) -> Measure
             continue;
         }
         println!(
-            "{law:?} seed {seed}, {shape:?} type, {}: {} unit terms, prior weight {}; type terms: {}; {}",
+            "{law:?} seed {seed}, {shape:?} type, {}: inputs {}; {} unit terms, prior weight {}; type terms: {}; {}",
             sequence_name(mode),
+            ty.model.inputs.iter().map(feature_name).collect::<Vec<_>>().join(", "),
             cal.terms,
             cal.prior_weight,
             ty.file.terms.iter().map(|t| t.name.as_str()).collect::<Vec<_>>().join(", "),

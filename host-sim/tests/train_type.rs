@@ -1151,3 +1151,82 @@ fn the_type_reads_the_simulators_own_unit_spread() {
         );
     }
 }
+
+/// `--rate-clock auto`: a type whose runs warm up by diffusion (the independent fleet) reads
+/// the network's dT/dt in that clock, says so, and writes model format 7; the unit
+/// calibrated against it is an ordinary model of the same inputs. Without the flag the
+/// slope stays (format 6, no such line). The flag without `--type-out` is refused in one
+/// line, nothing written.
+#[test]
+fn the_cli_reads_dt_dt_in_the_clock_a_type_chooses_when_asked() {
+    let dir = app_support::scratch_dir("type-clock");
+    write_independent(&dir, FleetLaw::Type, 5, 1);
+    let type_runs = indep_files(&dir, &[1, 2, 3, 4]);
+    let shape = ["--type-shape", "network"];
+    let auto = fogsim_ok(
+        &dir,
+        &train_args(
+            &type_runs,
+            &[
+                &shape[..],
+                &[
+                    "--type-out",
+                    "type.json",
+                    "--out",
+                    "shared.model",
+                    "--rate-clock",
+                    "auto",
+                ],
+            ]
+            .concat(),
+        ),
+    );
+    let said: Vec<&str> = auto
+        .lines()
+        .filter(|l| l.starts_with("dT/dt read as"))
+        .collect();
+    assert_eq!(said.len(), 1, "{auto}");
+    assert!(
+        said[0].starts_with("dT/dt read as the diffusion clock ("),
+        "{}",
+        said[0]
+    );
+    let bytes = std::fs::read(dir.join("shared.model")).unwrap();
+    assert_eq!(bytes[5], 7, "format version byte: {:?}", &bytes[..8]);
+    let m = read_model(&dir.join("shared.model")).unwrap();
+    assert!(m
+        .inputs
+        .iter()
+        .any(|s| s.kind == fog_core::model::format::FeatureKind::TempRateDiffusionCps));
+    // the unit step against it: an ordinary model with the type's inputs
+    let unit = unit_runs_cmd(&dir, &indep_files(&dir, &[5]), &["--out", "u5.model"]);
+    assert!(unit.status.success(), "{}", app_support::stderr(&unit));
+    assert_eq!(read_model(&dir.join("u5.model")).unwrap().inputs, m.inputs);
+
+    let slope = fogsim_ok(
+        &dir,
+        &train_args(
+            &type_runs,
+            &[
+                &shape[..],
+                &["--type-out", "type-s.json", "--out", "shared-s.model"],
+            ]
+            .concat(),
+        ),
+    );
+    assert!(!slope.contains("dT/dt read as"), "{slope}");
+    assert_eq!(std::fs::read(dir.join("shared-s.model")).unwrap()[5], 6);
+
+    let refused = fogsim(
+        &dir,
+        &train_args(
+            &type_runs,
+            &["--out", "alone.model", "--rate-clock", "auto"],
+        ),
+    );
+    let err = app_support::stderr(&refused);
+    assert!(!refused.status.success());
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("--rate-clock: needs --type-out"), "{err}");
+    assert!(!dir.join("alone.model").exists());
+}

@@ -383,13 +383,26 @@ fn row_keys(ds: &Dataset) -> Vec<(&str, u64)> {
         .collect()
 }
 
-/// Each set's dataset on `runs`, its inputs followed by `extra`.
-fn datasets_of(runs: &[Run], sets: &[InputSet], extra: &[FeatureSpec]) -> Result<Vec<Dataset>> {
+/// Each set's dataset on `runs`, its inputs followed by `extra`, its dT/dt read as `rate`
+/// (`TrainConfig::rate_input`).
+fn datasets_of(
+    runs: &[Run],
+    sets: &[InputSet],
+    extra: &[FeatureSpec],
+    rate: FeatureSpec,
+) -> Result<Vec<Dataset>> {
     sets.iter()
         .map(|set| {
             let specs: Vec<FeatureSpec> = set
                 .specs()
                 .into_iter()
+                .map(|s| {
+                    if s == FeatureSpec::plain(FeatureKind::TempRateCps) {
+                        rate
+                    } else {
+                        s
+                    }
+                })
                 .chain(extra.iter().copied())
                 .collect();
             dataset_from_runs(runs, &specs)
@@ -475,7 +488,7 @@ pub fn choose_inputs(
     inputs_criterion: &dyn InputCriterion,
     estimator_criterion: &dyn InputCriterion,
 ) -> Result<(InputSelection, Dataset)> {
-    let mut full = datasets_of(runs, candidates, &[])?;
+    let mut full = datasets_of(runs, candidates, &[], cfg.rate_input)?;
     if candidates.len() < 2 {
         let chosen = *candidates.first().ok_or(TrainError::EmptyDataset)?;
         return Ok((
@@ -538,7 +551,7 @@ pub fn choose_in_order_with(
     cfg: &TrainConfig,
     criterion: &dyn InputCriterion,
 ) -> Result<(InputSet, Vec<InputSetScore>)> {
-    let common = common_rows(&datasets_of(runs, order, extra)?);
+    let common = common_rows(&datasets_of(runs, order, extra, cfg.rate_input)?);
     let all: Vec<usize> = (0..order.len()).collect();
     let (best, scores) = choose_in_order(&all, order, &common, cfg, criterion)?;
     Ok((order[best], scores))

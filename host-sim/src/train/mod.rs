@@ -22,6 +22,7 @@ mod inputs;
 pub mod seek_refit;
 pub mod seek_score;
 pub mod type_unit;
+pub mod warmup_clock;
 
 pub use data::dataset::Dataset;
 pub use data::features::{

@@ -174,6 +174,12 @@ pub struct Args {
     /// that scores the type's shape [default: 280, `north-seek`'s seeks].
     #[arg(long = "seek-period-s")]
     pub seek_period_s: Option<f64>,
+    /// With `--type-out`: read the network's dT/dt in the clock the type's runs choose
+    /// (`auto`: the 60 s slope against time, or against a diffusion clock 1 - exp(-sqrt(t /
+    /// tau)) where the runs warm up so; model format 7) or always as the `slope`
+    /// [default: slope].
+    #[arg(long = "rate-clock", value_enum, default_value_t)]
+    pub rate_clock: crate::train::warmup_clock::RateClock,
 }
 
 fn parse_width_search(s: &str) -> Result<WidthSearch, String> {
@@ -275,6 +281,7 @@ impl Args {
             linear_on_rbf_inputs: self.linear_inputs,
             linear_by_t: self.linear_by_t,
             gyro_id: self.gyro_id.clone(),
+            rate_clock: self.rate_clock,
             ..TrainConfig::default()
         })
     }

@@ -108,6 +108,13 @@ fn inputs(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
             "--seek-period-s: needs --type TYPE (a unit calibration) or --type-out (the unit step that scores the type's shape)"
         );
     }
+    if args.rate_clock != crate::train::warmup_clock::RateClock::default()
+        && args.type_out.is_none()
+    {
+        anyhow::bail!(
+            "--rate-clock: needs --type-out (it chooses the clock from a type's runs; a unit calibrated with --type reads its type's)"
+        );
+    }
     Ok(inputs)
 }
 

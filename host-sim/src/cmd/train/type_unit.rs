@@ -79,18 +79,30 @@ pub(super) fn learn(
     if let Some(c) = &choice {
         print!("{}", c.summary());
     }
-    // what the law's clock choices said of their grid, once each whatever the rounds
+    // what the law's clock choices said of their grid, once each whatever the rounds; and
+    // the clock the network's dT/dt is read in (`warmup_clock`: the runs decide it, the
+    // same in every round)
     let mut edges: Vec<String> = Vec::new();
+    let mut rate_clock: Option<String> = None;
     let mut train = |runs: Vec<Run>| -> Result<RbfModel> {
         let shared = train_shared(shape, &runs, cfg, candidates)?;
-        if let SharedModel::Law(law) = &shared {
-            if let Some(e) = law.grid_edge().filter(|e| !edges.contains(e)) {
-                edges.push(e);
+        match &shared {
+            SharedModel::Law(law) => {
+                if let Some(e) = law.grid_edge().filter(|e| !edges.contains(e)) {
+                    edges.push(e);
+                }
             }
+            SharedModel::Network {
+                clock: Some(clock), ..
+            } => rate_clock = Some(clock.describe()),
+            SharedModel::Network { .. } => {}
         }
         Ok(shared.model().clone())
     };
     let ty = learn_type(runs, None, args.unit_fit, &mut train)?;
+    if let Some(c) = &rate_clock {
+        println!("{c}");
+    }
     for e in &edges {
         eprintln!("fogsim train: warning: {e}");
     }

@@ -69,6 +69,13 @@ pub struct TrainConfig {
     pub threads: Option<usize>,
     /// Which held-out score chooses the width and polynomial degree.
     pub criterion: crate::train::seek_score::Criterion,
+    /// The dT/dt input every input set reads (`train::warmup_clock`): the slope against
+    /// time by default, the diffusion clock where a type's runs choose it.
+    pub rate_input: fog_core::model::format::FeatureSpec,
+    /// Whether a type's network reads dT/dt in a clock its runs choose
+    /// (`--rate-clock auto`) or always as the slope (the default until the tests whose
+    /// premise it changes are rewritten: docs/record/fleet.md).
+    pub rate_clock: crate::train::warmup_clock::RateClock,
 }
 
 impl Default for TrainConfig {
@@ -91,6 +98,10 @@ impl Default for TrainConfig {
             gyro_id: String::from("sim"),
             threads: None,
             criterion: crate::train::seek_score::Criterion::training_default(),
+            rate_input: fog_core::model::format::FeatureSpec::plain(
+                fog_core::model::format::FeatureKind::TempRateCps,
+            ),
+            rate_clock: crate::train::warmup_clock::RateClock::default(),
         }
     }
 }

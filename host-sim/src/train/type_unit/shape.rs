@@ -32,6 +32,7 @@ use super::type_model::{check_type_runs, learn_type, TypeModel, MIN_TYPE_UNITS};
 use crate::io::runs::Run;
 use crate::train::cold_start::envelope_for;
 use crate::train::seek_score::seek_azimuth_first_pairs_per_run;
+use crate::train::warmup_clock::{warmup_clock_for, ClockChoice};
 use crate::train::{choose_inputs_default, train_model, InputSelection, InputSet, TrainConfig};
 
 /// The form of a type's shared model asked for (`--type-shape`).
@@ -86,6 +87,8 @@ pub enum SharedModel {
         selection: Box<InputSelection>,
         centres: usize,
         inputs: Vec<String>,
+        /// The clock its dT/dt is read in, and why (None: the slope, not chosen).
+        clock: Option<Box<ClockChoice>>,
     },
     Law(LawNetwork),
 }
@@ -105,10 +108,14 @@ impl SharedModel {
                 selection,
                 centres,
                 inputs,
+                clock,
                 ..
             } => format!(
-                "shared model: the network ({centres} centres, inputs {}):\n{}",
+                "shared model: the network ({centres} centres, inputs {}):\n{}{}",
                 inputs.join(", "),
+                clock
+                    .as_ref()
+                    .map_or(String::new(), |c| format!("  {}\n", c.describe())),
                 selection.summary(),
             ),
             Self::Law(law) => format!(
@@ -138,14 +145,14 @@ pub fn train_shared(
             &cfg.gyro_id,
         )?)),
         SharedShape::Network | SharedShape::NetworkLinear => {
-            let linear = TrainConfig {
-                linear_on_rbf_inputs: true,
+            // the dT/dt input in the clock the runs' warm-up follows (`warmup_clock`),
+            // where `--rate-clock auto` asks for it
+            let clock = warmup_clock_for(runs, cfg.rate_clock);
+            let cfg = &TrainConfig {
+                linear_on_rbf_inputs: cfg.linear_on_rbf_inputs
+                    || shape == SharedShape::NetworkLinear,
+                rate_input: clock.as_ref().map_or(cfg.rate_input, |c| c.rate_input),
                 ..cfg.clone()
-            };
-            let cfg = if shape == SharedShape::NetworkLinear {
-                &linear
-            } else {
-                cfg
             };
             let (selection, ds) = choose_inputs_default(runs, candidates, cfg)?;
             let trained = train_model(&ds, cfg)?;
@@ -156,6 +163,7 @@ pub fn train_shared(
                 selection: Box::new(selection),
                 centres: trained.report.n_centers,
                 inputs: trained.report.inputs,
+                clock: clock.map(Box::new),
             })
         }
     }

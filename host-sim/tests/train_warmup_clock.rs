@@ -1,0 +1,57 @@
+//! The warm-up clock of a type's dT/dt input (`train::warmup_clock`), chosen from the runs'
+//! own temperatures, on data the choice was not written on: the simulator's fleet (two
+//! thermal modes behind a lagging sensor: the slope stays, so every simulated figure
+//! stands), the independent fleet (a coil heated by diffusion: its clock, at about its
+//! type's time constant), the same independent units as 1 Hz logger rows, and the
+//! independent null twin (units identical: the same law, the same clock).
+
+use crate::common::fleet_independent::{cold_start_rows, fleet, FleetLaw};
+use fog_core::model::format::{FeatureKind, FeatureSpec};
+use fog_sim::io::runs::Run;
+use fog_sim::pipeline::campaign::CampaignSpec;
+use fog_sim::pipeline::fleet::{simulate_fleet, FleetType};
+use fog_sim::sim::unit_spread::TypeSpread;
+use fog_sim::train::warmup_clock::choose_warmup_clock;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+const AMBIENTS_C: [f64; 3] = [-40.0, 20.0, 60.0];
+
+#[test]
+fn the_simulators_fleet_keeps_the_slope_and_the_independent_one_takes_its_diffusion_clock() {
+    let sim_type = FleetType::paper(TypeSpread::default_spread(), "default", 81);
+    let plan = CampaignSpec {
+        ambients_c: AMBIENTS_C.to_vec(),
+        runs_per_ambient: 1,
+        ..CampaignSpec::paper(81)
+    };
+    let sim: Vec<Run> = simulate_fleet(&sim_type, 3, &plan, None)
+        .unwrap()
+        .into_iter()
+        .map(|c| c.run)
+        .collect();
+    let c = choose_warmup_clock(&sim);
+    println!("simulator: {}", c.describe());
+    assert_eq!(c.rate_input, FeatureSpec::plain(FeatureKind::TempRateCps));
+    assert!(c.exponential.1 < c.diffusion.1, "{}", c.describe());
+
+    for law in [FleetLaw::Type, FleetLaw::Identical] {
+        let f = fleet(law, 3, &AMBIENTS_C, 1, 45, 1);
+        let c = choose_warmup_clock(&f.runs);
+        println!("independent {law:?}: {}", c.describe());
+        assert_eq!(c.rate_input.kind, FeatureKind::TempRateDiffusionCps);
+        let tau = c.rate_input.tau_s as f64;
+        assert!((340.0..470.0).contains(&tau), "{law:?}: {}", c.describe());
+    }
+
+    // 1 Hz rows of the same law: the same choice (each row its own one-second window)
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let truth = fleet(FleetLaw::Type, 1, &AMBIENTS_C, 1, 1, 1).units[0];
+    let rows: Vec<Run> = AMBIENTS_C
+        .iter()
+        .map(|&a| cold_start_rows(&truth, a, 45, &mut rng, 1))
+        .collect();
+    let c = choose_warmup_clock(&rows);
+    println!("independent, 1 Hz rows: {}", c.describe());
+    assert_eq!(c.rate_input.kind, FeatureKind::TempRateDiffusionCps);
+}
