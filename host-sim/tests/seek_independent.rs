@@ -256,7 +256,7 @@ fn learn_independent_type(
 }
 
 /// How the type's network reads dT/dt (`INDEP_RATE_CLOCK=auto|slope`, default slope, as
-/// `train --rate-clock`).
+/// `train --warmup-clock`).
 fn rate_clock() -> RateClock {
     match std::env::var("INDEP_RATE_CLOCK").as_deref() {
         Ok("auto") => RateClock::Auto,

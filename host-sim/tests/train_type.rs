@@ -1152,7 +1152,7 @@ fn the_type_reads_the_simulators_own_unit_spread() {
     }
 }
 
-/// `--rate-clock auto`: a type whose runs warm up by diffusion (the independent fleet) reads
+/// `--warmup-clock auto`: a type whose runs warm up by diffusion (the independent fleet) reads
 /// the network's dT/dt in that clock, says so, and writes model format 7; the unit
 /// calibrated against it is an ordinary model of the same inputs. Without the flag the
 /// slope stays (format 6, no such line). The flag without `--type-out` is refused in one
@@ -1174,7 +1174,7 @@ fn the_cli_reads_dt_dt_in_the_clock_a_type_chooses_when_asked() {
                     "type.json",
                     "--out",
                     "shared.model",
-                    "--rate-clock",
+                    "--warmup-clock",
                     "auto",
                 ],
             ]
@@ -1221,12 +1221,12 @@ fn the_cli_reads_dt_dt_in_the_clock_a_type_chooses_when_asked() {
         &dir,
         &train_args(
             &type_runs,
-            &["--out", "alone.model", "--rate-clock", "auto"],
+            &["--out", "alone.model", "--warmup-clock", "auto"],
         ),
     );
     let err = app_support::stderr(&refused);
     assert!(!refused.status.success());
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
-    assert!(err.contains("--rate-clock: needs --type-out"), "{err}");
+    assert!(err.contains("--warmup-clock: needs --type-out"), "{err}");
     assert!(!dir.join("alone.model").exists());
 }

@@ -40,7 +40,7 @@ fn tau_grid_s() -> impl Iterator<Item = f64> {
 /// Ratio of neighbouring time constants of the first grid (250^(1/39), about 1.15).
 const TAU_GRID_STEP: f64 = 1.152_088;
 
-/// How a type's network reads dT/dt (`train --rate-clock`).
+/// How a type's network reads dT/dt (`train --warmup-clock`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum RateClock {

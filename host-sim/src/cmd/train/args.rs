@@ -176,9 +176,8 @@ pub struct Args {
     pub seek_period_s: Option<f64>,
     /// With `--type-out`: read the network's dT/dt in the clock the type's runs choose
     /// (`auto`: the 60 s slope against time, or against a diffusion clock 1 - exp(-sqrt(t /
-    /// tau)) where the runs warm up so; model format 7) or always as the `slope`
-    /// [default: slope].
-    #[arg(long = "rate-clock", value_enum, default_value_t)]
+    /// tau)) where the runs warm up so; model format 7) or always as the `slope`.
+    #[arg(long = "warmup-clock", value_enum, default_value_t)]
     pub rate_clock: crate::train::warmup_clock::RateClock,
 }
 

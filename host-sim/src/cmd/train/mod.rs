@@ -112,7 +112,7 @@ fn inputs(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
         && args.type_out.is_none()
     {
         anyhow::bail!(
-            "--rate-clock: needs --type-out (it chooses the clock from a type's runs; a unit calibrated with --type reads its type's)"
+            "--warmup-clock: needs --type-out (it chooses the clock from a type's runs; a unit calibrated with --type reads its type's)"
         );
     }
     Ok(inputs)

@@ -73,7 +73,7 @@ pub struct TrainConfig {
     /// time by default, the diffusion clock where a type's runs choose it.
     pub rate_input: fog_core::model::format::FeatureSpec,
     /// Whether a type's network reads dT/dt in a clock its runs choose
-    /// (`--rate-clock auto`) or always as the slope (the default until the tests whose
+    /// (`--warmup-clock auto`) or always as the slope (the default until the tests whose
     /// premise it changes are rewritten: docs/record/fleet.md).
     pub rate_clock: crate::train::warmup_clock::RateClock,
 }

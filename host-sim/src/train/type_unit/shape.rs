@@ -146,7 +146,7 @@ pub fn train_shared(
         )?)),
         SharedShape::Network | SharedShape::NetworkLinear => {
             // the dT/dt input in the clock the runs' warm-up follows (`warmup_clock`),
-            // where `--rate-clock auto` asks for it
+            // where `--warmup-clock auto` asks for it
             let clock = warmup_clock_for(runs, cfg.rate_clock);
             let cfg = &TrainConfig {
                 linear_on_rbf_inputs: cfg.linear_on_rbf_inputs
