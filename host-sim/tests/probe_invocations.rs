@@ -85,6 +85,7 @@ const NAME_FLAGS: &[&str] = &[
     "--method",
     "--criterion",
     "--inputs",
+    "--warmup-clock",
     "--qualification-inputs",
     "--preset",
     "--axis",
