@@ -914,6 +914,16 @@ fn bad_unit_calibration_inputs_fail_with_one_line_and_write_nothing() {
         .concat(),
         "--unit-runs 2: --type-units 0 trains the unit on its own runs alone",
     );
+    // the clock is the type's network's: no type, no clock to choose
+    check_refused(
+        &dir,
+        &[
+            &["north-seek", "--type-units", "0", "--warmup-clock", "auto"],
+            &seek[..],
+        ]
+        .concat(),
+        "--warmup-clock auto: --type-units 0 calibrates no unit against a type",
+    );
     // the faults, not the rest, made them fail: U4 is calibrated without them
     let u4 = indep_files(&dir, &[4]);
     let good: Vec<&str> = cal.split_whitespace().collect();
@@ -921,7 +931,7 @@ fn bad_unit_calibration_inputs_fail_with_one_line_and_write_nothing() {
     assert!(dir.join("out.model").exists());
     println!(
         "{} bad invocations: {:.1} s",
-        cases.len() + 3,
+        cases.len() + 4,
         t0.elapsed().as_secs_f64()
     );
     std::fs::remove_dir_all(dir).unwrap();

@@ -177,6 +177,10 @@ pub struct Args {
     /// chosen with the terms]. Needs `--type-units` of 3 or more.
     #[arg(long = "unit-prior-weight", allow_negative_numbers = true)]
     pub unit_prior_weight: Option<f64>,
+    /// How the type's network reads dT/dt (as `train --warmup-clock`): `slope` or `auto`
+    /// (the clock the type's runs choose) [default: slope]. Needs `--type-units`.
+    #[arg(long = "warmup-clock", value_enum)]
+    pub warmup_clock: Option<crate::train::warmup_clock::RateClock>,
 }
 
 /// Every how many chamber power-ons one is a warm restart (`--training-restarts-above-c`).
@@ -244,6 +248,7 @@ fn training_campaign(args: &Args) -> Result<(usize, Option<WarmRestarts>)> {
         ("--unit-spread", args.unit_spread.is_some()),
         ("--unit-terms", args.unit_terms.is_some()),
         ("--unit-prior-weight", args.unit_prior_weight.is_some()),
+        ("--warmup-clock", args.warmup_clock.is_some()),
     ];
     if let (None, Some((flag, _))) = (args.type_units, shapes_recipe.iter().find(|(_, g)| *g)) {
         bail!("{flag}: needs --type-units N (the unit recipe it shapes)");
@@ -410,6 +415,7 @@ fn recipe_of(args: &Args) -> Result<Option<UnitRecipe>> {
         unit_spread: spread_of(args.unit_spread.as_deref())?,
         unit_terms: args.unit_terms,
         unit_prior_weight: args.unit_prior_weight,
+        warmup_clock: args.warmup_clock.unwrap_or_default(),
     }))
 }
 

@@ -39,6 +39,25 @@ pub fn rms(x: &[f64]) -> f64 {
     (x.iter().map(|v| v * v).sum::<f64>() / x.len().max(1) as f64).sqrt()
 }
 
+/// Residual sum of squares of `y` about its least-squares line in `x` (`with_slope`) or
+/// about its mean; the line is taken flat when `x` does not spread. NaN for no points.
+pub fn line_residual_ss(x: &[f64], y: &[f64], with_slope: bool) -> f64 {
+    let n = x.len().min(y.len()) as f64;
+    let x_mean = x.iter().sum::<f64>() / n;
+    let y_mean = y.iter().sum::<f64>() / n;
+    let pairs = || x.iter().zip(y);
+    let sxx: f64 = x.iter().map(|a| (a - x_mean).powi(2)).sum();
+    let sxy: f64 = pairs().map(|(a, b)| (a - x_mean) * (b - y_mean)).sum();
+    let slope = if with_slope && sxx > 0.0 {
+        sxy / sxx
+    } else {
+        0.0
+    };
+    pairs()
+        .map(|(a, b)| (b - y_mean - slope * (a - x_mean)).powi(2))
+        .sum()
+}
+
 /// The pooled within-run standard deviation: the one "drift std" of several runs.
 ///
 /// Definition: each run's values are taken about that run's own mean (so constant
@@ -168,6 +187,20 @@ pub fn moving_std(t_s: &[f64], y: &[f64], window_s: f64) -> Vec<(f64, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_line_leaves_no_residual_about_itself_but_does_about_its_mean() {
+        let x = [0.0, 1.0, 2.0, 3.0];
+        let y = [1.0, 3.0, 5.0, 7.0];
+        assert!(line_residual_ss(&x, &y, true) < 1e-24);
+        // about the mean 4: 9 + 1 + 1 + 9
+        assert!((line_residual_ss(&x, &y, false) - 20.0).abs() < 1e-12);
+        // twin: a parabola keeps its curvature about its line
+        let p = [0.0, 1.0, 4.0, 9.0];
+        assert!((line_residual_ss(&x, &p, true) - 4.0).abs() < 1e-12);
+        // null: x that does not spread takes the line flat
+        assert_eq!(line_residual_ss(&[2.0; 4], &y, true), 20.0);
+    }
 
     #[test]
     fn pooled_std_ignores_group_offsets() {

@@ -20,10 +20,12 @@
 //! `MIN_CLOCK_RUNS` runs, or runs without a warm-up (nothing to fit), leave no test power
 //! and keep the slope.
 
+use fog_core::compensation::features::diffusion_clock_window_mean;
 use fog_core::model::format::{FeatureKind, FeatureSpec};
 use serde::Serialize;
 
 use crate::io::runs::Run;
+use crate::stats::line_residual_ss;
 
 /// The diffusion clock is taken above this many standard errors of the mean log ratio.
 pub const CLOCK_T_MIN: f64 = 2.0;
@@ -60,24 +62,21 @@ pub enum Family {
 }
 
 impl Family {
-    /// Mean of the family's clock over [b - w, b], t since power-on (closed forms).
+    /// Mean of the family's clock over [b - w, b], t since power-on (closed forms; the
+    /// diffusion clock's is the device's own, so the clock chosen is the clock read).
     fn clock_mean(self, tau_s: f64, b: f64, w: f64) -> f64 {
-        let a = (b - w).max(0.0);
-        let width = b - a;
-        let integral = |t: f64| match self {
-            Family::Exponential => t + tau_s * (-t / tau_s).exp(),
-            Family::Diffusion => {
-                let u = (t / tau_s).sqrt();
-                t + 2.0 * tau_s * (u + 1.0) * (-u).exp()
+        match self {
+            Family::Exponential => {
+                let a = (b - w).max(0.0);
+                let width = b - a;
+                if width > 0.0 {
+                    let integral = |t: f64| t + tau_s * (-t / tau_s).exp();
+                    (integral(b) - integral(a)) / width
+                } else {
+                    1.0 - (-b / tau_s).exp()
+                }
             }
-        };
-        if width > 0.0 {
-            (integral(b) - integral(a)) / width
-        } else {
-            match self {
-                Family::Exponential => 1.0 - (-b / tau_s).exp(),
-                Family::Diffusion => 1.0 - (-(b / tau_s).sqrt()).exp(),
-            }
+            Family::Diffusion => diffusion_clock_window_mean(tau_s, b, w),
         }
     }
 }
@@ -138,24 +137,6 @@ fn rows_of(run: &Run) -> Option<(Vec<f64>, f64, Vec<f64>)> {
     Some((t.to_vec(), w, temp.to_vec()))
 }
 
-/// Residual sum of squares of T = a + R g(t) (least squares in a and R).
-fn line_sse(x: &[f64], y: &[f64]) -> f64 {
-    let n = x.len() as f64;
-    let (xm, ym) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
-    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
-    for (a, b) in x.iter().zip(y) {
-        let (dx, dy) = (a - xm, b - ym);
-        sxx += dx * dx;
-        sxy += dx * dy;
-        syy += dy * dy;
-    }
-    if sxx > 0.0 {
-        (syy - sxy * sxy / sxx).max(0.0)
-    } else {
-        syy
-    }
-}
-
 /// Each run's residual sum under `family` at its best shared time constant: (tau, sums).
 /// The coarse grid's best is refined on a grid ten times finer between its neighbours.
 fn best_fit(family: Family, runs: &[(Vec<f64>, f64, Vec<f64>)]) -> (f64, Vec<f64>) {
@@ -177,7 +158,7 @@ fn best_on(
             .iter()
             .map(|(t, w, y)| {
                 let x: Vec<f64> = t.iter().map(|&b| family.clock_mean(tau, b, *w)).collect();
-                line_sse(&x, y)
+                line_residual_ss(&x, y, true)
             })
             .collect();
         let total: f64 = sums.iter().sum();

@@ -38,5 +38,5 @@ pub use extractor::{
     DEFAULT_RATE_SPAN_S, EXTRACTOR_RATE_POINTS,
 };
 pub use lag::{power_on_decay, power_on_decay_stretch, FirstOrderLag};
-pub use rate::{RateEstimate, TempRateEstimator};
+pub use rate::{diffusion_clock_window_mean, RateEstimate, TempRateEstimator};
 pub use window::{WindowAverager, WindowMean};

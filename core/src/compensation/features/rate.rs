@@ -207,35 +207,34 @@ impl<const N: usize> TempRateEstimator<N> {
         if w.is_nan() || w <= 0.0 {
             return None;
         }
-        let g = |t: f64| 1.0 - libm::exp(-libm::sqrt(t.max(0.0) / tau_s));
-        // mean of g over [a, b]: with u = sqrt(t / tau), the integral of exp(-u) dt is
-        // -2 tau (u + 1) exp(-u)
-        let g_mean = |b: f64| {
-            let a = (b - w).max(0.0);
-            let (ua, ub) = (libm::sqrt(a / tau_s), libm::sqrt(b.max(0.0) / tau_s));
-            let width = b - a;
-            if width <= 0.0 {
-                return g(b);
+        // Each window's edges through `DiffusionEdge`: a row's start is the row before's
+        // end when the rows are evenly spaced, so one exp and one sqrt a row (soft f64 on
+        // the M4F), and one pass of sums taken about the first point (7 points of a 60 s
+        // span: no cancellation to fear).
+        let mut end = DiffusionEdge::NONE;
+        let mut start = end;
+        let (mut x0, mut y0) = (f64::NAN, f64::NAN);
+        let (mut sx, mut sy, mut sxx, mut sxy) = (0.0, 0.0, 0.0, 0.0);
+        for &(t, y) in self.points.iter() {
+            start = end.or_at(tau_s, t - w);
+            end = start.or_at(tau_s, t);
+            let x = end.window_mean_since(&start, tau_s);
+            if x0.is_nan() {
+                (x0, y0) = (x, y);
             }
-            1.0 - 2.0 * tau_s * ((ua + 1.0) * libm::exp(-ua) - (ub + 1.0) * libm::exp(-ub)) / width
-        };
+            let (dx, dy) = (x - x0, y - y0);
+            sx += dx;
+            sy += dy;
+            sxx += dx * dx;
+            sxy += dx * dy;
+        }
         let nf = n as f64;
-        let (mut sx, mut sy) = (0.0, 0.0);
-        for &(t, y) in self.points.iter() {
-            sx += g_mean(t);
-            sy += y;
-        }
-        let (xm, ym) = (sx / nf, sy / nf);
-        let (mut sxx, mut sxy) = (0.0, 0.0);
-        for &(t, y) in self.points.iter() {
-            let xc = g_mean(t) - xm;
-            sxx += xc * xc;
-            sxy += xc * (y - ym);
-        }
+        let (sxx, sxy) = (sxx - sx * sx / nf, sxy - sx * sy / nf);
         if sxx.is_nan() || sxx <= 0.0 {
             return None;
         }
-        Some(sxy / sxx * (g(t_last) - g(t_last - w)) / w)
+        // g's mean rate over the last window, (g(t) - g(t - w)) / w, g = 1 - exp(-u)
+        Some(sxy / sxx * (start.exp_neg_u - end.exp_neg_u) / w)
     }
 
     /// How many points the flat extension of `new_flat_start` adds for points spanning
@@ -259,6 +258,63 @@ impl<const N: usize> TempRateEstimator<N> {
             fit as usize
         };
         Some((count, step))
+    }
+}
+
+/// The mean of the diffusion clock g(t) = 1 - exp(-sqrt(t / tau_s)) over the window
+/// [end_s - window_s, end_s] (clipped at power-on, t = 0), in closed form: with
+/// u = sqrt(t / tau), the integral of exp(-u) dt is -2 tau (u + 1) exp(-u). A window of no
+/// width gives g(end_s). The host's warm-up law fit (`fogsim train --warmup-clock`) places
+/// its rows with this same function, so the clock it chooses is the one the device reads.
+pub fn diffusion_clock_window_mean(tau_s: f64, end_s: f64, window_s: f64) -> f64 {
+    let start = DiffusionEdge::at(tau_s, (end_s - window_s).max(0.0));
+    DiffusionEdge::at(tau_s, end_s.max(0.0)).window_mean_since(&start, tau_s)
+}
+
+/// One edge of a window on the diffusion clock: t (>= 0), exp(-u) and (u + 1) exp(-u),
+/// u = sqrt(t / tau); g = 1 - exp(-u), and g's integral is t + 2 tau (u + 1) exp(-u).
+#[derive(Clone, Copy)]
+struct DiffusionEdge {
+    t_s: f64,
+    exp_neg_u: f64,
+    integral_part: f64,
+}
+
+impl DiffusionEdge {
+    /// No edge yet (equal to no time).
+    const NONE: DiffusionEdge = DiffusionEdge {
+        t_s: f64::NAN,
+        exp_neg_u: f64::NAN,
+        integral_part: f64::NAN,
+    };
+
+    fn at(tau_s: f64, t_s: f64) -> Self {
+        let u = libm::sqrt(t_s / tau_s);
+        let exp_neg_u = libm::exp(-u);
+        DiffusionEdge {
+            t_s,
+            exp_neg_u,
+            integral_part: (u + 1.0) * exp_neg_u,
+        }
+    }
+
+    /// This edge if it is at `t_s` (clipped at 0), else the edge there.
+    fn or_at(self, tau_s: f64, t_s: f64) -> Self {
+        let t_s = t_s.max(0.0);
+        if t_s == self.t_s {
+            self
+        } else {
+            DiffusionEdge::at(tau_s, t_s)
+        }
+    }
+
+    /// g's mean from `start` to this edge; g here when the window has no width.
+    fn window_mean_since(&self, start: &DiffusionEdge, tau_s: f64) -> f64 {
+        let width = self.t_s - start.t_s;
+        if width <= 0.0 {
+            return 1.0 - self.exp_neg_u;
+        }
+        1.0 - 2.0 * tau_s * (start.integral_part - self.integral_part) / width
     }
 }
 

@@ -84,6 +84,7 @@ pub fn compare_recipes(cfg: &MonteCarloConfig, keep_dir: &Path) -> Result<Recipe
         unit_spread: default_unit_spread(),
         unit_terms: None,
         unit_prior_weight: None,
+        warmup_clock: Default::default(),
     };
     let plan = OwnModelPlan {
         ambient_c: cfg.ambient_c,
@@ -287,6 +288,7 @@ mod tests {
             unit_spread: default_unit_spread(),
             unit_terms: None,
             unit_prior_weight: None,
+            warmup_clock: Default::default(),
         }
     }
 

@@ -28,6 +28,8 @@ use crate::train::type_unit::{
     calibrate_unit, choose_own, ordinary_model, resolve_shape, train_shared, ShapeScoring,
     SharedModel, TypeModel, TypeShape, UnitCalibration, UnitPlan,
 };
+use crate::train::warmup_clock::RateClock;
+use crate::train::TrainConfig;
 
 /// Ambients of the type's and the unit's chamber runs by default, degC.
 pub const RECIPE_AMBIENTS_C: [f64; 3] = [-40.0, 20.0, 60.0];
@@ -67,6 +69,8 @@ pub struct UnitRecipe {
     /// `--unit-prior-weight`; None: chosen by leave-one-run-out).
     pub unit_terms: Option<usize>,
     pub unit_prior_weight: Option<f64>,
+    /// How the type's network reads dT/dt (`train --warmup-clock`).
+    pub warmup_clock: RateClock,
 }
 
 /// The seeking unit's model and where it came from.
@@ -104,6 +108,7 @@ impl UnitRecipe {
             for (flag, given) in [
                 ("--unit-terms", self.unit_terms.is_some()),
                 ("--unit-prior-weight", self.unit_prior_weight.is_some()),
+                ("--warmup-clock auto", self.warmup_clock != RateClock::Slope),
             ] {
                 if given {
                     return Err(anyhow!(
@@ -225,7 +230,10 @@ pub fn learn_recipe_type(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<Rec
     // (a refit to pooled seeks trades the 10 s fit the backfitting needs for seek bias
     // averaged over units, and chose the grid's largest weight). The network is `train`'s,
     // as `train --type-out` makes it.
-    let cfg = train_config(plan, false);
+    let cfg = TrainConfig {
+        rate_clock: recipe.warmup_clock,
+        ..train_config(plan, false)
+    };
     let candidates = plan.inputs.candidates();
     // the shapes scored by what the unit step makes of units left out, its seeks those
     // of the type's own parameters (the seeking unit is not the type's to know)
@@ -405,6 +413,7 @@ mod tests {
             unit_spread,
             unit_terms: None,
             unit_prior_weight: None,
+            warmup_clock: RateClock::Slope,
         }
     }
 
