@@ -397,6 +397,9 @@ fn recipe_of(args: &Args) -> Result<Option<UnitRecipe>> {
     let Some(type_units) = args.type_units else {
         return Ok(None);
     };
+    if type_units == 0 && args.warmup_clock.is_some() {
+        bail!("--warmup-clock: --type-units 0 learns no type whose network reads dT/dt");
+    }
     Ok(Some(UnitRecipe {
         type_units,
         type_unit_runs: args.type_unit_runs.unwrap_or(DEFAULT_TYPE_UNIT_RUNS),

@@ -46,10 +46,10 @@ const TAU_GRID_STEP: f64 = 1.152_088;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum RateClock {
-    /// The device's slope against time, whatever the runs (the default).
-    #[default]
+    /// The device's slope against time, whatever the runs.
     Slope,
-    /// The clock the type's runs choose (`choose_warmup_clock`).
+    /// The clock the type's runs choose (`choose_warmup_clock`; the default).
+    #[default]
     Auto,
 }
 

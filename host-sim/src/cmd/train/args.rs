@@ -176,9 +176,10 @@ pub struct Args {
     pub seek_period_s: Option<f64>,
     /// With `--type-out`: read the network's dT/dt in the clock the type's runs choose
     /// (`auto`: the 60 s slope against time, or against a diffusion clock 1 - exp(-sqrt(t /
-    /// tau)) where the runs warm up so; model format 7) or always as the `slope`.
-    #[arg(long = "warmup-clock", value_enum, default_value_t)]
-    pub rate_clock: crate::train::warmup_clock::RateClock,
+    /// tau)) where the runs warm up so; model format 7) or always as the `slope`
+    /// [default: auto].
+    #[arg(long = "warmup-clock", value_enum)]
+    pub rate_clock: Option<crate::train::warmup_clock::RateClock>,
 }
 
 fn parse_width_search(s: &str) -> Result<WidthSearch, String> {
@@ -280,7 +281,7 @@ impl Args {
             linear_on_rbf_inputs: self.linear_inputs,
             linear_by_t: self.linear_by_t,
             gyro_id: self.gyro_id.clone(),
-            rate_clock: self.rate_clock,
+            rate_clock: self.rate_clock.unwrap_or_default(),
             ..TrainConfig::default()
         })
     }

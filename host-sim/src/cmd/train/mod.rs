@@ -108,9 +108,7 @@ fn inputs(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
             "--seek-period-s: needs --type TYPE (a unit calibration) or --type-out (the unit step that scores the type's shape)"
         );
     }
-    if args.rate_clock != crate::train::warmup_clock::RateClock::default()
-        && args.type_out.is_none()
-    {
+    if args.rate_clock.is_some() && args.type_out.is_none() {
         anyhow::bail!(
             "--warmup-clock: needs --type-out (it chooses the clock from a type's runs; a unit calibrated with --type reads its type's)"
         );

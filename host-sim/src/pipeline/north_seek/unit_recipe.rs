@@ -108,7 +108,6 @@ impl UnitRecipe {
             for (flag, given) in [
                 ("--unit-terms", self.unit_terms.is_some()),
                 ("--unit-prior-weight", self.unit_prior_weight.is_some()),
-                ("--warmup-clock auto", self.warmup_clock != RateClock::Slope),
             ] {
                 if given {
                     return Err(anyhow!(

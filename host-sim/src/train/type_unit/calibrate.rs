@@ -37,11 +37,13 @@
 use anyhow::{anyhow, bail, Result};
 use serde::Serialize;
 
-use super::misfit::{test_unit, Misfit, TypeSide};
+use super::misfit::{test_unit, Misfit, TypeSide, UnitSide};
+use super::resolved::RunMoments;
 use super::solve::{own_estimate, solve, Prior, UnitRows};
 use super::terms::fold;
 use super::type_model::TypeModel;
 use crate::io::runs::Run;
+use crate::stats::line_residual_ss;
 use crate::train::{dataset_from_runs, Dataset};
 use fog_core::model::format::RbfModel;
 
@@ -308,20 +310,101 @@ pub fn calibrate_unit(
     })
 }
 
-/// The misfit test of a unit's `rows` (read as the type read its units) against `ty`.
+/// The misfit test of a unit's `rows` (read as the type read its units) against `ty`:
+/// every term fitted at once first; while some term lacks test power, the one farthest
+/// from it is held at the type's mean and the rest refitted and tested, a smaller family
+/// (`resolved`), so nearly collinear terms, or many, do not take the power from what the
+/// runs resolve. A fitted term's estimate is then a combination of the unit's terms (the
+/// term plus A times the held terms' deviations), and its type side the same combination
+/// of each type unit's own estimate: their mean, and their scatter as the spread (the type
+/// units' estimation noise left in: the noise of a combination is not in the type file).
+/// Of these nested tests the one with the most terms with power is the answer, then the
+/// one whose most sensitive term would flag the smallest deviation (in the type's
+/// spreads; all at once when none is better): chosen by standard errors and the type's
+/// spread, never by the unit's deviations, so the level holds.
 fn misfit_of(ty: &TypeModel, rows: &UnitRows, unit_id: &str) -> Result<Misfit> {
-    let (own, se) = own_estimate(rows)?;
     let f = &ty.file;
     let names: Vec<String> = f.terms.iter().map(|t| t.name.clone()).collect();
     let (mean, spread) = (ty.mean(), ty.spread());
     let scatter: Vec<f64> = f.terms.iter().map(|t| t.scatter).collect();
+    let units = f.units.len();
     let side = TypeSide {
         mean: &mean,
         spread: &spread,
         scatter: &scatter,
-        units: f.units.len(),
+        units,
     };
-    Ok(test_unit(unit_id, &names, &own, &se, &side, rows.runs))
+    let (own, se) = own_estimate(rows)?;
+    let unit = UnitSide {
+        own: &own,
+        se: &se,
+        others_held: false,
+        runs: rows.runs,
+    };
+    let all_at_once = test_unit(unit_id, &names, &unit, &side);
+    let moments = RunMoments::of(rows);
+    let mut kept: Vec<usize> = (0..own.len()).filter(|&k| !rows.unseen(k)).collect();
+    // more terms with power, then the most sensitive term (the smallest deviation in
+    // spreads it would flag): the better test
+    let merit = |m: &Misfit| {
+        let tested = m.terms.iter().filter(|t| t.se.is_finite());
+        let sharpest = tested
+            .map(|t| t.power_shortfall())
+            .fold(f64::INFINITY, f64::min);
+        (m.terms.iter().filter(|t| t.has_power).count(), sharpest)
+    };
+    let better = |a: (usize, f64), b: (usize, f64)| a.0 > b.0 || (a.0 == b.0 && a.1 < b.1);
+    let mut best = (merit(&all_at_once), all_at_once.clone());
+    let mut test = all_at_once;
+    loop {
+        let weakest = kept
+            .iter()
+            .copied()
+            .filter(|&k| !test.terms[k].has_power)
+            .max_by(|&a, &b| {
+                let s = |k: usize| test.terms[k].power_shortfall();
+                s(a).total_cmp(&s(b))
+            });
+        let Some(drop) = weakest else { break };
+        kept.retain(|&k| k != drop);
+        if kept.is_empty() || units < 2 {
+            break;
+        }
+        let est = moments.held_estimate(&kept, &mean)?;
+        // each type unit's value of each fitted term's combination
+        let (mut c_mean, mut c_scatter) = (mean.clone(), scatter.clone());
+        for &k in &kept {
+            let values: Vec<f64> = f
+                .units
+                .iter()
+                .map(|u| {
+                    u.estimate[k]
+                        + (0..own.len())
+                            .map(|o| est.held_map[k][o] * (u.estimate[o] - mean[o]))
+                            .sum::<f64>()
+                })
+                .collect();
+            c_mean[k] = crate::stats::mean(&values);
+            c_scatter[k] = crate::stats::std_dev(&values);
+        }
+        let combined = TypeSide {
+            mean: &c_mean,
+            spread: &c_scatter,
+            scatter: &c_scatter,
+            units,
+        };
+        let held = UnitSide {
+            own: &est.own,
+            se: &est.se,
+            others_held: true,
+            runs: rows.runs,
+        };
+        test = test_unit(unit_id, &names, &held, &combined);
+        if better(merit(&test), best.0) {
+            best = (merit(&test), test.clone());
+        }
+    }
+    Ok(best.1)
 }
 
 /// Every candidate `plan` allows (`scan`) and the one chosen among them (`choose`); None
@@ -502,29 +585,16 @@ pub(super) fn seek_windows_mean_square(
             k as f64 * period_s
         };
         let hi = (k + 1) as f64 * period_s;
-        let window: Vec<(f64, f64)> = t_s
+        let (t_w, v_w): (Vec<f64>, Vec<f64>) = t_s
             .iter()
             .zip(res)
             .filter(|(&t, _)| t > lo && t <= hi)
-            .map(|(&t, &v)| (t, v))
-            .collect();
-        if window.len() < MIN_WINDOW_ROWS {
+            .unzip();
+        if t_w.len() < MIN_WINDOW_ROWS {
             continue;
         }
-        let n = window.len() as f64;
-        let t_mean = window.iter().map(|p| p.0).sum::<f64>() / n;
-        let v_mean = window.iter().map(|p| p.1).sum::<f64>() / n;
-        let sxx: f64 = window.iter().map(|p| (p.0 - t_mean).powi(2)).sum();
-        let sxy: f64 = window.iter().map(|p| (p.0 - t_mean) * (p.1 - v_mean)).sum();
-        let slope = if less_line && sxx > 0.0 {
-            sxy / sxx
-        } else {
-            0.0
-        };
-        let ss: f64 = window
-            .iter()
-            .map(|p| (p.1 - v_mean - slope * (p.0 - t_mean)).powi(2))
-            .sum();
+        let n = t_w.len() as f64;
+        let ss = line_residual_ss(&t_w, &v_w, less_line);
         sum += ss / n;
         windows += 1;
     }

@@ -13,6 +13,13 @@
 //! see even a unit `POWER_SIGMAS` spreads out (its se too large, e.g. T and dT/dt from
 //! runs at one ambient) has no test power, and is said to have none.
 //!
+//! Nearly collinear terms fitted all at once each have a large se and no power, though the
+//! runs resolve their combination, and every term tested widens the family's critical
+//! value; so the terms lacking power are held at the type's mean one by one, farthest from
+//! power first, and the rest refitted and tested, a smaller family, each against the same
+//! combination of the type's units' own estimates (`resolved`, `calibrate::misfit_of`).
+//! Held terms are not tested (no test power, said).
+//!
 //! A type's own units are tested the same way when the shape is chosen: each unit left out
 //! of a fold against the type its other units make (`shape::choose_shape`), so a type unit
 //! unlike the others is said before its runs shape the type.
@@ -38,12 +45,25 @@ pub struct TermTest {
     pub type_mean: f64,
     pub type_spread: f64,
     pub mean_se: f64,
-    /// (own - mean) / sqrt(spread^2 + se^2 + mean_se^2).
+    /// Whether other terms were held at the type's mean for this estimate (`resolved`):
+    /// then the own estimate, the type's mean and spread are those of the combination the
+    /// fit reads (the term plus the held terms' deviations through the rows).
+    pub others_held: bool,
+    /// (own - mean) / sqrt(spread^2 + mean_se^2 + se^2).
     pub z: f64,
     /// Critical |z| at the family-wise rate.
     pub critical: f64,
     pub has_power: bool,
     pub outside: bool,
+}
+
+impl TermTest {
+    /// How far the test is from power: critical |z| x its scale over `POWER_SIGMAS`
+    /// spreads (<= 1: a unit that far out would be flagged).
+    pub fn power_shortfall(&self) -> f64 {
+        let total = (self.type_spread.powi(2) + self.mean_se.powi(2) + self.se.powi(2)).sqrt();
+        self.critical * total / (POWER_SIGMAS * self.type_spread)
+    }
 }
 
 /// The misfit test of one unit.
@@ -85,8 +105,13 @@ impl Misfit {
             .map(|t| t.name.as_str())
             .collect();
         if !blind.is_empty() {
+            let held = if self.terms.iter().any(|t| t.others_held) {
+                "; the other terms were tested with these held at the type's mean, against the same combination of the type's units"
+            } else {
+                ""
+            };
             v.push(format!(
-                "unit {}: no test power for {} (its runs cannot tell a unit {POWER_SIGMAS} spreads out: more of its runs, at more ambients, or a type from more units give the test power)",
+                "unit {}: no test power for {} (its runs cannot tell a unit {POWER_SIGMAS} spreads out: more of its runs, at more ambients, or a type from more units give the test power){held}",
                 self.unit_id,
                 blind.join(", ")
             ));
@@ -112,17 +137,24 @@ pub struct TypeSide<'a> {
     pub units: usize,
 }
 
-/// Tests a unit's own estimates (`own`, jackknife `se` over its `unit_runs` runs) against
-/// the type (see the module notes).
-pub fn test_unit(
-    unit_id: &str,
-    names: &[String],
-    own: &[f64],
-    se: &[f64],
-    ty: &TypeSide,
-    unit_runs: usize,
-) -> Misfit {
-    let p = own.len().max(1) as f64;
+/// The unit's side: its own estimate of each term, the estimate's jackknife standard
+/// error over its `runs` runs (infinite: not tested), and whether other terms were held
+/// at the type's mean for it (`resolved::HeldEstimate`).
+#[derive(Clone, Copy, Debug)]
+pub struct UnitSide<'a> {
+    pub own: &'a [f64],
+    pub se: &'a [f64],
+    pub others_held: bool,
+    pub runs: usize,
+}
+
+/// Tests a unit's own estimates against the type (see the module notes).
+pub fn test_unit(unit_id: &str, names: &[String], unit: &UnitSide, ty: &TypeSide) -> Misfit {
+    let (own, se) = (unit.own, unit.se);
+    let unit_runs = unit.runs;
+    // the family: the terms tested (a term held at the type's mean, or one the rows
+    // cannot see, has an infinite se and is never found outside)
+    let p = se.iter().filter(|s| s.is_finite()).count().max(1) as f64;
     let tail = FAMILY_ALPHA / (2.0 * p);
     let dof_type = (ty.units as f64 - 1.0).max(1.0);
     let dof_unit = (unit_runs as f64 - 1.0).max(1.0);
@@ -154,6 +186,7 @@ pub fn test_unit(
                 type_mean: ty.mean[k],
                 type_spread: ty.spread[k],
                 mean_se,
+                others_held: unit.others_held && se[k].is_finite(),
                 z: if z.is_finite() { z } else { 0.0 },
                 critical,
                 has_power,
@@ -186,15 +219,18 @@ mod tests {
         test_unit(
             unit,
             &names(),
-            &own,
-            &se,
+            &UnitSide {
+                own: &own,
+                se: &se,
+                others_held: false,
+                runs,
+            },
             &TypeSide {
                 mean: &[0.0, 1.0],
                 spread: &[0.1, 0.1],
                 scatter: &[0.1, 0.1],
                 units: type_units,
             },
-            runs,
         )
     }
 

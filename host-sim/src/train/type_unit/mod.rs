@@ -14,6 +14,7 @@ pub mod folds;
 pub mod law;
 pub mod misfit;
 pub mod own;
+pub mod resolved;
 pub mod shape;
 pub mod solve;
 pub mod terms;
