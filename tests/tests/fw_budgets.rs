@@ -3,7 +3,8 @@
 //! - flash and static RAM of the application binary `fog-app` (llvm-size);
 //! - panic paths left in `fog-app` (calls into `core::panicking` found by disassembly);
 //! - instruction counts under `qemu -icount shift=0` (`src/bin/bench.rs`): per raw
-//!   sample, per 10 s update (35/64 centres, f32/fixed), per RBF evaluation, per Ed25519
+//!   sample, per 10 s update (35/64 centres, f32/fixed; 35 centres, f32, dT/dt in the
+//!   diffusion clock), per RBF evaluation, per Ed25519
 //!   verification; and from them the CPU load at 2 kHz on a 168 MHz Cortex-M4F.
 //!
 //! With `FOG_BUDGETS_OUT=<file>` the test also writes the Markdown budget table there.
@@ -32,6 +33,10 @@ const LOAD_CPU_HZ: f64 = 168e6;
 /// Regression ceilings for instruction counts (about 1.5x the measured values).
 const SAMPLE_INSTR_CEILING: u64 = 3_000;
 const UPDATE_INSTR_CEILING: u64 = 80_000;
+/// The update whose dT/dt is read in the diffusion clock: its estimator takes f64 `exp`
+/// and `sqrt` (soft-float on the M4F) of every point twice, 136,816 instructions measured
+/// (35 centres, f32; the plain update 36,118 in the same run).
+const DIFFUSION_UPDATE_INSTR_CEILING: u64 = 200_000;
 const VERIFY_INSTR_CEILING: u64 = 3_000_000;
 
 /// Call sites in `elf` that branch to `core::panicking::*` or to a panic stub, per caller.
@@ -150,6 +155,10 @@ fn firmware_fits_its_budgets() {
             "instructions per 10 s update, 35 centres, f32",
         ),
         (
+            "update_instr_35_f32_diffusion",
+            "instructions per 10 s update, 35 centres, f32, dT/dt in the diffusion clock",
+        ),
+        (
             "update_instr_35_fixed",
             "instructions per 10 s update, 35 centres, fixed point",
         ),
@@ -219,14 +228,18 @@ fn firmware_fits_its_budgets() {
         sample > 100 && sample <= SAMPLE_INSTR_CEILING,
         "per-sample {sample}"
     );
-    for k in [
-        "update_instr_35_f32",
-        "update_instr_35_fixed",
-        "update_instr_64_f32",
-        "update_instr_64_fixed",
+    for (k, ceiling) in [
+        ("update_instr_35_f32", UPDATE_INSTR_CEILING),
+        (
+            "update_instr_35_f32_diffusion",
+            DIFFUSION_UPDATE_INSTR_CEILING,
+        ),
+        ("update_instr_35_fixed", UPDATE_INSTR_CEILING),
+        ("update_instr_64_f32", UPDATE_INSTR_CEILING),
+        ("update_instr_64_fixed", UPDATE_INSTR_CEILING),
     ] {
         let v = get(k);
-        assert!(v > 1000 && v <= UPDATE_INSTR_CEILING, "{k} = {v}");
+        assert!(v > 1000 && v <= ceiling, "{k} = {v}");
     }
     let v = get("verify_instr");
     assert!(v > 10_000 && v <= VERIFY_INSTR_CEILING, "verify {v}");

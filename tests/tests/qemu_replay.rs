@@ -3,8 +3,9 @@
 //! application in the loop), then replayed twice through `fog_firmware::replay::run`:
 //! on the host and inside the firmware under QEMU (`src/bin/replay.rs`, semihosting
 //! files). Every 10 s window and every seek result must agree to the last bit, for the
-//! f32 and the fixed-point evaluator, and for a model on (T, dT/dt, d2T/dt2), the
-//! inputs `fogsim train --inputs t,rate,accel` deploys.
+//! f32 and the fixed-point evaluator, for a model on (T, dT/dt, d2T/dt2), the
+//! inputs `fogsim train --inputs t,rate,accel` deploys, and for a model whose dT/dt is
+//! read in the diffusion clock (`FeatureKind::TempRateDiffusionCps`, format version 7).
 //!
 //! Why bit-exact is the right bar: both sides execute the same Rust source; IEEE 754
 //! single and double arithmetic (+, -, *, /, sqrt) is correctly rounded on the M4F's
@@ -188,17 +189,23 @@ fn scenario_with(
     if !qemu_ready("qemu_replay") {
         return;
     }
-    // With a cubic polynomial base in T (model format version 2), evaluated by fog-core
-    // on both sides.
-    let mut model = warmup_model(35, n_inputs, 0.05, 35);
-    for spec in model.inputs.iter_mut() {
+    let model = synthetic_model(n_inputs, |spec| {
         if spec.kind == FeatureKind::TempAccelCps2 {
             spec.kind = accel;
         }
         if let (FeatureKind::TempLagC, Some(f)) = (spec.kind, fourth) {
             *spec = f;
         }
-    }
+    });
+    replay_both(evaluator, &model, tag);
+}
+
+/// The synthetic warm-up model on its first `n_inputs` of (T, dT/dt, d2T/dt2, lagged T),
+/// each input spec passed through `edit`, with a cubic polynomial base in T (model format
+/// version 2, evaluated by fog-core on both sides).
+fn synthetic_model(n_inputs: usize, edit: impl Fn(&mut FeatureSpec)) -> RbfModel {
+    let mut model = warmup_model(35, n_inputs, 0.05, 35);
+    model.inputs.iter_mut().for_each(edit);
     model
         .poly
         .extend_from_slice(&[0.03, -0.012, 0.004])
@@ -219,12 +226,13 @@ fn scenario_with(
             model.input_scale[j] = 0.5;
         }
     }
-    replay_both(evaluator, &model, tag);
+    model
 }
 
 /// Records a cold start with `model` in the loop, replays it on the host and under QEMU,
 /// and checks both against the recording to the last bit (and the firmware's stack).
-fn replay_both(evaluator: Evaluator, model: &RbfModel, tag: &str) {
+/// Returns the recording and the host replay's output.
+fn replay_both(evaluator: Evaluator, model: &RbfModel, tag: &str) -> (Recording, String) {
     let mut buf = [0u8; MAX_ENCODED_LEN];
     let n = model.encode(&mut buf).expect("model encodes");
     let model = RbfModel::decode(&buf[..n]).expect("model decodes");
@@ -350,6 +358,7 @@ fn replay_both(evaluator: Evaluator, model: &RbfModel, tag: &str) {
         std::fs::write(path, rows).expect("write stack rows");
     }
     let _ = std::fs::remove_dir_all(&dir);
+    (rec, host_out)
 }
 
 /// The replay firmware's evaluator argument.
@@ -483,5 +492,67 @@ fn firmware_replay_matches_host_bit_for_bit_clock() {
             tau_s: 510.0,
         }),
         "f32-clock",
+    );
+}
+
+/// The drift field of each window line of a replay's output (its hex bits).
+fn window_drifts(out: &str) -> Vec<&str> {
+    data_lines(out)
+        .iter()
+        .filter(|l| l.starts_with("W "))
+        .filter_map(|l| l.split_whitespace().nth(5))
+        .collect()
+}
+
+/// dT/dt read in the diffusion clock (`FeatureKind::TempRateDiffusionCps`, tau 400 s,
+/// model format version 7): the device runs that estimator (libm `exp` and `sqrt` of the
+/// clock) bit for bit as the host. The window lines' dT/dt column is the compensator's
+/// reported slope, not the model's input, so the proof that the estimator ran is the
+/// drift: the same recording replayed on the host with the input read as the plain slope
+/// must give other drifts.
+#[test]
+fn firmware_replay_matches_host_bit_for_bit_diffusion_clock_rate() {
+    if !qemu_ready("qemu_replay") {
+        return;
+    }
+    let rate_as = |to: FeatureSpec| {
+        synthetic_model(2, move |spec| {
+            if spec.kind == FeatureKind::TempRateCps {
+                *spec = to;
+            }
+        })
+    };
+    let diffusion = FeatureSpec {
+        kind: FeatureKind::TempRateDiffusionCps,
+        tau_s: 400.0,
+    };
+    let model = rate_as(diffusion);
+    assert!(
+        model.inputs.contains(&diffusion),
+        "the model reads the diffusion clock: {:?}",
+        model.inputs
+    );
+    assert_eq!(model.format_version(), 7, "written as format version 7");
+    let (rec, host_out) = replay_both(Evaluator::F32, &model, "f32-diffusion");
+
+    let mut slope_out = String::new();
+    replay::run(
+        config(Evaluator::F32),
+        Some(rate_as(FeatureSpec::plain(FeatureKind::TempRateCps))),
+        &rec.gyro_stream[..],
+        &rec.table_log[..],
+        &mut slope_out,
+    )
+    .expect("host replay with the plain slope");
+    let (clock, slope) = (window_drifts(&host_out), window_drifts(&slope_out));
+    assert_eq!(clock.len(), slope.len(), "same windows");
+    let differ = clock.iter().zip(&slope).filter(|(a, b)| a != b).count();
+    eprintln!(
+        "qemu_replay[f32-diffusion]: drift differs from the plain slope's in {differ} of {} windows",
+        clock.len()
+    );
+    assert!(
+        differ > 0,
+        "every drift equals the plain slope model's: the diffusion-clock rate did not run"
     );
 }

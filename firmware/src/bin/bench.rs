@@ -6,6 +6,8 @@
 //!   driver and decoder, the 1 Hz temperature, the application's `on_gyro` (averager);
 //! - `update_instr_<35|64>_<f32|fixed>`: the sample that closes a 10 s window (features,
 //!   RBF drift, compensation, validity), with 35 or 64 centres over (T, dT/dt);
+//! - `update_instr_35_f32_diffusion`: the same with dT/dt read in the diffusion clock
+//!   (`FeatureKind::TempRateDiffusionCps`, tau 400 s; model format version 7);
 //! - `predict_instr_<35|64>_<f32|fixed>`: one RBF evaluation alone;
 //! - `verify_instr`: one Ed25519 model-signature verification (`signature::verify_model`)
 //!   of MODEL with signature SIG if given as arguments (`verify_valid 1`), else of a
@@ -28,7 +30,7 @@ use embedded_hal_nb::serial::{ErrorKind, ErrorType, Read};
 use fog_core::compensation::compensator::Evaluator;
 use fog_core::hal::{Gyro, GyroSample, TableState, TempSample, Turntable};
 use fog_core::model::fixed::FixedModel;
-use fog_core::model::format::{RbfModel, MAX_ENCODED_LEN};
+use fog_core::model::format::{FeatureKind, FeatureSpec, RbfModel, MAX_ENCODED_LEN};
 use fog_core::model::rbf::predict_f32;
 use fog_core::model::synthetic::{warmup_inputs, warmup_model};
 use fog_core::sensor_link::gyro_frame::{GyroFrame, FRAME_LEN};
@@ -159,6 +161,24 @@ fn bench_update(model: &RbfModel, evaluator: Evaluator) -> u32 {
     (ticks * u64::from(icount::INSTR_PER_TICK) / n.max(1)) as u32
 }
 
+/// `model` with its dT/dt read in the diffusion clock (tau 400 s), over a range that keeps
+/// the bench's windows valid (the clock's rate of this warm-up is not the slope's).
+fn diffusion_clock(model: &RbfModel) -> RbfModel {
+    let mut m = model.clone();
+    for (j, spec) in m.inputs.iter_mut().enumerate() {
+        if spec.kind == FeatureKind::TempRateCps {
+            *spec = FeatureSpec {
+                kind: FeatureKind::TempRateDiffusionCps,
+                tau_s: 400.0,
+            };
+            if let (Some(lo), Some(hi)) = (m.input_min.get_mut(j), m.input_max.get_mut(j)) {
+                (*lo, *hi) = (-1.0, 1.0);
+            }
+        }
+    }
+    m
+}
+
 /// Mean instructions of one evaluation over 200 points of the warm-up.
 fn bench_predict(model: &RbfModel, fixed: Option<&FixedModel>) -> u32 {
     let mut ticks = 0u64;
@@ -205,6 +225,10 @@ fn main() -> ! {
             Err(_) => semihosting::println!("predict_instr_{}_fixed 0", name),
         }
     }
+    semihosting::println!(
+        "update_instr_35_f32_diffusion {}",
+        bench_update(&diffusion_clock(&m35), Evaluator::F32)
+    );
     bench_verify(&m35);
     semihosting::process::exit(0)
 }
