@@ -911,16 +911,34 @@ fn bad_unit_calibration_inputs_fail_with_one_line_and_write_nothing() {
         ),
     ];
     refuse_all(&dir, &cases, terms);
+    let seek_refusals = north_seek_recipe_refusals(&dir);
+    // the faults, not the rest, made them fail: U4 is calibrated without them
+    let u4 = indep_files(&dir, &[4]);
+    let good: Vec<&str> = cal.split_whitespace().collect();
+    fogsim_ok(&dir, &train_args(&u4, &good));
+    assert!(dir.join("out.model").exists());
+    println!(
+        "{} bad invocations: {:.1} s",
+        cases.len() + seek_refusals,
+        t0.elapsed().as_secs_f64()
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// `north-seek`'s unit recipe refused in `dir` (which holds `type.json` and
+/// `shared.model`): a type file as a model, a recipe option without the recipe, too few runs
+/// for the type-free recipe, a warm-up clock without a type. Returns how many were tried.
+fn north_seek_recipe_refusals(dir: &Path) -> usize {
     let seek = ["--starts", "1", "--seeks", "1", "--json", "out.json"];
     // a type file where a model is expected
     check_refused(
-        &dir,
+        dir,
         &[&["north-seek", "--model", "type.json"], &seek[..]].concat(),
         "--model type.json: more than 2048 bytes, a model is at most 2048 bytes",
     );
     // a unit recipe's option without the recipe, named (not only the missing flag)
     check_refused(
-        &dir,
+        dir,
         &[
             &["north-seek", "--model", "shared.model", "--unit-runs", "3"],
             &seek[..],
@@ -930,7 +948,7 @@ fn bad_unit_calibration_inputs_fail_with_one_line_and_write_nothing() {
     );
     // the type-free recipe trains the unit's runs as any model: too few for its folds
     check_refused(
-        &dir,
+        dir,
         &[
             &["north-seek", "--type-units", "0", "--unit-runs", "2"],
             &seek[..],
@@ -940,7 +958,7 @@ fn bad_unit_calibration_inputs_fail_with_one_line_and_write_nothing() {
     );
     // the clock is the type's network's: no type, no clock to choose
     check_refused(
-        &dir,
+        dir,
         &[
             &["north-seek", "--type-units", "0", "--warmup-clock", "auto"],
             &seek[..],
@@ -948,17 +966,7 @@ fn bad_unit_calibration_inputs_fail_with_one_line_and_write_nothing() {
         .concat(),
         "--warmup-clock: --type-units 0 learns no type whose network reads dT/dt",
     );
-    // the faults, not the rest, made them fail: U4 is calibrated without them
-    let u4 = indep_files(&dir, &[4]);
-    let good: Vec<&str> = cal.split_whitespace().collect();
-    fogsim_ok(&dir, &train_args(&u4, &good));
-    assert!(dir.join("out.model").exists());
-    println!(
-        "{} bad invocations: {:.1} s",
-        cases.len() + 4,
-        t0.elapsed().as_secs_f64()
-    );
-    std::fs::remove_dir_all(dir).unwrap();
+    4
 }
 
 /// `fogsim ARGS` in `dir` must fail with one line on stderr containing `needle`, and leave
