@@ -1,5 +1,6 @@
 //! `fogsim import` of the PAN thermal-vacuum MEMS log: burst means, LSM6DSM temperature
-//! conversion, rad/s -> deg/h, outlier removal, and rejection of malformed files.
+//! conversion, rad/s -> deg/h, outlier removal, and rejection of malformed files; the
+//! warm-up clock choice on the recording (one cooling run: no test power, the slope).
 
 use fog_sim::io::import::{import_pan, lsm6dsm_temp_c, PAN_HEADER};
 use std::path::PathBuf;
@@ -86,4 +87,26 @@ fn the_real_recording_when_present_gives_25_bursts_and_3_outliers() {
         t[0],
         t[24]
     );
+}
+
+/// The warm-up clock choice (`train --type-out`'s default) on the measured recording: one
+/// run of a unit cooling in a chamber, no power-on warm-up: fewer than 3 runs to test the
+/// choice, so it says it has no test power and keeps the slope.
+#[test]
+fn the_real_recording_keeps_the_slope_for_want_of_runs() {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/data/measured/pan-tvac-mems/TVCtest3_7_20.csv");
+    if !p.exists() {
+        eprintln!("skipped: {} not present on this machine", p.display());
+        return;
+    }
+    let imp = import_pan(&p, &[0]).unwrap();
+    let choice = fog_sim::train::warmup_clock::choose_warmup_clock(&imp.runs);
+    println!("{}", choice.describe());
+    assert!(
+        !choice.is_diffusion() && choice.t.is_none(),
+        "{}",
+        choice.describe()
+    );
+    assert!(choice.describe().contains("no test power"));
 }

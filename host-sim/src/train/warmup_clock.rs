@@ -118,8 +118,10 @@ impl ClockChoice {
             }
         };
         format!(
-            "dT/dt read as {taken} (warm-up fits over {} runs: exponential {:.0} s rms {:.4} degC, diffusion {:.0} s rms {:.4} degC; {margin})",
-            self.runs, self.exponential.0, self.exponential.1, self.diffusion.0, self.diffusion.1
+            "dT/dt read as {taken} (warm-up fits over {} run{}: exponential {:.0} s rms {:.4} degC, diffusion {:.0} s rms {:.4} degC; {margin})",
+            self.runs,
+            if self.runs == 1 { "" } else { "s" },
+            self.exponential.0, self.exponential.1, self.diffusion.0, self.diffusion.1
         )
     }
 }
