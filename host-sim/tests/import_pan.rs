@@ -67,14 +67,20 @@ fn malformed_files_are_rejected_with_the_line() {
     assert!(import_pan(&PathBuf::from("/nonexistent/TVC.csv"), &[0]).is_err());
 }
 
-#[test]
-fn the_real_recording_when_present_gives_25_bursts_and_3_outliers() {
+/// The measured recording, when this machine has it (else None, said on stderr).
+fn recording() -> Option<PathBuf> {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../../shared/data/measured/pan-tvac-mems/TVCtest3_7_20.csv");
     if !p.exists() {
         eprintln!("skipped: {} not present on this machine", p.display());
-        return;
+        return None;
     }
+    Some(p)
+}
+
+#[test]
+fn the_real_recording_when_present_gives_25_bursts_and_3_outliers() {
+    let Some(p) = recording() else { return };
     let imp = import_pan(&p, &[0, 1, 2]).unwrap();
     assert_eq!(
         (imp.samples, imp.bursts, imp.outliers_dropped),
@@ -94,12 +100,7 @@ fn the_real_recording_when_present_gives_25_bursts_and_3_outliers() {
 /// choice, so it says it has no test power and keeps the slope.
 #[test]
 fn the_real_recording_keeps_the_slope_for_want_of_runs() {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/data/measured/pan-tvac-mems/TVCtest3_7_20.csv");
-    if !p.exists() {
-        eprintln!("skipped: {} not present on this machine", p.display());
-        return;
-    }
+    let Some(p) = recording() else { return };
     let imp = import_pan(&p, &[0]).unwrap();
     let choice = fog_sim::train::warmup_clock::choose_warmup_clock(&imp.runs);
     println!("{}", choice.describe());
