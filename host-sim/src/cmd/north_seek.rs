@@ -177,8 +177,8 @@ pub struct Args {
     /// chosen with the terms]. Needs `--type-units` of 3 or more.
     #[arg(long = "unit-prior-weight", allow_negative_numbers = true)]
     pub unit_prior_weight: Option<f64>,
-    /// How the type's network reads dT/dt (as `train --warmup-clock`): `slope` or `auto`
-    /// (the clock the type's runs choose) [default: slope]. Needs `--type-units`.
+    /// How the type's network reads dT/dt (as `train --warmup-clock`): `auto` (the clock
+    /// the type's runs choose) or `slope` [default: auto]. Needs `--type-units` of 3 or more.
     #[arg(long = "warmup-clock", value_enum)]
     pub warmup_clock: Option<crate::train::warmup_clock::RateClock>,
 }

@@ -72,9 +72,8 @@ pub struct TrainConfig {
     /// The dT/dt input every input set reads (`train::warmup_clock`): the slope against
     /// time by default, the diffusion clock where a type's runs choose it.
     pub rate_input: fog_core::model::format::FeatureSpec,
-    /// Whether a type's network reads dT/dt in a clock its runs choose
-    /// (`--warmup-clock auto`) or always as the slope (the default until the tests whose
-    /// premise it changes are rewritten: docs/record/fleet.md).
+    /// Whether a type's network reads dT/dt in a clock its runs choose (`--warmup-clock
+    /// auto`, the default) or always as the slope.
     pub rate_clock: crate::train::warmup_clock::RateClock,
 }
 

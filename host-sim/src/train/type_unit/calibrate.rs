@@ -371,21 +371,9 @@ fn misfit_of(ty: &TypeModel, rows: &UnitRows, unit_id: &str) -> Result<Misfit> {
             break;
         }
         let est = moments.held_estimate(&kept, &mean)?;
-        // each type unit's value of each fitted term's combination
         let (mut c_mean, mut c_scatter) = (mean.clone(), scatter.clone());
         for &k in &kept {
-            let values: Vec<f64> = f
-                .units
-                .iter()
-                .map(|u| {
-                    u.estimate[k]
-                        + (0..own.len())
-                            .map(|o| est.held_map[k][o] * (u.estimate[o] - mean[o]))
-                            .sum::<f64>()
-                })
-                .collect();
-            c_mean[k] = crate::stats::mean(&values);
-            c_scatter[k] = crate::stats::std_dev(&values);
+            (c_mean[k], c_scatter[k]) = combination_over_units(ty, &est.held_map[k], k);
         }
         let combined = TypeSide {
             mean: &c_mean,
@@ -405,6 +393,28 @@ fn misfit_of(ty: &TypeModel, rows: &UnitRows, unit_id: &str) -> Result<Misfit> {
         }
     }
     Ok(best.1)
+}
+
+/// Term k's combination with the held terms (`held_row[o]`: held term o's weight,
+/// `resolved::HeldEstimate::held_map`) read on every unit of `ty`, from its own estimate:
+/// the combination's mean and scatter over the units.
+fn combination_over_units(ty: &TypeModel, held_row: &[f64], k: usize) -> (f64, f64) {
+    let mean = ty.mean();
+    let values: Vec<f64> = ty
+        .file
+        .units
+        .iter()
+        .map(|u| {
+            u.estimate[k]
+                + held_row
+                    .iter()
+                    .zip(&u.estimate)
+                    .zip(&mean)
+                    .map(|((a, e), m)| a * (e - m))
+                    .sum::<f64>()
+        })
+        .collect();
+    (crate::stats::mean(&values), crate::stats::std_dev(&values))
 }
 
 /// Every candidate `plan` allows (`scan`) and the one chosen among them (`choose`); None

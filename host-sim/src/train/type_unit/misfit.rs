@@ -13,9 +13,8 @@
 //! see even a unit `POWER_SIGMAS` spreads out (its se too large, e.g. T and dT/dt from
 //! runs at one ambient) has no test power, and is said to have none.
 //!
-//! Nearly collinear terms fitted all at once each have a large se and no power, though the
-//! runs resolve their combination, and every term tested widens the family's critical
-//! value; so the terms lacking power are held at the type's mean one by one, farthest from
+//! Every term tested widens the family's critical value, and nearly collinear terms
+//! fitted all at once each have a large se, though the runs resolve their combination; so the terms lacking power are held at the type's mean one by one, farthest from
 //! power first, and the rest refitted and tested, a smaller family, each against the same
 //! combination of the type's units' own estimates (`resolved`, `calibrate::misfit_of`).
 //! Held terms are not tested (no test power, said).

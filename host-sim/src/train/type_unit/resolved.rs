@@ -1,11 +1,12 @@
 //! The unit's own estimate of some of its terms with the others held at the type's mean:
 //! what the misfit test (`misfit`) reads when the unit's runs cannot resolve every term.
 //!
-//! Why: fitted all at once, nearly collinear unit terms (a warm-up gain and a Shupe
-//! coefficient once the rate input is exact, or a law type's twelve clock terms from six
-//! runs) each take a standard error larger than the type's spread, and the term-by-term
-//! test loses its power on every one of them, though the unit's runs fix their sum well.
-//! Held at the type's mean, the terms the runs cannot resolve no longer share the fit.
+//! Why: tested all at once, every term widens the family's critical value (a type of 5
+//! units and 3 terms: 5.8; a law type's 12 terms: above the 5-spread power bound for every
+//! term), and nearly collinear terms each take a large standard error, though the unit's
+//! runs fix their combination well (docs/record/fleet.md, "The misfit test on what the
+//! runs resolve"). Held at the type's mean, the terms the runs cannot resolve leave the
+//! fit and the family.
 //! Each fitted term's estimate is then exactly the all-at-once estimate plus the held
 //! terms' deviations through A = (X_I' X_I)^-1 X_I' X_O (`held_map`): a fixed linear
 //! combination of the unit's terms, so the misfit test reads the same combination of
