@@ -21,7 +21,8 @@ use fog_core::compensation::compensator::{
 };
 use fog_core::hal::{GyroSample, TableState, TempSample, Turntable};
 use fog_core::link::messages::{
-    Command, DeviceMessage, FaultState, Refusal, ResetReason, SeekReport, Status, LINK_VERSION,
+    Command, DeviceMessage, FaultState, Refusal, ResetReason, SeekFailureReport, SeekReport,
+    Status, LINK_VERSION,
 };
 use fog_core::model::format::RbfModel;
 use fog_core::model::heading::HeadingHarmonic;
@@ -185,6 +186,8 @@ pub struct App<T: Turntable, C: BorrowMut<Compensator> = Compensator> {
     /// (level until the first reading: a board without an inclinometer, the replay).
     tilt_window: TiltMean,
     tilt: Tilt,
+    /// A window has closed with readings (`tilt` is measured, not the level default).
+    tilt_measured: bool,
     /// Temperature state over the running seek's valid windows (the field record's).
     seek_temp: SeekTempState,
 }
@@ -234,6 +237,7 @@ where
             bit: BitWord::PASS,
             tilt_window: TiltMean::default(),
             tilt: Tilt::LEVEL,
+            tilt_measured: false,
             seek_temp: SeekTempState::new(),
         })
     }
@@ -409,11 +413,35 @@ where
         record_of_seek(r, validity, self.seek_temp.state(), model_crc32)
     }
 
+    /// The tilt a seek starts from: the last closed window's mean, or before any window
+    /// has closed with readings, the open window's readings so far. (A seek started in the
+    /// first window on a tilted base started from level and the first window's mean
+    /// restarted it, spending one of its motion restarts for nothing.)
+    fn start_tilt(&self) -> Tilt {
+        match (self.tilt_measured, self.tilt_window.mean()) {
+            (false, Some(t)) => t,
+            _ => self.tilt,
+        }
+    }
+
+    /// The link message of a seek that stopped without a result: why, when, and the
+    /// restarts it had used.
+    pub fn failure_report(&self, f: &SeekFailure<T::Error>) -> SeekFailureReport {
+        let (restarts, last_restart) = self.supervisor.restarts();
+        SeekFailureReport {
+            error: f.error,
+            t_s: f.t_s,
+            restarts,
+            last_restart,
+        }
+    }
+
     fn start_seek(&mut self, t_s: f64) -> Result<(), QualityError> {
         self.seek_temp.reset();
         self.table.last_error = None;
+        let tilt = self.start_tilt();
         self.supervisor
-            .start(&mut self.table, t_s, self.tilt, self.bit)?;
+            .start(&mut self.table, t_s, tilt, self.bit)?;
         self.seeks_started = self.seeks_started.saturating_add(1);
         self.next_table_poll_s = t_s + self.cfg.table_poll_s;
         Ok(())
@@ -476,6 +504,7 @@ where
         if let Some(w) = window {
             if let Some(t) = self.tilt_window.mean() {
                 self.tilt = t;
+                self.tilt_measured = true;
             }
             self.tilt_window = TiltMean::default();
             if self.supervisor.is_seeking() && w.status.is_valid() {

@@ -14,7 +14,9 @@
 //! - the seek restarts from its first position with its reason, on the console
 //!   (`FOG-SEEK-RESTART reason=GyroStall { gap_ms }`) and in the link status
 //!   (`restarts`, `last_restart`), where `gap_ms` is the sample time between the samples
-//!   around the stall.
+//!   around the stall;
+//! - three stalls more: two restarts, then the seek stops (`TooMuchMotion`, the last
+//!   reason the stall) and says so over the host link (`SeekFailed`, its restarts).
 //!
 //! Skips loudly without QEMU / the target unless FOG_REQUIRE_QEMU=1. Every wait is
 //! bounded; QEMU is killed when the test ends.
@@ -27,7 +29,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use fog_core::link::messages::{Command, DeviceMessage};
-use fog_core::seeking::quality::{MotionReason, SeekState};
+use fog_core::seeking::quality::{MotionReason, QualityError, SeekState};
 use fog_core::seeking::tilt::Tilt;
 use fog_sim::device::rig::{tcp_link, GyroCut, Rig, RigConfig};
 use fog_sim::device::upload::UploadClient;
@@ -54,7 +56,7 @@ fn field(line: &str, key: &str) -> u64 {
 }
 
 #[test]
-fn qemu_gyro_stall_mid_seek_keeps_time_counts_losses_and_restarts_with_reason() {
+fn qemu_gyro_stall_mid_seek_keeps_time_counts_losses_restarts_and_reports_the_failure() {
     if !qemu_ready("qemu_gyro_stall") {
         return;
     }
@@ -160,10 +162,34 @@ fn qemu_gyro_stall_mid_seek_keeps_time_counts_losses_and_restarts_with_reason() 
             })
         )
     );
+    // Two stalls more use the seek's restarts up; the fourth stops it, and the host hears
+    // why over the link (it once heard nothing, and a monitor waited for a result).
+    for k in 2..=4u8 {
+        let from = stall.next.load(Ordering::Relaxed) + 20;
+        stall.from.store(from, Ordering::Relaxed);
+        if k < 4 {
+            let restart = wait_line(&console, "FOG-SEEK-RESTART", WAIT);
+            assert!(restart.contains("GyroStall"), "stall {k}: {restart}");
+        }
+    }
+    let failed = read_link_until(&mut host, WAIT, |m| match m {
+        DeviceMessage::SeekFailed(f) => Some(f),
+        _ => None,
+    })
+    .unwrap_or_else(|| {
+        let rest: Vec<String> = console.try_iter().collect();
+        panic!("no seek failure over the link; the console since: {rest:#?}")
+    });
+    let reason = MotionReason::GyroStall {
+        gap_ms: gap_ms as u32,
+    };
     assert_eq!(
-        link_command(&mut host, Command::Abort, WAIT),
-        DeviceMessage::Accepted
+        (failed.error, failed.restarts, failed.last_restart),
+        (QualityError::TooMuchMotion(reason), 3, Some(reason)),
+        "{failed:?}"
     );
+    let s = wait_status(&mut host, WAIT, |s| s.state != SeekState::Seeking);
+    assert_eq!(s.state, SeekState::Ready, "{s:?}");
     stop.store(true, Ordering::Relaxed);
     let sum = rig.join().unwrap().expect("rig");
     eprintln!("rig: {sum:?}");

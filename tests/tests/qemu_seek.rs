@@ -49,7 +49,9 @@ use fog_core::model::heading::HeadingHarmonic;
 use fog_core::seeking::bit::{BitItem, BitWord};
 use fog_core::seeking::quality::{SeekState, Validity};
 use fog_core::seeking::tilt::Tilt;
-use fog_sim::device::monitor::{monitor, CsvAppend, MonitorOptions, MonitorSummary, ResultLog};
+use fog_sim::device::monitor::{
+    monitor, CsvAppend, Event, MonitorOptions, MonitorSummary, ResultLog,
+};
 use fog_sim::device::rig::{tcp_link, Rig, RigConfig, RigSummary};
 use fog_sim::device::upload::UploadClient;
 use fog_sim::registry::Registry;
@@ -134,13 +136,11 @@ fn session(
         commands,
     };
     let (mut statuses, mut reports) = (Vec::new(), Vec::new());
-    let sum = monitor(
-        &mut link,
-        log,
-        &opts,
-        |s| statuses.push(*s),
-        |r, _| reports.push(*r),
-    )
+    let sum = monitor(&mut link, log, &opts, |e| match e {
+        Event::Status(s) => statuses.push(*s),
+        Event::Result(r, _) => reports.push(*r),
+        Event::Failed(_) => {}
+    })
     .expect("monitor session");
     (sum, statuses, reports)
 }

@@ -24,8 +24,10 @@ use crate::seeking::tilt::Tilt;
 /// `faults` (safe mode), `Refusal` gained `SafeMode`; a version-1 peer cannot decode a
 /// version-2 status (postcard has no optional trailing fields), so both ends move
 /// together (they build against this crate). 3: `Command::GetFieldRecords` and
-/// `DeviceMessage::FieldRecords` appended (the earlier variants keep their bytes).
-pub const LINK_VERSION: u16 = 3;
+/// `DeviceMessage::FieldRecords` appended (the earlier variants keep their bytes). 4:
+/// `DeviceMessage::SeekFailed` appended: a seek that stops without a result says why (a
+/// monitor waited for a result that never came; the earlier variants keep their bytes).
+pub const LINK_VERSION: u16 = 4;
 
 /// Most field records in one `FieldRecords` reply (one reply fits `MAX_LINK_FRAME_LEN`).
 pub const MAX_FIELD_RECORDS_PER_REPLY: usize = 4;
@@ -89,6 +91,19 @@ pub enum DeviceMessage {
     Refused(Refusal),
     /// The answer to `GetFieldRecords`.
     FieldRecords(FieldRecordBatch),
+    /// A running seek stopped without a result (link version 4).
+    SeekFailed(SeekFailureReport),
+}
+
+/// Why a seek stopped without a result, and when.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SeekFailureReport {
+    pub error: QualityError,
+    /// When it stopped, s since power-on.
+    pub t_s: f64,
+    /// Restarts it had used (motion, gyro stalls) and the last reason.
+    pub restarts: u8,
+    pub last_restart: Option<MotionReason>,
 }
 
 /// Up to `MAX_FIELD_RECORDS_PER_REPLY` field records (the first `count` of `records`),
@@ -296,6 +311,15 @@ mod tests {
             ))),
             DeviceMessage::Refused(Refusal::NotSeeking),
             DeviceMessage::Refused(Refusal::SafeMode),
+            DeviceMessage::SeekFailed(SeekFailureReport {
+                error: QualityError::TooMuchMotion(MotionReason::RateJump {
+                    position: 3,
+                    sigmas: u16::MAX,
+                }),
+                t_s: 1e6,
+                restarts: u8::MAX,
+                last_restart: Some(MotionReason::GyroStall { gap_ms: u32::MAX }),
+            }),
             DeviceMessage::FieldRecords(full_batch()),
             DeviceMessage::FieldRecords(FieldRecordBatch {
                 records: [FieldRecord::ZERO; MAX_FIELD_RECORDS_PER_REPLY],

@@ -8,11 +8,13 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::{bail, Result};
-use fog_core::link::messages::{Command, Status};
+use fog_core::link::messages::{Command, SeekFailureReport, Status};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::upload::LinkArgs;
-use crate::device::monitor::{monitor, CsvAppend, MonitorOptions, ResultLog};
+use crate::device::monitor::{
+    monitor, CsvAppend, Event, MonitorOptions, MonitorSummary, ResultLog,
+};
 use crate::device::upload::device_gyro_id;
 use crate::io::utc::now_utc;
 use crate::registry::{self, Registry, SeekRecord};
@@ -36,7 +38,9 @@ pub struct Args {
         allow_negative_numbers = true
     )]
     pub latitude: Option<f32>,
-    /// Start a seek with this many table positions (2 or 4).
+    /// Start a seek with this many table positions (2 or 4). The session then fails if
+    /// the seek stops without a result (with the device's reason) or its results do not
+    /// come within --duration-s.
     #[arg(long = "positions", alias = "start", value_name = "POSITIONS")]
     pub start: Option<u8>,
     /// Stop after this many results.
@@ -73,31 +77,29 @@ pub fn run(a: Args) -> Result<()> {
     } else {
         ProgressBar::hidden()
     };
-    let sum = monitor(
-        &mut link,
-        &mut log,
-        &opts,
-        |s| {
-            if tty {
+    let sum = monitor(&mut link, &mut log, &opts, |e| {
+        let line = match e {
+            Event::Status(s) if tty => {
                 bar.set_position((s.progress.clamp(0.0, 1.0) * 1000.0) as u64);
                 bar.set_message(status_text(s));
-            } else {
-                println!("status utc={} {}", now_utc(), status_line(s));
+                return;
             }
-        },
-        |_, r| {
-            if tty {
-                bar.println(result_line(r));
-            } else {
-                println!("{}", result_line(r));
-            }
-        },
-    )?;
+            Event::Status(s) => format!("status utc={} {}", now_utc(), status_line(s)),
+            Event::Result(_, r) => result_line(r),
+            Event::Failed(f) => format!("failed utc={} {}", now_utc(), failure_line(f)),
+        };
+        if tty {
+            bar.println(line);
+        } else {
+            println!("{line}");
+        }
+    })?;
     bar.finish_and_clear();
     println!(
-        "summary statuses={} results={} bad_frames={} seek_retries={} gyro={gyro_id} registry={}{}",
+        "summary statuses={} results={} failed={} bad_frames={} seek_retries={} gyro={gyro_id} registry={}{}",
         sum.statuses,
         sum.results,
+        sum.failures.len(),
         sum.bad_frames,
         sum.start_retries,
         reg_path.display(),
@@ -114,7 +116,49 @@ pub fn run(a: Args) -> Result<()> {
     for r in &sum.refusals {
         println!("refused command={r}");
     }
+    if a.start.is_some() {
+        outcome_of_own_seek(&sum, a.results, a.duration_s)?;
+    }
     Ok(())
+}
+
+/// A session that started a seek fails unless it got its results: the seek stopped
+/// without one (the device's reason), or the time ran out (the last status said).
+fn outcome_of_own_seek(sum: &MonitorSummary, results: usize, duration_s: u64) -> Result<()> {
+    if let Some(f) = sum.failures.last() {
+        bail!(
+            "the seek stopped without a result at t={:.1} s since power-on: {} ({} restarts{})",
+            f.t_s,
+            f.error,
+            f.restarts,
+            f.last_restart
+                .map_or(String::new(), |r| format!(", the last for {r:?}"))
+        );
+    }
+    if sum.results < results {
+        bail!(
+            "{} of the {} results asked for (--results) within --duration-s {}; the last status: {}",
+            sum.results,
+            results,
+            duration_s,
+            sum.last_status
+                .as_ref()
+                .map_or("none".to_string(), status_line)
+        );
+    }
+    Ok(())
+}
+
+/// One seek failure as `key=value` fields (no spaces inside a value).
+pub fn failure_line(f: &SeekFailureReport) -> String {
+    format!(
+        "t_s={:.1} error={} restarts={} last_restart={}",
+        f.t_s,
+        format!("{:?}", f.error).replace(' ', ""),
+        f.restarts,
+        f.last_restart
+            .map_or("none".to_string(), |r| format!("{r:?}").replace(' ', ""))
+    )
 }
 
 /// The commands to send first, checked.
@@ -169,8 +213,8 @@ fn status_text(s: &Status) -> String {
 pub fn status_line(s: &Status) -> String {
     format!(
         "t_s={:.1} state={} progress={:.3} predicted_sigma_deg={:.4} temp_c={:.2} latitude_deg={:.4} \
-         pitch_deg={:.3} roll_deg={:.3} restarts={} bit={} model_crc32={} heading_cal={} \
-         faults_in_a_row={} safe_mode={}",
+         pitch_deg={:.3} roll_deg={:.3} restarts={} last_restart={} bit={} model_crc32={} \
+         heading_cal={} faults_in_a_row={} safe_mode={}",
         s.t_s,
         format!("{:?}", s.state).replace(' ', ""),
         s.progress,
@@ -180,6 +224,8 @@ pub fn status_line(s: &Status) -> String {
         s.tilt.pitch_deg,
         s.tilt.roll_deg,
         s.restarts,
+        s.last_restart
+            .map_or("none".to_string(), |r| format!("{r:?}").replace(' ', "")),
         bit_text(s),
         s.model_crc32
             .map_or("none".to_string(), |c| format!("0x{c:08X}")),
@@ -227,5 +273,45 @@ fn fault_text(f: &fog_core::link::messages::FaultState) -> String {
             f.last_cause,
             f.last_detail
         ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fog_core::seeking::quality::{MotionReason, QualityError};
+
+    #[test]
+    fn a_session_that_started_a_seek_fails_without_its_results_and_says_why() {
+        let mut sum = MonitorSummary {
+            results: 1,
+            ..MonitorSummary::default()
+        };
+        assert!(outcome_of_own_seek(&sum, 1, 300).is_ok());
+        sum.results = 0;
+        let e = outcome_of_own_seek(&sum, 1, 300).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "0 of the 1 results asked for (--results) within --duration-s 300; the last status: none"
+        );
+        let stall = MotionReason::GyroStall { gap_ms: 4000 };
+        sum.failures.push(SeekFailureReport {
+            error: QualityError::TooMuchMotion(stall),
+            t_s: 95.0,
+            restarts: 3,
+            last_restart: Some(stall),
+        });
+        let e = outcome_of_own_seek(&sum, 1, 300).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "the seek stopped without a result at t=95.0 s since power-on: seek stopped: base \
+             keeps moving (GyroStall { gap_ms: 4000 }) (3 restarts, the last for GyroStall { \
+             gap_ms: 4000 })"
+        );
+        assert_eq!(
+            failure_line(&sum.failures[0]),
+            "t_s=95.0 error=TooMuchMotion(GyroStall{gap_ms:4000}) restarts=3 \
+             last_restart=GyroStall{gap_ms:4000}"
+        );
     }
 }

@@ -235,10 +235,27 @@ impl Walk {
         eprintln!("$ {line}   ({:.1} s)", t0.elapsed().as_secs_f64());
         assert!(
             out.status.success(),
-            "{line}\n{stdout}\n{stderr}\n{}",
+            "{line}\n{stdout}\n{stderr}\n{}{}",
+            self.earlier_outputs(),
             self.job_logs()
         );
         self.outputs.push((line.to_string(), stdout));
+    }
+
+    /// The end of the output of every earlier command that printed something (a failure
+    /// can lie upstream: a monitor that saw no result, then a pull that found none).
+    fn earlier_outputs(&self) -> String {
+        self.outputs
+            .iter()
+            .filter(|(_, out)| !out.is_empty())
+            .map(|(l, out)| {
+                let cut = out.len().saturating_sub(3000);
+                let cut = (cut..=out.len())
+                    .find(|&i| out.is_char_boundary(i))
+                    .unwrap_or(0);
+                format!("--- earlier: {l}\n{}\n", &out[cut..])
+            })
+            .collect()
     }
 
     /// The end of every background job's log.

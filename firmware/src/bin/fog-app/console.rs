@@ -65,12 +65,16 @@ pub(crate) fn report<E: defmt::Format>(step: fog_firmware::app::Step<E>) {
             r.sigma_deg,
             r.duration_s
         ),
-        Some(SeekOutcome::Failed(f)) => defmt::error!(
-            "north seek aborted at t={} s: {} (turntable: {})",
-            f.t_s,
-            f.error,
-            f.table_error
-        ),
+        Some(SeekOutcome::Failed(f)) => {
+            defmt::error!(
+                "north seek aborted at t={} s: {} (turntable: {})",
+                f.t_s,
+                f.error,
+                f.table_error
+            );
+            #[cfg(feature = "log-semihosting")]
+            semihosting::eprintln!("FOG-SEEK-FAILED error={:?}", f.error);
+        }
         None => {}
     }
 }

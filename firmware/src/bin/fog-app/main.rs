@@ -246,11 +246,11 @@ fn main() -> ! {
             match gyro.read() {
                 Ok(Some(s)) => {
                     let health = watch.on_sample(now_s, s.t_s, s.rate_dph);
-                    if health.resumed {
+                    // A stall mid-seek restarts the seek, with its reason (or fails it).
+                    let stalled = health.resumed.then(|| {
                         defmt::info!("t={} s: gyro samples again", s.t_s);
-                        // A stall mid-seek restarts the seek, with its reason.
-                        report(app.on_gyro_stall(s.t_s, health.gap_s));
-                    }
+                        app.on_gyro_stall(s.t_s, health.gap_s)
+                    });
                     match health.stuck_event {
                         Some(StuckEvent::Stuck) => {
                             defmt::warn!("t={} s: gyro output stuck: windows invalid", s.t_s)
@@ -290,23 +290,33 @@ fn main() -> ! {
                     if let Some(w) = &step.window {
                         window_line(w, gyro.stats().frames_lost, gyro.uart_mut().dropped());
                     }
-                    if let Some(SeekOutcome::Failed(f)) = &step.seek {
-                        if f.table_error.is_some() {
-                            last_table_error_s = Some(now_s);
+                    for step in stalled.into_iter().chain(core::iter::once(step)) {
+                        match &step.seek {
+                            Some(SeekOutcome::Failed(f)) => {
+                                if f.table_error.is_some() {
+                                    last_table_error_s = Some(now_s);
+                                }
+                                // The host hears why: a monitor would otherwise wait for
+                                // a result that never comes.
+                                let failure = app.failure_report(f);
+                                send_link(tx_queue, DeviceMessage::SeekFailed(failure));
+                                next_status_s = now_s;
+                            }
+                            Some(SeekOutcome::Done(r, v)) => {
+                                let model_crc32 = server.active_info().map(|i| i.model_crc32);
+                                if let Some(record) = app.field_record(r, *v, model_crc32) {
+                                    append_field_record(field_log.as_mut(), record);
+                                }
+                                let report = app.report(r, *v);
+                                send_link(tx_queue, DeviceMessage::Result(report));
+                                seek_line(&report);
+                                // The state changed: a status now.
+                                next_status_s = now_s;
+                            }
+                            None => {}
                         }
+                        report(step);
                     }
-                    if let Some(SeekOutcome::Done(r, v)) = &step.seek {
-                        let model_crc32 = server.active_info().map(|i| i.model_crc32);
-                        if let Some(record) = app.field_record(r, *v, model_crc32) {
-                            append_field_record(field_log.as_mut(), record);
-                        }
-                        let report = app.report(r, *v);
-                        send_link(tx_queue, DeviceMessage::Result(report));
-                        seek_line(&report);
-                        // The state changed: a status now.
-                        next_status_s = now_s;
-                    }
-                    report(step);
                 }
                 Ok(None) => drained = true,
                 Err(e) => {

@@ -3,7 +3,8 @@
 //! Exists so an operator sees the device's live status (state, progress, predicted accuracy,
 //! BIT) and gets every seek result in a CSV. Frames are decoded with fog-core's
 //! `FrameReceiver` (the upload framing). The loop is bounded: it stops after `max_results`
-//! results or `max_duration`, whichever comes first.
+//! results or `max_duration`, whichever comes first, or when the seek it started stops
+//! without a result (`SeekFailed`, said with its reason).
 //!
 //! Results: every one is stored in the calibration registry with the context of the
 //! status before it (model CRC, temperature, latitude) and the gyro id, and, if asked,
@@ -19,7 +20,8 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use fog_core::link::messages::Refusal;
 use fog_core::link::messages::{
-    decode, encode, Command, DeviceFrame, DeviceMessage, HostFrame, SeekReport, Status,
+    decode, encode, Command, DeviceFrame, DeviceMessage, HostFrame, SeekFailureReport, SeekReport,
+    Status,
 };
 use fog_core::link::upload::{FrameReceiver, MAX_WIRE_FRAME_LEN, STATUS_REQUEST_PADDING};
 use fog_core::seeking::quality::{QualityError, SeekState};
@@ -49,6 +51,18 @@ pub struct MonitorSummary {
     pub last_status: Option<Status>,
     /// Seeks asked again after a BIT refusal, once the device was ready.
     pub start_retries: usize,
+    /// Seeks that stopped without a result, with the device's reason.
+    pub failures: Vec<SeekFailureReport>,
+}
+
+/// What the session shows as it comes.
+#[derive(Clone, Copy, Debug)]
+pub enum Event<'a> {
+    Status(&'a Status),
+    /// A result, as received and as stored in the registry.
+    Result(&'a SeekReport, &'a SeekRecord),
+    /// A seek stopped without a result.
+    Failed(&'a SeekFailureReport),
 }
 
 /// Runs the session on `link` (reads must time out, see `upload::open_link`).
@@ -56,8 +70,7 @@ pub fn monitor<L: Read + Write>(
     link: &mut L,
     log: &mut ResultLog,
     opts: &MonitorOptions,
-    mut on_status: impl FnMut(&Status),
-    mut on_result: impl FnMut(&SeekReport, &SeekRecord),
+    mut on_event: impl FnMut(Event),
 ) -> Result<MonitorSummary> {
     for c in &opts.commands {
         send(link, c)?;
@@ -74,7 +87,10 @@ pub fn monitor<L: Read + Write>(
     let mut sum = MonitorSummary::default();
     let deadline = Instant::now() + opts.max_duration;
     let mut buf = [0u8; 256];
-    while sum.results < opts.max_results && Instant::now() < deadline {
+    // The seek this session started stopped without a result: nothing more will come.
+    let started_seek_failed = |sum: &MonitorSummary| start.is_some() && !sum.failures.is_empty();
+    while sum.results < opts.max_results && Instant::now() < deadline && !started_seek_failed(&sum)
+    {
         let n = match read_polled(link, &mut buf).context("reading the link")? {
             Some(0) => break, // the device closed the link
             Some(n) => n,
@@ -96,7 +112,7 @@ pub fn monitor<L: Read + Write>(
                     }
                     let ready =
                         matches!(&m, DeviceMessage::Status(s) if s.state == SeekState::Ready);
-                    handle(m, log, &mut sum, &mut on_status, &mut on_result)?;
+                    handle(m, log, &mut sum, &mut on_event)?;
                     if let (true, true, Some(positions)) = (ready, start_pending, start) {
                         start_pending = false;
                         sum.start_retries += 1;
@@ -128,13 +144,12 @@ fn handle(
     msg: DeviceMessage,
     log: &mut ResultLog,
     sum: &mut MonitorSummary,
-    on_status: &mut impl FnMut(&Status),
-    on_result: &mut impl FnMut(&SeekReport, &SeekRecord),
+    on_event: &mut impl FnMut(Event),
 ) -> Result<()> {
     match msg {
         DeviceMessage::Status(s) => {
             sum.statuses += 1;
-            on_status(&s);
+            on_event(Event::Status(&s));
             sum.last_status = Some(s);
         }
         DeviceMessage::Result(r) => {
@@ -147,7 +162,11 @@ fn handle(
                 });
             let record = log.append(&r, ctx)?;
             sum.results += 1;
-            on_result(&r, &record);
+            on_event(Event::Result(&r, &record));
+        }
+        DeviceMessage::SeekFailed(f) => {
+            on_event(Event::Failed(&f));
+            sum.failures.push(f);
         }
         DeviceMessage::Accepted => sum.accepted += 1,
         DeviceMessage::Refused(why) => sum.refusals.push(format!("{why:?}")),
@@ -163,8 +182,7 @@ mod tests {
     use crate::registry::{Registry, RESULTS_CSV_HEADER};
     use fog_core::link::messages::{ResetReason, LINK_VERSION};
     use fog_core::seeking::bit::BitWord;
-    use fog_core::seeking::quality::SeekState;
-    use fog_core::seeking::quality::Validity;
+    use fog_core::seeking::quality::{MotionReason, SeekState, Validity};
     use fog_core::seeking::tilt::Tilt;
     use std::net::{TcpListener, TcpStream};
     use std::path::Path;
@@ -271,16 +289,73 @@ mod tests {
             ],
         };
         let mut progress = Vec::new();
-        let sum = monitor(
-            &mut link,
-            &mut log,
-            &opts,
-            |s| progress.push(s.progress),
-            |_, _| {},
-        )
+        let sum = monitor(&mut link, &mut log, &opts, |e| {
+            if let Event::Status(s) = e {
+                progress.push(s.progress);
+            }
+        })
         .unwrap();
         assert_eq!(dev.join().unwrap(), opts.commands);
         (sum, progress)
+    }
+
+    /// One session against a fake device that sends a status and a seek failure, then
+    /// keeps the link open and silent: the session's summary and how long it took.
+    fn failing_session(commands: Vec<Command>, name: &str) -> (MonitorSummary, Duration) {
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let addr = listener.local_addr().unwrap();
+        let (done_tx, done_rx) = std::sync::mpsc::channel::<()>();
+        let dev = std::thread::spawn(move || {
+            let (mut s, _) = listener.accept().unwrap();
+            let mut wire = [0u8; MAX_WIRE_FRAME_LEN];
+            for m in [
+                DeviceMessage::Status(status(0.5)),
+                DeviceMessage::SeekFailed(failure()),
+            ] {
+                let n = encode(&DeviceFrame::Link(m), &mut wire).unwrap();
+                s.write_all(&wire[..n]).unwrap();
+            }
+            let _ = done_rx.recv_timeout(Duration::from_secs(30));
+        });
+        let mut link = TcpStream::connect(addr).unwrap();
+        link.set_read_timeout(Some(Duration::from_millis(50)))
+            .unwrap();
+        let dir = scratch(name);
+        let reg = Registry::open(&dir.join("reg.sqlite")).unwrap();
+        let mut log = ResultLog::new(reg, None, "FOG-F1");
+        let opts = MonitorOptions {
+            max_results: 1,
+            max_duration: Duration::from_secs(3),
+            commands,
+        };
+        let t0 = Instant::now();
+        let sum = monitor(&mut link, &mut log, &opts, |_| {}).unwrap();
+        let took = t0.elapsed();
+        done_tx.send(()).unwrap();
+        dev.join().unwrap();
+        (sum, took)
+    }
+
+    fn failure() -> SeekFailureReport {
+        let stall = MotionReason::GyroStall { gap_ms: 4000 };
+        SeekFailureReport {
+            error: QualityError::TooMuchMotion(stall),
+            t_s: 95.0,
+            restarts: 3,
+            last_restart: Some(stall),
+        }
+    }
+
+    #[test]
+    fn the_seek_it_started_failing_ends_the_session_with_the_reason() {
+        // Its own seek: the failure ends the wait at once (the device stays connected).
+        let (sum, took) = failing_session(vec![Command::StartSeek { positions: 2 }], "failed-own");
+        assert_eq!((sum.results, sum.failures.clone()), (0, vec![failure()]));
+        assert!(took < Duration::from_secs(2), "{took:?}");
+        // Watching only (no start): the failure is kept and the session runs its time.
+        let (sum, took) = failing_session(vec![Command::GetStatus], "failed-watch");
+        assert_eq!((sum.results, sum.failures.clone()), (0, vec![failure()]));
+        assert!(took >= Duration::from_secs(3), "{took:?}");
     }
 
     #[test]
