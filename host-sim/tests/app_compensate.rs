@@ -69,3 +69,43 @@ fn compensation_improves_held_out_runs_and_json_has_the_issue_shape() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `out_of_range_windows` of `fogsim compensate DIR --model MODEL` (one run).
+fn out_of_range_windows(dir: &std::path::Path, runs: &str, model: &str) -> u64 {
+    let json = format!("{runs}.json");
+    let out = fogsim(
+        dir,
+        &["compensate", runs, "--model", model, "--json", &json],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join(&json)).unwrap()).unwrap();
+    v["runs"][0]["out_of_range_windows"].as_u64().unwrap()
+}
+
+/// A type model reading the power-on clocks (the law shape of a 3-unit fleet of 30 min
+/// cold starts) on a unit left on for an hour: no window leaves the declared range, the
+/// clocks' settled value being inside it (it flagged 86 of 360 windows, every one from
+/// 46 min on, and every seek then). The twin, a cold start at an ambient the fleet never
+/// saw (50 degC), is still flagged throughout.
+#[test]
+fn a_clock_model_from_half_hour_runs_keeps_a_unit_on_for_an_hour_in_range() {
+    let dir = scratch_dir("compensate-clock-range");
+    for args in [
+        "campaign --out fleet --units 3 --ambient 10,20,30 --runs 1 --minutes 30 --raw-rate-hz 1 --seed 3",
+        "train fleet --type-out type.json --out type.fogm",
+        "campaign --out long --ambient 20 --runs 1 --minutes 60 --raw-rate-hz 1 --seed 5",
+        "campaign --out hot --ambient 50 --runs 1 --minutes 30 --raw-rate-hz 1 --seed 5",
+    ] {
+        let args: Vec<&str> = args.split(' ').collect();
+        let out = fogsim(&dir, &args);
+        assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+    }
+    let ty = std::fs::read_to_string(dir.join("type.json")).unwrap();
+    assert!(
+        ty.contains("warm-up clock amplitude (400 s)"),
+        "the type reads the power-on clocks"
+    );
+    assert_eq!(out_of_range_windows(&dir, "long", "type.fogm"), 0);
+    assert_eq!(out_of_range_windows(&dir, "hot", "type.fogm"), 180);
+}

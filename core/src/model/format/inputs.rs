@@ -99,6 +99,18 @@ impl FeatureKind {
         )
     }
 
+    /// The value an input that is a function of the time since power-on alone tends to as
+    /// that time grows (exp(-t/tau) and (t/tau) exp(-t/tau) both to 0), `None` for inputs
+    /// that read the gyro. A unit on for longer than any training run is further on the
+    /// same curve, not in a state nobody saw: the trainer's declared range reaches this
+    /// value (the gyro's own inputs still guard its state).
+    pub const fn settled_value(self) -> Option<f32> {
+        match self {
+            FeatureKind::PowerOnDecay | FeatureKind::PowerOnDecayStretch => Some(0.0),
+            _ => None,
+        }
+    }
+
     /// True for kinds that take the power-on to be a cold start from a soak: the clock
     /// since power-on, the rise since the first reading, and the lag and flat-start d2T/dt2
     /// that start from the first reading as if it were the unit's settled state. A model

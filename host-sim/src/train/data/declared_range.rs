@@ -18,6 +18,12 @@
 //! Without replicates (dof = 0) there is no estimate and the raw envelope stays (said in
 //! the report). Far-off inputs (another ambient, a faster warm-up than any unit of the
 //! population) are still flagged.
+//!
+//! An input that is a function of the time since power-on alone (`FeatureKind::
+//! settled_value`: the power-on decays) reaches, on its late side, the value it settles
+//! to: a unit on for longer than the training runs is further along the same curve, and
+//! flagging it made every seek after the runs' length fail (a model trained on 30 min runs
+//! flagged a warm unit from 46 min on).
 
 use crate::stats::student_t::upper_quantile;
 use crate::train::data::dataset::Dataset;
@@ -113,6 +119,11 @@ pub fn declared_ranges(ds: &Dataset) -> Vec<InputRange> {
                 0.0
             };
             let widen = |n: usize| t * s * (1.0 + 1.0 / n as f64).sqrt();
+            let (mut declared_min, mut declared_max) = (lo.0 - widen(lo.1), hi.0 + widen(hi.1));
+            if let Some(v) = ds.specs.get(j).and_then(|f| f.kind.settled_value()) {
+                declared_min = declared_min.min(f64::from(v));
+                declared_max = declared_max.max(f64::from(v));
+            }
             InputRange {
                 input: ds.input_names[j].clone(),
                 envelope_min: lo.0,
@@ -120,8 +131,8 @@ pub fn declared_ranges(ds: &Dataset) -> Vec<InputRange> {
                 extreme_std: s,
                 dof,
                 t_factor: t,
-                declared_min: lo.0 - widen(lo.1),
-                declared_max: hi.0 + widen(hi.1),
+                declared_min,
+                declared_max,
             }
         })
         .collect()
@@ -175,6 +186,58 @@ mod tests {
         let ds = dataset(&maxima, &[Some(-40.0), Some(20.0), Some(60.0)]);
         let r = &declared_ranges(&ds)[0];
         assert_eq!((r.dof, r.declared_max, r.declared_min), (0, 1.1, 0.0));
+    }
+
+    #[test]
+    fn a_power_on_clock_reaches_its_settled_value_and_the_gyros_inputs_do_not() {
+        // Three 30 min runs at one ambient: exp(-t/400 s), (t/400 s) exp(-t/400 s) and a
+        // temperature rising to its settled value. The clocks' late side reaches 0 (a unit
+        // on for an hour is further along them); their early side and the temperature keep
+        // the envelope (identical runs: no widening).
+        let specs = vec![
+            FeatureSpec {
+                kind: FeatureKind::PowerOnDecay,
+                tau_s: 400.0,
+            },
+            FeatureSpec {
+                kind: FeatureKind::PowerOnDecayStretch,
+                tau_s: 400.0,
+            },
+            FeatureSpec::plain(FeatureKind::TempC),
+        ];
+        let names = vec!["decay".into(), "stretch".into(), "t".into()];
+        let mut ds = Dataset::with_specs(specs, names).unwrap();
+        let t: Vec<f64> = (1..=180).map(|k| 10.0 * f64::from(k)).collect();
+        let rows: Vec<Vec<f64>> = t
+            .iter()
+            .map(|&t| {
+                let u = t / 400.0;
+                vec![(-u).exp(), u * (-u).exp(), 20.0 + 8.0 * (1.0 - (-u).exp())]
+            })
+            .collect();
+        for r in 0..3 {
+            let id = ds
+                .push_group(&format!("r{r}"), &rows, &[0.0; 180], &t)
+                .unwrap();
+            ds.set_group_ambient(id, Some(20.0));
+        }
+        let ranges = declared_ranges(&ds);
+        let (first, last) = (&rows[0], &rows[179]);
+        assert_eq!(
+            (ranges[0].declared_min, ranges[0].declared_max),
+            (0.0, first[0])
+        );
+        assert_eq!(ranges[0].envelope_min, last[0]);
+        assert_eq!(ranges[1].declared_min, 0.0);
+        assert_eq!(
+            ranges[1].declared_max,
+            (-1.0f64).exp(),
+            "the peak at t = tau"
+        );
+        assert_eq!(
+            (ranges[2].declared_min, ranges[2].declared_max),
+            (first[2], last[2])
+        );
     }
 
     #[test]
