@@ -49,7 +49,8 @@ pub struct MonitorSummary {
     pub accepted: usize,
     pub refusals: Vec<String>,
     pub last_status: Option<Status>,
-    /// Seeks asked again after a BIT refusal, once the device was ready.
+    /// Seeks asked again (after a BIT refusal, once the device was ready, or after an
+    /// answer that did not come; `PendingStart`).
     pub start_retries: usize,
     /// Seeks that stopped without a result, with the device's reason.
     pub failures: Vec<SeekFailureReport>,
@@ -76,13 +77,11 @@ pub fn monitor<L: Read + Write>(
         send(link, c)?;
     }
     link.flush()?;
-    // A seek refused because a built-in test item fails (the gyro link not up yet, the
-    // model still warming up) is asked again when the device next reports `Ready`.
     let start = opts.commands.iter().find_map(|c| match c {
         Command::StartSeek { positions } => Some(*positions),
         _ => None,
     });
-    let mut start_pending = false;
+    let mut pending = start.map(|positions| PendingStart::new(positions, Instant::now()));
     let mut rx = FrameReceiver::new();
     let mut sum = MonitorSummary::default();
     let deadline = Instant::now() + opts.max_duration;
@@ -104,17 +103,14 @@ pub fn monitor<L: Read + Write>(
                 // An upload client's answers share the port.
                 Ok(DeviceFrame::Upload(_)) => sum.upload_frames += 1,
                 Ok(DeviceFrame::Link(m)) => {
-                    if matches!(
-                        m,
-                        DeviceMessage::Refused(Refusal::Quality(QualityError::Blocked(_)))
-                    ) {
-                        start_pending = start.is_some() && sum.results == 0;
+                    let again = pending
+                        .as_mut()
+                        .and_then(|p| p.on_message(&m, Instant::now()));
+                    if matches!(&m, DeviceMessage::Result(_)) {
+                        pending = None;
                     }
-                    let ready =
-                        matches!(&m, DeviceMessage::Status(s) if s.state == SeekState::Ready);
                     handle(m, log, &mut sum, &mut on_event)?;
-                    if let (true, true, Some(positions)) = (ready, start_pending, start) {
-                        start_pending = false;
+                    if let Some(positions) = again {
                         sum.start_retries += 1;
                         send(link, &Command::StartSeek { positions })?;
                         link.flush()?;
@@ -124,6 +120,68 @@ pub fn monitor<L: Read + Write>(
         }
     }
     Ok(sum)
+}
+
+/// The seek this session asked for, until the device is seen running it. It is asked
+/// again when the device next reports `Ready` after refusing it because a built-in test
+/// item fails (the gyro link not up yet, the model still warming up), or when no answer
+/// and no running seek came within `ANSWER_WAIT` (the device drops an answer it cannot
+/// send at once; the start itself may then have been refused and lost).
+#[derive(Clone, Copy, Debug)]
+struct PendingStart {
+    positions: u8,
+    sent: Instant,
+    blocked: bool,
+    /// Seen running, or refused for good: never asked again.
+    settled: bool,
+}
+
+/// How long an unanswered start is waited for before it is asked again: a device answers
+/// within a status period (1 s).
+const ANSWER_WAIT: Duration = Duration::from_secs(3);
+
+impl PendingStart {
+    fn new(positions: u8, sent: Instant) -> Self {
+        Self {
+            positions,
+            sent,
+            blocked: false,
+            settled: false,
+        }
+    }
+
+    /// Follows one message; `Some(positions)`: ask again now.
+    fn on_message(&mut self, m: &DeviceMessage, now: Instant) -> Option<u8> {
+        if self.settled {
+            return None;
+        }
+        match m {
+            DeviceMessage::Refused(Refusal::Quality(QualityError::Blocked(_))) => {
+                self.blocked = true;
+                None
+            }
+            DeviceMessage::Status(s) if s.state == SeekState::Seeking => {
+                // Running: nothing more to ask (a later `Ready` is its end, not a refusal).
+                self.settled = true;
+                None
+            }
+            DeviceMessage::Status(s)
+                if s.state == SeekState::Ready
+                    && (self.blocked || now.duration_since(self.sent) >= ANSWER_WAIT) =>
+            {
+                (self.blocked, self.sent) = (false, now);
+                Some(self.positions)
+            }
+            // Refused for good (tilt, busy, safe mode): not asked again.
+            DeviceMessage::Refused(
+                Refusal::Quality(_) | Refusal::SafeMode | Refusal::BadPositions,
+            ) => {
+                self.settled = true;
+                None
+            }
+            _ => None,
+        }
+    }
 }
 
 /// Sends one command. The zero bytes before it (empty frames, ignored) pay for the
@@ -344,6 +402,44 @@ mod tests {
             restarts: 3,
             last_restart: Some(stall),
         }
+    }
+
+    #[test]
+    fn a_start_is_asked_again_after_a_bit_refusal_or_a_lost_answer_and_never_once_running() {
+        let t0 = Instant::now();
+        let at = |s: f64| t0 + Duration::from_secs_f64(s);
+        let with = |state| {
+            DeviceMessage::Status(Status {
+                state,
+                ..status(0.0)
+            })
+        };
+        let (ready, seeking) = (with(SeekState::Ready), with(SeekState::Seeking));
+        let blocked = DeviceMessage::Refused(Refusal::Quality(QualityError::Blocked(
+            fog_core::seeking::bit::BitItem::GyroLink,
+        )));
+        // Refused while the gyro link was down: asked again at the next Ready.
+        let mut p = PendingStart::new(2, t0);
+        assert_eq!(p.on_message(&blocked, at(0.1)), None);
+        assert_eq!(p.on_message(&ready, at(0.5)), Some(2));
+        // No answer (dropped): a Ready within the wait is the device before the command...
+        let mut p = PendingStart::new(4, t0);
+        assert_eq!(p.on_message(&ready, at(1.0)), None);
+        // ...after it, the start is asked again, and once more only after another wait.
+        assert_eq!(p.on_message(&ready, at(3.5)), Some(4));
+        assert_eq!(p.on_message(&ready, at(4.5)), None);
+        assert_eq!(p.on_message(&ready, at(7.0)), Some(4));
+        // Seen running: its end (Ready) is not a refusal.
+        assert_eq!(p.on_message(&seeking, at(8.0)), None);
+        assert_eq!(p.on_message(&ready, at(100.0)), None);
+        // Refused for good (tilt): never asked again.
+        let mut p = PendingStart::new(2, t0);
+        let tilt = DeviceMessage::Refused(Refusal::Quality(QualityError::TiltOutOfRange {
+            tilt_cdeg: 3100,
+            max_cdeg: 3000,
+        }));
+        assert_eq!(p.on_message(&tilt, at(0.1)), None);
+        assert_eq!(p.on_message(&ready, at(10.0)), None);
     }
 
     #[test]
