@@ -698,15 +698,25 @@ fn the_type_and_unit_recipe_on_the_independent_fleet_and_its_twins() {
     let mut tally = Tally::default();
     // the Thue-Morse seek's worst |mean| / std over the ambients, type + unit runs, by shape
     let mut tm_bias: Vec<(TypeShape, f64)> = Vec::new();
+    let shapes = shapes();
     for seed in seeds() {
-        for shape in shapes() {
+        for &shape in &shapes {
             for law in fleets() {
+                // `auto` keeps the law on identical units (asserted below): measured with
+                // it, the law type there is measured once (the CI's time).
+                if shape == TypeShape::Law
+                    && law == FleetLaw::Identical
+                    && shapes.contains(&TypeShape::Auto)
+                    && type_unit_runs() == 6
+                {
+                    continue;
+                }
                 let m = measure(law, shape, seed, starts);
                 print_table(law, shape, &m.judged, starts);
                 tally.add(law, shape, &m.judged);
                 let tm = SeekMode::TwoPositionThueMorse;
                 let tm_shape = m.shapes.iter().find(|s| s.0 == tm).map(|s| s.1);
-                if seed == 1 && shape == TypeShape::Law && law == FleetLaw::Identical {
+                if seed == 1 && law == FleetLaw::Identical && tm_shape == Some(SharedShape::Law) {
                     assert!(!m.refused, "the null twin's U11 refused");
                     let met = cells_met(&m.judged, "type + unit runs", tm);
                     assert_eq!(met, 3, "the null twin's Thue-Morse cells met");
