@@ -73,7 +73,7 @@ pub(crate) fn report<E: defmt::Format>(step: fog_firmware::app::Step<E>) {
                 f.table_error
             );
             #[cfg(feature = "log-semihosting")]
-            semihosting::eprintln!("FOG-SEEK-FAILED error={:?}", f.error);
+            semihosting::eprintln!("FOG-SEEK-FAILED t_ms={}", (f.t_s * 1000.0) as u64);
         }
         None => {}
     }
