@@ -33,14 +33,18 @@ pub fn start_with_console(
     let stderr = qemu.0.stderr.take().expect("piped");
     std::thread::spawn(move || {
         // Semihosting stderr carries the text lines (defmt's binary frames go to
-        // stdout, docs/guide/firmware.md "The console: two channels"); keep the tagged ones.
+        // stdout, docs/guide/firmware.md "The console: two channels"); the tagged ones
+        // from their tag on.
         let mut reader = BufReader::new(stderr);
         let mut line = Vec::new();
         while reader.read_until(b'\n', &mut line).is_ok_and(|n| n > 0) {
             let text = String::from_utf8_lossy(&line);
-            if let Some(at) = text.find("FOG-") {
-                let _ = tx.send(text[at..].trim_end().to_string());
-            }
+            let _ = match text.find("FOG-") {
+                Some(at) => tx.send(text[at..].trim_end().to_string()),
+                // QEMU's own errors (a port it cannot bind, a missing file) and anything
+                // else: kept, tagged, so a wait that sees no tagged line shows them.
+                None => tx.send(format!("stderr: {}", text.trim_end())),
+            };
             line.clear();
         }
     });
