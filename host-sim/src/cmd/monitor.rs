@@ -154,11 +154,15 @@ pub fn failure_line(f: &SeekFailureReport) -> String {
     format!(
         "t_s={:.1} error={} restarts={} last_restart={}",
         f.t_s,
-        format!("{:?}", f.error).replace(' ', ""),
+        field_value(&f.error),
         f.restarts,
-        f.last_restart
-            .map_or("none".to_string(), |r| format!("{r:?}").replace(' ', ""))
+        f.last_restart.as_ref().map_or("none".into(), field_value)
     )
+}
+
+/// A value's Debug form without spaces, for one `key=value` field.
+fn field_value(v: &impl std::fmt::Debug) -> String {
+    format!("{v:?}").replace(' ', "")
 }
 
 /// The commands to send first, checked.
@@ -216,7 +220,7 @@ pub fn status_line(s: &Status) -> String {
          pitch_deg={:.3} roll_deg={:.3} restarts={} last_restart={} bit={} model_crc32={} \
          heading_cal={} faults_in_a_row={} safe_mode={}",
         s.t_s,
-        format!("{:?}", s.state).replace(' ', ""),
+        field_value(&s.state),
         s.progress,
         s.predicted_sigma_deg,
         s.temp_c,
@@ -224,8 +228,7 @@ pub fn status_line(s: &Status) -> String {
         s.tilt.pitch_deg,
         s.tilt.roll_deg,
         s.restarts,
-        s.last_restart
-            .map_or("none".to_string(), |r| format!("{r:?}").replace(' ', "")),
+        s.last_restart.as_ref().map_or("none".into(), field_value),
         bit_text(s),
         s.model_crc32
             .map_or("none".to_string(), |c| format!("0x{c:08X}")),

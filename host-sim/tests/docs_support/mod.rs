@@ -248,13 +248,7 @@ impl Walk {
         self.outputs
             .iter()
             .filter(|(_, out)| !out.is_empty())
-            .map(|(l, out)| {
-                let cut = out.len().saturating_sub(3000);
-                let cut = (cut..=out.len())
-                    .find(|&i| out.is_char_boundary(i))
-                    .unwrap_or(0);
-                format!("--- earlier: {l}\n{}\n", &out[cut..])
-            })
+            .map(|(l, out)| format!("--- earlier: {l}\n{}\n", tail_of(out.as_bytes())))
             .collect()
     }
 
@@ -314,7 +308,11 @@ impl Walk {
 
 /// The last lines of a job's log (QEMU's console carries binary defmt frames: lossy).
 fn tail(log: &Path) -> String {
-    let bytes = std::fs::read(log).unwrap_or_default();
+    tail_of(&std::fs::read(log).unwrap_or_default())
+}
+
+/// The last 4,000 bytes of an output, as text (lossy).
+fn tail_of(bytes: &[u8]) -> String {
     String::from_utf8_lossy(&bytes[bytes.len().saturating_sub(4000)..]).into_owned()
 }
 

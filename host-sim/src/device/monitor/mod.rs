@@ -106,9 +106,6 @@ pub fn monitor<L: Read + Write>(
                     let again = pending
                         .as_mut()
                         .and_then(|p| p.on_message(&m, Instant::now()));
-                    if matches!(&m, DeviceMessage::Result(_)) {
-                        pending = None;
-                    }
                     handle(m, log, &mut sum, &mut on_event)?;
                     if let Some(positions) = again {
                         sum.start_retries += 1;
@@ -160,8 +157,13 @@ impl PendingStart {
                 self.blocked = true;
                 None
             }
-            DeviceMessage::Status(s) if s.state == SeekState::Seeking => {
-                // Running: nothing more to ask (a later `Ready` is its end, not a refusal).
+            // Running, or already done: nothing more to ask (a later `Ready` is its end,
+            // not a refusal).
+            DeviceMessage::Status(Status {
+                state: SeekState::Seeking,
+                ..
+            })
+            | DeviceMessage::Result(_) => {
                 self.settled = true;
                 None
             }
