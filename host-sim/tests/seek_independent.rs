@@ -48,9 +48,9 @@ use fog_sim::train::type_unit::{
     calibrate_unit, choose_own, resolve_shape, OwnChoice, ShapeChoice, ShapeScoring, SharedShape,
     TypeModel, TypeShape, UnitPlan,
 };
-use fog_sim::train::warmup_clock::RateClock;
+use fog_sim::train::warmup_clock::{in_runs_clock, RateClock};
 use fog_sim::train::{
-    dataset_from_runs, default_specs, feature_name, train_model, InputChoice, TrainConfig,
+    choose_inputs_default, feature_name, train_model, InputChoice, InputSet, TrainConfig,
 };
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -233,14 +233,17 @@ fn met((all, worst13, bias, _): (f64, f64, f64, usize)) -> bool {
     all <= 1.1 && worst13 <= 1.15 && bias <= 0.3
 }
 
-/// The type-free recipe: `fogsim train`'s default trainer on the unit's runs alone, scored
-/// with the sequence's seek geometry.
+/// The type-free recipe: `fogsim train`'s default trainer on the unit's runs alone (T and
+/// dT/dt, dT/dt in the clock the runs choose, `--warmup-clock auto`; `INDEP_ALONE_CLOCK`
+/// as `INDEP_RATE_CLOCK`), scored with the sequence's seek geometry.
 fn train_alone(runs: &[Run], criterion: Criterion) -> RbfModel {
-    let ds = dataset_from_runs(runs, &default_specs()).unwrap();
     let cfg = TrainConfig {
         criterion,
+        rate_clock: clock_from_env("INDEP_ALONE_CLOCK"),
         ..TrainConfig::default()
     };
+    let (cfg, _) = in_runs_clock(runs, &cfg);
+    let (_, ds) = choose_inputs_default(runs, &[InputSet::TempRate], &cfg).unwrap();
     train_model(&ds, &cfg).unwrap().model
 }
 
@@ -289,11 +292,16 @@ fn with_scoring<R>(
 /// How the type's network reads dT/dt (`INDEP_RATE_CLOCK=auto|slope`, default `train
 /// --warmup-clock`'s).
 fn rate_clock() -> RateClock {
-    match std::env::var("INDEP_RATE_CLOCK").as_deref() {
+    clock_from_env("INDEP_RATE_CLOCK")
+}
+
+/// The clock the variable `var` names (`auto|slope`; unset: `train --warmup-clock`'s default).
+fn clock_from_env(var: &str) -> RateClock {
+    match std::env::var(var).as_deref() {
         Ok("auto") => RateClock::Auto,
         Ok("slope") => RateClock::Slope,
         Err(_) => RateClock::default(),
-        Ok(other) => panic!("INDEP_RATE_CLOCK: unknown clock {other}"),
+        Ok(other) => panic!("{var}: unknown clock {other}"),
     }
 }
 
@@ -694,9 +702,10 @@ impl Tally {
 /// The unit's own model beside its calibration (`type_unit::own`), seed 1, Thue-Morse,
 /// with a type whose network reads dT/dt as the slope (`--warmup-clock slope`), which
 /// cannot carry these units' warm-up (docs/record/fleet.md): 24 of the unit's runs take it
-/// out of its type (measured t 4.9, critical 2.5); with 6 runs they do not (t -1.6,
-/// critical 3.4), nor do the same 24 runs of the null twin, whose type carries the unit
-/// (t -4.0). (With 48 runs every seed 1-3 leaves, and the recipe meets 6 of 9 cells as the
+/// out of its type (measured t 5.0, critical 2.5; the own model read in the runs' clock,
+/// as `train` reads it since 2026-12-06: 4.9 with the slope); with 6 runs they do not (t
+/// -1.0, critical 3.4; -1.6), nor do the same 24 runs of the null twin, whose type carries
+/// the unit (t -4.4; -4.0). (With 48 runs every seed 1-3 leaves, and the recipe meets 6 of 9 cells as the
 /// unit's runs alone, against 2 of 9: docs/record/fleet.md.) With the clock the type
 /// chooses (the default) it carries the unit and 24 runs stay with it (t -2.3).
 ///

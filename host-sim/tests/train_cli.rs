@@ -91,6 +91,15 @@ fn train_writes_a_valid_model_and_rejects_bad_input_without_output() {
     );
     assert_eq!(linear_terms_line(&printed), "linear terms: none (pure RBF)");
     assert!(!m.centers.is_empty() && m.centers.len() <= 10);
+    // an exponential warm-up keeps dT/dt as the slope (`--warmup-clock auto`; its twin, a
+    // diffusion warm-up read in its clock: train_type::the_cli_reads_dt_dt_in_the_clock...)
+    assert!(
+        printed
+            .lines()
+            .any(|l| l.starts_with("dT/dt read as the slope against time")),
+        "{printed}"
+    );
+    assert!(m.inputs.iter().any(|s| s.kind == FeatureKind::TempRateCps));
     let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
     assert_eq!(report["n_runs"], 6);
     assert!(report["heldout_rms_dph"].as_f64().unwrap() < 0.01);

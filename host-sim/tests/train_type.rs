@@ -1199,8 +1199,9 @@ fn the_type_reads_the_simulators_own_unit_spread() {
 /// By default (`--warmup-clock auto`) a type whose runs warm up by diffusion (the
 /// independent fleet) reads the network's dT/dt in that clock, says so, and writes model
 /// format 7; the unit calibrated against it is an ordinary model of the same inputs. With
-/// `--warmup-clock slope` the slope stays (format 6, no such line). The flag without
-/// `--type-out` is refused in one line, nothing written.
+/// `--warmup-clock slope` the slope stays (format 6, no such line). The type-free `train`
+/// of one unit's runs chooses alike; beside `--type` the flag is refused in one line,
+/// nothing written.
 #[test]
 fn the_cli_reads_dt_dt_in_the_clock_a_type_chooses() {
     let dir = app_support::scratch_dir("type-clock");
@@ -1261,16 +1262,43 @@ fn the_cli_reads_dt_dt_in_the_clock_a_type_chooses() {
     assert!(!slope.contains("dT/dt read as"), "{slope}");
     assert_eq!(std::fs::read(dir.join("shared-s.model")).unwrap()[5], 6);
 
-    let refused = fogsim(
+    // the type-free `train` chooses the same way: two units' runs read in the diffusion
+    // clock by default, the slope kept with `--warmup-clock slope`
+    let unit5 = indep_files(&dir, &[5]);
+    let two = indep_files(&dir, &[4, 5]);
+    let alone = fogsim_ok(&dir, &train_args(&two, &["--out", "alone.model"]));
+    assert!(
+        alone
+            .lines()
+            .any(|l| l.starts_with("dT/dt read as the diffusion clock (")),
+        "{alone}"
+    );
+    let m = read_model(&dir.join("alone.model")).unwrap();
+    assert!(m
+        .inputs
+        .iter()
+        .any(|s| s.kind == fog_core::model::format::FeatureKind::TempRateDiffusionCps));
+    let alone_s = fogsim_ok(
         &dir,
-        &train_args(
-            &type_runs,
-            &["--out", "alone.model", "--warmup-clock", "slope"],
-        ),
+        &train_args(&two, &["--out", "alone-s.model", "--warmup-clock", "slope"]),
+    );
+    assert!(!alone_s.contains("dT/dt read as"), "{alone_s}");
+    assert_eq!(std::fs::read(dir.join("alone-s.model")).unwrap()[5], 6);
+
+    // a unit calibration reads its type's clock: the flag beside --type is refused
+    let refused = unit_runs_cmd(
+        &dir,
+        &unit5,
+        &["--out", "u5-s.model", "--warmup-clock", "slope"],
     );
     let err = app_support::stderr(&refused);
     assert!(!refused.status.success());
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
-    assert!(err.contains("--warmup-clock: needs --type-out"), "{err}");
-    assert!(!dir.join("alone.model").exists());
+    assert!(
+        err.contains(
+            "--warmup-clock: a unit calibrated with --type reads dT/dt in its type's clock"
+        ),
+        "{err}"
+    );
+    assert!(!dir.join("u5-s.model").exists());
 }

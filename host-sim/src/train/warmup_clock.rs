@@ -1,4 +1,5 @@
-//! Which clock a type's dT/dt input is read in, chosen from its runs' own temperatures.
+//! Which clock a model's dT/dt input is read in, chosen from its runs' own temperatures
+//! (a type's network, `train --type-out`, and the type-free `fogsim train`).
 //!
 //! Why: the device reads dT/dt as a 60 s least-squares slope of its thermometer, which is
 //! the rate of a warm-up whose rate is bounded at power-on (exponential modes, locally a
@@ -179,6 +180,21 @@ pub fn warmup_clock_for(runs: &[Run], how: RateClock) -> Option<ClockChoice> {
         RateClock::Slope => None,
         RateClock::Auto => Some(choose_warmup_clock(runs)),
     }
+}
+
+/// `cfg` with its dT/dt input (`TrainConfig::rate_input`) in the clock `runs` choose where
+/// `cfg.rate_clock` asks for one, and the choice (None: `Slope`, nothing chosen): how
+/// `fogsim train` and a type's network are trained.
+pub fn in_runs_clock(
+    runs: &[Run],
+    cfg: &crate::train::TrainConfig,
+) -> (crate::train::TrainConfig, Option<ClockChoice>) {
+    let clock = warmup_clock_for(runs, cfg.rate_clock);
+    let cfg = crate::train::TrainConfig {
+        rate_input: clock.as_ref().map_or(cfg.rate_input, |c| c.rate_input),
+        ..cfg.clone()
+    };
+    (cfg, clock)
 }
 
 /// The clock of the dT/dt input for a type learnt from `runs` (see the module's note).

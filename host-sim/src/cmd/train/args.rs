@@ -174,10 +174,10 @@ pub struct Args {
     /// that scores the type's shape [default: 280, `north-seek`'s seeks].
     #[arg(long = "seek-period-s")]
     pub seek_period_s: Option<f64>,
-    /// With `--type-out`: read the network's dT/dt in the clock the type's runs choose
-    /// (`auto`: the 60 s slope against time, or against a diffusion clock 1 - exp(-sqrt(t /
-    /// tau)) where the runs warm up so; model format 7) or always as the `slope`
-    /// [default: auto].
+    /// Read the model's dT/dt in the clock the runs choose (`auto`: the 60 s slope against
+    /// time, or against a diffusion clock 1 - exp(-sqrt(t / tau)) where the runs warm up
+    /// so; model format 7) or always as the `slope` [default: auto]; with `--type-out`, the
+    /// type's network's. A unit calibrated with `--type` reads its type's.
     #[arg(long = "warmup-clock", value_enum)]
     pub rate_clock: Option<crate::train::warmup_clock::RateClock>,
 }

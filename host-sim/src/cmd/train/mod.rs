@@ -19,6 +19,7 @@ use crate::io::runs::run_files;
 use crate::io::{read_runs_binned, OutputGuard, OutputLock, StagedFiles};
 use crate::train::cold_start::{self, envelope_for};
 use crate::train::seek_refit::{refit_for_seeks, SeekRefit};
+use crate::train::warmup_clock::in_runs_clock;
 use crate::train::{
     choose_inputs_default, train_model, InputChoice, InputSelection, TrainConfig, TrainOutcome,
     TrainReport, Verdict, GUARD_RATIO,
@@ -108,9 +109,9 @@ fn inputs(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
             "--seek-period-s: needs --type TYPE (a unit calibration) or --type-out (the unit step that scores the type's shape)"
         );
     }
-    if args.rate_clock.is_some() && args.type_out.is_none() {
+    if args.rate_clock.is_some() && args.type_model.is_some() {
         anyhow::bail!(
-            "--warmup-clock: needs --type-out (it chooses the clock from a type's runs; a unit calibrated with --type reads its type's)"
+            "--warmup-clock: a unit calibrated with --type reads dT/dt in its type's clock"
         );
     }
     Ok(inputs)
@@ -168,6 +169,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     if let Some(path) = &args.type_out {
         return type_unit::learn(&args, &cfg, &candidates, path, &runs);
+    }
+    // dT/dt in the clock the runs' warm-up follows (`--warmup-clock`, `warmup_clock`)
+    let (cfg, clock) = in_runs_clock(&runs, &cfg);
+    if let Some(c) = &clock {
+        println!("{}", c.describe());
     }
     let (selection, ds) = choose_inputs_default(&runs, &candidates, &cfg)?;
     if args.inputs == InputChoice::Auto {

@@ -24,6 +24,7 @@ use super::calibrate::{seek_windows_mean_square, UnitCalibration, UnitPlan};
 use crate::io::runs::Run;
 use crate::stats::student_t::upper_quantile;
 use crate::stats::{mean, mean_or_zero, std_dev};
+use crate::train::warmup_clock::in_runs_clock;
 use crate::train::{
     choose_inputs_default, dataset_from_runs, residuals_dph, train_model, InputSet, TrainConfig,
 };
@@ -157,13 +158,16 @@ fn paired_t(d: &[f64]) -> f64 {
     }
 }
 
-/// The unit's own model as `train` trains it without a type: its input choice over
-/// `candidates`, then its network, with `cfg`.
+/// The unit's own model as `train` trains it without a type: dT/dt in the clock the runs
+/// choose (`cfg.rate_clock`), its input choice over `candidates`, then its network, with
+/// `cfg`.
 pub fn ordinary_model(
     runs: &[Run],
     candidates: &[InputSet],
     cfg: &TrainConfig,
 ) -> Result<RbfModel> {
+    let (cfg, _) = in_runs_clock(runs, cfg);
+    let cfg = &cfg;
     let (_, ds) = choose_inputs_default(runs, candidates, cfg)?;
     Ok(train_model(&ds, cfg)?.model)
 }

@@ -32,7 +32,7 @@ use super::type_model::{check_type_runs, learn_type, TypeModel, MIN_TYPE_UNITS};
 use crate::io::runs::Run;
 use crate::train::cold_start::envelope_for;
 use crate::train::seek_score::seek_azimuth_first_pairs_per_run;
-use crate::train::warmup_clock::{warmup_clock_for, ClockChoice};
+use crate::train::warmup_clock::{in_runs_clock, ClockChoice};
 use crate::train::{choose_inputs_default, train_model, InputSelection, InputSet, TrainConfig};
 
 /// The form of a type's shared model asked for (`--type-shape`).
@@ -147,12 +147,11 @@ pub fn train_shared(
         SharedShape::Network | SharedShape::NetworkLinear => {
             // the dT/dt input in the clock the runs' warm-up follows (`warmup_clock`),
             // where `--warmup-clock auto` asks for it
-            let clock = warmup_clock_for(runs, cfg.rate_clock);
+            let (clocked, clock) = in_runs_clock(runs, cfg);
             let cfg = &TrainConfig {
                 linear_on_rbf_inputs: cfg.linear_on_rbf_inputs
                     || shape == SharedShape::NetworkLinear,
-                rate_input: clock.as_ref().map_or(cfg.rate_input, |c| c.rate_input),
-                ..cfg.clone()
+                ..clocked
             };
             let (selection, ds) = choose_inputs_default(runs, candidates, cfg)?;
             let trained = train_model(&ds, cfg)?;
