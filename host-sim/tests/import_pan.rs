@@ -95,7 +95,7 @@ fn the_real_recording_when_present_gives_25_bursts_and_3_outliers() {
     );
 }
 
-/// The warm-up clock choice (`train --type-out`'s default) on the measured recording: one
+/// The warm-up clock choice (`train`'s default, with or without `--type-out`) on the measured recording: one
 /// run of a unit cooling in a chamber, no power-on warm-up: fewer than 3 runs to test the
 /// choice, so it says it has no test power and keeps the slope.
 #[test]

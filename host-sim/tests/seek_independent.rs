@@ -45,13 +45,11 @@ use fog_sim::train::seek_refit::SeekSchedule;
 use fog_sim::train::seek_score::{Criterion, SeekGeometry};
 use fog_sim::train::type_unit::terms::Fit;
 use fog_sim::train::type_unit::{
-    calibrate_unit, choose_own, resolve_shape, OwnChoice, ShapeChoice, ShapeScoring, SharedShape,
-    TypeModel, TypeShape, UnitPlan,
+    calibrate_unit, choose_own, ordinary_model, resolve_shape, OwnChoice, ShapeChoice,
+    ShapeScoring, SharedShape, TypeModel, TypeShape, UnitPlan,
 };
-use fog_sim::train::warmup_clock::{in_runs_clock, RateClock};
-use fog_sim::train::{
-    choose_inputs_default, feature_name, train_model, InputChoice, InputSet, TrainConfig,
-};
+use fog_sim::train::warmup_clock::RateClock;
+use fog_sim::train::{feature_name, InputChoice, InputSet, TrainConfig};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::time::Instant;
@@ -242,9 +240,7 @@ fn train_alone(runs: &[Run], criterion: Criterion) -> RbfModel {
         rate_clock: clock_from_env("INDEP_ALONE_CLOCK"),
         ..TrainConfig::default()
     };
-    let (cfg, _) = in_runs_clock(runs, &cfg);
-    let (_, ds) = choose_inputs_default(runs, &[InputSet::TempRate], &cfg).unwrap();
-    train_model(&ds, &cfg).unwrap().model
+    ordinary_model(runs, &[InputSet::TempRate], &cfg).unwrap()
 }
 
 /// The type of shape `shape` learnt from `runs` as `train --type-out` learns it (`train`'s

@@ -111,7 +111,7 @@ fn inputs(args: &Args) -> anyhow::Result<Vec<PathBuf>> {
     }
     if args.rate_clock.is_some() && args.type_model.is_some() {
         anyhow::bail!(
-            "--warmup-clock: a unit calibrated with --type reads dT/dt in its type's clock"
+            "--warmup-clock: a unit calibrated with --type reads dT/dt in its type's clock (drop the flag here; give it to `train --type-out` when the type is learnt)"
         );
     }
     Ok(inputs)

@@ -3,8 +3,8 @@
 //!
 //! The unit step corrects the type's shared model by a few unit terms; where a unit differs
 //! from its type in a way those terms cannot carry (measured on the independent fleet:
-//! with 48 runs the unit's runs alone met 8 of 9 cells, the type + unit recipe 2 of 9), more
-//! runs never help it. So the unit's own model (the caller's ordinary training, the
+//! with 48 runs the unit's runs alone met 8 of 9 cells, the type + unit recipe 2 of 9, both
+//! reading dT/dt as the slope), more runs never help it. So the unit's own model (the caller's ordinary training, the
 //! type-free recipe) is scored the way the unit step scored its candidates: trained
 //! without some of the unit's runs, read on each run left out in the windows of the first
 //! `calibrate::SCORED_SEEKS` seeks, each window less what the seek cancels. It is taken only when the
@@ -167,7 +167,6 @@ pub fn ordinary_model(
     cfg: &TrainConfig,
 ) -> Result<RbfModel> {
     let (cfg, _) = in_runs_clock(runs, cfg);
-    let cfg = &cfg;
-    let (_, ds) = choose_inputs_default(runs, candidates, cfg)?;
-    Ok(train_model(&ds, cfg)?.model)
+    let (_, ds) = choose_inputs_default(runs, candidates, &cfg)?;
+    Ok(train_model(&ds, &cfg)?.model)
 }
