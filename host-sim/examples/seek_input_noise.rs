@@ -105,6 +105,7 @@ fn model_under_test(
             criterion: Criterion::seek_default(),
             inputs: fog_sim::train::InputChoice::Auto,
             seek_timing: None,
+            rate_clock: Default::default(),
         },
         fog_sim::pipeline::north_seek::own_model::CAMPAIGN_RUNS,
         None,

@@ -26,6 +26,7 @@ use fog_sim::pipeline::campaign_steps::train_with_config;
 use fog_sim::pipeline::north_seek::own_model::{
     choose_derivative_free, clock_spec, train_config, warmup_time_constant_s,
 };
+use fog_sim::train::warmup_clock::in_runs_clock;
 use fog_sim::train::InputSet;
 use seek_judge::{plan, seek_rms_deg};
 use soaked::{soaked_campaign_over, SoakedLaw, Tube, AMBIENT_C, RUNS};
@@ -47,11 +48,17 @@ fn outcome(law: SoakedLaw, tube: Tube, seed: u64) -> Outcome {
         .unwrap()
         .expect("soaked cold starts have a warm-up");
     let plan = plan(AMBIENT_C);
-    let choice = choose_derivative_free(&runs, InputSet::TempRate, tau_s, &plan).unwrap();
+    // dT/dt read as the own model reads it: in the clock its runs choose
+    let (cfg, _) = in_runs_clock(&runs, &train_config(&plan, false));
+    let choice = choose_derivative_free(&runs, InputSet::TempRate, tau_s, &cfg).unwrap();
     let refs: Vec<&Run> = runs.iter().collect();
     let fresh_rms = |set: InputSet| {
-        let specs: Vec<FeatureSpec> = set.specs().into_iter().chain([clock_spec(tau_s)]).collect();
-        let m = train_with_config(&refs, &specs, &train_config(&plan, false)).unwrap();
+        let specs: Vec<FeatureSpec> = set
+            .specs_reading_rate(cfg.rate_input)
+            .into_iter()
+            .chain([clock_spec(tau_s)])
+            .collect();
+        let m = train_with_config(&refs, &specs, &cfg).unwrap();
         seek_rms_deg(&m.model, &fresh, &specs)
     };
     let o = Outcome {

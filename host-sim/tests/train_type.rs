@@ -956,15 +956,21 @@ fn north_seek_recipe_refusals(dir: &Path) -> usize {
         .concat(),
         "--unit-runs 2: --type-units 0 trains the unit on its own runs alone",
     );
-    // the clock is the type's network's: no type, no clock to choose
+    // the clock is a trained model's: a model given is not trained
     check_refused(
         dir,
         &[
-            &["north-seek", "--type-units", "0", "--warmup-clock", "auto"],
+            &[
+                "north-seek",
+                "--model",
+                "shared.model",
+                "--warmup-clock",
+                "auto",
+            ],
             &seek[..],
         ]
         .concat(),
-        "--warmup-clock: --type-units 0 learns no type whose network reads dT/dt",
+        "--warmup-clock is for the model north-seek trains; --model shared.model is given",
     );
     4
 }

@@ -177,8 +177,9 @@ pub struct Args {
     /// chosen with the terms]. Needs `--type-units` of 3 or more.
     #[arg(long = "unit-prior-weight", allow_negative_numbers = true)]
     pub unit_prior_weight: Option<f64>,
-    /// How the type's network reads dT/dt (as `train --warmup-clock`): `auto` (the clock
-    /// the type's runs choose) or `slope` [default: auto]. Needs `--type-units` of 3 or more.
+    /// How every model north-seek trains reads dT/dt (as `train --warmup-clock`): `auto`
+    /// (the clock its runs choose: the type's network, the unit's own model, the type-free
+    /// recipe's and the default model) or `slope` [default: auto]. Refused with `--model`.
     #[arg(long = "warmup-clock", value_enum)]
     pub warmup_clock: Option<crate::train::warmup_clock::RateClock>,
 }
@@ -248,7 +249,6 @@ fn training_campaign(args: &Args) -> Result<(usize, Option<WarmRestarts>)> {
         ("--unit-spread", args.unit_spread.is_some()),
         ("--unit-terms", args.unit_terms.is_some()),
         ("--unit-prior-weight", args.unit_prior_weight.is_some()),
-        ("--warmup-clock", args.warmup_clock.is_some()),
     ];
     if let (None, Some((flag, _))) = (args.type_units, shapes_recipe.iter().find(|(_, g)| *g)) {
         bail!("{flag}: needs --type-units N (the unit recipe it shapes)");
@@ -271,6 +271,7 @@ fn training_campaign(args: &Args) -> Result<(usize, Option<WarmRestarts>)> {
             ("--inputs", args.inputs.is_some()),
             ("--training-runs", args.training_runs.is_some()),
             ("--save-model", args.save_model.is_some()),
+            ("--warmup-clock", args.warmup_clock.is_some()),
             (
                 "--training-restarts-above-c",
                 args.training_restarts_above_c.is_some(),
@@ -397,9 +398,6 @@ fn recipe_of(args: &Args) -> Result<Option<UnitRecipe>> {
     let Some(type_units) = args.type_units else {
         return Ok(None);
     };
-    if type_units == 0 && args.warmup_clock.is_some() {
-        bail!("--warmup-clock: --type-units 0 learns no type whose network reads dT/dt");
-    }
     Ok(Some(UnitRecipe {
         type_units,
         type_unit_runs: args.type_unit_runs.unwrap_or(DEFAULT_TYPE_UNIT_RUNS),
@@ -418,7 +416,6 @@ fn recipe_of(args: &Args) -> Result<Option<UnitRecipe>> {
         unit_spread: spread_of(args.unit_spread.as_deref())?,
         unit_terms: args.unit_terms,
         unit_prior_weight: args.unit_prior_weight,
-        warmup_clock: args.warmup_clock.unwrap_or_default(),
     }))
 }
 
@@ -478,6 +475,7 @@ pub fn run(args: Args) -> Result<()> {
                     restart_above_ambient_c: 0.0,
                     ..cfg.clone()
                 }),
+                rate_clock: args.warmup_clock.unwrap_or_default(),
             };
             match &recipe {
                 Some(recipe) => recipe_unit_model(recipe, &plan, &args, &mut params)?,

@@ -118,6 +118,21 @@ impl InputSet {
         specs
     }
 
+    /// `specs`, with its dT/dt read as `rate` (`TrainConfig::rate_input`: the slope, or
+    /// the clock the runs chose; `train::warmup_clock`).
+    pub fn specs_reading_rate(self, rate: FeatureSpec) -> Vec<FeatureSpec> {
+        self.specs()
+            .into_iter()
+            .map(|s| {
+                if s == FeatureSpec::plain(FeatureKind::TempRateCps) {
+                    rate
+                } else {
+                    s
+                }
+            })
+            .collect()
+    }
+
     /// Whether the set is another reading of the plain d2T/dt2's third state (the
     /// flat-start estimator, the rise since power-on): chosen in the second step only.
     pub fn is_alternative(self) -> bool {
@@ -394,15 +409,8 @@ fn datasets_of(
     sets.iter()
         .map(|set| {
             let specs: Vec<FeatureSpec> = set
-                .specs()
+                .specs_reading_rate(rate)
                 .into_iter()
-                .map(|s| {
-                    if s == FeatureSpec::plain(FeatureKind::TempRateCps) {
-                        rate
-                    } else {
-                        s
-                    }
-                })
                 .chain(extra.iter().copied())
                 .collect();
             dataset_from_runs(runs, &specs)

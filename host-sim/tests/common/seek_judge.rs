@@ -22,6 +22,7 @@ pub fn plan(ambient_c: f64) -> OwnModelPlan {
         criterion: Criterion::Seek(SeekGeometry::forward(DWELL_S, LATITUDE_DEG)),
         inputs: fog_sim::train::InputChoice::Auto,
         seek_timing: None,
+        rate_clock: Default::default(),
     }
 }
 

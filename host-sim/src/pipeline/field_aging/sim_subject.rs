@@ -90,6 +90,7 @@ fn own_model_plan(plan: &AgingPlan) -> Result<OwnModelPlan> {
         .map_err(|e| anyhow::anyhow!("criterion: {e}"))?,
         inputs: crate::train::InputChoice::Auto,
         seek_timing: Some(seek),
+        rate_clock: Default::default(),
     })
 }
 

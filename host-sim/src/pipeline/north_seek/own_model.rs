@@ -59,6 +59,11 @@
 //! `PowerOnDecay`, exp(-t / tau), with tau the campaign's own warm-up time: when its mean
 //! temperature rise reaches 1 - 1/e of the rise over the run (`warmup_time_constant_s`).
 //!
+//! dT/dt is read as `train` reads it: in the clock the runs' warm-up follows
+//! (`train::warmup_clock`; the slope where they follow exponential modes, as every
+//! simulated campaign does, the diffusion law's clock where a coil heated from one face
+//! warms as 1 - exp(-sqrt(t / tau))), unless the plan asks for the slope.
+//!
 //! With the clock, the input step ends with the derivative-free set (`t,rise`: T and the
 //! rise since power-on) as the one to beat (`choose_derivative_free`): the estimated
 //! derivatives stay only where they win by 2 standard errors run by run. On the independent
@@ -79,6 +84,7 @@ use crate::sim::GyroParams;
 use crate::train::cold_start::{envelope_for, rises_by_time, significant_rise_c};
 use crate::train::seek_refit::{refit_for_seeks, SeekRefit, SeekSchedule};
 use crate::train::seek_score::{seek_azimuth_rms_deg, Criterion, SeekGeometry};
+use crate::train::warmup_clock::{in_runs_clock, ClockChoice, RateClock};
 use crate::train::{
     choose_in_order_with, choose_inputs_default, criterion_for, dataset_from_runs, predict_batch,
     EstimatorChoice, InputChoice, InputSelection, InputSet, TrainConfig, TrainOutcome,
@@ -114,6 +120,9 @@ pub struct OwnModelPlan {
     /// (`train::seek_refit`), their timing measured with the trained model
     /// (`seek_schedule`); None: the model as trained.
     pub seek_timing: Option<MonteCarloConfig>,
+    /// How the model reads dT/dt (`train --warmup-clock`): in the clock its runs choose
+    /// (`Auto`, the default) or as the slope.
+    pub rate_clock: RateClock,
 }
 
 impl OwnModelPlan {
@@ -132,6 +141,8 @@ impl OwnModelPlan {
 pub struct OwnModel {
     pub trained: TrainOutcome,
     pub selection: InputSelection,
+    /// The clock its dT/dt is read in, and why (None: the slope, not chosen).
+    pub rate_clock: Option<ClockChoice>,
     /// The clock input's time constant, s (None: the runs show no warm-up to clock).
     pub clock_tau_s: Option<f64>,
     /// The model's inputs: the selection's, then the clock input when there is one.
@@ -155,7 +166,11 @@ pub struct OwnModel {
 impl OwnModel {
     /// One line per step and the decision, for people.
     pub fn summary(&self) -> String {
-        let mut s = match self.clock_tau_s {
+        let mut s = self
+            .rate_clock
+            .as_ref()
+            .map_or(String::new(), |c| format!("{}\n", c.describe()));
+        s += &match self.clock_tau_s {
             Some(tau) => format!(
                 "clock input: time since power-on, exp(-t / {tau:.0} s) (the runs' warm-up time)\n"
             ),
@@ -233,18 +248,20 @@ pub fn own_model_from_runs(
     // `train`'s defaults, with the plan's criterion choosing the d2T/dt2 estimator as well
     // as the shape. (Scoring each set with the clock beside it was tried and not kept:
     // docs/record/northfinder.md, "The one global model over training campaigns".)
+    // dT/dt in the clock the runs' warm-up follows (`train::warmup_clock`), as `train` reads it
+    let (cfg, rate_clock) = in_runs_clock(&runs, &train_config(plan, false));
     let candidates = plan.inputs.candidates();
-    let (mut selection, _) = choose_inputs_default(&runs, &candidates, &train_config(plan, false))
+    let (mut selection, _) = choose_inputs_default(&runs, &candidates, &cfg)
         .map_err(|e| anyhow!("choosing the own model's inputs: {e}"))?;
     let clock_tau_s = warmup_time_constant_s(&runs)?;
     if let (InputChoice::Auto, Some(tau_s)) = (plan.inputs, clock_tau_s) {
-        let choice = choose_derivative_free(&runs, selection.chosen, tau_s, plan)?;
+        let choice = choose_derivative_free(&runs, selection.chosen, tau_s, &cfg)?;
         selection.chosen = choice.chosen;
         selection.derivative_free = Some(choice.scores);
     }
     let specs: Vec<FeatureSpec> = selection
         .chosen
-        .specs()
+        .specs_reading_rate(cfg.rate_input)
         .into_iter()
         .chain(clock_tau_s.map(clock_spec))
         .collect();
@@ -271,6 +288,7 @@ pub fn own_model_from_runs(
         seek_refit,
         trained: shape.trained,
         selection,
+        rate_clock,
         clock_tau_s,
         specs,
         linear_inputs: shape.linear_inputs,
@@ -290,7 +308,8 @@ pub struct DerivativeFreeChoice {
 
 /// On soaked cold starts with a warm-up clock, the derivative-free set (T and the rise
 /// since power-on, `InputSet::TempRise`) against `chosen` (the input step's set), both
-/// with the clock, scored by the plan's criterion on the rows both can use; `chosen`
+/// with the clock, scored by `cfg`'s criterion on the rows both can use (dT/dt read as
+/// `cfg.rate_input`); `chosen`
 /// replaces the derivative-free set only when it is significantly better run by run
 /// (`SIGNIFICANT_GAIN_SE`).
 ///
@@ -307,12 +326,11 @@ pub fn choose_derivative_free(
     runs: &[Run],
     chosen: InputSet,
     tau_s: f64,
-    plan: &OwnModelPlan,
+    cfg: &TrainConfig,
 ) -> Result<DerivativeFreeChoice> {
-    let cfg = train_config(plan, false);
-    let criterion = criterion_for(&cfg);
+    let criterion = criterion_for(cfg);
     let order = [InputSet::TempRise, chosen];
-    let (chosen, tried) = choose_in_order_with(runs, &order, &[clock_spec(tau_s)], &cfg, criterion)
+    let (chosen, tried) = choose_in_order_with(runs, &order, &[clock_spec(tau_s)], cfg, criterion)
         .map_err(|e| anyhow!("derivative-free inputs: {e}"))?;
     Ok(DerivativeFreeChoice {
         chosen,
@@ -371,12 +389,13 @@ pub fn choose_linear_terms(
     })
 }
 
-/// The own model's trainer configuration: `train`'s defaults with the plan's criterion,
-/// and linear terms in the RBF inputs when `linear_inputs`.
+/// The own model's trainer configuration: `train`'s defaults with the plan's criterion and
+/// clock, and linear terms in the RBF inputs when `linear_inputs`.
 pub fn train_config(plan: &OwnModelPlan, linear_inputs: bool) -> TrainConfig {
     TrainConfig {
         gyro_id: "sim".into(),
         criterion: plan.criterion,
+        rate_clock: plan.rate_clock,
         linear_on_rbf_inputs: linear_inputs,
         ..TrainConfig::default()
     }
@@ -459,6 +478,7 @@ mod tests {
             criterion: Criterion::seek_default(),
             inputs: InputChoice::Auto,
             seek_timing: None,
+            rate_clock: RateClock::Auto,
         }
     }
 

@@ -84,7 +84,6 @@ pub fn compare_recipes(cfg: &MonteCarloConfig, keep_dir: &Path) -> Result<Recipe
         unit_spread: default_unit_spread(),
         unit_terms: None,
         unit_prior_weight: None,
-        warmup_clock: Default::default(),
     };
     let plan = OwnModelPlan {
         ambient_c: cfg.ambient_c,
@@ -100,6 +99,7 @@ pub fn compare_recipes(cfg: &MonteCarloConfig, keep_dir: &Path) -> Result<Recipe
             restart_above_ambient_c: 0.0,
             ..cfg.clone()
         }),
+        rate_clock: Default::default(),
     };
     let key = cache_key(&recipe)?;
     let type_path = keep_dir.join(format!("{TYPE_PREFIX}{key:016x}.json"));
@@ -288,7 +288,6 @@ mod tests {
             unit_spread: default_unit_spread(),
             unit_terms: None,
             unit_prior_weight: None,
-            warmup_clock: Default::default(),
         }
     }
 

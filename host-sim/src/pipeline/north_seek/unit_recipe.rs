@@ -28,8 +28,6 @@ use crate::train::type_unit::{
     calibrate_unit, choose_own, ordinary_model, resolve_shape, train_shared, ShapeScoring,
     SharedModel, TypeModel, TypeShape, UnitCalibration, UnitPlan,
 };
-use crate::train::warmup_clock::RateClock;
-use crate::train::TrainConfig;
 
 /// Ambients of the type's and the unit's chamber runs by default, degC.
 pub const RECIPE_AMBIENTS_C: [f64; 3] = [-40.0, 20.0, 60.0];
@@ -69,8 +67,6 @@ pub struct UnitRecipe {
     /// `--unit-prior-weight`; None: chosen by leave-one-run-out).
     pub unit_terms: Option<usize>,
     pub unit_prior_weight: Option<f64>,
-    /// How the type's network reads dT/dt (`train --warmup-clock`).
-    pub warmup_clock: RateClock,
 }
 
 /// The seeking unit's model and where it came from.
@@ -229,10 +225,7 @@ pub fn learn_recipe_type(recipe: &UnitRecipe, plan: &OwnModelPlan) -> Result<Rec
     // (a refit to pooled seeks trades the 10 s fit the backfitting needs for seek bias
     // averaged over units, and chose the grid's largest weight). The network is `train`'s,
     // as `train --type-out` makes it.
-    let cfg = TrainConfig {
-        rate_clock: recipe.warmup_clock,
-        ..train_config(plan, false)
-    };
+    let cfg = train_config(plan, false);
     let candidates = plan.inputs.candidates();
     // the shapes scored by what the unit step makes of units left out, its seeks those
     // of the type's own parameters (the seeking unit is not the type's to know)
@@ -412,7 +405,6 @@ mod tests {
             unit_spread,
             unit_terms: None,
             unit_prior_weight: None,
-            warmup_clock: RateClock::Slope,
         }
     }
 

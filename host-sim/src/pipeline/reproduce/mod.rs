@@ -196,6 +196,7 @@ pub fn qualification_plan(
         criterion: TrainConfig::default().criterion,
         inputs,
         seek_timing: Some(north_seek.clone()),
+        rate_clock: Default::default(),
     }
 }
 
