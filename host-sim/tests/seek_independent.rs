@@ -735,15 +735,18 @@ impl Tally {
 /// out of its type (measured t 5.0, critical 2.5; the own model read in the runs' clock,
 /// as `train` reads it since 2026-12-06: 4.9 with the slope); with 6 runs they do not (t
 /// -1.0, critical 3.4; -1.6), nor do the same 24 runs of the null twin, whose type carries
-/// the unit (t -4.4; -4.0). (With 48 runs every seed 1-3 leaves, and the recipe meets 6 of 9 cells as the
+/// the unit (t -3.4 with its type in the network with linear terms, which `auto` takes
+/// there since the twenty-sixth stop; with the law it took before, -4.4; -4.0). (With 48 runs every seed 1-3 leaves, and the recipe meets 6 of 9 cells as the
 /// unit's runs alone, against 2 of 9: docs/record/fleet.md.) With the clock the type
 /// chooses (the default) it carries the unit and 24 runs stay with it (t -2.3).
 ///
 /// Each type is learnt in the shape `--type-shape auto` takes on its fleet with this clock,
 /// given here rather than chosen again (the choice was 2/3 of this test's time and none of
 /// its assertions): the network with linear terms on the type fleet (t 2.7 against the law)
-/// and the law on the null twin (t 0.2); learnt so, each type was the one `auto` gave, field
-/// for field (measured 2026-12-06). The choice itself is asserted by
+/// and on the null twin (t 0.2, the law's modes refuted by its runs' diffusion warm-up,
+/// t 56.9: the network the base; the law there until 2026-12-06, twenty-sixth stop);
+/// learnt so, the type fleet's was the one `auto` gave, field for field (measured
+/// 2026-12-06). The choice itself is asserted by
 /// `the_type_and_unit_recipe_on_the_independent_fleet_and_its_twins` and the shape unit tests.
 #[test]
 fn a_unit_leaves_its_type_when_its_own_runs_say_more_and_only_then() {
@@ -757,17 +760,18 @@ fn a_unit_leaves_its_type_when_its_own_runs_say_more_and_only_then() {
     let differ = show(FleetLaw::Type, SharedShape::NetworkLinear, &[24, 6]);
     assert!(differ[0], "24 runs of a unit its type cannot carry");
     assert!(
-        !show(FleetLaw::Identical, SharedShape::Law, &[24])[0],
+        !show(FleetLaw::Identical, SharedShape::NetworkLinear, &[24])[0],
         "the null twin left its type"
     );
     assert!(!differ[1], "6 runs left the type");
 }
 
-/// Measured at 200 starts, seed 1 (the CI size): with identical units the type + unit
-/// recipe meets every target at every ambient with the Thue-Morse seek (law type), and
-/// `auto` keeps the law there; where units differ `auto` takes a network for the
-/// Thue-Morse seek, whose worst first-seek bias is then a fraction of the law type's (0.70
-/// of a std against 5.80); the odd twin's unit is refused. Over seeds 1-5 at 1,000 starts
+/// Measured at 200 starts, seed 1 (the CI size): the fleet's and its null twin's runs warm
+/// up by diffusion, which refutes the law's exponential modes, so `auto` takes a network
+/// for the Thue-Morse seek on both (the law only when better beyond the units' scatter);
+/// with identical units the type + unit recipe then meets every target at every ambient;
+/// where units differ the network's worst first-seek bias is a fraction of the law type's
+/// (0.70 of a std against 5.80); the odd twin's unit is refused. Over seeds 1-5 at 1,000 starts
 /// (docs/record/fleet.md): the single-effect twins put the law type's misses in the units'
 /// thermal differences, which its clocks do not carry on this law.
 #[test]
@@ -781,8 +785,8 @@ fn the_type_and_unit_recipe_on_the_independent_fleet_and_its_twins() {
     for seed in seeds() {
         for &shape in &shapes {
             for law in fleets() {
-                // At the CI size the law type on identical units is measured through
-                // `auto`, which keeps the law there (asserted below).
+                // At the CI size the law type on identical units is not measured: the null
+                // twin's assertions are on the type `auto` takes there.
                 if at_ci_size()
                     && shape == TypeShape::Law
                     && law == FleetLaw::Identical
@@ -796,17 +800,15 @@ fn the_type_and_unit_recipe_on_the_independent_fleet_and_its_twins() {
                 tally.add(law, shape, &m.judged);
                 let tm = SeekMode::TwoPositionThueMorse;
                 let tm_shape = m.shapes.iter().find(|s| s.0 == tm).map(|s| s.1);
-                if seed == 1 && law == FleetLaw::Identical && tm_shape == Some(SharedShape::Law) {
-                    assert!(!m.refused, "the null twin's U11 refused");
-                    let met = cells_met(&m.judged, "type + unit runs", tm);
-                    assert_eq!(met, 3, "the null twin's Thue-Morse cells met");
-                }
-                if seed == 1 && shape == TypeShape::Auto && type_unit_runs() == 6 {
-                    let want_law = law == FleetLaw::Identical;
-                    assert_eq!(
-                        tm_shape == Some(SharedShape::Law),
-                        want_law,
-                        "{law:?}: auto took {tm_shape:?}"
+                if at_ci_size() && seed == 1 && shape == TypeShape::Auto {
+                    if law == FleetLaw::Identical {
+                        assert!(!m.refused, "the null twin's U11 refused");
+                        let met = cells_met(&m.judged, "type + unit runs", tm);
+                        assert_eq!(met, 3, "the null twin's Thue-Morse cells met");
+                    }
+                    assert!(
+                        tm_shape.is_some_and(|s| s != SharedShape::Law),
+                        "{law:?}: auto took {tm_shape:?} on runs that warm up by diffusion"
                     );
                 }
                 if seed == 1 && law == FleetLaw::Type {

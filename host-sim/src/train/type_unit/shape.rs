@@ -16,7 +16,13 @@
 //! only when its pooled error is lower than the law's beyond what the units left out could
 //! make of it (the log ratio over its jackknife standard error, each unit left out in turn,
 //! above `SHAPE_T_MIN`); otherwise, and when too few units leave no test power, the law:
-//! the physical base. (A paired test of each unit's log ratio was tried first: it kept the
+//! the physical base. The law is the base only where the runs' temperatures follow its
+//! exponential modes: where they reject them for a diffusion warm-up (`warmup_clock`'s
+//! test on the type's own runs, the clock its network's dT/dt is read in), the network of
+//! the lower score is the base and the law is taken only when it is the better beyond the
+//! units' scatter. (With the law as the base at a tie, the independent fleet's coil kept it
+//! for the time-symmetric seek with 30 units, and that seek then missed every ambient:
+//! docs/record/fleet.md.) (A paired test of each unit's log ratio was tried first: it kept the
 //! law on independent fleets whose pooled error the network cut by a third, carried by a
 //! few units far off the type; docs/record/fleet.md.)
 
@@ -32,7 +38,7 @@ use super::type_model::{check_type_runs, learn_type, TypeModel, MIN_TYPE_UNITS};
 use crate::io::runs::Run;
 use crate::train::cold_start::envelope_for;
 use crate::train::seek_score::seek_azimuth_first_pairs_per_run;
-use crate::train::warmup_clock::{in_runs_clock, ClockChoice};
+use crate::train::warmup_clock::{choose_warmup_clock, in_runs_clock, ClockChoice};
 use crate::train::{choose_inputs_default, train_model, InputSelection, InputSet, TrainConfig};
 
 /// The form of a type's shared model asked for (`--type-shape`).
@@ -216,6 +222,12 @@ pub struct ShapeChoice {
     pub scores_deg: Vec<(SharedShape, f64)>,
     /// The network of the lower score, tested against the law.
     pub challenger: SharedShape,
+    /// The shape kept when neither is better beyond the units' scatter: the law, unless
+    /// the runs' warm-up refutes its exponential modes (`law_refuted_t`).
+    pub base: SharedShape,
+    /// The diffusion law's margin over the exponential modes on the type's runs where it
+    /// refutes them (`warmup_clock::choose_warmup_clock`'s t); None: the law is the base.
+    pub law_refuted_t: Option<f64>,
     /// Held-out units, and those where the challenger's error was the lower.
     pub units: usize,
     pub challenger_better_units: usize,
@@ -230,9 +242,15 @@ pub struct ShapeChoice {
 
 impl ShapeChoice {
     pub fn summary(&self) -> String {
+        let base = self.law_refuted_t.map_or(String::new(), |t| {
+            format!(
+                "shape's base: the {}: the type's runs warm up by diffusion, not by the law's exponential modes (t = {t:.1}); the law is taken only when better beyond the units' scatter\n",
+                self.base.name()
+            )
+        });
         if self.scores_deg.is_empty() {
             return format!(
-                "shape: {} ({} units: no test power for a choice; a type from at least {SHAPE_MIN_UNITS} units lets its units choose)\n",
+                "{base}shape: {} ({} units: no test power for a choice; a type from at least {SHAPE_MIN_UNITS} units lets its units choose)\n",
                 self.chosen.name(),
                 self.units
             );
@@ -253,7 +271,7 @@ impl ShapeChoice {
             )
         };
         format!(
-            "shape: {} (held-out first {SHAPE_SEEKS} seeks of {} units left out: {}; the {} better on {} of {} units, t = {:.1}, taken above {SHAPE_T_MIN})\n{outside}",
+            "{base}shape: {} (held-out first {SHAPE_SEEKS} seeks of {} units left out: {}; the {} better on {} of {} units, t = {:.1}, taken above {SHAPE_T_MIN})\n{outside}",
             self.chosen.name(),
             self.units,
             scores.join(", "),
@@ -287,13 +305,22 @@ fn outside_line(m: &Misfit) -> Option<String> {
 /// whole units, and scored on the held-out units' first `SHAPE_SEEKS` seeks (the seek of
 /// `scoring.cfg.criterion`) after their unit step (`heldout_sse`); the network of the lower
 /// score is taken over the law when its pooled error is lower beyond the units' scatter
-/// (`jackknife_t` > `SHAPE_T_MIN`).
+/// (`jackknife_t` > `SHAPE_T_MIN`); where the runs refute the law's exponential warm-up
+/// (`law_refuted`), the law is taken only when its error is the lower beyond it.
 pub fn choose_shape(runs: &[Run], scoring: &ShapeScoring) -> Result<ShapeChoice> {
     let unit_of_run = unit_of_runs(runs);
     let units = unit_of_run.iter().max().map_or(0, |m| m + 1);
+    let law_refuted_t = law_refuted(runs);
     if units < SHAPE_MIN_UNITS {
+        let base = if law_refuted_t.is_some() {
+            SharedShape::Network
+        } else {
+            SharedShape::Law
+        };
         return Ok(ShapeChoice {
-            chosen: AUTO_SHAPES[0],
+            chosen: base,
+            base,
+            law_refuted_t,
             scores_deg: Vec::new(),
             challenger: AUTO_SHAPES[1],
             units,
@@ -326,13 +353,21 @@ pub fn choose_shape(runs: &[Run], scoring: &ShapeScoring) -> Result<ShapeChoice>
         .iter()
         .map(|u| ms(&u[..], 0) - ms(&u[..], c))
         .collect();
-    let chosen_k = if d.len() >= SHAPE_MIN_UNITS && t > SHAPE_T_MIN {
-        c
-    } else {
-        0
+    let powered = d.len() >= SHAPE_MIN_UNITS;
+    let chosen_k = match law_refuted_t {
+        None if powered && t > SHAPE_T_MIN => c,
+        None => 0,
+        Some(_) if powered && t < -SHAPE_T_MIN => 0,
+        Some(_) => c,
     };
     Ok(ShapeChoice {
         chosen: AUTO_SHAPES[chosen_k],
+        base: if law_refuted_t.is_some() {
+            AUTO_SHAPES[c]
+        } else {
+            AUTO_SHAPES[0]
+        },
+        law_refuted_t,
         units_outside: std::mem::take(&mut outside[chosen_k]),
         scores_deg,
         challenger: AUTO_SHAPES[c],
@@ -340,6 +375,15 @@ pub fn choose_shape(runs: &[Run], scoring: &ShapeScoring) -> Result<ShapeChoice>
         challenger_better_units: d.iter().filter(|&&x| x > 0.0).count(),
         t_challenger_better: t,
     })
+}
+
+/// The diffusion law's margin (t) where the type's runs refute the law's exponential
+/// warm-up (`choose_warmup_clock` takes the diffusion clock on them), else None: the test
+/// that decides how a network reads dT/dt decides whether the law's modes are the units'
+/// physics, whatever clock `--warmup-clock` asks the network to read.
+fn law_refuted(runs: &[Run]) -> Option<f64> {
+    let clock = choose_warmup_clock(runs);
+    clock.is_diffusion().then_some(clock.t).flatten()
 }
 
 /// Squared azimuth errors and their count, per shape of `AUTO_SHAPES`, of one unit.
@@ -517,6 +561,13 @@ mod tests {
         // measured on the 10 s means: the network with linear terms, t = 5.5
         let got = choose(&fleet_of_units(7, &rise, &shupe));
         assert_ne!(got.chosen, SharedShape::Law, "{}", got.summary());
+        assert!(got.law_refuted_t.is_some(), "{}", got.summary());
+        assert!(got.summary().contains("warm up by diffusion"));
+        // three such units leave no test power for the choice, but their runs still
+        // refute the law's modes: the network, not the law
+        let three = choose(&fleet_of_units(3, &rise, &shupe));
+        assert_eq!(three.chosen, SharedShape::Network, "{}", three.summary());
+        assert!(three.summary().contains("no test power"));
     }
 
     /// `runs` with each unit's warm-up drift (`law_of_two_node`) scaled by its own gain:
@@ -575,6 +626,7 @@ mod tests {
             .collect();
         let got = choose(&runs);
         assert_eq!(got.chosen, SharedShape::Law);
+        assert_eq!(got.law_refuted_t, None, "{}", got.summary());
         assert!(got.scores_deg.is_empty());
         assert!(got.summary().contains("no test power"), "{}", got.summary());
     }
