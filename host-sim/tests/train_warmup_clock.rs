@@ -21,19 +21,25 @@ use rand_chacha::ChaCha8Rng;
 
 const AMBIENTS_C: [f64; 3] = [-40.0, 20.0, 60.0];
 
-#[test]
-fn the_simulators_fleet_keeps_the_slope_and_the_independent_one_takes_its_diffusion_clock() {
+/// The simulator's fleet 81 (the paper gyro, the default unit spread): `units` units'
+/// cold starts, `runs_per_ambient` at each of `ambients_c`.
+fn simulated(units: usize, ambients_c: &[f64], runs_per_ambient: usize) -> Vec<Run> {
     let sim_type = FleetType::paper(TypeSpread::default_spread(), "default", 81);
     let plan = CampaignSpec {
-        ambients_c: AMBIENTS_C.to_vec(),
-        runs_per_ambient: 1,
+        ambients_c: ambients_c.to_vec(),
+        runs_per_ambient,
         ..CampaignSpec::paper(81)
     };
-    let sim: Vec<Run> = simulate_fleet(&sim_type, 3, &plan, None)
+    simulate_fleet(&sim_type, units, &plan, None)
         .unwrap()
         .into_iter()
         .map(|c| c.run)
-        .collect();
+        .collect()
+}
+
+#[test]
+fn the_simulators_fleet_keeps_the_slope_and_the_independent_one_takes_its_diffusion_clock() {
+    let sim = simulated(3, &AMBIENTS_C, 1);
     let c = choose_warmup_clock(&sim);
     println!("simulator: {}", c.describe());
     assert_eq!(c.rate_input, FeatureSpec::plain(FeatureKind::TempRateCps));
@@ -89,18 +95,7 @@ fn the_own_model_recipe_reads_dt_dt_in_the_clock_its_runs_choose() {
     assert_eq!(kind, FeatureKind::TempRateCps, "{summary}");
     assert!(!chosen && !summary.contains("dT/dt read as"), "{summary}");
 
-    let sim_type = FleetType::paper(TypeSpread::default_spread(), "default", 81);
-    let campaign = CampaignSpec {
-        ambients_c: vec![20.0],
-        runs_per_ambient: 6,
-        ..CampaignSpec::paper(81)
-    };
-    let sim: Vec<Run> = simulate_fleet(&sim_type, 1, &campaign, None)
-        .unwrap()
-        .into_iter()
-        .map(|c| c.run)
-        .collect();
-    let (kind, chosen, summary) = rate_kind(sim, RateClock::Auto);
+    let (kind, chosen, summary) = rate_kind(simulated(1, &[20.0], 6), RateClock::Auto);
     assert_eq!(kind, FeatureKind::TempRateCps, "{summary}");
     assert!(
         chosen && summary.contains("dT/dt read as the slope against time"),
