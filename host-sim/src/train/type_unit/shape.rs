@@ -270,8 +270,15 @@ impl ShapeChoice {
                 self.units_outside.join(", ")
             )
         };
+        // which way the test runs: the network against the law as the base, or the law
+        // against the network
+        let rule = if self.law_refuted_t.is_some() {
+            format!("the law taken below -{SHAPE_T_MIN}")
+        } else {
+            format!("taken above {SHAPE_T_MIN}")
+        };
         format!(
-            "{base}shape: {} (held-out first {SHAPE_SEEKS} seeks of {} units left out: {}; the {} better on {} of {} units, t = {:.1}, taken above {SHAPE_T_MIN})\n{outside}",
+            "{base}shape: {} (held-out first {SHAPE_SEEKS} seeks of {} units left out: {}; the {} better on {} of {} units, t = {:.1}, {rule})\n{outside}",
             self.chosen.name(),
             self.units,
             scores.join(", "),
