@@ -1,5 +1,7 @@
 //! Which clock a model's dT/dt input is read in, chosen from its runs' own temperatures
-//! (a type's network, `train --type-out`, and the type-free `fogsim train`).
+//! (a type's network, `train --type-out`, the type-free `fogsim train` and `north-seek`'s
+//! own-model recipe). The same test tells a type's shape choice whether the runs follow
+//! the warm-up law's exponential modes at all (`type_unit::shape`).
 //!
 //! Why: the device reads dT/dt as a 60 s least-squares slope of its thermometer, which is
 //! the rate of a warm-up whose rate is bounded at power-on (exponential modes, locally a
@@ -184,7 +186,7 @@ pub fn warmup_clock_for(runs: &[Run], how: RateClock) -> Option<ClockChoice> {
 
 /// `cfg` with its dT/dt input (`TrainConfig::rate_input`) in the clock `runs` choose where
 /// `cfg.rate_clock` asks for one, and the choice (None: `Slope`, nothing chosen): how
-/// `fogsim train` and a type's network are trained.
+/// `fogsim train`, a type's network and `north-seek`'s own-model recipe are trained.
 pub fn in_runs_clock(
     runs: &[Run],
     cfg: &crate::train::TrainConfig,

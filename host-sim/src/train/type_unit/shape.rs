@@ -222,11 +222,9 @@ pub struct ShapeChoice {
     pub scores_deg: Vec<(SharedShape, f64)>,
     /// The network of the lower score, tested against the law.
     pub challenger: SharedShape,
-    /// The shape kept when neither is better beyond the units' scatter: the law, unless
-    /// the runs' warm-up refutes its exponential modes (`law_refuted_t`).
-    pub base: SharedShape,
     /// The diffusion law's margin over the exponential modes on the type's runs where it
-    /// refutes them (`warmup_clock::choose_warmup_clock`'s t); None: the law is the base.
+    /// refutes them (`warmup_clock::choose_warmup_clock`'s t): the challenger is then the
+    /// shape kept when neither is better beyond the units' scatter; None: the law is.
     pub law_refuted_t: Option<f64>,
     /// Held-out units, and those where the challenger's error was the lower.
     pub units: usize,
@@ -245,7 +243,7 @@ impl ShapeChoice {
         let base = self.law_refuted_t.map_or(String::new(), |t| {
             format!(
                 "shape's base: the {}: the type's runs warm up by diffusion, not by the law's exponential modes (t = {t:.1}); the law is taken only when better beyond the units' scatter\n",
-                self.base.name()
+                self.challenger.name()
             )
         });
         if self.scores_deg.is_empty() {
@@ -319,14 +317,9 @@ pub fn choose_shape(runs: &[Run], scoring: &ShapeScoring) -> Result<ShapeChoice>
     let units = unit_of_run.iter().max().map_or(0, |m| m + 1);
     let law_refuted_t = law_refuted(runs);
     if units < SHAPE_MIN_UNITS {
-        let base = if law_refuted_t.is_some() {
-            SharedShape::Network
-        } else {
-            SharedShape::Law
-        };
+        // no test power: the base, the law unless its modes are refuted
         return Ok(ShapeChoice {
-            chosen: base,
-            base,
+            chosen: AUTO_SHAPES[usize::from(law_refuted_t.is_some())],
             law_refuted_t,
             scores_deg: Vec::new(),
             challenger: AUTO_SHAPES[1],
@@ -369,11 +362,6 @@ pub fn choose_shape(runs: &[Run], scoring: &ShapeScoring) -> Result<ShapeChoice>
     };
     Ok(ShapeChoice {
         chosen: AUTO_SHAPES[chosen_k],
-        base: if law_refuted_t.is_some() {
-            AUTO_SHAPES[c]
-        } else {
-            AUTO_SHAPES[0]
-        },
         law_refuted_t,
         units_outside: std::mem::take(&mut outside[chosen_k]),
         scores_deg,
